@@ -1,0 +1,86 @@
+/*
+ * umbra api — scene documents (JSON, contract v1) to renderer scenes, problems (RFC 9457),
+ * and image encoders (PNG via libpng, EXR via OpenEXR's C core).
+ *
+ * Usage:
+ *   struct api_limits lim; api_limits_defaults(&lim);
+ *   struct api_scene *s; struct api_problem p;
+ *   if (api_scene_parse(body, len, &lim, &s, &p) != API_OK) { send p.status + api_problem_json(&p) }
+ *   rnd_render(ctx, &s->scene, &img, ...);
+ *   api_encode(s, &img, &bytes, &n, &p);  free(bytes);
+ *   api_scene_free(s);
+ *
+ * Ownership: a parsed api_scene owns every array its rnd_scene points to (one arena) and
+ * must be freed with api_scene_free() (NULL-safe). Encoders return malloc'd bytes the caller
+ * frees. Threading: no shared state; every function is safe to call from several threads.
+ * jansson is used only inside api/; this header does not expose it.
+ */
+#ifndef UMBRA_API_H
+#define UMBRA_API_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "umbra/rnd.h"
+
+enum api_result { API_OK = 0, API_ERR };
+
+/* RFC 9457 problem details. status is the HTTP status (400, 413, 422, 500...). */
+struct api_problem {
+	int status;
+	char type[96];      /* URI, e.g. "https://umbra.dev/problems/invalid-scene" */
+	char title[96];     /* short, per type, e.g. "Invalid scene" */
+	char detail[512];   /* human sentence saying what is wrong with which member */
+	char pointer[256];  /* RFC 6901 JSON Pointer of the offending member ("" = whole document) */
+};
+
+/* Fills p (status, type from status, title) with a printf-style detail. Returns API_ERR. */
+enum api_result api_problem_set(struct api_problem *p, int status, const char *pointer, const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+/* Writes the problem as an application/problem+json document (NUL-terminated, malloc'd). */
+char *api_problem_json(const struct api_problem *p);
+/* One line for CLI stderr: "400 Invalid scene: /lights/0/direction: must not be zero". */
+void api_problem_format(const struct api_problem *p, char *buf, size_t size);
+
+/* Resource limits; going over one is a 422. 0 = unlimited. */
+struct api_limits {
+	uint64_t max_pixels;             /* width*height (and per sheet when several views), default 16777216 */
+	uint64_t max_triangles;          /* after tessellation, default 20000000 */
+	uint32_t max_lights;             /* default 64 */
+	uint32_t max_shadow_resolution;  /* default 8192 */
+};
+void api_limits_defaults(struct api_limits *l);
+
+enum api_format { API_FORMAT_PNG, API_FORMAT_EXR };
+
+struct api_scene {
+	struct rnd_scene scene;     /* ready for rnd_render() */
+	enum api_format format;
+	int format_explicit;        /* output.format was given (else the Accept header may choose) */
+	uint32_t bit_depth;         /* 8 or 16 (png) */
+	int png_level;              /* zlib level for PNG, -1 = chosen by image size */
+	uint64_t triangles;         /* total after tessellation */
+	/* private: the arena that owns the arrays */
+	void *arena_;
+};
+
+/* Parses and validates a scene document. On failure fills p (400: malformed / wrong type /
+ * out of range / unknown member, with the member's JSON Pointer; 422: over a limit). */
+enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
+                                struct api_scene **out, struct api_problem *p);
+void api_scene_free(struct api_scene *s);
+/* Switches the output to the given format as if output.format had said so (Accept header,
+ * CLI -o extension): adjusts scene.output.pixels. Fails (400) for PNG with AOVs. */
+enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, struct api_problem *p);
+
+/* Encodes a rendered image as the scene asks (PNG 8/16-bit or EXR with AOVs). */
+enum api_result api_encode(const struct api_scene *s, const struct rnd_image *img, uint8_t **out, size_t *len,
+                           struct api_problem *p);
+/* PNG of an RGBA8 or RGBA16 image; level -1 = chosen by size. */
+enum api_result api_png_encode(const struct rnd_image *img, int level, uint8_t **out, size_t *len,
+                               struct api_problem *p);
+/* EXR (ZIP) of an RGBA32F image: R,G,B,A half plus the image's AOV planes as float. */
+enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p);
+
+const char *api_format_mime(enum api_format f);
+
+#endif

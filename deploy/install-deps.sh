@@ -1,0 +1,31 @@
+#!/bin/sh
+# Installs the Debian 12 packages umbra builds, runs and tests with.
+# Idempotent: does nothing (and needs no root) when every package is present.
+# Usage: deploy/install-deps.sh            (make run / make test call it)
+set -eu
+
+PKGS="build-essential pkg-config ca-certificates curl python3
+libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
+glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
+libopenexr-dev"
+
+missing=""
+for p in $PKGS; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed"; then
+    missing="$missing $p"
+  fi
+done
+[ -z "$missing" ] && exit 0
+
+echo "install-deps: installing:$missing" >&2
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "install-deps: need root (or sudo) to install:$missing" >&2; exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+# A fresh machine has no package lists; refresh them once before installing.
+$SUDO apt-get update -q
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -q --no-install-recommends $missing

@@ -1,0 +1,269 @@
+/*
+ * umbra renderer — public API (build/librenderer.a).
+ *
+ * Usage:
+ *   struct rnd_context_desc cd = {0};           // zero = default everywhere
+ *   struct rnd_context *ctx; struct rnd_error err;
+ *   if (rnd_context_create(&cd, &ctx, &err) != RND_OK) { fprintf(stderr, "%s\n", err.msg); ... }
+ *   struct rnd_scene scene; rnd_scene_defaults(&scene);   // then fill it (api/ does this from JSON)
+ *   struct rnd_image img = {0}; struct rnd_timings t;
+ *   if (rnd_render(ctx, &scene, &img, &t, &err) == RND_OK) { ...use img.pixels...; }
+ *   rnd_image_release(&img);
+ *   rnd_context_destroy(ctx);
+ *
+ * Ownership: the scene and every array it points to belong to the caller and are only read
+ * during rnd_render(). If rnd_render() returns RND_OK you own the image and must call
+ * rnd_image_release(); on failure the image is left empty. Release/destroy accept NULL/empty.
+ *
+ * Threading: rnd_render() may be called from several threads at once on one context; it takes
+ * one of the context's render slots (desc.slots, each with its own command buffer, fence and
+ * targets) and blocks until one is free. Create/destroy are not concurrent with anything.
+ *
+ * This header needs no Vulkan header: the context is opaque.
+ */
+#ifndef UMBRA_RND_H
+#define UMBRA_RND_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum rnd_result {
+	RND_OK = 0,
+	RND_ERR_INVALID,     /* the scene asks for something impossible (message says what) */
+	RND_ERR_LIMIT,       /* over a resource limit of this context or device */
+	RND_ERR_NO_DEVICE,   /* no Vulkan device / driver usable */
+	RND_ERR_VULKAN,      /* a Vulkan call failed; vk_result holds the VkResult */
+	RND_ERR_DEVICE_LOST, /* the device was lost: the context is FAILED, recreate it */
+	RND_ERR_OOM,         /* host or device memory exhausted */
+	RND_ERR_TIMEOUT,     /* the render passed its deadline */
+	RND_ERR_IO,          /* a file (pipeline cache) could not be read or written */
+};
+
+struct rnd_error {
+	enum rnd_result code;
+	int vk_result;       /* VkResult when code == RND_ERR_VULKAN/DEVICE_LOST, else 0 */
+	char msg[256];       /* what failed first, e.g. "vkCreateImage (shadow map 4096x4096): ..." */
+};
+
+/* ---- scene description (api/ fills it from JSON; all angles in radians here) ---- */
+
+enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYLINDER, RND_SHAPE_MESH };
+
+enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK };
+
+struct rnd_material {
+	float base_color[4];  /* linear RGBA, default 0.8 0.8 0.8 1 */
+	float roughness;      /* 0.5 */
+	float metallic;       /* 0 */
+	float emissive[3];    /* 0 */
+	enum rnd_alpha_mode alpha_mode;
+	float alpha_cutoff;   /* 0.5 */
+	bool shadow_catcher;  /* not drawn; only received shadows show */
+};
+
+struct rnd_object {
+	enum rnd_shape shape;
+	float size[3];        /* plane: [sx, 0, sz]; box: [sx, sy, sz] */
+	float radius;         /* sphere, cylinder */
+	float height;         /* cylinder */
+	uint32_t segments;    /* sphere, cylinder (>= 3) */
+	/* mesh: positions xyz (vertex_count*3 floats); optional indices (index_count, multiple of 3;
+	 * when NULL the vertices are a triangle list); optional normals xyz and uvs uv per vertex. */
+	const float *positions;
+	uint32_t vertex_count;
+	const uint32_t *indices;
+	uint32_t index_count;
+	const float *normals;
+	const float *uvs;
+	float model[16];      /* object -> world, column-major (T*R*S resolved by the caller) */
+	uint32_t material;    /* index into scene.materials */
+	bool cast_shadows, receive_shadows, double_sided;
+};
+
+enum rnd_light_type { RND_LIGHT_DIRECTIONAL, RND_LIGHT_SPOT, RND_LIGHT_POINT };
+
+enum rnd_filter { RND_FILTER_AUTO, RND_FILTER_HARD, RND_FILTER_PCF, RND_FILTER_PCSS, RND_FILTER_VSM, RND_FILTER_EVSM };
+enum rnd_dir_mode { RND_DIR_AUTO, RND_DIR_FIT, RND_DIR_CASCADES, RND_DIR_CLIPMAP };
+enum rnd_vsm_precision { RND_VSM_AUTO, RND_VSM_FP32, RND_VSM_FP16 };
+
+/* Resolved shadow settings of one light (api/ merges root `shadows` and the light's `shadow`).
+ * Zero / false in a member marked "0 = renderer" means the renderer chooses. */
+struct rnd_shadow {
+	bool enabled;                 /* true */
+	enum rnd_filter filter;       /* AUTO */
+	uint32_t resolution;          /* 64..8192, 0 = renderer */
+	uint32_t pcf_radius;          /* 0..5, default 1 */
+	bool bias_set;                /* false = renderer defaults for the three below */
+	float bias_constant, bias_slope, bias_normal; /* normal offset in texels */
+	enum rnd_dir_mode dir_mode;   /* AUTO */
+	uint32_t cascades;            /* 1..4, 0 = renderer (4) */
+	float split_lambda;           /* 0..1, default 0.75 */
+	float max_distance;           /* 0 = renderer (camera far / scene bounds) */
+	float blend;                  /* fraction of a cascade, default 0.1 */
+	float fade;                   /* fraction of max_distance, default 0.1 */
+	uint32_t clipmap_levels;      /* 1..8, 0 = renderer */
+	float clipmap_extent;         /* 0 = renderer */
+	enum rnd_vsm_precision vsm_precision; /* AUTO */
+	float vsm_blur;               /* texels, default 2 */
+	float vsm_light_bleed;        /* 0..1, default 0.2 */
+	float vsm_exponent;           /* 0 = by precision */
+	bool contact_enabled;         /* false */
+	float contact_distance, contact_thickness; /* 0 = renderer */
+	uint32_t contact_steps;       /* 0 = renderer */
+};
+
+struct rnd_light {
+	enum rnd_light_type type;
+	float direction[3];   /* directional/spot: the way the light travels (not normalised) */
+	float position[3];    /* spot/point */
+	float color[3];       /* linear, default 1 1 1 */
+	float intensity;      /* directional: irradiance; spot/point: intensity (candela-like) */
+	float angular_diameter; /* directional, radians, 0 = hard */
+	float range;          /* spot/point, 0 = unbounded */
+	float inner_angle, outer_angle; /* spot half-angles, radians (0, pi/4 default) */
+	float radius;         /* spot/point light size, metres, 0 = hard */
+	struct rnd_shadow shadow;
+};
+
+enum rnd_camera_type { RND_CAMERA_PERSPECTIVE, RND_CAMERA_ORTHOGRAPHIC };
+enum rnd_camera_fit { RND_FIT_NONE, RND_FIT_SCENE, RND_FIT_OBJECTS };
+
+struct rnd_camera {
+	enum rnd_camera_type type;
+	float position[3], target[3], up[3];
+	float fov_y;          /* radians, perspective (default 45 deg) */
+	float height;         /* orthographic: world units over the image height */
+	float near, far;      /* 0 = derived from the scene bounds */
+	float exposure;       /* EV */
+	enum rnd_camera_fit fit;  /* != NONE: position/target derived from the bounds */
+	float fit_direction[3];
+	float fit_margin;     /* fraction of the frame, default 0.1 */
+};
+
+enum rnd_tonemap { RND_TONEMAP_NEUTRAL, RND_TONEMAP_ACES, RND_TONEMAP_NONE };
+enum rnd_debug { RND_DEBUG_NONE, RND_DEBUG_SHADOW, RND_DEBUG_CASCADES, RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS };
+
+/* What the renderer writes into rnd_image.pixels. */
+enum rnd_pixel_format {
+	RND_PIXELS_RGBA8,     /* display-referred: exposure, tone map, sRGB encoding applied */
+	RND_PIXELS_RGBA16,    /* the same at 16 bits per channel (host-endian uint16) */
+	RND_PIXELS_RGBA32F,   /* linear scene-referred (exposure applied, no tone map) */
+};
+
+/* Extra per-pixel outputs (bit mask), float32 planes in rnd_image.aov. */
+enum rnd_aov {
+	RND_AOV_SHADOW = 1u << 0, /* one plane per light: visibility, 1 = lit */
+	RND_AOV_DEPTH  = 1u << 1, /* view-space depth, +inf where no geometry */
+	RND_AOV_NORMAL = 1u << 2, /* world normal, 3 planes */
+	RND_AOV_ALBEDO = 1u << 3, /* base colour, 3 planes */
+};
+
+struct rnd_output {
+	enum rnd_pixel_format pixels; /* RGBA8 */
+	bool transparent;     /* background alpha 0 */
+	enum rnd_tonemap tonemap;
+	uint32_t msaa;        /* 1 or 4 (default 4) */
+	uint32_t aovs;        /* enum rnd_aov mask */
+	enum rnd_debug debug;
+	uint32_t debug_light;
+};
+
+struct rnd_environment {
+	float background[4];  /* linear RGBA, default 0.5 0.5 0.5 1 */
+	float ambient_sky[3], ambient_ground[3];
+	float ambient_intensity;
+};
+
+struct rnd_scene {
+	uint32_t width, height;
+	struct rnd_camera camera;
+	struct rnd_environment environment;
+	const struct rnd_material *materials; uint32_t material_count;
+	const struct rnd_object *objects;     uint32_t object_count;
+	const struct rnd_light *lights;       uint32_t light_count;
+	struct rnd_output output;
+};
+
+/* Contract defaults: 512x512, perspective camera at (0,0,5) looking at the origin, default
+ * environment, no objects, no lights, RGBA8 PNG-style output with neutral tone map, MSAA 4. */
+void rnd_scene_defaults(struct rnd_scene *scene);
+void rnd_material_defaults(struct rnd_material *m);
+void rnd_object_defaults(struct rnd_object *o);     /* identity model, casts/receives, 2-sided */
+void rnd_light_defaults(struct rnd_light *l, enum rnd_light_type type);
+void rnd_shadow_defaults(struct rnd_shadow *s);
+
+/* Triangles the renderer will draw for an object (tessellation of the contract's shapes). */
+uint64_t rnd_object_triangle_count(const struct rnd_object *o);
+
+/* ---- result ---- */
+
+#define RND_MAX_AOV_PLANES 40
+
+struct rnd_image {
+	uint32_t width, height;
+	enum rnd_pixel_format format;
+	size_t stride;        /* bytes per row of pixels */
+	void *pixels;         /* RGBA, rows top to bottom */
+	uint32_t aov_count;   /* float32 planes, width*height each, rows top to bottom */
+	char aov_names[RND_MAX_AOV_PLANES][24]; /* "shadow.0", "Z", "N.X", "albedo.R", ... */
+	float *aov[RND_MAX_AOV_PLANES];
+};
+void rnd_image_release(struct rnd_image *img);
+
+/* Milliseconds per stage of one render. */
+struct rnd_timings {
+	double upload_ms;     /* tessellation + copy to the GPU */
+	double shadow_ms;     /* shadow passes (GPU) */
+	double main_ms;       /* main pass + resolve (GPU) */
+	double readback_ms;   /* copy back to host memory */
+	uint32_t shadow_maps_rendered, shadow_maps_reused;
+};
+
+/* ---- context ---- */
+
+typedef void (*rnd_log_fn)(void *user, int level /* 0 error 1 warn 2 info */, const char *msg);
+
+struct rnd_context_desc {
+	const char *device_name;   /* substring of the device name to pick; NULL = $UMBRA_DEVICE, else a GPU, else lavapipe */
+	bool validation;           /* enable VK_LAYER_KHRONOS_validation; messages are counted and logged */
+	const char *pipeline_cache_path; /* loaded at create, saved by rnd_context_save_cache(); NULL = none */
+	uint32_t slots;            /* concurrent renders (render slots); 0 = 1 */
+	uint32_t max_width, max_height; /* 0 = 8192 */
+	rnd_log_fn log; void *log_user;
+};
+
+struct rnd_info {
+	char device_name[256];
+	char driver_name[256];
+	char driver_info[256];
+	uint32_t api_version;
+	bool is_cpu;               /* lavapipe / software rasteriser */
+	uint32_t max_image_dimension;
+	uint32_t max_shadow_resolution;
+	bool moments_fp32_filterable;
+};
+
+enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct rnd_context **out,
+                                   struct rnd_error *err);
+void rnd_context_destroy(struct rnd_context *ctx);
+void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info);
+/* Validation-layer messages (warnings and errors) seen since create. Tests require 0. */
+uint32_t rnd_context_validation_messages(const struct rnd_context *ctx);
+/* Writes the pipeline cache to desc.pipeline_cache_path (atomic rename). */
+enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error *err);
+
+/* Renders one scene. Blocks until done. See the threading note at the top. */
+enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *scene,
+                           struct rnd_image *out, struct rnd_timings *timings, struct rnd_error *err);
+
+const char *rnd_result_str(enum rnd_result r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

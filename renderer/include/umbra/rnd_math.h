@@ -1,0 +1,61 @@
+/*
+ * umbra renderer — small vector/matrix math shared by the renderer and api/.
+ *
+ * Conventions: float arrays; matrices are 4x4 column-major (m[col*4 + row]) as in glTF and
+ * GLSL; right-handed world, +Y up. Projections produce Vulkan clip space: depth 0..1 and the
+ * Y axis flipped, so that image row 0 is the top of the picture and NDC y (contract sense,
+ * +1 = top) equals -clip.y/clip.w. No allocation, no state: every function is thread-safe.
+ * Output pointers may alias inputs unless a function says otherwise.
+ */
+#ifndef UMBRA_RND_MATH_H
+#define UMBRA_RND_MATH_H
+
+#include <stdbool.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct rnd_aabb { float min[3], max[3]; };
+
+float rnd_v3_dot(const float a[3], const float b[3]);
+void rnd_v3_cross(float out[3], const float a[3], const float b[3]);
+void rnd_v3_sub(float out[3], const float a[3], const float b[3]);
+void rnd_v3_add(float out[3], const float a[3], const float b[3]);
+void rnd_v3_scale(float out[3], const float a[3], float s);
+float rnd_v3_length(const float a[3]);
+/* Returns false (and leaves out = a) when |a| is 0 or not finite. */
+bool rnd_v3_normalize(float out[3], const float a[3]);
+
+void rnd_mat4_identity(float m[16]);
+/* out = a * b; out may not alias a or b. */
+void rnd_mat4_mul(float out[16], const float a[16], const float b[16]);
+/* T * R * S with q = [x,y,z,w] (normalised here; a zero quaternion gives identity rotation). */
+void rnd_mat4_trs(float out[16], const float t[3], const float q[4], const float s[3]);
+/* View matrix (world -> view, camera looks down -Z). An `up` parallel to the view direction
+ * is replaced by -Z, or by +Y when the view itself is along Z (contract §7). */
+void rnd_mat4_look_at(float out[16], const float eye[3], const float target[3], const float up[3]);
+/* Perspective, vertical fov in radians, Vulkan clip (y flipped, z in 0..1: near -> 0). */
+void rnd_mat4_perspective(float out[16], float fov_y, float aspect, float znear, float zfar);
+/* Orthographic box in view space (x in l..r, y in b..t, visible z in -n..-f), Vulkan clip. */
+void rnd_mat4_ortho(float out[16], float l, float r, float b, float t, float znear, float zfar);
+/* Returns false when m is singular (out untouched). */
+bool rnd_mat4_invert(float out[16], const float m[16]);
+/* Determinant of the upper-left 3x3 block (negative = mirroring transform). */
+float rnd_mat4_det3(const float m[16]);
+void rnd_mat4_mul_point(float out[3], const float m[16], const float p[3]);   /* w = 1, divides by w */
+void rnd_mat4_mul_dir(float out[3], const float m[16], const float d[3]);     /* w = 0 */
+/* Inverse-transpose of the upper 3x3, as a 4x4 (for normals). False when singular. */
+bool rnd_mat4_normal_matrix(float out[16], const float m[16]);
+
+void rnd_aabb_empty(struct rnd_aabb *b);
+bool rnd_aabb_is_empty(const struct rnd_aabb *b);
+void rnd_aabb_add_point(struct rnd_aabb *b, const float p[3]);
+void rnd_aabb_union(struct rnd_aabb *b, const struct rnd_aabb *o);
+/* Bounds of the 8 transformed corners of b. */
+void rnd_aabb_transform(struct rnd_aabb *out, const struct rnd_aabb *b, const float m[16]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

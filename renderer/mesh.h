@@ -1,0 +1,42 @@
+/*
+ * renderer/mesh — tessellation of the contract's shapes into world-space triangles.
+ *
+ * Usage: rnd_mesh_counts() tells how many vertices and indices an object needs; the caller
+ * reserves that much (usually straight in a mapped GPU buffer) and rnd_mesh_write() fills it.
+ * Vertices are in world space (object.model applied; normals by the inverse transpose,
+ * renormalised); a negative-determinant model swaps the winding so front faces stay front.
+ * Front faces are counter-clockwise seen from outside, as in glTF.
+ *
+ * Tessellation (contract §2): plane = 2 triangles in XZ, normal +Y; box = 6 faces x 2
+ * triangles with flat normals; sphere = UV sphere of `segments` longitudes x segments/2
+ * latitudes (smooth normals, poles as triangle fans); cylinder = `segments` side quads with
+ * smooth normals + two capped fans with flat normals; mesh = as given (flat normals computed
+ * when none given; with no indices, the vertices are a triangle list).
+ * Pure C, no Vulkan, thread-safe.
+ */
+#ifndef UMBRA_RENDERER_MESH_H
+#define UMBRA_RENDERER_MESH_H
+
+#include <stdint.h>
+#include "umbra/rnd.h"
+#include "umbra/rnd_math.h"
+
+struct rnd_vertex {
+	float pos[3];
+	float nrm[3];
+	float uv[2];
+};
+
+/* Vertex and index counts rnd_mesh_write() will produce for o. */
+void rnd_mesh_counts(const struct rnd_object *o, uint32_t *vertex_count, uint32_t *index_count);
+
+/* Writes the object's vertices and indices (indices offset by base_vertex) and grows
+ * *bounds by the world-space vertices. Returns RND_ERR_INVALID (message in err) for a mesh
+ * whose indices reference missing vertices or whose model matrix is singular. */
+enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
+                               uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err);
+
+/* Object-space bounds before any tessellation (cheap; for culling and camera derivation). */
+void rnd_mesh_local_bounds(const struct rnd_object *o, struct rnd_aabb *out);
+
+#endif

@@ -1,0 +1,42 @@
+#!/bin/sh
+# tests/run.sh — runs every test suite and ends with one line "N passed, N failed".
+# Env: BUILD (build dir), SHARED (../shared), ASAN=1 under make test-asan.
+# Each suite prints "N passed, N failed" as its last line; this script adds them up.
+BUILD=${BUILD:-build}
+SHARED=${SHARED:-../shared}
+export BUILD SHARED
+# Any validation-layer message fails a render test (the renderer counts them).
+export UMBRA_VALIDATION=1
+if [ -n "${ASAN:-}" ]; then
+	export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_odr_violation=0"
+	export LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0"
+	export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+fi
+total_pass=0; total_fail=0
+run_suite() {
+	name=$1; shift
+	echo "== $name"
+	log=$(mktemp)
+	"$@" >"$log" 2>&1
+	rc=$?
+	cat "$log"
+	line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
+	if [ -z "$line" ]; then
+		echo "FAIL - $name: exited $rc without a result line"
+		total_fail=$((total_fail + 1))
+	else
+		p=${line%% passed*}; f=${line#*passed, }; f=${f%% failed*}
+		total_pass=$((total_pass + p)); total_fail=$((total_fail + f))
+		if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
+			echo "FAIL - $name: exited $rc (sanitizer report?)"
+			total_fail=$((total_fail + 1))
+		fi
+	fi
+	rm -f "$log"
+}
+run_suite unit "$BUILD/tests/unit_tests"
+[ -x "$BUILD/tests/gpu_tests" ] && run_suite gpu "$BUILD/tests/gpu_tests"
+[ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
+[ -f tests/cli.sh ] && run_suite cli sh tests/cli.sh
+echo "$total_pass passed, $total_fail failed"
+[ "$total_fail" -eq 0 ]
