@@ -16,7 +16,7 @@
 
 typedef void (*test_fn)(void);
 void test_register(const char *name, test_fn fn);
-void test_fail_at(const char *file, int line, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+void test_fail_at(const char *file, int line, const char *cond, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 
 #define TEST(name)                                                                  \
 	static void name(void);                                                     \
@@ -24,8 +24,8 @@ void test_fail_at(const char *file, int line, const char *fmt, ...) __attribute_
 	static void name(void)
 
 #define CHECK(cond, ...)                                                            \
-	do { if (!(cond)) test_fail_at(__FILE__, __LINE__, "CHECK(" #cond ") " __VA_ARGS__); } while (0)
+	do { if (!(cond)) test_fail_at(__FILE__, __LINE__, "CHECK(" #cond ")", " " __VA_ARGS__); } while (0)
 #define REQUIRE(cond, ...)                                                          \
-	do { if (!(cond)) { test_fail_at(__FILE__, __LINE__, "REQUIRE(" #cond ") " __VA_ARGS__); return; } } while (0)
+	do { if (!(cond)) { test_fail_at(__FILE__, __LINE__, "REQUIRE(" #cond ")", " " __VA_ARGS__); return; } } while (0)
 
 #endif

@@ -14,10 +14,10 @@ void test_register(const char *name, test_fn fn)
 	if (ntests < MAX_TESTS) { tests[ntests].name = name; tests[ntests].fn = fn; ntests++; }
 }
 
-void test_fail_at(const char *file, int line, const char *fmt, ...)
+void test_fail_at(const char *file, int line, const char *cond, const char *fmt, ...)
 {
 	va_list ap;
-	fprintf(stdout, "  %s:%d: ", file, line);
+	fprintf(stdout, "  %s:%d: %s", file, line, cond);
 	va_start(ap, fmt);
 	vfprintf(stdout, fmt, ap);
 	va_end(ap);

@@ -226,6 +226,8 @@ struct rnd_timings {
 
 /* ---- context ---- */
 
+struct rnd_context; /* opaque */
+
 typedef void (*rnd_log_fn)(void *user, int level /* 0 error 1 warn 2 info */, const char *msg);
 
 struct rnd_context_desc {

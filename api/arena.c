@@ -1,0 +1,97 @@
+/*
+ * api/arena — bump allocator over a list of malloc'd chunks (see arena.h).
+ */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "arena.h"
+
+#define ARENA_CHUNK (64u * 1024u)
+#define ARENA_ALIGN 16u
+
+struct chunk {
+	struct chunk *next;
+	size_t size, used;
+	/* Keeps data[] 16-byte aligned on every ABI we build for. */
+	_Alignas(16) unsigned char data[];
+};
+
+struct api_arena {
+	struct chunk *head;   /* the chunk small allocations come from */
+	struct chunk *big;    /* dedicated chunks of big allocations */
+};
+
+struct api_arena *api_arena_create(void)
+{
+	return calloc(1, sizeof(struct api_arena));
+}
+
+static void free_list(struct chunk *c)
+{
+	while (c) {
+		struct chunk *next = c->next;
+		free(c);
+		c = next;
+	}
+}
+
+void api_arena_destroy(struct api_arena *a)
+{
+	if (!a) return;
+	free_list(a->head);
+	free_list(a->big);
+	free(a);
+}
+
+static struct chunk *chunk_new(size_t size)
+{
+	if (size > SIZE_MAX - sizeof(struct chunk)) return NULL;
+	struct chunk *c = malloc(sizeof(struct chunk) + size);
+	if (!c) return NULL;
+	c->next = NULL;
+	c->size = size;
+	c->used = 0;
+	return c;
+}
+
+void *api_arena_alloc(struct api_arena *a, size_t n)
+{
+	if (!a) return NULL;
+	if (n == 0) n = 1;
+	if (n > SIZE_MAX - ARENA_ALIGN) return NULL;
+	n = (n + ARENA_ALIGN - 1) & ~(size_t)(ARENA_ALIGN - 1);
+	if (n > ARENA_CHUNK / 4) {
+		/* A chunk of its own: the current small chunk keeps its free tail. */
+		struct chunk *c = chunk_new(n);
+		if (!c) return NULL;
+		c->used = n;
+		c->next = a->big;
+		a->big = c;
+		memset(c->data, 0, n);
+		return c->data;
+	}
+	if (!a->head || a->head->size - a->head->used < n) {
+		struct chunk *c = chunk_new(ARENA_CHUNK);
+		if (!c) return NULL;
+		c->next = a->head;
+		a->head = c;
+	}
+	void *p = a->head->data + a->head->used;
+	a->head->used += n;
+	memset(p, 0, n);
+	return p;
+}
+
+void *api_arena_calloc(struct api_arena *a, size_t n, size_t size)
+{
+	if (size && n > SIZE_MAX / size) return NULL;
+	return api_arena_alloc(a, n * size);
+}
+
+char *api_arena_strdup(struct api_arena *a, const char *s)
+{
+	size_t n = strlen(s) + 1;
+	char *d = api_arena_alloc(a, n);
+	if (d) memcpy(d, s, n);
+	return d;
+}

@@ -1,0 +1,112 @@
+/*
+ * api/problem — RFC 9457 problem details: one type URI and title per HTTP status, the
+ * application/problem+json document, and the one-line form the CLI prints.
+ * Also the resource-limit defaults and MIME types, which belong to no other module.
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <jansson.h>
+#include "api.h"
+
+#define PROBLEM_BASE "https://umbra.dev/problems/"
+
+static const struct {
+	int status;
+	const char *type;
+	const char *title;
+} problem_types[] = {
+	{400, "invalid-scene", "Invalid scene"},
+	{404, "not-found", "Not found"},
+	{405, "method-not-allowed", "Method not allowed"},
+	{408, "request-timeout", "Request timeout"},
+	{413, "body-too-large", "Request body too large"},
+	{415, "unsupported-media-type", "Unsupported media type"},
+	{422, "limit-exceeded", "Resource limit exceeded"},
+	{500, "internal-error", "Internal error"},
+	{503, "unavailable", "Service unavailable"},
+	{504, "deadline-exceeded", "Render deadline exceeded"},
+};
+
+static void copy_str(char *dst, size_t size, const char *src)
+{
+	snprintf(dst, size, "%s", src ? src : "");
+}
+
+enum api_result api_problem_set(struct api_problem *p, int status, const char *pointer, const char *fmt, ...)
+{
+	if (!p) return API_ERR;
+	const char *type = NULL, *title = NULL;
+	for (size_t i = 0; i < sizeof problem_types / sizeof problem_types[0]; i++) {
+		if (problem_types[i].status == status) {
+			type = problem_types[i].type;
+			title = problem_types[i].title;
+			break;
+		}
+	}
+	p->status = status;
+	if (type) {
+		snprintf(p->type, sizeof p->type, PROBLEM_BASE "%s", type);
+		copy_str(p->title, sizeof p->title, title);
+	} else {
+		copy_str(p->type, sizeof p->type, "about:blank");
+		copy_str(p->title, sizeof p->title, status >= 500 ? "Server error" : "Request error");
+	}
+	copy_str(p->pointer, sizeof p->pointer, pointer);
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(p->detail, sizeof p->detail, fmt ? fmt : "", ap);
+	va_end(ap);
+	return API_ERR;
+}
+
+char *api_problem_json(const struct api_problem *p)
+{
+	if (!p) return NULL;
+	json_t *o = json_object();
+	if (!o) return NULL;
+	/* jansson rejects invalid UTF-8; a detail or pointer truncated mid-character must still
+	 * produce a document, so each string falls back to an ASCII-only copy. */
+	const char *keys[] = {"type", "title", "detail", "pointer"};
+	const char *vals[] = {p->type, p->title, p->detail, p->pointer};
+	for (int i = 0; i < 4; i++) {
+		json_t *s = json_string(vals[i]);
+		if (!s) {
+			char ascii[sizeof p->detail];
+			size_t n = 0;
+			for (const char *c = vals[i]; *c && n + 1 < sizeof ascii; c++)
+				ascii[n++] = (unsigned char)*c < 0x80 ? *c : '?';
+			ascii[n] = 0;
+			s = json_string(ascii);
+		}
+		if (i == 2) json_object_set_new(o, "status", json_integer(p->status));
+		json_object_set_new(o, keys[i], s);
+	}
+	char *s = json_dumps(o, JSON_COMPACT | JSON_PRESERVE_ORDER);
+	json_decref(o);
+	return s;
+}
+
+void api_problem_format(const struct api_problem *p, char *buf, size_t size)
+{
+	if (!buf || !size) return;
+	if (!p) { buf[0] = 0; return; }
+	if (p->pointer[0])
+		snprintf(buf, size, "%d %s: %s: %s", p->status, p->title, p->pointer, p->detail);
+	else
+		snprintf(buf, size, "%d %s: %s", p->status, p->title, p->detail);
+}
+
+void api_limits_defaults(struct api_limits *l)
+{
+	if (!l) return;
+	l->max_pixels = 16777216;
+	l->max_triangles = 20000000;
+	l->max_lights = 64;
+	l->max_shadow_resolution = 8192;
+}
+
+const char *api_format_mime(enum api_format f)
+{
+	return f == API_FORMAT_EXR ? "image/x-exr" : "image/png";
+}

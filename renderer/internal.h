@@ -1,0 +1,136 @@
+/*
+ * renderer/internal.h — what the renderer's modules share; never included outside renderer/.
+ *
+ * Ownership: struct rnd_context owns the device, the pipelines (pipelines.c) and the render
+ * slots (slot.c). A slot owns everything one render needs (command buffer, fence, query pool,
+ * descriptor set, buffers and images that grow to fit and are kept for the next render).
+ * Threading: the context is read-only after create except slot hand-out (slot_mu/slot_cv) and
+ * queue submission (queue_mu). A slot is used by one thread at a time.
+ */
+#ifndef UMBRA_RENDERER_INTERNAL_H
+#define UMBRA_RENDERER_INTERNAL_H
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdarg.h>
+#include <vulkan/vulkan.h>
+#include "umbra/rnd.h"
+#include "umbra/rnd_math.h"
+#include "umbra_shared.h"
+#include "error.h"
+
+#define RND_COLOR_FORMAT_COUNT 3   /* enum rnd_pixel_format */
+#define RND_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+#define RND_SHADOW_FORMAT VK_FORMAT_D32_SFLOAT
+#define RND_MAX_VARIANTS 256
+
+/* Map a VkResult to a result + message "what: VK_ERROR_..." */
+enum rnd_result rnd_fail_vk(struct rnd_error *err, VkResult vr, const char *what);
+const char *rnd_vk_str(VkResult r);
+
+struct rnd_buffer {
+	VkBuffer buf;
+	VkDeviceMemory mem;
+	VkDeviceSize size;
+	void *map;               /* persistently mapped (all our buffers are host-visible) */
+};
+
+struct rnd_image_res {
+	VkImage img;
+	VkDeviceMemory mem;
+	VkImageView view;        /* whole image */
+	VkFormat format;
+	uint32_t width, height, layers, samples;
+};
+
+struct rnd_pipelines {
+	VkDescriptorSetLayout set_layout;
+	VkPipelineLayout layout;
+	VkSampler shadow_sampler;            /* nearest, clamp to border white (depth 1 = lit) */
+	/* [cull: 0 none, 1 back] */
+	VkPipeline shadow[2];
+	/* [msaa: 0 = 1x, 1 = 4x][cull] depth-only pre-pass of the camera view */
+	VkPipeline prepass[2][2];
+	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
+	VkShaderModule mesh_vs, mesh_fs;
+	pthread_mutex_t mu;
+	uint32_t variant_count;
+	struct rnd_main_variant {
+		struct rnd_main_key {
+			uint32_t format;             /* enum rnd_pixel_format */
+			uint32_t samples;            /* 1 or 4 */
+			uint32_t cull_back;
+			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
+		} key;
+		VkPipeline pipeline;
+	} variants[RND_MAX_VARIANTS];
+};
+
+struct rnd_slot;
+
+struct rnd_context {
+	struct rnd_context_desc desc;
+	char cache_path[4096];
+	VkInstance instance;
+	VkDebugUtilsMessengerEXT messenger;
+	VkPhysicalDevice phys;
+	VkPhysicalDeviceProperties props;
+	VkPhysicalDeviceMemoryProperties mem_props;
+	char driver_name[256], driver_info[256];
+	VkDevice device;
+	VkQueue queue;
+	uint32_t queue_family;
+	VkPipelineCache pipeline_cache;
+	struct rnd_pipelines pipes;
+	bool has_debug_utils;
+	bool timestamps;                     /* queue supports timestamps */
+	float timestamp_period;              /* ns per tick */
+	bool gather_ok;                      /* shadow format supports textureGather (sampled) */
+	VkFormat color_formats[RND_COLOR_FORMAT_COUNT];
+
+	pthread_mutex_t queue_mu;
+	pthread_mutex_t slot_mu;
+	pthread_cond_t slot_cv;
+	struct rnd_slot **slots;
+	uint32_t slot_count;
+	uint32_t slot_free_mask_unused;
+	bool *slot_busy;
+
+	volatile int validation_count;       /* atomically incremented by the messenger */
+	volatile int failed;                 /* device lost: every render fails */
+};
+
+void rnd_log(const struct rnd_context *ctx, int level, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* Debug name for any Vulkan object (no-op without VK_EXT_debug_utils). */
+void rnd_name(const struct rnd_context *ctx, VkObjectType type, uint64_t handle, const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+#define RND_NAME(ctx, type, h, ...) rnd_name((ctx), (type), (uint64_t)(uintptr_t)(h), __VA_ARGS__)
+
+/* memory.c */
+enum rnd_result rnd_buffer_create(struct rnd_context *ctx, VkDeviceSize size, VkBufferUsageFlags usage,
+                                  const char *name, struct rnd_buffer *out, struct rnd_error *err);
+void rnd_buffer_destroy(struct rnd_context *ctx, struct rnd_buffer *b);
+/* Grows b to at least size (power-of-two steps); contents are not kept. */
+enum rnd_result rnd_buffer_reserve(struct rnd_context *ctx, struct rnd_buffer *b, VkDeviceSize size,
+                                   VkBufferUsageFlags usage, const char *name, struct rnd_error *err);
+enum rnd_result rnd_image_create(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h, uint32_t layers,
+                                 uint32_t samples, VkImageUsageFlags usage, VkImageAspectFlags aspect,
+                                 const char *name, struct rnd_image_res *out, struct rnd_error *err);
+void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
+
+/* pipelines.c */
+enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err);
+void rnd_pipelines_release(struct rnd_context *ctx);
+/* The main-pass pipeline for key, compiled on first use (thread-safe). */
+enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
+                                   struct rnd_error *err);
+/* Number of main-pass variants compiled so far (warm-up checks). */
+uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx);
+
+/* slot.c */
+struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx);
+void rnd_slot_release(struct rnd_context *ctx, struct rnd_slot *s);
+enum rnd_result rnd_slots_init(struct rnd_context *ctx, struct rnd_error *err);
+void rnd_slots_release(struct rnd_context *ctx);
+
+#endif

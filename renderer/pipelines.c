@@ -1,0 +1,262 @@
+/*
+ * renderer/pipelines.c — shader modules (SPIR-V embedded at build time), the one descriptor
+ * set layout and pipeline layout, the shadow sampler, and every graphics pipeline, all
+ * created once per context so that no render compiles anything.
+ *
+ * Pipelines use dynamic rendering (Vulkan 1.3): no render pass or framebuffer objects.
+ * Variants: shadow depth-only [cull none/back]; main [output format][MSAA 1/4][cull none/back].
+ */
+#include <string.h>
+#include "internal.h"
+#include "mesh.h"
+#include "shadow.vert.spv.h"
+#include "mesh.vert.spv.h"
+#include "mesh.frag.spv.h"
+
+static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
+                                   VkShaderModule *out, struct rnd_error *err)
+{
+	VkShaderModuleCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = size, .pCode = code};
+	VkResult vr = vkCreateShaderModule(ctx->device, &ci, NULL, out);
+	if (vr != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkCreateShaderModule");
+	RND_NAME(ctx, VK_OBJECT_TYPE_SHADER_MODULE, *out, "%s", name);
+	return RND_OK;
+}
+
+static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	VkResult vr;
+	VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+	VkDescriptorSetLayoutBinding b[UMBRA_BINDING_COUNT] = {
+		{UMBRA_BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
+		{UMBRA_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, NULL},
+		{UMBRA_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, NULL},
+		{UMBRA_BINDING_SHADOW_VIEWS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, NULL},
+		{UMBRA_BINDING_SHADOW_MAP, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, NULL},
+	};
+	VkDescriptorSetLayoutCreateInfo dci = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = UMBRA_BINDING_COUNT, .pBindings = b,
+	};
+	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &p->set_layout)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout");
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, p->set_layout, "umbra frame set layout");
+	VkPushConstantRange pcr = {stages, 0, sizeof(struct umbra_push)};
+	VkPipelineLayoutCreateInfo lci = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 1, .pSetLayouts = &p->set_layout,
+		.pushConstantRangeCount = 1, .pPushConstantRanges = &pcr,
+	};
+	if ((vr = vkCreatePipelineLayout(ctx->device, &lci, NULL, &p->layout)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreatePipelineLayout");
+	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, p->layout, "umbra pipeline layout");
+	/* Nearest + border white: lookups outside a shadow map read depth 1 (lit). Comparison is
+	 * done in the shader (see mesh.frag). */
+	VkSamplerCreateInfo sci = {
+		.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
+		.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+		.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER, .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
+		.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, .borderColor = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE,
+		.maxLod = 0.0f,
+	};
+	if ((vr = vkCreateSampler(ctx->device, &sci, NULL, &p->shadow_sampler)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreateSampler");
+	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->shadow_sampler, "umbra shadow sampler");
+	return RND_OK;
+}
+
+struct pipe_desc {
+	VkShaderModule vs, fs;      /* fs may be 0: depth only */
+	VkFormat color;             /* VK_FORMAT_UNDEFINED: no colour attachment */
+	VkFormat depth;
+	uint32_t samples;
+	bool cull_back;
+	bool shadow;                /* depth bias + clamp, LESS compare; else reversed-Z */
+	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
+	const VkSpecializationInfo *spec;  /* fragment stage */
+	const char *name;
+};
+
+static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_desc *d, VkPipeline *out,
+                                     struct rnd_error *err)
+{
+	VkPipelineShaderStageCreateInfo stages[2] = {
+		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = d->vs, .pName = "main"},
+		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = d->fs, .pName = "main",
+		 .pSpecializationInfo = d->spec},
+	};
+	VkVertexInputBindingDescription vb = {0, sizeof(struct rnd_vertex), VK_VERTEX_INPUT_RATE_VERTEX};
+	VkVertexInputAttributeDescription va[3] = {
+		{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, pos)},
+		{1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, nrm)},
+		{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
+	};
+	VkPipelineVertexInputStateCreateInfo vi = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+		.vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
+		.vertexAttributeDescriptionCount = d->fs ? 3 : 1, .pVertexAttributeDescriptions = va,
+	};
+	VkPipelineInputAssemblyStateCreateInfo ia = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO, .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+	};
+	VkPipelineViewportStateCreateInfo vp = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO, .viewportCount = 1, .scissorCount = 1,
+	};
+	VkPhysicalDeviceFeatures feats;
+	vkGetPhysicalDeviceFeatures(ctx->phys, &feats);
+	VkPipelineRasterizationStateCreateInfo rs = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+		.depthClampEnable = d->shadow && feats.depthClamp,
+		.polygonMode = VK_POLYGON_MODE_FILL,
+		.cullMode = d->cull_back ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE,
+		/* The projections flip Y into Vulkan's y-down framebuffer, so the picture is upright
+		 * and glTF's counter-clockwise front faces stay counter-clockwise on screen. */
+		.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
+		.depthBiasEnable = d->shadow,
+		.lineWidth = 1.0f,
+	};
+	VkPipelineMultisampleStateCreateInfo ms = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO, .rasterizationSamples = (VkSampleCountFlagBits)d->samples,
+	};
+	VkPipelineDepthStencilStateCreateInfo ds = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+		.depthTestEnable = VK_TRUE, .depthWriteEnable = !d->after_prepass,
+		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL
+		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
+	};
+	VkPipelineColorBlendAttachmentState cba = {.colorWriteMask = 0xf};
+	VkPipelineColorBlendStateCreateInfo cb = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+		.attachmentCount = d->color != VK_FORMAT_UNDEFINED ? 1 : 0, .pAttachments = &cba,
+	};
+	VkDynamicState dyn[3] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_DEPTH_BIAS};
+	VkPipelineDynamicStateCreateInfo dy = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, .dynamicStateCount = d->shadow ? 3 : 2, .pDynamicStates = dyn,
+	};
+	VkPipelineRenderingCreateInfo rci = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
+		.colorAttachmentCount = d->color != VK_FORMAT_UNDEFINED ? 1 : 0, .pColorAttachmentFormats = &d->color,
+		.depthAttachmentFormat = d->depth,
+	};
+	VkGraphicsPipelineCreateInfo ci = {
+		.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, .pNext = &rci,
+		.stageCount = d->fs ? 2 : 1, .pStages = stages,
+		.pVertexInputState = &vi, .pInputAssemblyState = &ia, .pViewportState = &vp, .pRasterizationState = &rs,
+		.pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb, .pDynamicState = &dy,
+		.layout = ctx->pipes.layout,
+	};
+	VkResult vr = vkCreateGraphicsPipelines(ctx->device, ctx->pipeline_cache, 1, &ci, NULL, out);
+	if (vr != VK_SUCCESS) {
+		rnd_fail_vk(err, vr, "vkCreateGraphicsPipelines");
+		snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg), " (%s)", d->name);
+		return err->code;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE, *out, "%s", d->name);
+	return RND_OK;
+}
+
+enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	enum rnd_result r;
+	VkShaderModule shadow_vs = VK_NULL_HANDLE;
+	pthread_mutex_init(&p->mu, NULL);
+	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_mesh_vert, sizeof spv_mesh_vert, "mesh.vert", &p->mesh_vs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_mesh_frag, sizeof spv_mesh_frag, "mesh.frag", &p->mesh_fs, err)) != RND_OK) goto fail;
+	for (int cull = 0; cull < 2; cull++) {
+		struct pipe_desc d = {
+			.vs = shadow_vs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
+			.cull_back = cull, .shadow = true, .name = cull ? "shadow depth (cull back)" : "shadow depth",
+		};
+		if ((r = make_pipeline(ctx, &d, &p->shadow[cull], err)) != RND_OK) goto fail;
+	}
+	/* Depth pre-pass of the main view: the main pass then tests EQUAL, so every pixel is shaded
+	 * by its visible surface only (lavapipe shades whole 4x4 blocks per triangle, and two-sided
+	 * closed meshes would otherwise shade their hidden back halves too). */
+	for (int m = 0; m < 2; m++) {
+		for (int cull = 0; cull < 2; cull++) {
+			char name[48];
+			snprintf(name, sizeof name, "depth prepass msaa%d%s", m ? 4 : 1, cull ? " cull back" : "");
+			struct pipe_desc d = {
+				.vs = p->mesh_vs, .color = VK_FORMAT_UNDEFINED, .depth = RND_DEPTH_FORMAT, .samples = m ? 4 : 1,
+				.cull_back = cull, .name = name,
+			};
+			if ((r = make_pipeline(ctx, &d, &p->prepass[m][cull], err)) != RND_OK) goto fail;
+		}
+	}
+	/* The shadow pipelines keep what they need from their module. */
+	vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
+	return RND_OK;
+
+fail:
+	if (shadow_vs) vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
+	rnd_pipelines_release(ctx);
+	return r;
+}
+
+enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
+                                   struct rnd_error *err)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	enum rnd_result r = RND_OK;
+	pthread_mutex_lock(&p->mu);
+	for (uint32_t i = 0; i < p->variant_count; i++) {
+		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
+			*out = p->variants[i].pipeline;
+			pthread_mutex_unlock(&p->mu);
+			return RND_OK;
+		}
+	}
+	if (p->variant_count == RND_MAX_VARIANTS) {
+		r = rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
+		goto out;
+	}
+	VkSpecializationMapEntry entries[UMBRA_SC_COUNT];
+	for (uint32_t i = 0; i < UMBRA_SC_COUNT; i++)
+		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
+	VkSpecializationInfo spec = {UMBRA_SC_COUNT, entries, sizeof key->sc, key->sc};
+	char name[96];
+	snprintf(name, sizeof name, "main fmt%u msaa%u%s sc %u/%u/%u/%u/%u/%u/%u", key->format, key->samples,
+	         key->cull_back ? " cull" : "", key->sc[0], key->sc[1], key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6]);
+	struct pipe_desc d = {
+		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
+		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = true, .name = name,
+	};
+	VkPipeline pipe;
+	if ((r = make_pipeline(ctx, &d, &pipe, err)) != RND_OK) goto out;
+	p->variants[p->variant_count].key = *key;
+	p->variants[p->variant_count].pipeline = pipe;
+	p->variant_count++;
+	*out = pipe;
+out:
+	pthread_mutex_unlock(&p->mu);
+	return r;
+}
+
+uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx)
+{
+	pthread_mutex_lock(&ctx->pipes.mu);
+	uint32_t n = ctx->pipes.variant_count;
+	pthread_mutex_unlock(&ctx->pipes.mu);
+	return n;
+}
+
+void rnd_pipelines_release(struct rnd_context *ctx)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	if (!ctx->device) return;
+	for (uint32_t i = 0; i < p->variant_count; i++) vkDestroyPipeline(ctx->device, p->variants[i].pipeline, NULL);
+	for (int c = 0; c < 2; c++) {
+		if (p->shadow[c]) vkDestroyPipeline(ctx->device, p->shadow[c], NULL);
+		for (int m = 0; m < 2; m++)
+			if (p->prepass[m][c]) vkDestroyPipeline(ctx->device, p->prepass[m][c], NULL);
+	}
+	if (p->mesh_fs) vkDestroyShaderModule(ctx->device, p->mesh_fs, NULL);
+	if (p->mesh_vs) vkDestroyShaderModule(ctx->device, p->mesh_vs, NULL);
+	if (p->shadow_sampler) vkDestroySampler(ctx->device, p->shadow_sampler, NULL);
+	if (p->layout) vkDestroyPipelineLayout(ctx->device, p->layout, NULL);
+	if (p->set_layout) vkDestroyDescriptorSetLayout(ctx->device, p->set_layout, NULL);
+	pthread_mutex_destroy(&p->mu);
+	memset(p, 0, sizeof *p);
+}

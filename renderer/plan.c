@@ -1,0 +1,344 @@
+/*
+ * renderer/plan.c — camera and shadow-view planning (see plan.h). Pure math.
+ *
+ * Directional lights: `fit` is one orthographic map around the whole scene; `cascades` are
+ * camera-centred bounding spheres of the practical split scheme's slices (a sphere around the
+ * eye is invariant under camera rotation, so rotating in place moves no cascade), snapped to
+ * whole texels in a light basis that does not depend on the camera (translating the camera
+ * moves shadows by whole texels: no shimmer); their depth range covers the scene bounds and
+ * depth clamp pancakes casters in front of the near plane.
+ */
+#include <math.h>
+#include <string.h>
+#include "error.h"
+#include "plan.h"
+
+static const float DEFAULT_RES = 2048.0f;
+
+static void reverse_z(float m[16])
+{
+	/* z' = w - z: depth 0..1 becomes 1..0, far-away depths keep float precision. */
+	for (int c = 0; c < 4; c++) m[c * 4 + 2] = m[c * 4 + 3] - m[c * 4 + 2];
+}
+
+enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, uint32_t height,
+                                const struct rnd_aabb *bounds, struct rnd_camera_plan *out, struct rnd_error *err)
+{
+	memset(out, 0, sizeof *out);
+	out->aspect = (float)width / (float)height;
+	out->ortho = cam->type == RND_CAMERA_ORTHOGRAPHIC;
+	out->fov_y = cam->fov_y > 0 ? cam->fov_y : 45.0f * (float)M_PI / 180.0f;
+	out->ortho_height = cam->height;
+	float pos[3], target[3];
+	memcpy(pos, cam->position, sizeof pos);
+	memcpy(target, cam->target, sizeof target);
+	bool empty = !bounds || rnd_aabb_is_empty(bounds);
+
+	if (cam->fit != RND_FIT_NONE) {
+		/* Auto-framing: the bounding sphere fills the frame up to the margin. */
+		float dir[3];
+		if (!rnd_v3_normalize(dir, cam->fit_direction))
+			return rnd_fail(err, RND_ERR_INVALID, "camera fit direction must not be zero");
+		float c[3] = {0, 0, 0}, r = 1.0f;
+		if (!empty) {
+			float d[3];
+			for (int i = 0; i < 3; i++) c[i] = 0.5f * (bounds->min[i] + bounds->max[i]);
+			rnd_v3_sub(d, bounds->max, bounds->min);
+			r = fmaxf(0.5f * rnd_v3_length(d), 1e-3f);
+		}
+		float margin = cam->fit_margin;
+		float half = 0.5f * out->fov_y * (1.0f - 2.0f * margin);
+		float half_x = atanf(tanf(half) * fminf(out->aspect, 1.0f));
+		float dist = r / sinf(fminf(half, half_x));
+		for (int i = 0; i < 3; i++) { target[i] = c[i]; pos[i] = c[i] - dir[i] * dist; }
+		out->ortho = false;
+	}
+	memcpy(out->pos, pos, sizeof pos);
+	float fwd[3];
+	rnd_v3_sub(fwd, target, pos);
+	if (!rnd_v3_normalize(out->fwd, fwd))
+		return rnd_fail(err, RND_ERR_INVALID, "camera position and target are the same point");
+	rnd_mat4_look_at(out->view, pos, target, cam->up);
+
+	float znear = cam->near, zfar = cam->far;
+	if (znear <= 0 || zfar <= 0) {
+		float dmin = 1e30f, dmax = -1e30f;
+		if (!empty) {
+			for (int i = 0; i < 8; i++) {
+				float p[3] = {i & 1 ? bounds->max[0] : bounds->min[0], i & 2 ? bounds->max[1] : bounds->min[1],
+				              i & 4 ? bounds->max[2] : bounds->min[2]};
+				float d[3];
+				rnd_v3_sub(d, p, pos);
+				float z = rnd_v3_dot(d, out->fwd);
+				dmin = fminf(dmin, z); dmax = fmaxf(dmax, z);
+			}
+		}
+		if (empty || dmax <= 0) { dmin = 0.1f; dmax = 100.0f; }
+		if (zfar <= 0) zfar = dmax * 1.01f + 1e-3f;
+		if (znear <= 0) {
+			if (out->ortho) znear = cam->near > 0 ? cam->near : 0.0f;
+			else znear = fmaxf(dmin * 0.99f, zfar * 1e-4f);
+		}
+	}
+	if (zfar <= znear) zfar = znear + 1.0f;
+	out->znear = znear; out->zfar = zfar;
+	if (out->ortho) {
+		float h = cam->height > 0 ? cam->height : 1.0f, w = h * out->aspect;
+		rnd_mat4_ortho(out->proj, -w / 2, w / 2, -h / 2, h / 2, znear, zfar);
+	} else {
+		rnd_mat4_perspective(out->proj, out->fov_y, out->aspect, znear, zfar);
+	}
+	reverse_z(out->proj);
+	rnd_mat4_mul(out->view_proj, out->proj, out->view);
+	float up[3] = {out->view[1], out->view[5], out->view[9]};
+	memcpy(out->up, up, sizeof up);
+	return RND_OK;
+}
+
+void rnd_cascade_splits(float znear, float zfar, uint32_t n, float lambda, float out[4])
+{
+	for (uint32_t i = 0; i < 4; i++) out[i] = zfar;
+	for (uint32_t i = 1; i <= n && i <= 4; i++) {
+		float t = (float)i / (float)n;
+		float lg = znear * powf(zfar / znear, t);
+		float un = znear + (zfar - znear) * t;
+		out[i - 1] = lambda * lg + (1.0f - lambda) * un;
+	}
+	if (n >= 1 && n <= 4) out[n - 1] = zfar; /* exact, no rounding drift */
+}
+
+bool rnd_aabb_in_frustum(const struct rnd_aabb *b, const float m[16], bool no_near)
+{
+	/* Planes from the rows of m (Gribb-Hartmann), Vulkan clip: -w<=x<=w, -w<=y<=w, 0<=z<=w. */
+	float row[4][4];
+	for (int r = 0; r < 4; r++)
+		for (int c = 0; c < 4; c++) row[r][c] = m[c * 4 + r];
+	float planes[6][4];
+	for (int c = 0; c < 4; c++) {
+		planes[0][c] = row[3][c] + row[0][c];
+		planes[1][c] = row[3][c] - row[0][c];
+		planes[2][c] = row[3][c] + row[1][c];
+		planes[3][c] = row[3][c] - row[1][c];
+		planes[4][c] = row[3][c] - row[2][c];  /* far: z <= w */
+		planes[5][c] = row[2][c];              /* near: z >= 0 */
+	}
+	int np = no_near ? 5 : 6;
+	for (int i = 0; i < np; i++) {
+		/* The corner furthest along the plane normal. */
+		float p[3];
+		for (int k = 0; k < 3; k++) p[k] = planes[i][k] >= 0 ? b->max[k] : b->min[k];
+		if (planes[i][0] * p[0] + planes[i][1] * p[1] + planes[i][2] * p[2] + planes[i][3] < 0) return false;
+	}
+	return true;
+}
+
+/* A light basis (rotation only) looking along d. */
+static void light_basis(float view[16], const float d[3])
+{
+	float zero[3] = {0, 0, 0};
+	float up[3] = {0, 1, 0};
+	if (fabsf(d[1]) > 0.99f) { up[1] = 0; up[2] = 1; }
+	rnd_mat4_look_at(view, zero, d, up);
+}
+
+/* Light-space depth range (distances along the light axis) covering the scene bounds. */
+static void depth_range(const float view[16], const struct rnd_aabb *bounds, float *zmin, float *zmax)
+{
+	*zmin = 1e30f; *zmax = -1e30f;
+	for (int i = 0; i < 8; i++) {
+		float p[3] = {i & 1 ? bounds->max[0] : bounds->min[0], i & 2 ? bounds->max[1] : bounds->min[1],
+		              i & 4 ? bounds->max[2] : bounds->min[2]};
+		float q[3];
+		rnd_mat4_mul_point(q, view, p);
+		*zmin = fminf(*zmin, -q[2]); *zmax = fmaxf(*zmax, -q[2]);
+	}
+	float pad = fmaxf((*zmax - *zmin) * 0.01f, 1e-3f);
+	*zmin -= pad; *zmax += pad;
+}
+
+static void ortho_view(struct umbra_shadow_view *v, const float view[16], float cx, float cy, float half,
+                       float zmin, float zmax, float res, const float dir[3])
+{
+	float proj[16];
+	rnd_mat4_ortho(proj, cx - half, cx + half, cy - half, cy + half, zmin, zmax);
+	rnd_mat4_mul(v->view_proj, proj, view);
+	v->params[0] = 2.0f * half / res;
+	v->params[1] = 0.0f;
+	v->params[2] = zmin;
+	v->params[3] = zmax;
+	v->light_dir[0] = dir[0]; v->light_dir[1] = dir[1]; v->light_dir[2] = dir[2];
+	v->light_dir[3] = res;
+}
+
+static void persp_view(struct umbra_shadow_view *v, const float eye[3], const float dir[3], const float up[3],
+                       float fov, float znear, float zfar, float res)
+{
+	float view[16], proj[16], target[3];
+	rnd_v3_add(target, eye, dir);
+	rnd_mat4_look_at(view, eye, target, up);
+	rnd_mat4_perspective(proj, fov, 1.0f, znear, zfar);
+	rnd_mat4_mul(v->view_proj, proj, view);
+	v->params[0] = 2.0f * tanf(fov * 0.5f) / res;
+	v->params[1] = 1.0f;
+	v->params[2] = znear;
+	v->params[3] = zfar;
+	v->light_dir[0] = dir[0]; v->light_dir[1] = dir[1]; v->light_dir[2] = dir[2];
+	v->light_dir[3] = res;
+}
+
+/* Farthest distance from p to the box (for spot/point far planes). */
+static float max_dist(const float p[3], const struct rnd_aabb *b)
+{
+	float d2 = 0;
+	for (int k = 0; k < 3; k++) {
+		float a = fmaxf(fabsf(p[k] - b->min[k]), fabsf(p[k] - b->max[k]));
+		d2 += a * a;
+	}
+	return sqrtf(d2);
+}
+
+static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
+{
+	if (s->dir_mode == RND_DIR_CASCADES) return true;
+	if (s->dir_mode == RND_DIR_FIT || s->dir_mode == RND_DIR_CLIPMAP) return false;
+	/* auto: one fitted map when the whole scene is seen at about one scale (its size is
+	 * within a few camera distances); else cascades. */
+	float c[3], d[3], e[3];
+	for (int k = 0; k < 3; k++) c[k] = 0.5f * (b->min[k] + b->max[k]);
+	rnd_v3_sub(d, b->max, b->min);
+	rnd_v3_sub(e, c, cam->pos);
+	float dist = fmaxf(rnd_v3_length(e), cam->znear);
+	return rnd_v3_length(d) > 8.0f * dist;
+}
+
+enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
+                                const struct rnd_camera_plan *cam, struct rnd_shadow_plan *out, struct rnd_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (scene->light_count > UMBRA_MAX_LIGHTS)
+		return rnd_fail(err, RND_ERR_LIMIT, "%u lights: the renderer takes at most %d", scene->light_count, UMBRA_MAX_LIGHTS);
+	bool empty = rnd_aabb_is_empty(bounds);
+	/* One resolution for every layer: the largest any light asks for. */
+	uint32_t res = 0;
+	for (uint32_t i = 0; i < scene->light_count; i++)
+		if (scene->lights[i].shadow.enabled && scene->lights[i].shadow.resolution > res) res = scene->lights[i].shadow.resolution;
+	out->resolution = res ? res : (uint32_t)DEFAULT_RES;
+	float fres = (float)out->resolution;
+
+	for (uint32_t i = 0; i < scene->light_count && !empty; i++) {
+		const struct rnd_light *L = &scene->lights[i];
+		const struct rnd_shadow *s = &L->shadow;
+		struct rnd_light_plan *lp = &out->lights[i];
+		if (!s->enabled) continue;
+		float size = L->type == RND_LIGHT_DIRECTIONAL ? L->angular_diameter : L->radius;
+		enum rnd_filter f = s->filter;
+		if (f == RND_FILTER_AUTO) f = size > 0 ? RND_FILTER_PCSS : RND_FILTER_PCF;
+		switch (f) {
+		case RND_FILTER_HARD: lp->filter = UMBRA_FILTER_HARD; break;
+		case RND_FILTER_PCF: lp->filter = UMBRA_FILTER_PCF; break;
+		case RND_FILTER_PCSS: lp->filter = UMBRA_FILTER_PCSS; break;
+		default:
+			return rnd_fail(err, RND_ERR_INVALID, "light %u: shadow filter '%s' is not implemented by this renderer yet",
+			                i, f == RND_FILTER_VSM ? "vsm" : "evsm");
+		}
+		lp->pcf_radius = s->pcf_radius > 5 ? 5 : s->pcf_radius;
+		lp->search_texels = 24.0f;
+		if (s->bias_set) {
+			lp->bias_constant = s->bias_constant; lp->bias_slope = s->bias_slope; lp->bias_normal = s->bias_normal;
+		} else {
+			/* Slope-scaled hardware bias for surfaces at grazing light, plus a normal offset of
+			 * 1.5 texels for curved receivers; no per-scene tuning. */
+			lp->bias_constant = 1.0f; lp->bias_slope = 1.75f; lp->bias_normal = 1.5f;
+		}
+		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
+		bool cascades = false;
+		uint32_t ncasc = 1;
+		if (L->type == RND_LIGHT_DIRECTIONAL && use_cascades(s, bounds, cam)) {
+			cascades = true;
+			ncasc = s->cascades ? s->cascades : 4;
+			need = ncasc;
+		}
+		if (out->view_count + need > UMBRA_MAX_SHADOW_VIEWS)
+			return rnd_fail(err, RND_ERR_LIMIT, "light %u: more than %d shadow views in one scene", i, UMBRA_MAX_SHADOW_VIEWS);
+		lp->first_view = out->view_count;
+		lp->view_count = need;
+
+		if (L->type == RND_LIGHT_DIRECTIONAL) {
+			float d[3], view[16];
+			if (!rnd_v3_normalize(d, L->direction))
+				return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
+			light_basis(view, d);
+			float zmin, zmax;
+			depth_range(view, bounds, &zmin, &zmax);
+			if (!cascades) {
+				/* fit: the light-space box around the scene bounds, square texels */
+				struct rnd_aabb lb;
+				rnd_aabb_transform(&lb, bounds, view);
+				float cx = 0.5f * (lb.min[0] + lb.max[0]), cy = 0.5f * (lb.min[1] + lb.max[1]);
+				float half = 0.5f * fmaxf(lb.max[0] - lb.min[0], lb.max[1] - lb.min[1]);
+				half *= 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
+				ortho_view(&out->views[out->view_count], view, cx, cy, half, zmin, zmax, fres, d);
+				out->view_light[out->view_count] = i;
+				out->view_ortho[out->view_count++] = true;
+			} else {
+				float maxd = s->max_distance > 0 ? s->max_distance : cam->zfar;
+				float scene_far = max_dist(cam->pos, bounds);
+				if (maxd > scene_far) maxd = scene_far;
+				float split_near = fmaxf(cam->znear, 0.05f);
+				if (maxd <= split_near) maxd = split_near * 2.0f;
+				rnd_cascade_splits(split_near, maxd, ncasc, s->split_lambda, lp->splits);
+				/* Distance from the eye to a far corner of the slice at depth z. */
+				float k = cam->ortho ? 0.0f : tanf(cam->fov_y * 0.5f);
+				float corner = sqrtf(1.0f + k * k * (1.0f + cam->aspect * cam->aspect));
+				float eye_ls[3];
+				rnd_mat4_mul_point(eye_ls, view, cam->pos);
+				for (uint32_t c = 0; c < ncasc; c++) {
+					float r = lp->splits[c] * corner;
+					if (cam->ortho) {
+						float h = cam->ortho_height * 0.5f, w = h * cam->aspect;
+						r = sqrtf(lp->splits[c] * lp->splits[c] + h * h + w * w);
+					}
+					/* Round the radius up to a coarse step so small changes of near/far do not
+					 * change the texel size; then snap the centre to whole texels. */
+					r = ceilf(r * 16.0f) / 16.0f;
+					float texel = 2.0f * r / fres;
+					float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
+					float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
+					ortho_view(&out->views[out->view_count], view, cx, cy, r, zmin, zmax, fres, d);
+					out->view_light[out->view_count] = i;
+					out->view_ortho[out->view_count++] = true;
+				}
+			}
+		} else {
+			float reach = L->range > 0 ? L->range : max_dist(L->position, bounds);
+			float zfar = fmaxf(reach, 0.1f) * 1.01f;
+			float znear = fmaxf(zfar * 1e-3f, 0.01f);
+			/* Widen the frustum by the filter footprint so taps near an edge stay inside
+			 * this view: no seams between cube faces, no clipped cones. */
+			float margin = (float)(lp->pcf_radius + 2) + (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
+			float grow = 1.0f + 2.0f * margin / fres;
+			if (L->type == RND_LIGHT_SPOT) {
+				float d[3];
+				if (!rnd_v3_normalize(d, L->direction))
+					return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
+				float up[3] = {0, 1, 0};
+				if (fabsf(d[1]) > 0.99f) { up[1] = 0; up[2] = 1; }
+				float half = fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f);
+				float fov = 2.0f * atanf(tanf(half) * grow);
+				persp_view(&out->views[out->view_count], L->position, d, up, fov, znear, zfar, fres);
+				out->view_light[out->view_count] = i;
+				out->view_ortho[out->view_count++] = false;
+			} else {
+				static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+				static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+				float fov = 2.0f * atanf(grow);
+				for (int f6 = 0; f6 < 6; f6++) {
+					persp_view(&out->views[out->view_count], L->position, dirs[f6], ups[f6], fov, znear, zfar, fres);
+					out->view_light[out->view_count] = i;
+					out->view_ortho[out->view_count++] = false;
+				}
+			}
+		}
+	}
+	return RND_OK;
+}

@@ -1,0 +1,58 @@
+/*
+ * renderer/plan.h — per-render CPU planning: the camera (view, reversed-Z projection, derived
+ * near/far) and the shadow views of every light (fit, cascades, spot cone, point cube faces).
+ *
+ * Pure math: no Vulkan calls, no allocation; unit-tested in tests/unit/test_plan.c.
+ */
+#ifndef UMBRA_RENDERER_PLAN_H
+#define UMBRA_RENDERER_PLAN_H
+
+#include "umbra/rnd.h"
+#include "umbra/rnd_math.h"
+#include "umbra_shared.h"
+
+struct rnd_camera_plan {
+	float view[16], proj[16], view_proj[16];   /* proj is reversed-Z: near -> 1, far -> 0 */
+	float pos[3], fwd[3], up[3];
+	float znear, zfar;
+	float fov_y, aspect;                       /* perspective */
+	float ortho_height;                        /* orthographic */
+	bool ortho;
+};
+
+/* Resolves the camera against the scene bounds (fit, derived near/far). bounds may be empty. */
+enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, uint32_t height,
+                                const struct rnd_aabb *bounds, struct rnd_camera_plan *out, struct rnd_error *err);
+
+struct rnd_light_plan {
+	uint32_t first_view, view_count;           /* view_count 0 = unshadowed */
+	uint32_t filter;                           /* UMBRA_FILTER_* */
+	uint32_t pcf_radius;
+	float bias_constant, bias_slope, bias_normal;
+	float splits[4];                           /* cascades: far view depth of each */
+	float search_texels;                       /* PCSS blocker search cap */
+};
+
+struct rnd_shadow_plan {
+	uint32_t resolution;                       /* texels per side, every layer */
+	uint32_t view_count;
+	struct umbra_shadow_view views[UMBRA_MAX_SHADOW_VIEWS];
+	uint32_t view_light[UMBRA_MAX_SHADOW_VIEWS]; /* light index of each view */
+	bool view_ortho[UMBRA_MAX_SHADOW_VIEWS];     /* skip near-plane culling (depth clamp) */
+	struct rnd_light_plan lights[UMBRA_MAX_LIGHTS];
+};
+
+/* Plans every light's shadow views. Fails (RND_ERR_INVALID / RND_ERR_LIMIT) for settings the
+ * renderer cannot honour, saying which light and why. */
+enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
+                                const struct rnd_camera_plan *cam, struct rnd_shadow_plan *out, struct rnd_error *err);
+
+/* Practical split scheme: far distance of each of n cascades between znear and zfar,
+ * lambda 0 = uniform, 1 = logarithmic. */
+void rnd_cascade_splits(float znear, float zfar, uint32_t n, float lambda, float out[4]);
+
+/* True when the box is (conservatively) at least partly inside the clip volume of m.
+ * With no_near the near plane is ignored (depth clamp catches casters in front of it). */
+bool rnd_aabb_in_frustum(const struct rnd_aabb *b, const float m[16], bool no_near);
+
+#endif

@@ -1,0 +1,232 @@
+/*
+ * renderer/slot.c — render slots (see slot.h): creation, hand-out, growth, release.
+ */
+#include <stdlib.h>
+#include <string.h>
+#include "slot.h"
+
+static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, struct rnd_slot **out, struct rnd_error *err)
+{
+	VkResult vr;
+	enum rnd_result r;
+	struct rnd_slot *s = calloc(1, sizeof *s);
+	if (!s) return rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
+	s->index = index;
+	VkCommandPoolCreateInfo pci = {
+		.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+		.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, .queueFamilyIndex = ctx->queue_family,
+	};
+	if ((vr = vkCreateCommandPool(ctx->device, &pci, NULL, &s->pool)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkCreateCommandPool");
+		goto fail_pool;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_COMMAND_POOL, s->pool, "slot %u command pool", index);
+	VkCommandBufferAllocateInfo cai = {
+		.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, .commandPool = s->pool,
+		.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1,
+	};
+	if ((vr = vkAllocateCommandBuffers(ctx->device, &cai, &s->cmd)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkAllocateCommandBuffers");
+		goto fail_cmd;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_COMMAND_BUFFER, s->cmd, "slot %u commands", index);
+	VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+	if ((vr = vkCreateFence(ctx->device, &fci, NULL, &s->fence)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkCreateFence");
+		goto fail_cmd;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_FENCE, s->fence, "slot %u fence", index);
+	if (ctx->timestamps) {
+		VkQueryPoolCreateInfo qci = {
+			.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = RND_TS_COUNT,
+		};
+		if ((vr = vkCreateQueryPool(ctx->device, &qci, NULL, &s->queries)) != VK_SUCCESS) {
+			r = rnd_fail_vk(err, vr, "vkCreateQueryPool");
+			goto fail_queries;
+		}
+		RND_NAME(ctx, VK_OBJECT_TYPE_QUERY_POOL, s->queries, "slot %u timestamps", index);
+	}
+	VkDescriptorPoolSize sizes[3] = {
+		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+	};
+	VkDescriptorPoolCreateInfo dpi = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 3, .pPoolSizes = sizes,
+	};
+	if ((vr = vkCreateDescriptorPool(ctx->device, &dpi, NULL, &s->desc_pool)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkCreateDescriptorPool");
+		goto fail_desc_pool;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->desc_pool, "slot %u descriptor pool", index);
+	VkDescriptorSetAllocateInfo dai = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->desc_pool,
+		.descriptorSetCount = 1, .pSetLayouts = &ctx->pipes.set_layout,
+	};
+	if ((vr = vkAllocateDescriptorSets(ctx->device, &dai, &s->set)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets");
+		goto fail_set;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET, s->set, "slot %u frame set", index);
+	*out = s;
+	return RND_OK;
+
+fail_set:
+	vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
+fail_desc_pool:
+	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
+fail_queries:
+	vkDestroyFence(ctx->device, s->fence, NULL);
+fail_cmd:
+	vkDestroyCommandPool(ctx->device, s->pool, NULL); /* frees the command buffer */
+fail_pool:
+	free(s);
+	return r;
+}
+
+static void shadow_destroy(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	if (s->shadow_layers)
+		for (uint32_t i = 0; i < s->shadow.layers; i++)
+			if (s->shadow_layers[i]) vkDestroyImageView(ctx->device, s->shadow_layers[i], NULL);
+	free(s->shadow_layers);
+	s->shadow_layers = NULL;
+	rnd_image_destroy(ctx, &s->shadow);
+	s->shadow_initialised = false;
+}
+
+static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	if (!s) return;
+	shadow_destroy(ctx, s);
+	rnd_image_destroy(ctx, &s->resolve);
+	rnd_image_destroy(ctx, &s->depth);
+	rnd_image_destroy(ctx, &s->color_ms);
+	rnd_buffer_destroy(ctx, &s->readback);
+	rnd_buffer_destroy(ctx, &s->params);
+	rnd_buffer_destroy(ctx, &s->indices);
+	rnd_buffer_destroy(ctx, &s->vertices);
+	vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
+	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
+	vkDestroyFence(ctx->device, s->fence, NULL);
+	vkDestroyCommandPool(ctx->device, s->pool, NULL);
+	free(s);
+}
+
+enum rnd_result rnd_slots_init(struct rnd_context *ctx, struct rnd_error *err)
+{
+	ctx->slot_count = ctx->desc.slots;
+	ctx->slots = calloc(ctx->slot_count, sizeof *ctx->slots);
+	ctx->slot_busy = calloc(ctx->slot_count, sizeof *ctx->slot_busy);
+	if (!ctx->slots || !ctx->slot_busy) {
+		free(ctx->slots); free(ctx->slot_busy);
+		ctx->slots = NULL; ctx->slot_busy = NULL;
+		return rnd_fail(err, RND_ERR_OOM, "out of memory for %u render slots", ctx->slot_count);
+	}
+	for (uint32_t i = 0; i < ctx->slot_count; i++) {
+		enum rnd_result r = slot_create(ctx, i, &ctx->slots[i], err);
+		if (r != RND_OK) {
+			rnd_slots_release(ctx);
+			return r;
+		}
+	}
+	return RND_OK;
+}
+
+void rnd_slots_release(struct rnd_context *ctx)
+{
+	if (!ctx->slots) return;
+	for (uint32_t i = 0; i < ctx->slot_count; i++) slot_destroy(ctx, ctx->slots[i]);
+	free(ctx->slots);
+	free(ctx->slot_busy);
+	ctx->slots = NULL;
+	ctx->slot_busy = NULL;
+}
+
+struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx)
+{
+	pthread_mutex_lock(&ctx->slot_mu);
+	for (;;) {
+		for (uint32_t i = 0; i < ctx->slot_count; i++) {
+			if (!ctx->slot_busy[i]) {
+				ctx->slot_busy[i] = true;
+				pthread_mutex_unlock(&ctx->slot_mu);
+				return ctx->slots[i];
+			}
+		}
+		pthread_cond_wait(&ctx->slot_cv, &ctx->slot_mu);
+	}
+}
+
+void rnd_slot_release(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	pthread_mutex_lock(&ctx->slot_mu);
+	ctx->slot_busy[s->index] = false;
+	pthread_cond_signal(&ctx->slot_cv);
+	pthread_mutex_unlock(&ctx->slot_mu);
+}
+
+enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, VkFormat color, uint32_t w, uint32_t h,
+                                 uint32_t samples, struct rnd_error *err)
+{
+	enum rnd_result r;
+	bool same = s->resolve.img && s->resolve.format == color && s->resolve.width == w && s->resolve.height == h &&
+	            s->depth.samples == samples;
+	if (same) return RND_OK;
+	rnd_image_destroy(ctx, &s->color_ms);
+	rnd_image_destroy(ctx, &s->depth);
+	rnd_image_destroy(ctx, &s->resolve);
+	char name[64];
+	snprintf(name, sizeof name, "slot %u colour", s->index);
+	if ((r = rnd_image_create(ctx, color, w, h, 1, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->resolve, err)) != RND_OK)
+		return r;
+	if (samples > 1) {
+		snprintf(name, sizeof name, "slot %u colour msaa", s->index);
+		if ((r = rnd_image_create(ctx, color, w, h, 1, samples,
+		                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+		                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->color_ms, err)) != RND_OK)
+			goto fail;
+	}
+	snprintf(name, sizeof name, "slot %u depth", s->index);
+	if ((r = rnd_image_create(ctx, RND_DEPTH_FORMAT, w, h, 1, samples,
+	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+	                          VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->depth, err)) != RND_OK)
+		goto fail;
+	return RND_OK;
+fail:
+	rnd_image_destroy(ctx, &s->color_ms);
+	rnd_image_destroy(ctx, &s->resolve);
+	return r;
+}
+
+enum rnd_result rnd_slot_shadow(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, uint32_t layers,
+                                struct rnd_error *err)
+{
+	if (s->shadow.img && s->shadow.width == res && s->shadow.layers >= layers) return RND_OK;
+	shadow_destroy(ctx, s);
+	char name[64];
+	snprintf(name, sizeof name, "slot %u shadow maps", s->index);
+	enum rnd_result r = rnd_image_create(ctx, RND_SHADOW_FORMAT, res, res, layers, 1,
+	                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                                     VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->shadow, err);
+	if (r != RND_OK) return r;
+	s->shadow_layers = calloc(layers, sizeof *s->shadow_layers);
+	if (!s->shadow_layers) {
+		shadow_destroy(ctx, s);
+		return rnd_fail(err, RND_ERR_OOM, "out of memory for %u shadow layer views", layers);
+	}
+	for (uint32_t i = 0; i < layers; i++) {
+		VkImageViewCreateInfo vci = {
+			.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = s->shadow.img, .viewType = VK_IMAGE_VIEW_TYPE_2D,
+			.format = RND_SHADOW_FORMAT, .subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, i, 1},
+		};
+		VkResult vr = vkCreateImageView(ctx->device, &vci, NULL, &s->shadow_layers[i]);
+		if (vr != VK_SUCCESS) {
+			shadow_destroy(ctx, s);
+			return rnd_fail_vk(err, vr, "vkCreateImageView (shadow layer)");
+		}
+		RND_NAME(ctx, VK_OBJECT_TYPE_IMAGE_VIEW, s->shadow_layers[i], "slot %u shadow layer %u", s->index, i);
+	}
+	return RND_OK;
+}

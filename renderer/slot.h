@@ -1,0 +1,39 @@
+/*
+ * renderer/slot.h — a render slot: everything one render in flight needs, kept between
+ * renders so that a steady stream of similar requests allocates nothing.
+ *
+ * Ownership: the context owns its slots (slot.c creates them at context create). A slot is
+ * handed to one thread by rnd_slot_acquire() and returned by rnd_slot_release(). Buffers and
+ * images grow to fit (targets are recreated when size, format or sample count change) only
+ * after the slot's fence has signalled, so the GPU never sees a resource freed under it.
+ */
+#ifndef UMBRA_RENDERER_SLOT_H
+#define UMBRA_RENDERER_SLOT_H
+
+#include "internal.h"
+
+enum { RND_TS_START, RND_TS_SHADOW_END, RND_TS_MAIN_END, RND_TS_COPY_END, RND_TS_COUNT };
+
+struct rnd_slot {
+	uint32_t index;
+	VkCommandPool pool;
+	VkCommandBuffer cmd;
+	VkFence fence;
+	VkQueryPool queries;
+	VkDescriptorPool desc_pool;
+	VkDescriptorSet set;
+
+	struct rnd_buffer vertices, indices, params, readback;
+	struct rnd_image_res color_ms, depth, resolve, shadow;
+	VkImageView *shadow_layers;    /* one 2D view per shadow layer (render targets) */
+	bool shadow_initialised;       /* layout known (kept in SHADER_READ_ONLY between renders) */
+};
+
+/* Makes the colour/depth targets match (format, w, h, samples). */
+enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, VkFormat color, uint32_t w, uint32_t h,
+                                 uint32_t samples, struct rnd_error *err);
+/* Makes the shadow array hold at least `layers` layers of res x res. */
+enum rnd_result rnd_slot_shadow(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, uint32_t layers,
+                                struct rnd_error *err);
+
+#endif

@@ -1,0 +1,27 @@
+/*
+ * umbrad growable text buffer (git's strbuf, smaller): metrics exposition and JSON answers.
+ *
+ * Zero-initialised = empty. An allocation failure sets `failed` and later appends do nothing,
+ * so callers check once at the end. srv_buf_detach() hands the malloc'd, NUL-terminated text
+ * to the caller (you now own it; free()) and leaves the buffer empty.
+ */
+#ifndef UMBRA_SRV_BUF_H
+#define UMBRA_SRV_BUF_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+struct srv_buf {
+	char *data;
+	size_t len, cap;
+	bool failed;
+};
+
+void srv_buf_printf(struct srv_buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void srv_buf_puts(struct srv_buf *b, const char *s);
+/* Appends s as a JSON string, quotes included. */
+void srv_buf_json_str(struct srv_buf *b, const char *s);
+char *srv_buf_detach(struct srv_buf *b, size_t *len);  /* NULL if an append failed */
+void srv_buf_release(struct srv_buf *b);
+
+#endif

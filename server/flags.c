@@ -1,0 +1,205 @@
+/*
+ * umbrad configuration: contract defaults, then UMBRA_* environment variables, then flags
+ * (a flag wins over its variable). Every flag --name-with-dashes has the variable
+ * UMBRA_NAME_WITH_DASHES; UMBRA_VALIDATION=1 (no flag) turns the Vulkan validation layer on.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "srv.h"
+
+enum opt_kind { OPT_STR, OPT_UINT, OPT_SIZE, OPT_LOGFMT };
+
+struct opt_def {
+	const char *name;
+	enum opt_kind kind;
+	const char *arg, *help;
+	size_t offset;      /* into struct srv_config, or (size_t)-1 for limits below */
+	uint64_t min, max;
+};
+
+#define CFG(m) offsetof(struct srv_config, m)
+#define LIM(m) (offsetof(struct srv_config, limits) + offsetof(struct api_limits, m))
+
+static const struct opt_def opts[] = {
+	{ "listen", OPT_STR, "ADDR:PORT", "address to listen on (127.0.0.1:8080; port 0 = any free port)", CFG(listen), 0, 0 },
+	{ "port-file", OPT_STR, "PATH", "write the bound port to PATH once listening", CFG(port_file), 0, 0 },
+	{ "workers", OPT_UINT, "N", "render threads and context slots (default: online CPUs)", CFG(workers), 1, 256 },
+	{ "queue", OPT_UINT, "N", "renders that may wait for a worker before 503 (64)", CFG(queue), 1, 1000000 },
+	{ "max-body", OPT_SIZE, "BYTES", "largest request body, K/M/G suffixes (64M)", CFG(max_body), 1, UINT64_MAX },
+	{ "max-pixels", OPT_SIZE, "N", "largest width*height, 0 = no limit (16777216)", LIM(max_pixels), 0, UINT64_MAX },
+	{ "max-triangles", OPT_SIZE, "N", "most triangles after tessellation, 0 = no limit (20M)", LIM(max_triangles), 0, UINT64_MAX },
+	{ "max-lights", OPT_UINT, "N", "most lights, 0 = no limit (64)", LIM(max_lights), 0, UINT32_MAX },
+	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
+	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
+	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to", CFG(asset_root), 0, 0 },
+	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
+	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
+	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
+	{ "max-connections", OPT_UINT, "N", "concurrent connections (1024)", CFG(max_connections), 1, 1000000 },
+	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
+	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
+};
+#define OPT_COUNT (sizeof opts / sizeof opts[0])
+
+static void usage(FILE *f)
+{
+	fprintf(f, "usage: umbrad [FLAGS]\n"
+	           "HTTP render daemon: POST /v1/render (scene JSON -> PNG/EXR), GET /healthz, /readyz,\n"
+	           "/metrics, /v1/info. Every flag can also be set as UMBRA_<FLAG> (e.g. UMBRA_MAX_BODY);\n"
+	           "a flag wins over its variable. UMBRA_VALIDATION=1 enables the Vulkan validation layer.\n\n");
+	for (size_t i = 0; i < OPT_COUNT; i++) {
+		char left[64];
+		snprintf(left, sizeof left, "--%s %s", opts[i].name, opts[i].arg);
+		fprintf(f, "  %-34s %s\n", left, opts[i].help);
+	}
+	fprintf(f, "  %-34s %s\n", "--help", "this text");
+}
+
+static int parse_u64(const char *s, bool suffixes, uint64_t *out)
+{
+	char *end;
+	errno = 0;
+	if (!s || !*s || *s == '-')
+		return -1;
+	unsigned long long v = strtoull(s, &end, 10);
+	if (errno || end == s)
+		return -1;
+	uint64_t mul = 1;
+	if (suffixes && *end) {
+		switch (*end) {
+		case 'k': case 'K': mul = 1ull << 10; break;
+		case 'm': case 'M': mul = 1ull << 20; break;
+		case 'g': case 'G': mul = 1ull << 30; break;
+		default: return -1;
+		}
+		end++;
+		if (*end == 'i' || *end == 'I')
+			end++;
+		if (*end == 'b' || *end == 'B')
+			end++;
+	}
+	if (*end)
+		return -1;
+	if (v > UINT64_MAX / mul)
+		return -1;
+	*out = v * mul;
+	return 0;
+}
+
+/* Applies one value; `from` names its source for the message ("--workers", "UMBRA_WORKERS"). */
+static int apply(struct srv_config *cfg, const struct opt_def *o, const char *val, const char *from)
+{
+	char *base = (char *)cfg;
+	uint64_t v;
+	switch (o->kind) {
+	case OPT_STR:
+		if (!val || !*val) {
+			fprintf(stderr, "umbrad: %s: empty value\n", from);
+			return -1;
+		}
+		*(const char **)(base + o->offset) = val;
+		return 0;
+	case OPT_LOGFMT:
+		if (val && !strcasecmp(val, "text"))
+			cfg->log_format = SRV_LOG_TEXT;
+		else if (val && !strcasecmp(val, "json"))
+			cfg->log_format = SRV_LOG_JSON;
+		else {
+			fprintf(stderr, "umbrad: %s: '%s' is not text or json\n", from, val ? val : "");
+			return -1;
+		}
+		return 0;
+	case OPT_UINT:
+	case OPT_SIZE:
+		if (parse_u64(val, o->kind == OPT_SIZE, &v) != 0 || v < o->min || v > o->max) {
+			fprintf(stderr, "umbrad: %s: '%s' is not a number in %llu..%llu\n", from, val ? val : "",
+			        (unsigned long long)o->min, (unsigned long long)o->max);
+			return -1;
+		}
+		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
+		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles))
+			*(uint64_t *)(base + o->offset) = v;
+		else
+			*(uint32_t *)(base + o->offset) = (uint32_t)v;
+		return 0;
+	}
+	return -1;
+}
+
+int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+{
+	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
+	memset(cfg, 0, sizeof *cfg);
+	cfg->listen = "127.0.0.1:8080";
+	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+	cfg->workers = ncpu > 0 ? (unsigned)(ncpu > 256 ? 256 : ncpu) : 1;
+	cfg->queue = 64;
+	cfg->max_body = 64ull << 20;
+	api_limits_defaults(&cfg->limits);
+	cfg->deadline_ms = 30000;
+	cfg->log_format = SRV_LOG_TEXT;
+	cfg->max_connections = 1024;
+	cfg->idle_timeout_s = 60;
+	cfg->drain_timeout_s = 60;
+	const char *v = getenv("UMBRA_VALIDATION");
+	cfg->validation = v && *v && strcmp(v, "0") != 0;
+
+	/* Environment first. */
+	for (size_t i = 0; i < OPT_COUNT; i++) {
+		char env[64] = "UMBRA_";
+		size_t n = strlen(env);
+		for (const char *p = opts[i].name; *p && n + 1 < sizeof env; p++)
+			env[n++] = *p == '-' ? '_' : (char)(*p >= 'a' && *p <= 'z' ? *p - 32 : *p);
+		env[n] = 0;
+		const char *val = getenv(env);
+		if (val && apply(cfg, &opts[i], val, env) != 0)
+			return -1;
+	}
+
+	/* Then flags. */
+	struct option lopts[OPT_COUNT + 2];
+	for (size_t i = 0; i < OPT_COUNT; i++)
+		lopts[i] = (struct option){ opts[i].name, required_argument, NULL, (int)(i + 1000) };
+	lopts[OPT_COUNT] = (struct option){ "help", no_argument, NULL, 'h' };
+	lopts[OPT_COUNT + 1] = (struct option){ 0 };
+	optind = 1;
+	for (;;) {
+		int c = getopt_long(argc, argv, "h", lopts, NULL);
+		if (c == -1)
+			break;
+		if (c == 'h') {
+			usage(stdout);
+			return 1;
+		}
+		if (c < 1000) {
+			usage(stderr);
+			return -1;
+		}
+		const struct opt_def *o = &opts[c - 1000];
+		char from[64];
+		snprintf(from, sizeof from, "--%s", o->name);
+		if (apply(cfg, o, optarg, from) != 0)
+			return -1;
+	}
+	if (optind < argc) {
+		fprintf(stderr, "umbrad: unexpected argument '%s'\n", argv[optind]);
+		usage(stderr);
+		return -1;
+	}
+	if (cfg->asset_root && access(cfg->asset_root, R_OK | X_OK) != 0) {
+		fprintf(stderr, "umbrad: --asset-root: cannot open '%s': %s\n", cfg->asset_root, strerror(errno));
+		return -1;
+	}
+	return 0;
+}
+
+void srv_config_release(struct srv_config *cfg)
+{
+	(void)cfg; /* every string points into argv or the environment */
+}

@@ -1,0 +1,82 @@
+/*
+ * umbrad logging (see log.h).
+ */
+#include "log.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static enum srv_log_format log_format = SRV_LOG_TEXT;
+
+static const char *const level_names[] = { "error", "warn", "info" };
+
+void srv_log_init(enum srv_log_format format)
+{
+	log_format = format;
+}
+
+static void log_timestamp(char *buf, size_t size)
+{
+	struct timespec ts;
+	struct tm tm;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	gmtime_r(&ts.tv_sec, &tm);
+	size_t n = strftime(buf, size, "%Y-%m-%dT%H:%M:%S", &tm);
+	snprintf(buf + n, size - n, ".%03ldZ", ts.tv_nsec / 1000000);
+}
+
+/* Writes the whole line at once; a short write to stderr is not worth a retry loop. */
+static void log_write(char *line, size_t len, size_t cap)
+{
+	if (len >= cap - 1)
+		len = cap - 2;
+	line[len++] = '\n';
+	ssize_t w = write(STDERR_FILENO, line, len);
+	(void)w;
+}
+
+void srv_log(enum srv_log_level level, const char *fmt, ...)
+{
+	char ts[40], msg[1024], line[2300];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(msg, sizeof msg, fmt, ap);
+	va_end(ap);
+	log_timestamp(ts, sizeof ts);
+	int n;
+	if (log_format == SRV_LOG_JSON) {
+		char esc[2048];
+		srv_json_escape(esc, sizeof esc, msg);
+		n = snprintf(line, sizeof line, "{\"ts\":\"%s\",\"level\":\"%s\",\"msg\":\"%s\"}", ts,
+		             level_names[level], esc);
+	} else {
+		n = snprintf(line, sizeof line, "%s %-5s %s", ts, level_names[level], msg);
+	}
+	if (n > 0)
+		log_write(line, (size_t)n, sizeof line);
+}
+
+void srv_log_request(const char *method, const char *path, const char *route, int status,
+                     uint64_t bytes, double ms, const char *request_id)
+{
+	char ts[40], line[1024], epath[400], eid[200], emethod[40];
+	log_timestamp(ts, sizeof ts);
+	srv_json_escape(epath, sizeof epath, path);
+	srv_json_escape(eid, sizeof eid, request_id);
+	srv_json_escape(emethod, sizeof emethod, method);
+	int n;
+	if (log_format == SRV_LOG_JSON)
+		n = snprintf(line, sizeof line,
+		             "{\"ts\":\"%s\",\"level\":\"info\",\"msg\":\"request\",\"method\":\"%s\","
+		             "\"path\":\"%s\",\"route\":\"%s\",\"status\":%d,\"bytes\":%llu,\"ms\":%.3f,"
+		             "\"request_id\":\"%s\"}",
+		             ts, emethod, epath, route, status, (unsigned long long)bytes, ms, eid);
+	else
+		n = snprintf(line, sizeof line, "%s info  %s %s %d %lluB %.1fms route=%s id=%s", ts,
+		             emethod, epath, status, (unsigned long long)bytes, ms, route, eid);
+	if (n > 0)
+		log_write(line, (size_t)n, sizeof line);
+}

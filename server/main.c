@@ -1,0 +1,153 @@
+/*
+ * umbrad main: configuration, start-up order and graceful shutdown.
+ *
+ * Start-up: listen first (so /healthz answers and /readyz says 503 during start-up), then
+ * create the renderer context, warm up its pipelines, start the workers, and only then
+ * report ready. SIGTERM/SIGINT: /readyz turns 503, the listening socket closes, queued and
+ * in-flight renders finish and are answered, the pipeline cache is saved, exit 0.
+ * Exit codes: 0 clean, 1 start-up failure, 2 bad flags, 3 validation-layer messages seen.
+ */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/random.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "log.h"
+#include "metrics.h"
+#include "queue.h"
+#include "srv.h"
+
+double srv_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+void srv_json_escape(char *dst, size_t size, const char *src)
+{
+	static const char hex[] = "0123456789abcdef";
+	size_t o = 0;
+	for (; src && *src && o + 7 < size; src++) {
+		unsigned char c = (unsigned char)*src;
+		if (c == '"' || c == '\\') {
+			dst[o++] = '\\';
+			dst[o++] = (char)c;
+		} else if (c < 0x20 || c == 0x7f) {
+			dst[o++] = '\\';
+			dst[o++] = 'u';
+			dst[o++] = '0';
+			dst[o++] = '0';
+			dst[o++] = hex[c >> 4];
+			dst[o++] = hex[c & 15];
+		} else {
+			dst[o++] = (char)c;
+		}
+	}
+	if (size)
+		dst[o < size ? o : size - 1] = 0;
+}
+
+/* Waits until every begun request has been answered and completed, or the timeout. */
+static void wait_pending(struct srv_server *s, double timeout_s)
+{
+	double end = srv_now() + timeout_s;
+	while (atomic_load(&s->pending) > 0 && srv_now() < end) {
+		struct timespec ts = { 0, 10 * 1000 * 1000 };
+		nanosleep(&ts, NULL);
+	}
+	unsigned left = atomic_load(&s->pending);
+	if (left)
+		srv_log(SRV_LOG_WARN, "drain: %u requests still open after %.0f s; closing them", left, timeout_s);
+}
+
+int main(int argc, char **argv)
+{
+	static struct srv_server srv;
+	struct srv_server *s = &srv;
+	int exit_code = 1;
+
+	int rc = srv_config_load(&s->cfg, argc, argv);
+	if (rc > 0)
+		return 0;
+	if (rc < 0)
+		return 2;
+	srv_log_init(s->cfg.log_format);
+
+	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
+	 * main thread takes the signals with sigwait(). */
+	sigset_t sigs;
+	sigemptyset(&sigs);
+	sigaddset(&sigs, SIGTERM);
+	sigaddset(&sigs, SIGINT);
+	pthread_sigmask(SIG_BLOCK, &sigs, NULL);
+	signal(SIGPIPE, SIG_IGN);
+
+	pthread_rwlockattr_t rwa;
+	pthread_rwlockattr_init(&rwa);
+	pthread_rwlockattr_setkind_np(&rwa, PTHREAD_RWLOCK_PREFER_WRITER_NONRECURSIVE_NP);
+	pthread_rwlock_init(&s->ctx_lock, &rwa);
+	pthread_rwlockattr_destroy(&rwa);
+	if (getrandom(&s->id_seed, sizeof s->id_seed, 0) != sizeof s->id_seed)
+		s->id_seed = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32);
+
+	s->metrics = srv_metrics_create();
+	s->queue = srv_queue_create(s->cfg.queue);
+	if (!s->metrics || !s->queue) {
+		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
+		goto out_free;
+	}
+	srv_log(SRV_LOG_INFO, "umbrad %s starting: %u workers, queue %u, max body %llu, deadline %u ms",
+	        UMBRA_VERSION, s->cfg.workers, s->cfg.queue, (unsigned long long)s->cfg.max_body, s->cfg.deadline_ms);
+	if (s->cfg.asset_root)
+		srv_log(SRV_LOG_WARN, "--asset-root '%s' is accepted but models by `path` are not supported by this build's scene parser",
+		        s->cfg.asset_root);
+	if (srv_http_start(s) != 0)
+		goto out_free;
+	if (srv_context_open(s) != 0)
+		goto out_http;
+	if (srv_warmup(s) != 0)
+		goto out_context;
+	if (srv_workers_start(s) != 0)
+		goto out_workers;
+	atomic_store(&s->ready, true);
+	srv_log(SRV_LOG_INFO, "ready");
+
+	int sig = 0;
+	while (sigwait(&sigs, &sig) != 0)
+		;
+	srv_log(SRV_LOG_INFO, "%s: draining (%u queued, %u rendering)", sig == SIGINT ? "SIGINT" : "SIGTERM",
+	        srv_queue_depth(s->queue), atomic_load(&s->in_flight));
+	exit_code = 0;
+
+out_workers:
+	atomic_store(&s->draining, true);
+	srv_http_quiesce(s);
+	srv_queue_close(s->queue);
+	srv_workers_join(s);
+	wait_pending(s, s->cfg.drain_timeout_s);
+out_context:
+	atomic_store(&s->draining, true);
+	srv_http_stop(s);
+	{
+		int msgs = srv_context_close(s);
+		if (msgs > 0) {
+			srv_log(SRV_LOG_ERROR, "the Vulkan validation layer reported %d messages", msgs);
+			if (exit_code == 0)
+				exit_code = 3;
+		}
+	}
+	goto out_free;
+out_http:
+	srv_http_stop(s);
+out_free:
+	srv_queue_destroy(s->queue);
+	srv_metrics_destroy(s->metrics);
+	pthread_rwlock_destroy(&s->ctx_lock);
+	if (exit_code == 0)
+		srv_log(SRV_LOG_INFO, "stopped");
+	return exit_code;
+}

@@ -1,0 +1,284 @@
+/*
+ * umbrad metrics (see metrics.h). Histograms use fixed latency buckets from 1 ms to 60 s.
+ */
+#include "metrics.h"
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "buf.h"
+#include "queue.h"
+
+static const double bucket_bounds[] = { 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25,
+	0.5, 1, 2.5, 5, 10, 30, 60 };
+#define BUCKETS (sizeof bucket_bounds / sizeof bucket_bounds[0])
+
+struct srv_histogram {
+	uint64_t bucket[BUCKETS];   /* non-cumulative here, summed when written */
+	uint64_t count;
+	double sum;
+};
+
+/* Requests by (route, status): a short list, found by linear search. */
+#define MAX_STATUS_SERIES 96
+struct srv_status_series {
+	enum srv_route route;
+	int status;
+	uint64_t count;
+};
+
+struct srv_metrics {
+	pthread_mutex_t mu;
+	struct srv_status_series series[MAX_STATUS_SERIES];
+	unsigned series_count;
+	struct srv_histogram duration[SRV_ROUTE_COUNT];
+	struct srv_histogram stage[SRV_STAGE_COUNT];
+	struct srv_histogram queue_wait;
+	uint64_t counter[SRV_CTR_COUNT];
+};
+
+struct srv_metrics *srv_metrics_create(void)
+{
+	struct srv_metrics *m = calloc(1, sizeof *m);
+	if (!m)
+		return NULL;
+	if (pthread_mutex_init(&m->mu, NULL) != 0) {
+		free(m);
+		return NULL;
+	}
+	return m;
+}
+
+void srv_metrics_destroy(struct srv_metrics *m)
+{
+	if (!m)
+		return;
+	pthread_mutex_destroy(&m->mu);
+	free(m);
+}
+
+static void histogram_observe(struct srv_histogram *h, double v)
+{
+	size_t i = 0;
+	while (i < BUCKETS && v > bucket_bounds[i])
+		i++;
+	if (i < BUCKETS)
+		h->bucket[i]++;
+	h->count++;
+	h->sum += v;
+}
+
+void srv_metrics_request(struct srv_metrics *m, enum srv_route route, int status, double seconds,
+                         uint64_t bytes)
+{
+	pthread_mutex_lock(&m->mu);
+	unsigned i;
+	for (i = 0; i < m->series_count; i++)
+		if (m->series[i].route == route && m->series[i].status == status)
+			break;
+	if (i == m->series_count && i < MAX_STATUS_SERIES) {
+		m->series[i] = (struct srv_status_series){ .route = route, .status = status };
+		m->series_count++;
+	}
+	if (i < m->series_count)
+		m->series[i].count++;
+	histogram_observe(&m->duration[route], seconds);
+	m->counter[SRV_CTR_BYTES_OUT] += bytes;
+	pthread_mutex_unlock(&m->mu);
+}
+
+void srv_metrics_stage(struct srv_metrics *m, enum srv_stage stage, double seconds)
+{
+	pthread_mutex_lock(&m->mu);
+	histogram_observe(&m->stage[stage], seconds);
+	pthread_mutex_unlock(&m->mu);
+}
+
+void srv_metrics_queue_wait(struct srv_metrics *m, double seconds)
+{
+	pthread_mutex_lock(&m->mu);
+	histogram_observe(&m->queue_wait, seconds);
+	pthread_mutex_unlock(&m->mu);
+}
+
+void srv_metrics_add(struct srv_metrics *m, enum srv_counter c, uint64_t n)
+{
+	pthread_mutex_lock(&m->mu);
+	m->counter[c] += n;
+	pthread_mutex_unlock(&m->mu);
+}
+
+static void write_histogram(struct srv_buf *b, const char *name, const char *labels,
+                            const struct srv_histogram *h)
+{
+	uint64_t cum = 0;
+	const char *sep = labels[0] ? "," : "";
+	for (size_t i = 0; i < BUCKETS; i++) {
+		cum += h->bucket[i];
+		srv_buf_printf(b, "%s_bucket{%s%sle=\"%g\"} %llu\n", name, labels, sep, bucket_bounds[i],
+		               (unsigned long long)cum);
+	}
+	srv_buf_printf(b, "%s_bucket{%s%sle=\"+Inf\"} %llu\n", name, labels, sep,
+	               (unsigned long long)h->count);
+	if (labels[0]) {
+		srv_buf_printf(b, "%s_sum{%s} %.9g\n", name, labels, h->sum);
+		srv_buf_printf(b, "%s_count{%s} %llu\n", name, labels, (unsigned long long)h->count);
+	} else {
+		srv_buf_printf(b, "%s_sum %.9g\n", name, h->sum);
+		srv_buf_printf(b, "%s_count %llu\n", name, (unsigned long long)h->count);
+	}
+}
+
+static void write_counter(struct srv_buf *b, const char *name, const char *help, uint64_t v)
+{
+	srv_buf_printf(b, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", name, help, name, name,
+	               (unsigned long long)v);
+}
+
+static void write_gauge(struct srv_buf *b, const char *name, const char *help, double v)
+{
+	srv_buf_printf(b, "# HELP %s %s\n# TYPE %s gauge\n%s %.17g\n", name, help, name, name, v);
+}
+
+static long process_rss_bytes(void)
+{
+	long pages_total = 0, pages_rss = 0;
+	FILE *f = fopen("/proc/self/statm", "r");
+	if (!f)
+		return 0;
+	if (fscanf(f, "%ld %ld", &pages_total, &pages_rss) != 2)
+		pages_rss = 0;
+	fclose(f);
+	return pages_rss * sysconf(_SC_PAGESIZE);
+}
+
+static long process_open_fds(void)
+{
+	DIR *d = opendir("/proc/self/fd");
+	if (!d)
+		return 0;
+	long n = 0;
+	struct dirent *e;
+	while ((e = readdir(d)))
+		if (e->d_name[0] != '.')
+			n++;
+	closedir(d);
+	return n - 1; /* the directory stream itself */
+}
+
+/* Label values are escaped for the exposition format: backslash, quote, newline. */
+static void label_escape(char *dst, size_t size, const char *src)
+{
+	size_t o = 0;
+	for (; src && *src && o + 3 < size; src++) {
+		if (*src == '\\' || *src == '"') {
+			dst[o++] = '\\';
+			dst[o++] = *src;
+		} else if (*src == '\n') {
+			dst[o++] = '\\';
+			dst[o++] = 'n';
+		} else {
+			dst[o++] = *src;
+		}
+	}
+	dst[o] = 0;
+}
+
+char *srv_metrics_text(struct srv_server *s, size_t *len)
+{
+	struct srv_metrics *m = s->metrics;
+	struct srv_metrics snap;
+	struct srv_buf b = { 0 };
+	char labels[128];
+
+	pthread_mutex_lock(&m->mu);
+	memcpy(&snap, m, sizeof snap);
+	pthread_mutex_unlock(&m->mu);
+
+	srv_buf_puts(&b, "# HELP umbra_requests_total HTTP requests answered, by route and status.\n"
+	                 "# TYPE umbra_requests_total counter\n");
+	for (unsigned i = 0; i < snap.series_count; i++)
+		srv_buf_printf(&b, "umbra_requests_total{route=\"%s\",status=\"%d\"} %llu\n",
+		               srv_route_name(snap.series[i].route), snap.series[i].status,
+		               (unsigned long long)snap.series[i].count);
+
+	srv_buf_puts(&b, "# HELP umbra_request_duration_seconds Time from request arrival to answer.\n"
+	                 "# TYPE umbra_request_duration_seconds histogram\n");
+	for (int r = 0; r < SRV_ROUTE_COUNT; r++) {
+		if (!snap.duration[r].count)
+			continue;
+		snprintf(labels, sizeof labels, "route=\"%s\"", srv_route_name((enum srv_route)r));
+		write_histogram(&b, "umbra_request_duration_seconds", labels, &snap.duration[r]);
+	}
+
+	srv_buf_puts(&b, "# HELP umbra_stage_seconds Time per render stage.\n"
+	                 "# TYPE umbra_stage_seconds histogram\n");
+	for (int st = 0; st < SRV_STAGE_COUNT; st++) {
+		snprintf(labels, sizeof labels, "stage=\"%s\"", srv_stage_name((enum srv_stage)st));
+		write_histogram(&b, "umbra_stage_seconds", labels, &snap.stage[st]);
+	}
+
+	srv_buf_puts(&b, "# HELP umbra_queue_wait_seconds Time a render waited in the queue.\n"
+	                 "# TYPE umbra_queue_wait_seconds histogram\n");
+	write_histogram(&b, "umbra_queue_wait_seconds", "", &snap.queue_wait);
+
+	unsigned qi = s->queue ? srv_queue_depth_prio(s->queue, SRV_PRIO_INTERACTIVE) : 0;
+	unsigned qb = s->queue ? srv_queue_depth_prio(s->queue, SRV_PRIO_BULK) : 0;
+	srv_buf_printf(&b, "# HELP umbra_queue_depth Renders waiting for a worker.\n"
+	                   "# TYPE umbra_queue_depth gauge\n"
+	                   "umbra_queue_depth %u\n"
+	                   "# HELP umbra_queue_depth_by_priority Renders waiting, by X-Priority.\n"
+	                   "# TYPE umbra_queue_depth_by_priority gauge\n"
+	                   "umbra_queue_depth_by_priority{priority=\"interactive\"} %u\n"
+	                   "umbra_queue_depth_by_priority{priority=\"bulk\"} %u\n", qi + qb, qi, qb);
+	write_gauge(&b, "umbra_queue_capacity", "Most renders that may wait in the queue.",
+	            s->queue ? srv_queue_capacity(s->queue) : 0);
+	write_gauge(&b, "umbra_renders_in_flight", "Renders running now.", atomic_load(&s->in_flight));
+	write_gauge(&b, "umbra_workers", "Render worker threads (context render slots).",
+	            s->cfg.workers);
+	write_gauge(&b, "umbra_ready", "1 when /readyz answers 200.",
+	            atomic_load(&s->ready) && !atomic_load(&s->draining));
+	write_gauge(&b, "umbra_draining", "1 after SIGTERM/SIGINT.", atomic_load(&s->draining));
+
+	srv_buf_puts(&b, "# HELP umbra_renders_total Renders attempted by workers, by result.\n"
+	                 "# TYPE umbra_renders_total counter\n");
+	srv_buf_printf(&b, "umbra_renders_total{result=\"ok\"} %llu\n",
+	               (unsigned long long)snap.counter[SRV_CTR_RENDER_OK]);
+	srv_buf_printf(&b, "umbra_renders_total{result=\"error\"} %llu\n",
+	               (unsigned long long)snap.counter[SRV_CTR_RENDER_FAILED]);
+	write_counter(&b, "umbra_shadow_maps_rendered_total", "Shadow maps rendered.",
+	              snap.counter[SRV_CTR_SHADOW_RENDERED]);
+	write_counter(&b, "umbra_shadow_maps_reused_total", "Shadow maps reused from the renderer's cache.",
+	              snap.counter[SRV_CTR_SHADOW_REUSED]);
+	write_counter(&b, "umbra_not_modified_total", "Renders answered 304 from If-None-Match (ETag hits).",
+	              snap.counter[SRV_CTR_NOT_MODIFIED]);
+	write_counter(&b, "umbra_queue_rejected_total", "Renders refused with 503 because the queue was full.",
+	              snap.counter[SRV_CTR_QUEUE_REJECTED]);
+	write_counter(&b, "umbra_deadline_exceeded_total", "Renders answered 504.",
+	              snap.counter[SRV_CTR_DEADLINE]);
+	write_counter(&b, "umbra_device_lost_total", "Lost devices (context recreated).",
+	              snap.counter[SRV_CTR_DEVICE_LOST]);
+	write_counter(&b, "umbra_response_bytes_total", "Bytes of answer bodies.",
+	              snap.counter[SRV_CTR_BYTES_OUT]);
+
+	uint32_t vmsg = s->validation_lost;
+	char dev[300] = "", drv[300] = "";
+	if (atomic_load(&s->ready)) {
+		pthread_rwlock_rdlock(&s->ctx_lock);
+		if (s->ctx)
+			vmsg += rnd_context_validation_messages(s->ctx);
+		label_escape(dev, sizeof dev, s->info.device_name);
+		label_escape(drv, sizeof drv, s->info.driver_name);
+		pthread_rwlock_unlock(&s->ctx_lock);
+	}
+	write_gauge(&b, "umbra_validation_messages", "Vulkan validation-layer messages since start.", vmsg);
+	srv_buf_printf(&b, "# HELP umbra_build_info Build and device.\n# TYPE umbra_build_info gauge\n"
+	                   "umbra_build_info{version=\"%s\",device=\"%s\",driver=\"%s\"} 1\n",
+	               UMBRA_VERSION, dev, drv);
+	write_gauge(&b, "process_resident_memory_bytes", "Resident set size.", (double)process_rss_bytes());
+	write_gauge(&b, "process_open_fds", "Open file descriptors.", (double)process_open_fds());
+	return srv_buf_detach(&b, len);
+}

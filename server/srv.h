@@ -1,0 +1,161 @@
+/*
+ * umbrad — the HTTP render daemon (build/umbrad). Shared types of the server modules.
+ *
+ * Modules (prefix srv_):
+ *   flags.c    srv_config: defaults, UMBRA_* environment, command-line flags, --help
+ *   main.c     startup (listen, context, warm-up, workers), signals, graceful drain, exit code
+ *   http.c     libmicrohttpd callbacks: routes, body reading, negotiation, answers
+ *   queue.c    the bounded two-level (interactive before bulk) job queue
+ *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
+ *   metrics.c  Prometheus counters, gauges and histograms
+ *   log.c      one line per event or request on stderr, text or JSON
+ *
+ * Threading: libmicrohttpd runs one internal polling thread (epoll where available) that does
+ * all socket I/O and calls http.c. A POST /v1/render is read completely, then its connection is
+ * suspended and the request is handed to the queue; a worker thread renders it, stores the
+ * answer in the request and resumes the connection, and the polling thread sends it. Nothing
+ * on the polling thread waits for a render.
+ *
+ * Ownership: one struct srv_request per HTTP request, created by http.c on the first call of
+ * the access handler and freed by http.c when libmicrohttpd reports the request completed.
+ * While a request is queued or rendering, the worker owns its result fields; it gives them back
+ * by calling srv_request_finish() (which resumes the connection) and never touches the request
+ * again.
+ */
+#ifndef UMBRA_SRV_H
+#define UMBRA_SRV_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "api.h"
+#include "umbra/rnd.h"
+
+#ifndef UMBRA_VERSION
+#define UMBRA_VERSION "0.1.0"
+#endif
+
+struct srv_queue;
+struct srv_metrics;
+struct MHD_Daemon;
+struct MHD_Connection;
+
+enum srv_log_format { SRV_LOG_TEXT, SRV_LOG_JSON };
+
+/* Everything the flags and UMBRA_* variables configure. Zero-initialised = not set. */
+struct srv_config {
+	const char *listen;            /* ADDR:PORT, default 127.0.0.1:8080; port 0 = ephemeral */
+	const char *port_file;         /* written with the bound port once listening */
+	unsigned workers;              /* render threads = context slots, default: online CPUs */
+	unsigned queue;                /* queued renders (not counting those rendering), default 64 */
+	uint64_t max_body;             /* bytes, default 64 MiB */
+	struct api_limits limits;      /* 422 limits */
+	unsigned deadline_ms;          /* 0 = none, default 30000 */
+	const char *asset_root;        /* directory models' `path` is relative to */
+	const char *pipeline_cache;    /* pipeline cache file, loaded at start, saved at exit */
+	enum srv_log_format log_format;
+	const char *device;            /* substring of the Vulkan device name */
+	unsigned max_connections;      /* concurrent TCP connections, default 1024 */
+	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
+	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
+	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
+};
+
+enum srv_route {
+	SRV_ROUTE_RENDER, SRV_ROUTE_HEALTHZ, SRV_ROUTE_READYZ, SRV_ROUTE_METRICS, SRV_ROUTE_INFO,
+	SRV_ROUTE_OTHER,
+	SRV_ROUTE_COUNT
+};
+const char *srv_route_name(enum srv_route r);
+
+enum srv_priority { SRV_PRIO_INTERACTIVE, SRV_PRIO_BULK, SRV_PRIO_COUNT };
+
+enum srv_stage { SRV_STAGE_PARSE, SRV_STAGE_UPLOAD, SRV_STAGE_SHADOW, SRV_STAGE_MAIN,
+	SRV_STAGE_READBACK, SRV_STAGE_ENCODE, SRV_STAGE_COUNT };
+const char *srv_stage_name(enum srv_stage s);
+
+/* The daemon. One per process; every module gets a pointer to it. */
+struct srv_server {
+	struct srv_config cfg;
+	struct MHD_Daemon *daemon;
+	uint16_t port;
+	struct srv_queue *queue;
+	struct srv_metrics *metrics;
+
+	/* The shared renderer. Renders hold ctx_lock for reading; recovery after a lost device
+	 * takes it for writing, destroys and recreates the context (ctx_gen counts recreations). */
+	pthread_rwlock_t ctx_lock;
+	struct rnd_context *ctx;
+	unsigned ctx_gen;
+	struct rnd_info info;          /* of the current context, valid once ready */
+	uint32_t validation_lost;      /* validation messages of destroyed contexts */
+
+	pthread_t *threads;
+	unsigned thread_count;
+
+	atomic_bool ready;             /* context created and warm-up done */
+	atomic_bool draining;          /* SIGTERM/SIGINT seen: no new work */
+	atomic_uint pending;           /* requests begun and not yet completed by libmicrohttpd */
+	atomic_uint in_flight;         /* renders running now */
+	atomic_uint_fast64_t next_id;  /* request id counter */
+	uint64_t id_seed;
+};
+
+/* One HTTP request (see the ownership note at the top). */
+enum srv_req_state { SRV_REQ_HEADERS, SRV_REQ_BODY, SRV_REQ_QUEUED, SRV_REQ_FINISHED, SRV_REQ_ANSWERED };
+
+struct srv_request {
+	struct srv_server *srv;
+	struct MHD_Connection *conn;
+	struct srv_request *next;      /* queue link */
+	enum srv_req_state state;
+	enum srv_route route;
+	enum srv_priority priority;
+	char method[16];
+	char path[128];                /* for logs, truncated */
+	char id[80];                   /* X-Request-Id */
+	double t_start, t_queued;      /* monotonic seconds */
+
+	/* body of POST /v1/render */
+	char *body;
+	size_t body_len, body_cap;
+	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
+	uint64_t body_hash;            /* FNV-1a 64, running */
+	char etag[40];
+	bool want_exr;                 /* Accept prefers image/x-exr */
+
+	/* result, written by the worker before srv_request_finish() */
+	int status;
+	uint8_t *out;                  /* malloc'd answer body */
+	size_t out_len;
+	const char *content_type;
+	char server_timing[320];
+};
+
+/* Worker side: stores nothing more and resumes the connection so http.c sends the answer. */
+void srv_request_finish(struct srv_request *req);
+
+/* http.c */
+int srv_http_start(struct srv_server *s);           /* 0 or -1 (logged) */
+void srv_http_quiesce(struct srv_server *s);        /* stops accepting connections */
+void srv_http_stop(struct srv_server *s);
+
+/* worker.c */
+int srv_context_open(struct srv_server *s);         /* create + info; 0 or -1 (logged) */
+int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged) */
+int srv_workers_start(struct srv_server *s);
+void srv_workers_join(struct srv_server *s);        /* after srv_queue_close() */
+int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */
+
+/* flags.c: 0 ok, 1 --help printed (exit 0), -1 error printed (exit 2). */
+int srv_config_load(struct srv_config *cfg, int argc, char **argv);
+void srv_config_release(struct srv_config *cfg);
+
+/* Small shared helpers (main.c). */
+double srv_now(void);                               /* monotonic seconds */
+void srv_json_escape(char *dst, size_t size, const char *src); /* without the quotes */
+
+#endif

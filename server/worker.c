@@ -1,0 +1,343 @@
+/*
+ * umbrad workers: the shared rnd_context (create, warm-up, recovery after a lost device,
+ * cache save) and the threads that turn a queued request into an answer:
+ *   deadline check -> api_scene_parse -> Accept -> deadline check -> rnd_render -> api_encode
+ *   -> deadline check -> srv_request_finish().
+ * A worker never touches the request after srv_request_finish().
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "log.h"
+#include "metrics.h"
+#include "queue.h"
+#include "srv.h"
+
+/* ---- context ---- */
+
+static void rnd_log_cb(void *user, int level, const char *msg)
+{
+	(void)user;
+	srv_log(level <= 0 ? SRV_LOG_ERROR : level == 1 ? SRV_LOG_WARN : SRV_LOG_INFO, "renderer: %s", msg);
+}
+
+static int context_create(struct srv_server *s, struct rnd_context **out)
+{
+	struct rnd_context_desc cd = { 0 };
+	struct rnd_error err = { 0 };
+	cd.device_name = s->cfg.device;
+	cd.validation = s->cfg.validation;
+	cd.pipeline_cache_path = s->cfg.pipeline_cache;
+	cd.slots = s->cfg.workers;
+	cd.log = rnd_log_cb;
+	enum rnd_result r = rnd_context_create(&cd, out, &err);
+	if (r != RND_OK) {
+		srv_log(SRV_LOG_ERROR, "cannot create the renderer context: %s (%s)", err.msg, rnd_result_str(r));
+		*out = NULL;
+		return -1;
+	}
+	return 0;
+}
+
+int srv_context_open(struct srv_server *s)
+{
+	struct rnd_context *ctx;
+	if (context_create(s, &ctx) != 0)
+		return -1;
+	pthread_rwlock_wrlock(&s->ctx_lock);
+	s->ctx = ctx;
+	rnd_context_info(ctx, &s->info);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	srv_log(SRV_LOG_INFO, "device \"%s\", driver \"%s\" %s%s, %u render slots%s", s->info.device_name,
+	        s->info.driver_name, s->info.driver_info, s->info.is_cpu ? " (CPU)" : "", s->cfg.workers,
+	        s->cfg.validation ? ", validation on" : "");
+	return 0;
+}
+
+/* After RND_ERR_DEVICE_LOST from the context of generation `gen`: the first worker to get
+ * here waits for the other renders to leave, then destroys and recreates the context; the
+ * others see a newer generation and do nothing. /readyz answers 503 meanwhile. */
+static void context_recover(struct srv_server *s, unsigned gen)
+{
+	pthread_rwlock_wrlock(&s->ctx_lock);
+	if (s->ctx_gen == gen) {
+		atomic_store(&s->ready, false);
+		srv_metrics_add(s->metrics, SRV_CTR_DEVICE_LOST, 1);
+		srv_log(SRV_LOG_ERROR, "device lost: recreating the renderer context");
+		if (s->ctx)
+			s->validation_lost += rnd_context_validation_messages(s->ctx);
+		rnd_context_destroy(s->ctx);
+		s->ctx = NULL;
+		s->ctx_gen++;
+		struct rnd_context *ctx;
+		if (context_create(s, &ctx) == 0) {
+			s->ctx = ctx;
+			rnd_context_info(ctx, &s->info);
+			atomic_store(&s->ready, true);
+			srv_log(SRV_LOG_INFO, "renderer context recreated on \"%s\"", s->info.device_name);
+		}
+	}
+	pthread_rwlock_unlock(&s->ctx_lock);
+}
+
+static enum rnd_result render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
+                              struct rnd_timings *t, struct rnd_error *err)
+{
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	unsigned gen = s->ctx_gen;
+	enum rnd_result r;
+	if (!s->ctx) {
+		memset(err, 0, sizeof *err);
+		err->code = r = RND_ERR_DEVICE_LOST;
+		snprintf(err->msg, sizeof err->msg, "the renderer context could not be recreated after a lost device");
+	} else {
+		atomic_fetch_add(&s->in_flight, 1);
+		r = rnd_render(s->ctx, scene, img, t, err);
+		atomic_fetch_sub(&s->in_flight, 1);
+	}
+	pthread_rwlock_unlock(&s->ctx_lock);
+	if (r == RND_ERR_DEVICE_LOST)
+		context_recover(s, gen);
+	return r;
+}
+
+int srv_context_close(struct srv_server *s)
+{
+	pthread_rwlock_wrlock(&s->ctx_lock);
+	uint32_t msgs = s->validation_lost;
+	if (s->ctx) {
+		struct rnd_error err = { 0 };
+		if (s->cfg.pipeline_cache) {
+			if (rnd_context_save_cache(s->ctx, &err) != RND_OK)
+				srv_log(SRV_LOG_WARN, "cannot save the pipeline cache '%s': %s", s->cfg.pipeline_cache, err.msg);
+			else
+				srv_log(SRV_LOG_INFO, "pipeline cache saved to '%s'", s->cfg.pipeline_cache);
+		}
+		msgs += rnd_context_validation_messages(s->ctx);
+		rnd_context_destroy(s->ctx);
+		s->ctx = NULL;
+	}
+	pthread_rwlock_unlock(&s->ctx_lock);
+	return (int)msgs;
+}
+
+/* ---- warm-up ---- */
+
+/* lavapipe compiles each pipeline at its first use: render one tiny scene per combination
+ * before /readyz says 200. The first must succeed; the others only warn (a renderer without
+ * some feature still serves the rest). */
+#define WARM_SCENE(lights, output) \
+	"{\"width\":32,\"height\":32," \
+	"\"camera\":{\"type\":\"perspective\",\"position\":[3,2,3],\"target\":[0,0.5,0],\"fov_y\":45}," \
+	"\"objects\":[{\"shape\":\"plane\",\"size\":[4,4]}," \
+	"{\"shape\":\"box\",\"size\":[1,1,1],\"transform\":{\"translation\":[0,0.5,0]}}," \
+	"{\"shape\":\"sphere\",\"radius\":0.4,\"segments\":8,\"transform\":{\"translation\":[1,0.4,0]}}]," \
+	"\"lights\":[" lights "],\"shadows\":{\"resolution\":64},\"output\":" output "}"
+#define WARM_DIR(filter) "{\"type\":\"directional\",\"direction\":[-0.5,-1,-0.3],\"shadow\":{\"filter\":\"" filter "\"}}"
+#define WARM_SPOT(filter) "{\"type\":\"spot\",\"position\":[2,3,1],\"direction\":[-2,-3,-1],\"shadow\":{\"filter\":\"" filter "\"}}"
+#define WARM_POINT(filter) "{\"type\":\"point\",\"position\":[-1,2,1],\"shadow\":{\"filter\":\"" filter "\"}}"
+
+static const struct { const char *name, *json; } warm_scenes[] = {
+	{ "msaa 1, pcf", WARM_SCENE(WARM_DIR("pcf"), "{\"format\":\"png\",\"msaa\":1}") },
+	{ "msaa 4, pcf", WARM_SCENE(WARM_DIR("pcf"), "{\"format\":\"png\",\"msaa\":4}") },
+	{ "msaa 1, spot+point", WARM_SCENE(WARM_SPOT("pcss") "," WARM_POINT("hard"), "{\"format\":\"png\",\"msaa\":1}") },
+	{ "msaa 4, spot+point", WARM_SCENE(WARM_SPOT("pcss") "," WARM_POINT("pcf"), "{\"format\":\"png\",\"msaa\":4}") },
+	{ "msaa 4, vsm+evsm", WARM_SCENE(WARM_DIR("vsm") "," WARM_SPOT("evsm"), "{\"format\":\"png\",\"msaa\":4}") },
+};
+
+int srv_warmup(struct srv_server *s)
+{
+	double t0 = srv_now();
+	for (size_t i = 0; i < sizeof warm_scenes / sizeof warm_scenes[0]; i++) {
+		double t1 = srv_now();
+		struct api_scene *sc = NULL;
+		struct api_problem p = { 0 };
+		struct api_limits lim = { 0 };
+		struct rnd_image img = { 0 };
+		struct rnd_timings t = { 0 };
+		struct rnd_error err = { 0 };
+		uint8_t *bytes = NULL;
+		size_t len = 0;
+		int ok = 0;
+		if (api_scene_parse(warm_scenes[i].json, strlen(warm_scenes[i].json), &lim, &sc, &p) != API_OK) {
+			char msg[700];
+			api_problem_format(&p, msg, sizeof msg);
+			srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, msg);
+		} else if (render(s, &sc->scene, &img, &t, &err) != RND_OK) {
+			srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, err.msg);
+		} else if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
+			srv_log(SRV_LOG_WARN, "warm-up '%s': encode: %s", warm_scenes[i].name, p.detail);
+		} else {
+			ok = 1;
+			srv_log(SRV_LOG_INFO, "warm-up '%s': %.0f ms", warm_scenes[i].name, (srv_now() - t1) * 1000);
+		}
+		free(bytes);
+		rnd_image_release(&img);
+		api_scene_free(sc);
+		if (!ok && i == 0) {
+			srv_log(SRV_LOG_ERROR, "warm-up failed: the renderer cannot render the basic scene");
+			return -1;
+		}
+	}
+	srv_log(SRV_LOG_INFO, "warm-up done in %.0f ms", (srv_now() - t0) * 1000);
+	return 0;
+}
+
+/* ---- jobs ---- */
+
+static void job_problem(struct srv_request *req, const struct api_problem *p)
+{
+	req->status = p->status;
+	req->content_type = "application/problem+json";
+	char *json = api_problem_json(p);
+	req->out = (uint8_t *)json;
+	req->out_len = json ? strlen(json) : 0;
+}
+
+static bool past_deadline(const struct srv_server *s, const struct srv_request *req, double now)
+{
+	return s->cfg.deadline_ms && (now - req->t_queued) * 1000.0 > (double)s->cfg.deadline_ms;
+}
+
+static void job_deadline(struct srv_server *s, struct srv_request *req, const char *when, double now)
+{
+	struct api_problem p;
+	api_problem_set(&p, 504, "", "the render passed its deadline of %u ms %s (%.0f ms since it was queued)",
+	                s->cfg.deadline_ms, when, (now - req->t_queued) * 1000.0);
+	srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
+	job_problem(req, &p);
+}
+
+static int render_status(enum rnd_result r)
+{
+	switch (r) {
+	case RND_ERR_INVALID: return 400;
+	case RND_ERR_LIMIT: return 422;
+	case RND_ERR_TIMEOUT: return 504;
+	case RND_ERR_OOM: return 503;
+	default: return 500;
+	}
+}
+
+static void job_run(struct srv_server *s, struct srv_request *req)
+{
+	double t_pop = srv_now();
+	srv_metrics_queue_wait(s->metrics, t_pop - req->t_queued);
+	if (past_deadline(s, req, t_pop)) {
+		job_deadline(s, req, "while waiting in the queue", t_pop);
+		return;
+	}
+
+	struct api_scene *sc = NULL;
+	struct api_problem p = { 0 };
+	struct rnd_image img = { 0 };
+	struct rnd_timings t = { 0 };
+	struct rnd_error err = { 0 };
+	uint8_t *bytes = NULL;
+	size_t len = 0;
+
+	double t0 = srv_now();
+	if (api_scene_parse(req->body, req->body_len, &s->cfg.limits, &sc, &p) != API_OK) {
+		job_problem(req, &p);
+		return;
+	}
+	if (req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) {
+		job_problem(req, &p);
+		goto out;
+	}
+	/* The body is no longer needed: give its memory back before the render. */
+	free(req->body);
+	req->body = NULL;
+	req->body_cap = 0;
+	double parse_s = srv_now() - t0;
+	srv_metrics_stage(s->metrics, SRV_STAGE_PARSE, parse_s);
+
+	double t1 = srv_now();
+	if (past_deadline(s, req, t1)) {
+		job_deadline(s, req, "before rendering", t1);
+		goto out;
+	}
+	enum rnd_result r = render(s, &sc->scene, &img, &t, &err);
+	if (r != RND_OK) {
+		srv_metrics_add(s->metrics, SRV_CTR_RENDER_FAILED, 1);
+		if (r == RND_ERR_TIMEOUT)
+			srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
+		api_problem_set(&p, render_status(r), "", "%s", err.msg[0] ? err.msg : rnd_result_str(r));
+		srv_log(SRV_LOG_WARN, "request %s: render failed: %s (%s)", req->id, err.msg, rnd_result_str(r));
+		job_problem(req, &p);
+		goto out;
+	}
+	srv_metrics_add(s->metrics, SRV_CTR_RENDER_OK, 1);
+	srv_metrics_add(s->metrics, SRV_CTR_SHADOW_RENDERED, t.shadow_maps_rendered);
+	srv_metrics_add(s->metrics, SRV_CTR_SHADOW_REUSED, t.shadow_maps_reused);
+	srv_metrics_stage(s->metrics, SRV_STAGE_UPLOAD, t.upload_ms / 1000.0);
+	srv_metrics_stage(s->metrics, SRV_STAGE_SHADOW, t.shadow_ms / 1000.0);
+	srv_metrics_stage(s->metrics, SRV_STAGE_MAIN, t.main_ms / 1000.0);
+	srv_metrics_stage(s->metrics, SRV_STAGE_READBACK, t.readback_ms / 1000.0);
+
+	double t2 = srv_now();
+	if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
+		job_problem(req, &p);
+		goto out;
+	}
+	double encode_s = srv_now() - t2;
+	srv_metrics_stage(s->metrics, SRV_STAGE_ENCODE, encode_s);
+
+	double t3 = srv_now();
+	if (past_deadline(s, req, t3)) {
+		free(bytes);
+		job_deadline(s, req, "while rendering", t3);
+		goto out;
+	}
+	req->status = 200;
+	req->out = bytes;
+	req->out_len = len;
+	req->content_type = api_format_mime(sc->format);
+	snprintf(req->server_timing, sizeof req->server_timing,
+	         "queue;dur=%.3f, parse;dur=%.3f, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
+	         "readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
+	         (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, t.upload_ms, t.shadow_ms, t.main_ms,
+	         t.readback_ms, encode_s * 1000.0, (t3 - req->t_queued) * 1000.0);
+out:
+	rnd_image_release(&img);
+	api_scene_free(sc);
+}
+
+static void *worker_main(void *arg)
+{
+	struct srv_server *s = arg;
+	struct srv_request *req;
+	while ((req = srv_queue_pop(s->queue))) {
+		job_run(s, req);
+		srv_request_finish(req);
+	}
+	return NULL;
+}
+
+int srv_workers_start(struct srv_server *s)
+{
+	s->threads = calloc(s->cfg.workers, sizeof *s->threads);
+	if (!s->threads) {
+		srv_log(SRV_LOG_ERROR, "cannot allocate %u worker threads", s->cfg.workers);
+		return -1;
+	}
+	for (unsigned i = 0; i < s->cfg.workers; i++) {
+		int e = pthread_create(&s->threads[i], NULL, worker_main, s);
+		if (e != 0) {
+			srv_log(SRV_LOG_ERROR, "cannot start worker thread %u: %s", i, strerror(e));
+			return -1; /* srv_workers_join() joins those started */
+		}
+		s->thread_count++;
+	}
+	return 0;
+}
+
+void srv_workers_join(struct srv_server *s)
+{
+	for (unsigned i = 0; i < s->thread_count; i++)
+		pthread_join(s->threads[i], NULL);
+	free(s->threads);
+	s->threads = NULL;
+	s->thread_count = 0;
+}

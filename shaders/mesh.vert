@@ -1,0 +1,20 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "umbra_shared.h"
+// Main pass: vertices arrive in world space (tessellated and transformed on the CPU).
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock { umbra_frame frame; };
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_nrm;
+layout(location = 2) in vec2 a_uv;
+layout(location = 0) out vec3 v_pos;
+layout(location = 1) out vec3 v_nrm;
+layout(location = 2) out vec2 v_uv;
+// The depth pre-pass and the main pass must produce bit-identical depth (EQUAL test).
+invariant gl_Position;
+void main()
+{
+	v_pos = a_pos;
+	v_nrm = a_nrm;
+	v_uv = a_uv;
+	gl_Position = frame.view_proj * vec4(a_pos, 1.0);
+}

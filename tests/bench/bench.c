@@ -1,0 +1,122 @@
+/*
+ * tests/bench/bench.c — warm-process benchmark: renders each scene file given on the command
+ * line N times in one process (after one warm-up render) and prints median milliseconds per
+ * stage (parse, upload, shadow, main, readback, encode), the median total and images/s.
+ *
+ *   build/tests/bench [-n N] SCENE.json...
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "api.h"
+#include "umbra/rnd.h"
+
+static double now_ms(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+static int cmp(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+	qsort(v, (size_t)n, sizeof *v, cmp);
+	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static char *slurp(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	char *b = malloc((size_t)n + 1);
+	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
+	fclose(f);
+	*len = (size_t)n;
+	return b;
+}
+
+enum { S_PARSE, S_UPLOAD, S_SHADOW, S_MAIN, S_READBACK, S_ENCODE, S_TOTAL, S_COUNT };
+static const char *names[S_COUNT] = {"parse", "upload", "shadow", "main", "readback", "encode", "total"};
+
+int main(int argc, char **argv)
+{
+	int n = 15;
+	int first = 1;
+	if (argc > 2 && !strcmp(argv[1], "-n")) { n = atoi(argv[2]); first = 3; }
+	if (n < 1) n = 1;
+	struct rnd_context_desc cd = {.slots = 1};
+	struct rnd_context *ctx;
+	struct rnd_error err;
+	if (rnd_context_create(&cd, &ctx, &err) != RND_OK) { fprintf(stderr, "bench: %s\n", err.msg); return 1; }
+	struct rnd_info info;
+	rnd_context_info(ctx, &info);
+	printf("device: %s (%s), %d runs per scene after 1 warm-up, medians in ms\n", info.device_name, info.driver_name, n);
+	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "parse", "upload", "shadow", "main", "readback",
+	       "encode", "total", "img/s", "KiB");
+	int rc = 0;
+	for (int a = first; a < argc; a++) {
+		size_t len;
+		char *json = slurp(argv[a], &len);
+		if (!json) { fprintf(stderr, "bench: cannot read %s\n", argv[a]); rc = 1; continue; }
+		double *t = calloc((size_t)(n * S_COUNT), sizeof *t);
+		size_t bytes_out = 0;
+		struct api_limits lim;
+		api_limits_defaults(&lim);
+		lim.max_triangles = 0;
+		for (int i = -1; i < n && rc == 0; i++) {
+			double t0 = now_ms();
+			struct api_scene *s;
+			struct api_problem p;
+			if (api_scene_parse(json, len, &lim, &s, &p) != API_OK) {
+				fprintf(stderr, "bench: %s: %s %s\n", argv[a], p.pointer, p.detail); rc = 1; break;
+			}
+			double t1 = now_ms();
+			struct rnd_image img;
+			struct rnd_timings tm;
+			if (rnd_render(ctx, &s->scene, &img, &tm, &err) != RND_OK) {
+				fprintf(stderr, "bench: %s: %s\n", argv[a], err.msg); api_scene_free(s); rc = 1; break;
+			}
+			double t2 = now_ms();
+			uint8_t *out; size_t olen;
+			if (api_encode(s, &img, &out, &olen, &p) != API_OK) { fprintf(stderr, "bench: encode: %s\n", p.detail); rc = 1; }
+			else free(out);
+			double t3 = now_ms();
+			bytes_out = olen;
+			rnd_image_release(&img);
+			api_scene_free(s);
+			if (i < 0) continue;
+			double *r = t + (size_t)i * S_COUNT;
+			r[S_PARSE] = t1 - t0; r[S_UPLOAD] = tm.upload_ms; r[S_SHADOW] = tm.shadow_ms; r[S_MAIN] = tm.main_ms;
+			r[S_READBACK] = tm.readback_ms; r[S_ENCODE] = t3 - t2; r[S_TOTAL] = t3 - t0;
+			(void)t2;
+		}
+		if (rc == 0) {
+			const char *base = strrchr(argv[a], '/');
+			printf("%-22s", base ? base + 1 : argv[a]);
+			double col[S_COUNT];
+			for (int s = 0; s < S_COUNT; s++) {
+				double v[1024];
+				int m = n < 1024 ? n : 1024;
+				for (int i = 0; i < m; i++) v[i] = t[(size_t)i * S_COUNT + s];
+				col[s] = median(v, m);
+				printf(" %8.2f", col[s]);
+			}
+			printf(" %8.1f %8zu\n", 1000.0 / col[S_TOTAL], bytes_out / 1024);
+		}
+		free(t);
+		free(json);
+	}
+	(void)names;
+	rnd_context_destroy(ctx);
+	return rc;
+}

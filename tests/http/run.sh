@@ -1,0 +1,383 @@
+#!/bin/sh
+# tests/http/run.sh — black-box tests of $BUILD/umbrad over loopback (127.0.0.1, ephemeral
+# ports) with curl; contract §5. Prints "ok - x" / "FAIL - x" per test and, last,
+# "N passed, N failed". Env: BUILD (build dir), SHARED (../shared), ASAN=1 or a BUILD path
+# containing "asan" for fewer repetitions, UMBRA_VALIDATION (tests/run.sh sets 1: a daemon that
+# saw validation messages exits non-zero, which fails its exit test).
+BUILD=${BUILD:-build}
+SHARED=${SHARED:-../shared}
+UMBRAD=${UMBRAD:-$BUILD/umbrad}
+REPS=500
+[ -n "${ASAN:-}" ] && REPS=100
+case "$BUILD" in *asan*) REPS=100 ;; esac
+START_TIMEOUT=${START_TIMEOUT:-240}
+
+T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-http.XXXXXX")
+pass=0
+fail=0
+PIDS=""
+
+ok() { echo "ok - $1"; pass=$((pass + 1)); }
+nok() { echo "FAIL - $1${2:+: $2}"; fail=$((fail + 1)); }
+# check NAME CMD...: ok when CMD succeeds.
+check() { n=$1; shift; if "$@"; then ok "$n"; else nok "$n"; fi; }
+
+cleanup() {
+	for p in $PIDS; do kill -9 "$p" 2>/dev/null; done
+	rm -rf "$T"
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM
+
+if [ ! -x "$UMBRAD" ]; then
+	nok "daemon binary" "$UMBRAD not built"
+	echo "$pass passed, $fail failed"
+	exit 1
+fi
+
+# ---- helpers ----
+
+# start NAME FLAGS...: starts a daemon; sets PID and URL (and NAME.log). Waits for /readyz.
+start() {
+	name=$1; shift
+	rm -f "$T/$name.port"
+	"$UMBRAD" --listen 127.0.0.1:0 --port-file "$T/$name.port" "$@" 2>"$T/$name.log" &
+	PID=$!
+	PIDS="$PIDS $PID"
+	i=0
+	while [ ! -s "$T/$name.port" ]; do
+		i=$((i + 1))
+		if [ $i -gt $((START_TIMEOUT * 10)) ] || ! kill -0 "$PID" 2>/dev/null; then
+			nok "start $name" "no port file; log:"; sed 's/^/# /' "$T/$name.log" | tail -n 20
+			URL=""; return 1
+		fi
+		sleep 0.1
+	done
+	URL="http://127.0.0.1:$(cat "$T/$name.port")"
+	FIRST_READY=""
+	i=0
+	while :; do
+		code=$(curl -s -o /dev/null -D "$T/$name.ready.hdr" -w '%{http_code}' --max-time 5 "$URL/readyz")
+		[ -z "$FIRST_READY" ] && FIRST_READY=$code && cp "$T/$name.ready.hdr" "$T/$name.first-ready.hdr"
+		[ "$code" = 200 ] && break
+		i=$((i + 1))
+		if [ $i -gt $((START_TIMEOUT * 10)) ] || ! kill -0 "$PID" 2>/dev/null; then
+			nok "start $name" "/readyz never 200 (last $code); log:"; sed 's/^/# /' "$T/$name.log" | tail -n 20
+			return 1
+		fi
+		sleep 0.1
+	done
+	return 0
+}
+
+# stop NAME PID: SIGTERM, then the exit status must be 0 (clean drain, no validation messages).
+stop() {
+	kill -TERM "$2" 2>/dev/null
+	wait "$2"
+	rc=$?
+	if [ "$rc" -eq 0 ]; then ok "$1 exits 0 after SIGTERM"; else
+		nok "$1 exits 0 after SIGTERM" "exit $rc; log:"; grep -v ' info ' "$T/$1.log" | tail -n 20 | sed 's/^/# /'
+	fi
+}
+
+# post NAME FILE [CURL ARGS...]: POST FILE to /v1/render; prints the status; NAME.body/.hdr.
+post() {
+	pn=$1; pf=$2; shift 2
+	curl -s --max-time 120 -o "$T/$pn.body" -D "$T/$pn.hdr" -w '%{http_code}' \
+		-H 'Content-Type: application/json' --data-binary "@$pf" "$@" "$URL/v1/render"
+}
+# get NAME PATH [CURL ARGS...]
+get() {
+	gn=$1; gp=$2; shift 2
+	curl -s --max-time 30 -o "$T/$gn.body" -D "$T/$gn.hdr" -w '%{http_code}' "$@" "$URL$gp"
+}
+# hdr NAME HEADER: the header's value from NAME.hdr (the last answer in it).
+hdr() {
+	tr -d '\r' <"$T/$1.hdr" | grep -i "^$2:" | tail -n 1 | sed 's/^[^:]*: *//'
+}
+# png_size FILE: "WxH" when FILE is a PNG (signature + IHDR), else nothing.
+png_size() {
+	[ "$(od -An -tx1 -N8 "$1" 2>/dev/null | tr -d ' \n')" = 89504e470d0a1a0a ] || return 1
+	[ "$(od -An -c -j12 -N4 "$1" | tr -d ' \n')" = IHDR ] || return 1
+	set -- $(od -An -tu1 -j16 -N8 "$1")
+	echo "$(( ($1 << 24) | ($2 << 16) | ($3 << 8) | $4 ))x$(( ($5 << 24) | ($6 << 16) | ($7 << 8) | $8 ))"
+}
+is_exr() { [ "$(od -An -tx1 -N4 "$1" 2>/dev/null | tr -d ' \n')" = 762f3101 ]; }
+# problem NAME STATUS POINTER: NAME.body is problem+json with that status and pointer
+# (POINTER "-" = any pointer member present).
+problem() {
+	ct=$(hdr "$1" Content-Type)
+	case "$ct" in application/problem+json*) ;; *) echo "# content-type '$ct'"; return 1 ;; esac
+	python3 - "$T/$1.body" "$2" "$3" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+ok = d.get("status") == int(sys.argv[2]) and all(k in d for k in ("type", "title", "detail", "pointer"))
+if sys.argv[3] != "-":
+    ok = ok and d.get("pointer") == sys.argv[3]
+if not ok:
+    print("# problem:", json.dumps(d))
+sys.exit(0 if ok else 1)
+PY
+}
+# metric NAME_WITH_LABELS: its value in the last /metrics scrape (T/metrics.body).
+metric() {
+	awk -v m="$1" '$1 == m { print $2; f = 1 } END { if (!f) print 0 }' "$T/metrics.body" | head -n 1
+}
+rss_kb() { awk '/^VmRSS:/ { print $2 }' "/proc/$1/status"; }
+fd_count() { ls "/proc/$1/fd" | wc -l | tr -d ' '; }
+
+# ---- scenes ----
+
+scene() { # scene W H MSAA SEGMENTS EXTRA_ROOT_MEMBERS
+	cat <<EOF2
+{"width": $1, "height": $2,
+ "camera": {"type": "perspective", "position": [4, 3, 4], "target": [0, 0.8, 0], "up": [0, 1, 0], "fov_y": 40},
+ "materials": {"grey": {"base_color": [0.7, 0.7, 0.7], "roughness": 0.8, "metallic": 0}},
+ "objects": [
+  {"shape": "plane", "size": [10, 10], "material": "grey"},
+  {"shape": "sphere", "radius": 1, "segments": $4, "material": "grey", "transform": {"translation": [0, 1, 0]}}
+ ],
+ "lights": [{"type": "directional", "direction": [-0.5, -1, -0.3], "intensity": 3, "shadow": {"filter": "pcf"}}],
+ "shadows": {"resolution": 512},
+ "output": {"msaa": $3}$5}
+EOF2
+}
+scene 64 64 1 32 "" >"$T/small.json"
+scene 64 48 1 32 "" >"$T/small-64x48.json"
+# The flood scene must keep one worker busy for a while on lavapipe.
+scene 512 512 4 256 ', "x-flood": 1' | sed 's/"resolution": 512/"resolution": 2048/' >"$T/slow.json"
+scene 2000 2000 1 32 "" >"$T/pixels.json"
+scene 64 64 1 2048 "" >"$T/triangles.json"
+sed 's/"resolution": 512/"resolution": 4096/' "$T/small.json" >"$T/shadowres.json"
+sed 's/"lights": \[\(.*\)\],$/"lights": [\1, \1, \1, \1, \1],/' "$T/small.json" >"$T/lights.json"
+printf '{"width": 64, "height": 64, "camera": {' >"$T/malformed.json"
+sed 's/"intensity": 3,/"intensity": 3, "colour": [1, 1, 1],/' "$T/small.json" >"$T/unknown.json"
+sed 's/"width": 64/"width": "64"/' "$T/small.json" >"$T/wrongtype.json"
+sed 's/"width": 64/"width": 0/' "$T/small.json" >"$T/range.json"
+sed 's/"msaa": 1/"msaa": 1, "format": "exr"/' "$T/small.json" >"$T/exr.json"
+head -c 2097152 /dev/zero | tr '\0' ' ' >"$T/huge.json"
+
+# ==== main daemon ====
+echo "# starting the main daemon (reps $REPS)"
+start main --max-body 1M --max-pixels 1000000 --max-triangles 200000 --max-lights 4 \
+	--max-shadow-resolution 2048 --queue 64 || { echo "$pass passed, $fail failed"; exit 1; }
+MAIN=$PID
+MAIN_URL=$URL
+if [ "$FIRST_READY" = 503 ]; then
+	check "readyz 503 with Retry-After before ready" grep -qi '^Retry-After:' "$T/main.first-ready.hdr"
+fi
+grep -q "listening on http://127.0.0.1:$(cat "$T/main.port")" "$T/main.log" && ok "start-up log names the bound port" || nok "start-up log names the bound port"
+
+# -- GET routes
+c=$(get h /healthz); check "GET /healthz 200" [ "$c" = 200 ]
+c=$(get h /healthz -I); check "HEAD /healthz 200" [ "$c" = 200 ]
+c=$(get r /readyz); check "GET /readyz 200 when ready" [ "$c" = 200 ]
+c=$(get i /v1/info)
+check "GET /v1/info 200 JSON" [ "$c" = 200 ]
+check "/v1/info has version, device, driver, limits, filters, formats" python3 - "$T/i.body" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+ok = all(k in d for k in ("version", "device", "driver", "limits", "filters", "formats"))
+ok = ok and set(["hard", "pcf", "pcss", "vsm", "evsm"]) <= set(d["filters"]) and "png" in d["formats"] and "exr" in d["formats"]
+ok = ok and d["limits"].get("max_pixels") == 1000000
+print("# info:", json.dumps(d)[:300])
+sys.exit(0 if ok else 1)
+PY
+c=$(get m /metrics)
+check "GET /metrics 200 text/plain" [ "$c" = 200 ]
+case "$(hdr m Content-Type)" in text/plain*) ok "/metrics Content-Type text/plain" ;; *) nok "/metrics Content-Type text/plain" "$(hdr m Content-Type)" ;; esac
+
+# -- errors of the routing layer
+c=$(get e404 /nope); check "unknown route 404" [ "$c" = 404 ]
+check "404 is problem+json" problem e404 404 -
+c=$(get e405 /v1/render); check "GET /v1/render 405" [ "$c" = 405 ]
+check "405 has Allow: POST" [ "$(hdr e405 Allow)" = POST ]
+check "405 is problem+json" problem e405 405 -
+c=$(curl -s -o /dev/null -D "$T/e405b.hdr" -w '%{http_code}' -X POST --data x "$URL/healthz")
+check "POST /healthz 405 with Allow GET" sh -c "[ $c = 405 ] && tr -d '\r' <'$T/e405b.hdr' | grep -qi '^Allow:.*GET'"
+c=$(post e415 "$T/small.json" -H 'Content-Type: text/plain'); check "text/plain body 415" [ "$c" = 415 ]
+check "415 is problem+json" problem e415 415 -
+c=$(curl -s -o /dev/null -w '%{http_code}' --max-time 30 --data-binary "@$T/small.json" -H 'Content-Type:' "$URL/v1/render")
+check "missing Content-Type 415" [ "$c" = 415 ]
+c=$(post e413 "$T/huge.json"); check "2 MiB body over --max-body 1M: 413" [ "$c" = 413 ]
+check "413 is problem+json" problem e413 413 -
+c=$(post e413c "$T/huge.json" -H 'Transfer-Encoding: chunked'); check "chunked body over --max-body: 413" [ "$c" = 413 ]
+
+# -- scene errors (400 with the member's pointer; 422 over the limits)
+c=$(post malformed "$T/malformed.json"); check "malformed JSON 400" [ "$c" = 400 ]
+check "malformed JSON problem+json" problem malformed 400 -
+c=$(post unknown "$T/unknown.json"); check "unknown member 400" [ "$c" = 400 ]
+check "unknown member pointer /lights/0/colour" problem unknown 400 /lights/0/colour
+c=$(post wrongtype "$T/wrongtype.json"); check "wrong type 400" [ "$c" = 400 ]
+check "wrong type pointer /width" problem wrongtype 400 /width
+c=$(post range "$T/range.json"); check "out-of-range value 400" [ "$c" = 400 ]
+check "out-of-range pointer /width" problem range 400 /width
+c=$(post pixels "$T/pixels.json"); check "over --max-pixels 422" [ "$c" = 422 ]
+check "422 is problem+json" problem pixels 422 -
+c=$(post tris "$T/triangles.json"); check "over --max-triangles 422" [ "$c" = 422 ]
+c=$(post lights "$T/lights.json"); check "over --max-lights 422" [ "$c" = 422 ]
+c=$(post shres "$T/shadowres.json"); check "over --max-shadow-resolution 422" [ "$c" = 422 ]
+c=$(post prio "$T/small.json" -H 'X-Priority: urgent'); check "unknown X-Priority 400" [ "$c" = 400 ]
+
+# -- renders
+c=$(post r1 "$T/small.json"); check "POST /v1/render 200" [ "$c" = 200 ]
+check "Content-Type image/png" [ "$(hdr r1 Content-Type)" = image/png ]
+check "valid PNG 64x64" [ "$(png_size "$T/r1.body")" = 64x64 ]
+st=$(hdr r1 Server-Timing)
+echo "# Server-Timing: $st"
+check "Server-Timing has parse, upload, shadow, main, readback, encode" sh -c '
+	for s in parse upload shadow main readback encode; do
+		echo "$1" | grep -Eq "(^|[ ,])$s;dur=[0-9.]+" || exit 1
+	done' - "$st"
+etag=$(hdr r1 ETag)
+check "strong ETag" sh -c "echo '$etag' | grep -Eq '^\"[^\"]+\"\$'"
+check "generated X-Request-Id" [ -n "$(hdr r1 X-Request-Id)" ]
+c=$(post r2 "$T/small.json" -H 'X-Request-Id: test-id-42')
+check "caller's X-Request-Id echoed" [ "$(hdr r2 X-Request-Id)" = test-id-42 ]
+check "same body, same bytes" cmp -s "$T/r1.body" "$T/r2.body"
+check "same body, same ETag" [ "$(hdr r2 ETag)" = "$etag" ]
+c=$(post r3 "$T/small-64x48.json"); check "other body 200, 64x48" [ "$(png_size "$T/r3.body")" = 64x48 ]
+check "other body, other ETag" [ "$(hdr r3 ETag)" != "$etag" ]
+c=$(post r304 "$T/small.json" -H "If-None-Match: $etag"); check "If-None-Match with the ETag: 304" [ "$c" = 304 ]
+c=$(post rexr "$T/small.json" -H 'Accept: image/x-exr'); check "Accept: image/x-exr 200" [ "$c" = 200 ]
+check "Accept: image/x-exr gives image/x-exr" [ "$(hdr rexr Content-Type)" = image/x-exr ]
+check "EXR magic" is_exr "$T/rexr.body"
+check "Accept changes the ETag" [ "$(hdr rexr ETag)" != "$etag" ]
+c=$(post rexr2 "$T/exr.json"); check "output.format exr: image/x-exr" sh -c "[ $c = 200 ] && [ '$(hdr rexr2 Content-Type)' = image/x-exr ]"
+c=$(post rpng "$T/small.json" -H 'Accept: image/png, image/x-exr;q=0.5'); check "Accept preferring PNG: image/png" [ "$(hdr rpng Content-Type)" = image/png ]
+c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
+
+# -- 20 concurrent requests
+i=0
+while [ $i -lt 20 ]; do
+	curl -s --max-time 120 -o "$T/c$i.png" -w '%{http_code}' -H 'Content-Type: application/json' \
+		--data-binary "@$T/small.json" "$URL/v1/render" >"$T/c$i.code" &
+	i=$((i + 1))
+done
+wait
+bad=0
+i=0
+while [ $i -lt 20 ]; do
+	[ "$(cat "$T/c$i.code")" = 200 ] && cmp -s "$T/c$i.png" "$T/r1.body" || bad=$((bad + 1))
+	i=$((i + 1))
+done
+check "20 concurrent renders all 200 and byte-identical" [ $bad -eq 0 ]
+
+c=$(get metrics /metrics)
+check "metrics count the 200 renders" [ "$(metric 'umbra_requests_total{route="/v1/render",status="200"}')" -ge 25 ]
+check "metrics have the stage histograms" grep -q 'umbra_stage_seconds_bucket{stage="shadow",le="+Inf"}' "$T/metrics.body"
+check "metrics have the request-duration histogram" grep -q '^umbra_request_duration_seconds_count{route="/v1/render"}' "$T/metrics.body"
+check "metrics have queue depth and in-flight gauges" sh -c "grep -q '^umbra_queue_depth ' '$T/metrics.body' && grep -q '^umbra_renders_in_flight ' '$T/metrics.body'"
+check "metrics have shadow-map reuse" grep -q '^umbra_shadow_maps_reused_total ' "$T/metrics.body"
+check "metrics count 413/415/422" sh -c "grep -q 'status=\"413\"' '$T/metrics.body' && grep -q 'status=\"415\"' '$T/metrics.body' && grep -q 'status=\"422\"' '$T/metrics.body'"
+check "access log line per request" grep -q 'POST /v1/render 200 .*id=test-id-42' "$T/main.log"
+
+# -- resources over $REPS sequential small renders (keep-alive batches of 50)
+fd0=$(fd_count $MAIN); rss0=$(rss_kb $MAIN)
+n=0; bad=0
+while [ $n -lt "$REPS" ]; do
+	set --
+	k=0
+	while [ $k -lt 50 ]; do set -- "$@" -o /dev/null "$URL/v1/render"; k=$((k + 1)); done
+	codes=$(curl -s --max-time 300 -w '%{http_code}\n' -H 'Content-Type: application/json' \
+		--data-binary "@$T/small.json" "$@")
+	bad=$((bad + $(echo "$codes" | grep -vc '^200$')))
+	n=$((n + 50))
+	[ $n -eq 100 ] && { fd1=$(fd_count $MAIN); rss1=$(rss_kb $MAIN); }
+done
+fd2=$(fd_count $MAIN); rss2=$(rss_kb $MAIN)
+echo "# $REPS sequential renders: fds $fd0 -> $fd1 (after 100) -> $fd2; RSS KiB $rss0 -> $rss1 (after 100) -> $rss2"
+check "$REPS sequential renders all 200" [ $bad -eq 0 ]
+check "no fd growth over $REPS requests" [ "$fd2" -le $((fd0 + 2)) ]
+check "RSS bounded over $REPS requests (< 48 MiB growth after the first 100)" [ $((rss2 - rss1)) -lt 49152 ]
+
+# ==== flood: one worker, queue of 2 ====
+echo "# starting the flood daemon"
+if start flood --workers 1 --queue 2; then
+	FLOOD=$PID
+	# Priority: occupy the worker, queue bulk then interactive: the interactive one ends first.
+	curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' --data-binary "@$T/slow.json" "$URL/v1/render" &
+	sleep 0.3
+	(curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' -H 'X-Priority: bulk' \
+		--data-binary "@$T/slow.json" "$URL/v1/render"; echo bulk >>"$T/order") &
+	sleep 0.3
+	(curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' -H 'X-Priority: interactive' \
+		--data-binary "@$T/small.json" "$URL/v1/render"; echo interactive >>"$T/order") &
+	wait
+	check "interactive served before queued bulk" [ "$(head -n 1 "$T/order")" = interactive ]
+
+	# Flood: 16 at once -> 1 rendering + 2 queued; the rest 503 at once with Retry-After.
+	i=0
+	while [ $i -lt 16 ]; do
+		curl -s --max-time 120 -o "$T/f$i.body" -D "$T/f$i.hdr" -w '%{http_code}' -H 'Content-Type: application/json' \
+			--data-binary "@$T/slow.json" "$URL/v1/render" >"$T/f$i.code" &
+		i=$((i + 1))
+	done
+	wait
+	n200=0; n503=0; other=0; noretry=0
+	i=0
+	while [ $i -lt 16 ]; do
+		case "$(cat "$T/f$i.code")" in
+		200) n200=$((n200 + 1)) ;;
+		503) n503=$((n503 + 1)); f503=f$i; hdr f$i Retry-After | grep -q '^[0-9]' || noretry=$((noretry + 1)) ;;
+		*) other=$((other + 1)) ;;
+		esac
+		i=$((i + 1))
+	done
+	echo "# flood of 16: $n200 x 200, $n503 x 503, $other other"
+	check "flood: every request answered 200 or 503, none hung" [ $other -eq 0 ]
+	check "flood: queue full answered 503" [ $n503 -ge 1 ]
+	check "flood: 503 carries Retry-After" [ $noretry -eq 0 ]
+	check "flood: the accepted ones rendered" [ $n200 -ge 3 ]
+	[ -n "${f503:-}" ] && check "flood: 503 is problem+json" problem $f503 503 -
+	c=$(get metrics /metrics)
+	check "metrics count queue rejections" [ "$(metric umbra_queue_rejected_total)" -ge 1 ]
+	stop flood $FLOOD
+fi
+
+# ==== deadline: --deadline-ms 1 ====
+echo "# starting the deadline daemon"
+if start deadline --workers 1 --deadline-ms 1; then
+	c=$(post d1 "$T/small.json"); check "render past --deadline-ms: 504" [ "$c" = 504 ]
+	check "504 is problem+json" problem d1 504 -
+	stop deadline $PID
+fi
+
+# ==== SIGTERM under load (main daemon) ====
+URL=$MAIN_URL
+get metrics /metrics >/dev/null
+base=$(metric umbra_queue_wait_seconds_count)
+i=0
+while [ $i -lt 8 ]; do
+	curl -s --max-time 120 -o "$T/t$i.png" -w '%{http_code}' -H 'Content-Type: application/json' \
+		--data-binary "@$T/slow.json" "$URL/v1/render" >"$T/t$i.code" &
+	i=$((i + 1))
+done
+# Wait until all 8 are accepted (queued or taken by a worker), then SIGTERM.
+i=0
+while [ $i -lt 300 ]; do
+	get metrics /metrics >/dev/null
+	taken=$(metric umbra_queue_wait_seconds_count); queued=$(metric umbra_queue_depth)
+	[ $((${taken%.*} - ${base%.*} + ${queued%.*})) -ge 8 ] && break
+	sleep 0.1; i=$((i + 1))
+done
+kill -TERM $MAIN
+sleep 0.2
+c=$(curl -s -o /dev/null -w '%{http_code}' --max-time 5 "$URL/readyz")
+check "after SIGTERM no new connection is ready" [ "$c" != 200 ]
+wait $MAIN
+rc=$?
+bad=0
+i=0
+while [ $i -lt 8 ]; do
+	[ "$(cat "$T/t$i.code")" = 200 ] && [ "$(png_size "$T/t$i.png")" = 512x512 ] || bad=$((bad + 1))
+	i=$((i + 1))
+done
+check "SIGTERM under load: all 8 accepted renders answered 200" [ $bad -eq 0 ]
+if [ $rc -eq 0 ]; then ok "main exits 0 after SIGTERM under load"; else
+	nok "main exits 0 after SIGTERM under load" "exit $rc"; grep -v ' info ' "$T/main.log" | tail -n 20 | sed 's/^/# /'
+fi
+check "drain logged" grep -q 'SIGTERM: draining' "$T/main.log"
+
+echo "$pass passed, $fail failed"
+[ $fail -eq 0 ]
