@@ -8,7 +8,7 @@ BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
 GLSLANG ?= glslangValidator
-PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib
+PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib assimp libjpeg
 
 OPT ?= -O2
 SAN ?=

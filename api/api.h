@@ -47,6 +47,11 @@ struct api_limits {
 	uint64_t max_triangles;          /* after tessellation, default 20000000 */
 	uint32_t max_lights;             /* default 64 */
 	uint32_t max_shadow_resolution;  /* default 8192 */
+	/* Directory that model `path`s are relative to (NULL = none: a `path` is a 400). A path never
+	 * leaves it: no absolute paths, no ".." components, no symlinks that resolve outside. */
+	const char *asset_root;          /* default NULL */
+	/* Bound of the process-wide cache of imported models (bytes; 0 = do not cache). */
+	uint64_t model_cache_bytes;      /* default 268435456 (256 MiB) */
 };
 void api_limits_defaults(struct api_limits *l);
 
@@ -59,8 +64,9 @@ struct api_scene {
 	uint32_t bit_depth;         /* 8 or 16 (png) */
 	int png_level;              /* zlib level for PNG, -1 = chosen by image size */
 	uint64_t triangles;         /* total after tessellation */
-	/* private: the arena that owns the arrays */
+	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
+	void *models_;
 };
 
 /* Parses and validates a scene document. On failure fills p (400: malformed / wrong type /
@@ -68,6 +74,26 @@ struct api_scene {
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
                                 struct api_scene **out, struct api_problem *p);
 void api_scene_free(struct api_scene *s);
+
+/* A named binary part of the request (multipart/form-data), referenced by a model's `part`.
+ * The bytes are only read during the parse (imported models are copied or cached). */
+struct api_part {
+	const char *name;
+	const uint8_t *data;
+	size_t len;
+};
+/* api_scene_parse() with the request's binary parts; a `part` that names none of them is a 400.
+ * api_scene_parse() is this with no parts. */
+enum api_result api_scene_parse_parts(const char *json, size_t len, const struct api_limits *limits,
+                                      const struct api_part *parts, size_t nparts,
+                                      struct api_scene **out, struct api_problem *p);
+
+/* Imported models are cached process-wide (LRU, bounded by limits.model_cache_bytes, keyed by
+ * the file's bytes). Counters since start; any pointer may be NULL. Thread-safe. */
+void api_model_cache_stats(uint64_t *hits, uint64_t *misses, uint64_t *bytes);
+/* Drops every cached model (models still used by a scene live until that scene is freed).
+ * For tests and shutdown: after it and after every scene is freed, nothing is left allocated. */
+void api_model_cache_clear(void);
 /* Switches the output to the given format as if output.format had said so (Accept header,
  * CLI -o extension): adjusts scene.output.pixels. Fails (400) for PNG with AOVs. */
 enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, struct api_problem *p);

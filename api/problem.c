@@ -104,6 +104,8 @@ void api_limits_defaults(struct api_limits *l)
 	l->max_triangles = 20000000;
 	l->max_lights = 64;
 	l->max_shadow_resolution = 8192;
+	l->asset_root = NULL;
+	l->model_cache_bytes = 256u << 20;
 }
 
 const char *api_format_mime(enum api_format f)

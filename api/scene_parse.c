@@ -10,18 +10,27 @@
  *
  * Vectors (colours, positions, quaternions, matrices, mesh arrays) are reported at the member,
  * never at one element: "/lights/0/color" with "color must not have negative components".
- * Every array the rnd_scene points to lives in the scene's arena (api/arena.h).
+ * Every array the rnd_scene points to lives in the scene's arena (api/arena.h), except the
+ * geometry and textures of imported models: those live in the (immutable, cached) model
+ * (api/model.h), of which the scene holds a reference until api_scene_free().
  */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <jansson.h>
 #include "api.h"
 #include "arena.h"
+#include "model.h"
 #include "umbra/rnd_math.h"
 
 #define DEG2RAD (3.14159265358979323846 / 180.0)
@@ -41,7 +50,24 @@ struct pctx {
 	struct rnd_material *mats;
 	uint32_t mat_count, mat_cap;
 	uint32_t default_mat;         /* UINT32_MAX until an object needs it */
+	/* Models: the request's binary parts, every model the scene holds a reference to, and the
+	 * one the object being parsed imported (taken by parse_root). */
+	const struct api_part *parts;
+	size_t nparts;
+	struct model_ref *models;
+	struct api_model *cur_model;
 };
+
+/* A reference to an imported model, released in api_scene_free() (the node is in the arena). */
+struct model_ref {
+	struct model_ref *next;
+	struct api_model *model;
+};
+
+static void model_refs_release(struct model_ref *r)
+{
+	for (; r; r = r->next) api_model_release(r->model);
+}
 
 /* ---- JSON Pointer of the member being checked ---- */
 
@@ -699,6 +725,57 @@ static int parse_mesh(struct pctx *c, json_t *j, struct rnd_object *o)
 	return 0;
 }
 
+#define MAX_ASSET_BYTES (1ull << 30)
+
+/* Reads `path` (already checked: relative, no ".." component) under the asset root into a
+ * malloc'd buffer. Symlinks are followed only while they stay inside the root. 0 or -1 (400 at
+ * the current pointer, 500 when the root itself is unusable). */
+static int read_asset(struct pctx *c, const char *path, unsigned char **out, size_t *len)
+{
+	const char *root = c->lim->asset_root;
+	if (!root || !root[0]) return fail(c, "path cannot be used: no asset root configured on this server");
+	char rroot[PATH_MAX], full[PATH_MAX], real[PATH_MAX];
+	if (!realpath(root, rroot)) {
+		api_problem_set(c->p, 500, c->ptr, "the asset root cannot be resolved: %s", strerror(errno));
+		return -1;
+	}
+	if ((size_t)snprintf(full, sizeof full, "%s/%s", rroot, path) >= sizeof full)
+		return fail(c, "path is too long");
+	if (!realpath(full, real)) return fail(c, "path \"%.128s\" cannot be opened: %s", path, strerror(errno));
+	size_t n = strlen(rroot);
+	bool inside = !strcmp(rroot, "/") || (!strncmp(real, rroot, n) && real[n] == '/');
+	if (!inside) return fail(c, "path \"%.128s\" leaves the asset root (through a symbolic link)", path);
+	int fd = open(real, O_RDONLY | O_CLOEXEC);
+	if (fd < 0) return fail(c, "path \"%.128s\" cannot be opened: %s", path, strerror(errno));
+	struct stat st;
+	int rc = 0;
+	unsigned char *buf = NULL;
+	if (fstat(fd, &st) < 0 || !S_ISREG(st.st_mode)) {
+		rc = fail(c, "path \"%.128s\" is not a regular file", path);
+	} else if ((uint64_t)st.st_size > MAX_ASSET_BYTES || !st.st_size) {
+		rc = fail(c, "path \"%.128s\" is empty or larger than %llu bytes", path, MAX_ASSET_BYTES);
+	} else if (!(buf = malloc((size_t)st.st_size))) {
+		rc = fail(c, "path \"%.128s\" is too large to read (out of memory)", path);
+	} else {
+		size_t got = 0;
+		while (got < (size_t)st.st_size) {
+			ssize_t r = read(fd, buf + got, (size_t)st.st_size - got);
+			if (r < 0 && errno == EINTR) continue;
+			if (r <= 0) break;
+			got += (size_t)r;
+		}
+		if (got != (size_t)st.st_size) {
+			free(buf);
+			buf = NULL;
+			rc = fail(c, "path \"%.128s\" could not be read", path);
+		}
+	}
+	close(fd);
+	*out = buf;
+	*len = buf ? (size_t)st.st_size : 0;
+	return rc;
+}
+
 static int parse_model(struct pctx *c, json_t *j)
 {
 	static const char *const sources[] = {"data", "path", "part"};
@@ -714,14 +791,15 @@ static int parse_model(struct pctx *c, json_t *j)
 	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
 	int f;
 	if (get_enum(c, j, "format", formats, &f) < 0) return -1;
+	bool given = json_object_get(j, "format") != NULL;
 	json_t *v = json_object_get(j, first);
 	size_t old = ptr_push(c, first);
 	int rc = 0;
+	unsigned char *b = NULL;
+	size_t len = 0;
 	if (!json_is_string(v)) {
 		rc = fail(c, "%s must be a string, not %s", first, type_name(v));
 	} else if (!strcmp(first, "data")) {
-		unsigned char *b;
-		size_t len;
 		if (decode_b64_member(c, "data", v, &b, &len) < 0) rc = -1;
 		else if (!len) rc = fail(c, "data must not be empty");
 	} else if (!strcmp(first, "path")) {
@@ -731,13 +809,46 @@ static int parse_model(struct pctx *c, json_t *j)
 		for (const char *q = s; !bad && *q; q = strchr(q, '/') ? strchr(q, '/') + 1 : q + strlen(q))
 			if (q[0] == '.' && q[1] == '.' && (q[2] == '/' || q[2] == 0)) bad = true;
 		if (bad) rc = fail(c, "path must be a relative path inside the asset root (no leading \"/\", no \"..\")");
+		else rc = read_asset(c, s, &b, &len);
+		if (!rc && !given) { /* the extension says what the bytes may not (obj, ascii stl) */
+			const char *dot = strrchr(s, '.');
+			for (int i = 0; dot && formats[i]; i++)
+				if (!strcasecmp(dot + 1, formats[i])) { f = i; given = true; }
+		}
 	} else if (!json_string_length(v)) {
 		rc = fail(c, "part must name a part of the multipart request");
+	} else {
+		const char *name = json_string_value(v);
+		size_t i = 0;
+		while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
+		if (i == c->nparts) rc = fail(c, "part \"%.64s\" is not a part of this request", name);
+		else if (!c->parts[i].len) rc = fail(c, "part \"%.64s\" is empty", name);
+		else b = (unsigned char *)c->parts[i].data, len = c->parts[i].len;
 	}
+	if (rc == 0) {
+		struct api_model *m = NULL;
+		char err[400];
+		struct model_ref *ref = api_arena_alloc(c->arena, sizeof *ref);
+		if (!ref) {
+			rc = fail(c, "out of memory");
+		} else if (api_model_get(b, len, given ? (enum api_model_format)f : API_MODEL_SNIFF,
+		                         c->lim->model_cache_bytes, &m, err, sizeof err) != API_OK) {
+			/* Named by the object's name, else by its path, else by its source member. */
+			json_t *nm = json_object_get(j, "name");
+			const char *what = json_is_string(nm) ? json_string_value(nm)
+			                   : !strcmp(first, "path") ? json_string_value(v) : NULL;
+			if (what) rc = fail(c, "model \"%.128s\" (%s) could not be imported: %s", what, first, err);
+			else rc = fail(c, "the model in %s could not be imported: %s", first, err);
+		} else {
+			ref->model = m;
+			ref->next = c->models;
+			c->models = ref;
+			c->cur_model = m;
+		}
+	}
+	if (!strcmp(first, "path")) free(b);
 	ptr_pop(c, old);
-	if (rc < 0) return -1;
-	defer(c, true, "shape", "shape \"model\" is not supported yet");
-	return 0;
+	return rc < 0 ? -1 : 0;
 }
 
 static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
@@ -782,7 +893,7 @@ static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 		if (parse_mesh(c, j, o) < 0) return -1;
 		break;
 	default:
-		/* Validated, then answered 422: an empty mesh stands in for it meanwhile. */
+		/* An empty mesh until parse_root expands it into one object per mesh instance. */
 		o->shape = RND_SHAPE_MESH;
 		if (parse_model(c, j) < 0) return -1;
 		break;
@@ -1142,6 +1253,57 @@ static void set_pixels(struct api_scene *s)
 	else s->scene.output.pixels = s->bit_depth == 16 ? RND_PIXELS_RGBA16 : RND_PIXELS_RGBA8;
 }
 
+/* Replaces every model object by one mesh object per instance of its model, under the
+ * object's transform, with the model's materials (appended to the scene's) unless the object
+ * names its own. Returns 0 or -1 (out of memory / too many objects). */
+static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *models, struct rnd_scene *sc)
+{
+	uint64_t nobj = 0, nmat = c->mat_count;
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		nobj += models[i] ? models[i]->instance_count : 1;
+		if (models[i] && !json_object_get(json_array_get(objs, i), "material")) nmat += models[i]->material_count;
+	}
+	if (nobj > UINT32_MAX / 2 || nmat > UINT32_MAX / 2) return fail(c, "the scene has too many objects");
+	struct rnd_object *objects = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *objects);
+	struct rnd_material *mats = api_arena_calloc(c->arena, nmat ? nmat : 1, sizeof *mats);
+	if (!objects || !mats) return fail(c, "out of memory");
+	memcpy(mats, c->mats, c->mat_count * sizeof *mats);
+	uint32_t no = 0, nm = c->mat_count;
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct api_model *m = models[i];
+		if (!m) {
+			objects[no++] = sc->objects[i];
+			continue;
+		}
+		bool own = json_object_get(json_array_get(objs, i), "material") != NULL;
+		uint32_t base = nm;
+		if (!own) {
+			memcpy(mats + nm, m->materials, m->material_count * sizeof *mats);
+			nm += m->material_count;
+		}
+		for (uint32_t k = 0; k < m->instance_count; k++) {
+			const struct api_model_instance *in = &m->instances[k];
+			const struct api_model_mesh *me = &m->meshes[in->mesh];
+			struct rnd_object *o = &objects[no++];
+			*o = sc->objects[i];   /* shadows, sidedness, material override */
+			o->shape = RND_SHAPE_MESH;
+			o->positions = me->positions;
+			o->vertex_count = me->vertex_count;
+			o->indices = me->indices;
+			o->index_count = me->index_count;
+			o->normals = me->normals;
+			o->uvs = me->uvs;
+			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);
+			if (!own) o->material = base + me->material;
+		}
+	}
+	c->mats = mats;
+	c->mat_count = c->mat_cap = nm;
+	sc->objects = objects;
+	sc->object_count = no;
+	return 0;
+}
+
 static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 {
 	struct rnd_scene *sc = &s->scene;
@@ -1243,11 +1405,15 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		size_t old = ptr_push(c, "objects");
 		uint64_t total = 0;
 		int rc = 0;
+		struct api_model **models = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *models);
+		if (!models) return fail(c, "out of memory");
 		for (size_t i = 0; i < nobj; i++) {
 			size_t o2 = ptr_index(c, i);
+			c->cur_model = NULL;
 			rc = parse_object(c, json_array_get(objs, i), &objects[i]);
+			models[i] = c->cur_model;
 			if (!rc) {
-				uint64_t t = rnd_object_triangle_count(&objects[i]);
+				uint64_t t = models[i] ? models[i]->triangles : rnd_object_triangle_count(&objects[i]);
 				total += t;
 				s->triangles = total;
 				uint64_t max = c->lim->max_triangles;
@@ -1267,6 +1433,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		if (rc) return -1;
 		sc->objects = objects;
 		sc->object_count = (uint32_t)nobj;
+		if (c->models && expand_models(c, objs, models, sc) < 0) return -1;
 	}
 
 	struct rnd_shadow root_shadow;
@@ -1338,6 +1505,13 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
                                 struct api_scene **out, struct api_problem *p)
 {
+	return api_scene_parse_parts(json, len, limits, NULL, 0, out, p);
+}
+
+enum api_result api_scene_parse_parts(const char *json, size_t len, const struct api_limits *limits,
+                                      const struct api_part *parts, size_t nparts,
+                                      struct api_scene **out, struct api_problem *p)
+{
 	struct api_problem scratch;
 	struct api_limits deflim;
 	if (!p) p = &scratch;
@@ -1357,7 +1531,7 @@ enum api_result api_scene_parse(const char *json, size_t len, const struct api_l
 		snprintf(p->title, sizeof p->title, "Malformed JSON");
 		return API_ERR;
 	}
-	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX};
+	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts};
 	c.arena = api_arena_create();
 	struct api_scene *s = c.arena ? api_arena_alloc(c.arena, sizeof *s) : NULL;
 	if (!s) {
@@ -1379,17 +1553,21 @@ enum api_result api_scene_parse(const char *json, size_t len, const struct api_l
 		rc = -1;
 	}
 	if (rc < 0) {
+		model_refs_release(c.models);
 		api_arena_destroy(c.arena);
 		return API_ERR;
 	}
+	s->models_ = c.models;
 	*out = s;
 	return API_OK;
 }
 
 void api_scene_free(struct api_scene *s)
 {
-	/* The scene itself lives in its arena. */
-	if (s) api_arena_destroy(s->arena_);
+	/* The scene itself lives in its arena; the models it points into are referenced. */
+	if (!s) return;
+	model_refs_release(s->models_);
+	api_arena_destroy(s->arena_);
 }
 
 enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, struct api_problem *p)

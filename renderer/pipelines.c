@@ -93,7 +93,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	VkPipelineVertexInputStateCreateInfo vi = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
 		.vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
-		.vertexAttributeDescriptionCount = d->fs ? 3 : 1, .pVertexAttributeDescriptions = va,
+		.vertexAttributeDescriptionCount = d->shadow ? 1 : 3, .pVertexAttributeDescriptions = va,
 	};
 	VkPipelineInputAssemblyStateCreateInfo ia = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO, .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,

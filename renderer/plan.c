@@ -243,13 +243,8 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 		}
 		lp->pcf_radius = s->pcf_radius > 5 ? 5 : s->pcf_radius;
 		lp->search_texels = 24.0f;
-		if (s->bias_set) {
-			lp->bias_constant = s->bias_constant; lp->bias_slope = s->bias_slope; lp->bias_normal = s->bias_normal;
-		} else {
-			/* Slope-scaled hardware bias for surfaces at grazing light, plus a normal offset of
-			 * 1.5 texels for curved receivers; no per-scene tuning. */
-			lp->bias_constant = 1.0f; lp->bias_slope = 1.75f; lp->bias_normal = 1.5f;
-		}
+		/* Defaults come from rnd_shadow_defaults(); see there. */
+		lp->bias_constant = s->bias_constant; lp->bias_slope = s->bias_slope; lp->bias_normal = s->bias_normal;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false;
 		uint32_t ncasc = 1;

@@ -67,7 +67,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets");
 		goto fail_set;
 	}
-	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET, s->set, "slot %u frame set", index);
+	/* Descriptor sets stay unnamed: lavapipe never frees a set's debug name with its pool. */
 	*out = s;
 	return RND_OK;
 

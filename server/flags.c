@@ -37,7 +37,8 @@ static const struct opt_def opts[] = {
 	{ "max-lights", OPT_UINT, "N", "most lights, 0 = no limit (64)", LIM(max_lights), 0, UINT32_MAX },
 	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
 	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
-	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to", CFG(asset_root), 0, 0 },
+	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to (none: `path` is a 400)", CFG(asset_root), 0, 0 },
+	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", LIM(model_cache_bytes), 0, UINT64_MAX },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
@@ -123,7 +124,8 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 			return -1;
 		}
 		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
-		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles))
+		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles) ||
+		    o->offset == LIM(model_cache_bytes))
 			*(uint64_t *)(base + o->offset) = v;
 		else
 			*(uint32_t *)(base + o->offset) = (uint32_t)v;
@@ -196,6 +198,7 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		fprintf(stderr, "umbrad: --asset-root: cannot open '%s': %s\n", cfg->asset_root, strerror(errno));
 		return -1;
 	}
+	cfg->limits.asset_root = cfg->asset_root;
 	return 0;
 }
 

@@ -71,11 +71,27 @@ static enum srv_route route_of(const char *url)
 
 /* ---- answers ---- */
 
+void srv_request_drop_body(struct srv_request *req)
+{
+	free(req->body);
+	req->body = NULL;
+	req->body_len = req->body_cap = 0;
+	for (size_t i = 0; i < req->part_count; i++) {
+		free(req->parts[i].name);
+		free(req->parts[i].data);
+	}
+	free(req->parts);
+	req->parts = NULL;
+	req->part_count = 0;
+}
+
 static void request_free(struct srv_request *req)
 {
 	if (!req)
 		return;
-	free(req->body);
+	if (req->post)
+		MHD_destroy_post_processor(req->post);
+	srv_request_drop_body(req);
 	free(req->out);
 	free(req);
 }
@@ -221,6 +237,73 @@ static bool json_content_type(const char *ct)
 	return n > 17 && !strncasecmp(ct, "application/", 12) && !strncasecmp(ct + n - 5, "+json", 5);
 }
 
+static bool multipart_content_type(const char *ct)
+{
+	if (!ct)
+		return false;
+	while (*ct == ' ' || *ct == '\t')
+		ct++;
+	return !strncasecmp(ct, "multipart/form-data", 19) && strchr("; \t", ct[19]);
+}
+
+/* Grows a byte buffer to hold `need` bytes plus a NUL. */
+static bool grow(uint8_t **data, size_t *cap, size_t need)
+{
+	if (need + 1 <= *cap)
+		return true;
+	size_t c = *cap ? *cap : 4096;
+	while (c < need + 1)
+		c *= 2;
+	uint8_t *p = realloc(*data, c);
+	if (!p)
+		return false;
+	*data = p;
+	*cap = c;
+	return true;
+}
+
+#define MAX_PARTS 64
+
+/* libmicrohttpd's multipart parser hands over each part's bytes in order. */
+static enum MHD_Result part_data(void *cls, enum MHD_ValueKind kind, const char *key, const char *filename,
+                                 const char *content_type, const char *transfer_encoding, const char *data,
+                                 uint64_t off, size_t size)
+{
+	struct srv_request *req = cls;
+	(void)kind; (void)filename; (void)content_type; (void)transfer_encoding;
+	if (!key)
+		return MHD_YES;
+	struct srv_part *part = NULL;
+	for (size_t i = 0; i < req->part_count; i++)
+		if (!strcmp(req->parts[i].name, key))
+			part = &req->parts[i];
+	if (part && off == 0 && part->len) {
+		req->part_error = "two parts have the same name";
+		return MHD_NO;
+	}
+	if (!part) {
+		if (req->part_count == MAX_PARTS) {
+			req->part_error = "more than 64 parts";
+			return MHD_NO;
+		}
+		struct srv_part *parts = realloc(req->parts, (req->part_count + 1) * sizeof *parts);
+		if (!parts)
+			return MHD_NO;
+		req->parts = parts;
+		part = &parts[req->part_count];
+		*part = (struct srv_part){ .name = strdup(key) };
+		if (!part->name)
+			return MHD_NO;
+		req->part_count++;
+	}
+	if (!grow(&part->data, &part->cap, part->len + size))
+		return MHD_NO;
+	memcpy(part->data + part->len, data, size);
+	part->len += size;
+	part->data[part->len] = 0;
+	return MHD_YES;
+}
+
 /* Accept: true when image/x-exr is preferred (higher q) over image/png. Wildcards count with
  * their q for both; a tie keeps PNG, the default. */
 static bool accept_prefers_exr(const char *accept)
@@ -307,8 +390,9 @@ static enum MHD_Result render_begin(struct srv_request *req, struct MHD_Connecti
 	if (!is_ready(s))
 		return answer_not_ready(req);
 	const char *ct = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-	if (!json_content_type(ct))
-		return respond_problem(req, 415, NULL, "", "Content-Type must be application/json, not '%s'",
+	bool multipart = multipart_content_type(ct);
+	if (!multipart && !json_content_type(ct))
+		return respond_problem(req, 415, NULL, "", "Content-Type must be application/json or multipart/form-data, not '%s'",
 		                       ct ? ct : "(none)");
 	const char *ce = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_ENCODING);
 	if (ce && strcasecmp(ce, "identity") != 0)
@@ -328,12 +412,17 @@ static enum MHD_Result render_begin(struct srv_request *req, struct MHD_Connecti
 		if (!errno && end != cl && n > s->cfg.max_body)
 			return respond_problem(req, 413, NULL, "", "the body of %llu bytes is over the limit of %llu bytes",
 			                       n, (unsigned long long)s->cfg.max_body);
-		if (!errno && end != cl && n > 0) {
+		if (!errno && end != cl && n > 0 && !multipart) {
 			req->body = malloc((size_t)n + 1);
 			if (!req->body)
 				return respond_problem(req, 503, NULL, "", "out of memory for a body of %llu bytes", n);
 			req->body_cap = (size_t)n + 1;
 		}
+	}
+	if (multipart) {
+		req->post = MHD_create_post_processor(conn, 64 * 1024, part_data, req);
+		if (!req->post)
+			return respond_problem(req, 400, NULL, "", "multipart/form-data without a usable boundary");
 	}
 	req->want_exr = accept_prefers_exr(MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT));
 	req->body_hash = FNV_OFFSET;
@@ -345,12 +434,19 @@ static enum MHD_Result render_begin(struct srv_request *req, struct MHD_Connecti
 static bool render_body(struct srv_request *req, const char *data, size_t size)
 {
 	struct srv_server *s = req->srv;
-	if (req->body_discarded || req->body_len + size > s->cfg.max_body) {
-		free(req->body);
-		req->body = NULL;
-		req->body_discarded += req->body_len + size;
-		req->body_len = req->body_cap = 0;
+	if (req->body_discarded || req->body_received + size > s->cfg.max_body) {
+		if (!req->body_discarded)
+			srv_request_drop_body(req);
+		req->body_discarded += req->body_received + size;
+		req->body_received = 0;
 		return false;
+	}
+	req->body_received += size;
+	req->body_hash = fnv1a(req->body_hash, data, size);
+	if (req->post) {
+		if (!req->part_error && MHD_post_process(req->post, data, size) != MHD_YES && !req->part_error)
+			req->part_error = "malformed multipart/form-data body";
+		return true;
 	}
 	if (req->body_len + size + 1 > req->body_cap) {
 		size_t cap = req->body_cap ? req->body_cap : 4096;
@@ -368,7 +464,6 @@ static bool render_body(struct srv_request *req, const char *data, size_t size)
 	}
 	memcpy(req->body + req->body_len, data, size);
 	req->body_len += size;
-	req->body_hash = fnv1a(req->body_hash, data, size);
 	return true;
 }
 
@@ -378,6 +473,26 @@ static enum MHD_Result render_body_done(struct srv_request *req, struct MHD_Conn
 	if (req->body_discarded)
 		return respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
 		                       (unsigned long long)s->cfg.max_body);
+	if (req->post) {
+		if (MHD_destroy_post_processor(req->post) != MHD_YES && !req->part_error)
+			req->part_error = "truncated multipart/form-data body";
+		req->post = NULL;
+		if (req->part_error)
+			return respond_problem(req, 400, NULL, "", "%s", req->part_error);
+		/* The `scene` part is the document; the others stay as named parts. */
+		for (size_t i = 0; i < req->part_count; i++) {
+			if (strcmp(req->parts[i].name, "scene") != 0)
+				continue;
+			req->body = (char *)req->parts[i].data;
+			req->body_len = req->parts[i].len;
+			req->body_cap = req->parts[i].cap;
+			free(req->parts[i].name);
+			req->parts[i] = req->parts[--req->part_count];
+			break;
+		}
+		if (!req->body)
+			return respond_problem(req, 400, NULL, "", "the multipart/form-data request has no `scene` part");
+	}
 	if (!req->body_len)
 		return respond_problem(req, 400, NULL, "", "the request has no body: a scene document is required");
 	req->body[req->body_len] = 0;

@@ -53,6 +53,19 @@ void srv_log(enum srv_log_level level, const char *fmt, ...)
 		n = snprintf(line, sizeof line, "{\"ts\":\"%s\",\"level\":\"%s\",\"msg\":\"%s\"}", ts,
 		             level_names[level], esc);
 	} else {
+		/* One event, one line: a multi-line message (validation layer) is folded. */
+		char *o = msg;
+		for (const char *i = msg; *i; i++) {
+			if (*i == '\n' || *i == '\r' || *i == '\t') {
+				while (i[1] == ' ' || i[1] == '\t' || i[1] == '\n' || i[1] == '\r')
+					i++;
+				if (o > msg && o[-1] != ' ')
+					*o++ = ' ';
+			} else {
+				*o++ = *i;
+			}
+		}
+		*o = 0;
 		n = snprintf(line, sizeof line, "%s %-5s %s", ts, level_names[level], msg);
 	}
 	if (n > 0)

@@ -102,9 +102,6 @@ int main(int argc, char **argv)
 	}
 	srv_log(SRV_LOG_INFO, "umbrad %s starting: %u workers, queue %u, max body %llu, deadline %u ms",
 	        UMBRA_VERSION, s->cfg.workers, s->cfg.queue, (unsigned long long)s->cfg.max_body, s->cfg.deadline_ms);
-	if (s->cfg.asset_root)
-		srv_log(SRV_LOG_WARN, "--asset-root '%s' is accepted but models by `path` are not supported by this build's scene parser",
-		        s->cfg.asset_root);
 	if (srv_http_start(s) != 0)
 		goto out_free;
 	if (srv_context_open(s) != 0)
@@ -144,6 +141,7 @@ out_context:
 out_http:
 	srv_http_stop(s);
 out_free:
+	api_model_cache_clear();
 	srv_queue_destroy(s->queue);
 	srv_metrics_destroy(s->metrics);
 	pthread_rwlock_destroy(&s->ctx_lock);

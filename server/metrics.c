@@ -264,6 +264,12 @@ char *srv_metrics_text(struct srv_server *s, size_t *len)
 	write_counter(&b, "umbra_response_bytes_total", "Bytes of answer bodies.",
 	              snap.counter[SRV_CTR_BYTES_OUT]);
 
+	uint64_t mhits = 0, mmiss = 0, mbytes = 0;
+	api_model_cache_stats(&mhits, &mmiss, &mbytes);
+	write_counter(&b, "umbra_model_cache_hits_total", "Imported models found in the model cache.", mhits);
+	write_counter(&b, "umbra_model_cache_misses_total", "Imported models decoded.", mmiss);
+	write_gauge(&b, "umbra_model_cache_bytes", "Bytes held by the model cache.", (double)mbytes);
+
 	uint32_t vmsg = s->validation_lost;
 	char dev[300] = "", drv[300] = "";
 	if (atomic_load(&s->ready)) {

@@ -10,7 +10,8 @@
  *   umbra_renders_total{result}, umbra_shadow_maps_rendered_total,
  *   umbra_shadow_maps_reused_total (the renderer's shadow cache hits), umbra_not_modified_total
  *   (ETag hits), umbra_queue_rejected_total, umbra_deadline_exceeded_total,
- *   umbra_device_lost_total, umbra_response_bytes_total    counters
+ *   umbra_device_lost_total, umbra_response_bytes_total, umbra_model_cache_hits_total,
+ *   umbra_model_cache_misses_total    counters; umbra_model_cache_bytes gauge
  *   umbra_validation_messages, umbra_build_info{version,device,driver}, process_resident_memory_bytes,
  *   process_open_fds                            gauges
  *

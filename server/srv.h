@@ -42,6 +42,7 @@ struct srv_queue;
 struct srv_metrics;
 struct MHD_Daemon;
 struct MHD_Connection;
+struct MHD_PostProcessor;
 
 enum srv_log_format { SRV_LOG_TEXT, SRV_LOG_JSON };
 
@@ -54,7 +55,7 @@ struct srv_config {
 	uint64_t max_body;             /* bytes, default 64 MiB */
 	struct api_limits limits;      /* 422 limits */
 	unsigned deadline_ms;          /* 0 = none, default 30000 */
-	const char *asset_root;        /* directory models' `path` is relative to */
+	const char *asset_root;        /* directory models' `path` is relative to (limits.asset_root) */
 	const char *pipeline_cache;    /* pipeline cache file, loaded at start, saved at exit */
 	enum srv_log_format log_format;
 	const char *device;            /* substring of the Vulkan device name */
@@ -104,6 +105,13 @@ struct srv_server {
 	uint64_t id_seed;
 };
 
+/* A named part of a multipart/form-data render request (a model's `part`). */
+struct srv_part {
+	char *name;
+	uint8_t *data;
+	size_t len, cap;
+};
+
 /* One HTTP request (see the ownership note at the top). */
 enum srv_req_state { SRV_REQ_HEADERS, SRV_REQ_BODY, SRV_REQ_QUEUED, SRV_REQ_FINISHED, SRV_REQ_ANSWERED };
 
@@ -119,9 +127,15 @@ struct srv_request {
 	char id[80];                   /* X-Request-Id */
 	double t_start, t_queued;      /* monotonic seconds */
 
-	/* body of POST /v1/render */
+	/* body of POST /v1/render: the scene document, or for multipart/form-data the `scene` part
+	 * (moved here when the body is complete) and the other named parts */
+	struct MHD_PostProcessor *post;
+	struct srv_part *parts;
+	size_t part_count;
+	const char *part_error;        /* why the multipart body is unusable, or NULL */
 	char *body;
 	size_t body_len, body_cap;
+	uint64_t body_received;        /* raw body bytes so far (multipart included) */
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
 	uint64_t body_hash;            /* FNV-1a 64, running */
 	char etag[40];
@@ -137,6 +151,8 @@ struct srv_request {
 
 /* Worker side: stores nothing more and resumes the connection so http.c sends the answer. */
 void srv_request_finish(struct srv_request *req);
+/* Frees the body and the parts (the worker calls it once the scene is parsed). */
+void srv_request_drop_body(struct srv_request *req);
 
 /* http.c */
 int srv_http_start(struct srv_server *s);           /* 0 or -1 (logged) */

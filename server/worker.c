@@ -238,7 +238,14 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 	size_t len = 0;
 
 	double t0 = srv_now();
-	if (api_scene_parse(req->body, req->body_len, &s->cfg.limits, &sc, &p) != API_OK) {
+	struct api_part parts[64];
+	size_t nparts = req->part_count < 64 ? req->part_count : 64;
+	for (size_t i = 0; i < nparts; i++)
+		parts[i] = (struct api_part){ req->parts[i].name, req->parts[i].data, req->parts[i].len };
+	enum api_result pr = api_scene_parse_parts(req->body, req->body_len, &s->cfg.limits, parts, nparts, &sc, &p);
+	/* The body and parts are no longer needed: give their memory back before the render. */
+	srv_request_drop_body(req);
+	if (pr != API_OK) {
 		job_problem(req, &p);
 		return;
 	}
@@ -246,10 +253,6 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 		job_problem(req, &p);
 		goto out;
 	}
-	/* The body is no longer needed: give its memory back before the render. */
-	free(req->body);
-	req->body = NULL;
-	req->body_cap = 0;
 	double parse_s = srv_now() - t0;
 	srv_metrics_stage(s->metrics, SRV_STAGE_PARSE, parse_s);
 

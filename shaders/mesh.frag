@@ -53,7 +53,9 @@ float bilinear_compare(vec2 p, float layer, float ref, float res)
 }
 
 // (2r+1)^2 bilinear PCF taps, done as (r+1)^2 gathers over the (2r+2)^2 texel footprint.
-float pcf(vec2 p, float layer, float ref, float res, int r)
+// grad: receiver depth change per texel (receiver-plane bias), so wide kernels on sloped
+// receivers do not shadow the receiver itself.
+float pcf(vec2 p, float layer, float ref, float res, int r, vec2 grad)
 {
 	vec2 q = p - 0.5;
 	vec2 base = floor(q);
@@ -63,7 +65,8 @@ float pcf(vec2 p, float layer, float ref, float res, int r)
 	for (int j = 0; j <= 2 * r; j += 2) {
 		for (int i = 0; i <= 2 * r; i += 2) {
 			vec2 corner = base + vec2(float(i - r), float(j - r)) + 1.0;
-			vec4 lit = step(vec4(ref), textureGather(shadow_map, vec3(corner / res, layer)));
+			float rc = ref + dot(grad, corner - p);
+			vec4 lit = step(vec4(rc), textureGather(shadow_map, vec3(corner / res, layer)));
 			float wx0 = i == 0 ? 1.0 - f.x : 1.0, wx1 = i + 1 == last ? f.x : 1.0;
 			float wy0 = j == 0 ? 1.0 - f.y : 1.0, wy1 = j + 1 == last ? f.y : 1.0;
 			sum += lit.w * wx0 * wy0 + lit.z * wx1 * wy0 + lit.x * wx0 * wy1 + lit.y * wx1 * wy1;
@@ -94,22 +97,28 @@ float view_distance(umbra_shadow_view v, float d)
 
 // PCSS: blocker search over the region that could shade this point, penumbra from the
 // light's size by similar triangles, then a rotated Poisson PCF of that width.
-float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, float res)
+float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, float res, vec2 grad)
 {
 	float zr = view_distance(v, ref);
 	float texel = v.params.y > 0.5 ? v.params.x * zr : v.params.x;   // world size of a texel at the receiver
 	float size = L.params.y;                                          // tan(angular radius) or radius (m)
 	bool persp = v.params.y > 0.5;
-	// Search radius: the penumbra a blocker halfway to the light would make, capped.
-	float search = persp ? size * 0.5 / texel : size * zr * 0.5 / texel;
+	// Search radius: the widest penumbra a blocker between the light's near plane and the
+	// receiver could cast here, capped.
+	float zn = v.params.z;
+	float search = persp ? size * (zr - zn) / (zr * v.params.x * max(zn, 1e-3)) : size * (zr - zn) / texel;
 	search = clamp(search, 1.0, L.shadow_params.y);
 	float a = ign(gl_FragCoord.xy) * 2.0 * PI;
 	mat2 rot = mat2(cos(a), sin(a), -sin(a), cos(a));
 	float blockers = 0.0, sum_d = 0.0;
+	// Texels of the receiver's own plane must not count as blockers: compare against the
+	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
+	float slack = abs(grad.x) + abs(grad.y) + 1e-6;
 	for (int i = 0; i < 16; i++) {
-		vec2 q = p + rot * poisson(i * 2) * search;
+		vec2 off = rot * poisson(i * 2) * search;
+		vec2 q = p + off;
 		vec4 d = textureGather(shadow_map, vec3(q / res, layer));
-		vec4 b = step(d, vec4(ref - 1e-6));   // 1 where the texel is a blocker (closer to the light)
+		vec4 b = step(d, vec4(ref + dot(grad, off) - slack));   // 1 where the texel is a blocker
 		blockers += dot(b, vec4(1.0));
 		sum_d += dot(b, d);
 	}
@@ -119,9 +128,26 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, f
 	float w = persp ? 2.0 * size * (zr - zb) / max(zb, 1e-4) : 2.0 * size * (zr - zb);
 	float radius = max(0.5 * w / texel, 1.0);
 	float sum = 0.0;
-	for (int i = 0; i < 32; i++)
-		sum += bilinear_compare(p + rot * poisson(i) * radius, layer, ref, res);
+	for (int i = 0; i < 32; i++) {
+		vec2 off = rot * poisson(i) * radius;
+		sum += bilinear_compare(p + off, layer, ref + dot(grad, off), res);
+	}
 	return sum / 32.0;
+}
+
+// Receiver plane: how the receiver's light-space depth changes per shadow-map texel, from its
+// normal. Orthographic views only (their transform is affine: the plane stays a plane);
+// perspective views rely on the normal offset alone.
+vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
+{
+	if (v.params.y > 0.5) return vec2(0.0);
+	mat3 a = mat3(v.view_proj);
+	vec3 r0 = vec3(a[0][0], a[1][0], a[2][0]), r1 = vec3(a[0][1], a[1][1], a[2][1]), r2 = vec3(a[0][2], a[1][2], a[2][2]);
+	// Normal of the plane in light clip space: (A^-T) n = S^-2 A n for A = S R.
+	vec3 ns = (a * n) / vec3(dot(r0, r0), dot(r1, r1), dot(r2, r2));
+	if (abs(ns.z) < 1e-8) return vec2(0.0);
+	vec2 g = -ns.xy / ns.z * (2.0 / res);
+	return clamp(g, vec2(-0.01), vec2(0.01));
 }
 
 // Visibility of light L at world position pos with geometric normal n.
@@ -161,9 +187,10 @@ float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint
 	float ref = clamp(sc.z, 0.0, 1.0);     // depth clamp: casters before the near plane pancake to 0
 	float layer = float(vi);
 	uint filt = L.shadow.z;
+	vec2 grad = receiver_gradient(v, n, res);
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, layer, ref, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, layer, ref, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, layer, ref, res, int(L.shadow.w));
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, layer, ref, res, grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, layer, ref, res, int(L.shadow.w), grad);
 	return 1.0;
 }
 

@@ -9,12 +9,13 @@ layout(location = 2) in vec2 a_uv;
 layout(location = 0) out vec3 v_pos;
 layout(location = 1) out vec3 v_nrm;
 layout(location = 2) out vec2 v_uv;
-// The depth pre-pass and the main pass must produce bit-identical depth (EQUAL test).
-invariant gl_Position;
 void main()
 {
 	v_pos = a_pos;
 	v_nrm = a_nrm;
 	v_uv = a_uv;
-	gl_Position = frame.view_proj * vec4(a_pos, 1.0);
+	// The depth pre-pass and the main pass run this same code and must produce bit-identical
+	// depth (EQUAL test): `precise` forbids contractions that could differ between pipelines.
+	precise vec4 clip = frame.view_proj * vec4(a_pos, 1.0);
+	gl_Position = clip;
 }

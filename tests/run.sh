@@ -11,6 +11,8 @@ if [ -n "${ASAN:-}" ]; then
 	export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_odr_violation=0"
 	export LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0"
 	export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+	# Keep the Vulkan driver mapped at exit so its leaks can be attributed (tests/lsan.supp).
+	export VK_LOADER_DISABLE_DYNAMIC_LIBRARY_UNLOADING=1
 fi
 total_pass=0; total_fail=0
 run_suite() {

@@ -146,6 +146,7 @@ scene 64 64 1 32 "" >"$T/small.json"
 scene 64 48 1 32 "" >"$T/small-64x48.json"
 # The flood scene must keep one worker busy for a while on lavapipe.
 scene 512 512 4 256 ', "x-flood": 1' | sed 's/"resolution": 512/"resolution": 2048/' >"$T/slow.json"
+scene 2048 2048 4 256 ', "x-flood": 2' | sed 's/"resolution": 512/"resolution": 2048/' >"$T/slower.json"
 scene 2000 2000 1 32 "" >"$T/pixels.json"
 scene 64 64 1 2048 "" >"$T/triangles.json"
 sed 's/"resolution": 512/"resolution": 4096/' "$T/small.json" >"$T/shadowres.json"
@@ -155,11 +156,24 @@ sed 's/"intensity": 3,/"intensity": 3, "colour": [1, 1, 1],/' "$T/small.json" >"
 sed 's/"width": 64/"width": "64"/' "$T/small.json" >"$T/wrongtype.json"
 sed 's/"width": 64/"width": 0/' "$T/small.json" >"$T/range.json"
 sed 's/"msaa": 1/"msaa": 1, "format": "exr"/' "$T/small.json" >"$T/exr.json"
+mkdir -p "$T/assets"
+printf 'v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
+sed 's/"objects": \[/"objects": [{"shape": "model", "path": "tri.obj"},/' "$T/small.json" >"$T/model-path.json"
+sed 's/"objects": \[/"objects": [{"shape": "model", "path": "..\/small.json"},/' "$T/small.json" >"$T/model-escape.json"
+sed 's/"objects": \[/"objects": [{"shape": "model", "part": "mesh", "format": "obj"},/' "$T/small.json" >"$T/model-part.json"
 head -c 2097152 /dev/zero | tr '\0' ' ' >"$T/huge.json"
+
+# ==== flags ====
+"$UMBRAD" --help >"$T/help.out" 2>&1; rc=$?
+check "--help exits 0 and lists the flags" sh -c "[ $rc = 0 ] && grep -q -- '--max-body' '$T/help.out' && grep -q -- '--deadline-ms' '$T/help.out'"
+"$UMBRAD" --no-such-flag >/dev/null 2>&1; rc=$?
+check "unknown flag exits 2" [ $rc = 2 ]
+UMBRA_WORKERS=zero "$UMBRAD" >/dev/null 2>&1; rc=$?
+check "bad UMBRA_WORKERS exits 2" [ $rc = 2 ]
 
 # ==== main daemon ====
 echo "# starting the main daemon (reps $REPS)"
-start main --max-body 1M --max-pixels 1000000 --max-triangles 200000 --max-lights 4 \
+start main --asset-root "$T/assets" --max-body 1M --max-pixels 1000000 --max-triangles 200000 --max-lights 4 \
 	--max-shadow-resolution 2048 --queue 64 || { echo "$pass passed, $fail failed"; exit 1; }
 MAIN=$PID
 MAIN_URL=$URL
@@ -195,7 +209,9 @@ check "405 has Allow: POST" [ "$(hdr e405 Allow)" = POST ]
 check "405 is problem+json" problem e405 405 -
 c=$(curl -s -o /dev/null -D "$T/e405b.hdr" -w '%{http_code}' -X POST --data x "$URL/healthz")
 check "POST /healthz 405 with Allow GET" sh -c "[ $c = 405 ] && tr -d '\r' <'$T/e405b.hdr' | grep -qi '^Allow:.*GET'"
-c=$(post e415 "$T/small.json" -H 'Content-Type: text/plain'); check "text/plain body 415" [ "$c" = 415 ]
+c=$(curl -s --max-time 30 -o "$T/e415.body" -D "$T/e415.hdr" -w '%{http_code}' -H 'Content-Type: text/plain' \
+	--data-binary "@$T/small.json" "$URL/v1/render")
+check "text/plain body 415" [ "$c" = 415 ]
 check "415 is problem+json" problem e415 415 -
 c=$(curl -s -o /dev/null -w '%{http_code}' --max-time 30 --data-binary "@$T/small.json" -H 'Content-Type:' "$URL/v1/render")
 check "missing Content-Type 415" [ "$c" = 415 ]
@@ -246,15 +262,25 @@ check "Accept changes the ETag" [ "$(hdr rexr ETag)" != "$etag" ]
 c=$(post rexr2 "$T/exr.json"); check "output.format exr: image/x-exr" sh -c "[ $c = 200 ] && [ '$(hdr rexr2 Content-Type)' = image/x-exr ]"
 c=$(post rpng "$T/small.json" -H 'Accept: image/png, image/x-exr;q=0.5'); check "Accept preferring PNG: image/png" [ "$(hdr rpng Content-Type)" = image/png ]
 c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
+c=$(post mpath "$T/model-path.json"); check "model by path under --asset-root 200" [ "$c" = 200 ]
+c=$(post mesc "$T/model-escape.json"); check "model path escaping --asset-root 400" [ "$c" = 400 ]
+check "escaping path problem names the member" problem mesc 400 /objects/0/path
+c=$(curl -s --max-time 60 -o "$T/mp.body" -D "$T/mp.hdr" -w '%{http_code}' -F "scene=@$T/model-part.json;type=application/json" \
+	-F "mesh=@$T/assets/tri.obj;type=application/octet-stream" "$URL/v1/render")
+check "multipart/form-data scene + model part 200" sh -c "[ $c = 200 ] && [ '$(png_size "$T/mp.body")' = 64x64 ]"
+c=$(curl -s --max-time 60 -o "$T/mp2.body" -D "$T/mp2.hdr" -w '%{http_code}' -F "mesh=@$T/assets/tri.obj" "$URL/v1/render")
+check "multipart without a scene part 400" [ "$c" = 400 ]
 
 # -- 20 concurrent requests
+cpids=""
 i=0
 while [ $i -lt 20 ]; do
 	curl -s --max-time 120 -o "$T/c$i.png" -w '%{http_code}' -H 'Content-Type: application/json' \
 		--data-binary "@$T/small.json" "$URL/v1/render" >"$T/c$i.code" &
+	cpids="$cpids $!"
 	i=$((i + 1))
 done
-wait
+wait $cpids
 bad=0
 i=0
 while [ $i -lt 20 ]; do
@@ -293,27 +319,47 @@ check "RSS bounded over $REPS requests (< 48 MiB growth after the first 100)" [ 
 
 # ==== flood: one worker, queue of 2 ====
 echo "# starting the flood daemon"
-if start flood --workers 1 --queue 2; then
+# The queue bound comes from the environment here, to cover UMBRA_* variables.
+UMBRA_QUEUE=2
+export UMBRA_QUEUE
+start flood --workers 1
+ok_flood=$?
+unset UMBRA_QUEUE
+if [ $ok_flood -eq 0 ]; then
 	FLOOD=$PID
 	# Priority: occupy the worker, queue bulk then interactive: the interactive one ends first.
-	curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' --data-binary "@$T/slow.json" "$URL/v1/render" &
-	sleep 0.3
+	# Only meaningful when the occupying render outlasts the queueing (it does on lavapipe).
+	rm -f "$T/order"
+	(curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' --data-binary "@$T/slower.json" \
+		"$URL/v1/render"; echo "occupier $(date +%s%N)" >>"$T/order") &
+	cpids="$!"
+	sleep 0.15
 	(curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' -H 'X-Priority: bulk' \
-		--data-binary "@$T/slow.json" "$URL/v1/render"; echo bulk >>"$T/order") &
-	sleep 0.3
+		--data-binary "@$T/slow.json" "$URL/v1/render"; echo "bulk $(date +%s%N)" >>"$T/order") &
+	cpids="$cpids $!"
+	sleep 0.15
+	t_int=$(date +%s%N)
 	(curl -s --max-time 120 -o /dev/null -H 'Content-Type: application/json' -H 'X-Priority: interactive' \
-		--data-binary "@$T/small.json" "$URL/v1/render"; echo interactive >>"$T/order") &
-	wait
-	check "interactive served before queued bulk" [ "$(head -n 1 "$T/order")" = interactive ]
+		--data-binary "@$T/small.json" "$URL/v1/render"; echo "interactive $(date +%s%N)" >>"$T/order") &
+	cpids="$cpids $!"
+	wait $cpids
+	t_occ=$(awk '$1 == "occupier" { print $2 }' "$T/order")
+	if [ "$t_occ" -lt "$t_int" ]; then
+		ok "interactive served before queued bulk # SKIP renders too fast to queue behind"
+	else
+		check "interactive served before queued bulk" [ "$(grep -v occupier "$T/order" | head -n 1 | cut -d' ' -f1)" = interactive ]
+	fi
 
 	# Flood: 16 at once -> 1 rendering + 2 queued; the rest 503 at once with Retry-After.
+	cpids=""
 	i=0
 	while [ $i -lt 16 ]; do
 		curl -s --max-time 120 -o "$T/f$i.body" -D "$T/f$i.hdr" -w '%{http_code}' -H 'Content-Type: application/json' \
 			--data-binary "@$T/slow.json" "$URL/v1/render" >"$T/f$i.code" &
+		cpids="$cpids $!"
 		i=$((i + 1))
 	done
-	wait
+	wait $cpids
 	n200=0; n503=0; other=0; noretry=0
 	i=0
 	while [ $i -lt 16 ]; do
@@ -337,9 +383,18 @@ fi
 
 # ==== deadline: --deadline-ms 1 ====
 echo "# starting the deadline daemon"
-if start deadline --workers 1 --deadline-ms 1; then
-	c=$(post d1 "$T/small.json"); check "render past --deadline-ms: 504" [ "$c" = 504 ]
+if start deadline --workers 1 --deadline-ms 1 --log-format json; then
+	c=$(post d1 "$T/small.json" -H 'X-Request-Id: deadline-1'); check "render past --deadline-ms: 504" [ "$c" = 504 ]
 	check "504 is problem+json" problem d1 504 -
+	check "--log-format json: every line is a JSON object; the access line has the fields" python3 - "$T/deadline.log" <<'PY'
+import json, sys
+ok = False
+for line in open(sys.argv[1]):
+    d = json.loads(line)
+    if d.get("request_id") == "deadline-1":
+        ok = d["status"] == 504 and d["method"] == "POST" and d["route"] == "/v1/render" and "ms" in d and "bytes" in d
+sys.exit(0 if ok else 1)
+PY
 	stop deadline $PID
 fi
 
@@ -347,10 +402,12 @@ fi
 URL=$MAIN_URL
 get metrics /metrics >/dev/null
 base=$(metric umbra_queue_wait_seconds_count)
+cpids=""
 i=0
 while [ $i -lt 8 ]; do
 	curl -s --max-time 120 -o "$T/t$i.png" -w '%{http_code}' -H 'Content-Type: application/json' \
 		--data-binary "@$T/slow.json" "$URL/v1/render" >"$T/t$i.code" &
+	cpids="$cpids $!"
 	i=$((i + 1))
 done
 # Wait until all 8 are accepted (queued or taken by a worker), then SIGTERM.
@@ -367,6 +424,7 @@ c=$(curl -s -o /dev/null -w '%{http_code}' --max-time 5 "$URL/readyz")
 check "after SIGTERM no new connection is ready" [ "$c" != 200 ]
 wait $MAIN
 rc=$?
+wait $cpids
 bad=0
 i=0
 while [ $i -lt 8 ]; do

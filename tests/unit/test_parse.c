@@ -239,12 +239,12 @@ static const struct bad bad_docs[] = {
 	{BASE ",'turntable':{'frames':0}}", 400, "/turntable/frames", "between 1 and 1024"},
 	{BASE ",'turntable':{'frames':4,'elevation':100}}", 400, "/turntable/elevation", "between -90 and 90"},
 	/* a 400 anywhere wins over a 422 found earlier */
-	{"{" C ",'objects':[{'shape':'model','path':'a.glb'}],'lights':[{'type':'spot'}]}", 400,
+	{BASE ",'turntable':{'frames':4},'lights':[{'type':'spot'}]}", 400,
 	 "/lights/0/direction", "required"},
 	/* 422: valid, but unsupported or over a limit */
-	{"{" C ",'objects':[{'shape':'model','path':'models/a.glb'}]}", 422, "/objects/0/shape", "not supported yet"},
-	{"{" C ",'objects':[{'shape':'model','data':'Z2xURg==','format':'glb'}]}", 422, "/objects/0/shape",
-	 "not supported yet"},
+	{"{" C ",'objects':[{'shape':'model','path':'models/a.glb'}]}", 400, "/objects/0/path", "no asset root configured"},
+	{"{" C ",'objects':[{'shape':'model','data':'Z2xURg==','format':'glb'}]}", 400, "/objects/0/data",
+	 "could not be imported"},
 	{BASE ",'views':[{'position':[0,0,5]},{'position':[5,0,0]}]}", 422, "/views", "not supported yet"},
 	{BASE ",'turntable':{'frames':8,'elevation':20}}", 422, "/turntable", "not supported yet"},
 	{BASE ",'materials':{'t':{'base_color_texture':'iVBORw0KGgo='}}}", 422, "/materials/t/base_color_texture",

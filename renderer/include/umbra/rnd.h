@@ -56,6 +56,13 @@ enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYL
 
 enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK };
 
+/* A decoded texture: RGBA8, rows top to bottom, colour channels sRGB-encoded (as in PNG/JPEG
+ * files and glTF base-colour textures), alpha linear. */
+struct rnd_texture {
+	const uint8_t *rgba;
+	uint32_t width, height;
+};
+
 struct rnd_material {
 	float base_color[4];  /* linear RGBA, default 0.8 0.8 0.8 1 */
 	float roughness;      /* 0.5 */
@@ -64,6 +71,7 @@ struct rnd_material {
 	enum rnd_alpha_mode alpha_mode;
 	float alpha_cutoff;   /* 0.5 */
 	bool shadow_catcher;  /* not drawn; only received shadows show */
+	const struct rnd_texture *base_color_texture; /* NULL = none; multiplies base_color, sampled with the uvs */
 };
 
 struct rnd_object {
@@ -98,8 +106,8 @@ struct rnd_shadow {
 	enum rnd_filter filter;       /* AUTO */
 	uint32_t resolution;          /* 64..8192, 0 = renderer */
 	uint32_t pcf_radius;          /* 0..5, default 1 */
-	bool bias_set;                /* false = renderer defaults for the three below */
-	float bias_constant, bias_slope, bias_normal; /* normal offset in texels */
+	bool bias_set;                /* the caller gave `bias` (informational: the values are always used) */
+	float bias_constant, bias_slope, bias_normal; /* defaults 1, 1.75, 1.5; normal offset in texels */
 	enum rnd_dir_mode dir_mode;   /* AUTO */
 	uint32_t cascades;            /* 1..4, 0 = renderer (4) */
 	float split_lambda;           /* 0..1, default 0.75 */
@@ -180,8 +188,12 @@ struct rnd_environment {
 };
 
 struct rnd_scene {
-	uint32_t width, height;
+	uint32_t width, height;   /* of one view */
 	struct rnd_camera camera;
+	/* Several views of one scene (contract `views` / `turntable`): when view_count > 0 these
+	 * cameras replace `camera` and the image is a sheet of ceil(sqrt(n)) columns, row-major,
+	 * each view width x height; shadow maps that do not depend on the camera render once. */
+	const struct rnd_camera *views; uint32_t view_count;
 	struct rnd_environment environment;
 	const struct rnd_material *materials; uint32_t material_count;
 	const struct rnd_object *objects;     uint32_t object_count;
@@ -205,7 +217,8 @@ uint64_t rnd_object_triangle_count(const struct rnd_object *o);
 #define RND_MAX_AOV_PLANES 40
 
 struct rnd_image {
-	uint32_t width, height;
+	uint32_t width, height;   /* the whole sheet when the scene has several views */
+	uint32_t view_count, view_columns, view_width, view_height; /* 1, 1, width, height for one view */
 	enum rnd_pixel_format format;
 	size_t stride;        /* bytes per row of pixels */
 	void *pixels;         /* RGBA, rows top to bottom */

@@ -1,0 +1,158 @@
+/*
+ * api/image_decode — PNG (libpng's simplified API) and JPEG (libjpeg-turbo) to RGBA8, for the
+ * base-colour textures of imported models (and of materials). See model.h.
+ *
+ * Both decoders check the header's size against max_pixels before allocating, so a small file
+ * that claims to be 100000x100000 costs nothing. libjpeg reports errors through longjmp; the
+ * error manager below turns that into an API_ERR with the library's message.
+ */
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <png.h>
+#include <jpeglib.h>
+#include "model.h"
+
+#define DEFAULT_MAX_PIXELS (64ull << 20)
+
+static enum api_result err_set(char *err, size_t n, const char *fmt, const char *arg)
+{
+	if (err && n) snprintf(err, n, fmt, arg);
+	return API_ERR;
+}
+
+static enum api_result decode_png(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                  uint32_t *w, uint32_t *h, char *err, size_t errsize)
+{
+	png_image img;
+	memset(&img, 0, sizeof img);
+	img.version = PNG_IMAGE_VERSION;
+	if (!png_image_begin_read_from_memory(&img, data, len))
+		return err_set(err, errsize, "PNG: %s", img.message);
+	if (!img.width || !img.height || (uint64_t)img.width * img.height > max_pixels) {
+		png_image_free(&img);
+		return err_set(err, errsize, "PNG: %s", "the image is empty or over the texture size limit");
+	}
+	img.format = PNG_FORMAT_RGBA;
+	size_t size = PNG_IMAGE_SIZE(img);
+	uint8_t *px = malloc(size);
+	if (!px) {
+		png_image_free(&img);
+		return err_set(err, errsize, "PNG: %s", "out of memory");
+	}
+	/* A NULL background: alpha is kept, not composited. */
+	if (!png_image_finish_read(&img, NULL, px, 0, NULL)) {
+		free(px);
+		png_image_free(&img);
+		return err_set(err, errsize, "PNG: %s", img.message);
+	}
+	*w = img.width;
+	*h = img.height;
+	*rgba = px;
+	png_image_free(&img);
+	return API_OK;
+}
+
+struct jpeg_err {
+	struct jpeg_error_mgr mgr;
+	jmp_buf jump;
+	char msg[JMSG_LENGTH_MAX];
+};
+
+static void jpeg_error_exit(j_common_ptr cinfo)
+{
+	struct jpeg_err *e = (struct jpeg_err *)cinfo->err;
+	(*cinfo->err->format_message)(cinfo, e->msg);
+	longjmp(e->jump, 1);
+}
+
+/* Warnings (corrupt-data recoveries) are not fatal and not printed on stderr. */
+static void jpeg_quiet(j_common_ptr cinfo, int level)
+{
+	(void)cinfo;
+	(void)level;
+}
+
+static enum api_result decode_jpeg(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                   uint32_t *w, uint32_t *h, char *err, size_t errsize)
+{
+	struct jpeg_decompress_struct cinfo;
+	struct jpeg_err jerr;
+	/* volatile: written after setjmp and read after a longjmp back to it. */
+	uint8_t *volatile px = NULL;
+	uint8_t *volatile row = NULL;
+	memset(&cinfo, 0, sizeof cinfo);
+	cinfo.err = jpeg_std_error(&jerr.mgr);
+	jerr.mgr.error_exit = jpeg_error_exit;
+	jerr.mgr.emit_message = jpeg_quiet;
+	jerr.msg[0] = 0;
+	if (setjmp(jerr.jump)) {
+		jpeg_destroy_decompress(&cinfo);
+		free(px);
+		free(row);
+		return err_set(err, errsize, "JPEG: %s", jerr.msg);
+	}
+	jpeg_create_decompress(&cinfo);
+	jpeg_mem_src(&cinfo, data, (unsigned long)len);
+	jpeg_read_header(&cinfo, TRUE);
+	/* CMYK comes out as-is; everything else as RGB. */
+	int cmyk = cinfo.jpeg_color_space == JCS_CMYK || cinfo.jpeg_color_space == JCS_YCCK;
+	cinfo.out_color_space = cmyk ? JCS_CMYK : JCS_RGB;
+	uint64_t npx = (uint64_t)cinfo.image_width * cinfo.image_height;
+	if (!npx || npx > max_pixels) {
+		jpeg_destroy_decompress(&cinfo);
+		return err_set(err, errsize, "JPEG: %s", "the image is empty or over the texture size limit");
+	}
+	jpeg_start_decompress(&cinfo);
+	uint32_t width = cinfo.output_width, height = cinfo.output_height;
+	int comps = cinfo.output_components;
+	px = malloc((size_t)width * height * 4);
+	row = malloc((size_t)width * (size_t)comps);
+	if (!px || !row) {
+		jpeg_destroy_decompress(&cinfo);
+		free(px);
+		free(row);
+		return err_set(err, errsize, "JPEG: %s", "out of memory");
+	}
+	while (cinfo.output_scanline < height) {
+		uint32_t y = cinfo.output_scanline;
+		JSAMPROW rows[1] = {row};
+		if (jpeg_read_scanlines(&cinfo, rows, 1) != 1) break;
+		uint8_t *d = px + (size_t)y * width * 4;
+		for (uint32_t x = 0; x < width; x++, d += 4) {
+			const uint8_t *s = row + (size_t)x * (size_t)comps;
+			if (comps == 1) {
+				d[0] = d[1] = d[2] = s[0];
+			} else if (comps == 4) {
+				/* Adobe CMYK JPEGs store inverted values: R = C*K/255 on the stored bytes. */
+				d[0] = (uint8_t)(s[0] * s[3] / 255);
+				d[1] = (uint8_t)(s[1] * s[3] / 255);
+				d[2] = (uint8_t)(s[2] * s[3] / 255);
+			} else {
+				d[0] = s[0]; d[1] = s[1]; d[2] = s[2];
+			}
+			d[3] = 255;
+		}
+	}
+	jpeg_finish_decompress(&cinfo);
+	jpeg_destroy_decompress(&cinfo);
+	free(row);
+	*w = width;
+	*h = height;
+	*rgba = px;
+	return API_OK;
+}
+
+enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                 uint32_t *width, uint32_t *height, char *err, size_t errsize)
+{
+	*rgba = NULL;
+	*width = *height = 0;
+	if (!max_pixels) max_pixels = DEFAULT_MAX_PIXELS;
+	if (data && len >= 8 && !memcmp(data, "\x89PNG\r\n\x1a\n", 8))
+		return decode_png(data, len, max_pixels, rgba, width, height, err, errsize);
+	if (data && len >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff)
+		return decode_jpeg(data, len, max_pixels, rgba, width, height, err, errsize);
+	return err_set(err, errsize, "%s", "the image is neither PNG nor JPEG");
+}

@@ -1,0 +1,80 @@
+/*
+ * api/model — imported 3D models (contract shape "model"): glb, self-contained gltf, obj, stl,
+ * ply through the Assimp C API, base-colour textures through api/image_decode.c, and a bounded
+ * LRU cache of imported models keyed by their bytes.
+ *
+ * Usage (api/scene_parse.c does this for every model object):
+ *   struct api_model *m; char err[400];
+ *   if (api_model_get(bytes, len, API_MODEL_SNIFF, cache_bytes, &m, err, sizeof err) != API_OK) 400 with err;
+ *   ...m->instances[i] -> one rnd_object each, m->materials[...] appended to the scene...
+ *   api_model_release(m);          // when the scene that uses it is freed
+ *
+ * Ownership: api_model_get() hands you one reference; release it with api_model_release()
+ * (NULL-safe). A model is immutable once returned: every array (geometry, materials, textures)
+ * lives as long as the model, so an rnd_scene may point straight into it while it holds the
+ * reference, even after the cache has evicted the entry.
+ *
+ * Threading: every function is safe to call from several threads. The cache is guarded by one
+ * mutex; imports of different bytes run in parallel except for the Assimp call itself, which
+ * is serialised because Assimp's C API keeps its last error in one global string.
+ */
+#ifndef UMBRA_API_MODEL_H
+#define UMBRA_API_MODEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "api.h"
+
+enum api_model_format {
+	API_MODEL_SNIFF = -1,     /* tell from the bytes */
+	API_MODEL_GLB = 0, API_MODEL_GLTF, API_MODEL_OBJ, API_MODEL_STL, API_MODEL_PLY,
+};
+
+/* One geometry array set (an Assimp mesh, triangles only). */
+struct api_model_mesh {
+	const float *positions;   /* xyz per vertex */
+	const float *normals;     /* xyz per vertex, always present (generated when the file has none) */
+	const float *uvs;         /* uv per vertex (glTF convention: v = 0 at the image's top row), or NULL */
+	const uint32_t *indices;  /* index_count, a multiple of 3, every index < vertex_count */
+	uint32_t vertex_count, index_count;
+	uint32_t material;        /* index into api_model.materials */
+};
+
+/* A node's use of a mesh: one rnd_object. */
+struct api_model_instance {
+	uint32_t mesh;
+	float model[16];          /* node -> model root, column-major (all parent nodes applied) */
+};
+
+struct api_model {
+	const struct api_model_mesh *meshes;       uint32_t mesh_count;
+	const struct api_model_instance *instances; uint32_t instance_count;
+	const struct rnd_material *materials;      uint32_t material_count; /* textures point into the model */
+	uint64_t triangles;       /* over all instances */
+	enum api_model_format format;
+	/* private */
+	size_t bytes_;            /* what the cache charges for it */
+	void *priv_;
+};
+
+/* Imports (or finds in the cache) the model in data[0..len). format API_MODEL_SNIFF tells it
+ * from the bytes. cache_bytes bounds the cache after this insertion (0 = do not cache this
+ * one). Returns API_OK with *out (one reference), or API_ERR with a sentence in err (Assimp's
+ * message or what was wrong with the bytes; never mentions the caller's member names). */
+enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format, uint64_t cache_bytes,
+                              struct api_model **out, char *err, size_t errsize);
+void api_model_release(struct api_model *m);
+
+/* Tells the format from the bytes; API_MODEL_SNIFF when it cannot. */
+enum api_model_format api_model_sniff(const uint8_t *data, size_t len);
+const char *api_model_format_name(enum api_model_format f);
+
+/* ---- image decoding (api/image_decode.c) ---- */
+
+/* Decodes a PNG or JPEG into malloc'd RGBA8 (rows top to bottom, colour as stored, i.e. sRGB).
+ * At most max_pixels pixels (0 = 64 Mi). Returns API_OK with *rgba (you free it), or API_ERR
+ * with a sentence in err. */
+enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                 uint32_t *width, uint32_t *height, char *err, size_t errsize);
+
+#endif

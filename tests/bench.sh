@@ -1,0 +1,28 @@
+#!/bin/sh
+# tests/bench.sh — `make bench`: warm-process medians per stage for the bench scenes, the
+# generated 100k / 1M triangle meshes, the cold CLI, and (when present) the HTTP benchmark.
+# Env: BUILD, SHARED. Numbers go to stdout; nothing here asserts a time.
+set -eu
+BUILD=${BUILD:-build}
+SHARED=${SHARED:-../shared}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+python3 "$SHARED/bench/gen-mesh-scene.py" 100000 >"$tmp/mesh-100k.json"
+python3 "$SHARED/bench/gen-mesh-scene.py" 1000000 >"$tmp/mesh-1m.json"
+echo "== warm process (build/tests/bench)"
+"$BUILD/tests/bench" -n "${BENCH_RUNS:-15}" "$SHARED/bench/thumb-256.json" "$SHARED/bench/thumb-512.json" \
+	"$SHARED/bench/thumb-1024.json" "$SHARED/bench/studio-spots.json" "$SHARED/bench/outdoor-csm.json" "$tmp/mesh-100k.json"
+"$BUILD/tests/bench" -n 5 "$tmp/mesh-1m.json"
+echo
+echo "== cold CLI (new process each: device + pipelines + first-use JIT), thumb-512"
+for i in 1 2 3; do
+	s=$(date +%s%N)
+	"$BUILD/umbra-render" "$SHARED/bench/thumb-512.json" -o "$tmp/cold.png"
+	e=$(date +%s%N)
+	echo "run $i: $(( (e - s) / 1000000 )) ms"
+done
+if [ -x "$BUILD/tests/http_bench" ] && [ -f tests/bench/http_bench.sh ]; then
+	echo
+	echo "== HTTP (umbrad over loopback)"
+	BUILD=$BUILD SHARED=$SHARED sh tests/bench/http_bench.sh
+fi
