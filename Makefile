@@ -51,7 +51,7 @@ deps:
 	@sh deploy/install-deps.sh
 
 # Shaders: SPIR-V embedded as C arrays (spv_<file>_<stage>).
-$(BUILD)/shaders/%.spv.h: shaders/% $(wildcard shaders/*.h) | $(BUILD)/shaders
+$(BUILD)/shaders/%.spv.h: shaders/% $(wildcard shaders/*.h shaders/*.glsl) | $(BUILD)/shaders
 	$(GLSLANG) -V --target-env vulkan1.2 -Ishaders --vn spv_$(subst .,_,$*) -o $@ $< >/dev/null || \
 	  { $(GLSLANG) -V --target-env vulkan1.2 -Ishaders -o /dev/null $<; exit 1; }
 $(BUILD)/shaders:

@@ -44,15 +44,20 @@ struct rnd_image_res {
 };
 
 struct rnd_pipelines {
-	VkDescriptorSetLayout set_layout;
+	VkDescriptorSetLayout set_layout;     /* set 0: frame, materials, lights, views, shadow maps */
+	VkDescriptorSetLayout texture_layout; /* set 1: the draw's base-colour texture */
 	VkPipelineLayout layout;
 	VkSampler shadow_sampler;            /* nearest, clamp to border white (depth 1 = lit) */
+	VkSampler texture_sampler;           /* material textures: linear, repeat */
 	/* [cull: 0 none, 1 back] */
 	VkPipeline shadow[2];
 	/* [msaa: 0 = 1x, 1 = 4x][cull] depth-only pre-pass of the camera view */
 	VkPipeline prepass[2][2];
+	/* alpha-tested (alpha_mode MASK) variants of the two depth-only passes */
+	VkPipeline shadow_masked[2];
+	VkPipeline prepass_masked[2][2];
 	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
-	VkShaderModule mesh_vs, mesh_fs;
+	VkShaderModule mesh_vs, mesh_fs, aov_fs;
 	pthread_mutex_t mu;
 	uint32_t variant_count;
 	struct rnd_main_variant {
@@ -60,6 +65,7 @@ struct rnd_pipelines {
 			uint32_t format;             /* enum rnd_pixel_format */
 			uint32_t samples;            /* 1 or 4 */
 			uint32_t cull_back;
+			uint32_t aov;                /* 1 = the AOV pass (aov.frag, 4 x RGBA32F, 1 sample) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;

@@ -12,6 +12,9 @@
 #include "shadow.vert.spv.h"
 #include "mesh.vert.spv.h"
 #include "mesh.frag.spv.h"
+#include "aov.frag.spv.h"
+#include "masked.vert.spv.h"
+#include "masked.frag.spv.h"
 
 static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
                                    VkShaderModule *out, struct rnd_error *err)
@@ -41,9 +44,19 @@ static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *e
 	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &p->set_layout)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout");
 	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, p->set_layout, "umbra frame set layout");
+	/* Set 1: one texture per draw (lavapipe has no dynamic indexing of sampler arrays). */
+	VkDescriptorSetLayoutBinding tb = {UMBRA_BINDING_BASE_TEXTURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
+	                                   VK_SHADER_STAGE_FRAGMENT_BIT, NULL};
+	VkDescriptorSetLayoutCreateInfo tci0 = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 1, .pBindings = &tb,
+	};
+	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &tci0, NULL, &p->texture_layout)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (texture)");
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, p->texture_layout, "umbra texture set layout");
+	VkDescriptorSetLayout sets[2] = {p->set_layout, p->texture_layout};
 	VkPushConstantRange pcr = {stages, 0, sizeof(struct umbra_push)};
 	VkPipelineLayoutCreateInfo lci = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 1, .pSetLayouts = &p->set_layout,
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 2, .pSetLayouts = sets,
 		.pushConstantRangeCount = 1, .pPushConstantRanges = &pcr,
 	};
 	if ((vr = vkCreatePipelineLayout(ctx->device, &lci, NULL, &p->layout)) != VK_SUCCESS)
@@ -61,6 +74,15 @@ static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *e
 	if ((vr = vkCreateSampler(ctx->device, &sci, NULL, &p->shadow_sampler)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateSampler");
 	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->shadow_sampler, "umbra shadow sampler");
+	/* Material textures: bilinear, repeat (glTF's default wrap); no mipmaps are built. */
+	VkSamplerCreateInfo tci = {
+		.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
+		.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST, .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT,
+		.addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT, .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = 0.0f,
+	};
+	if ((vr = vkCreateSampler(ctx->device, &tci, NULL, &p->texture_sampler)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreateSampler (textures)");
+	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->texture_sampler, "umbra texture sampler");
 	return RND_OK;
 }
 
@@ -72,6 +94,8 @@ struct pipe_desc {
 	bool cull_back;
 	bool shadow;                /* depth bias + clamp, LESS compare; else reversed-Z */
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
+	bool uv_only;               /* vertex input: position (0) and uv (2) */
+	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	const VkSpecializationInfo *spec;  /* fragment stage */
 	const char *name;
 };
@@ -90,10 +114,19 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		{1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, nrm)},
 		{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
 	};
+	VkVertexInputAttributeDescription va_uv[2] = {va[0], va[2]};
+	uint32_t ncolor = d->color == VK_FORMAT_UNDEFINED ? 0 : d->color_count ? d->color_count : 1;
+	VkFormat formats[UMBRA_AOV_ATTACHMENTS];
+	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
+	for (uint32_t i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) {
+		formats[i] = d->color;
+		cbas[i] = (VkPipelineColorBlendAttachmentState){.colorWriteMask = 0xf};
+	}
 	VkPipelineVertexInputStateCreateInfo vi = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
 		.vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
-		.vertexAttributeDescriptionCount = d->shadow ? 1 : 3, .pVertexAttributeDescriptions = va,
+		.vertexAttributeDescriptionCount = d->uv_only ? 2 : d->shadow ? 1 : 3,
+		.pVertexAttributeDescriptions = d->uv_only ? va_uv : va,
 	};
 	VkPipelineInputAssemblyStateCreateInfo ia = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO, .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
@@ -123,10 +156,9 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL
 		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
 	};
-	VkPipelineColorBlendAttachmentState cba = {.colorWriteMask = 0xf};
 	VkPipelineColorBlendStateCreateInfo cb = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-		.attachmentCount = d->color != VK_FORMAT_UNDEFINED ? 1 : 0, .pAttachments = &cba,
+		.attachmentCount = ncolor, .pAttachments = cbas,
 	};
 	VkDynamicState dyn[3] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_DEPTH_BIAS};
 	VkPipelineDynamicStateCreateInfo dy = {
@@ -134,7 +166,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	};
 	VkPipelineRenderingCreateInfo rci = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
-		.colorAttachmentCount = d->color != VK_FORMAT_UNDEFINED ? 1 : 0, .pColorAttachmentFormats = &d->color,
+		.colorAttachmentCount = ncolor, .pColorAttachmentFormats = formats,
 		.depthAttachmentFormat = d->depth,
 	};
 	VkGraphicsPipelineCreateInfo ci = {
@@ -158,12 +190,30 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 {
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r;
-	VkShaderModule shadow_vs = VK_NULL_HANDLE;
+	VkShaderModule shadow_vs = VK_NULL_HANDLE, masked_vs = VK_NULL_HANDLE, masked_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
 	if ((r = make_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
 	if ((r = make_module(ctx, spv_mesh_vert, sizeof spv_mesh_vert, "mesh.vert", &p->mesh_vs, err)) != RND_OK) goto fail;
 	if ((r = make_module(ctx, spv_mesh_frag, sizeof spv_mesh_frag, "mesh.frag", &p->mesh_fs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_aov_frag, sizeof spv_aov_frag, "aov.frag", &p->aov_fs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_masked_vert, sizeof spv_masked_vert, "masked.vert", &masked_vs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_masked_frag, sizeof spv_masked_frag, "masked.frag", &masked_fs, err)) != RND_OK) goto fail;
+	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
+	for (int cull = 0; cull < 2; cull++) {
+		struct pipe_desc d = {
+			.vs = masked_vs, .fs = masked_fs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
+			.cull_back = cull, .shadow = true, .uv_only = true, .name = "shadow depth (alpha mask)",
+		};
+		if ((r = make_pipeline(ctx, &d, &p->shadow_masked[cull], err)) != RND_OK) goto fail;
+		for (int m = 0; m < 2; m++) {
+			struct pipe_desc dp = {
+				.vs = masked_vs, .fs = masked_fs, .color = VK_FORMAT_UNDEFINED, .depth = RND_DEPTH_FORMAT,
+				.samples = m ? 4 : 1, .cull_back = cull, .uv_only = true, .name = "depth prepass (alpha mask)",
+			};
+			if ((r = make_pipeline(ctx, &dp, &p->prepass_masked[m][cull], err)) != RND_OK) goto fail;
+		}
+	}
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
 			.vs = shadow_vs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
@@ -185,11 +235,15 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 			if ((r = make_pipeline(ctx, &d, &p->prepass[m][cull], err)) != RND_OK) goto fail;
 		}
 	}
-	/* The shadow pipelines keep what they need from their module. */
+	/* These pipelines keep what they need from their modules. */
+	vkDestroyShaderModule(ctx->device, masked_fs, NULL);
+	vkDestroyShaderModule(ctx->device, masked_vs, NULL);
 	vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
 	return RND_OK;
 
 fail:
+	if (masked_fs) vkDestroyShaderModule(ctx->device, masked_fs, NULL);
+	if (masked_vs) vkDestroyShaderModule(ctx->device, masked_vs, NULL);
 	if (shadow_vs) vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
 	rnd_pipelines_release(ctx);
 	return r;
@@ -223,6 +277,14 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = true, .name = name,
 	};
+	if (key->aov) {
+		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
+		d.fs = p->aov_fs;
+		d.color = VK_FORMAT_R32G32B32A32_SFLOAT;
+		d.color_count = UMBRA_AOV_ATTACHMENTS;
+		d.samples = 1;
+		d.after_prepass = false;
+	}
 	VkPipeline pipe;
 	if ((r = make_pipeline(ctx, &d, &pipe, err)) != RND_OK) goto out;
 	p->variants[p->variant_count].key = *key;
@@ -249,14 +311,20 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 	for (uint32_t i = 0; i < p->variant_count; i++) vkDestroyPipeline(ctx->device, p->variants[i].pipeline, NULL);
 	for (int c = 0; c < 2; c++) {
 		if (p->shadow[c]) vkDestroyPipeline(ctx->device, p->shadow[c], NULL);
-		for (int m = 0; m < 2; m++)
+		if (p->shadow_masked[c]) vkDestroyPipeline(ctx->device, p->shadow_masked[c], NULL);
+		for (int m = 0; m < 2; m++) {
 			if (p->prepass[m][c]) vkDestroyPipeline(ctx->device, p->prepass[m][c], NULL);
+			if (p->prepass_masked[m][c]) vkDestroyPipeline(ctx->device, p->prepass_masked[m][c], NULL);
+		}
 	}
+	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
+	if (p->texture_sampler) vkDestroySampler(ctx->device, p->texture_sampler, NULL);
 	if (p->mesh_fs) vkDestroyShaderModule(ctx->device, p->mesh_fs, NULL);
 	if (p->mesh_vs) vkDestroyShaderModule(ctx->device, p->mesh_vs, NULL);
 	if (p->shadow_sampler) vkDestroySampler(ctx->device, p->shadow_sampler, NULL);
 	if (p->layout) vkDestroyPipelineLayout(ctx->device, p->layout, NULL);
 	if (p->set_layout) vkDestroyDescriptorSetLayout(ctx->device, p->set_layout, NULL);
+	if (p->texture_layout) vkDestroyDescriptorSetLayout(ctx->device, p->texture_layout, NULL);
 	pthread_mutex_destroy(&p->mu);
 	memset(p, 0, sizeof *p);
 }

@@ -15,41 +15,10 @@
 #include <time.h>
 #include "mesh.h"
 #include "plan.h"
-#include "slot.h"
+#include "record.h"
 
 /* How long a submitted render may take before the device is considered hung. */
 #define RND_FENCE_TIMEOUT_NS (120ull * 1000 * 1000 * 1000)
-
-struct draw {
-	uint32_t first_index, index_count;
-	struct rnd_aabb bounds;
-	uint32_t material;
-	uint32_t flags;
-	bool cast, cull_back;
-	bool closed;        /* sphere / box / cylinder: back faces never show from outside */
-	bool single_sided;  /* double_sided: false */
-};
-
-/* Culling back faces of a closed primitive changes nothing in the picture as long as the
- * viewer is outside it and it lies wholly beyond the near plane; it halves the triangles
- * lavapipe rasterises and shades. */
-static bool camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b)
-{
-	for (int i = 0; i < 8; i++) {
-		float p[3] = {i & 1 ? b->max[0] : b->min[0], i & 2 ? b->max[1] : b->min[1], i & 4 ? b->max[2] : b->min[2]};
-		float d[3];
-		rnd_v3_sub(d, p, cam->pos);
-		if (rnd_v3_dot(d, cam->fwd) <= cam->znear * 1.01f) return false;
-	}
-	return true;
-}
-
-static bool point_outside(const float p[3], const struct rnd_aabb *b, float pad)
-{
-	for (int k = 0; k < 3; k++)
-		if (p[k] < b->min[k] - pad || p[k] > b->max[k] + pad) return true;
-	return false;
-}
 
 static double now_ms(void)
 {
@@ -77,29 +46,17 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 		return rnd_fail(err, RND_ERR_INVALID, "debug_light %u names no light", sc->output.debug_light);
 	if (sc->output.debug == RND_DEBUG_ATLAS)
 		return rnd_fail(err, RND_ERR_INVALID, "debug view 'atlas' is not implemented by this renderer yet");
-	if (sc->output.aovs)
-		return rnd_fail(err, RND_ERR_INVALID, "AOVs are not implemented by this renderer yet");
+	if (sc->output.aovs && sc->output.pixels != RND_PIXELS_RGBA32F)
+		return rnd_fail(err, RND_ERR_INVALID, "AOVs need the linear RGBA32F output (EXR)");
+	uint32_t planes = (sc->output.aovs & RND_AOV_DEPTH ? 1 : 0) + (sc->output.aovs & RND_AOV_NORMAL ? 3 : 0) +
+	                  (sc->output.aovs & RND_AOV_ALBEDO ? 3 : 0) + (sc->output.aovs & RND_AOV_SHADOW ? sc->light_count : 0);
+	if (planes > RND_MAX_AOV_PLANES)
+		return rnd_fail(err, RND_ERR_LIMIT, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)", planes,
+		                RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
+	for (uint32_t i = 0; i < sc->view_count; i++)
+		if (!sc->views) return rnd_fail(err, RND_ERR_INVALID, "view_count %u with no views", sc->view_count);
+	if (sc->view_count > 1024) return rnd_fail(err, RND_ERR_LIMIT, "%u views: at most 1024", sc->view_count);
 	return RND_OK;
-}
-
-static void image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
-                          VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                          VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)
-{
-	VkImageMemoryBarrier2 b = {
-		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
-		.srcStageMask = src_stage, .srcAccessMask = src_access, .dstStageMask = dst_stage, .dstAccessMask = dst_access,
-		.oldLayout = from, .newLayout = to, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .image = img, .subresourceRange = {aspect, 0, 1, 0, layers},
-	};
-	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
-	vkCmdPipelineBarrier2(cmd, &di);
-}
-
-static float srgb_encode(float c)
-{
-	c = c < 0 ? 0 : c > 1 ? 1 : c;
-	return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
 /* 32 Poisson-disk taps in the unit disk (PCSS blocker search and filtering). */
@@ -119,7 +76,7 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 /* Fills the uniform/storage regions and points the slot's descriptor set at them. */
 static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                     const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                    struct rnd_error *err)
+                                    const struct rnd_texture *const *tex, uint32_t ntex, struct rnd_error *err)
 {
 	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
 	if (ctx->props.limits.minUniformBufferOffsetAlignment > al) al = ctx->props.limits.minUniformBufferOffsetAlignment;
@@ -180,7 +137,10 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		memcpy(m[i].emissive, in->emissive, sizeof in->emissive);
 		m[i].emissive[3] = in->roughness;
 		m[i].params[0] = in->metallic;
-		m[i].params[1] = in->alpha_cutoff;
+		m[i].params[1] = in->alpha_mode == RND_ALPHA_MASK ? in->alpha_cutoff : -1.0f;
+		m[i].tex[1] = in->alpha_mode == RND_ALPHA_MASK;
+		m[i].tex[0] = in->base_color_texture != NULL;
+		(void)tex; (void)ntex;
 	}
 
 	struct umbra_light *l = (struct umbra_light *)(base + off_light);
@@ -216,6 +176,17 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		{s->params.buf, off_view, nview * sizeof(struct umbra_shadow_view)},
 	};
 	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, s->shadow.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	VkDescriptorImageInfo ti[UMBRA_MAX_TEXTURES];
+	VkWriteDescriptorSet tw[UMBRA_MAX_TEXTURES];
+	for (uint32_t t = 0; t < ntex; t++) {
+		ti[t] = (VkDescriptorImageInfo){ctx->pipes.texture_sampler, s->textures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+		tw[t] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[1 + t],
+			.dstBinding = UMBRA_BINDING_BASE_TEXTURE, .descriptorCount = 1,
+			.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ti[t],
+		};
+	}
+	if (ntex) vkUpdateDescriptorSets(ctx->device, ntex, tw, 0, NULL);
 	VkWriteDescriptorSet w[5];
 	for (int i = 0; i < 5; i++) {
 		w[i] = (VkWriteDescriptorSet){
@@ -228,208 +199,6 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	}
 	vkUpdateDescriptorSets(ctx->device, 5, w, 0, NULL);
 	return RND_OK;
-}
-
-static void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                           const struct rnd_shadow_plan *sp, const struct draw *draws, uint32_t ndraw,
-                           uint32_t *casters_drawn)
-{
-	VkCommandBuffer cmd = s->cmd;
-	uint32_t layers = s->shadow.layers;
-	/* Old contents are never needed: every used layer is cleared. */
-	image_barrier(cmd, s->shadow.img, VK_IMAGE_ASPECT_DEPTH_BIT, layers,
-	              VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-	              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-	uint32_t res = sp->resolution;
-	VkDeviceSize zero = 0;
-	for (uint32_t v = 0; v < sp->view_count; v++) {
-		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
-		VkRenderingAttachmentInfo da = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->shadow_layers[v],
-			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
-		};
-		VkRenderingInfo ri = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {res, res}}, .layerCount = 1,
-			.pDepthAttachment = &da,
-		};
-		vkCmdBeginRendering(cmd, &ri);
-		VkViewport vp = {0, 0, (float)res, (float)res, 0, 1};
-		VkRect2D scissor = {{0, 0}, {res, res}};
-		vkCmdSetViewport(cmd, 0, 1, &vp);
-		vkCmdSetScissor(cmd, 0, 1, &scissor);
-		vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
-		vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
-		vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
-		struct umbra_push push = {0};
-		memcpy(push.view_proj, sp->views[v].view_proj, sizeof push.view_proj);
-		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-		                   sizeof push, &push);
-		int bound = -1;
-		const struct rnd_light *L = &sc->lights[sp->view_light[v]];
-		for (uint32_t i = 0; i < ndraw; i++) {
-			const struct draw *d = &draws[i];
-			if (!d->cast || !d->index_count) continue;
-			if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) continue;
-			int cull = d->single_sided ||
-			           (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
-			if (bound != cull) {
-				vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.shadow[cull]);
-				bound = cull;
-			}
-			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
-			(*casters_drawn)++;
-		}
-		vkCmdEndRendering(cmd);
-	}
-	image_barrier(cmd, s->shadow.img, VK_IMAGE_ASPECT_DEPTH_BIT, layers,
-	              sp->view_count ? VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED,
-	              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-	              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-}
-
-/* The specialization key of this scene's main pass (see mesh.frag). */
-static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
-                     uint32_t ndraw, struct rnd_main_key *k)
-{
-	memset(k, 0, sizeof *k);
-	k->format = (uint32_t)sc->output.pixels;
-	k->samples = sc->output.msaa > 1 ? 4 : 1;
-	for (uint32_t i = 0; i < sc->light_count; i++) {
-		const struct rnd_light_plan *lp = &sp->lights[i];
-		uint32_t type = sc->lights[i].type == RND_LIGHT_DIRECTIONAL ? UMBRA_LIGHT_DIRECTIONAL
-		              : sc->lights[i].type == RND_LIGHT_SPOT ? UMBRA_LIGHT_SPOT : UMBRA_LIGHT_POINT;
-		k->sc[UMBRA_SC_LIGHT_TYPES] |= 1u << type;
-		if (lp->view_count) k->sc[UMBRA_SC_FILTERS] |= 1u << lp->filter;
-		if (type == UMBRA_LIGHT_DIRECTIONAL && lp->view_count > 1) k->sc[UMBRA_SC_CASCADES] = 1;
-	}
-	switch (sc->output.debug) {
-	case RND_DEBUG_SHADOW: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_SHADOW; break;
-	case RND_DEBUG_CASCADES: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_CASCADES; break;
-	case RND_DEBUG_NORMALS: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_NORMALS; break;
-	case RND_DEBUG_DEPTH: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_DEPTH; break;
-	default: break;
-	}
-	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;
-	k->sc[UMBRA_SC_TONEMAP] = k->sc[UMBRA_SC_LINEAR] ? 0
-	                        : sc->output.tonemap == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES
-	                        : sc->output.tonemap == RND_TONEMAP_NONE ? UMBRA_TONEMAP_NONE : UMBRA_TONEMAP_NEUTRAL;
-	for (uint32_t i = 0; i < ndraw; i++)
-		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
-}
-
-static enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                                   const struct rnd_shadow_plan *sp, const struct draw *draws, uint32_t ndraw,
-                                   struct rnd_error *err)
-{
-	struct rnd_main_key key;
-	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
-	main_key(sc, sp, draws, ndraw, &key);
-	for (uint32_t i = 0; i < ndraw; i++) {
-		uint32_t c = draws[i].cull_back;
-		if (!draws[i].index_count || pipes[c]) continue;
-		key.cull_back = c;
-		enum rnd_result r = rnd_pipelines_main(ctx, &key, &pipes[c], err);
-		if (r != RND_OK) return r;
-	}
-	VkCommandBuffer cmd = s->cmd;
-	uint32_t w = sc->width, h = sc->height;
-	bool ms = sc->output.msaa > 1;
-	VkImage target = ms ? s->color_ms.img : s->resolve.img;
-	image_barrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
-	              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-	if (ms)
-		image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
-		              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-	image_barrier(cmd, s->depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	              VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
-	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-
-	/* The background is the requested colour itself (sRGB-encoded for display outputs), not
-	 * tone mapped: a caller asking for white gets 255. */
-	VkClearColorValue clear;
-	const float *bg = sc->environment.background;
-	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
-	for (int k = 0; k < 3; k++) clear.float32[k] = linear ? bg[k] : srgb_encode(bg[k]);
-	clear.float32[3] = sc->output.transparent ? 0.0f : bg[3];
-	if (sc->output.debug == RND_DEBUG_SHADOW) clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
-
-	VkRenderingAttachmentInfo ca = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = ms ? s->color_ms.view : s->resolve.view,
-		.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-		.resolveMode = ms ? VK_RESOLVE_MODE_AVERAGE_BIT : VK_RESOLVE_MODE_NONE,
-		.resolveImageView = ms ? s->resolve.view : VK_NULL_HANDLE,
-		.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-		.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-		.storeOp = ms ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE,
-		.clearValue.color = clear,
-	};
-	VkRenderingAttachmentInfo da = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->depth.view,
-		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-		.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0}, /* reversed Z */
-	};
-	VkRenderingInfo ri = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
-		.colorAttachmentCount = 1, .pColorAttachments = &ca, .pDepthAttachment = &da,
-	};
-	vkCmdBeginRendering(cmd, &ri);
-	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
-	VkRect2D scissor = {{0, 0}, {w, h}};
-	vkCmdSetViewport(cmd, 0, 1, &vp);
-	vkCmdSetScissor(cmd, 0, 1, &scissor);
-	VkDeviceSize zero = 0;
-	vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
-	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
-	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
-	VkPipeline bound = VK_NULL_HANDLE;
-	for (uint32_t i = 0; i < ndraw; i++) {
-		const struct draw *d = &draws[i];
-		if (!d->index_count) continue;
-		VkPipeline p = ctx->pipes.prepass[ms][d->cull_back];
-		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
-	}
-	for (uint32_t i = 0; i < ndraw; i++) {
-		const struct draw *d = &draws[i];
-		if (!d->index_count) continue;
-		VkPipeline p = pipes[d->cull_back];
-		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
-		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-		                   sizeof push, &push);
-		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
-	}
-	vkCmdEndRendering(cmd);
-	return RND_OK;
-}
-
-static void record_readback(struct rnd_slot *s, const struct rnd_scene *sc)
-{
-	VkCommandBuffer cmd = s->cmd;
-	image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-	              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-	              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-	VkBufferImageCopy region = {
-		.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, .imageExtent = {sc->width, sc->height, 1},
-	};
-	vkCmdCopyImageToBuffer(cmd, s->resolve.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
-	VkBufferMemoryBarrier2 bb = {
-		.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT,
-		.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->readback.buf, .size = VK_WHOLE_SIZE,
-	};
-	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
-	vkCmdPipelineBarrier2(cmd, &di);
 }
 
 static size_t pixel_size(enum rnd_pixel_format f)
@@ -478,11 +247,132 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		d->flags = (o->receive_shadows ? UMBRA_DRAW_RECEIVE_SHADOWS : 0) | (catcher ? UMBRA_DRAW_SHADOW_CATCHER : 0);
 		/* A shadow catcher receives shadows and casts none (contract §7). */
 		d->cast = o->cast_shadows && !catcher;
+		d->masked = sc->material_count && sc->materials[o->material].alpha_mode == RND_ALPHA_MASK;
+		d->texture_set = 0; /* set by textures() */
 		d->single_sided = !o->double_sided;
 		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER;
 		d->cull_back = d->single_sided;
 		rnd_aabb_union(bounds, &d->bounds);
 		vbase += v; ibase += x;
+	}
+	return RND_OK;
+}
+
+/* Creates the scene's distinct base-colour textures in the slot and stages their texels. */
+static enum rnd_result textures(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
+                                struct draw *draws, const struct rnd_texture **tex, uint32_t *ntex, struct rnd_error *err)
+{
+	enum rnd_result r;
+	uint32_t n = 0;
+	VkDeviceSize bytes = 0;
+	rnd_slot_drop_textures(ctx, s);
+	for (uint32_t i = 0; i < sc->material_count; i++) {
+		const struct rnd_texture *t = sc->materials[i].base_color_texture;
+		if (!t) continue;
+		uint32_t k = 0;
+		while (k < n && tex[k] != t) k++;
+		if (k < n) continue;
+		if (n == UMBRA_MAX_TEXTURES)
+			return rnd_fail(err, RND_ERR_LIMIT, "more than %d distinct textures in one scene", UMBRA_MAX_TEXTURES);
+		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
+			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", i, t->width, t->height);
+		tex[n++] = t;
+		bytes += (VkDeviceSize)t->width * t->height * 4;
+	}
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct rnd_texture *t = sc->material_count ? sc->materials[sc->objects[i].material].base_color_texture : NULL;
+		for (uint32_t k = 0; t && k < n; k++)
+			if (tex[k] == t) draws[i].texture_set = 1 + k;
+	}
+	*ntex = n;
+	if (!n) return RND_OK;
+	if ((r = rnd_buffer_reserve(ctx, &s->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "slot staging", err)) != RND_OK)
+		return r;
+	VkDeviceSize off = 0;
+	for (uint32_t i = 0; i < n; i++) {
+		char name[48];
+		snprintf(name, sizeof name, "slot %u texture %u", s->index, i);
+		if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, tex[i]->width, tex[i]->height, 1, 1,
+		                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
+		                          name, &s->textures[i], err)) != RND_OK)
+			return r;
+		s->texture_count = i + 1;
+		size_t sz = (size_t)tex[i]->width * tex[i]->height * 4;
+		memcpy((uint8_t *)s->staging.map + off, tex[i]->rgba, sz);
+		off += sz;
+	}
+	return RND_OK;
+}
+
+/* Number of AOV passes the scene's AOVs need (see aov.frag). */
+static uint32_t aov_passes(const struct rnd_scene *sc)
+{
+	if (!sc->output.aovs) return 0;
+	uint32_t n = (sc->output.aovs & RND_AOV_SHADOW) ? sc->light_count : 0;
+	return n <= 8 ? 1 : 1 + (n - 8 + 15) / 16;
+}
+
+/* Turns the AOV attachments in the readback buffer (RGBA32F, sheet-sized each) into named
+ * float planes. */
+static enum rnd_result split_aovs(const struct rnd_scene *sc, const float *rb, size_t att_floats, uint32_t npix,
+                                  struct rnd_image *out, struct rnd_error *err)
+{
+	uint32_t aovs = sc->output.aovs;
+	struct { char name[24]; uint32_t att, comp; } plan[RND_MAX_AOV_PLANES];
+	uint32_t n = 0;
+	if (aovs & RND_AOV_SHADOW) {
+		for (uint32_t i = 0; i < sc->light_count; i++) {
+			uint32_t att = i < 8 ? 2 + i / 4 : 4 + (i - 8) / 4, comp = i % 4;
+			snprintf(plan[n].name, sizeof plan[n].name, "shadow.%u", i);
+			plan[n].att = att; plan[n].comp = comp; n++;
+		}
+	}
+	if (aovs & RND_AOV_DEPTH) { snprintf(plan[n].name, 24, "Z"); plan[n].att = 0; plan[n].comp = 0; n++; }
+	if (aovs & RND_AOV_NORMAL) {
+		const char *nm[3] = {"N.X", "N.Y", "N.Z"};
+		for (int k = 0; k < 3; k++) { snprintf(plan[n].name, 24, "%s", nm[k]); plan[n].att = 0; plan[n].comp = 1 + k; n++; }
+	}
+	if (aovs & RND_AOV_ALBEDO) {
+		const char *nm[3] = {"albedo.R", "albedo.G", "albedo.B"};
+		for (int k = 0; k < 3; k++) { snprintf(plan[n].name, 24, "%s", nm[k]); plan[n].att = 1; plan[n].comp = k; n++; }
+	}
+	for (uint32_t p = 0; p < n; p++) {
+		float *plane = malloc((size_t)npix * sizeof(float));
+		if (!plane) return rnd_fail(err, RND_ERR_OOM, "out of memory for AOV '%s'", plan[p].name);
+		const float *src = rb + plan[p].att * att_floats + plan[p].comp;
+		for (uint32_t i = 0; i < npix; i++) plane[i] = src[(size_t)i * 4];
+		out->aov[p] = plane;
+		memcpy(out->aov_names[p], plan[p].name, sizeof out->aov_names[p]);
+		out->aov_count = p + 1;
+	}
+	return RND_OK;
+}
+
+static enum rnd_result submit_and_wait(struct rnd_context *ctx, struct rnd_slot *s, struct rnd_timings *tm,
+                                       struct rnd_error *err)
+{
+	VkResult vr;
+	VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &s->cmd};
+	double t0 = now_ms();
+	pthread_mutex_lock(&ctx->queue_mu);
+	vr = vkQueueSubmit(ctx->queue, 1, &si, s->fence);
+	pthread_mutex_unlock(&ctx->queue_mu);
+	if (vr != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkQueueSubmit");
+	vr = vkWaitForFences(ctx->device, 1, &s->fence, VK_TRUE, RND_FENCE_TIMEOUT_NS);
+	if (vr != VK_SUCCESS)
+		/* A render that does not finish in minutes means a hung or lost device. */
+		return rnd_fail_vk(err, vr == VK_TIMEOUT ? VK_ERROR_DEVICE_LOST : vr, "vkWaitForFences (render)");
+	vkResetFences(ctx->device, 1, &s->fence);
+	double t1 = now_ms();
+	uint64_t ts[RND_TS_COUNT];
+	if (s->queries && vkGetQueryPoolResults(ctx->device, s->queries, 0, RND_TS_COUNT, sizeof ts, ts, sizeof ts[0],
+	                                        VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
+		double k = ctx->timestamp_period / 1e6;
+		tm->shadow_ms += (double)(ts[RND_TS_SHADOW_END] - ts[RND_TS_START]) * k;
+		tm->main_ms += (double)(ts[RND_TS_MAIN_END] - ts[RND_TS_SHADOW_END]) * k;
+		tm->readback_ms += (double)(ts[RND_TS_COPY_END] - ts[RND_TS_MAIN_END]) * k;
+	} else {
+		tm->main_ms += t1 - t0;
 	}
 	return RND_OK;
 }
@@ -499,6 +389,15 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		return rnd_fail(err, RND_ERR_DEVICE_LOST, "the Vulkan device was lost earlier; the context must be recreated");
 	if ((r = validate(ctx, sc, err)) != RND_OK) return r;
 
+	uint32_t nviews = sc->view_count ? sc->view_count : 1;
+	uint32_t cols = 1;
+	while (cols * cols < nviews) cols++;
+	uint32_t rows = (nviews + cols - 1) / cols;
+	uint64_t sheet_w = (uint64_t)cols * sc->width, sheet_h = (uint64_t)rows * sc->height;
+	if (sheet_w > 65536 || sheet_h > 65536 || sheet_w * sheet_h > (1ull << 28))
+		return rnd_fail(err, RND_ERR_LIMIT, "a sheet of %u views is %llux%llu pixels: too large", nviews,
+		                (unsigned long long)sheet_w, (unsigned long long)sheet_h);
+
 	/* Per-request memory: one block for the draw list and the shadow plan. */
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
 	void *arena = malloc(draws_bytes + sizeof(struct rnd_shadow_plan));
@@ -510,79 +409,98 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	double t0 = now_ms();
 	struct rnd_aabb bounds;
 	struct rnd_camera_plan cam;
+	const struct rnd_texture *tex[UMBRA_MAX_TEXTURES];
+	uint32_t ntex = 0;
 	if ((r = upload(ctx, s, sc, draws, &bounds, err)) != RND_OK) goto done;
+	if ((r = textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;
 	tm.upload_ms = now_ms() - t0;
-	if ((r = rnd_camera_plan(&sc->camera, sc->width, sc->height, &bounds, &cam, err)) != RND_OK) goto done;
-	for (uint32_t i = 0; i < sc->object_count; i++)
-		if (draws[i].closed && !draws[i].single_sided) draws[i].cull_back = camera_outside(&cam, &draws[i].bounds);
-	if ((r = rnd_shadow_plan(sc, &bounds, &cam, sp, err)) != RND_OK) goto done;
-	uint32_t layers = sp->view_count ? sp->view_count : 1;
-	uint32_t res = sp->view_count ? sp->resolution : (s->shadow.img ? s->shadow.width : 64);
-	if ((r = rnd_slot_shadow(ctx, s, res, layers, err)) != RND_OK) goto done;
+
 	VkFormat fmt = ctx->color_formats[sc->output.pixels];
 	if ((r = rnd_slot_targets(ctx, s, fmt, sc->width, sc->height, sc->output.msaa, err)) != RND_OK) goto done;
+	uint32_t passes = aov_passes(sc);
+	if (passes && (r = rnd_slot_aov(ctx, s, sc->width, sc->height, err)) != RND_OK) goto done;
 	size_t px = pixel_size(sc->output.pixels);
-	VkDeviceSize rb = (VkDeviceSize)sc->width * sc->height * px;
+	VkDeviceSize color_bytes = sheet_w * sheet_h * px;
+	VkDeviceSize att_bytes = sheet_w * sheet_h * 16;
+	VkDeviceSize rb = color_bytes + (VkDeviceSize)passes * UMBRA_AOV_ATTACHMENTS * att_bytes;
 	if ((r = rnd_buffer_reserve(ctx, &s->readback, rb, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "slot readback", err)) != RND_OK)
 		goto done;
-	if ((r = write_params(ctx, s, sc, &cam, sp, err)) != RND_OK) goto done;
+	if (nviews > 1) memset(s->readback.map, 0, color_bytes); /* unused cells of the sheet */
 
-	if ((vr = vkResetCommandBuffer(s->cmd, 0)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkResetCommandBuffer"); goto done; }
-	VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
-	if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkBeginCommandBuffer"); goto done; }
-	if (s->queries) {
-		vkCmdResetQueryPool(s->cmd, s->queries, 0, RND_TS_COUNT);
-		vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, s->queries, RND_TS_START);
-	}
-	uint32_t casters = 0;
-	record_shadows(ctx, s, sc, sp, draws, sc->object_count, &casters);
-	if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_SHADOW_END);
-	if ((r = record_main(ctx, s, sc, sp, draws, sc->object_count, err)) != RND_OK) {
-		vkEndCommandBuffer(s->cmd);
-		goto done;
-	}
-	if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_MAIN_END);
-	record_readback(s, sc);
-	if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_COPY_END);
-	if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkEndCommandBuffer"); goto done; }
-
-	double t_submit = now_ms();
-	VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &s->cmd};
-	pthread_mutex_lock(&ctx->queue_mu);
-	vr = vkQueueSubmit(ctx->queue, 1, &si, s->fence);
-	pthread_mutex_unlock(&ctx->queue_mu);
-	if (vr != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkQueueSubmit"); goto lost_check; }
-	vr = vkWaitForFences(ctx->device, 1, &s->fence, VK_TRUE, RND_FENCE_TIMEOUT_NS);
-	if (vr != VK_SUCCESS) {
-		/* A render that does not finish in minutes means a hung or lost device. */
-		r = rnd_fail_vk(err, vr == VK_TIMEOUT ? VK_ERROR_DEVICE_LOST : vr, "vkWaitForFences (render)");
-		goto lost_check;
-	}
-	vkResetFences(ctx->device, 1, &s->fence);
-	double t_done = now_ms();
-
-	if (s->queries) {
-		uint64_t ts[RND_TS_COUNT];
-		if (vkGetQueryPoolResults(ctx->device, s->queries, 0, RND_TS_COUNT, sizeof ts, ts, sizeof ts[0],
-		                          VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
-			double k = ctx->timestamp_period / 1e6;
-			tm.shadow_ms = (double)(ts[RND_TS_SHADOW_END] - ts[RND_TS_START]) * k;
-			tm.main_ms = (double)(ts[RND_TS_MAIN_END] - ts[RND_TS_SHADOW_END]) * k;
-			tm.readback_ms = (double)(ts[RND_TS_COPY_END] - ts[RND_TS_MAIN_END]) * k;
+	bool shadows_ready = false;
+	for (uint32_t v = 0; v < nviews; v++) {
+		const struct rnd_camera *camera = sc->view_count ? &sc->views[v] : &sc->camera;
+		if ((r = rnd_camera_plan(camera, sc->width, sc->height, &bounds, &cam, err)) != RND_OK) goto done;
+		for (uint32_t i = 0; i < sc->object_count; i++)
+			draws[i].cull_back = draws[i].single_sided ||
+			                     (draws[i].closed && record_camera_outside(&cam, &draws[i].bounds));
+		if ((r = rnd_shadow_plan(sc, &bounds, &cam, sp, err)) != RND_OK) goto done;
+		/* Shadow maps that do not depend on the camera (fit, spot, point) render once per
+		 * request; cascades follow the camera and render per view. */
+		bool camera_dependent = false;
+		for (uint32_t i = 0; i < sc->light_count; i++)
+			if (sc->lights[i].type == RND_LIGHT_DIRECTIONAL && sp->lights[i].view_count > 1) camera_dependent = true;
+		bool draw_shadows = !shadows_ready || camera_dependent;
+		if (draw_shadows) {
+			uint32_t layers = sp->view_count ? sp->view_count : 1;
+			uint32_t res = sp->view_count ? sp->resolution : (s->shadow.img ? s->shadow.width : 64);
+			if ((r = rnd_slot_shadow(ctx, s, res, layers, err)) != RND_OK) goto done;
 		}
-	} else {
-		tm.main_ms = t_done - t_submit;
+		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, err)) != RND_OK) goto done;
+
+		uint32_t col = v % cols, row = v / cols;
+		VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sheet_w + (VkDeviceSize)col * sc->width);
+		struct record_view rv = {
+			.sc = sc, .cam = &cam, .sp = sp, .draws = draws, .ndraw = sc->object_count, .aov_passes = passes,
+			.color_offset = cell * px, .aov_offset = color_bytes + cell * 16, .aov_stride = att_bytes,
+			.sheet_width = (uint32_t)sheet_w,
+		};
+		if ((vr = vkResetCommandBuffer(s->cmd, 0)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkResetCommandBuffer"); goto done; }
+		VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+		if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkBeginCommandBuffer"); goto done; }
+		if (s->queries) {
+			vkCmdResetQueryPool(s->cmd, s->queries, 0, RND_TS_COUNT);
+			vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, s->queries, RND_TS_START);
+		}
+		if (v == 0) record_textures(s, tex, ntex);
+		uint32_t casters = 0;
+		if (draw_shadows) {
+			record_shadows(ctx, s, &rv, &casters);
+			tm.shadow_maps_rendered += sp->view_count;
+		} else {
+			tm.shadow_maps_reused += sp->view_count;
+		}
+		shadows_ready = true;
+		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_SHADOW_END);
+		if ((r = record_main(ctx, s, &rv, err)) != RND_OK || (passes && (r = record_aov(ctx, s, &rv, err)) != RND_OK)) {
+			vkEndCommandBuffer(s->cmd);
+			goto done;
+		}
+		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_MAIN_END);
+		record_readback(s, &rv);
+		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_COPY_END);
+		if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkEndCommandBuffer"); goto done; }
+		if ((r = submit_and_wait(ctx, s, &tm, err)) != RND_OK) goto lost_check;
 	}
-	tm.shadow_maps_rendered = sp->view_count;
 
 	double t_copy = now_ms();
-	out->pixels = malloc(rb);
-	if (!out->pixels) { r = rnd_fail(err, RND_ERR_OOM, "out of memory for a %ux%u image", sc->width, sc->height); goto done; }
-	memcpy(out->pixels, s->readback.map, rb);
-	out->width = sc->width;
-	out->height = sc->height;
+	out->pixels = malloc(color_bytes);
+	if (!out->pixels) { r = rnd_fail(err, RND_ERR_OOM, "out of memory for a %llux%llu image",
+	                                 (unsigned long long)sheet_w, (unsigned long long)sheet_h); goto done; }
+	memcpy(out->pixels, s->readback.map, color_bytes);
+	out->width = (uint32_t)sheet_w;
+	out->height = (uint32_t)sheet_h;
 	out->format = sc->output.pixels;
-	out->stride = sc->width * px;
+	out->stride = sheet_w * px;
+	out->view_count = nviews;
+	out->view_columns = cols;
+	out->view_width = sc->width;
+	out->view_height = sc->height;
+	if (passes && (r = split_aovs(sc, (const float *)((const uint8_t *)s->readback.map + color_bytes), att_bytes / 4,
+	                              (uint32_t)(sheet_w * sheet_h), out, err)) != RND_OK) {
+		rnd_image_release(out);
+		goto done;
+	}
 	tm.readback_ms += now_ms() - t_copy;
 	r = RND_OK;
 	goto done;
@@ -593,6 +511,8 @@ lost_check:
 		rnd_log(ctx, 0, "device lost: %s", err ? err->msg : "");
 	}
 done:
+	/* Everything this render submitted has completed (each submit is waited on). */
+	rnd_slot_drop_textures(ctx, s);
 	rnd_slot_release(ctx, s);
 	free(arena);
 	if (timings) *timings = tm;

@@ -68,9 +68,42 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		goto fail_set;
 	}
 	/* Descriptor sets stay unnamed: lavapipe never frees a set's debug name with its pool. */
+	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + UMBRA_MAX_TEXTURES};
+	VkDescriptorPoolCreateInfo tpi = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1 + UMBRA_MAX_TEXTURES, .poolSizeCount = 1,
+		.pPoolSizes = &tsize,
+	};
+	if ((vr = vkCreateDescriptorPool(ctx->device, &tpi, NULL, &s->texture_pool)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkCreateDescriptorPool (textures)");
+		goto fail_set;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->texture_pool, "slot %u texture descriptor pool", index);
+	VkDescriptorSetLayout layouts[1 + UMBRA_MAX_TEXTURES];
+	for (int i = 0; i < 1 + UMBRA_MAX_TEXTURES; i++) layouts[i] = ctx->pipes.texture_layout;
+	VkDescriptorSetAllocateInfo tai = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->texture_pool,
+		.descriptorSetCount = 1 + UMBRA_MAX_TEXTURES, .pSetLayouts = layouts,
+	};
+	if ((vr = vkAllocateDescriptorSets(ctx->device, &tai, s->texture_sets)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets (textures)");
+		goto fail_texture_pool;
+	}
+	char name[48];
+	snprintf(name, sizeof name, "slot %u white texture", index);
+	if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, 1, 1, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->white, err)) != RND_OK)
+		goto fail_texture_pool;
+	VkDescriptorImageInfo wi = {ctx->pipes.texture_sampler, s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	VkWriteDescriptorSet ww = {
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[0], .dstBinding = UMBRA_BINDING_BASE_TEXTURE,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
+	};
+	vkUpdateDescriptorSets(ctx->device, 1, &ww, 0, NULL);
 	*out = s;
 	return RND_OK;
 
+fail_texture_pool:
+	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
 fail_set:
 	vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
 fail_desc_pool:
@@ -99,6 +132,12 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 {
 	if (!s) return;
 	shadow_destroy(ctx, s);
+	rnd_slot_drop_textures(ctx, s);
+	rnd_image_destroy(ctx, &s->white);
+	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
+	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
+	rnd_image_destroy(ctx, &s->aov_depth);
+	rnd_buffer_destroy(ctx, &s->staging);
 	rnd_image_destroy(ctx, &s->resolve);
 	rnd_image_destroy(ctx, &s->depth);
 	rnd_image_destroy(ctx, &s->color_ms);
@@ -229,4 +268,34 @@ enum rnd_result rnd_slot_shadow(struct rnd_context *ctx, struct rnd_slot *s, uin
 		RND_NAME(ctx, VK_OBJECT_TYPE_IMAGE_VIEW, s->shadow_layers[i], "slot %u shadow layer %u", s->index, i);
 	}
 	return RND_OK;
+}
+
+void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	for (uint32_t i = 0; i < s->texture_count; i++) rnd_image_destroy(ctx, &s->textures[i]);
+	s->texture_count = 0;
+}
+
+enum rnd_result rnd_slot_aov(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, struct rnd_error *err)
+{
+	enum rnd_result r;
+	if (s->aov_depth.img && s->aov_depth.width == w && s->aov_depth.height == h) return RND_OK;
+	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
+	rnd_image_destroy(ctx, &s->aov_depth);
+	char name[64];
+	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) {
+		snprintf(name, sizeof name, "slot %u aov %d", s->index, i);
+		if ((r = rnd_image_create(ctx, VK_FORMAT_R32G32B32A32_SFLOAT, w, h, 1, 1,
+		                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+		                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->aov[i], err)) != RND_OK)
+			goto fail;
+	}
+	snprintf(name, sizeof name, "slot %u aov depth", s->index);
+	if ((r = rnd_image_create(ctx, RND_DEPTH_FORMAT, w, h, 1, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+	                          VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->aov_depth, err)) != RND_OK)
+		goto fail;
+	return RND_OK;
+fail:
+	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
+	return r;
 }

@@ -23,7 +23,17 @@ struct rnd_slot {
 	VkDescriptorPool desc_pool;
 	VkDescriptorSet set;
 
-	struct rnd_buffer vertices, indices, params, readback;
+	struct rnd_buffer vertices, indices, params, readback, staging;
+	/* this render's material textures (destroyed when the next render starts) */
+	struct rnd_image_res textures[UMBRA_MAX_TEXTURES];
+	uint32_t texture_count;
+	/* set 1 per texture: [0] the white 1x1 (untextured draws), [1 + i] textures[i] */
+	VkDescriptorPool texture_pool;
+	VkDescriptorSet texture_sets[1 + UMBRA_MAX_TEXTURES];
+	struct rnd_image_res white;
+	bool white_ready;             /* cleared to white and in SHADER_READ_ONLY layout */
+	/* AOV pass targets: UMBRA_AOV_ATTACHMENTS x RGBA32F + a single-sample depth */
+	struct rnd_image_res aov[UMBRA_AOV_ATTACHMENTS], aov_depth;
 	struct rnd_image_res color_ms, depth, resolve, shadow;
 	VkImageView *shadow_layers;    /* one 2D view per shadow layer (render targets) */
 	bool shadow_initialised;       /* layout known (kept in SHADER_READ_ONLY between renders) */
@@ -32,6 +42,10 @@ struct rnd_slot {
 /* Makes the colour/depth targets match (format, w, h, samples). */
 enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, VkFormat color, uint32_t w, uint32_t h,
                                  uint32_t samples, struct rnd_error *err);
+/* Makes the AOV targets match w x h. */
+enum rnd_result rnd_slot_aov(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, struct rnd_error *err);
+/* Destroys the previous render's textures. */
+void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 /* Makes the shadow array hold at least `layers` layers of res x res. */
 enum rnd_result rnd_slot_shadow(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, uint32_t layers,
                                 struct rnd_error *err);

@@ -16,10 +16,15 @@
 #define UMBRA_BINDING_SHADOW_VIEWS   3  /* storage  umbra_shadow_view[] */
 #define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2DArray, depth, one layer per shadow view */
 #define UMBRA_BINDING_COUNT          5
+/* Set 1: the material's base-colour texture (sRGB), bound per draw; a white 1x1 when none. */
+#define UMBRA_SET_MATERIAL           1
+#define UMBRA_BINDING_BASE_TEXTURE   0
 
 #define UMBRA_MAX_LIGHTS        64
 #define UMBRA_MAX_SHADOW_VIEWS  256   /* directional 1..4 (cascades), spot 1, point 6 */
 #define UMBRA_MAX_MATERIALS     4096
+#define UMBRA_MAX_TEXTURES      16    /* distinct base-colour textures in one scene */
+#define UMBRA_AOV_ATTACHMENTS   4     /* RGBA32F targets of one AOV pass */
 
 /* umbra_light.color.w: light type */
 #define UMBRA_LIGHT_DIRECTIONAL 0
@@ -88,7 +93,8 @@ struct umbra_frame {
 struct umbra_material {
 	U_VEC4 base_color;       /* linear rgba */
 	U_VEC4 emissive;         /* rgb, a roughness */
-	U_VEC4 params;           /* x metallic, y alpha cutoff, z flags (as float bits: use uint) */
+	U_VEC4 params;           /* x metallic, y alpha cutoff */
+	U_UVEC4 tex;             /* x 1 = has a base-colour texture (set 1), y 1 = alpha mask */
 };
 
 struct umbra_light {
@@ -112,7 +118,7 @@ struct umbra_shadow_view {
 /* One push-constant block for every pipeline (80 bytes). */
 struct umbra_push {
 	U_MAT4 view_proj;        /* shadow pass: light view-projection */
-	U_UVEC4 info;            /* main pass: x material index, y UMBRA_DRAW_* flags */
+	U_UVEC4 info;            /* x material index, y UMBRA_DRAW_* flags, z AOV pass: first light */
 };
 
 #endif

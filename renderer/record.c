@@ -1,0 +1,412 @@
+/*
+ * renderer/record.c — command recording for one view (see record.h).
+ */
+#include <math.h>
+#include <string.h>
+#include "record.h"
+
+/* Culling back faces of a closed primitive changes nothing in the picture as long as the
+ * viewer is outside it and it lies wholly beyond the near plane; it halves the triangles
+ * lavapipe rasterises and shades. */
+bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b)
+{
+	for (int i = 0; i < 8; i++) {
+		float p[3] = {i & 1 ? b->max[0] : b->min[0], i & 2 ? b->max[1] : b->min[1], i & 4 ? b->max[2] : b->min[2]};
+		float d[3];
+		rnd_v3_sub(d, p, cam->pos);
+		if (rnd_v3_dot(d, cam->fwd) <= cam->znear * 1.01f) return false;
+	}
+	return true;
+}
+
+static bool point_outside(const float p[3], const struct rnd_aabb *b, float pad)
+{
+	for (int k = 0; k < 3; k++)
+		if (p[k] < b->min[k] - pad || p[k] > b->max[k] + pad) return true;
+	return false;
+}
+
+void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
+                          VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                          VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)
+{
+	VkImageMemoryBarrier2 b = {
+		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
+		.srcStageMask = src_stage, .srcAccessMask = src_access, .dstStageMask = dst_stage, .dstAccessMask = dst_access,
+		.oldLayout = from, .newLayout = to, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .image = img, .subresourceRange = {aspect, 0, 1, 0, layers},
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
+	vkCmdPipelineBarrier2(cmd, &di);
+}
+
+static float srgb_encode(float c)
+{
+	c = c < 0 ? 0 : c > 1 ? 1 : c;
+	return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
+}
+
+void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t *casters_drawn)
+{
+	const struct rnd_scene *sc = rv->sc;
+	const struct rnd_shadow_plan *sp = rv->sp;
+	const struct draw *draws = rv->draws;
+	uint32_t ndraw = rv->ndraw;
+	VkCommandBuffer cmd = s->cmd;
+	uint32_t layers = s->shadow.layers;
+	/* Old contents are never needed: every used layer is cleared. */
+	record_image_barrier(cmd, s->shadow.img, VK_IMAGE_ASPECT_DEPTH_BIT, layers,
+	              VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+	              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
+	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+	uint32_t res = sp->resolution;
+	VkDeviceSize zero = 0;
+	for (uint32_t v = 0; v < sp->view_count; v++) {
+		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
+		VkRenderingAttachmentInfo da = {
+			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->shadow_layers[v],
+			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
+		};
+		VkRenderingInfo ri = {
+			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {res, res}}, .layerCount = 1,
+			.pDepthAttachment = &da,
+		};
+		vkCmdBeginRendering(cmd, &ri);
+		VkViewport vp = {0, 0, (float)res, (float)res, 0, 1};
+		VkRect2D scissor = {{0, 0}, {res, res}};
+		vkCmdSetViewport(cmd, 0, 1, &vp);
+		vkCmdSetScissor(cmd, 0, 1, &scissor);
+		vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
+		vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
+		vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
+		/* Masked casters read materials and textures; the set's shadow-map binding is not
+		 * used by the alpha-test shader while the map is a render target. */
+		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+		struct umbra_push push = {0};
+		memcpy(push.view_proj, sp->views[v].view_proj, sizeof push.view_proj);
+		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+		                   sizeof push, &push);
+		VkPipeline bound = VK_NULL_HANDLE;
+		const struct rnd_light *L = &sc->lights[sp->view_light[v]];
+		for (uint32_t i = 0; i < ndraw; i++) {
+			const struct draw *d = &draws[i];
+			if (!d->cast || !d->index_count) continue;
+			if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) continue;
+			int cull = d->single_sided ||
+			           (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
+			VkPipeline p = d->masked ? ctx->pipes.shadow_masked[cull] : ctx->pipes.shadow[cull];
+			if (bound != p) {
+				vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p);
+				bound = p;
+			}
+			if (d->masked) {
+				push.info[0] = d->material;
+				vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+				                   0, sizeof push, &push);
+			}
+			if (d->masked)
+				vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
+				                        &s->texture_sets[d->texture_set], 0, NULL);
+			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+			(*casters_drawn)++;
+		}
+		vkCmdEndRendering(cmd);
+	}
+	record_image_barrier(cmd, s->shadow.img, VK_IMAGE_ASPECT_DEPTH_BIT, layers,
+	              sp->view_count ? VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED,
+	              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+	              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+/* The specialization key of this scene's main pass (see mesh.frag). */
+static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
+                     uint32_t ndraw, struct rnd_main_key *k)
+{
+	memset(k, 0, sizeof *k);
+	k->format = (uint32_t)sc->output.pixels;
+	k->samples = sc->output.msaa > 1 ? 4 : 1;
+	for (uint32_t i = 0; i < sc->light_count; i++) {
+		const struct rnd_light_plan *lp = &sp->lights[i];
+		uint32_t type = sc->lights[i].type == RND_LIGHT_DIRECTIONAL ? UMBRA_LIGHT_DIRECTIONAL
+		              : sc->lights[i].type == RND_LIGHT_SPOT ? UMBRA_LIGHT_SPOT : UMBRA_LIGHT_POINT;
+		k->sc[UMBRA_SC_LIGHT_TYPES] |= 1u << type;
+		if (lp->view_count) k->sc[UMBRA_SC_FILTERS] |= 1u << lp->filter;
+		if (type == UMBRA_LIGHT_DIRECTIONAL && lp->view_count > 1) k->sc[UMBRA_SC_CASCADES] = 1;
+	}
+	switch (sc->output.debug) {
+	case RND_DEBUG_SHADOW: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_SHADOW; break;
+	case RND_DEBUG_CASCADES: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_CASCADES; break;
+	case RND_DEBUG_NORMALS: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_NORMALS; break;
+	case RND_DEBUG_DEPTH: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_DEPTH; break;
+	default: break;
+	}
+	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;
+	k->sc[UMBRA_SC_TONEMAP] = k->sc[UMBRA_SC_LINEAR] ? 0
+	                        : sc->output.tonemap == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES
+	                        : sc->output.tonemap == RND_TONEMAP_NONE ? UMBRA_TONEMAP_NONE : UMBRA_TONEMAP_NEUTRAL;
+	for (uint32_t i = 0; i < ndraw; i++)
+		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
+}
+
+enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                            struct rnd_error *err)
+{
+	const struct rnd_scene *sc = rv->sc;
+	const struct rnd_shadow_plan *sp = rv->sp;
+	const struct draw *draws = rv->draws;
+	uint32_t ndraw = rv->ndraw;
+	struct rnd_main_key key;
+	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+	main_key(sc, sp, draws, ndraw, &key);
+	for (uint32_t i = 0; i < ndraw; i++) {
+		uint32_t c = draws[i].cull_back;
+		if (!draws[i].index_count || pipes[c]) continue;
+		key.cull_back = c;
+		enum rnd_result r = rnd_pipelines_main(ctx, &key, &pipes[c], err);
+		if (r != RND_OK) return r;
+	}
+	VkCommandBuffer cmd = s->cmd;
+	uint32_t w = sc->width, h = sc->height;
+	bool ms = sc->output.msaa > 1;
+	VkImage target = ms ? s->color_ms.img : s->resolve.img;
+	record_image_barrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
+	              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+	if (ms)
+		record_image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
+		              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+	record_image_barrier(cmd, s->depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	              VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
+	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+
+	/* The background is the requested colour itself (sRGB-encoded for display outputs), not
+	 * tone mapped: a caller asking for white gets 255. */
+	VkClearColorValue clear;
+	const float *bg = sc->environment.background;
+	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
+	for (int k = 0; k < 3; k++) clear.float32[k] = linear ? bg[k] : srgb_encode(bg[k]);
+	clear.float32[3] = sc->output.transparent ? 0.0f : bg[3];
+	if (sc->output.debug == RND_DEBUG_SHADOW) clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
+
+	VkRenderingAttachmentInfo ca = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = ms ? s->color_ms.view : s->resolve.view,
+		.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+		.resolveMode = ms ? VK_RESOLVE_MODE_AVERAGE_BIT : VK_RESOLVE_MODE_NONE,
+		.resolveImageView = ms ? s->resolve.view : VK_NULL_HANDLE,
+		.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+		.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+		.storeOp = ms ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE,
+		.clearValue.color = clear,
+	};
+	VkRenderingAttachmentInfo da = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->depth.view,
+		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+		.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0}, /* reversed Z */
+	};
+	VkRenderingInfo ri = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
+		.colorAttachmentCount = 1, .pColorAttachments = &ca, .pDepthAttachment = &da,
+	};
+	vkCmdBeginRendering(cmd, &ri);
+	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
+	VkRect2D scissor = {{0, 0}, {w, h}};
+	vkCmdSetViewport(cmd, 0, 1, &vp);
+	vkCmdSetScissor(cmd, 0, 1, &scissor);
+	VkDeviceSize zero = 0;
+	vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
+	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
+	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+	VkPipeline bound = VK_NULL_HANDLE;
+	for (uint32_t i = 0; i < ndraw; i++) {
+		const struct draw *d = &draws[i];
+		if (!d->index_count) continue;
+		VkPipeline p = d->masked ? ctx->pipes.prepass_masked[ms][d->cull_back] : ctx->pipes.prepass[ms][d->cull_back];
+		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+		if (d->masked) {
+			struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
+			memcpy(push.view_proj, rv->cam->view_proj, sizeof push.view_proj);
+			vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+			                   sizeof push, &push);
+		}
+		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
+		                        &s->texture_sets[d->texture_set], 0, NULL);
+		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+	}
+	for (uint32_t i = 0; i < ndraw; i++) {
+		const struct draw *d = &draws[i];
+		if (!d->index_count) continue;
+		VkPipeline p = pipes[d->cull_back];
+		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
+		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+		                   sizeof push, &push);
+		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
+		                        &s->texture_sets[d->texture_set], 0, NULL);
+		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+	}
+	vkCmdEndRendering(cmd);
+	return RND_OK;
+}
+
+enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                           struct rnd_error *err)
+{
+	const struct rnd_scene *sc = rv->sc;
+	VkCommandBuffer cmd = s->cmd;
+	uint32_t w = sc->width, h = sc->height;
+	struct rnd_main_key key;
+	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+	main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
+	memset(&key.sc[UMBRA_SC_DEBUG], 0, sizeof key.sc[0]);
+	key.sc[UMBRA_SC_DEBUG] = 0;
+	key.sc[UMBRA_SC_LINEAR] = 1;
+	key.sc[UMBRA_SC_TONEMAP] = 0;
+	key.sc[UMBRA_SC_CATCHER] = 0;
+	key.format = RND_PIXELS_RGBA32F;
+	key.samples = 1;
+	key.aov = 1;
+	for (uint32_t i = 0; i < rv->ndraw; i++) {
+		uint32_t c = rv->draws[i].cull_back;
+		if (!rv->draws[i].index_count || pipes[c]) continue;
+		key.cull_back = c;
+		enum rnd_result r = rnd_pipelines_main(ctx, &key, &pipes[c], err);
+		if (r != RND_OK) return r;
+	}
+	VkDeviceSize zero = 0;
+	for (uint32_t pass = 0; pass < rv->aov_passes; pass++) {
+		VkRenderingAttachmentInfo ca[UMBRA_AOV_ATTACHMENTS];
+		for (uint32_t a = 0; a < UMBRA_AOV_ATTACHMENTS; a++) {
+			record_image_barrier(cmd, s->aov[a].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+			                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+			                     VK_ACCESS_2_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+			                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+			/* No geometry: Z = +inf, normal and albedo 0, visibility 1. */
+			VkClearColorValue c = {{1.0f, 1.0f, 1.0f, 1.0f}};
+			if (pass == 0 && a == 0) c = (VkClearColorValue){{INFINITY, 0.0f, 0.0f, 0.0f}};
+			if (pass == 0 && a == 1) c = (VkClearColorValue){{0.0f, 0.0f, 0.0f, 0.0f}};
+			ca[a] = (VkRenderingAttachmentInfo){
+				.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->aov[a].view,
+				.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+				.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.color = c,
+			};
+		}
+		record_image_barrier(cmd, s->aov_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+		VkRenderingAttachmentInfo da = {
+			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->aov_depth.view,
+			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+			.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0},
+		};
+		VkRenderingInfo ri = {
+			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
+			.colorAttachmentCount = UMBRA_AOV_ATTACHMENTS, .pColorAttachments = ca, .pDepthAttachment = &da,
+		};
+		vkCmdBeginRendering(cmd, &ri);
+		VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
+		VkRect2D scissor = {{0, 0}, {w, h}};
+		vkCmdSetViewport(cmd, 0, 1, &vp);
+		vkCmdSetScissor(cmd, 0, 1, &scissor);
+		vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
+		vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
+		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+		VkPipeline bound = VK_NULL_HANDLE;
+		uint32_t first_light = pass == 0 ? 0 : 8 + 16 * (pass - 1);
+		for (uint32_t i = 0; i < rv->ndraw; i++) {
+			const struct draw *d = &rv->draws[i];
+			if (!d->index_count) continue;
+			/* A shadow catcher is geometry for the AOVs (contract §7). */
+			VkPipeline p = pipes[d->cull_back];
+			if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+			struct umbra_push push = {.info = {d->material, d->flags, first_light, 0}};
+			vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+			                   sizeof push, &push);
+			vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
+			                        &s->texture_sets[d->texture_set], 0, NULL);
+			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+		}
+		vkCmdEndRendering(cmd);
+		/* Copy this pass's targets out before the next pass clears them. */
+		for (uint32_t a = 0; a < UMBRA_AOV_ATTACHMENTS; a++) {
+			record_image_barrier(cmd, s->aov[a].img, VK_IMAGE_ASPECT_COLOR_BIT, 1,
+			                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+			                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+			                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+			VkBufferImageCopy region = {
+				.bufferOffset = rv->aov_offset + (VkDeviceSize)(pass * UMBRA_AOV_ATTACHMENTS + a) * rv->aov_stride,
+				.bufferRowLength = rv->sheet_width,
+				.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, .imageExtent = {w, h, 1},
+			};
+			vkCmdCopyImageToBuffer(cmd, s->aov[a].img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
+		}
+	}
+	return RND_OK;
+}
+
+void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, uint32_t n)
+{
+	VkCommandBuffer cmd = s->cmd;
+	VkDeviceSize off = 0;
+	if (!s->white_ready) {
+		/* The slot's 1x1 white texture, bound for untextured draws. */
+		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+		VkClearColorValue white = {{1.0f, 1.0f, 1.0f, 1.0f}};
+		VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+		vkCmdClearColorImage(cmd, s->white.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &white, 1, &range);
+		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+		                     VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+		s->white_ready = true;
+	}
+	for (uint32_t i = 0; i < n; i++) {
+		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+		VkBufferImageCopy region = {
+			.bufferOffset = off, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+			.imageExtent = {tex[i]->width, tex[i]->height, 1},
+		};
+		vkCmdCopyBufferToImage(cmd, s->staging.buf, s->textures[i].img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+		                     VK_ACCESS_2_TRANSFER_WRITE_BIT,
+		                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+		off += (VkDeviceSize)tex[i]->width * tex[i]->height * 4;
+	}
+}
+
+void record_readback(struct rnd_slot *s, const struct record_view *rv)
+{
+	const struct rnd_scene *sc = rv->sc;
+	VkCommandBuffer cmd = s->cmd;
+	record_image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+	              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+	              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+	VkBufferImageCopy region = {
+		.bufferOffset = rv->color_offset, .bufferRowLength = rv->sheet_width,
+		.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, .imageExtent = {sc->width, sc->height, 1},
+	};
+	vkCmdCopyImageToBuffer(cmd, s->resolve.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
+	VkBufferMemoryBarrier2 bb = {
+		.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT,
+		.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->readback.buf, .size = VK_WHOLE_SIZE,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
+	vkCmdPipelineBarrier2(cmd, &di);
+}
+

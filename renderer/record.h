@@ -1,0 +1,56 @@
+/*
+ * renderer/record.h — recording one view's commands into a slot's command buffer: texture
+ * uploads, shadow passes, the camera's depth pre-pass + main pass, the AOV passes, and the
+ * copies into the readback buffer. Called by render.c only; nothing here submits or waits.
+ */
+#ifndef UMBRA_RENDERER_RECORD_H
+#define UMBRA_RENDERER_RECORD_H
+
+#include "plan.h"
+#include "slot.h"
+
+/* One object's draw, made by render.c's upload. */
+struct draw {
+	uint32_t first_index, index_count;
+	struct rnd_aabb bounds;
+	uint32_t material;
+	uint32_t flags;      /* UMBRA_DRAW_* */
+	bool cast, cull_back;
+	bool closed;         /* sphere / box / cylinder: back faces never show from outside */
+	bool single_sided;   /* double_sided: false */
+	bool masked;         /* alpha_mode MASK: alpha-tested depth passes */
+	uint32_t texture_set; /* slot->texture_sets index: 0 = white, 1 + i = texture i */
+};
+
+/* Everything the recorders need to know about this view. */
+struct record_view {
+	const struct rnd_scene *sc;
+	const struct rnd_camera_plan *cam;
+	const struct rnd_shadow_plan *sp;
+	const struct draw *draws;
+	uint32_t ndraw;
+	uint32_t aov_passes;           /* 0 = no AOVs */
+	VkDeviceSize color_offset;     /* where this view's pixels go in the readback buffer */
+	VkDeviceSize aov_offset;       /* where its first AOV attachment goes */
+	VkDeviceSize aov_stride;       /* bytes between AOV attachments' regions */
+	uint32_t sheet_width;          /* pixels per readback row */
+};
+
+void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
+                          VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage,
+                          VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
+/* Copies the staged texels (slot->staging, tightly packed in texture order) into the slot's
+ * texture images and leaves them ready for sampling. */
+void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, uint32_t n);
+void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v, uint32_t *casters_drawn);
+enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
+                            struct rnd_error *err);
+enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
+                           struct rnd_error *err);
+/* Copies the resolved colour (and AOV targets) into the readback buffer, then makes it host-visible. */
+void record_readback(struct rnd_slot *s, const struct record_view *v);
+
+/* Culling helpers shared with render.c. */
+bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b);
+
+#endif

@@ -1,0 +1,52 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "umbra_shared.h"
+#include "shading.glsl"
+// AOV pass (single-sample, after the main pass): writes what EXR outputs carry besides colour.
+// Pass 0: (Z, N.x, N.y, N.z), (albedo.rgb, 1), visibility of lights 0..3, lights 4..7.
+// Pass k > 0: visibility of lights 8 + 16(k-1) ... in four vec4s. pc.info.z = first light.
+// Visibility is the shadow test alone (no N.L, cone or range), 1 where shadows are off.
+
+layout(location = 0) out vec4 o_aov0;
+layout(location = 1) out vec4 o_aov1;
+layout(location = 2) out vec4 o_aov2;
+layout(location = 3) out vec4 o_aov3;
+
+float visibility(uint i, vec3 n_geo, bool receive)
+{
+	if (i >= frame.mode.w || !receive || SC_FILTERS == 0u) return 1.0;
+	umbra_light L = lights[i];
+	if ((SC_LIGHT_TYPES & (1u << uint(L.color.w))) == 0u) return 1.0;
+	float atten;
+	vec3 l = light_dir(L, v_pos, atten);
+	uint view;
+	return shadow_visibility(L, v_pos, n_geo, l, view);
+}
+
+vec4 visibility4(uint first, vec3 n_geo, bool receive)
+{
+	return vec4(visibility(first, n_geo, receive), visibility(first + 1u, n_geo, receive),
+	            visibility(first + 2u, n_geo, receive), visibility(first + 3u, n_geo, receive));
+}
+
+void main()
+{
+	umbra_material m = materials[pc.info.x];
+	vec4 bc = base_color(m);
+	vec3 n_geo = normalize(v_nrm);
+	if (!gl_FrontFacing) n_geo = -n_geo;
+	bool receive = (pc.info.y & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
+	uint first = pc.info.z;
+	if (first == 0u) {
+		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
+		o_aov0 = vec4(z, n_geo);
+		o_aov1 = vec4(bc.rgb, 1.0);
+		o_aov2 = visibility4(0u, n_geo, receive);
+		o_aov3 = visibility4(4u, n_geo, receive);
+	} else {
+		o_aov0 = visibility4(first, n_geo, receive);
+		o_aov1 = visibility4(first + 4u, n_geo, receive);
+		o_aov2 = visibility4(first + 8u, n_geo, receive);
+		o_aov3 = visibility4(first + 12u, n_geo, receive);
+	}
+}

@@ -1,0 +1,314 @@
+// shaders/shading.glsl — what the main pass (mesh.frag) and the AOV pass (aov.frag) share:
+// bindings, specialization constants, shadow filtering, lighting. Included after
+// umbra_shared.h; the including shader declares its outputs and main().
+// Main pass: metallic-roughness shading (Lambert + GGX), hemisphere ambient, directional /
+// spot / point lights in the contract's units, shadow filtering, tone map and encoding.
+//
+// Shadow maps hold plain depth (D32) in one array layer per shadow view. lavapipe cannot
+// filter depth formats linearly, so filtering happens here: textureGather fetches 2x2 texels,
+// each is compared with the receiver depth and the results are weighted bilinearly.
+
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock { umbra_frame frame; };
+layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonly buffer Materials { umbra_material materials[]; };
+layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_LIGHTS) readonly buffer Lights { umbra_light lights[]; };
+layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) readonly buffer Views { umbra_shadow_view views[]; };
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2DArray shadow_map;
+layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
+layout(push_constant) uniform PushBlock { umbra_push pc; };
+
+// Specialization constants: each pipeline variant carries only the code its scene needs.
+// lavapipe executes both sides of a divergent-looking branch under a mask, so dead paths
+// (other filters, debug views, tone maps) would otherwise cost every pixel.
+layout(constant_id = UMBRA_SC_FILTERS) const uint SC_FILTERS = 7u;     // bit (1 << UMBRA_FILTER_*)
+layout(constant_id = UMBRA_SC_DEBUG) const uint SC_DEBUG = 0u;         // UMBRA_DEBUG_*
+layout(constant_id = UMBRA_SC_LINEAR) const uint SC_LINEAR = 0u;       // 1 = scene-referred output
+layout(constant_id = UMBRA_SC_TONEMAP) const uint SC_TONEMAP = 0u;     // UMBRA_TONEMAP_*
+layout(constant_id = UMBRA_SC_CATCHER) const uint SC_CATCHER = 0u;     // scene has shadow catchers
+layout(constant_id = UMBRA_SC_LIGHT_TYPES) const uint SC_LIGHT_TYPES = 7u; // bit (1 << UMBRA_LIGHT_*)
+layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any directional light has cascades
+
+layout(location = 0) in vec3 v_pos;
+layout(location = 1) in vec3 v_nrm;
+layout(location = 2) in vec2 v_uv;
+
+const float PI = 3.14159265358979;
+
+// ---- shadow sampling -------------------------------------------------------------------
+
+// Poisson-disk taps live in the frame uniform block (a dynamically indexed constant array
+// would be rebuilt per invocation by lavapipe).
+vec2 poisson(int i) { vec4 v = frame.poisson[i >> 1]; return (i & 1) == 0 ? v.xy : v.zw; }
+
+// Bilinearly weighted comparison of the 2x2 texels around texel-space point p (texel centres
+// at +0.5). Outside the map everything is lit (border depth 1).
+float bilinear_compare(vec2 p, float layer, float ref, float res)
+{
+	vec2 q = p - 0.5;
+	vec2 base = floor(q);
+	vec2 f = q - base;
+	vec4 d = textureGather(shadow_map, vec3((base + 1.0) / res, layer));
+	// gather order: x = (i0,j1), y = (i1,j1), z = (i1,j0), w = (i0,j0)
+	vec4 lit = step(vec4(ref), d);
+	return mix(mix(lit.w, lit.z, f.x), mix(lit.x, lit.y, f.x), f.y);
+}
+
+// (2r+1)^2 bilinear PCF taps, done as (r+1)^2 gathers over the (2r+2)^2 texel footprint.
+// grad: receiver depth change per texel (receiver-plane bias), so wide kernels on sloped
+// receivers do not shadow the receiver itself.
+float pcf(vec2 p, float layer, float ref, float res, int r, vec2 grad)
+{
+	vec2 q = p - 0.5;
+	vec2 base = floor(q);
+	vec2 f = q - base;
+	float sum = 0.0;
+	int last = 2 * r + 1;
+	for (int j = 0; j <= 2 * r; j += 2) {
+		for (int i = 0; i <= 2 * r; i += 2) {
+			vec2 corner = base + vec2(float(i - r), float(j - r)) + 1.0;
+			float rc = ref + dot(grad, corner - p);
+			vec4 lit = step(vec4(rc), textureGather(shadow_map, vec3(corner / res, layer)));
+			float wx0 = i == 0 ? 1.0 - f.x : 1.0, wx1 = i + 1 == last ? f.x : 1.0;
+			float wy0 = j == 0 ? 1.0 - f.y : 1.0, wy1 = j + 1 == last ? f.y : 1.0;
+			sum += lit.w * wx0 * wy0 + lit.z * wx1 * wy0 + lit.x * wx0 * wy1 + lit.y * wx1 * wy1;
+		}
+	}
+	float n = float(last);
+	return sum / (n * n);
+}
+
+float hard(vec2 p, float layer, float ref, float res)
+{
+	ivec2 t = ivec2(floor(p));
+	if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(int(res))))) return 1.0;
+	return ref <= texelFetch(shadow_map, ivec3(t, int(layer)), 0).r ? 1.0 : 0.0;
+}
+
+// Per-pixel rotation for the Poisson disk (interleaved gradient noise): deterministic, so the
+// same request gives the same bytes.
+float ign(vec2 px) { return fract(52.9829189 * fract(dot(px, vec2(0.06711056, 0.00583715)))); }
+
+// Distance along the light's axis (world units) for a stored depth of view v.
+float view_distance(umbra_shadow_view v, float d)
+{
+	float n = v.params.z, f = v.params.w;
+	if (v.params.y > 0.5) return n * f / (f - d * (f - n));   // perspective depth 0..1 -> linear
+	return n + d * (f - n);                                   // orthographic: linear
+}
+
+// PCSS: blocker search over the region that could shade this point, penumbra from the
+// light's size by similar triangles, then a rotated Poisson PCF of that width.
+float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, float res, vec2 grad)
+{
+	float zr = view_distance(v, ref);
+	float texel = v.params.y > 0.5 ? v.params.x * zr : v.params.x;   // world size of a texel at the receiver
+	float size = L.params.y;                                          // tan(angular radius) or radius (m)
+	bool persp = v.params.y > 0.5;
+	// Search radius: the widest penumbra a blocker between the light's near plane and the
+	// receiver could cast here, capped.
+	float zn = v.params.z;
+	float search = persp ? size * (zr - zn) / (zr * v.params.x * max(zn, 1e-3)) : size * (zr - zn) / texel;
+	search = clamp(search, 1.0, L.shadow_params.y);
+	float a = ign(gl_FragCoord.xy) * 2.0 * PI;
+	mat2 rot = mat2(cos(a), sin(a), -sin(a), cos(a));
+	float blockers = 0.0, sum_d = 0.0;
+	// Texels of the receiver's own plane must not count as blockers: compare against the
+	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
+	float slack = abs(grad.x) + abs(grad.y) + 1e-6;
+	for (int i = 0; i < 16; i++) {
+		vec2 off = rot * poisson(i * 2) * search;
+		vec2 q = p + off;
+		vec4 d = textureGather(shadow_map, vec3(q / res, layer));
+		vec4 b = step(d, vec4(ref + dot(grad, off) - slack));   // 1 where the texel is a blocker
+		blockers += dot(b, vec4(1.0));
+		sum_d += dot(b, d);
+	}
+	if (blockers < 0.5) return 1.0;
+	float zb = view_distance(v, sum_d / blockers);
+	// Penumbra width in world units at the receiver.
+	float w = persp ? 2.0 * size * (zr - zb) / max(zb, 1e-4) : 2.0 * size * (zr - zb);
+	float radius = max(0.5 * w / texel, 1.0);
+	float sum = 0.0;
+	for (int i = 0; i < 32; i++) {
+		vec2 off = rot * poisson(i) * radius;
+		sum += bilinear_compare(p + off, layer, ref + dot(grad, off), res);
+	}
+	return sum / 32.0;
+}
+
+// Receiver plane: how the receiver's light-space depth changes per shadow-map texel, from its
+// normal. Orthographic views only (their transform is affine: the plane stays a plane);
+// perspective views rely on the normal offset alone.
+vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
+{
+	if (v.params.y > 0.5) return vec2(0.0);
+	mat3 a = mat3(v.view_proj);
+	vec3 r0 = vec3(a[0][0], a[1][0], a[2][0]), r1 = vec3(a[0][1], a[1][1], a[2][1]), r2 = vec3(a[0][2], a[1][2], a[2][2]);
+	// Normal of the plane in light clip space: (A^-T) n = S^-2 A n for A = S R.
+	vec3 ns = (a * n) / vec3(dot(r0, r0), dot(r1, r1), dot(r2, r2));
+	if (abs(ns.z) < 1e-8) return vec2(0.0);
+	vec2 g = -ns.xy / ns.z * (2.0 / res);
+	return clamp(g, vec2(-0.01), vec2(0.01));
+}
+
+// Visibility of light L at world position pos with geometric normal n.
+float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint view_out)
+{
+	view_out = 0u;
+	if (L.shadow.y == 0u) return 1.0;
+	uint vi = L.shadow.x;
+	uint type = uint(L.color.w);
+	if (type == UMBRA_LIGHT_POINT) {
+		vec3 d = pos - L.position.xyz;
+		vec3 ad = abs(d);
+		uint face = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u)
+		          : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
+		vi += face;
+	} else if (SC_CASCADES != 0u && type == UMBRA_LIGHT_DIRECTIONAL && L.shadow.y > 1u) {
+		float z = dot(pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
+		uint c = 0u;
+		while (c + 1u < L.shadow.y && z > L.splits[c]) c++;
+		vi += c;
+	}
+	view_out = vi - L.shadow.x;
+	umbra_shadow_view v = views[vi];
+	float res = v.light_dir.w;
+	// Normal offset: move the lookup point along the normal by a few texels (world units at
+	// this point), more at grazing angles where acne appears first.
+	vec4 lc0 = v.view_proj * vec4(pos, 1.0);
+	float dist = v.params.y > 0.5 ? max(lc0.w, 1e-4) : 1.0;
+	float texel = v.params.x * dist;
+	float ndl = clamp(dot(n, to_light), 0.0, 1.0);
+	vec3 p = pos + n * (L.shadow_params.x * texel * (1.0 - 0.5 * ndl));
+	vec4 lc = v.view_proj * vec4(p, 1.0);
+	vec3 sc = lc.xyz / lc.w;
+	if (sc.z > 1.0) return 1.0;            // beyond the light's far plane: nothing recorded there
+	vec2 uv = sc.xy * 0.5 + 0.5;
+	vec2 tp = uv * res;
+	float ref = clamp(sc.z, 0.0, 1.0);     // depth clamp: casters before the near plane pancake to 0
+	float layer = float(vi);
+	uint filt = L.shadow.z;
+	vec2 grad = receiver_gradient(v, n, res);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, layer, ref, res);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, layer, ref, res, grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, layer, ref, res, int(L.shadow.w), grad);
+	return 1.0;
+}
+
+// ---- shading ---------------------------------------------------------------------------
+
+// Direction towards light L from pos and its attenuation: inverse square with the
+// KHR_lights_punctual range window, and the smooth spot cone.
+vec3 light_dir(umbra_light L, vec3 pos, out float atten)
+{
+	uint type = uint(L.color.w);
+	atten = 1.0;
+	if ((SC_LIGHT_TYPES & (1u << UMBRA_LIGHT_DIRECTIONAL)) != 0u && type == UMBRA_LIGHT_DIRECTIONAL)
+		return -L.direction.xyz;
+	vec3 d = L.position.xyz - pos;
+	float dist2 = max(dot(d, d), 1e-8);
+	vec3 l = d * inversesqrt(dist2);
+	atten = 1.0 / dist2;
+	if (L.position.w > 0.0) {
+		float r = sqrt(dist2) / L.position.w;
+		atten *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
+	}
+	if ((SC_LIGHT_TYPES & (1u << UMBRA_LIGHT_SPOT)) != 0u && type == UMBRA_LIGHT_SPOT) {
+		float cos_outer = L.direction.w, cos_inner = L.params.x;
+		float cd = dot(L.direction.xyz, -l);
+		float t = clamp((cd - cos_outer) / max(cos_inner - cos_outer, 1e-4), 0.0, 1.0);
+		atten *= t * t;
+	}
+	return l;
+}
+
+// Base colour times its texture (sRGB texels decode to linear in the sampler); masked
+// texels below the cutoff are discarded, as glTF alpha_mode MASK.
+vec4 base_color(umbra_material m)
+{
+	vec4 c = m.base_color;
+	if (m.tex.x != 0u) c *= texture(base_texture, v_uv);
+	if (m.tex.y != 0u && c.a < m.params.y) discard;
+	return c;
+}
+
+// Direct light from every light: with and without shadows (the shadow catcher needs both),
+// and the visibility of the debug light.
+void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bool receive,
+               out vec3 lit, out vec3 unshadowed, out float debug_vis, out uint debug_view)
+{
+	float a2 = rough * rough * rough * rough;
+	float ndv = max(dot(N, V), 1e-4);
+	lit = vec3(0.0);
+	unshadowed = vec3(0.0);
+	debug_vis = 1.0;
+	debug_view = 0u;
+	uint light_count = frame.mode.w;
+	for (uint i = 0u; i < light_count; i++) {
+		umbra_light L = lights[i];
+		uint type = uint(L.color.w);
+		if ((SC_LIGHT_TYPES & (1u << type)) == 0u) continue;
+		float atten;
+		vec3 l = light_dir(L, v_pos, atten);
+		float ndl = dot(N, l);
+		uint view = 0u;
+		float vis = SC_FILTERS != 0u && receive ? shadow_visibility(L, v_pos, n_geo, l, view) : 1.0;
+		if (i == frame.mode.z) { debug_vis = vis; debug_view = view; }
+		if (ndl <= 0.0 || atten <= 0.0) continue;
+		vec3 h = normalize(l + V);
+		float ndh = max(dot(N, h), 0.0), vdh = max(dot(V, h), 0.0);
+		float dd = ndh * ndh * (a2 - 1.0) + 1.0;
+		float D = a2 / (PI * dd * dd);
+		float vis_g = 0.5 / (ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2));
+		vec3 F = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
+		vec3 brdf = c_diff / PI + F * (D * vis_g);
+		vec3 e = L.color.rgb * atten * ndl;
+		unshadowed += brdf * e;
+		lit += brdf * e * vis;
+	}
+}
+
+vec3 tonemap_neutral(vec3 color)
+{
+	const float start = 0.8 - 0.04;
+	const float desat = 0.15;
+	float x = min(color.r, min(color.g, color.b));
+	float offset = x < 0.08 ? x - 6.25 * x * x : 0.04;
+	color -= offset;
+	float peak = max(color.r, max(color.g, color.b));
+	if (peak < start) return color;
+	const float d = 1.0 - start;
+	float new_peak = 1.0 - d * d / (peak + d - start);
+	color *= new_peak / peak;
+	float g = 1.0 - 1.0 / (desat * (peak - new_peak) + 1.0);
+	return mix(color, vec3(new_peak), g);
+}
+
+vec3 tonemap_aces(vec3 x)   // Narkowicz's fit of the ACES RRT+ODT
+{
+	return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+vec3 srgb_encode(vec3 c)
+{
+	c = clamp(c, 0.0, 1.0);
+	return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+vec3 display(vec3 radiance)
+{
+	if (SC_LINEAR != 0u) return radiance;   // linear scene-referred output (EXR)
+	vec3 c = radiance;
+	if (SC_TONEMAP == UMBRA_TONEMAP_NEUTRAL) c = tonemap_neutral(c);
+	else if (SC_TONEMAP == UMBRA_TONEMAP_ACES) c = tonemap_aces(c);
+	return srgb_encode(c);
+}
+
+// Tint per cascade / clipmap level: 0 red, 1 green, 2 blue, 3 yellow, 4 magenta, 5 cyan, ...
+vec3 cascade_tint(uint i)
+{
+	uint k = i % 6u;
+	vec3 c = k == 0u ? vec3(1, 0.3, 0.3) : k == 1u ? vec3(0.3, 1, 0.3) : k == 2u ? vec3(0.3, 0.4, 1)
+	       : k == 3u ? vec3(1, 1, 0.3) : k == 4u ? vec3(1, 0.3, 1) : vec3(0.3, 1, 1);
+	return i >= 6u ? c * 0.6 : c;
+}
+
