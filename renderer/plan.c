@@ -246,9 +246,13 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 		/* Defaults come from rnd_shadow_defaults(); see there. */
 		lp->bias_constant = s->bias_constant; lp->bias_slope = s->bias_slope; lp->bias_normal = s->bias_normal;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
-		bool cascades = false;
+		bool cascades = false, clipmap = false;
 		uint32_t ncasc = 1;
-		if (L->type == RND_LIGHT_DIRECTIONAL && use_cascades(s, bounds, cam)) {
+		if (L->type == RND_LIGHT_DIRECTIONAL && s->dir_mode == RND_DIR_CLIPMAP) {
+			clipmap = true;
+			ncasc = s->clipmap_levels ? s->clipmap_levels : 6;
+			need = ncasc;
+		} else if (L->type == RND_LIGHT_DIRECTIONAL && use_cascades(s, bounds, cam)) {
 			cascades = true;
 			ncasc = s->cascades ? s->cascades : 4;
 			need = ncasc;
@@ -265,7 +269,25 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 			light_basis(view, d);
 			float zmin, zmax;
 			depth_range(view, bounds, &zmin, &zmax);
-			if (!cascades) {
+			if (clipmap) {
+				/* Concentric camera-centred levels, each twice as wide as the one before;
+				 * every level snapped to its own texel grid. */
+				float maxd = s->max_distance > 0 ? s->max_distance : fminf(cam->zfar, max_dist(cam->pos, bounds));
+				float extent = s->clipmap_extent > 0 ? s->clipmap_extent : 2.0f * maxd / (float)(1u << (ncasc - 1));
+				float eye_ls[3];
+				rnd_mat4_mul_point(eye_ls, view, cam->pos);
+				for (uint32_t c = 0; c < ncasc; c++) {
+					float half = 0.5f * extent * (float)(1u << c);
+					float texel = 2.0f * half / fres;
+					float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
+					float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
+					ortho_view(&out->views[out->view_count], view, cx, cy, half, zmin, zmax, fres, d);
+					out->view_light[out->view_count] = i;
+					out->view_ortho[out->view_count++] = true;
+				}
+				lp->clipmap = true;
+				lp->max_distance = s->max_distance > 0 ? s->max_distance : 0.5f * extent * (float)(1u << (ncasc - 1));
+			} else if (!cascades) {
 				/* fit: the light-space box around the scene bounds, square texels */
 				struct rnd_aabb lb;
 				rnd_aabb_transform(&lb, bounds, view);
@@ -275,6 +297,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 				ortho_view(&out->views[out->view_count], view, cx, cy, half, zmin, zmax, fres, d);
 				out->view_light[out->view_count] = i;
 				out->view_ortho[out->view_count++] = true;
+				lp->max_distance = s->max_distance;
 			} else {
 				float maxd = s->max_distance > 0 ? s->max_distance : cam->zfar;
 				float scene_far = max_dist(cam->pos, bounds);
@@ -282,6 +305,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 				float split_near = fmaxf(cam->znear, 0.05f);
 				if (maxd <= split_near) maxd = split_near * 2.0f;
 				rnd_cascade_splits(split_near, maxd, ncasc, s->split_lambda, lp->splits);
+				lp->max_distance = maxd;
 				/* Distance from the eye to a far corner of the slice at depth z. */
 				float k = cam->ortho ? 0.0f : tanf(cam->fov_y * 0.5f);
 				float corner = sqrtf(1.0f + k * k * (1.0f + cam->aspect * cam->aspect));
@@ -304,6 +328,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 					out->view_ortho[out->view_count++] = true;
 				}
 			}
+			lp->fade_start = lp->max_distance * (1.0f - fminf(fmaxf(s->fade, 0.0f), 1.0f));
 		} else {
 			float reach = L->range > 0 ? L->range : max_dist(L->position, bounds);
 			float zfar = fmaxf(reach, 0.1f) * 1.01f;

@@ -31,6 +31,11 @@ struct rnd_light_plan {
 	float bias_constant, bias_slope, bias_normal;
 	float splits[4];                           /* cascades: far view depth of each */
 	float search_texels;                       /* PCSS blocker search cap */
+	bool clipmap;                              /* views are clipmap levels (else cascades / one map) */
+	float max_distance;                        /* view depth where shadows end (0 = never) */
+	float fade_start;                          /* view depth where the fade to unshadowed starts */
+	bool moments;                              /* VSM / EVSM: moment maps are built from the depth */
+	bool evsm;
 };
 
 struct rnd_shadow_plan {

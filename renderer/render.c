@@ -165,6 +165,9 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		l[i].shadow_params[0] = lp->bias_normal;
 		l[i].shadow_params[1] = lp->search_texels;
 		l[i].shadow_params[2] = in->shadow.blend;
+		l[i].shadow_params[3] = lp->fade_start;
+		l[i].params[2] = lp->clipmap ? 1.0f : 0.0f;
+		l[i].params[3] = lp->max_distance;
 		memcpy(l[i].splits, lp->splits, sizeof lp->splits);
 	}
 	memcpy(base + off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));

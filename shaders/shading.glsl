@@ -151,25 +151,15 @@ vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
 }
 
 // Visibility of light L at world position pos with geometric normal n.
-float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint view_out)
+// Moment shadow maps (VSM / EVSM2): Chebyshev's upper bound on the blurred moments.
+float moments(umbra_light L, umbra_shadow_view v, vec2 uv, float layer, float ref)
 {
-	view_out = 0u;
-	if (L.shadow.y == 0u) return 1.0;
-	uint vi = L.shadow.x;
-	uint type = uint(L.color.w);
-	if (type == UMBRA_LIGHT_POINT) {
-		vec3 d = pos - L.position.xyz;
-		vec3 ad = abs(d);
-		uint face = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u)
-		          : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
-		vi += face;
-	} else if (SC_CASCADES != 0u && type == UMBRA_LIGHT_DIRECTIONAL && L.shadow.y > 1u) {
-		float z = dot(pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
-		uint c = 0u;
-		while (c + 1u < L.shadow.y && z > L.splits[c]) c++;
-		vi += c;
-	}
-	view_out = vi - L.shadow.x;
+	return 1.0;
+}
+
+// Visibility of light L at pos (geometric normal n) in one shadow view vi.
+float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
+{
 	umbra_shadow_view v = views[vi];
 	float res = v.light_dir.w;
 	// Normal offset: move the lookup point along the normal by a few texels (world units at
@@ -190,8 +180,68 @@ float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint
 	vec2 grad = receiver_gradient(v, n, res);
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, layer, ref, res);
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, layer, ref, res, grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, layer, ref);
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, layer, ref, res, int(L.shadow.w), grad);
 	return 1.0;
+}
+
+// Largest |x|, |y| of pos in view vi's clip space (<= 1: inside the level).
+float view_extent(uint vi, vec3 pos)
+{
+	vec4 c = views[vi].view_proj * vec4(pos, 1.0);
+	return max(abs(c.x), abs(c.y)) / c.w;
+}
+
+// Visibility of light L at world position pos with geometric normal n: picks the cube face,
+// cascade or clipmap level, blends across cascade / level borders, fades out towards the
+// light's max distance. view_out: the cascade / level / face used (debug views).
+float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint view_out)
+{
+	view_out = 0u;
+	if (L.shadow.y == 0u) return 1.0;
+	uint first = L.shadow.x, count = L.shadow.y;
+	uint type = uint(L.color.w);
+	if (type == UMBRA_LIGHT_POINT) {
+		vec3 d = pos - L.position.xyz;
+		vec3 ad = abs(d);
+		uint face = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u)
+		          : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
+		view_out = face;
+		return sample_view(L, first + face, pos, n, to_light);
+	}
+	float z = dot(pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
+	float max_d = L.params.w, fade_start = L.shadow_params.w;
+	if (max_d > 0.0 && z >= max_d) return 1.0;
+	float vis;
+	if (SC_CASCADES == 0u || type != UMBRA_LIGHT_DIRECTIONAL || count == 1u) {
+		vis = sample_view(L, first, pos, n, to_light);
+	} else if (L.params.z > 0.5) {
+		// Clipmap: the finest level that contains the point; blend into the next level over
+		// the outer `blend` fraction of this one.
+		uint c = 0u;
+		float e = view_extent(first, pos);
+		while (c + 1u < count && e > 0.98) { c++; e = view_extent(first + c, pos); }
+		view_out = c;
+		vis = sample_view(L, first + c, pos, n, to_light);
+		float band = max(L.shadow_params.z, 1e-3);
+		float t = clamp((e - (0.98 - band)) / band, 0.0, 1.0);
+		if (t > 0.0 && c + 1u < count) vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light), t);
+	} else {
+		uint c = 0u;
+		while (c + 1u < count && z > L.splits[c]) c++;
+		view_out = c;
+		vis = sample_view(L, first + c, pos, n, to_light);
+		// Blend band at the far end of each cascade: no visible seam between cascades.
+		float prev = c == 0u ? 0.0 : L.splits[c - 1u];
+		float start = L.splits[c] - L.shadow_params.z * (L.splits[c] - prev);
+		if (c + 1u < count && z > start) {
+			float t = clamp((z - start) / max(L.splits[c] - start, 1e-6), 0.0, 1.0);
+			vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light), t);
+		}
+	}
+	// Distance fade to unshadowed before max distance, so the end of the shadows has no edge.
+	if (max_d > 0.0 && z > fade_start) vis = mix(vis, 1.0, smoothstep(fade_start, max_d, z));
+	return vis;
 }
 
 // ---- shading ---------------------------------------------------------------------------

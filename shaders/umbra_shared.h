@@ -35,6 +35,7 @@
 #define UMBRA_FILTER_HARD 1
 #define UMBRA_FILTER_PCF  2
 #define UMBRA_FILTER_PCSS 3
+#define UMBRA_FILTER_MOMENTS 4   /* vsm / evsm (light.shadow_params / moment params say which) */
 
 /* umbra_frame.mode.y: debug view */
 #define UMBRA_DEBUG_NONE     0
@@ -101,10 +102,11 @@ struct umbra_light {
 	U_VEC4 color;            /* rgb * intensity; w type */
 	U_VEC4 position;         /* xyz; w range (0 = unbounded) */
 	U_VEC4 direction;        /* xyz normalised travel direction; w cos(outer) */
-	U_VEC4 params;           /* x cos(inner), y size: tan(angular radius) or radius (m), z, w */
+	U_VEC4 params;           /* x cos(inner), y size: tan(angular radius) or radius (m),
+	                            z 1 = clipmap levels (else cascades), w max distance (0 = none) */
 	U_UVEC4 shadow;          /* x first view, y view count (0 = unshadowed), z filter, w pcf radius */
 	U_VEC4 shadow_params;    /* x normal offset (texels), y max search radius (texels),
-	                            z blend band (fraction), w fade start (view depth; 0 = none) */
+	                            z blend band (fraction), w fade start (view depth) */
 	U_VEC4 splits;           /* directional cascades: far view depth of cascade 0..3 */
 };
 

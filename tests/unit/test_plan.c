@@ -103,6 +103,14 @@ TEST(plan_cascade_splits_practical_scheme)
 		for (int i = 1; i < 4; i++) CHECK(s[i] > s[i - 1], "lambda %g: split %d %g <= split %d %g", lam, i, s[i], i - 1, s[i - 1]);
 		CHECK(s[0] > n, "lambda %g: first split %g not beyond near", lam, s[0]);
 	}
+	/* Odd values: the last split is still exactly far (no pow/lerp rounding drift). */
+	static const float odd[][3] = {{0.37f, 77.7f, 0.6f}, {0.013f, 913.3f, 0.9f}, {1.7f, 3.3f, 0.33f}, {0.05f, 141.42136f, 0.75f}};
+	for (int i = 0; i < 4; i++) {
+		float s[4];
+		rnd_cascade_splits(odd[i][0], odd[i][1], 4, odd[i][2], s);
+		CHECK(s[3] == odd[i][1], "near %g far %.9g lambda %g: last split %.9g", odd[i][0], odd[i][1], odd[i][2], s[3]);
+		for (int k = 1; k < 4; k++) CHECK(s[k] > s[k - 1], "odd case %d not increasing", i);
+	}
 	/* Fewer cascades: the last used split is exactly far, unused entries hold far. */
 	for (uint32_t cnt = 1; cnt <= 3; cnt++) {
 		float s[4] = {-1, -1, -1, -1};
