@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "internal.h"
+#include "moments.h"
 
 const char *rnd_vk_str(VkResult r)
 {
@@ -364,12 +365,15 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if ((r = create_device(ctx, err)) != RND_OK) goto fail_device;
 	create_pipeline_cache(ctx);
 	if ((r = rnd_pipelines_init(ctx, err)) != RND_OK) goto fail_pipelines;
+	if ((r = rnd_moments_init(ctx, err)) != RND_OK) goto fail_moments;
 	if ((r = rnd_slots_init(ctx, err)) != RND_OK) goto fail_slots;
 	rnd_log(ctx, 2, "device '%s' (%s %s)", ctx->props.deviceName, ctx->driver_name, ctx->driver_info);
 	*out = ctx;
 	return RND_OK;
 
 fail_slots:
+	rnd_moments_release(ctx);
+fail_moments:
 	rnd_pipelines_release(ctx);
 fail_pipelines:
 	if (ctx->pipeline_cache) vkDestroyPipelineCache(ctx->device, ctx->pipeline_cache, NULL);
@@ -389,6 +393,7 @@ void rnd_context_destroy(struct rnd_context *ctx)
 	if (!ctx) return;
 	if (ctx->device) vkDeviceWaitIdle(ctx->device); /* once, at shutdown: nothing may be in flight */
 	rnd_slots_release(ctx);
+	rnd_moments_release(ctx);
 	rnd_pipelines_release(ctx);
 	if (ctx->pipeline_cache) vkDestroyPipelineCache(ctx->device, ctx->pipeline_cache, NULL);
 	if (ctx->device) vkDestroyDevice(ctx->device, NULL);

@@ -72,6 +72,15 @@ struct rnd_pipelines {
 	} variants[RND_MAX_VARIANTS];
 };
 
+struct rnd_moments {
+	VkDescriptorSetLayout set_layout;
+	VkPipelineLayout layout;
+	VkPipeline pipeline;                 /* moments.comp */
+	VkSampler sampler;                   /* linear, clamp to edge */
+	bool fp32;                           /* R32G32_SFLOAT filterable + storable */
+	bool available;                      /* VSM / EVSM can be offered at all */
+};
+
 struct rnd_slot;
 
 struct rnd_context {
@@ -88,6 +97,7 @@ struct rnd_context {
 	uint32_t queue_family;
 	VkPipelineCache pipeline_cache;
 	struct rnd_pipelines pipes;
+	struct rnd_moments moments;
 	bool has_debug_utils;
 	bool timestamps;                     /* queue supports timestamps */
 	float timestamp_period;              /* ns per tick */

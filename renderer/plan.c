@@ -82,6 +82,8 @@ enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, ui
 	}
 	if (zfar <= znear) zfar = znear + 1.0f;
 	out->znear = znear; out->zfar = zfar;
+	out->user_near = cam->near > 0 ? cam->near : 0.0f;
+	out->user_far = cam->far > 0 ? cam->far : 0.0f;
 	if (out->ortho) {
 		float h = cam->height > 0 ? cam->height : 1.0f, w = h * out->aspect;
 		rnd_mat4_ortho(out->proj, -w / 2, w / 2, -h / 2, h / 2, znear, zfar);
@@ -237,9 +239,16 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 		case RND_FILTER_HARD: lp->filter = UMBRA_FILTER_HARD; break;
 		case RND_FILTER_PCF: lp->filter = UMBRA_FILTER_PCF; break;
 		case RND_FILTER_PCSS: lp->filter = UMBRA_FILTER_PCSS; break;
+		case RND_FILTER_VSM:
+		case RND_FILTER_EVSM:
+			lp->filter = UMBRA_FILTER_MOMENTS;
+			lp->moments = true;
+			lp->evsm = f == RND_FILTER_EVSM;
+			lp->evsm_exponent = s->vsm_exponent;
+			lp->fp16 = s->vsm_precision == RND_VSM_FP16;
+			break;
 		default:
-			return rnd_fail(err, RND_ERR_INVALID, "light %u: shadow filter '%s' is not implemented by this renderer yet",
-			                i, f == RND_FILTER_VSM ? "vsm" : "evsm");
+			return rnd_fail(err, RND_ERR_INVALID, "light %u: unknown shadow filter %d", i, (int)f);
 		}
 		lp->pcf_radius = s->pcf_radius > 5 ? 5 : s->pcf_radius;
 		lp->search_texels = 24.0f;
@@ -299,10 +308,16 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 				out->view_ortho[out->view_count++] = true;
 				lp->max_distance = s->max_distance;
 			} else {
-				float maxd = s->max_distance > 0 ? s->max_distance : cam->zfar;
-				float scene_far = max_dist(cam->pos, bounds);
-				if (maxd > scene_far) maxd = scene_far;
-				float split_near = fmaxf(cam->znear, 0.05f);
+				/* Splits must not depend on where the camera is (a derived near/far does), or
+				 * the cascades' texel size would change as it moves: use the light's
+				 * max_distance, else the caller's far, capped by the scene's size. */
+				float diag[3];
+				rnd_v3_sub(diag, bounds->max, bounds->min);
+				float maxd = rnd_v3_length(diag);
+				if (cam->user_far > 0 && cam->user_far < maxd) maxd = cam->user_far;
+				if (s->max_distance > 0) maxd = s->max_distance;
+				float split_near = cam->user_near > 0 ? cam->user_near : fmaxf(0.05f, maxd / 2000.0f);
+				split_near = fmaxf(split_near, 0.05f);
 				if (maxd <= split_near) maxd = split_near * 2.0f;
 				rnd_cascade_splits(split_near, maxd, ncasc, s->split_lambda, lp->splits);
 				lp->max_distance = maxd;
@@ -320,6 +335,11 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 					/* Round the radius up to a coarse step so small changes of near/far do not
 					 * change the texel size; then snap the centre to whole texels. */
 					r = ceilf(r * 16.0f) / 16.0f;
+					/* Room for the half texel that snapping moves the centre by and for the
+					 * filter footprint, so taps near a cascade's edge stay inside it. */
+					float margin = 0.5f + (float)lp->pcf_radius + 2.0f +
+					               (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
+					r *= fres / (fres - 2.0f * margin);
 					float texel = 2.0f * r / fres;
 					float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
 					float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;

@@ -15,6 +15,7 @@ struct rnd_camera_plan {
 	float view[16], proj[16], view_proj[16];   /* proj is reversed-Z: near -> 1, far -> 0 */
 	float pos[3], fwd[3], up[3];
 	float znear, zfar;
+	float user_near, user_far;                 /* as the caller gave them (0 = derived) */
 	float fov_y, aspect;                       /* perspective */
 	float ortho_height;                        /* orthographic */
 	bool ortho;
@@ -36,6 +37,8 @@ struct rnd_light_plan {
 	float fade_start;                          /* view depth where the fade to unshadowed starts */
 	bool moments;                              /* VSM / EVSM: moment maps are built from the depth */
 	bool evsm;
+	float evsm_exponent;                       /* 0 = by precision (render.c decides) */
+	bool fp16;                                 /* vsm.precision fp16 asked for */
 };
 
 struct rnd_shadow_plan {

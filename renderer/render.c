@@ -15,6 +15,7 @@
 #include <time.h>
 #include "mesh.h"
 #include "plan.h"
+#include "moments.h"
 #include "record.h"
 
 /* How long a submitted render may take before the device is considered hung. */
@@ -169,6 +170,14 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		l[i].params[2] = lp->clipmap ? 1.0f : 0.0f;
 		l[i].params[3] = lp->max_distance;
 		memcpy(l[i].splits, lp->splits, sizeof lp->splits);
+		if (lp->moments) {
+			float c = lp->evsm_exponent;
+			l[i].moment_params[0] = lp->evsm ? c : 0.0f;
+			l[i].moment_params[1] = fminf(fmaxf(in->shadow.vsm_light_bleed, 0.0f), 0.999f);
+			/* Variance floor: a fraction of the warped depth's scale (EVSM) or of the
+			 * depth range (VSM), so flat receivers do not self-shadow. */
+			l[i].moment_params[2] = lp->evsm ? 1e-4f : 2e-6f;
+		}
 	}
 	memcpy(base + off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));
 
@@ -190,7 +199,12 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		};
 	}
 	if (ntex) vkUpdateDescriptorSets(ctx->device, ntex, tw, 0, NULL);
-	VkWriteDescriptorSet w[5];
+	VkDescriptorImageInfo mi = {ctx->moments.sampler, s->moments.view, VK_IMAGE_LAYOUT_GENERAL};
+	VkWriteDescriptorSet w[6];
+	w[5] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
+	};
 	for (int i = 0; i < 5; i++) {
 		w[i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
@@ -200,7 +214,24 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, 5, w, 0, NULL);
+	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
+	if (s->moments_tmp.img) {
+		/* moments.comp: depth in, blur temporary, moments out */
+		VkDescriptorImageInfo ci[3] = {
+			{ctx->pipes.shadow_sampler, s->shadow.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+			{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
+			{VK_NULL_HANDLE, s->moments.view, VK_IMAGE_LAYOUT_GENERAL},
+		};
+		VkWriteDescriptorSet cw[3];
+		for (uint32_t i = 0; i < 3; i++)
+			cw[i] = (VkWriteDescriptorSet){
+				.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
+				.descriptorCount = 1,
+				.descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+				.pImageInfo = &ci[i],
+			};
+		vkUpdateDescriptorSets(ctx->device, 3, cw, 0, NULL);
+	}
 	return RND_OK;
 }
 
@@ -444,10 +475,24 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		for (uint32_t i = 0; i < sc->light_count; i++)
 			if (sc->lights[i].type == RND_LIGHT_DIRECTIONAL && sp->lights[i].view_count > 1) camera_dependent = true;
 		bool draw_shadows = !shadows_ready || camera_dependent;
+		bool any_moments = false, fp16 = false;
+		for (uint32_t i = 0; i < sc->light_count; i++)
+			if (sp->lights[i].moments && sp->lights[i].view_count) { any_moments = true; fp16 |= sp->lights[i].fp16; }
+		if (any_moments && !ctx->moments.available) {
+			r = rnd_fail(err, RND_ERR_INVALID, "shadow filters vsm/evsm need storage images this device lacks");
+			goto done;
+		}
+		VkFormat mfmt = rnd_moments_format(ctx, fp16);
+		for (uint32_t i = 0; i < sc->light_count; i++) {
+			struct rnd_light_plan *lp = &sp->lights[i];
+			float cmax = rnd_moments_max_exponent(mfmt);
+			if (lp->evsm) lp->evsm_exponent = lp->evsm_exponent > 0 ? fminf(lp->evsm_exponent, cmax) : cmax;
+		}
 		if (draw_shadows) {
 			uint32_t layers = sp->view_count ? sp->view_count : 1;
 			uint32_t res = sp->view_count ? sp->resolution : (s->shadow.img ? s->shadow.width : 64);
 			if ((r = rnd_slot_shadow(ctx, s, res, layers, err)) != RND_OK) goto done;
+			if ((r = rnd_slot_moments(ctx, s, mfmt, res, any_moments ? layers : 0, err)) != RND_OK) goto done;
 		}
 		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, err)) != RND_OK) goto done;
 
@@ -467,8 +512,19 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		}
 		if (v == 0) record_textures(s, tex, ntex);
 		uint32_t casters = 0;
+		if (!s->moments_initialised) {
+			VkImage imgs[2] = {s->moments.img, s->moments_tmp.img};
+			for (int k = 0; k < 2; k++)
+				if (imgs[k])
+					record_image_barrier(s->cmd, imgs[k], VK_IMAGE_ASPECT_COLOR_BIT, VK_REMAINING_ARRAY_LAYERS,
+					                     VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0,
+					                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+					                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+			s->moments_initialised = true;
+		}
 		if (draw_shadows) {
 			record_shadows(ctx, s, &rv, &casters);
+			if (any_moments) rnd_moments_record(ctx, s, sp, sc);
 			tm.shadow_maps_rendered += sp->view_count;
 		} else {
 			tm.shadow_maps_reused += sp->view_count;

@@ -49,7 +49,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	VkDescriptorPoolSize sizes[3] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2},
 	};
 	VkDescriptorPoolCreateInfo dpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 3, .pPoolSizes = sizes,
@@ -99,8 +99,30 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 	};
 	vkUpdateDescriptorSets(ctx->device, 1, &ww, 0, NULL);
+	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
+	VkDescriptorPoolCreateInfo mpi = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = msizes,
+	};
+	if ((vr = vkCreateDescriptorPool(ctx->device, &mpi, NULL, &s->moments_pool)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkCreateDescriptorPool (moments)");
+		goto fail_white;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->moments_pool, "slot %u moments descriptor pool", index);
+	VkDescriptorSetAllocateInfo mai = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->moments_pool,
+		.descriptorSetCount = 1, .pSetLayouts = &ctx->moments.set_layout,
+	};
+	if ((vr = vkAllocateDescriptorSets(ctx->device, &mai, &s->moments_set)) != VK_SUCCESS) {
+		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets (moments)");
+		goto fail_moments_pool;
+	}
 	*out = s;
 	return RND_OK;
+
+fail_moments_pool:
+	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
+fail_white:
+	rnd_image_destroy(ctx, &s->white);
 
 fail_texture_pool:
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
@@ -135,6 +157,9 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_slot_drop_textures(ctx, s);
 	rnd_image_destroy(ctx, &s->white);
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
+	rnd_image_destroy(ctx, &s->moments);
+	rnd_image_destroy(ctx, &s->moments_tmp);
+	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
 	rnd_image_destroy(ctx, &s->aov_depth);
 	rnd_buffer_destroy(ctx, &s->staging);
@@ -298,4 +323,31 @@ enum rnd_result rnd_slot_aov(struct rnd_context *ctx, struct rnd_slot *s, uint32
 fail:
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
 	return r;
+}
+
+enum rnd_result rnd_slot_moments(struct rnd_context *ctx, struct rnd_slot *s, VkFormat f, uint32_t res, uint32_t layers,
+                                 struct rnd_error *err)
+{
+	enum rnd_result r;
+	if (!layers) {
+		if (s->moments.img) return RND_OK;   /* any image will do as the placeholder */
+		f = VK_FORMAT_R16G16_SFLOAT; res = 4; layers = 1;
+	} else if (s->moments.img && s->moments.format == f && s->moments.width == res && s->moments.layers >= layers) {
+		return RND_OK;
+	}
+	rnd_image_destroy(ctx, &s->moments);
+	rnd_image_destroy(ctx, &s->moments_tmp);
+	s->moments_initialised = false;
+	char name[48];
+	snprintf(name, sizeof name, "slot %u moments", s->index);
+	if ((r = rnd_image_create(ctx, f, res, res, layers, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT,
+	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments, err)) != RND_OK)
+		return r;
+	snprintf(name, sizeof name, "slot %u moments blur", s->index);
+	if ((r = rnd_image_create(ctx, VK_FORMAT_R32G32_SFLOAT, res, res, layers, 1, VK_IMAGE_USAGE_STORAGE_BIT,
+	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments_tmp, err)) != RND_OK) {
+		rnd_image_destroy(ctx, &s->moments);
+		return r;
+	}
+	return RND_OK;
 }

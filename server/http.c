@@ -311,7 +311,7 @@ static bool accept_prefers_exr(const char *accept)
 	if (!accept)
 		return false;
 	double q_png = -1, q_exr = -1, q_wild = -1;
-	int spec_png = 0, spec_exr = 0;
+	bool spec_png = false, spec_exr = false;
 	const char *p = accept;
 	while (*p) {
 		while (*p == ' ' || *p == ',')
@@ -337,10 +337,10 @@ static bool accept_prefers_exr(const char *accept)
 			*--end = 0;
 		if (!strcasecmp(buf, "image/png")) {
 			q_png = q;
-			spec_png = 2;
-		} else if (!strcasecmp(buf, "image/x-exr") || !strcasecmp(buf, "image/aces")) {
+			spec_png = true;
+		} else if (!strcasecmp(buf, "image/x-exr")) {
 			q_exr = q;
-			spec_exr = 2;
+			spec_exr = true;
 		} else if (!strcasecmp(buf, "image/*") || !strcasecmp(buf, "*/*")) {
 			if (q > q_wild)
 				q_wild = q;
@@ -372,8 +372,8 @@ static bool etag_matches(const char *inm, const char *etag)
 			p++;
 		if (!*p)
 			break;
-		if (*p == '*')
-			return true;
+		/* "*" is not a match: a render always has a representation to make, and an
+		 * unconditional 304 would hide it. */
 		if (!strncmp(p, "W/", 2))
 			p += 2;
 		size_t n = strcspn(p, ", \t");
@@ -443,6 +443,8 @@ static bool render_body(struct srv_request *req, const char *data, size_t size)
 	}
 	req->body_received += size;
 	req->body_hash = fnv1a(req->body_hash, data, size);
+	if (req->body_oom)
+		return true; /* the rest is read and dropped; answered 503 at the end */
 	if (req->post) {
 		if (!req->part_error && MHD_post_process(req->post, data, size) != MHD_YES && !req->part_error)
 			req->part_error = "malformed multipart/form-data body";
@@ -456,8 +458,9 @@ static bool render_body(struct srv_request *req, const char *data, size_t size)
 			cap = s->cfg.max_body + 1;
 		char *p = realloc(req->body, cap);
 		if (!p) {
-			req->body_discarded += size;
-			return false;
+			srv_request_drop_body(req);
+			req->body_oom = true;
+			return true;
 		}
 		req->body = p;
 		req->body_cap = cap;
@@ -473,6 +476,8 @@ static enum MHD_Result render_body_done(struct srv_request *req, struct MHD_Conn
 	if (req->body_discarded)
 		return respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
 		                       (unsigned long long)s->cfg.max_body);
+	if (req->body_oom)
+		return respond_problem(req, 503, NULL, "", "out of memory while reading the body");
 	if (req->post) {
 		if (MHD_destroy_post_processor(req->post) != MHD_YES && !req->part_error)
 			req->part_error = "truncated multipart/form-data body";

@@ -136,6 +136,7 @@ struct srv_request {
 	char *body;
 	size_t body_len, body_cap;
 	uint64_t body_received;        /* raw body bytes so far (multipart included) */
+	bool body_oom;                 /* a body buffer could not grow: answer 503 */
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
 	uint64_t body_hash;            /* FNV-1a 64, running */
 	char etag[40];

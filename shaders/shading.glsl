@@ -13,6 +13,7 @@ layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonl
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_LIGHTS) readonly buffer Lights { umbra_light lights[]; };
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) readonly buffer Views { umbra_shadow_view views[]; };
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2DArray shadow_map;
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2DArray moment_map;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
 layout(push_constant) uniform PushBlock { umbra_push pc; };
 
@@ -152,9 +153,20 @@ vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
 
 // Visibility of light L at world position pos with geometric normal n.
 // Moment shadow maps (VSM / EVSM2): Chebyshev's upper bound on the blurred moments.
+// The moments are blurred and filtered linearly, so the filter is as wide as the blur; the
+// variance floor and light-bleed reduction trade softness against leaks.
 float moments(umbra_light L, umbra_shadow_view v, vec2 uv, float layer, float ref)
 {
-	return 1.0;
+	vec2 m = texture(moment_map, vec3(uv, layer)).xy;
+	float c = L.moment_params.x;
+	float t = c > 0.0 ? exp(c * ref) : ref;
+	float min_var = c > 0.0 ? L.moment_params.z * c * t * c * t * 1e-4 : L.moment_params.z;
+	if (t <= m.x) return 1.0;
+	float var = max(m.y - m.x * m.x, min_var);
+	float d = t - m.x;
+	float p = var / (var + d * d);
+	float lbr = L.moment_params.y;
+	return clamp((p - lbr) / (1.0 - lbr), 0.0, 1.0);
 }
 
 // Visibility of light L at pos (geometric normal n) in one shadow view vi.

@@ -15,7 +15,12 @@
 #define UMBRA_BINDING_LIGHTS         2  /* storage  umbra_light[] */
 #define UMBRA_BINDING_SHADOW_VIEWS   3  /* storage  umbra_shadow_view[] */
 #define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2DArray, depth, one layer per shadow view */
-#define UMBRA_BINDING_COUNT          5
+#define UMBRA_BINDING_MOMENTS        5  /* sampler2DArray, blurred moments (linear filtering) */
+#define UMBRA_BINDING_COUNT          6
+/* moments.comp's own set 0 */
+#define UMBRA_MOMENTS_BINDING_DEPTH  0
+#define UMBRA_MOMENTS_BINDING_TMP    1
+#define UMBRA_MOMENTS_BINDING_OUT    2
 /* Set 1: the material's base-colour texture (sRGB), bound per draw; a white 1x1 when none. */
 #define UMBRA_SET_MATERIAL           1
 #define UMBRA_BINDING_BASE_TEXTURE   0
@@ -108,6 +113,7 @@ struct umbra_light {
 	U_VEC4 shadow_params;    /* x normal offset (texels), y max search radius (texels),
 	                            z blend band (fraction), w fade start (view depth) */
 	U_VEC4 splits;           /* directional cascades: far view depth of cascade 0..3 */
+	U_VEC4 moment_params;    /* x EVSM exponent (0 = VSM), y light-bleed reduction, z min variance */
 };
 
 struct umbra_shadow_view {

@@ -1,0 +1,146 @@
+/*
+ * renderer/moments.c — moment shadow maps (VSM and EVSM2) for every light type: a compute
+ * pipeline (shaders/moments.comp) that turns a depth layer into blurred moments, and the
+ * recording of its two passes per shadow view. Created once per context; the moment images
+ * themselves belong to the render slots (slot.c).
+ *
+ * Format: R32G32_SFLOAT where the device can filter it linearly and store to it, else
+ * R16G16_SFLOAT (the EVSM exponent is then clamped so exp(2cd) fits in a half).
+ */
+#include <math.h>
+#include <string.h>
+#include "moments.h"
+#include "record.h"
+#include "moments.comp.spv.h"
+
+static bool format_ok(const struct rnd_context *ctx, VkFormat f)
+{
+	VkFormatProperties fp;
+	vkGetPhysicalDeviceFormatProperties(ctx->phys, f, &fp);
+	VkFormatFeatureFlags need = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT |
+	                            VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT;
+	return (fp.optimalTilingFeatures & need) == need;
+}
+
+enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
+{
+	struct rnd_moments *m = &ctx->moments;
+	VkResult vr;
+	VkPhysicalDeviceFeatures f;
+	vkGetPhysicalDeviceFeatures(ctx->phys, &f);
+	m->fp32 = format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) && f.shaderStorageImageExtendedFormats;
+	m->available = f.shaderStorageImageWriteWithoutFormat && f.shaderStorageImageExtendedFormats &&
+	               format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) | format_ok(ctx, VK_FORMAT_R16G16_SFLOAT);
+	VkDescriptorSetLayoutBinding b[3] = {
+		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
+		{UMBRA_MOMENTS_BINDING_TMP, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
+		{UMBRA_MOMENTS_BINDING_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
+	};
+	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 3, .pBindings = b};
+	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &m->set_layout)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (moments)");
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, m->set_layout, "moments set layout");
+	VkPushConstantRange pcr = {VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(struct rnd_moments_push)};
+	VkPipelineLayoutCreateInfo lci = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 1, .pSetLayouts = &m->set_layout,
+		.pushConstantRangeCount = 1, .pPushConstantRanges = &pcr,
+	};
+	if ((vr = vkCreatePipelineLayout(ctx->device, &lci, NULL, &m->layout)) != VK_SUCCESS) {
+		rnd_fail_vk(err, vr, "vkCreatePipelineLayout (moments)");
+		goto fail;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, m->layout, "moments pipeline layout");
+	VkShaderModule mod;
+	VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = sizeof spv_moments_comp, .pCode = spv_moments_comp};
+	if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &mod)) != VK_SUCCESS) {
+		rnd_fail_vk(err, vr, "vkCreateShaderModule (moments.comp)");
+		goto fail;
+	}
+	VkComputePipelineCreateInfo cci = {
+		.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+		.stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = mod, .pName = "main"},
+		.layout = m->layout,
+	};
+	vr = vkCreateComputePipelines(ctx->device, ctx->pipeline_cache, 1, &cci, NULL, &m->pipeline);
+	vkDestroyShaderModule(ctx->device, mod, NULL);
+	if (vr != VK_SUCCESS) {
+		rnd_fail_vk(err, vr, "vkCreateComputePipelines (moments)");
+		goto fail;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE, m->pipeline, "moments blur");
+	VkSamplerCreateInfo sci = {
+		.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
+		.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST, .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+		.addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+	};
+	if ((vr = vkCreateSampler(ctx->device, &sci, NULL, &m->sampler)) != VK_SUCCESS) {
+		rnd_fail_vk(err, vr, "vkCreateSampler (moments)");
+		goto fail;
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, m->sampler, "moments sampler");
+	return RND_OK;
+fail:
+	rnd_moments_release(ctx);
+	return err->code;
+}
+
+void rnd_moments_release(struct rnd_context *ctx)
+{
+	struct rnd_moments *m = &ctx->moments;
+	if (!ctx->device) return;
+	if (m->sampler) vkDestroySampler(ctx->device, m->sampler, NULL);
+	if (m->pipeline) vkDestroyPipeline(ctx->device, m->pipeline, NULL);
+	if (m->layout) vkDestroyPipelineLayout(ctx->device, m->layout, NULL);
+	if (m->set_layout) vkDestroyDescriptorSetLayout(ctx->device, m->set_layout, NULL);
+	memset(m, 0, sizeof *m);
+}
+
+VkFormat rnd_moments_format(const struct rnd_context *ctx, bool want_fp16)
+{
+	return ctx->moments.fp32 && !want_fp16 ? VK_FORMAT_R32G32_SFLOAT : VK_FORMAT_R16G16_SFLOAT;
+}
+
+float rnd_moments_max_exponent(VkFormat f)
+{
+	/* exp(2 c) must stay finite: half max 65504 -> c <= 5.54; float -> c <= 44. */
+	return f == VK_FORMAT_R32G32_SFLOAT ? 42.0f : 5.54f;
+}
+
+void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
+                        const struct rnd_scene *sc)
+{
+	struct rnd_moments *m = &ctx->moments;
+	VkCommandBuffer cmd = s->cmd;
+	VkMemoryBarrier2 mb = {
+		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+		.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
+	vkCmdPipelineBarrier2(cmd, &di);
+	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->pipeline);
+	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
+	uint32_t res = sp->resolution;
+	uint32_t groups = (res + 7) / 8;
+	for (int pass = 0; pass < 2; pass++) {
+		for (uint32_t v = 0; v < sp->view_count; v++) {
+			const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
+			if (!lp->moments) continue;
+			float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
+			struct rnd_moments_push push = {
+				.info = {v, (uint32_t)pass, (uint32_t)ceilf(blur), res},
+				.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), 0, 0},
+			};
+			vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+			vkCmdDispatch(cmd, groups, groups, 1);
+		}
+		/* Pass 1 reads what pass 0 wrote; the main pass samples what pass 1 wrote. */
+		mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+		mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+		mb.dstStageMask = pass == 0 ? VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+		mb.dstAccessMask = pass == 0 ? VK_ACCESS_2_SHADER_STORAGE_READ_BIT : VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+		vkCmdPipelineBarrier2(cmd, &di);
+	}
+}

@@ -1,0 +1,27 @@
+/*
+ * renderer/moments.h — VSM / EVSM2 moment maps (see moments.c). The context owns the compute
+ * pipeline; each slot owns its moment images (slot.c). Recording happens after the shadow
+ * passes of a render, for every shadow view of a light whose filter is vsm or evsm.
+ */
+#ifndef UMBRA_RENDERER_MOMENTS_H
+#define UMBRA_RENDERER_MOMENTS_H
+
+#include "plan.h"
+#include "slot.h"
+
+struct rnd_moments_push {
+	uint32_t info[4];   /* layer, pass, blur radius, resolution */
+	float params[4];    /* EVSM exponent (0 = VSM), Gaussian sigma */
+};
+
+enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err);
+void rnd_moments_release(struct rnd_context *ctx);
+/* The moment format for a request (fp16 when asked or when fp32 cannot be filtered). */
+VkFormat rnd_moments_format(const struct rnd_context *ctx, bool want_fp16);
+float rnd_moments_max_exponent(VkFormat f);
+/* Records both blur passes for every moment view of the plan into s->cmd. The slot's
+ * moment images must hold the plan's layers and s->moments_set must point at them. */
+void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
+                        const struct rnd_scene *sc);
+
+#endif
