@@ -505,10 +505,16 @@ TEST(plan_shadow_limits_and_errors)
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK, "42 shadowed of 43: %s", err.msg);
 	CHECK(sp.lights[0].view_count == 0 && sp.lights[1].first_view == 0, "unshadowed light takes no view");
 	lights[0].shadow.enabled = true;
-	/* Unimplemented filter. */
+	/* Moment filters plan moment views; EVSM keeps the caller's exponent for render.c to clamp. */
 	sc.light_count = 1;
 	lights[0].shadow.filter = RND_FILTER_VSM;
-	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_ERR_INVALID, "vsm is not implemented");
+	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.lights[0].moments && !sp.lights[0].evsm &&
+	      sp.lights[0].filter == UMBRA_FILTER_MOMENTS, "vsm plans moment maps");
+	lights[0].shadow.filter = RND_FILTER_EVSM;
+	lights[0].shadow.vsm_exponent = 7.0f;
+	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.lights[0].evsm && sp.lights[0].evsm_exponent == 7.0f,
+	      "evsm plans moment maps with the exponent");
+	lights[0].shadow.vsm_exponent = 0.0f;
 	lights[0].shadow.filter = RND_FILTER_AUTO;
 	/* Resolution: the largest any light asks for; default 2048. */
 	sc.light_count = 2;
