@@ -576,6 +576,11 @@ out:
 
 /* ---- materials ---- */
 
+/* The renderer's bounds on base-colour textures (renderer/render.c textures()). */
+#define MAX_TEXTURE_SIDE 16384u
+#define MAX_TEXTURE_PIXELS (64ull << 20)
+#define MAX_TEXTURES 16u
+
 static const char *const MATERIAL_MEMBERS[] = {"base_color", "base_color_texture", "alpha_mode", "alpha_cutoff",
                                                "roughness", "metallic", "emissive", "shadow_catcher", NULL};
 
@@ -617,7 +622,33 @@ static int parse_material(struct pctx *c, json_t *j, struct rnd_material *m, con
 			ptr_pop(c, old);
 			return -1;
 		}
-		defer(c, true, NULL, "base_color_texture is not supported yet");
+		/* Decoded now (a texture the renderer would refuse is caught here, with its pointer) and
+		 * copied into the arena, which owns it with the rest of the scene. */
+		uint8_t *rgba = NULL;
+		uint32_t w = 0, h = 0;
+		char err[200];
+		if (api_image_decode(b, len, MAX_TEXTURE_PIXELS, &rgba, &w, &h, err, sizeof err) != API_OK) {
+			fail(c, "base_color_texture could not be decoded: %s", err);
+			ptr_pop(c, old);
+			return -1;
+		}
+		struct rnd_texture *t = api_arena_alloc(c->arena, sizeof *t);
+		uint8_t *px = api_arena_calloc(c->arena, (size_t)w * h, 4);
+		if (!t || !px) {
+			free(rgba);
+			fail(c, "base_color_texture is too large (out of memory)");
+			ptr_pop(c, old);
+			return -1;
+		}
+		memcpy(px, rgba, (size_t)w * h * 4);
+		free(rgba);
+		t->rgba = px;
+		t->width = w;
+		t->height = h;
+		m->base_color_texture = t;
+		if (w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE)
+			defer(c, false, NULL, "base_color_texture is %ux%u texels, over the limit of %u per side", w, h,
+			      MAX_TEXTURE_SIDE);
 		ptr_pop(c, old);
 	}
 	return 0;
@@ -1304,6 +1335,129 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 	return 0;
 }
 
+/* ---- several views ---- */
+
+#define MAX_VIEWS 1024u
+/* The renderer's bounds on a sheet (renderer/render.c rnd_render()). */
+#define MAX_SHEET_SIDE 65536u
+#define MAX_SHEET_PIXELS (1ull << 28)
+
+struct turntable {
+	uint32_t frames;      /* 0 = no turntable */
+	double elevation;     /* degrees */
+	double distance;      /* 0 = fitted */
+};
+
+/* Grows [lo, hi] by the object's object-space bounds under its model matrix. */
+static void object_bounds(const struct rnd_object *o, double lo[3], double hi[3])
+{
+	float a[3], b[3];
+	switch (o->shape) {
+	case RND_SHAPE_PLANE:
+		a[0] = -0.5f * o->size[0]; a[1] = 0; a[2] = -0.5f * o->size[2];
+		break;
+	case RND_SHAPE_BOX:
+		for (int k = 0; k < 3; k++) a[k] = -0.5f * o->size[k];
+		break;
+	case RND_SHAPE_SPHERE:
+		a[0] = a[1] = a[2] = -o->radius;
+		break;
+	case RND_SHAPE_CYLINDER:
+		a[0] = a[2] = -o->radius; a[1] = -0.5f * o->height;
+		break;
+	default: { /* mesh: the vertices it draws */
+		if (!o->vertex_count || !o->positions) return;
+		for (int k = 0; k < 3; k++) { a[k] = FLT_MAX; b[k] = -FLT_MAX; }
+		for (uint32_t v = 0; v < o->vertex_count; v++)
+			for (int k = 0; k < 3; k++) {
+				float x = o->positions[3 * v + k];
+				if (x < a[k]) a[k] = x;
+				if (x > b[k]) b[k] = x;
+			}
+		goto corners;
+	}
+	}
+	for (int k = 0; k < 3; k++) b[k] = -a[k];
+corners:
+	for (int i = 0; i < 8; i++) {
+		double p[3] = {i & 1 ? b[0] : a[0], i & 2 ? b[1] : a[1], i & 4 ? b[2] : a[2]};
+		for (int k = 0; k < 3; k++) {
+			const float *m = o->model;
+			double w = m[k] * p[0] + m[4 + k] * p[1] + m[8 + k] * p[2] + m[12 + k];
+			if (w < lo[k]) lo[k] = w;
+			if (w > hi[k]) hi[k] = w;
+		}
+	}
+}
+
+/* Centre and radius of the scene's "objects" bounds: every object except planes and shadow
+ * catchers (all objects when that leaves none; the unit sphere at the origin when empty). */
+static void objects_sphere(const struct rnd_scene *sc, const struct rnd_material *mats, double centre[3],
+                           double *radius)
+{
+	double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+	for (int pass = 0; pass < 2 && lo[0] > hi[0]; pass++)
+		for (uint32_t i = 0; i < sc->object_count; i++) {
+			const struct rnd_object *o = &sc->objects[i];
+			if (!pass && (o->shape == RND_SHAPE_PLANE || mats[o->material].shadow_catcher)) continue;
+			object_bounds(o, lo, hi);
+		}
+	if (lo[0] > hi[0]) {
+		centre[0] = centre[1] = centre[2] = 0;
+		*radius = 1;
+		return;
+	}
+	double d2 = 0;
+	for (int k = 0; k < 3; k++) {
+		centre[k] = 0.5 * (lo[k] + hi[k]);
+		d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+	}
+	*radius = fmax(0.5 * sqrt(d2), 1e-3);
+}
+
+/* The turntable's cameras: frame k looks at the objects' bounds centre from azimuth 360°·k/N
+ * (frame 0 on +Z, then counter-clockwise seen from above, i.e. towards +X) at the elevation,
+ * from `distance`, or else from where the bounding sphere fills the frame up to a 0.1 margin
+ * (as camera fit does). Perspective, up +Y, fov_y from the root camera when it is a perspective
+ * one (else 45°), exposure from the root camera; near/far derived from the scene bounds (a
+ * root camera's near/far were chosen for its own position). */
+static int turntable_views(struct pctx *c, const struct turntable *tt, struct rnd_scene *sc)
+{
+	struct rnd_camera *vs = api_arena_calloc(c->arena, tt->frames, sizeof *vs);
+	if (!vs) return fail_at(c, "turntable", "out of memory");
+	double centre[3], r;
+	objects_sphere(sc, c->mats, centre, &r);
+	const struct rnd_camera *root = &sc->camera;
+	double fov = root->type == RND_CAMERA_PERSPECTIVE && root->fov_y > 0 ? root->fov_y : 45.0 * DEG2RAD;
+	double dist = tt->distance;
+	if (!(dist > 0)) {
+		double aspect = (double)sc->width / sc->height, half = 0.5 * fov * (1.0 - 2.0 * 0.1);
+		double half_x = atan(tan(half) * fmin(aspect, 1.0));
+		dist = r / sin(fmin(half, half_x));
+	}
+	double el = tt->elevation * DEG2RAD;
+	for (uint32_t k = 0; k < tt->frames; k++) {
+		struct rnd_camera *v = &vs[k];
+		double az = 2.0 * M_PI * k / tt->frames;
+		/* Unit vector from the centre to the camera (the view direction is its opposite). */
+		double d[3] = {cos(el) * sin(az), sin(el), cos(el) * cos(az)};
+		v->type = RND_CAMERA_PERSPECTIVE;
+		for (int i = 0; i < 3; i++) {
+			v->target[i] = (float)centre[i];
+			v->position[i] = (float)(centre[i] + dist * d[i]);
+			v->fit_direction[i] = (float)-d[i];
+		}
+		v->up[0] = 0; v->up[1] = 1; v->up[2] = 0;
+		v->fov_y = (float)fov;
+		v->exposure = root->exposure;
+		v->fit = RND_FIT_NONE;
+		v->fit_margin = 0.1f;
+	}
+	sc->views = vs;
+	sc->view_count = tt->frames;
+	return 0;
+}
+
 static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 {
 	struct rnd_scene *sc = &s->scene;
@@ -1350,6 +1504,9 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		if (rc) return -1;
 	}
 
+	/* `camera` is required unless `views` or `turntable` gives the cameras; when present with
+	 * them it supplies the defaults of every view (views: each member not given; turntable:
+	 * fov_y, near, far, exposure). */
 	json_t *cam = json_object_get(root, "camera"), *views = json_object_get(root, "views"),
 	       *turn = json_object_get(root, "turntable");
 	if (cam) {
@@ -1357,40 +1514,47 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		int rc = parse_camera(c, cam, &sc->camera);
 		ptr_pop(c, old);
 		if (rc < 0) return -1;
-	} else if (!views) {
-		return fail_at(c, "camera", "camera is required");
+	} else if (!views && !turn) {
+		return fail_at(c, "camera", "camera is required (unless views or turntable gives the cameras)");
 	}
 	if (views && turn) return fail_at(c, "turntable", "turntable cannot be combined with views");
 	if (views) {
 		size_t old = ptr_push(c, "views");
 		int rc = 0;
-		if (!json_is_array(views) || !json_array_size(views))
-			rc = fail(c, "views must be a non-empty array of cameras");
-		for (size_t i = 0; !rc && i < json_array_size(views); i++) {
-			struct rnd_camera v = sc->camera;
+		size_t n = json_is_array(views) ? json_array_size(views) : 0;
+		struct rnd_camera *vs = NULL;
+		if (!n) rc = fail(c, "views must be a non-empty array of cameras");
+		else if (n > MAX_VIEWS) rc = fail(c, "views has %zu cameras, at most %u are allowed", n, MAX_VIEWS);
+		else if (!(vs = api_arena_calloc(c->arena, n, sizeof *vs))) rc = fail(c, "out of memory");
+		for (size_t i = 0; !rc && i < n; i++) {
+			vs[i] = sc->camera;
 			size_t o2 = ptr_index(c, i);
-			rc = parse_camera(c, json_array_get(views, i), &v);
+			rc = parse_camera(c, json_array_get(views, i), &vs[i]);
 			ptr_pop(c, o2);
 		}
-		if (!rc) defer(c, true, NULL, "views (several cameras in one request) is not supported yet");
 		ptr_pop(c, old);
 		if (rc) return -1;
+		sc->views = vs;
+		sc->view_count = (uint32_t)n;
 	}
+	struct turntable tt = {0};
 	if (turn) {
 		json_t *sub;
 		size_t old;
 		int rc = enter(c, root, "turntable", TURNTABLE_MEMBERS, "turntable", &sub, &old);
 		if (rc < 0) return -1;
 		static const struct range elev = {-90, 90, false, false};
-		long long frames;
-		double d;
-		rc = get_int(c, sub, "frames", 1, 1024, &frames);
+		long long frames = 0;
+		double el = 20, dist = 0;
+		rc = get_int(c, sub, "frames", 1, MAX_VIEWS, &frames);
 		if (rc == 0) rc = fail_at(c, "frames", "frames is required for a turntable");
-		if (rc > 0 && (get_num(c, sub, "elevation", &elev, &d) < 0 || get_num(c, sub, "distance", &R_POS, &d) < 0))
+		if (rc > 0 && (get_num(c, sub, "elevation", &elev, &el) < 0 || get_num(c, sub, "distance", &R_POS, &dist) < 0))
 			rc = -1;
-		if (rc > 0) defer(c, true, NULL, "turntable is not supported yet");
 		ptr_pop(c, old);
 		if (rc < 0) return -1;
+		tt.frames = (uint32_t)frames;
+		tt.elevation = el;
+		tt.distance = dist;
 	}
 
 	json_t *env = json_object_get(root, "environment");
@@ -1435,6 +1599,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		sc->object_count = (uint32_t)nobj;
 		if (c->models && expand_models(c, objs, models, sc) < 0) return -1;
 	}
+	if (tt.frames && turntable_views(c, &tt, sc) < 0) return -1;
 
 	struct rnd_shadow root_shadow;
 	rnd_shadow_defaults(&root_shadow);
@@ -1496,9 +1661,39 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		defer(c, false, sc->height > sc->width ? "height" : "width",
 		      "width x height = %llu pixels is over this server's limit of %llu", (unsigned long long)px,
 		      (unsigned long long)c->lim->max_pixels);
+	if (sc->view_count) {
+		/* Several views: the whole sheet counts (ceil(sqrt(n)) columns, unused cells included). */
+		uint32_t n = sc->view_count, cols = 1;
+		while (cols * cols < n) cols++;
+		uint32_t rows = (n + cols - 1) / cols;
+		uint64_t sw = (uint64_t)cols * sc->width, sh = (uint64_t)rows * sc->height, sheet = sw * sh;
+		const char *key = views ? "views" : "turntable";
+		if (c->lim->max_pixels && sheet > c->lim->max_pixels)
+			defer(c, false, key, "%u views of %ux%u make a %llux%llu sheet (%llu pixels), over this server's "
+			      "limit of %llu", n, sc->width, sc->height, (unsigned long long)sw, (unsigned long long)sh,
+			      (unsigned long long)sheet, (unsigned long long)c->lim->max_pixels);
+		else if (sw > MAX_SHEET_SIDE || sh > MAX_SHEET_SIDE || sheet > MAX_SHEET_PIXELS)
+			defer(c, false, key, "%u views of %ux%u make a %llux%llu sheet, over the renderer's limit (%u per "
+			      "side, %llu pixels)", n, sc->width, sc->height, (unsigned long long)sw, (unsigned long long)sh,
+			      MAX_SHEET_SIDE, (unsigned long long)MAX_SHEET_PIXELS);
+	}
 
 	sc->materials = c->mats;
 	sc->material_count = c->mat_count;
+	const struct rnd_texture *seen[MAX_TEXTURES];
+	uint32_t ntex = 0;
+	for (uint32_t i = 0; i < c->mat_count && ntex <= MAX_TEXTURES; i++) {
+		const struct rnd_texture *t = c->mats[i].base_color_texture;
+		uint32_t k = 0;
+		while (t && k < ntex && seen[k] != t) k++;
+		if (!t || k < ntex) continue;
+		if (ntex == MAX_TEXTURES) {
+			defer(c, false, "materials", "the scene has more than %u distinct base-colour textures (the "
+			      "renderer's limit)", MAX_TEXTURES);
+			break;
+		}
+		seen[ntex++] = t;
+	}
 	return 0;
 }
 

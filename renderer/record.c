@@ -148,8 +148,17 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	k->sc[UMBRA_SC_TONEMAP] = k->sc[UMBRA_SC_LINEAR] ? 0
 	                        : sc->output.tonemap == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES
 	                        : sc->output.tonemap == RND_TONEMAP_NONE ? UMBRA_TONEMAP_NONE : UMBRA_TONEMAP_NEUTRAL;
-	for (uint32_t i = 0; i < ndraw; i++)
+	uint64_t dense = 0;
+	for (uint32_t i = 0; i < ndraw; i++) {
 		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
+		if (draws[i].texture_set) k->sc[UMBRA_SC_TEXTURES] = 1;
+		if (draws[i].masked) k->sc[UMBRA_SC_MASKED] = 1;
+		if (!draws[i].cull_back) dense += draws[i].index_count / 3;
+	}
+	/* A depth pre-pass pays off where many small two-sided triangles would each shade whole
+	 * 4x4 blocks only to be hidden (lavapipe shades per triangle); closed primitives seen from
+	 * outside are back-face culled instead and need none. */
+	k->prepass = dense > 20000;
 }
 
 enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
@@ -224,7 +233,7 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
 	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
 	VkPipeline bound = VK_NULL_HANDLE;
-	for (uint32_t i = 0; i < ndraw; i++) {
+	for (uint32_t i = 0; i < ndraw && key.prepass; i++) {
 		const struct draw *d = &draws[i];
 		if (!d->index_count) continue;
 		VkPipeline p = d->masked ? ctx->pipes.prepass_masked[ms][d->cull_back] : ctx->pipes.prepass[ms][d->cull_back];
@@ -272,6 +281,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	key.format = RND_PIXELS_RGBA32F;
 	key.samples = 1;
 	key.aov = 1;
+	key.prepass = 0;
 	for (uint32_t i = 0; i < rv->ndraw; i++) {
 		uint32_t c = rv->draws[i].cull_back;
 		if (!rv->draws[i].index_count || pipes[c]) continue;

@@ -27,6 +27,8 @@ layout(constant_id = UMBRA_SC_TONEMAP) const uint SC_TONEMAP = 0u;     // UMBRA_
 layout(constant_id = UMBRA_SC_CATCHER) const uint SC_CATCHER = 0u;     // scene has shadow catchers
 layout(constant_id = UMBRA_SC_LIGHT_TYPES) const uint SC_LIGHT_TYPES = 7u; // bit (1 << UMBRA_LIGHT_*)
 layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any directional light has cascades
+layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 1u;   // any material has a texture
+layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 1u;       // any material is alpha-masked
 
 layout(location = 0) in vec3 v_pos;
 layout(location = 1) in vec3 v_nrm;
@@ -288,8 +290,8 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 vec4 base_color(umbra_material m)
 {
 	vec4 c = m.base_color;
-	if (m.tex.x != 0u) c *= texture(base_texture, v_uv);
-	if (m.tex.y != 0u && c.a < m.params.y) discard;
+	if (SC_TEXTURES != 0u && m.tex.x != 0u) c *= texture(base_texture, v_uv);
+	if (SC_MASKED != 0u && m.tex.y != 0u && c.a < m.params.y) discard;
 	return c;
 }
 

@@ -66,7 +66,9 @@
 #define UMBRA_SC_CATCHER     4
 #define UMBRA_SC_LIGHT_TYPES 5
 #define UMBRA_SC_CASCADES    6
-#define UMBRA_SC_COUNT       7
+#define UMBRA_SC_TEXTURES    7
+#define UMBRA_SC_MASKED      8
+#define UMBRA_SC_COUNT       9
 
 /* umbra_material.params.z flags */
 #define UMBRA_MATERIAL_SHADOW_CATCHER 1u
