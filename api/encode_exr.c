@@ -3,6 +3,10 @@
  *
  * Channels: R, G, B, A as HALF from the RGBA32F image (linear, scene-referred), then one FLOAT
  * channel per AOV plane under the renderer's name ("shadow.0", "Z", "N.X", "albedo.R", ...).
+ * One view: a single-part file. Several views (a sheet, rnd_image.view_count > 1): a multi-part
+ * file with one part per view, named "view0", "view1", ... in view order, each view_width x
+ * view_height with the same channels, cut from the view's cell of the sheet (and of every AOV
+ * plane, which has the sheet's layout); unused cells of the sheet are not written.
  * The library writes at explicit offsets (the chunk table is patched at the end), so the
  * write callback grows the buffer to offset + size and copies there.
  */
@@ -114,14 +118,26 @@ enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_
 				                       img->aov_names[i]);
 	}
 
-	const size_t w = img->width, h = img->height;
+	const size_t W = img->width, H = img->height;
+	/* Views: one part per view ("view0", "view1", ...), each the view's cell of the sheet. */
+	uint32_t nview = img->view_count ? img->view_count : 1, cols = img->view_columns ? img->view_columns : 1;
+	uint32_t vw = img->view_width ? img->view_width : img->width, vh = img->view_height ? img->view_height : img->height;
+	if (nview > 1) {
+		uint32_t rows = (nview + cols - 1) / cols;
+		if (nview > 1024 || !cols || (uint64_t)cols * vw > W || (uint64_t)rows * vh > H)
+			return api_problem_set(p, 500, "", "EXR encoder: %u views of %ux%u in %u columns do not fit a %ux%u sheet",
+			                       nview, vw, vh, cols, img->width, img->height);
+	} else {
+		vw = img->width;
+		vh = img->height;
+	}
 	/* Planar half copies of R, G, B, A: the core's packer then only copies rows. */
-	uint16_t *half = malloc(w * h * 4 * sizeof(uint16_t));
+	uint16_t *half = malloc(W * H * 4 * sizeof(uint16_t));
 	if (!half) return api_problem_set(p, 500, "", "EXR encoder: out of memory");
-	for (size_t y = 0; y < h; y++) {
+	for (size_t y = 0; y < H; y++) {
 		const float *row = (const float *)(const void *)((const uint8_t *)img->pixels + y * img->stride);
-		for (size_t x = 0; x < w; x++)
-			for (size_t c = 0; c < 4; c++) half[c * w * h + y * w + x] = float_to_half(row[4 * x + c]);
+		for (size_t x = 0; x < W; x++)
+			for (size_t c = 0; c < 4; c++) half[c * W * H + y * W + x] = float_to_half(row[4 * x + c]);
 	}
 
 	struct exr_job job = {{0}};
@@ -133,54 +149,70 @@ enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_
 	exr_context_t ctx = NULL;
 	exr_encode_pipeline_t enc = {0};
 	bool enc_live = false;
-	int part = 0;
 	exr_result_t rv = exr_start_write(&ctx, "umbra.exr", EXR_WRITE_FILE_DIRECTLY, &init);
-	if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, "", EXR_STORAGE_SCANLINE, &part);
-	if (rv == EXR_ERR_SUCCESS)
-		rv = exr_initialize_required_attr_simple(ctx, part, (int32_t)w, (int32_t)h, EXR_COMPRESSION_ZIP);
-	for (int c = 0; rv == EXR_ERR_SUCCESS && c < 4; c++)
-		rv = exr_add_channel(ctx, part, RGBA_NAMES[c], EXR_PIXEL_HALF, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
-	for (uint32_t i = 0; rv == EXR_ERR_SUCCESS && i < naov; i++)
-		rv = exr_add_channel(ctx, part, img->aov_names[i], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+	for (uint32_t v = 0; rv == EXR_ERR_SUCCESS && v < nview; v++) {
+		char name[16] = "";
+		if (nview > 1) snprintf(name, sizeof name, "view%u", v);
+		int part = 0;
+		rv = exr_add_part(ctx, name, EXR_STORAGE_SCANLINE, &part);
+		if (rv == EXR_ERR_SUCCESS)
+			rv = exr_initialize_required_attr_simple(ctx, part, (int32_t)vw, (int32_t)vh, EXR_COMPRESSION_ZIP);
+		for (int c = 0; rv == EXR_ERR_SUCCESS && c < 4; c++)
+			rv = exr_add_channel(ctx, part, RGBA_NAMES[c], EXR_PIXEL_HALF, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+		for (uint32_t i = 0; rv == EXR_ERR_SUCCESS && i < naov; i++)
+			rv = exr_add_channel(ctx, part, img->aov_names[i], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+	}
 	if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
 
-	int32_t lines = 0;
-	if (rv == EXR_ERR_SUCCESS) rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
-	for (int32_t y = 0; rv == EXR_ERR_SUCCESS && y < (int32_t)h; y += lines) {
-		exr_chunk_info_t ci;
-		rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
-		if (rv != EXR_ERR_SUCCESS) break;
-		rv = enc_live ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
-		if (rv != EXR_ERR_SUCCESS) break;
-		/* The library lists channels sorted by name: match each by name. */
-		for (int16_t c = 0; c < enc.channel_count; c++) {
-			exr_coding_channel_info_t *ch = &enc.channels[c];
-			const uint8_t *src = NULL;
-			for (int k = 0; k < 4 && !src; k++)
-				if (!strcmp(ch->channel_name, RGBA_NAMES[k]))
-					src = (const uint8_t *)(half + (size_t)k * w * h + (size_t)ci.start_y * w);
-			if (src) {
-				ch->user_bytes_per_element = 2;
-				ch->user_data_type = EXR_PIXEL_HALF;
-				ch->user_pixel_stride = 2;
-				ch->user_line_stride = (int32_t)(w * 2);
-			} else {
-				for (uint32_t i = 0; i < naov && !src; i++)
-					if (!strcmp(ch->channel_name, img->aov_names[i]))
-						src = (const uint8_t *)(img->aov[i] + (size_t)ci.start_y * w);
-				ch->user_bytes_per_element = 4;
-				ch->user_data_type = EXR_PIXEL_FLOAT;
-				ch->user_pixel_stride = 4;
-				ch->user_line_stride = (int32_t)(w * 4);
-			}
-			ch->encode_from_ptr = src;
-		}
-		if (!enc_live) {
-			enc_live = true;
-			rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+	for (uint32_t part = 0; rv == EXR_ERR_SUCCESS && part < nview; part++) {
+		/* The cell's top-left pixel in the sheet. */
+		const size_t x0 = (size_t)(part % cols) * vw, y0 = (size_t)(part / cols) * vh;
+		int32_t lines = 0;
+		rv = exr_get_scanlines_per_chunk(ctx, (int)part, &lines);
+		for (int32_t y = 0; rv == EXR_ERR_SUCCESS && y < (int32_t)vh; y += lines) {
+			exr_chunk_info_t ci;
+			rv = exr_write_scanline_chunk_info(ctx, (int)part, y, &ci);
 			if (rv != EXR_ERR_SUCCESS) break;
+			rv = enc_live ? exr_encoding_update(ctx, (int)part, &ci, &enc)
+			              : exr_encoding_initialize(ctx, (int)part, &ci, &enc);
+			if (rv != EXR_ERR_SUCCESS) break;
+			const size_t first = (y0 + (size_t)ci.start_y) * W + x0; /* sheet index of the chunk's first pixel */
+			/* The library lists channels sorted by name: match each by name. */
+			for (int16_t c = 0; c < enc.channel_count; c++) {
+				exr_coding_channel_info_t *ch = &enc.channels[c];
+				const uint8_t *src = NULL;
+				for (int k = 0; k < 4 && !src; k++)
+					if (!strcmp(ch->channel_name, RGBA_NAMES[k]))
+						src = (const uint8_t *)(half + (size_t)k * W * H + first);
+				if (src) {
+					ch->user_bytes_per_element = 2;
+					ch->user_data_type = EXR_PIXEL_HALF;
+					ch->user_pixel_stride = 2;
+					ch->user_line_stride = (int32_t)(W * 2);
+				} else {
+					for (uint32_t i = 0; i < naov && !src; i++)
+						if (!strcmp(ch->channel_name, img->aov_names[i]))
+							src = (const uint8_t *)(img->aov[i] + first);
+					ch->user_bytes_per_element = 4;
+					ch->user_data_type = EXR_PIXEL_FLOAT;
+					ch->user_pixel_stride = 4;
+					ch->user_line_stride = (int32_t)(W * 4);
+				}
+				ch->encode_from_ptr = src;
+			}
+			if (!enc_live) {
+				enc_live = true;
+				rv = exr_encoding_choose_default_routines(ctx, (int)part, &enc);
+				if (rv != EXR_ERR_SUCCESS) break;
+			}
+			rv = exr_encoding_run(ctx, (int)part, &enc);
 		}
-		rv = exr_encoding_run(ctx, part, &enc);
+		/* A pipeline belongs to one part. */
+		if (enc_live) {
+			exr_encoding_destroy(ctx, &enc);
+			enc_live = false;
+			memset(&enc, 0, sizeof enc);
+		}
 	}
 	if (enc_live) exr_encoding_destroy(ctx, &enc);
 	exr_result_t fin = ctx ? exr_finish(&ctx) : EXR_ERR_SUCCESS;

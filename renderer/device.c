@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include "internal.h"
 #include "moments.h"
+#include "shadow_cache.h"
 
 const char *rnd_vk_str(VkResult r)
 {
@@ -350,6 +351,7 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if (!ctx->desc.slots) ctx->desc.slots = 1;
 	if (!ctx->desc.max_width) ctx->desc.max_width = 8192;
 	if (!ctx->desc.max_height) ctx->desc.max_height = 8192;
+	if (!ctx->desc.atlas_size) ctx->desc.atlas_size = 4096;
 	if (ctx->desc.pipeline_cache_path) snprintf(ctx->cache_path, sizeof ctx->cache_path, "%s", ctx->desc.pipeline_cache_path);
 	ctx->desc.pipeline_cache_path = ctx->cache_path;
 	ctx->desc.device_name = NULL; /* not kept: the caller's string may go away */
@@ -367,10 +369,13 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if ((r = rnd_pipelines_init(ctx, err)) != RND_OK) goto fail_pipelines;
 	if ((r = rnd_moments_init(ctx, err)) != RND_OK) goto fail_moments;
 	if ((r = rnd_slots_init(ctx, err)) != RND_OK) goto fail_slots;
+	if ((r = rnd_cache_init(ctx, err)) != RND_OK) goto fail_cache;
 	rnd_log(ctx, 2, "device '%s' (%s %s)", ctx->props.deviceName, ctx->driver_name, ctx->driver_info);
 	*out = ctx;
 	return RND_OK;
 
+fail_cache:
+	rnd_slots_release(ctx);
 fail_slots:
 	rnd_moments_release(ctx);
 fail_moments:
@@ -392,6 +397,7 @@ void rnd_context_destroy(struct rnd_context *ctx)
 {
 	if (!ctx) return;
 	if (ctx->device) vkDeviceWaitIdle(ctx->device); /* once, at shutdown: nothing may be in flight */
+	rnd_cache_release_all(ctx);
 	rnd_slots_release(ctx);
 	rnd_moments_release(ctx);
 	rnd_pipelines_release(ctx);

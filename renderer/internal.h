@@ -83,6 +83,7 @@ struct rnd_moments {
 };
 
 struct rnd_slot;
+struct rnd_shadow_cache;
 
 struct rnd_context {
 	struct rnd_context_desc desc;
@@ -99,6 +100,10 @@ struct rnd_context {
 	VkPipelineCache pipeline_cache;
 	struct rnd_pipelines pipes;
 	struct rnd_moments moments;
+	struct rnd_shadow_cache *cache;      /* shadow_cache.c */
+	struct rnd_image_res atlas_depth;    /* D32, GENERAL layout, every shadow view is a tile */
+	struct rnd_image_res atlas_moments;  /* VSM / EVSM moments, same tiles */
+	uint64_t stats_hits, stats_misses;
 	bool has_debug_utils;
 	bool timestamps;                     /* queue supports timestamps */
 	float timestamp_period;              /* ns per tick */

@@ -124,11 +124,7 @@ enum rnd_result rnd_image_create(struct rnd_context *ctx, VkFormat format, uint3
 	}
 	VkImageViewCreateInfo vci = {
 		.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = out->img,
-		/* Sampled depth images (shadow maps) and storage images (moment maps) are arrays
-		 * (sampler2DArray / image2DArray) even with one layer. */
-		.viewType = layers > 1 || ((usage & VK_IMAGE_USAGE_SAMPLED_BIT) && aspect == VK_IMAGE_ASPECT_DEPTH_BIT) ||
-		            (usage & VK_IMAGE_USAGE_STORAGE_BIT)
-		            ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
+		.viewType = layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
 		.format = format, .subresourceRange = {aspect, 0, 1, 0, layers},
 	};
 	if ((vr = vkCreateImageView(ctx->device, &vci, NULL, &out->view)) != VK_SUCCESS) {

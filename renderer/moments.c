@@ -113,34 +113,32 @@ void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struc
 	VkCommandBuffer cmd = s->cmd;
 	VkMemoryBarrier2 mb = {
 		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
-		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-		.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, .srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
 		.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
 		.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
-	vkCmdPipelineBarrier2(cmd, &di);
 	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->pipeline);
 	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
-	uint32_t res = sp->resolution;
-	uint32_t groups = (res + 7) / 8;
-	for (int pass = 0; pass < 2; pass++) {
-		for (uint32_t v = 0; v < sp->view_count; v++) {
-			const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
-			if (!lp->moments) continue;
-			float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
+	for (uint32_t v = 0; v < sp->view_count; v++) {
+		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
+		if (!lp->moments || sp->view_skip[v]) continue;
+		const float *rect = sp->views[v].rect;
+		uint32_t res = (uint32_t)rect[2], groups = (res + 7) / 8;
+		float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
+		for (uint32_t pass = 0; pass < 2; pass++) {
+			/* The temporary is shared by every view: wait for the previous pass's use of it. */
+			vkCmdPipelineBarrier2(cmd, &di);
 			struct rnd_moments_push push = {
-				.info = {v, (uint32_t)pass, (uint32_t)ceilf(blur), res},
-				.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), 0, 0},
+				.info = {(uint32_t)rect[0], (uint32_t)rect[1], pass, (uint32_t)ceilf(blur)},
+				.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), (float)res, 0},
 			};
 			vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
 			vkCmdDispatch(cmd, groups, groups, 1);
 		}
-		/* Pass 1 reads what pass 0 wrote; the main pass samples what pass 1 wrote. */
-		mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-		mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-		mb.dstStageMask = pass == 0 ? VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-		mb.dstAccessMask = pass == 0 ? VK_ACCESS_2_SHADER_STORAGE_READ_BIT : VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-		vkCmdPipelineBarrier2(cmd, &di);
 	}
+	/* The main and AOV passes sample the moment atlas. */
+	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+	vkCmdPipelineBarrier2(cmd, &di);
 }

@@ -10,8 +10,8 @@
 #include "slot.h"
 
 struct rnd_moments_push {
-	uint32_t info[4];   /* layer, pass, blur radius, resolution */
-	float params[4];    /* EVSM exponent (0 = VSM), Gaussian sigma */
+	uint32_t info[4];   /* tile x, tile y, pass, blur radius */
+	float params[4];    /* EVSM exponent (0 = VSM), Gaussian sigma, tile size */
 };
 
 enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err);
@@ -19,8 +19,9 @@ void rnd_moments_release(struct rnd_context *ctx);
 /* The moment format for a request (fp16 when asked or when fp32 cannot be filtered). */
 VkFormat rnd_moments_format(const struct rnd_context *ctx, bool want_fp16);
 float rnd_moments_max_exponent(VkFormat f);
-/* Records both blur passes for every moment view of the plan into s->cmd. The slot's
- * moment images must hold the plan's layers and s->moments_set must point at them. */
+/* Records both blur passes for every rendered moment view of the plan into s->cmd: depth
+ * tile -> moments -> the same tile of the moment atlas. s->moments_set must point at the
+ * atlases and a blur temporary as large as the largest tile. */
 void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
                         const struct rnd_scene *sc);
 

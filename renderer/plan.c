@@ -168,8 +168,8 @@ static void ortho_view(struct umbra_shadow_view *v, const float view[16], float 
 	v->params[1] = 0.0f;
 	v->params[2] = zmin;
 	v->params[3] = zmax;
-	v->light_dir[0] = dir[0]; v->light_dir[1] = dir[1]; v->light_dir[2] = dir[2];
-	v->light_dir[3] = res;
+	(void)dir;
+	v->rect[2] = res;   /* x, y and the atlas size are filled in when the tile is granted */
 }
 
 static void persp_view(struct umbra_shadow_view *v, const float eye[3], const float dir[3], const float up[3],
@@ -184,8 +184,8 @@ static void persp_view(struct umbra_shadow_view *v, const float eye[3], const fl
 	v->params[1] = 1.0f;
 	v->params[2] = znear;
 	v->params[3] = zfar;
-	v->light_dir[0] = dir[0]; v->light_dir[1] = dir[1]; v->light_dir[2] = dir[2];
-	v->light_dir[3] = res;
+	(void)dir;
+	v->rect[2] = res;   /* x, y and the atlas size are filled in when the tile is granted */
 }
 
 /* Farthest distance from p to the box (for spot/point far planes). */
@@ -220,18 +220,22 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 	if (scene->light_count > UMBRA_MAX_LIGHTS)
 		return rnd_fail(err, RND_ERR_LIMIT, "%u lights: the renderer takes at most %d", scene->light_count, UMBRA_MAX_LIGHTS);
 	bool empty = rnd_aabb_is_empty(bounds);
-	/* One resolution for every layer: the largest any light asks for. */
-	uint32_t res = 0;
-	for (uint32_t i = 0; i < scene->light_count; i++)
-		if (scene->lights[i].shadow.enabled && scene->lights[i].shadow.resolution > res) res = scene->lights[i].shadow.resolution;
-	out->resolution = res ? res : (uint32_t)DEFAULT_RES;
-	float fres = (float)out->resolution;
+	out->resolution = 0;
 
 	for (uint32_t i = 0; i < scene->light_count && !empty; i++) {
 		const struct rnd_light *L = &scene->lights[i];
 		const struct rnd_shadow *s = &L->shadow;
 		struct rnd_light_plan *lp = &out->lights[i];
 		if (!s->enabled) continue;
+		/* Tile size: the light's resolution rounded up to a power of two (atlas tiles), else
+		 * by type: a sun map covers the whole view, a spot cone less, a cube face a sixth. */
+		uint32_t want = s->resolution ? s->resolution
+		              : L->type == RND_LIGHT_DIRECTIONAL ? (uint32_t)DEFAULT_RES : L->type == RND_LIGHT_SPOT ? 1024 : 512;
+		uint32_t res = 64;
+		while (res < want && res < 8192) res *= 2;
+		lp->resolution = res;
+		if (res > out->resolution) out->resolution = res;
+		float fres = (float)res;
 		float size = L->type == RND_LIGHT_DIRECTIONAL ? L->angular_diameter : L->radius;
 		enum rnd_filter f = s->filter;
 		if (f == RND_FILTER_AUTO) f = size > 0 ? RND_FILTER_PCSS : RND_FILTER_PCF;

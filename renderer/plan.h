@@ -39,14 +39,16 @@ struct rnd_light_plan {
 	bool evsm;
 	float evsm_exponent;                       /* 0 = by precision (render.c decides) */
 	bool fp16;                                 /* vsm.precision fp16 asked for */
+	uint32_t resolution;                       /* tile size asked for (power of two) */
 };
 
 struct rnd_shadow_plan {
-	uint32_t resolution;                       /* texels per side, every layer */
+	uint32_t resolution;                       /* the largest tile any light asks for */
 	uint32_t view_count;
 	struct umbra_shadow_view views[UMBRA_MAX_SHADOW_VIEWS];
 	uint32_t view_light[UMBRA_MAX_SHADOW_VIEWS]; /* light index of each view */
 	bool view_ortho[UMBRA_MAX_SHADOW_VIEWS];     /* skip near-plane culling (depth clamp) */
+	bool view_skip[UMBRA_MAX_SHADOW_VIEWS];      /* tile already holds this map (render.c sets) */
 	struct rnd_light_plan lights[UMBRA_MAX_LIGHTS];
 };
 

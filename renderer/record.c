@@ -53,29 +53,39 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 	const struct draw *draws = rv->draws;
 	uint32_t ndraw = rv->ndraw;
 	VkCommandBuffer cmd = s->cmd;
-	uint32_t layers = s->shadow.layers;
-	/* Old contents are never needed: every used layer is cleared. */
-	record_image_barrier(cmd, s->shadow.img, VK_IMAGE_ASPECT_DEPTH_BIT, layers,
-	              VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-	              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-	uint32_t res = sp->resolution;
+	/* The atlas stays in GENERAL layout. Earlier submissions (other renders) may still sample
+	 * or write other tiles; this render writes only its own tiles, so an execution and memory
+	 * dependency on what came before is all that is needed. */
+	VkMemoryBarrier2 mb = {
+		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+		.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, .srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT |
+		                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		.dstAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+		                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
+	vkCmdPipelineBarrier2(cmd, &di);
 	VkDeviceSize zero = 0;
 	for (uint32_t v = 0; v < sp->view_count; v++) {
+		if (sp->view_skip[v]) continue;
 		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
+		const float *rect = sp->views[v].rect;
+		int32_t x = (int32_t)rect[0], y = (int32_t)rect[1];
+		uint32_t res = (uint32_t)rect[2];
 		VkRenderingAttachmentInfo da = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->shadow_layers[v],
-			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = ctx->atlas_depth.view,
+			.imageLayout = VK_IMAGE_LAYOUT_GENERAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
 			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
 		};
+		/* Clearing and drawing stay inside the tile: the render area is the tile. */
 		VkRenderingInfo ri = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {res, res}}, .layerCount = 1,
+			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{x, y}, {res, res}}, .layerCount = 1,
 			.pDepthAttachment = &da,
 		};
 		vkCmdBeginRendering(cmd, &ri);
-		VkViewport vp = {0, 0, (float)res, (float)res, 0, 1};
-		VkRect2D scissor = {{0, 0}, {res, res}};
+		VkViewport vp = {(float)x, (float)y, (float)res, (float)res, 0, 1};
+		VkRect2D scissor = {{x, y}, {res, res}};
 		vkCmdSetViewport(cmd, 0, 1, &vp);
 		vkCmdSetScissor(cmd, 0, 1, &scissor);
 		vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
@@ -114,12 +124,12 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		}
 		vkCmdEndRendering(cmd);
 	}
-	record_image_barrier(cmd, s->shadow.img, VK_IMAGE_ASPECT_DEPTH_BIT, layers,
-	              sp->view_count ? VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED,
-	              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-	              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+	/* The maps are read by the moment blur and the main and AOV passes. */
+	mb.srcStageMask = VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+	mb.srcAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+	vkCmdPipelineBarrier2(cmd, &di);
 }
 
 /* The specialization key of this scene's main pass (see mesh.frag). */

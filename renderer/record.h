@@ -12,6 +12,7 @@
 /* One object's draw, made by render.c's upload. */
 struct draw {
 	uint32_t first_index, index_count;
+	uint32_t first_vertex, vertex_count;
 	struct rnd_aabb bounds;
 	uint32_t material;
 	uint32_t flags;      /* UMBRA_DRAW_* */

@@ -17,6 +17,7 @@
 #include "plan.h"
 #include "moments.h"
 #include "record.h"
+#include "shadow_cache.h"
 
 /* How long a submitted render may take before the device is considered hung. */
 #define RND_FENCE_TIMEOUT_NS (120ull * 1000 * 1000 * 1000)
@@ -187,7 +188,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		{s->params.buf, off_light, nlight * sizeof(struct umbra_light)},
 		{s->params.buf, off_view, nview * sizeof(struct umbra_shadow_view)},
 	};
-	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, s->shadow.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
 	VkDescriptorImageInfo ti[UMBRA_MAX_TEXTURES];
 	VkWriteDescriptorSet tw[UMBRA_MAX_TEXTURES];
 	for (uint32_t t = 0; t < ntex; t++) {
@@ -199,7 +200,11 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		};
 	}
 	if (ntex) vkUpdateDescriptorSets(ctx->device, ntex, tw, 0, NULL);
-	VkDescriptorImageInfo mi = {ctx->moments.sampler, s->moments.view, VK_IMAGE_LAYOUT_GENERAL};
+	/* Without a moment atlas (no storage images) no light uses moments; the binding still
+	 * needs an image. */
+	VkDescriptorImageInfo mi = ctx->atlas_moments.view
+		? (VkDescriptorImageInfo){ctx->moments.sampler, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL}
+		: (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
 	VkWriteDescriptorSet w[6];
 	w[5] = (VkWriteDescriptorSet){
 		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
@@ -215,12 +220,12 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		};
 	}
 	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
-	if (s->moments_tmp.img) {
+	if (s->moments_tmp.img && ctx->atlas_moments.view) {
 		/* moments.comp: depth in, blur temporary, moments out */
 		VkDescriptorImageInfo ci[3] = {
-			{ctx->pipes.shadow_sampler, s->shadow.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+			{ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL},
 			{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
-			{VK_NULL_HANDLE, s->moments.view, VK_IMAGE_LAYOUT_GENERAL},
+			{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
 		};
 		VkWriteDescriptorSet cw[3];
 		for (uint32_t i = 0; i < 3; i++)
@@ -276,6 +281,8 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		}
 		d->first_index = ibase;
 		d->index_count = x;
+		d->first_vertex = vbase;
+		d->vertex_count = v;
 		d->material = sc->material_count ? o->material : 0;
 		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
 		d->flags = (o->receive_shadows ? UMBRA_DRAW_RECEIVE_SHADOWS : 0) | (catcher ? UMBRA_DRAW_SHADOW_CATCHER : 0);
@@ -432,6 +439,11 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		return rnd_fail(err, RND_ERR_LIMIT, "a sheet of %u views is %llux%llu pixels: too large", nviews,
 		                (unsigned long long)sheet_w, (unsigned long long)sheet_h);
 
+	struct rnd_cache_grant grants[UMBRA_MAX_LIGHTS];
+	uint32_t grant_light[UMBRA_MAX_LIGHTS];
+	uint32_t ngrant = 0;
+	bool granted = false;
+
 	/* Per-request memory: one block for the draw list and the shadow plan. */
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
 	void *arena = malloc(draws_bytes + sizeof(struct rnd_shadow_plan));
@@ -461,7 +473,27 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		goto done;
 	if (nviews > 1) memset(s->readback.map, 0, color_bytes); /* unused cells of the sheet */
 
-	bool shadows_ready = false;
+	/* What every spot/point key starts from: the casters' world-space geometry, their
+	 * culling and alpha masks (with texture content), and the scene bounds (far planes). */
+	uint64_t geo = rnd_hash(0x756d627261ull, &bounds, sizeof bounds);
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct draw *d = &draws[i];
+		if (!d->cast || !d->index_count) continue;
+		uint32_t flags[3] = {d->single_sided, d->closed, d->masked};
+		geo = rnd_hash(geo, flags, sizeof flags);
+		geo = rnd_hash(geo, (const struct rnd_vertex *)s->vertices.map + d->first_vertex,
+		               (size_t)d->vertex_count * sizeof(struct rnd_vertex));
+		geo = rnd_hash(geo, (const uint32_t *)s->indices.map + d->first_index, (size_t)d->index_count * 4);
+		if (d->masked) {
+			const struct rnd_material *m = &sc->materials[sc->objects[i].material];
+			geo = rnd_hash(geo, &m->alpha_cutoff, sizeof m->alpha_cutoff);
+			geo = rnd_hash(geo, m->base_color, sizeof m->base_color);
+			if (m->base_color_texture)
+				geo = rnd_hash(geo, m->base_color_texture->rgba,
+				               (size_t)m->base_color_texture->width * m->base_color_texture->height * 4);
+		}
+	}
+
 	for (uint32_t v = 0; v < nviews; v++) {
 		const struct rnd_camera *camera = sc->view_count ? &sc->views[v] : &sc->camera;
 		if ((r = rnd_camera_plan(camera, sc->width, sc->height, &bounds, &cam, err)) != RND_OK) goto done;
@@ -469,31 +501,61 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 			draws[i].cull_back = draws[i].single_sided ||
 			                     (draws[i].closed && record_camera_outside(&cam, &draws[i].bounds));
 		if ((r = rnd_shadow_plan(sc, &bounds, &cam, sp, err)) != RND_OK) goto done;
-		/* Shadow maps that do not depend on the camera (fit, spot, point) render once per
-		 * request; cascades follow the camera and render per view. */
-		bool camera_dependent = false;
+		bool any_moments = false;
 		for (uint32_t i = 0; i < sc->light_count; i++)
-			if (sc->lights[i].type == RND_LIGHT_DIRECTIONAL && sp->lights[i].view_count > 1) camera_dependent = true;
-		bool draw_shadows = !shadows_ready || camera_dependent;
-		bool any_moments = false, fp16 = false;
-		for (uint32_t i = 0; i < sc->light_count; i++)
-			if (sp->lights[i].moments && sp->lights[i].view_count) { any_moments = true; fp16 |= sp->lights[i].fp16; }
-		if (any_moments && !ctx->moments.available) {
+			if (sp->lights[i].moments && sp->lights[i].view_count) any_moments = true;
+		if (any_moments && !ctx->atlas_moments.img) {
 			r = rnd_fail(err, RND_ERR_INVALID, "shadow filters vsm/evsm need storage images this device lacks");
 			goto done;
 		}
-		VkFormat mfmt = rnd_moments_format(ctx, fp16);
 		for (uint32_t i = 0; i < sc->light_count; i++) {
 			struct rnd_light_plan *lp = &sp->lights[i];
-			float cmax = rnd_moments_max_exponent(mfmt);
+			/* exp(2cd) must stay finite in the precision asked for (fp16 storage limits c). */
+			float cmax = rnd_moments_max_exponent(lp->fp16 ? VK_FORMAT_R16G16_SFLOAT : ctx->atlas_moments.format);
 			if (lp->evsm) lp->evsm_exponent = lp->evsm_exponent > 0 ? fminf(lp->evsm_exponent, cmax) : cmax;
 		}
-		if (draw_shadows) {
-			uint32_t layers = sp->view_count ? sp->view_count : 1;
-			uint32_t res = sp->view_count ? sp->resolution : (s->shadow.img ? s->shadow.width : 64);
-			if ((r = rnd_slot_shadow(ctx, s, res, layers, err)) != RND_OK) goto done;
-			if ((r = rnd_slot_moments(ctx, s, mfmt, res, any_moments ? layers : 0, err)) != RND_OK) goto done;
+
+		/* Tiles: granted once per request. Spot and point maps are keyed for reuse by later
+		 * requests; directional maps are transient. Later views re-render only the maps that
+		 * follow the camera (cascades, clipmap levels) into the same tiles. */
+		if (!granted) {
+			struct rnd_cache_request req[UMBRA_MAX_LIGHTS];
+			for (uint32_t i = 0; i < sc->light_count; i++) {
+				const struct rnd_light_plan *lp = &sp->lights[i];
+				if (!lp->view_count) continue;
+				uint64_t key = 0;
+				if (sc->lights[i].type != RND_LIGHT_DIRECTIONAL) {
+					float k[8] = {lp->bias_constant, lp->bias_slope, (float)lp->resolution, (float)lp->filter,
+					              lp->moments ? (lp->evsm ? lp->evsm_exponent : -1.0f) : 0.0f,
+					              lp->moments ? sc->lights[i].shadow.vsm_blur : 0.0f, (float)sc->lights[i].type, 0};
+					key = rnd_hash(geo, k, sizeof k);
+					key = rnd_hash(key, &sp->views[lp->first_view], lp->view_count * sizeof(struct umbra_shadow_view));
+					if (!key) key = 1;
+				}
+				grant_light[ngrant] = i;
+				req[ngrant++] = (struct rnd_cache_request){key, lp->view_count, lp->resolution};
+			}
+			if ((r = rnd_cache_acquire(ctx, req, ngrant, grants, err)) != RND_OK) { ngrant = 0; goto done; }
+			granted = true;
 		}
+		uint32_t max_moment_res = 0;
+		for (uint32_t k = 0; k < ngrant; k++) {
+			const struct rnd_light_plan *lp = &sp->lights[grant_light[k]];
+			bool follows_camera = sc->lights[grant_light[k]].type == RND_LIGHT_DIRECTIONAL && lp->view_count > 1;
+			bool skip = grants[k].hit || (v > 0 && !follows_camera);
+			for (uint32_t t = 0; t < lp->view_count; t++) {
+				float *rect = sp->views[lp->first_view + t].rect;
+				rect[0] = (float)grants[k].tile[t].x;
+				rect[1] = (float)grants[k].tile[t].y;
+				rect[2] = (float)grants[k].res;
+				rect[3] = (float)ctx->desc.atlas_size;
+				sp->view_skip[lp->first_view + t] = skip;
+				if (skip) tm.shadow_maps_reused++;
+				else tm.shadow_maps_rendered++;
+			}
+			if (lp->moments && !skip && grants[k].res > max_moment_res) max_moment_res = grants[k].res;
+		}
+		if (max_moment_res && (r = rnd_slot_moments_tmp(ctx, s, max_moment_res, err)) != RND_OK) goto done;
 		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, err)) != RND_OK) goto done;
 
 		uint32_t col = v % cols, row = v / cols;
@@ -511,25 +573,15 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 			vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, s->queries, RND_TS_START);
 		}
 		if (v == 0) record_textures(s, tex, ntex);
-		uint32_t casters = 0;
-		if (!s->moments_initialised) {
-			VkImage imgs[2] = {s->moments.img, s->moments_tmp.img};
-			for (int k = 0; k < 2; k++)
-				if (imgs[k])
-					record_image_barrier(s->cmd, imgs[k], VK_IMAGE_ASPECT_COLOR_BIT, VK_REMAINING_ARRAY_LAYERS,
-					                     VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0,
-					                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-					                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+		if (!s->moments_initialised && s->moments_tmp.img) {
+			record_image_barrier(s->cmd, s->moments_tmp.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+			                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
 			s->moments_initialised = true;
 		}
-		if (draw_shadows) {
-			record_shadows(ctx, s, &rv, &casters);
-			if (any_moments) rnd_moments_record(ctx, s, sp, sc);
-			tm.shadow_maps_rendered += sp->view_count;
-		} else {
-			tm.shadow_maps_reused += sp->view_count;
-		}
-		shadows_ready = true;
+		uint32_t casters = 0;
+		record_shadows(ctx, s, &rv, &casters);
+		if (max_moment_res) rnd_moments_record(ctx, s, sp, sc);
 		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_SHADOW_END);
 		if ((r = record_main(ctx, s, &rv, err)) != RND_OK || (passes && (r = record_aov(ctx, s, &rv, err)) != RND_OK)) {
 			vkEndCommandBuffer(s->cmd);
@@ -571,6 +623,7 @@ lost_check:
 	}
 done:
 	/* Everything this render submitted has completed (each submit is waited on). */
+	if (granted) rnd_cache_release(ctx, grants, ngrant, r == RND_OK);
 	rnd_slot_drop_textures(ctx, s);
 	rnd_slot_release(ctx, s);
 	free(arena);

@@ -139,25 +139,12 @@ fail_pool:
 	return r;
 }
 
-static void shadow_destroy(struct rnd_context *ctx, struct rnd_slot *s)
-{
-	if (s->shadow_layers)
-		for (uint32_t i = 0; i < s->shadow.layers; i++)
-			if (s->shadow_layers[i]) vkDestroyImageView(ctx->device, s->shadow_layers[i], NULL);
-	free(s->shadow_layers);
-	s->shadow_layers = NULL;
-	rnd_image_destroy(ctx, &s->shadow);
-	s->shadow_initialised = false;
-}
-
 static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 {
 	if (!s) return;
-	shadow_destroy(ctx, s);
 	rnd_slot_drop_textures(ctx, s);
 	rnd_image_destroy(ctx, &s->white);
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
-	rnd_image_destroy(ctx, &s->moments);
 	rnd_image_destroy(ctx, &s->moments_tmp);
 	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
@@ -264,36 +251,6 @@ fail:
 	return r;
 }
 
-enum rnd_result rnd_slot_shadow(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, uint32_t layers,
-                                struct rnd_error *err)
-{
-	if (s->shadow.img && s->shadow.width == res && s->shadow.layers >= layers) return RND_OK;
-	shadow_destroy(ctx, s);
-	char name[64];
-	snprintf(name, sizeof name, "slot %u shadow maps", s->index);
-	enum rnd_result r = rnd_image_create(ctx, RND_SHADOW_FORMAT, res, res, layers, 1,
-	                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-	                                     VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->shadow, err);
-	if (r != RND_OK) return r;
-	s->shadow_layers = calloc(layers, sizeof *s->shadow_layers);
-	if (!s->shadow_layers) {
-		shadow_destroy(ctx, s);
-		return rnd_fail(err, RND_ERR_OOM, "out of memory for %u shadow layer views", layers);
-	}
-	for (uint32_t i = 0; i < layers; i++) {
-		VkImageViewCreateInfo vci = {
-			.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = s->shadow.img, .viewType = VK_IMAGE_VIEW_TYPE_2D,
-			.format = RND_SHADOW_FORMAT, .subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, i, 1},
-		};
-		VkResult vr = vkCreateImageView(ctx->device, &vci, NULL, &s->shadow_layers[i]);
-		if (vr != VK_SUCCESS) {
-			shadow_destroy(ctx, s);
-			return rnd_fail_vk(err, vr, "vkCreateImageView (shadow layer)");
-		}
-		RND_NAME(ctx, VK_OBJECT_TYPE_IMAGE_VIEW, s->shadow_layers[i], "slot %u shadow layer %u", s->index, i);
-	}
-	return RND_OK;
-}
 
 void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s)
 {
@@ -325,29 +282,13 @@ fail:
 	return r;
 }
 
-enum rnd_result rnd_slot_moments(struct rnd_context *ctx, struct rnd_slot *s, VkFormat f, uint32_t res, uint32_t layers,
-                                 struct rnd_error *err)
+enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err)
 {
-	enum rnd_result r;
-	if (!layers) {
-		if (s->moments.img) return RND_OK;   /* any image will do as the placeholder */
-		f = VK_FORMAT_R16G16_SFLOAT; res = 4; layers = 1;
-	} else if (s->moments.img && s->moments.format == f && s->moments.width == res && s->moments.layers >= layers) {
-		return RND_OK;
-	}
-	rnd_image_destroy(ctx, &s->moments);
+	if (s->moments_tmp.img && s->moments_tmp.width >= res) return RND_OK;
 	rnd_image_destroy(ctx, &s->moments_tmp);
 	s->moments_initialised = false;
 	char name[48];
-	snprintf(name, sizeof name, "slot %u moments", s->index);
-	if ((r = rnd_image_create(ctx, f, res, res, layers, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT,
-	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments, err)) != RND_OK)
-		return r;
 	snprintf(name, sizeof name, "slot %u moments blur", s->index);
-	if ((r = rnd_image_create(ctx, VK_FORMAT_R32G32_SFLOAT, res, res, layers, 1, VK_IMAGE_USAGE_STORAGE_BIT,
-	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments_tmp, err)) != RND_OK) {
-		rnd_image_destroy(ctx, &s->moments);
-		return r;
-	}
-	return RND_OK;
+	return rnd_image_create(ctx, VK_FORMAT_R32G32_SFLOAT, res, res, 1, 1, VK_IMAGE_USAGE_STORAGE_BIT,
+	                        VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments_tmp, err);
 }

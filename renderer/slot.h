@@ -34,14 +34,12 @@ struct rnd_slot {
 	bool white_ready;             /* cleared to white and in SHADER_READ_ONLY layout */
 	/* AOV pass targets: UMBRA_AOV_ATTACHMENTS x RGBA32F + a single-sample depth */
 	struct rnd_image_res aov[UMBRA_AOV_ATTACHMENTS], aov_depth;
-	/* moment maps (VSM / EVSM): final (sampled, GENERAL layout) and blur temporary */
-	struct rnd_image_res moments, moments_tmp;
-	bool moments_initialised;     /* both images in GENERAL layout */
+	/* moment maps (VSM / EVSM) are blurred through this tile-sized temporary (GENERAL layout) */
+	struct rnd_image_res moments_tmp;
+	bool moments_initialised;     /* moments_tmp is in GENERAL layout */
 	VkDescriptorPool moments_pool;
 	VkDescriptorSet moments_set;
-	struct rnd_image_res color_ms, depth, resolve, shadow;
-	VkImageView *shadow_layers;    /* one 2D view per shadow layer (render targets) */
-	bool shadow_initialised;       /* layout known (kept in SHADER_READ_ONLY between renders) */
+	struct rnd_image_res color_ms, depth, resolve;
 };
 
 /* Makes the colour/depth targets match (format, w, h, samples). */
@@ -49,14 +47,9 @@ enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, Vk
                                  uint32_t samples, struct rnd_error *err);
 /* Makes the AOV targets match w x h. */
 enum rnd_result rnd_slot_aov(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, struct rnd_error *err);
-/* Makes the moment images hold `layers` layers of res x res in format f (a small placeholder
- * when layers is 0, so the frame set always has a valid image). */
-enum rnd_result rnd_slot_moments(struct rnd_context *ctx, struct rnd_slot *s, VkFormat f, uint32_t res, uint32_t layers,
-                                 struct rnd_error *err);
+/* Makes the moment blur temporary at least res x res. */
+enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err);
 /* Destroys the previous render's textures. */
 void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
-/* Makes the shadow array hold at least `layers` layers of res x res. */
-enum rnd_result rnd_slot_shadow(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, uint32_t layers,
-                                struct rnd_error *err);
 
 #endif

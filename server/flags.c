@@ -41,6 +41,7 @@ static const struct opt_def opts[] = {
 	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", LIM(model_cache_bytes), 0, UINT64_MAX },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
+	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (4096)", CFG(atlas_size), 0, 16384 },
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
 	{ "max-connections", OPT_UINT, "N", "concurrent connections (1024)", CFG(max_connections), 1, 1000000 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
@@ -194,15 +195,14 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		usage(stderr);
 		return -1;
 	}
+	if (cfg->atlas_size & (cfg->atlas_size - 1)) {
+		fprintf(stderr, "umbrad: --atlas-size: %u is not a power of two\n", cfg->atlas_size);
+		return -1;
+	}
 	if (cfg->asset_root && access(cfg->asset_root, R_OK | X_OK) != 0) {
 		fprintf(stderr, "umbrad: --asset-root: cannot open '%s': %s\n", cfg->asset_root, strerror(errno));
 		return -1;
 	}
 	cfg->limits.asset_root = cfg->asset_root;
 	return 0;
-}
-
-void srv_config_release(struct srv_config *cfg)
-{
-	(void)cfg; /* every string points into argv or the environment */
 }

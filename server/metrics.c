@@ -272,14 +272,25 @@ char *srv_metrics_text(struct srv_server *s, size_t *len)
 
 	uint32_t vmsg = s->validation_lost;
 	char dev[300] = "", drv[300] = "";
+	struct rnd_stats st = { 0 };
 	if (atomic_load(&s->ready)) {
 		pthread_rwlock_rdlock(&s->ctx_lock);
-		if (s->ctx)
+		if (s->ctx) {
 			vmsg += rnd_context_validation_messages(s->ctx);
+			rnd_context_stats(s->ctx, &st);
+		}
 		label_escape(dev, sizeof dev, s->info.device_name);
 		label_escape(drv, sizeof drv, s->info.driver_name);
 		pthread_rwlock_unlock(&s->ctx_lock);
 	}
+	write_gauge(&b, "umbra_atlas_size_texels", "Texels per side of the shadow atlas.", st.atlas_size);
+	write_gauge(&b, "umbra_atlas_occupancy_ratio", "Share of shadow-atlas texels held by tiles.", st.atlas_occupancy);
+	write_gauge(&b, "umbra_atlas_tiles", "Tiles in the shadow atlas.", st.atlas_tiles);
+	write_gauge(&b, "umbra_shadow_cache_maps", "Spot/point shadow maps kept for reuse.", st.cached_maps);
+	write_counter(&b, "umbra_shadow_cache_hits_total", "Lights whose shadow passes were skipped (cache hits).",
+	              st.shadow_cache_hits);
+	write_counter(&b, "umbra_shadow_cache_misses_total", "Lights whose shadow passes were rendered (cache misses).",
+	              st.shadow_cache_misses);
 	write_gauge(&b, "umbra_validation_messages", "Vulkan validation-layer messages since start.", vmsg);
 	srv_buf_printf(&b, "# HELP umbra_build_info Build and device.\n# TYPE umbra_build_info gauge\n"
 	                   "umbra_build_info{version=\"%s\",device=\"%s\",driver=\"%s\"} 1\n",

@@ -12,6 +12,8 @@
  *   (ETag hits), umbra_queue_rejected_total, umbra_deadline_exceeded_total,
  *   umbra_device_lost_total, umbra_response_bytes_total, umbra_model_cache_hits_total,
  *   umbra_model_cache_misses_total    counters; umbra_model_cache_bytes gauge
+ *   umbra_atlas_size_texels, umbra_atlas_occupancy_ratio, umbra_atlas_tiles, umbra_shadow_cache_maps
+ *   gauges and umbra_shadow_cache_hits_total / _misses_total counters (rnd_context_stats)
  *   umbra_validation_messages, umbra_build_info{version,device,driver}, process_resident_memory_bytes,
  *   process_open_fds                            gauges
  *

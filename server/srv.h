@@ -9,6 +9,7 @@
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
  *   metrics.c  Prometheus counters, gauges and histograms
  *   log.c      one line per event or request on stderr, text or JSON
+ *   buf.c      growable text buffer for the metrics and JSON answers
  *
  * Threading: libmicrohttpd runs one internal polling thread (epoll where available) that does
  * all socket I/O and calls http.c. A POST /v1/render is read completely, then its connection is
@@ -59,6 +60,7 @@ struct srv_config {
 	const char *pipeline_cache;    /* pipeline cache file, loaded at start, saved at exit */
 	enum srv_log_format log_format;
 	const char *device;            /* substring of the Vulkan device name */
+	unsigned atlas_size;           /* shadow atlas side, 0 = renderer default */
 	unsigned max_connections;      /* concurrent TCP connections, default 1024 */
 	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
@@ -167,9 +169,9 @@ int srv_workers_start(struct srv_server *s);
 void srv_workers_join(struct srv_server *s);        /* after srv_queue_close() */
 int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */
 
-/* flags.c: 0 ok, 1 --help printed (exit 0), -1 error printed (exit 2). */
+/* flags.c: 0 ok, 1 --help printed (exit 0), -1 error printed (exit 2). The strings in cfg
+ * point into argv or the environment: nothing to free. */
 int srv_config_load(struct srv_config *cfg, int argc, char **argv);
-void srv_config_release(struct srv_config *cfg);
 
 /* Small shared helpers (main.c). */
 double srv_now(void);                               /* monotonic seconds */

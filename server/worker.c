@@ -30,6 +30,7 @@ static int context_create(struct srv_server *s, struct rnd_context **out)
 	cd.validation = s->cfg.validation;
 	cd.pipeline_cache_path = s->cfg.pipeline_cache;
 	cd.slots = s->cfg.workers;
+	cd.atlas_size = s->cfg.atlas_size;
 	cd.log = rnd_log_cb;
 	enum rnd_result r = rnd_context_create(&cd, out, &err);
 	if (r != RND_OK) {

@@ -1,16 +1,16 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "umbra_shared.h"
-// Moment shadow maps (VSM, EVSM2) from a depth layer, with a separable Gaussian blur.
-// Pass 0: depth -> moments, horizontal blur -> tmp. Pass 1: vertical blur tmp -> moments.
-// One implementation for every light type: it works on whichever layer it is given.
+// Moment shadow maps (VSM, EVSM2) from one depth-atlas tile, with a separable Gaussian blur.
+// Pass 0: depth -> moments, horizontal blur -> tmp (tile-local). Pass 1: vertical blur tmp ->
+// the same tile of the moment atlas. One implementation for every light type.
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) uniform sampler2DArray depth_map;
-layout(set = 0, binding = UMBRA_MOMENTS_BINDING_TMP, rg32f) uniform image2DArray tmp_img;
-layout(set = 0, binding = UMBRA_MOMENTS_BINDING_OUT) writeonly uniform image2DArray out_img;
+layout(set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) uniform sampler2D depth_atlas;
+layout(set = 0, binding = UMBRA_MOMENTS_BINDING_TMP, rg32f) uniform image2D tmp_img;
+layout(set = 0, binding = UMBRA_MOMENTS_BINDING_OUT) writeonly uniform image2D out_img;
 layout(push_constant) uniform Push {
-	uvec4 info;   // x layer, y pass, z radius (texels), w resolution
-	vec4 params;  // x exponent (0 = VSM: plain depth), y sigma (texels)
+	uvec4 info;   // x, y: tile offset in the atlas; z pass; w blur radius (texels)
+	vec4 params;  // x exponent (0 = VSM: plain depth), y sigma (texels), z tile size
 } pc;
 
 vec2 to_moments(float d)
@@ -23,27 +23,27 @@ vec2 to_moments(float d)
 void main()
 {
 	ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-	int res = int(pc.info.w);
+	int res = int(pc.params.z);
 	if (p.x >= res || p.y >= res) return;
-	int layer = int(pc.info.x);
-	int r = int(pc.info.z);
+	ivec2 origin = ivec2(pc.info.xy);
+	int r = int(pc.info.w);
 	float sigma = max(pc.params.y, 0.5);
 	vec2 sum = vec2(0.0);
 	float wsum = 0.0;
 	for (int k = -r; k <= r; k++) {
 		float w = exp(-0.5 * float(k * k) / (sigma * sigma));
 		vec2 m;
-		if (pc.info.y == 0u) {
+		if (pc.info.z == 0u) {
 			ivec2 q = ivec2(clamp(p.x + k, 0, res - 1), p.y);
-			m = to_moments(texelFetch(depth_map, ivec3(q, layer), 0).r);
+			m = to_moments(texelFetch(depth_atlas, origin + q, 0).r);
 		} else {
 			ivec2 q = ivec2(p.x, clamp(p.y + k, 0, res - 1));
-			m = imageLoad(tmp_img, ivec3(q, layer)).xy;
+			m = imageLoad(tmp_img, q).xy;
 		}
 		sum += w * m;
 		wsum += w;
 	}
 	vec4 v = vec4(sum / wsum, 0.0, 1.0);
-	if (pc.info.y == 0u) imageStore(tmp_img, ivec3(p, layer), v);
-	else imageStore(out_img, ivec3(p, layer), v);
+	if (pc.info.z == 0u) imageStore(tmp_img, p, v);
+	else imageStore(out_img, origin + p, v);
 }

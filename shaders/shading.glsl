@@ -4,7 +4,7 @@
 // Main pass: metallic-roughness shading (Lambert + GGX), hemisphere ambient, directional /
 // spot / point lights in the contract's units, shadow filtering, tone map and encoding.
 //
-// Shadow maps hold plain depth (D32) in one array layer per shadow view. lavapipe cannot
+// Shadow maps hold plain depth (D32), one tile of the depth atlas per shadow view. lavapipe cannot
 // filter depth formats linearly, so filtering happens here: textureGather fetches 2x2 texels,
 // each is compared with the receiver depth and the results are weighted bilinearly.
 
@@ -12,8 +12,8 @@ layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock 
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonly buffer Materials { umbra_material materials[]; };
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_LIGHTS) readonly buffer Lights { umbra_light lights[]; };
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) readonly buffer Views { umbra_shadow_view views[]; };
-layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2DArray shadow_map;
-layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2DArray moment_map;
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2D shadow_atlas;
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2D moment_atlas;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
 layout(push_constant) uniform PushBlock { umbra_push pc; };
 
@@ -42,14 +42,24 @@ const float PI = 3.14159265358979;
 // would be rebuilt per invocation by lavapipe).
 vec2 poisson(int i) { vec4 v = frame.poisson[i >> 1]; return (i & 1) == 0 ? v.xy : v.zw; }
 
+// Every shadow view is a tile of the depth atlas: rect = (x, y, size, atlas size) in texels.
+// Gathers the 2x2 texels around tile-local point q, kept inside the tile so filters never
+// read a neighbouring tile (views are widened by the filter footprint, so this only clamps
+// at the very edge).
+vec4 gather_tile(vec4 rect, vec2 q)
+{
+	q = clamp(q, vec2(1.0), vec2(rect.z - 1.0));
+	return textureGather(shadow_atlas, (rect.xy + q) / rect.w);
+}
+
 // Bilinearly weighted comparison of the 2x2 texels around texel-space point p (texel centres
 // at +0.5). Outside the map everything is lit (border depth 1).
-float bilinear_compare(vec2 p, float layer, float ref, float res)
+float bilinear_compare(vec2 p, vec4 rect, float ref, float res)
 {
 	vec2 q = p - 0.5;
 	vec2 base = floor(q);
 	vec2 f = q - base;
-	vec4 d = textureGather(shadow_map, vec3((base + 1.0) / res, layer));
+	vec4 d = gather_tile(rect, base + 1.0);
 	// gather order: x = (i0,j1), y = (i1,j1), z = (i1,j0), w = (i0,j0)
 	vec4 lit = step(vec4(ref), d);
 	return mix(mix(lit.w, lit.z, f.x), mix(lit.x, lit.y, f.x), f.y);
@@ -58,7 +68,7 @@ float bilinear_compare(vec2 p, float layer, float ref, float res)
 // (2r+1)^2 bilinear PCF taps, done as (r+1)^2 gathers over the (2r+2)^2 texel footprint.
 // grad: receiver depth change per texel (receiver-plane bias), so wide kernels on sloped
 // receivers do not shadow the receiver itself.
-float pcf(vec2 p, float layer, float ref, float res, int r, vec2 grad)
+float pcf(vec2 p, vec4 rect, float ref, float res, int r, vec2 grad)
 {
 	vec2 q = p - 0.5;
 	vec2 base = floor(q);
@@ -69,7 +79,7 @@ float pcf(vec2 p, float layer, float ref, float res, int r, vec2 grad)
 		for (int i = 0; i <= 2 * r; i += 2) {
 			vec2 corner = base + vec2(float(i - r), float(j - r)) + 1.0;
 			float rc = ref + dot(grad, corner - p);
-			vec4 lit = step(vec4(rc), textureGather(shadow_map, vec3(corner / res, layer)));
+			vec4 lit = step(vec4(rc), gather_tile(rect, corner));
 			float wx0 = i == 0 ? 1.0 - f.x : 1.0, wx1 = i + 1 == last ? f.x : 1.0;
 			float wy0 = j == 0 ? 1.0 - f.y : 1.0, wy1 = j + 1 == last ? f.y : 1.0;
 			sum += lit.w * wx0 * wy0 + lit.z * wx1 * wy0 + lit.x * wx0 * wy1 + lit.y * wx1 * wy1;
@@ -79,11 +89,11 @@ float pcf(vec2 p, float layer, float ref, float res, int r, vec2 grad)
 	return sum / (n * n);
 }
 
-float hard(vec2 p, float layer, float ref, float res)
+float hard(vec2 p, vec4 rect, float ref, float res)
 {
 	ivec2 t = ivec2(floor(p));
 	if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(int(res))))) return 1.0;
-	return ref <= texelFetch(shadow_map, ivec3(t, int(layer)), 0).r ? 1.0 : 0.0;
+	return ref <= texelFetch(shadow_atlas, ivec2(rect.xy) + t, 0).r ? 1.0 : 0.0;
 }
 
 // Per-pixel rotation for the Poisson disk (interleaved gradient noise): deterministic, so the
@@ -100,7 +110,7 @@ float view_distance(umbra_shadow_view v, float d)
 
 // PCSS: blocker search over the region that could shade this point, penumbra from the
 // light's size by similar triangles, then a rotated Poisson PCF of that width.
-float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, float res, vec2 grad)
+float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, float res, vec2 grad)
 {
 	float zr = view_distance(v, ref);
 	float texel = v.params.y > 0.5 ? v.params.x * zr : v.params.x;   // world size of a texel at the receiver
@@ -120,7 +130,7 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, f
 	for (int i = 0; i < 16; i++) {
 		vec2 off = rot * poisson(i * 2) * search;
 		vec2 q = p + off;
-		vec4 d = textureGather(shadow_map, vec3(q / res, layer));
+		vec4 d = gather_tile(rect, q);
 		vec4 b = step(d, vec4(ref + dot(grad, off) - slack));   // 1 where the texel is a blocker
 		blockers += dot(b, vec4(1.0));
 		sum_d += dot(b, d);
@@ -133,7 +143,7 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, float layer, float ref, f
 	float sum = 0.0;
 	for (int i = 0; i < 32; i++) {
 		vec2 off = rot * poisson(i) * radius;
-		sum += bilinear_compare(p + off, layer, ref + dot(grad, off), res);
+		sum += bilinear_compare(p + off, rect, ref + dot(grad, off), res);
 	}
 	return sum / 32.0;
 }
@@ -157,9 +167,9 @@ vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
 // Moment shadow maps (VSM / EVSM2): Chebyshev's upper bound on the blurred moments.
 // The moments are blurred and filtered linearly, so the filter is as wide as the blur; the
 // variance floor and light-bleed reduction trade softness against leaks.
-float moments(umbra_light L, umbra_shadow_view v, vec2 uv, float layer, float ref)
+float moments(umbra_light L, umbra_shadow_view v, vec2 uv, vec4 rect, float ref)
 {
-	vec2 m = texture(moment_map, vec3(uv, layer)).xy;
+	vec2 m = texture(moment_atlas, (rect.xy + clamp(uv * rect.z, vec2(0.5), vec2(rect.z - 0.5))) / rect.w).xy;
 	float c = L.moment_params.x;
 	float t = c > 0.0 ? exp(c * ref) : ref;
 	float min_var = c > 0.0 ? L.moment_params.z * c * t * c * t * 1e-4 : L.moment_params.z;
@@ -175,7 +185,7 @@ float moments(umbra_light L, umbra_shadow_view v, vec2 uv, float layer, float re
 float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 {
 	umbra_shadow_view v = views[vi];
-	float res = v.light_dir.w;
+	float res = v.rect.z;
 	// Normal offset: move the lookup point along the normal by a few texels (world units at
 	// this point), more at grazing angles where acne appears first.
 	vec4 lc0 = v.view_proj * vec4(pos, 1.0);
@@ -186,16 +196,17 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 	vec4 lc = v.view_proj * vec4(p, 1.0);
 	vec3 sc = lc.xyz / lc.w;
 	if (sc.z > 1.0) return 1.0;            // beyond the light's far plane: nothing recorded there
+	if (any(greaterThan(abs(sc.xy), vec2(1.0)))) return 1.0;   // outside this view: nothing casts
 	vec2 uv = sc.xy * 0.5 + 0.5;
 	vec2 tp = uv * res;
 	float ref = clamp(sc.z, 0.0, 1.0);     // depth clamp: casters before the near plane pancake to 0
-	float layer = float(vi);
+	vec4 rect = v.rect;
 	uint filt = L.shadow.z;
 	vec2 grad = receiver_gradient(v, n, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, layer, ref, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, layer, ref, res, grad);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, layer, ref);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, layer, ref, res, int(L.shadow.w), grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, rect, ref, res);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, rect, ref);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, rect, ref, res, int(L.shadow.w), grad);
 	return 1.0;
 }
 

@@ -14,8 +14,8 @@
 #define UMBRA_BINDING_MATERIALS      1  /* storage  umbra_material[] */
 #define UMBRA_BINDING_LIGHTS         2  /* storage  umbra_light[] */
 #define UMBRA_BINDING_SHADOW_VIEWS   3  /* storage  umbra_shadow_view[] */
-#define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2DArray, depth, one layer per shadow view */
-#define UMBRA_BINDING_MOMENTS        5  /* sampler2DArray, blurred moments (linear filtering) */
+#define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2D, the depth atlas: one tile per shadow view */
+#define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
 #define UMBRA_BINDING_COUNT          6
 /* moments.comp's own set 0 */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0
@@ -122,7 +122,7 @@ struct umbra_shadow_view {
 	U_MAT4 view_proj;        /* world -> light clip (depth 0..1, near 0) */
 	U_VEC4 params;           /* x world size of one texel (ortho) or at distance 1 (perspective),
 	                            y 1 = perspective, z near, w far */
-	U_VEC4 light_dir;        /* xyz: direction the light travels in this view (ortho), w resolution */
+	U_VEC4 rect;             /* this view's tile in the shadow atlases: x, y, size, atlas size (texels) */
 };
 
 /* One push-constant block for every pipeline (80 bytes). */

@@ -61,8 +61,8 @@ int main(int argc, char **argv)
 	struct rnd_info info;
 	rnd_context_info(ctx, &info);
 	printf("device: %s (%s), %d runs per scene after 1 warm-up, medians in ms\n", info.device_name, info.driver_name, n);
-	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n", "scene", "parse", "upload", "shadow", "main", "readback",
-	       "encode", "total", "img/s", "KiB");
+	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s %9s\n", "scene", "parse", "upload", "shadow", "main", "readback",
+	       "encode", "total", "img/s", "KiB", "maps r/k");
 	int rc = 0;
 	for (int a = first; a < argc; a++) {
 		size_t len;
@@ -70,6 +70,7 @@ int main(int argc, char **argv)
 		if (!json) { fprintf(stderr, "bench: cannot read %s\n", argv[a]); rc = 1; continue; }
 		double *t = calloc((size_t)(n * S_COUNT), sizeof *t);
 		size_t bytes_out = 0;
+		uint32_t maps_rendered = 0, maps_reused = 0;
 		struct api_limits lim;
 		api_limits_defaults(&lim);
 		lim.max_triangles = 0;
@@ -92,6 +93,8 @@ int main(int argc, char **argv)
 			else free(out);
 			double t3 = now_ms();
 			bytes_out = olen;
+			maps_rendered = tm.shadow_maps_rendered;
+			maps_reused = tm.shadow_maps_reused;
 			rnd_image_release(&img);
 			api_scene_free(s);
 			if (i < 0) continue;
@@ -111,7 +114,8 @@ int main(int argc, char **argv)
 				col[s] = median(v, m);
 				printf(" %8.2f", col[s]);
 			}
-			printf(" %8.1f %8zu\n", 1000.0 / col[S_TOTAL], bytes_out / 1024);
+			/* maps: shadow maps rendered / kept from an earlier request (last run) */
+			printf(" %8.1f %8zu %4u/%-4u\n", 1000.0 / col[S_TOTAL], bytes_out / 1024, maps_rendered, maps_reused);
 		}
 		free(t);
 		free(json);

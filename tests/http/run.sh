@@ -11,6 +11,22 @@ REPS=500
 [ -n "${ASAN:-}" ] && REPS=100
 case "$BUILD" in *asan*) REPS=100 ;; esac
 START_TIMEOUT=${START_TIMEOUT:-240}
+# ASan daemons: the Vulkan loader of Debian 12 (1.3.239) unloads the driver at vkDestroyInstance
+# whatever VK_LOADER_DISABLE_DYNAMIC_LIBRARY_UNLOADING says, so LeakSanitizer sees the driver's
+# own leaks as "<unknown module>" and tests/lsan.supp cannot name them. Preloading the driver
+# (after the ASan runtime, which must come first) keeps it mapped. Daemons only: curl and
+# python3 run without it.
+DAEMON_PRELOAD=""
+asan_rt=$(ldd "$UMBRAD" 2>/dev/null | awk '/libasan/ { print $3; exit }')
+RSS_BOUND_KB=32768
+if [ -n "$asan_rt" ]; then
+	REPS=100
+	# ASan holds freed memory in its quarantine (256 MiB by default): LeakSanitizer checks leaks.
+	RSS_BOUND_KB=307200
+	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
+		[ -f "$lvp" ] && DAEMON_PRELOAD="$asan_rt $lvp" && break
+	done
+fi
 
 T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-http.XXXXXX")
 pass=0
@@ -41,7 +57,7 @@ fi
 start() {
 	name=$1; shift
 	rm -f "$T/$name.port"
-	"$UMBRAD" --listen 127.0.0.1:0 --port-file "$T/$name.port" "$@" 2>"$T/$name.log" &
+	LD_PRELOAD="$DAEMON_PRELOAD" "$UMBRAD" --listen 127.0.0.1:0 --port-file "$T/$name.port" "$@" 2>"$T/$name.log" &
 	PID=$!
 	PIDS="$PIDS $PID"
 	i=0
@@ -173,7 +189,7 @@ check "bad UMBRA_WORKERS exits 2" [ $rc = 2 ]
 
 # ==== main daemon ====
 echo "# starting the main daemon (reps $REPS)"
-start main --asset-root "$T/assets" --max-body 1M --max-pixels 1000000 --max-triangles 200000 --max-lights 4 \
+start main --asset-root "$T/assets" --pipeline-cache "$T/pipeline.cache" --max-body 1M --max-pixels 1000000 --max-triangles 200000 --max-lights 4 \
 	--max-shadow-resolution 2048 --queue 64 || { echo "$pass passed, $fail failed"; exit 1; }
 MAIN=$PID
 MAIN_URL=$URL
@@ -295,27 +311,29 @@ check "metrics have the stage histograms" grep -q 'umbra_stage_seconds_bucket{st
 check "metrics have the request-duration histogram" grep -q '^umbra_request_duration_seconds_count{route="/v1/render"}' "$T/metrics.body"
 check "metrics have queue depth and in-flight gauges" sh -c "grep -q '^umbra_queue_depth ' '$T/metrics.body' && grep -q '^umbra_renders_in_flight ' '$T/metrics.body'"
 check "metrics have shadow-map reuse" grep -q '^umbra_shadow_maps_reused_total ' "$T/metrics.body"
+check "metrics have atlas occupancy" grep -q '^umbra_atlas_occupancy_ratio ' "$T/metrics.body"
 check "metrics count 413/415/422" sh -c "grep -q 'status=\"413\"' '$T/metrics.body' && grep -q 'status=\"415\"' '$T/metrics.body' && grep -q 'status=\"422\"' '$T/metrics.body'"
 check "access log line per request" grep -q 'POST /v1/render 200 .*id=test-id-42' "$T/main.log"
 
-# -- resources over $REPS sequential small renders (keep-alive batches of 50)
+# -- resources over $REPS sequential small renders (keep-alive batches of 25); the growth is
+# measured after the first fifth, once caches and allocator pools have settled.
 fd0=$(fd_count $MAIN); rss0=$(rss_kb $MAIN)
-n=0; bad=0
+n=0; bad=0; fd1=""
 while [ $n -lt "$REPS" ]; do
 	set --
 	k=0
-	while [ $k -lt 50 ]; do set -- "$@" -o /dev/null "$URL/v1/render"; k=$((k + 1)); done
+	while [ $k -lt 25 ]; do set -- "$@" -o /dev/null "$URL/v1/render"; k=$((k + 1)); done
 	codes=$(curl -s --max-time 300 -w '%{http_code}\n' -H 'Content-Type: application/json' \
 		--data-binary "@$T/small.json" "$@")
 	bad=$((bad + $(echo "$codes" | grep -vc '^200$')))
-	n=$((n + 50))
-	[ $n -eq 100 ] && { fd1=$(fd_count $MAIN); rss1=$(rss_kb $MAIN); }
+	n=$((n + 25))
+	if [ -z "$fd1" ] && [ $n -ge $((REPS / 5)) ]; then fd1=$(fd_count $MAIN); rss1=$(rss_kb $MAIN); n1=$n; fi
 done
 fd2=$(fd_count $MAIN); rss2=$(rss_kb $MAIN)
-echo "# $REPS sequential renders: fds $fd0 -> $fd1 (after 100) -> $fd2; RSS KiB $rss0 -> $rss1 (after 100) -> $rss2"
+echo "# $REPS sequential renders: fds $fd0 -> $fd1 (after $n1) -> $fd2; RSS KiB $rss0 -> $rss1 (after $n1) -> $rss2"
 check "$REPS sequential renders all 200" [ $bad -eq 0 ]
 check "no fd growth over $REPS requests" [ "$fd2" -le $((fd0 + 2)) ]
-check "RSS bounded over $REPS requests (< 48 MiB growth after the first 100)" [ $((rss2 - rss1)) -lt 49152 ]
+check "RSS bounded over $REPS requests (< $((RSS_BOUND_KB / 1024)) MiB growth after the first $n1)" [ $((rss2 - rss1)) -lt $RSS_BOUND_KB ]
 
 # ==== flood: one worker, queue of 2 ====
 echo "# starting the flood daemon"
@@ -436,6 +454,7 @@ if [ $rc -eq 0 ]; then ok "main exits 0 after SIGTERM under load"; else
 	nok "main exits 0 after SIGTERM under load" "exit $rc"; grep -v ' info ' "$T/main.log" | tail -n 20 | sed 's/^/# /'
 fi
 check "drain logged" grep -q 'SIGTERM: draining' "$T/main.log"
+check "pipeline cache saved at exit" [ -s "$T/pipeline.cache" ]
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -183,9 +183,12 @@ static void exr_quiet(exr_const_context_t ctx, exr_result_t code, const char *ms
 	(void)msg;
 }
 
-/* Reads every channel of part 0 as float planes (names[i], planes[i]); returns channel count. */
-static int exr_decode(const uint8_t *data, size_t len, int *w, int *h, char names[48][32], int types[48],
-                      float *planes[48])
+/* Reads every channel of part `part` as float planes (names[i], planes[i]); returns the channel
+ * count, or a negative value. *nparts gets the file's part count, pname the part's name ("" when
+ * it has none), *comp its compression. */
+static int exr_decode_part(const uint8_t *data, size_t len, int part, int *nparts, char pname[32],
+                           exr_compression_t *comp, int *w, int *h, char names[48][32], int types[48],
+                           float *planes[48])
 {
 	struct exr_in in = {data, len};
 	exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -195,16 +198,22 @@ static int exr_decode(const uint8_t *data, size_t len, int *w, int *h, char name
 	init.error_handler_fn = exr_quiet;
 	exr_context_t ctx;
 	if (exr_start_read(&ctx, "mem.exr", &init) != EXR_ERR_SUCCESS) return -1;
-	int nparts = 0;
-	exr_get_count(ctx, &nparts);
-	exr_compression_t comp;
-	exr_get_compression(ctx, 0, &comp);
+	*nparts = 0;
+	exr_get_count(ctx, nparts);
+	if (part >= *nparts) {
+		exr_finish(&ctx);
+		return -1;
+	}
+	const char *nm = NULL;
+	pname[0] = 0;
+	if (exr_get_name(ctx, part, &nm) == EXR_ERR_SUCCESS && nm) snprintf(pname, 32, "%s", nm);
+	exr_get_compression(ctx, part, comp);
 	exr_attr_box2i_t dw;
-	exr_get_data_window(ctx, 0, &dw);
+	exr_get_data_window(ctx, part, &dw);
 	*w = dw.max.x - dw.min.x + 1;
 	*h = dw.max.y - dw.min.y + 1;
 	const exr_attr_chlist_t *chl;
-	exr_get_channels(ctx, 0, &chl);
+	exr_get_channels(ctx, part, &chl);
 	int n = chl->num_channels;
 	for (int i = 0; i < n && i < 48; i++) {
 		snprintf(names[i], 32, "%s", chl->entries[i].name.str);
@@ -212,15 +221,15 @@ static int exr_decode(const uint8_t *data, size_t len, int *w, int *h, char name
 		planes[i] = calloc((size_t)*w * (size_t)*h, sizeof(float));
 	}
 	int32_t lines = 0;
-	exr_get_scanlines_per_chunk(ctx, 0, &lines);
+	exr_get_scanlines_per_chunk(ctx, part, &lines);
 	exr_decode_pipeline_t dec = {0};
 	bool live = false;
 	exr_result_t rv = EXR_ERR_SUCCESS;
 	for (int y = dw.min.y; rv == EXR_ERR_SUCCESS && y <= dw.max.y; y += lines) {
 		exr_chunk_info_t ci;
-		rv = exr_read_scanline_chunk_info(ctx, 0, y, &ci);
+		rv = exr_read_scanline_chunk_info(ctx, part, y, &ci);
 		if (rv) break;
-		rv = live ? exr_decoding_update(ctx, 0, &ci, &dec) : exr_decoding_initialize(ctx, 0, &ci, &dec);
+		rv = live ? exr_decoding_update(ctx, part, &ci, &dec) : exr_decoding_initialize(ctx, part, &ci, &dec);
 		if (rv) break;
 		for (int c = 0; c < dec.channel_count; c++) {
 			exr_coding_channel_info_t *ch = &dec.channels[c];
@@ -234,14 +243,26 @@ static int exr_decode(const uint8_t *data, size_t len, int *w, int *h, char name
 		}
 		if (!live) {
 			live = true;
-			rv = exr_decoding_choose_default_routines(ctx, 0, &dec);
+			rv = exr_decoding_choose_default_routines(ctx, part, &dec);
 			if (rv) break;
 		}
-		rv = exr_decoding_run(ctx, 0, &dec);
+		rv = exr_decoding_run(ctx, part, &dec);
 	}
 	if (live) exr_decoding_destroy(ctx, &dec);
 	exr_finish(&ctx);
-	if (rv != EXR_ERR_SUCCESS || nparts != 1 || comp != EXR_COMPRESSION_ZIP) n = -(int)rv - 2;
+	if (rv != EXR_ERR_SUCCESS) n = -(int)rv - 2;
+	return n;
+}
+
+/* Part 0 of a single-part ZIP file (anything else is an error). */
+static int exr_decode(const uint8_t *data, size_t len, int *w, int *h, char names[48][32], int types[48],
+                      float *planes[48])
+{
+	int nparts = 0;
+	char pname[32];
+	exr_compression_t comp = EXR_COMPRESSION_NONE;
+	int n = exr_decode_part(data, len, 0, &nparts, pname, &comp, w, h, names, types, planes);
+	if (n >= 0 && (nparts != 1 || comp != EXR_COMPRESSION_ZIP)) n = -1;
 	return n;
 }
 
@@ -328,4 +349,87 @@ TEST(exr_encode_dispatch)
 	free(out);
 	rnd_image_release(&img);
 	api_scene_free(s);
+}
+
+/* A sheet of 5 views (3 columns, 2 rows, one unused cell) with two AOV planes: a multi-part
+ * EXR whose part k ("view<k>") holds exactly cell k of the sheet and of every AOV plane. */
+TEST(exr_multipart_views)
+{
+	const uint32_t VW = 7, VH = 21, COLS = 3, ROWS = 2, NV = 5; /* 21 lines: a partial 16-line chunk */
+	struct rnd_image img = make_image(VW * COLS, VH * ROWS, RND_PIXELS_RGBA32F, false);
+	img.view_count = NV;
+	img.view_columns = COLS;
+	img.view_width = VW;
+	img.view_height = VH;
+	const uint32_t W = img.width, H = img.height;
+	/* Tag every pixel with its view and position: R = view, G = x in cell, B = y in cell. */
+	for (uint32_t y = 0; y < H; y++)
+		for (uint32_t x = 0; x < W; x++) {
+			float *px = (float *)(void *)((uint8_t *)img.pixels + y * img.stride) + 4 * x;
+			uint32_t v = (y / VH) * COLS + x / VW;
+			px[0] = (float)v; px[1] = (float)(x % VW); px[2] = (float)(y % VH); px[3] = v < NV ? 1.0f : 0.0f;
+		}
+	const char *aov_names[] = {"Z", "shadow.0"};
+	img.aov_count = 2;
+	for (int a = 0; a < 2; a++) {
+		snprintf(img.aov_names[a], sizeof img.aov_names[a], "%s", aov_names[a]);
+		img.aov[a] = malloc(sizeof(float) * W * H);
+		for (uint32_t i = 0; i < W * H; i++) img.aov[a][i] = (float)a * 100000.0f + (float)i + 0.25f;
+	}
+	img.aov[0][VW + 2] = INFINITY; /* view 1, pixel (2, 0) */
+
+	uint8_t *out = NULL;
+	size_t len = 0;
+	struct api_problem p;
+	REQUIRE(api_exr_encode(&img, &out, &len, &p) == API_OK, "%s", p.detail);
+	for (int part = 0; part < (int)NV; part++) {
+		int nparts = 0, w = 0, h = 0, types[48];
+		char pname[32], names[48][32], want[32];
+		exr_compression_t comp = EXR_COMPRESSION_NONE;
+		float *planes[48] = {0};
+		int n = exr_decode_part(out, len, part, &nparts, pname, &comp, &w, &h, names, types, planes);
+		REQUIRE(n == 6, "part %d: channels %d", part, n);
+		CHECK(nparts == (int)NV, "parts %d", nparts);
+		snprintf(want, sizeof want, "view%d", part);
+		CHECK(!strcmp(pname, want), "part %d is named \"%s\"", part, pname);
+		CHECK(w == (int)VW && h == (int)VH && comp == EXR_COMPRESSION_ZIP, "part %d: %dx%d", part, w, h);
+		const char *sorted[] = {"A", "B", "G", "R", "Z", "shadow.0"};
+		for (int i = 0; i < 6; i++) CHECK(!strcmp(names[i], sorted[i]), "part %d channel %d %s", part, i, names[i]);
+		const float *A = planes[0], *B = planes[1], *G = planes[2], *R = planes[3], *Z = planes[4], *S = planes[5];
+		uint32_t x0 = (uint32_t)part % COLS * VW, y0 = (uint32_t)part / COLS * VH;
+		int bad = 0;
+		for (uint32_t y = 0; y < VH; y++)
+			for (uint32_t x = 0; x < VW; x++) {
+				size_t i = (size_t)y * VW + x, si = (size_t)(y0 + y) * W + x0 + x;
+				if (R[i] != (float)part || G[i] != (float)x || B[i] != (float)y || A[i] != 1.0f) bad++;
+				if (!(Z[i] == img.aov[0][si] || (isinf(Z[i]) && isinf(img.aov[0][si]))) || S[i] != img.aov[1][si]) bad++;
+			}
+		CHECK(bad == 0, "part %d: %d pixels differ from its cell", part, bad);
+		if (part == 1) CHECK(isinf(Z[2]), "Z = +inf survives");
+		for (int i = 0; i < n; i++) free(planes[i]);
+	}
+	free(out);
+
+	/* One view: single part, unnamed, the whole image. */
+	img.view_count = 1;
+	img.view_columns = 1;
+	img.view_width = W;
+	img.view_height = H;
+	REQUIRE(api_exr_encode(&img, &out, &len, &p) == API_OK, "%s", p.detail);
+	int w, h, types[48];
+	char names[48][32];
+	float *planes[48] = {0};
+	int n = exr_decode(out, len, &w, &h, names, types, planes);
+	CHECK(n == 6 && w == (int)W && h == (int)H, "n %d %dx%d", n, w, h);
+	for (int i = 0; i < n && i < 48; i++) free(planes[i]);
+	free(out);
+
+	/* A view layout that does not fit the image is refused. */
+	img.view_count = 7;
+	img.view_columns = 3;
+	img.view_width = VW;
+	img.view_height = VH;
+	out = NULL;
+	CHECK(api_exr_encode(&img, &out, &len, &p) == API_ERR && p.status == 500 && !out);
+	rnd_image_release(&img);
 }

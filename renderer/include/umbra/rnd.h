@@ -249,6 +249,7 @@ struct rnd_context_desc {
 	const char *pipeline_cache_path; /* loaded at create, saved by rnd_context_save_cache(); NULL = none */
 	uint32_t slots;            /* concurrent renders (render slots); 0 = 1 */
 	uint32_t max_width, max_height; /* 0 = 8192 */
+	uint32_t atlas_size;       /* texels per side of the shadow atlases (power of two), 0 = 4096 */
 	rnd_log_fn log; void *log_user;
 };
 
@@ -269,6 +270,17 @@ void rnd_context_destroy(struct rnd_context *ctx);
 void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info);
 /* Validation-layer messages (warnings and errors) seen since create. Tests require 0. */
 uint32_t rnd_context_validation_messages(const struct rnd_context *ctx);
+
+/* Counters for metrics; thread-safe. */
+struct rnd_stats {
+	uint32_t atlas_size;
+	double atlas_occupancy;          /* share of atlas texels held by tiles, 0..1 */
+	uint32_t atlas_tiles;
+	uint32_t cached_maps;            /* spot / point shadow maps kept for reuse */
+	uint64_t shadow_cache_hits;      /* lights whose shadow passes were skipped */
+	uint64_t shadow_cache_misses;
+};
+void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
 /* Writes the pipeline cache to desc.pipeline_cache_path (atomic rename). */
 enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error *err);
 

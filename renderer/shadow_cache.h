@@ -1,0 +1,50 @@
+/*
+ * renderer/shadow_cache.h — the persistent shadow atlases and what lives in them.
+ *
+ * The context owns one depth atlas (D32) and one moment atlas (two channels, fp32 where the
+ * device filters it, else fp16), both atlas_size² texels, created at start-up and kept in
+ * GENERAL layout for the life of the process. Every shadow view of every render is a square
+ * tile of these atlases (atlas.c hands them out):
+ *   - spot and point lights get cached entries keyed by a hash of everything that shapes their
+ *     maps (caster geometry, the light's view matrices, resolution, bias, filter settings);
+ *     a later request with the same key reuses the tiles and skips their shadow passes;
+ *   - directional lights get transient tiles (their maps follow the camera), freed at the end
+ *     of the render.
+ * When the atlas is full, unreferenced entries are evicted oldest first, then resolutions go
+ * down (never below 64): shadows are never dropped.
+ *
+ * Threading: every call takes the cache mutex. An entry in use by a render (refs > 0) is
+ * never evicted; a new entry is only visible to other renders after its render completed
+ * (rnd_cache_release with ok = true), so no render reads a tile another is writing.
+ */
+#ifndef UMBRA_RENDERER_SHADOW_CACHE_H
+#define UMBRA_RENDERER_SHADOW_CACHE_H
+
+#include "atlas.h"
+#include "internal.h"
+
+struct rnd_cache_request {
+	uint64_t key;         /* 0 = not cacheable (transient) */
+	uint32_t tiles;       /* 1, or 6 for a point light, or the cascade / level count */
+	uint32_t res;         /* wanted tile size (power of two) */
+};
+
+struct rnd_cache_grant {
+	uint32_t entry;       /* index for rnd_cache_release */
+	struct rnd_tile tile[8];
+	uint32_t res;         /* granted (maybe smaller than asked) */
+	bool hit;             /* tiles already hold this key's maps: skip their passes */
+};
+
+enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err);
+void rnd_cache_release_all(struct rnd_context *ctx);
+/* Grants tiles for n requests at once (all or none). */
+enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cache_request *req, uint32_t n,
+                                  struct rnd_cache_grant *out, struct rnd_error *err);
+/* Ends a render's use: ok = the render completed, so new entries become reusable. */
+void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g, uint32_t n, bool ok);
+
+/* 64-bit hash of bytes, word at a time (content keys, not security). */
+uint64_t rnd_hash(uint64_t h, const void *data, size_t len);
+
+#endif
