@@ -20,6 +20,9 @@ LDFLAGS += -pthread $(SAN)
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 CFLAGS += $(PKG_CFLAGS)
+# The build's version (in /v1/info and the ETag): the commit, "-dirty" with local changes.
+UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || echo unknown)
+CFLAGS += -DUMBRA_VERSION=\"$(UMBRA_VERSION)\"
 LIBS := $(PKG_LIBS) -lm
 
 RND_SRC := $(wildcard renderer/*.c)
@@ -93,12 +96,15 @@ test-asan: deps
 	@BUILD=build/asan SHARED=$(SHARED) ASAN=1 sh tests/run.sh
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench
 	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/bench.sh
 
 $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^
 
 clean:
 	rm -rf $(BUILD)

@@ -67,6 +67,7 @@ struct rnd_pipelines {
 			uint32_t cull_back;
 			uint32_t aov;                /* 1 = the AOV pass (aov.frag, 4 x RGBA32F, 1 sample) */
 			uint32_t prepass;            /* 1 = after a depth pre-pass: depth EQUAL, no writes */
+			uint32_t atlas_view;         /* 1 = debug view `atlas` (fullscreen.vert + atlas.frag) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;

@@ -15,6 +15,8 @@
 #include "aov.frag.spv.h"
 #include "masked.vert.spv.h"
 #include "masked.frag.spv.h"
+#include "fullscreen.vert.spv.h"
+#include "atlas.frag.spv.h"
 
 static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
                                    VkShaderModule *out, struct rnd_error *err)
@@ -97,6 +99,7 @@ struct pipe_desc {
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
 	bool uv_only;               /* vertex input: position (0) and uv (2) */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
+	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	const VkSpecializationInfo *spec;  /* fragment stage */
 	const char *name;
 };
@@ -125,8 +128,9 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	}
 	VkPipelineVertexInputStateCreateInfo vi = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-		.vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
-		.vertexAttributeDescriptionCount = d->uv_only ? 2 : d->shadow ? 1 : 3,
+		.pVertexBindingDescriptions = &vb,
+		.vertexBindingDescriptionCount = d->no_vertices ? 0 : 1,
+		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 2 : d->shadow ? 1 : 3,
 		.pVertexAttributeDescriptions = d->uv_only ? va_uv : va,
 	};
 	VkPipelineInputAssemblyStateCreateInfo ia = {
@@ -153,7 +157,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	};
 	VkPipelineDepthStencilStateCreateInfo ds = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-		.depthTestEnable = VK_TRUE, .depthWriteEnable = !d->after_prepass,
+		.depthTestEnable = !d->no_vertices, .depthWriteEnable = !d->after_prepass && !d->no_vertices,
 		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL
 		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
 	};
@@ -279,6 +283,19 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
 	};
+	VkShaderModule fs_vs = VK_NULL_HANDLE, fs_fs = VK_NULL_HANDLE;
+	if (key->atlas_view) {
+		/* Debug view of the depth atlas: a fullscreen triangle. */
+		if ((r = make_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &fs_vs, err)) != RND_OK ||
+		    (r = make_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
+			goto out_modules;
+		d.vs = fs_vs;
+		d.fs = fs_fs;
+		d.spec = NULL;
+		d.no_vertices = true;
+		d.after_prepass = false;
+		d.cull_back = false;
+	}
 	if (key->aov) {
 		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
 		d.fs = p->aov_fs;
@@ -288,7 +305,11 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.after_prepass = false;
 	}
 	VkPipeline pipe;
-	if ((r = make_pipeline(ctx, &d, &pipe, err)) != RND_OK) goto out;
+	r = make_pipeline(ctx, &d, &pipe, err);
+out_modules:
+	if (fs_fs) vkDestroyShaderModule(ctx->device, fs_fs, NULL);
+	if (fs_vs) vkDestroyShaderModule(ctx->device, fs_vs, NULL);
+	if (r != RND_OK) goto out;
 	p->variants[p->variant_count].key = *key;
 	p->variants[p->variant_count].pipeline = pipe;
 	p->variant_count++;

@@ -169,6 +169,11 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	 * 4x4 blocks only to be hidden (lavapipe shades per triangle); closed primitives seen from
 	 * outside are back-face culled instead and need none. */
 	k->prepass = dense > 20000;
+	if (sc->output.debug == RND_DEBUG_ATLAS) {
+		memset(k->sc, 0, sizeof k->sc);
+		k->prepass = 0;
+		k->atlas_view = 1;
+	}
 }
 
 enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
@@ -181,6 +186,12 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
 	main_key(sc, sp, draws, ndraw, &key);
+	VkPipeline atlas_pipe = VK_NULL_HANDLE;
+	if (key.atlas_view) {
+		enum rnd_result r = rnd_pipelines_main(ctx, &key, &atlas_pipe, err);
+		if (r != RND_OK) return r;
+		ndraw = 0;   /* the picture is the atlas, not the scene */
+	}
 	for (uint32_t i = 0; i < ndraw; i++) {
 		uint32_t c = draws[i].cull_back;
 		if (!draws[i].index_count || pipes[c]) continue;
@@ -242,6 +253,10 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
 	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
 	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+	if (atlas_pipe) {
+		vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, atlas_pipe);
+		vkCmdDraw(cmd, 3, 1, 0, 0);
+	}
 	VkPipeline bound = VK_NULL_HANDLE;
 	for (uint32_t i = 0; i < ndraw && key.prepass; i++) {
 		const struct draw *d = &draws[i];

@@ -46,8 +46,6 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 			return rnd_fail(err, RND_ERR_INVALID, "object %u: material %u does not exist", i, sc->objects[i].material);
 	if (sc->output.debug == RND_DEBUG_SHADOW && sc->output.debug_light >= sc->light_count && sc->light_count > 0)
 		return rnd_fail(err, RND_ERR_INVALID, "debug_light %u names no light", sc->output.debug_light);
-	if (sc->output.debug == RND_DEBUG_ATLAS)
-		return rnd_fail(err, RND_ERR_INVALID, "debug view 'atlas' is not implemented by this renderer yet");
 	if (sc->output.aovs && sc->output.pixels != RND_PIXELS_RGBA32F)
 		return rnd_fail(err, RND_ERR_INVALID, "AOVs need the linear RGBA32F output (EXR)");
 	uint32_t planes = (sc->output.aovs & RND_AOV_DEPTH ? 1 : 0) + (sc->output.aovs & RND_AOV_NORMAL ? 3 : 0) +

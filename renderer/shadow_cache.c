@@ -68,6 +68,17 @@ static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *e
 	}
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = n, .pImageMemoryBarriers = b};
 	vkCmdPipelineBarrier2(s->cmd, &di);
+	/* Empty texels read as "nothing here" (depth 1) in the atlas debug view. */
+	VkClearDepthStencilValue one = {1.0f, 0};
+	VkImageSubresourceRange range = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+	vkCmdClearDepthStencilImage(s->cmd, ctx->atlas_depth.img, VK_IMAGE_LAYOUT_GENERAL, &one, 1, &range);
+	VkMemoryBarrier2 mb = {
+		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT,
+		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+		.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+	};
+	VkDependencyInfo dm = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
+	vkCmdPipelineBarrier2(s->cmd, &dm);
 	if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkEndCommandBuffer (atlas init)");
 	VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &s->cmd};
 	if ((vr = vkQueueSubmit(ctx->queue, 1, &si, s->fence)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkQueueSubmit (atlas init)");
@@ -90,7 +101,8 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 	pthread_mutex_init(&c->mu, NULL);
 	ctx->cache = c;
 	if ((r = rnd_image_create(ctx, RND_SHADOW_FORMAT, size, size, 1, 1,
-	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+	                          VK_IMAGE_USAGE_TRANSFER_DST_BIT,
 	                          VK_IMAGE_ASPECT_DEPTH_BIT, "shadow depth atlas", &ctx->atlas_depth, err)) != RND_OK)
 		goto fail;
 	if (ctx->moments.available &&

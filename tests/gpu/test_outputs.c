@@ -127,6 +127,22 @@ TEST(outputs_views_sheet_layout)
 	rnd_image_release(&img);
 }
 
+TEST(outputs_fit_objects_leaves_planes_out)
+{
+	/* Camera fit "objects" frames the sphere alone (the 10x10 plane is left out): the sphere is
+	 * centred and its bounding sphere (radius sqrt 3) fills the frame up to the margin 0.2. */
+	struct rnd_image img;
+	REQUIRE(gpu_render(&img, "{'width':64,'height':64," VIEW_SCENE ",'camera':{'fit':'objects',"
+	                         "'direction':[0.3,-0.4,-1],'margin':0.2,'fov_y':50},'output':{'msaa':1}}"));
+	img.view_columns = img.view_columns ? img.view_columns : 1;
+	double cx, cy, dist = sqrt(3.0) / sin(0.5 * 50 * GPU_DEG * 0.6);
+	double r_px = 32 * tan(asin(1 / dist)) / tan(25 * GPU_DEG), area = GPU_PI * r_px * r_px;
+	int n = red_centroid(&img, 0, &cx, &cy);
+	CHECK(fabs(cx - 32) < 1.0 && fabs(cy - 32) < 1.0 && fabs(n - area) < 0.08 * area,
+	      "sphere centroid (%.2f, %.2f) over %d px, want (32, 32) over about %.0f", cx, cy, n, area);
+	rnd_image_release(&img);
+}
+
 /* Reads the part names and sizes of an EXR in memory. Returns the part count or -1. */
 struct exr_in { const uint8_t *data; size_t len; };
 static int64_t exr_read(exr_const_context_t ctx, void *user, void *buf, uint64_t sz, uint64_t off,
