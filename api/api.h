@@ -70,7 +70,21 @@ struct api_scene {
 };
 
 /* Parses and validates a scene document. On failure fills p (400: malformed / wrong type /
- * out of range / unknown member, with the member's JSON Pointer; 422: over a limit). */
+ * out of range / unknown member, with the member's JSON Pointer; 422: over a limit).
+ *
+ * Several views: root `views` (cameras; each starts from the root `camera` when there is one)
+ * or `turntable` ({frames 1..1024, elevation -90..90 degrees (20), distance > 0}) fill
+ * scene.views / view_count, and `camera` may then be absent. Turntable frame k looks at the
+ * centre of the objects' bounds (every object but planes and shadow catchers; all objects when
+ * only those exist) from azimuth 360°·k/N (frame 0 on +Z, frame N/4 on +X) at the elevation:
+ * view direction -(cos el·sin az, sin el, cos el·cos az), up +Y, fov_y of a perspective root
+ * camera (else 45°), the root camera's exposure, near/far derived; from `distance`, or else
+ * where the bounding sphere fills the frame with a 0.1 margin (the camera-fit rule). Cameras
+ * with `fit: "objects"` are placed the same way here (fit becomes RND_FIT_NONE) because the
+ * renderer's fit frames the whole scene. The sheet (ceil(sqrt(n)) columns, unused cells
+ * included) counts against max_pixels: 422 at /views or /turntable.
+ * Material `base_color_texture` is decoded here (PNG/JPEG, 400 at the member when it cannot be);
+ * more than 16 distinct textures, or one over 16384 texels a side, is a 422. */
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
                                 struct api_scene **out, struct api_problem *p);
 void api_scene_free(struct api_scene *s);
@@ -98,13 +112,17 @@ void api_model_cache_clear(void);
  * CLI -o extension): adjusts scene.output.pixels. Fails (400) for PNG with AOVs. */
 enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, struct api_problem *p);
 
-/* Encodes a rendered image as the scene asks (PNG 8/16-bit or EXR with AOVs). */
+/* Encodes a rendered image as the scene asks (PNG 8/16-bit or EXR with AOVs). Several views:
+ * the PNG is the sheet as rendered; the EXR is multi-part (see api_exr_encode). */
 enum api_result api_encode(const struct api_scene *s, const struct rnd_image *img, uint8_t **out, size_t *len,
                            struct api_problem *p);
 /* PNG of an RGBA8 or RGBA16 image; level -1 = chosen by size. */
 enum api_result api_png_encode(const struct rnd_image *img, int level, uint8_t **out, size_t *len,
                                struct api_problem *p);
-/* EXR (ZIP) of an RGBA32F image: R,G,B,A half plus the image's AOV planes as float. */
+/* EXR (ZIP) of an RGBA32F image: R,G,B,A half plus the image's AOV planes as float. An image of
+ * several views (img->view_count > 1, a sheet) becomes a multi-part EXR: one part per view, named
+ * "view0", "view1", ..., each view_width x view_height with the same channels, cut from the
+ * view's cell of the sheet and of every AOV plane. One view: a single part with no name. */
 enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p);
 
 const char *api_format_mime(enum api_format f);

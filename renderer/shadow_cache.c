@@ -162,63 +162,102 @@ static bool alloc_tiles(struct rnd_shadow_cache *c, struct rnd_cache_entry *e, u
 	return true;
 }
 
+static uint32_t free_slot(struct rnd_shadow_cache *c)
+{
+	for (uint32_t i = 0; i < MAX_ENTRIES; i++)
+		if (!c->entries[i].live) return i;
+	if (evict_one(c))
+		for (uint32_t i = 0; i < MAX_ENTRIES; i++)
+			if (!c->entries[i].live) return i;
+	return MAX_ENTRIES;
+}
+
 enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cache_request *req, uint32_t n,
                                   struct rnd_cache_grant *out, struct rnd_error *err)
 {
 	struct rnd_shadow_cache *c = ctx->cache;
 	enum rnd_result r = RND_OK;
-	uint32_t done = 0;
+	uint32_t res[UMBRA_MAX_LIGHTS], order[UMBRA_MAX_LIGHTS], nmiss = 0;
+	bool granted[UMBRA_MAX_LIGHTS] = {false};
+	if (n > UMBRA_MAX_LIGHTS) return rnd_fail(err, RND_ERR_LIMIT, "%u shadowed lights: at most %d", n, UMBRA_MAX_LIGHTS);
 	pthread_mutex_lock(&c->mu);
 	c->clock++;
-	for (; done < n; done++) {
-		const struct rnd_cache_request *q = &req[done];
-		struct rnd_cache_grant *g = &out[done];
+	/* 1. Completed maps with the same key are reused as they are. */
+	for (uint32_t k = 0; k < n; k++) {
+		const struct rnd_cache_request *q = &req[k];
+		struct rnd_cache_grant *g = &out[k];
 		memset(g, 0, sizeof *g);
-		if (q->tiles > 8) { r = rnd_fail(err, RND_ERR_LIMIT, "%u tiles for one light", q->tiles); break; }
-		/* A completed map with this key: reuse it. */
-		bool found = false;
-		for (uint32_t i = 0; q->key && i < MAX_ENTRIES && !found; i++) {
+		if (q->tiles == 0 || q->tiles > 8) { r = rnd_fail(err, RND_ERR_LIMIT, "%u tiles for one light", q->tiles); goto fail; }
+		for (uint32_t i = 0; q->key && i < MAX_ENTRIES; i++) {
 			struct rnd_cache_entry *e = &c->entries[i];
 			if (e->live && e->valid && e->key == q->key && e->ntiles == q->tiles) {
 				e->refs++;
 				e->last_use = c->clock;
 				g->entry = i; g->res = e->res; g->hit = true;
 				memcpy(g->tile, e->tile, sizeof e->tile);
-				found = true;
+				granted[k] = true;
 				__atomic_add_fetch(&ctx->stats_hits, 1, __ATOMIC_RELAXED);
+				break;
 			}
 		}
-		if (found) continue;
-		uint32_t slot = MAX_ENTRIES;
-		for (uint32_t i = 0; i < MAX_ENTRIES && slot == MAX_ENTRIES; i++)
-			if (!c->entries[i].live) slot = i;
-		if (slot == MAX_ENTRIES && evict_one(c))
-			for (uint32_t i = 0; i < MAX_ENTRIES && slot == MAX_ENTRIES; i++)
-				if (!c->entries[i].live) slot = i;
-		if (slot == MAX_ENTRIES) { r = rnd_fail(err, RND_ERR_LIMIT, "shadow cache: all %d entries in use", MAX_ENTRIES); break; }
+		if (granted[k]) continue;
+		res[k] = q->res < 64 ? 64 : q->res > c->atlas.size ? c->atlas.size : q->res;
+		order[nmiss++] = k;
+	}
+	/* 2. Budget: what is not held by maps in use (by this or other renders) can be had,
+	 * evicting unused maps. Over budget, the largest maps give up resolution first. */
+	uint64_t held = 0;
+	for (uint32_t i = 0; i < MAX_ENTRIES; i++)
+		if (c->entries[i].live && c->entries[i].refs)
+			held += (uint64_t)c->entries[i].ntiles * c->entries[i].res * c->entries[i].res;
+	uint64_t budget = (uint64_t)c->atlas.size * c->atlas.size - held;
+	for (;;) {
+		uint64_t need = 0;
+		uint32_t big = n;
+		for (uint32_t m = 0; m < nmiss; m++) {
+			uint32_t k = order[m];
+			need += (uint64_t)req[k].tiles * res[k] * res[k];
+			if (res[k] > 64 && (big == n || res[k] > res[big])) big = k;
+		}
+		if (need <= budget || big == n) break;
+		res[big] /= 2;
+	}
+	/* 3. Allocate the largest first (fewest holes), evicting unused maps as needed; where
+	 * fragmentation still leaves no room, that light goes down one more step. */
+	for (uint32_t a = 0; a < nmiss; a++)
+		for (uint32_t b2 = a + 1; b2 < nmiss; b2++)
+			if (res[order[b2]] > res[order[a]]) { uint32_t t = order[a]; order[a] = order[b2]; order[b2] = t; }
+	for (uint32_t m = 0; m < nmiss; m++) {
+		uint32_t k = order[m];
+		const struct rnd_cache_request *q = &req[k];
+		struct rnd_cache_grant *g = &out[k];
+		uint32_t slot = free_slot(c);
+		if (slot == MAX_ENTRIES) { r = rnd_fail(err, RND_ERR_LIMIT, "shadow cache: all %d entries in use", MAX_ENTRIES); goto fail; }
 		struct rnd_cache_entry *e = &c->entries[slot];
-		uint32_t res = q->res < 64 ? 64 : q->res > c->atlas.size ? c->atlas.size : q->res;
-		/* Make room: evict unused maps first, then lower this light's resolution. */
 		bool ok = false;
 		while (!ok) {
-			ok = alloc_tiles(c, e, q->tiles, res);
-			if (ok) break;
-			if (evict_one(c)) continue;
-			if (res <= 64) break;
-			res /= 2;
+			ok = alloc_tiles(c, e, q->tiles, res[k]);
+			if (ok || evict_one(c)) continue;
+			if (res[k] <= 64) break;
+			res[k] /= 2;
 		}
 		if (!ok) {
 			r = rnd_fail(err, RND_ERR_LIMIT, "shadow atlas (%ux%u) is full: %u tiles of 64 do not fit next to the "
 			             "maps in use (raise the atlas size)", c->atlas.size, c->atlas.size, q->tiles);
-			break;
+			goto fail;
 		}
 		e->live = true; e->valid = false; e->key = q->key; e->refs = 1; e->last_use = c->clock;
-		g->entry = slot; g->res = res; g->hit = false;
+		g->entry = slot; g->res = e->res; g->hit = false;
 		memcpy(g->tile, e->tile, sizeof e->tile);
+		granted[k] = true;
 		if (q->key) __atomic_add_fetch(&ctx->stats_misses, 1, __ATOMIC_RELAXED);
 	}
 	pthread_mutex_unlock(&c->mu);
-	if (r != RND_OK) rnd_cache_release(ctx, out, done, false);
+	return RND_OK;
+fail:
+	pthread_mutex_unlock(&c->mu);
+	for (uint32_t k = 0; k < n; k++)
+		if (granted[k]) rnd_cache_release(ctx, &out[k], 1, false);
 	return r;
 }
 
