@@ -39,17 +39,28 @@ enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, ui
 		float dir[3];
 		if (!rnd_v3_normalize(dir, cam->fit_direction))
 			return rnd_fail(err, RND_ERR_INVALID, "camera fit direction must not be zero");
-		float c[3] = {0, 0, 0}, r = 1.0f;
-		if (!empty) {
-			float d[3];
-			for (int i = 0; i < 3; i++) c[i] = 0.5f * (bounds->min[i] + bounds->max[i]);
-			rnd_v3_sub(d, bounds->max, bounds->min);
-			r = fmaxf(0.5f * rnd_v3_length(d), 1e-3f);
+		/* Tight fit: aim at the bounds' centre along `dir`, then back off until every corner
+		 * of the box projects inside the frame less the margin (margin = fraction of the frame
+		 * on each side), so the widest corner touches the margin. */
+		float c[3] = {0, 0, 0};
+		struct rnd_aabb b = {{-1, -1, -1}, {1, 1, 1}};
+		if (!empty) b = *bounds;
+		for (int i = 0; i < 3; i++) c[i] = 0.5f * (b.min[i] + b.max[i]);
+		float eye0[3], basis[16];
+		for (int i = 0; i < 3; i++) eye0[i] = c[i] - dir[i];
+		rnd_mat4_look_at(basis, eye0, c, cam->up);
+		float shrink = fmaxf(1.0f - 2.0f * cam->fit_margin, 0.05f);
+		float ty = tanf(0.5f * out->fov_y) * shrink, tx = tanf(0.5f * out->fov_y) * out->aspect * shrink;
+		float dist = 1e-3f;
+		for (int i = 0; i < 8; i++) {
+			float p[3] = {i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]};
+			float q[3], rel[3];
+			rnd_v3_sub(rel, p, c);
+			rnd_mat4_mul_dir(q, basis, rel);     /* view axes: x right, y up, -z forward */
+			float z = -q[2];                     /* along the view direction */
+			dist = fmaxf(dist, fabsf(q[0]) / tx - z);
+			dist = fmaxf(dist, fabsf(q[1]) / ty - z);
 		}
-		float margin = cam->fit_margin;
-		float half = 0.5f * out->fov_y * (1.0f - 2.0f * margin);
-		float half_x = atanf(tanf(half) * fminf(out->aspect, 1.0f));
-		float dist = r / sinf(fminf(half, half_x));
 		for (int i = 0; i < 3; i++) { target[i] = c[i]; pos[i] = c[i] - dir[i] * dist; }
 		out->ortho = false;
 	}

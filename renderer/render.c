@@ -456,6 +456,13 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	const struct rnd_texture *tex[UMBRA_MAX_TEXTURES];
 	uint32_t ntex = 0;
 	if ((r = upload(ctx, s, sc, draws, &bounds, err)) != RND_OK) goto done;
+	/* Auto-framing `fit: objects` leaves out planes and shadow catchers (the ground). */
+	struct rnd_aabb obj_bounds;
+	rnd_aabb_empty(&obj_bounds);
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		if (sc->objects[i].shape != RND_SHAPE_PLANE && !(draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER))
+			rnd_aabb_union(&obj_bounds, &draws[i].bounds);
+	if (rnd_aabb_is_empty(&obj_bounds)) obj_bounds = bounds;
 	if ((r = textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;
 	tm.upload_ms = now_ms() - t0;
 
@@ -494,7 +501,17 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 
 	for (uint32_t v = 0; v < nviews; v++) {
 		const struct rnd_camera *camera = sc->view_count ? &sc->views[v] : &sc->camera;
-		if ((r = rnd_camera_plan(camera, sc->width, sc->height, &bounds, &cam, err)) != RND_OK) goto done;
+		if ((r = rnd_camera_plan(camera, sc->width, sc->height, camera->fit == RND_FIT_OBJECTS ? &obj_bounds : &bounds,
+		                         &cam, err)) != RND_OK)
+			goto done;
+		if (camera->fit == RND_FIT_OBJECTS) {
+			/* Framed on the objects, but near/far must still hold the whole scene. */
+			struct rnd_camera c2 = *camera;
+			memcpy(c2.position, cam.pos, sizeof cam.pos);
+			for (int k = 0; k < 3; k++) c2.target[k] = cam.pos[k] + cam.fwd[k];
+			c2.fit = RND_FIT_NONE;
+			if ((r = rnd_camera_plan(&c2, sc->width, sc->height, &bounds, &cam, err)) != RND_OK) goto done;
+		}
 		for (uint32_t i = 0; i < sc->object_count; i++)
 			draws[i].cull_back = draws[i].single_sided ||
 			                     (draws[i].closed && record_camera_outside(&cam, &draws[i].bounds));
