@@ -76,7 +76,8 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 /* Fills the uniform/storage regions and points the slot's descriptor set at them. */
 static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                     const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                    const struct rnd_texture *const *tex, uint32_t ntex, struct rnd_error *err)
+                                    const struct rnd_texture *const *tex, uint32_t ntex, float exposure,
+                                    struct rnd_error *err)
 {
 	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
 	if (ctx->props.limits.minUniformBufferOffsetAlignment > al) al = ctx->props.limits.minUniformBufferOffsetAlignment;
@@ -106,7 +107,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		f->ambient_sky[k] = sc->environment.ambient_sky[k] * sc->environment.ambient_intensity;
 		f->ambient_ground[k] = sc->environment.ambient_ground[k] * sc->environment.ambient_intensity;
 	}
-	f->params[0] = exp2f(sc->camera.exposure);
+	f->params[0] = exp2f(exposure);
 	f->params[1] = cam->znear;
 	f->params[2] = cam->zfar;
 	f->mode[0] = sc->output.tonemap == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES
@@ -476,7 +477,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	VkDeviceSize rb = color_bytes + (VkDeviceSize)passes * UMBRA_AOV_ATTACHMENTS * att_bytes;
 	if ((r = rnd_buffer_reserve(ctx, &s->readback, rb, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "slot readback", err)) != RND_OK)
 		goto done;
-	if (nviews > 1) memset(s->readback.map, 0, color_bytes); /* unused cells of the sheet */
+	if (nviews > 1) memset(s->readback.map, 0, rb); /* unused cells of the sheet (colour and AOVs) */
 
 	/* What every spot/point key starts from: the casters' world-space geometry, their
 	 * culling and alpha masks (with texture content), and the scene bounds (far planes). */
@@ -571,7 +572,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 			if (lp->moments && !skip && grants[k].res > max_moment_res) max_moment_res = grants[k].res;
 		}
 		if (max_moment_res && (r = rnd_slot_moments_tmp(ctx, s, max_moment_res, err)) != RND_OK) goto done;
-		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, err)) != RND_OK) goto done;
+		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, camera->exposure, err)) != RND_OK) goto done;
 
 		uint32_t col = v % cols, row = v / cols;
 		VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sheet_w + (VkDeviceSize)col * sc->width);

@@ -13,6 +13,20 @@ echo "== warm process (build/tests/bench)"
 "$BUILD/tests/bench" -n "${BENCH_RUNS:-15}" "$SHARED/bench/thumb-256.json" "$SHARED/bench/thumb-512.json" \
 	"$SHARED/bench/thumb-1024.json" "$SHARED/bench/studio-spots.json" "$SHARED/bench/outdoor-csm.json" "$tmp/mesh-100k.json"
 "$BUILD/tests/bench" -n 5 "$tmp/mesh-1m.json"
+python3 tests/bench/variants.py "$SHARED/bench" "$tmp/v"
+echo
+echo "== shadow filters (thumb-512) and directional modes (outdoor-csm)"
+"$BUILD/tests/bench" -n "${BENCH_RUNS_SMALL:-7}" "$tmp"/v/thumb512-*.json "$tmp"/v/outdoor-*.json
+echo
+echo "== shadowed lights: studio-spots with 1 / 4 / 16 spot+point lights; warm runs reuse cached maps (maps r/k)"
+"$BUILD/tests/bench" -n "${BENCH_RUNS_SMALL:-7}" "$tmp"/v/studio-1lights.json "$tmp"/v/studio-4lights.json "$tmp"/v/studio-16lights.json
+echo
+echo "== 16-frame turntable (one sheet) against one 256x256 view of the same scene"
+"$BUILD/tests/bench" -n 3 "$tmp"/v/studio-single256.json "$tmp"/v/studio-turntable16.json
+echo
+echo "== imported models (binary STL, inline base64): cold import every run, then cached"
+"$BUILD/tests/bench" -n 3 -c "$tmp"/v/model-10k.json "$tmp"/v/model-100k.json "$tmp"/v/model-1m.json
+"$BUILD/tests/bench" -n 3 "$tmp"/v/model-10k.json "$tmp"/v/model-100k.json "$tmp"/v/model-1m.json
 echo
 echo "== cold CLI (new process each: device + pipelines + first-use JIT), thumb-512"
 for i in 1 2 3; do

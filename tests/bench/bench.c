@@ -3,7 +3,7 @@
  * line N times in one process (after one warm-up render) and prints median milliseconds per
  * stage (parse, upload, shadow, main, readback, encode), the median total and images/s.
  *
- *   build/tests/bench [-n N] SCENE.json...
+ *   build/tests/bench [-n N] [-c] SCENE.json...     (-c: import models cold every run)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,7 +52,12 @@ int main(int argc, char **argv)
 {
 	int n = 15;
 	int first = 1;
-	if (argc > 2 && !strcmp(argv[1], "-n")) { n = atoi(argv[2]); first = 3; }
+	int cold_models = 0;   /* -c: no model cache, every run imports its models again */
+	for (;;) {
+		if (argc > first + 1 && !strcmp(argv[first], "-n")) { n = atoi(argv[first + 1]); first += 2; }
+		else if (argc > first && !strcmp(argv[first], "-c")) { cold_models = 1; first += 1; }
+		else break;
+	}
 	if (n < 1) n = 1;
 	struct rnd_context_desc cd = {.slots = 1};
 	struct rnd_context *ctx;
@@ -74,6 +79,7 @@ int main(int argc, char **argv)
 		struct api_limits lim;
 		api_limits_defaults(&lim);
 		lim.max_triangles = 0;
+		if (cold_models) lim.model_cache_bytes = 0;
 		for (int i = -1; i < n && rc == 0; i++) {
 			double t0 = now_ms();
 			struct api_scene *s;

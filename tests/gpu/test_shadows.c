@@ -195,6 +195,25 @@ TEST(shadow_analytic_cascades_pcf)
 	sun_cases("'filter':'pcf','pcf_radius':1,'directional':{'mode':'cascades'}", "cascades/pcf1", false, __LINE__);
 }
 
+TEST(shadow_analytic_clipmap_hard)
+{
+	sun_cases("'filter':'hard','directional':{'mode':'clipmap','clipmap_levels':4,'clipmap_extent':4}", "clipmap/hard",
+	          false, __LINE__);
+}
+
+TEST(shadow_analytic_clipmap_pcf)
+{
+	sun_cases("'filter':'pcf','pcf_radius':1,'directional':{'mode':'clipmap'}", "clipmap/pcf1", false, __LINE__);
+}
+
+TEST(shadow_analytic_cascades_blend_fade)
+{
+	/* A wide blend band and a fade that starts beyond the scene: blending two cascades of the
+	 * same geometry must not move the shadow. */
+	sun_cases("'filter':'pcf','pcf_radius':1,'directional':{'mode':'cascades','blend':0.5,'max_distance':60,'fade':0.1}",
+	          "cascades/pcf1 blend 0.5", false, __LINE__);
+}
+
 TEST(shadow_analytic_ortho_camera)
 {
 	sun_cases("'filter':'hard','directional':{'mode':'fit'}", "ortho fit/hard", true, __LINE__);

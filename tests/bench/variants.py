@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""Writes the benchmark's scene variants into DIR: thumb-512 with each shadow filter,
+outdoor-csm with each directional mode, studio-spots with 1/4/16 shadowed lights, models of
+10k/100k/1M triangles (binary STL, base64 inline), and a 16-frame turntable.
+Usage: variants.py SHARED_BENCH_DIR OUT_DIR"""
+import base64, copy, json, math, os, struct, sys
+
+src, out = sys.argv[1], sys.argv[2]
+os.makedirs(out, exist_ok=True)
+load = lambda n: json.load(open(os.path.join(src, n)))
+def save(name, doc):
+    with open(os.path.join(out, name), "w") as f:
+        json.dump(doc, f)
+
+thumb = load("thumb-512.json")
+for f in ("hard", "pcf", "pcss", "vsm", "evsm"):
+    d = copy.deepcopy(thumb)
+    d["shadows"] = {"filter": f}
+    if f == "pcss":
+        d["lights"][0]["angular_diameter"] = 2.0
+    save("thumb512-%s.json" % f, d)
+
+outdoor = load("outdoor-csm.json")
+for m in ("fit", "cascades", "clipmap"):
+    d = copy.deepcopy(outdoor)
+    d["lights"][0].setdefault("shadow", {}).setdefault("directional", {})["mode"] = m
+    save("outdoor-%s.json" % m, d)
+
+studio = load("studio-spots.json")
+shadowed = [i for i, l in enumerate(studio["lights"]) if l.get("shadow", True) is not False]
+for n in (1, 4, 16):
+    d = copy.deepcopy(studio)
+    lights = [l for l in d["lights"] if l["type"] != "directional"]
+    while len(lights) < n:
+        l = copy.deepcopy(lights[len(lights) % max(1, len(lights))])
+        if "position" in l:
+            l["position"] = [l["position"][0] + 0.37 * len(lights), l["position"][1], l["position"][2] - 0.21 * len(lights)]
+        lights.append(l)
+    d["lights"] = lights[:n]
+    save("studio-%dlights.json" % n, d)
+
+def sphere_stl(tris):
+    seg = max(8, int(math.sqrt(tris / 2)))
+    rows, cols = seg, seg
+    pts = lambda i, j: (math.sin(math.pi * i / rows) * math.cos(2 * math.pi * j / cols),
+                        math.cos(math.pi * i / rows), math.sin(math.pi * i / rows) * math.sin(2 * math.pi * j / cols))
+    body = bytearray()
+    count = 0
+    for i in range(rows):
+        for j in range(cols):
+            a, b, c, e = pts(i, j), pts(i, j + 1), pts(i + 1, j), pts(i + 1, j + 1)
+            for t in ((a, b, c), (b, e, c)):
+                body += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *p) for p in t) + b"\0\0"
+                count += 1
+    return b"\0" * 80 + struct.pack("<I", count) + bytes(body)
+
+for n, label in ((10000, "10k"), (100000, "100k"), (1000000, "1m")):
+    d = {"width": 512, "height": 512,
+         "camera": {"fit": "objects", "direction": [-1, -0.6, -1], "margin": 0.1},
+         "objects": [{"shape": "plane", "size": [20, 20], "transform": {"translation": [0, -1, 0]}},
+                     {"shape": "model", "format": "stl", "data": base64.b64encode(sphere_stl(n)).decode()}],
+         "lights": [{"type": "directional", "direction": [-0.5, -1, -0.3]}]}
+    save("model-%s.json" % label, d)
+
+d = copy.deepcopy(studio)
+d["turntable"] = {"frames": 16, "elevation": 25}
+d.pop("camera", None)
+d["width"], d["height"] = 256, 256
+save("studio-turntable16.json", d)
+d = copy.deepcopy(studio)
+d["width"], d["height"] = 256, 256
+save("studio-single256.json", d)
