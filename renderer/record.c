@@ -273,9 +273,12 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 		                        &s->texture_sets[d->texture_set], 0, NULL);
 		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
 	}
-	for (uint32_t i = 0; i < ndraw; i++) {
+	/* Closed primitives first, open surfaces (planes, meshes) after: what a ground plane
+	 * hides behind objects then fails the early depth test instead of being shaded. */
+	for (uint32_t k = 0; k < 2 * ndraw; k++) {
+		uint32_t i = k % ndraw;
 		const struct draw *d = &draws[i];
-		if (!d->index_count) continue;
+		if (!d->index_count || d->closed != (k < ndraw)) continue;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
 		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};

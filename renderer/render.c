@@ -82,8 +82,9 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
 	if (ctx->props.limits.minUniformBufferOffsetAlignment > al) al = ctx->props.limits.minUniformBufferOffsetAlignment;
 	uint32_t nmat = sc->material_count ? sc->material_count : 1;
-	uint32_t nlight = sc->light_count ? sc->light_count : 1;
-	uint32_t nview = sp->view_count ? sp->view_count : 1;
+	/* Lights and views are uniform blocks of their declared (maximum) size. */
+	uint32_t nlight = UMBRA_MAX_LIGHTS;
+	uint32_t nview = UMBRA_MAX_SHADOW_VIEWS;
 	VkDeviceSize off_frame = 0;
 	VkDeviceSize off_mat = align_up(sizeof(struct umbra_frame), al);
 	VkDeviceSize off_light = align_up(off_mat + nmat * sizeof(struct umbra_material), al);
@@ -213,7 +214,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		w[i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
 			.descriptorCount = 1,
-			.descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+			.descriptorType = i == 0 || i == 2 || i == 3 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
 			                : i == 4 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};

@@ -47,8 +47,8 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		RND_NAME(ctx, VK_OBJECT_TYPE_QUERY_POOL, s->queries, "slot %u timestamps", index);
 	}
 	VkDescriptorPoolSize sizes[3] = {
-		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3},
+		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
+		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
 		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2},
 	};
 	VkDescriptorPoolCreateInfo dpi = {

@@ -10,8 +10,10 @@
 
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock { umbra_frame frame; };
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonly buffer Materials { umbra_material materials[]; };
-layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_LIGHTS) readonly buffer Lights { umbra_light lights[]; };
-layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) readonly buffer Views { umbra_shadow_view views[]; };
+// Lights and shadow views are uniform blocks: every lane reads the same entry, which lavapipe
+// turns into one broadcast load (storage-buffer loads are gathered lane by lane).
+layout(std140, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_LIGHTS) uniform Lights { umbra_light lights[UMBRA_MAX_LIGHTS]; };
+layout(std140, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) uniform Views { umbra_shadow_view views[UMBRA_MAX_SHADOW_VIEWS]; };
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2D shadow_atlas;
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2D moment_atlas;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
@@ -188,12 +190,12 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 	float res = v.rect.z;
 	// Normal offset: move the lookup point along the normal by a few texels (world units at
 	// this point), more at grazing angles where acne appears first.
+	// lc = M (pos + n o) = M pos + (M n) o: one full transform and one of the normal.
 	vec4 lc0 = v.view_proj * vec4(pos, 1.0);
 	float dist = v.params.y > 0.5 ? max(lc0.w, 1e-4) : 1.0;
 	float texel = v.params.x * dist;
 	float ndl = clamp(dot(n, to_light), 0.0, 1.0);
-	vec3 p = pos + n * (L.shadow_params.x * texel * (1.0 - 0.5 * ndl));
-	vec4 lc = v.view_proj * vec4(p, 1.0);
+	vec4 lc = lc0 + (v.view_proj * vec4(n, 0.0)) * (L.shadow_params.x * texel * (1.0 - 0.5 * ndl));
 	vec3 sc = lc.xyz / lc.w;
 	if (sc.z > 1.0) return 1.0;            // beyond the light's far plane: nothing recorded there
 	if (any(greaterThan(abs(sc.xy), vec2(1.0)))) return 1.0;   // outside this view: nothing casts
@@ -202,11 +204,10 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 	float ref = clamp(sc.z, 0.0, 1.0);     // depth clamp: casters before the near plane pancake to 0
 	vec4 rect = v.rect;
 	uint filt = L.shadow.z;
-	vec2 grad = receiver_gradient(v, n, res);
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, rect, ref, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, receiver_gradient(v, n, res));
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, rect, ref);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, rect, ref, res, int(L.shadow.w), grad);
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, rect, ref, res, int(L.shadow.w), receiver_gradient(v, n, res));
 	return 1.0;
 }
 

@@ -12,8 +12,8 @@
 #define UMBRA_SET_FRAME              0
 #define UMBRA_BINDING_FRAME          0  /* uniform  umbra_frame */
 #define UMBRA_BINDING_MATERIALS      1  /* storage  umbra_material[] */
-#define UMBRA_BINDING_LIGHTS         2  /* storage  umbra_light[] */
-#define UMBRA_BINDING_SHADOW_VIEWS   3  /* storage  umbra_shadow_view[] */
+#define UMBRA_BINDING_LIGHTS         2  /* uniform  umbra_light[UMBRA_MAX_LIGHTS] */
+#define UMBRA_BINDING_SHADOW_VIEWS   3  /* uniform  umbra_shadow_view[UMBRA_MAX_SHADOW_VIEWS] */
 #define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2D, the depth atlas: one tile per shadow view */
 #define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
 #define UMBRA_BINDING_COUNT          6
