@@ -223,6 +223,9 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
 	for (int k = 0; k < 3; k++) clear.float32[k] = linear ? bg[k] : srgb_encode(bg[k]);
 	clear.float32[3] = sc->output.transparent ? 0.0f : bg[3];
+	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
+	 * colour at edges (render.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
+	if (sc->output.transparent) clear.float32[0] = clear.float32[1] = clear.float32[2] = 0.0f;
 	if (sc->output.debug == RND_DEBUG_SHADOW) clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
 
 	VkRenderingAttachmentInfo ca = {

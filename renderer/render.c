@@ -389,6 +389,33 @@ static enum rnd_result split_aovs(const struct rnd_scene *sc, const float *rb, s
 	return RND_OK;
 }
 
+/* 8/16-bit outputs with transparency: straight alpha (PNG's convention) from the premultiplied
+ * resolve. RGBA32F (EXR) stays premultiplied, as EXR expects. */
+static void unpremultiply(void *pixels, uint64_t n, enum rnd_pixel_format f)
+{
+	if (f == RND_PIXELS_RGBA8) {
+		uint8_t *p = pixels;
+		for (uint64_t i = 0; i < n; i++, p += 4) {
+			unsigned a = p[3];
+			if (a == 0 || a == 255) continue;
+			for (int k = 0; k < 3; k++) {
+				unsigned v = (p[k] * 255u + a / 2) / a;
+				p[k] = (uint8_t)(v > 255 ? 255 : v);
+			}
+		}
+	} else if (f == RND_PIXELS_RGBA16) {
+		uint16_t *p = pixels;
+		for (uint64_t i = 0; i < n; i++, p += 4) {
+			uint32_t a = p[3];
+			if (a == 0 || a == 65535) continue;
+			for (int k = 0; k < 3; k++) {
+				uint32_t v = (p[k] * 65535u + a / 2) / a;
+				p[k] = (uint16_t)(v > 65535 ? 65535 : v);
+			}
+		}
+	}
+}
+
 static enum rnd_result submit_and_wait(struct rnd_context *ctx, struct rnd_slot *s, struct rnd_timings *tm,
                                        struct rnd_error *err)
 {
@@ -616,6 +643,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if (!out->pixels) { r = rnd_fail(err, RND_ERR_OOM, "out of memory for a %llux%llu image",
 	                                 (unsigned long long)sheet_w, (unsigned long long)sheet_h); goto done; }
 	memcpy(out->pixels, s->readback.map, color_bytes);
+	if (sc->output.transparent && sc->output.debug == RND_DEBUG_NONE) unpremultiply(out->pixels, sheet_w * sheet_h, sc->output.pixels);
 	out->width = (uint32_t)sheet_w;
 	out->height = (uint32_t)sheet_h;
 	out->format = sc->output.pixels;

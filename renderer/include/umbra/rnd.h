@@ -173,7 +173,8 @@ enum rnd_aov {
 
 struct rnd_output {
 	enum rnd_pixel_format pixels; /* RGBA8 */
-	bool transparent;     /* background alpha 0 */
+	bool transparent;     /* background (0,0,0,0); RGBA8/16 come back with straight alpha,
+	                         RGBA32F premultiplied (as PNG and EXR expect) */
 	enum rnd_tonemap tonemap;
 	uint32_t msaa;        /* 1 or 4 (default 4) */
 	uint32_t aovs;        /* enum rnd_aov mask */
