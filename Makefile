@@ -47,7 +47,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench clean
+.PHONY: all deps run test test-asan bench fuzz clean
 all: $(BINS)
 
 deps:
@@ -105,6 +105,13 @@ $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
+
+# libFuzzer target for the scene parser (clang): build/fuzz/fuzz_scene tests/fuzz/corpus
+fuzz:
+	@$(MAKE) --no-print-directory BUILD=build/fuzz CC=clang OPT=-O1 \
+	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a
+	clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
+	  -o build/fuzz/fuzz_scene tests/fuzz/fuzz_scene.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS)
 
 clean:
 	rm -rf $(BUILD)

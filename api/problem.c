@@ -53,10 +53,13 @@ enum api_result api_problem_set(struct api_problem *p, int status, const char *p
 		copy_str(p->title, sizeof p->title, status >= 500 ? "Server error" : "Request error");
 	}
 	copy_str(p->pointer, sizeof p->pointer, pointer);
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(p->detail, sizeof p->detail, fmt ? fmt : "", ap);
-	va_end(ap);
+	p->detail[0] = '\0';
+	if (fmt) {
+		va_list ap;
+		va_start(ap, fmt);
+		vsnprintf(p->detail, sizeof p->detail, fmt, ap);
+		va_end(ap);
+	}
 	return API_ERR;
 }
 

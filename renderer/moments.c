@@ -30,7 +30,7 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 	vkGetPhysicalDeviceFeatures(ctx->phys, &f);
 	m->fp32 = format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) && f.shaderStorageImageExtendedFormats;
 	m->available = f.shaderStorageImageWriteWithoutFormat && f.shaderStorageImageExtendedFormats &&
-	               format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) | format_ok(ctx, VK_FORMAT_R16G16_SFLOAT);
+	               (format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) || format_ok(ctx, VK_FORMAT_R16G16_SFLOAT));
 	VkDescriptorSetLayoutBinding b[3] = {
 		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_TMP, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},

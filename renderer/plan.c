@@ -210,6 +210,27 @@ static float max_dist(const float p[3], const struct rnd_aabb *b)
 	return sqrtf(d2);
 }
 
+/* Tile size of a spot or point light with no resolution of its own: by importance, here the
+ * share of the view its lit region covers (range, else the scene's extent from the light).
+ * A light filling the view gets 2048 (spot) or 1024 per cube face, a small one down to 256,
+ * so many small lights share the atlas and a large one gets resolution. */
+static uint32_t light_importance_res(const struct rnd_light *L, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
+{
+	float reach = max_dist(L->position, b);
+	if (L->range > 0 && L->range < reach) reach = L->range;
+	if (L->type == RND_LIGHT_SPOT) reach *= fminf(sinf(fminf(L->outer_angle, 1.5f)) + 0.25f, 1.0f);
+	float d[3];
+	rnd_v3_sub(d, L->position, cam->pos);
+	float dist = rnd_v3_length(d);
+	float frac;
+	if (cam->ortho) frac = reach / fmaxf(0.5f * cam->ortho_height, 1e-6f);
+	else frac = dist <= reach ? 1.0f : tanf(asinf(reach / dist)) / tanf(0.5f * cam->fov_y);
+	frac = fminf(fmaxf(frac, 0.0f), 1.0f);
+	float top = L->type == RND_LIGHT_SPOT ? 2048.0f : 1024.0f;
+	float want = fmaxf(top * frac, 256.0f);
+	return (uint32_t)want;
+}
+
 static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
 {
 	if (s->dir_mode == RND_DIR_CASCADES) return true;
@@ -241,7 +262,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 		/* Tile size: the light's resolution rounded up to a power of two (atlas tiles), else
 		 * by type: a sun map covers the whole view, a spot cone less, a cube face a sixth. */
 		uint32_t want = s->resolution ? s->resolution
-		              : L->type == RND_LIGHT_DIRECTIONAL ? (uint32_t)DEFAULT_RES : L->type == RND_LIGHT_SPOT ? 1024 : 512;
+		              : L->type == RND_LIGHT_DIRECTIONAL ? (uint32_t)DEFAULT_RES : light_importance_res(L, bounds, cam);
 		uint32_t res = 64;
 		while (res < want && res < 8192) res *= 2;
 		lp->resolution = res;

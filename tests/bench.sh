@@ -18,6 +18,9 @@ echo
 echo "== shadow filters (thumb-512) and directional modes (outdoor-csm)"
 "$BUILD/tests/bench" -n "${BENCH_RUNS_SMALL:-7}" "$tmp"/v/thumb512-*.json "$tmp"/v/outdoor-*.json
 echo
+echo "== outputs: encode cost per format and size (encode column)"
+"$BUILD/tests/bench" -n 3 "$tmp"/v/out-*.json
+echo
 echo "== shadowed lights: studio-spots with 1 / 4 / 16 spot+point lights; warm runs reuse cached maps (maps r/k)"
 "$BUILD/tests/bench" -n "${BENCH_RUNS_SMALL:-7}" "$tmp"/v/studio-1lights.json "$tmp"/v/studio-4lights.json "$tmp"/v/studio-16lights.json
 echo

@@ -20,6 +20,15 @@ for f in ("hard", "pcf", "pcss", "vsm", "evsm"):
         d["lights"][0]["angular_diameter"] = 2.0
     save("thumb512-%s.json" % f, d)
 
+# Outputs: encode cost per format and size.
+for size in (256, 512, 1024):
+    for fmt, extra in (("png8", {"format": "png"}), ("png16", {"format": "png", "bit_depth": 16}),
+                       ("exr", {"format": "exr"}), ("exr-aovs", {"format": "exr", "aovs": ["shadow", "depth", "normal", "albedo"]})):
+        d = copy.deepcopy(thumb)
+        d["width"] = d["height"] = size
+        d["output"] = extra
+        save("out-%d-%s.json" % (size, fmt), d)
+
 outdoor = load("outdoor-csm.json")
 for m in ("fit", "cascades", "clipmap"):
     d = copy.deepcopy(outdoor)

@@ -1,6 +1,7 @@
 /* tests — renderer/plan.c: camera planning, cascade splits, shadow views (fit, cascades, spot,
  * point cube faces) and frustum culling, checked against values computed here independently. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "test.h"
 #include "plan.h"
@@ -519,9 +520,13 @@ TEST(plan_shadow_limits_and_errors)
 	lights[0].shadow.resolution = 512; lights[1].shadow.resolution = 4096;
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.resolution == 4096, "resolution %u", sp.resolution);
 	lights[0].shadow.resolution = 0; lights[1].shadow.resolution = 0;
-	/* Defaults by type: a cube face of a point light is 512 (the sun's map 2048, a spot 1024). */
-	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.resolution == 512 && sp.lights[0].resolution == 512,
-	      "default point resolution %u", sp.resolution);
+	/* Without a resolution, a point light's face size follows its share of the view: between
+	 * 256 and 1024, a power of two, and a light whose lit region fills the view gets 1024. */
+	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK, "%s", err.msg);
+	for (uint32_t i = 0; i < 2; i++) {
+		uint32_t r = sp.lights[i].resolution;
+		CHECK(r >= 256 && r <= 1024 && (r & (r - 1)) == 0, "light %u: face size %u", i, r);
+	}
 	/* A resolution that is not a power of two rounds up to the next tile size. */
 	lights[0].shadow.resolution = 1000;
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.lights[0].resolution == 1024,
@@ -755,4 +760,32 @@ TEST(plan_camera_fit_frames_bounds)
 	struct rnd_camera_plan cp;
 	struct rnd_error err = {0};
 	CHECK(rnd_camera_plan(&cam, 512, 512, &b, &cp, &err) == RND_ERR_INVALID, "zero fit direction must fail");
+}
+
+TEST(plan_light_importance_sets_tile_size)
+{
+	/* Two point lights without a resolution: one whose lit region fills the view, one small
+	 * (range 0.3 m) far from the camera. The first gets the largest face, the second the least. */
+	struct rnd_scene sc;
+	rnd_scene_defaults(&sc);
+	struct rnd_light lights[2];
+	rnd_light_defaults(&lights[0], RND_LIGHT_POINT);
+	rnd_light_defaults(&lights[1], RND_LIGHT_POINT);
+	lights[0].position[0] = 0; lights[0].position[1] = 2; lights[0].position[2] = 0;
+	lights[1].position[0] = 40; lights[1].position[1] = 1; lights[1].position[2] = -40;
+	lights[1].range = 0.3f;
+	sc.lights = lights;
+	sc.light_count = 2;
+	struct rnd_aabb b = {{-50, 0, -50}, {50, 5, 50}};
+	struct rnd_camera cam = sc.camera;
+	cam.position[0] = 0; cam.position[1] = 3; cam.position[2] = 8;
+	cam.target[0] = 0; cam.target[1] = 0; cam.target[2] = 0;
+	struct rnd_camera_plan cp;
+	struct rnd_shadow_plan *sp = calloc(1, sizeof *sp);
+	struct rnd_error err = {0};
+	REQUIRE(sp && rnd_camera_plan(&cam, 512, 512, &b, &cp, &err) == RND_OK, "camera: %s", err.msg);
+	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
+	CHECK(sp->lights[0].resolution == 1024, "near light face %u", sp->lights[0].resolution);
+	CHECK(sp->lights[1].resolution == 256, "small far light face %u", sp->lights[1].resolution);
+	free(sp);
 }
