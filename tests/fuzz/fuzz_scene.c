@@ -2,7 +2,8 @@
  * tests/fuzz/fuzz_scene.c — libFuzzer target for the scene parser (api_scene_parse): any
  * bytes must give either a scene or a problem with a status, never a crash, a leak or UB.
  *
- *   make fuzz && build/fuzz/fuzz_scene -max_total_time=60 tests/fuzz/corpus
+ *   make fuzz && mkdir -p build/fuzz/corpus && build/fuzz/fuzz_scene -max_total_time=60 build/fuzz/corpus tests/fuzz/corpus
+ *   (new inputs go to the first directory; tests/fuzz/corpus holds the seeds)
  */
 #include <stdint.h>
 #include <stdlib.h>
