@@ -64,6 +64,8 @@ struct api_scene {
 	uint32_t bit_depth;         /* 8 or 16 (png) */
 	int png_level;              /* zlib level for PNG, -1 = chosen by image size */
 	uint64_t triangles;         /* total after tessellation */
+	uint64_t asset_hash;        /* hash of files read under the asset root (`path` models), 0 = none:
+	                               the answer depends on them, so caches and ETags must too */
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;

@@ -40,6 +40,7 @@ struct pctx {
 	struct api_arena *arena;
 	struct api_problem *p;
 	const struct api_limits *lim;
+	uint64_t asset_hash;          /* FNV-1a of every file read under the asset root */
 	char ptr[sizeof(((struct api_problem *)0)->pointer)];
 	size_t len;
 	/* The first deferred 422 (limit or unsupported feature). */
@@ -804,6 +805,14 @@ static int read_asset(struct pctx *c, const char *path, unsigned char **out, siz
 	close(fd);
 	*out = buf;
 	*len = buf ? (size_t)st.st_size : 0;
+	/* The answer depends on the file, not only on the request: fold its bytes (and name)
+	 * into the scene's asset hash so the server's ETag changes when the file does. */
+	if (buf) {
+		uint64_t h = c->asset_hash ? c->asset_hash : 0xcbf29ce484222325ull;
+		for (const char *q = path; *q; q++) h = (h ^ (unsigned char)*q) * 0x100000001b3ull;
+		for (size_t i = 0; i < *len; i++) h = (h ^ buf[i]) * 0x100000001b3ull;
+		c->asset_hash = h;
+	}
 	return rc;
 }
 
@@ -1415,28 +1424,6 @@ static void objects_sphere(const struct rnd_scene *sc, const struct rnd_material
 	*radius = fmax(0.5 * sqrt(d2), 1e-3);
 }
 
-/* Places a camera of fit "objects" from the bounds computed here (the renderer's fit frames the
- * whole scene bounds, planes included): perspective, looking along fit_direction at the bounds
- * centre from where the bounding sphere fills the frame up to fit_margin (the same rule as the
- * renderer's fit, renderer/plan.c). fit becomes NONE; fit_direction and fit_margin stay. */
-static void resolve_fit_objects(struct rnd_camera *cam, const double centre[3], double r, uint32_t width,
-                                uint32_t height)
-{
-	double d[3] = {cam->fit_direction[0], cam->fit_direction[1], cam->fit_direction[2]};
-	double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-	if (!(len > 0)) return; /* the parser never lets a zero direction through */
-	double fov = cam->fov_y > 0 ? cam->fov_y : 45.0 * DEG2RAD;
-	double aspect = (double)width / height, half = 0.5 * fov * (1.0 - 2.0 * cam->fit_margin);
-	double half_x = atan(tan(half) * fmin(aspect, 1.0));
-	double dist = r / sin(fmin(half, half_x));
-	for (int i = 0; i < 3; i++) {
-		cam->target[i] = (float)centre[i];
-		cam->position[i] = (float)(centre[i] - d[i] / len * dist);
-	}
-	cam->type = RND_CAMERA_PERSPECTIVE;
-	cam->fov_y = (float)fov;
-	cam->fit = RND_FIT_NONE;
-}
 
 /* The turntable's cameras: frame k looks at the objects' bounds centre from azimuth 360°·k/N
  * (frame 0 on +Z, then counter-clockwise seen from above, i.e. towards +X) at the elevation,
@@ -1623,19 +1610,8 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		if (c->models && expand_models(c, objs, models, sc) < 0) return -1;
 	}
 	if (tt.frames && turntable_views(c, &tt, sc) < 0) return -1;
-	{
-		bool any = sc->camera.fit == RND_FIT_OBJECTS;
-		for (uint32_t i = 0; i < sc->view_count && !tt.frames; i++) any |= sc->views[i].fit == RND_FIT_OBJECTS;
-		if (any) {
-			double centre[3], r;
-			objects_sphere(sc, c->mats, centre, &r);
-			if (sc->camera.fit == RND_FIT_OBJECTS) resolve_fit_objects(&sc->camera, centre, r, sc->width, sc->height);
-			for (uint32_t i = 0; i < sc->view_count && !tt.frames; i++)
-				if (sc->views[i].fit == RND_FIT_OBJECTS)
-					resolve_fit_objects((struct rnd_camera *)&sc->views[i], centre, r, sc->width, sc->height);
-		}
-	}
-
+	/* `fit` (scene or objects) stays for the renderer: it frames the bounds tightly to the
+	 * margin, leaving planes and shadow catchers out for `objects`. */
 	struct rnd_shadow root_shadow;
 	rnd_shadow_defaults(&root_shadow);
 	json_t *shj = json_object_get(root, "shadows");
@@ -1788,6 +1764,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 		return API_ERR;
 	}
 	s->models_ = c.models;
+	s->asset_hash = c.asset_hash;
 	*out = s;
 	return API_OK;
 }

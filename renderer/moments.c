@@ -132,6 +132,7 @@ void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struc
 			struct rnd_moments_push push = {
 				.info = {(uint32_t)rect[0], (uint32_t)rect[1], pass, (uint32_t)ceilf(blur)},
 				.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), (float)res, 0},
+				.proj = {sp->views[v].params[2], sp->views[v].params[3], sp->views[v].params[1], 0},
 			};
 			vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
 			vkCmdDispatch(cmd, groups, groups, 1);

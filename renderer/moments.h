@@ -12,6 +12,7 @@
 struct rnd_moments_push {
 	uint32_t info[4];   /* tile x, tile y, pass, blur radius */
 	float params[4];    /* EVSM exponent (0 = VSM), Gaussian sigma, tile size */
+	float proj[4];      /* near, far, 1 = perspective */
 };
 
 enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err);

@@ -212,7 +212,8 @@ static float max_dist(const float p[3], const struct rnd_aabb *b)
 
 /* Tile size of a spot or point light with no resolution of its own: by importance, here the
  * share of the view its lit region covers (range, else the scene's extent from the light).
- * A light filling the view gets 2048 (spot) or 1024 per cube face, a small one down to 256,
+ * A light filling the view gets 1024 (spot) or 512 per cube face (six of them), a small one
+ * down to 256 (an explicit `resolution` asks for more),
  * so many small lights share the atlas and a large one gets resolution. */
 static uint32_t light_importance_res(const struct rnd_light *L, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
 {
@@ -226,7 +227,7 @@ static uint32_t light_importance_res(const struct rnd_light *L, const struct rnd
 	if (cam->ortho) frac = reach / fmaxf(0.5f * cam->ortho_height, 1e-6f);
 	else frac = dist <= reach ? 1.0f : tanf(asinf(reach / dist)) / tanf(0.5f * cam->fov_y);
 	frac = fminf(fmaxf(frac, 0.0f), 1.0f);
-	float top = L->type == RND_LIGHT_SPOT ? 2048.0f : 1024.0f;
+	float top = L->type == RND_LIGHT_SPOT ? 1024.0f : 512.0f;
 	float want = fmaxf(top * frac, 256.0f);
 	return (uint32_t)want;
 }

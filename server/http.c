@@ -361,7 +361,7 @@ static void suspend_before_push(struct srv_request *req)
 	MHD_suspend_connection(req->conn);
 }
 
-static bool etag_matches(const char *inm, const char *etag)
+bool srv_etag_matches(const char *inm, const char *etag)
 {
 	if (!inm)
 		return false;
@@ -511,7 +511,12 @@ static enum MHD_Result render_body_done(struct srv_request *req, struct MHD_Conn
 	h = fnv1a(h, s->info.driver_info, strlen(s->info.driver_info));
 	pthread_rwlock_unlock(&s->ctx_lock);
 	snprintf(req->etag, sizeof req->etag, "\"%016llx\"", (unsigned long long)h);
-	if (etag_matches(MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH), req->etag)) {
+	/* A scene that reads models from --asset-root may change without its body changing: its
+	 * ETag is only known after parsing, so it never gets an early 304. */
+	bool reads_assets = memmem(req->body, req->body_len, "\"path\"", 6) != NULL;
+	const char *inm = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
+	if (reads_assets && inm) snprintf(req->if_none_match, sizeof req->if_none_match, "%s", inm);
+	if (!reads_assets && srv_etag_matches(inm, req->etag)) {
 		srv_metrics_add(s->metrics, SRV_CTR_NOT_MODIFIED, 1);
 		return respond(req, 304, NULL, NULL, 0, NULL);
 	}

@@ -142,6 +142,7 @@ struct srv_request {
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
 	uint64_t body_hash;            /* FNV-1a 64, running */
 	char etag[40];
+	char if_none_match[256];       /* checked after parsing for scenes that read asset files */
 	bool want_exr;                 /* Accept prefers image/x-exr */
 
 	/* result, written by the worker before srv_request_finish() */
@@ -176,5 +177,8 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv);
 /* Small shared helpers (main.c). */
 double srv_now(void);                               /* monotonic seconds */
 void srv_json_escape(char *dst, size_t size, const char *src); /* without the quotes */
+
+/* True when an If-None-Match value lists etag (strong comparison; "*" never matches). */
+bool srv_etag_matches(const char *if_none_match, const char *etag);
 
 #endif

@@ -297,6 +297,15 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 		job_problem(req, &p);
 		return;
 	}
+	if (sc->asset_hash) {
+		/* The image depends on files under --asset-root as well as on the body. */
+		unsigned long long h = strtoull(req->etag + 1, NULL, 16) ^ sc->asset_hash;
+		snprintf(req->etag, sizeof req->etag, "\"%016llx\"", h * 0x100000001b3ull);
+		if (req->if_none_match[0] && srv_etag_matches(req->if_none_match, req->etag)) {
+			req->status = 304;
+			goto out;
+		}
+	}
 	if (req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) {
 		job_problem(req, &p);
 		goto out;

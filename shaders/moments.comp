@@ -11,10 +11,17 @@ layout(set = 0, binding = UMBRA_MOMENTS_BINDING_OUT) writeonly uniform image2D o
 layout(push_constant) uniform Push {
 	uvec4 info;   // x, y: tile offset in the atlas; z pass; w blur radius (texels)
 	vec4 params;  // x exponent (0 = VSM: plain depth), y sigma (texels), z tile size
+	vec4 proj;    // x near, y far, z 1 = perspective view (depth is made linear first)
 } pc;
 
 vec2 to_moments(float d)
 {
+	// Perspective depth crowds near 1: moments of it would have no variance to speak of.
+	// Linear depth over near..far instead (mesh.frag's moments() does the same to its ref).
+	if (pc.proj.z > 0.5) {
+		float n = pc.proj.x, f = pc.proj.y;
+		d = (n * f / (f - d * (f - n)) - n) / (f - n);
+	}
 	if (pc.params.x <= 0.0) return vec2(d, d * d);
 	float e = exp(pc.params.x * d);   // EVSM2: positive exponential warp
 	return vec2(e, e * e);

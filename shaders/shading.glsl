@@ -172,6 +172,7 @@ vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
 float moments(umbra_light L, umbra_shadow_view v, vec2 uv, vec4 rect, float ref)
 {
 	vec2 m = texture(moment_atlas, (rect.xy + clamp(uv * rect.z, vec2(0.5), vec2(rect.z - 0.5))) / rect.w).xy;
+	if (v.params.y > 0.5) ref = (view_distance(v, ref) - v.params.z) / (v.params.w - v.params.z);   // as moments.comp
 	float c = L.moment_params.x;
 	float t = c > 0.0 ? exp(c * ref) : ref;
 	float min_var = c > 0.0 ? L.moment_params.z * c * t * c * t * 1e-4 : L.moment_params.z;

@@ -130,12 +130,29 @@ TEST(outputs_views_sheet_layout)
 TEST(outputs_fit_objects_leaves_planes_out)
 {
 	/* Camera fit "objects" frames the sphere alone (the 10x10 plane is left out): the sphere is
-	 * centred and its bounding sphere (radius sqrt 3) fills the frame up to the margin 0.2. */
+	 * centred and the camera backs off until the corners of its bounding box (half-size 1)
+	 * project inside the frame less the margin 0.2 on each side. */
 	struct rnd_image img;
 	REQUIRE(gpu_render(&img, "{'width':64,'height':64," VIEW_SCENE ",'camera':{'fit':'objects',"
 	                         "'direction':[0.3,-0.4,-1],'margin':0.2,'fov_y':50},'output':{'msaa':1}}"));
 	img.view_columns = img.view_columns ? img.view_columns : 1;
-	double cx, cy, dist = sqrt(3.0) / sin(0.5 * 50 * GPU_DEG * 0.6);
+	double cx, cy, dist = 0;
+	{
+		double d[3] = {0.3, -0.4, -1}, up[3] = {0, 1, 0}, rt[3], u[3];
+		double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+		for (int k = 0; k < 3; k++) d[k] /= dl;
+		rt[0] = d[1] * up[2] - d[2] * up[1]; rt[1] = d[2] * up[0] - d[0] * up[2]; rt[2] = d[0] * up[1] - d[1] * up[0];
+		double rl = sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
+		for (int k = 0; k < 3; k++) rt[k] /= rl;
+		u[0] = rt[1] * d[2] - rt[2] * d[1]; u[1] = rt[2] * d[0] - rt[0] * d[2]; u[2] = rt[0] * d[1] - rt[1] * d[0];
+		double t = tan(25 * GPU_DEG) * (1 - 2 * 0.2);
+		for (int i = 0; i < 8; i++) {
+			double c[3] = {i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1};
+			double x = c[0] * rt[0] + c[1] * rt[1] + c[2] * rt[2], y = c[0] * u[0] + c[1] * u[1] + c[2] * u[2];
+			double z = c[0] * d[0] + c[1] * d[1] + c[2] * d[2];
+			dist = fmax(dist, fmax(fabs(x) / t - z, fabs(y) / t - z));
+		}
+	}
 	double r_px = 32 * tan(asin(1 / dist)) / tan(25 * GPU_DEG), area = GPU_PI * r_px * r_px;
 	int n = red_centroid(&img, 0, &cx, &cy);
 	CHECK(fabs(cx - 32) < 1.0 && fabs(cy - 32) < 1.0 && fabs(n - area) < 0.08 * area,

@@ -279,6 +279,15 @@ c=$(post rexr2 "$T/exr.json"); check "output.format exr: image/x-exr" sh -c "[ $
 c=$(post rpng "$T/small.json" -H 'Accept: image/png, image/x-exr;q=0.5'); check "Accept preferring PNG: image/png" [ "$(hdr rpng Content-Type)" = image/png ]
 c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
 c=$(post mpath "$T/model-path.json"); check "model by path under --asset-root 200" [ "$c" = 200 ]
+# The answer depends on the file under --asset-root: when it changes, so must the ETag, and the
+# old ETag must not earn a 304.
+mtag=$(hdr mpath ETag)
+c=$(post mpath304 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model, same file: 304" [ "$c" = 304 ]
+cp "$T/assets/tri.obj" "$T/tri.obj.orig"
+printf 'v -1 0 -1\nv 1 0 -1\nv 0 0.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
+c=$(post mpath2 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model file changed: 200, not 304" [ "$c" = 200 ]
+check "asset model file changed: other ETag" [ "$(hdr mpath2 ETag)" != "$mtag" ]
+cp "$T/tri.obj.orig" "$T/assets/tri.obj"
 c=$(post mesc "$T/model-escape.json"); check "model path escaping --asset-root 400" [ "$c" = 400 ]
 check "escaping path problem names the member" problem mesc 400 /objects/0/path
 c=$(curl -s --max-time 60 -o "$T/mp.body" -D "$T/mp.hdr" -w '%{http_code}' -F "scene=@$T/model-part.json;type=application/json" \

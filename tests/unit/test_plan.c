@@ -521,11 +521,11 @@ TEST(plan_shadow_limits_and_errors)
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.resolution == 4096, "resolution %u", sp.resolution);
 	lights[0].shadow.resolution = 0; lights[1].shadow.resolution = 0;
 	/* Without a resolution, a point light's face size follows its share of the view: between
-	 * 256 and 1024, a power of two, and a light whose lit region fills the view gets 1024. */
+	 * 256 and 512, a power of two, and a light whose lit region fills the view gets 512. */
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK, "%s", err.msg);
 	for (uint32_t i = 0; i < 2; i++) {
 		uint32_t r = sp.lights[i].resolution;
-		CHECK(r >= 256 && r <= 1024 && (r & (r - 1)) == 0, "light %u: face size %u", i, r);
+		CHECK(r >= 256 && r <= 512 && (r & (r - 1)) == 0, "light %u: face size %u", i, r);
 	}
 	/* A resolution that is not a power of two rounds up to the next tile size. */
 	lights[0].shadow.resolution = 1000;
@@ -785,7 +785,7 @@ TEST(plan_light_importance_sets_tile_size)
 	struct rnd_error err = {0};
 	REQUIRE(sp && rnd_camera_plan(&cam, 512, 512, &b, &cp, &err) == RND_OK, "camera: %s", err.msg);
 	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
-	CHECK(sp->lights[0].resolution == 1024, "near light face %u", sp->lights[0].resolution);
+	CHECK(sp->lights[0].resolution == 512, "near light face %u", sp->lights[0].resolution);
 	CHECK(sp->lights[1].resolution == 256, "small far light face %u", sp->lights[1].resolution);
 	free(sp);
 }
