@@ -12,6 +12,7 @@
 #include "moments.h"
 #include "record.h"
 #include "moments.comp.spv.h"
+#include "tile_copy.comp.spv.h"
 
 static bool format_ok(const struct rnd_context *ctx, VkFormat f)
 {
@@ -31,12 +32,13 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 	m->fp32 = format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) && f.shaderStorageImageExtendedFormats;
 	m->available = f.shaderStorageImageWriteWithoutFormat && f.shaderStorageImageExtendedFormats &&
 	               (format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) || format_ok(ctx, VK_FORMAT_R16G16_SFLOAT));
-	VkDescriptorSetLayoutBinding b[3] = {
+	VkDescriptorSetLayoutBinding b[4] = {
 		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_TMP, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
+		{UMBRA_MOMENTS_BINDING_ATLAS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 	};
-	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 3, .pBindings = b};
+	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 4, .pBindings = b};
 	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &m->set_layout)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (moments)");
 	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, m->set_layout, "moments set layout");
@@ -50,24 +52,30 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 		goto fail;
 	}
 	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, m->layout, "moments pipeline layout");
-	VkShaderModule mod;
-	VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = sizeof spv_moments_comp, .pCode = spv_moments_comp};
-	if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &mod)) != VK_SUCCESS) {
-		rnd_fail_vk(err, vr, "vkCreateShaderModule (moments.comp)");
-		goto fail;
-	}
-	VkComputePipelineCreateInfo cci = {
-		.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-		.stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = mod, .pName = "main"},
-		.layout = m->layout,
+	const struct { const uint32_t *code; size_t size; VkPipeline *out; const char *name; } progs[2] = {
+		{spv_moments_comp, sizeof spv_moments_comp, &m->pipeline, "moments blur"},
+		{spv_tile_copy_comp, sizeof spv_tile_copy_comp, &m->copy_pipeline, "shadow tile copy"},
 	};
-	vr = vkCreateComputePipelines(ctx->device, ctx->pipeline_cache, 1, &cci, NULL, &m->pipeline);
-	vkDestroyShaderModule(ctx->device, mod, NULL);
-	if (vr != VK_SUCCESS) {
-		rnd_fail_vk(err, vr, "vkCreateComputePipelines (moments)");
-		goto fail;
+	for (int i = 0; i < 2; i++) {
+		VkShaderModule mod;
+		VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = progs[i].size, .pCode = progs[i].code};
+		if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &mod)) != VK_SUCCESS) {
+			rnd_fail_vk(err, vr, "vkCreateShaderModule (compute)");
+			goto fail;
+		}
+		VkComputePipelineCreateInfo cci = {
+			.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+			.stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = mod, .pName = "main"},
+			.layout = m->layout,
+		};
+		vr = vkCreateComputePipelines(ctx->device, ctx->pipeline_cache, 1, &cci, NULL, progs[i].out);
+		vkDestroyShaderModule(ctx->device, mod, NULL);
+		if (vr != VK_SUCCESS) {
+			rnd_fail_vk(err, vr, "vkCreateComputePipelines");
+			goto fail;
+		}
+		RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE, *progs[i].out, "%s", progs[i].name);
 	}
-	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE, m->pipeline, "moments blur");
 	VkSamplerCreateInfo sci = {
 		.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
 		.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST, .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
@@ -90,6 +98,7 @@ void rnd_moments_release(struct rnd_context *ctx)
 	if (!ctx->device) return;
 	if (m->sampler) vkDestroySampler(ctx->device, m->sampler, NULL);
 	if (m->pipeline) vkDestroyPipeline(ctx->device, m->pipeline, NULL);
+	if (m->copy_pipeline) vkDestroyPipeline(ctx->device, m->copy_pipeline, NULL);
 	if (m->layout) vkDestroyPipelineLayout(ctx->device, m->layout, NULL);
 	if (m->set_layout) vkDestroyDescriptorSetLayout(ctx->device, m->set_layout, NULL);
 	memset(m, 0, sizeof *m);
@@ -106,40 +115,39 @@ float rnd_moments_max_exponent(VkFormat f)
 	return f == VK_FORMAT_R32G32_SFLOAT ? 42.0f : 5.54f;
 }
 
-void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
-                        const struct rnd_scene *sc)
+void rnd_tile_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v,
+                     const struct rnd_scene *sc)
 {
 	struct rnd_moments *m = &ctx->moments;
 	VkCommandBuffer cmd = s->cmd;
+	const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
+	const float *rect = sp->views[v].rect;
+	uint32_t res = (uint32_t)rect[2], groups = (res + 7) / 8;
+	float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
+	struct rnd_moments_push push = {
+		.info = {(uint32_t)rect[0], (uint32_t)rect[1], 0, (uint32_t)ceilf(blur)},
+		.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), (float)res, 0},
+		.proj = {sp->views[v].params[2], sp->views[v].params[3], sp->views[v].params[1], 0},
+	};
+	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
+	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->copy_pipeline);
+	vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+	vkCmdDispatch(cmd, groups, groups, 1);
+	if (!lp->moments) return;
 	VkMemoryBarrier2 mb = {
 		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
-		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, .srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
 		.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
 		.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
 	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->pipeline);
-	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
-	for (uint32_t v = 0; v < sp->view_count; v++) {
-		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
-		if (!lp->moments || sp->view_skip[v]) continue;
-		const float *rect = sp->views[v].rect;
-		uint32_t res = (uint32_t)rect[2], groups = (res + 7) / 8;
-		float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
-		for (uint32_t pass = 0; pass < 2; pass++) {
-			/* The temporary is shared by every view: wait for the previous pass's use of it. */
-			vkCmdPipelineBarrier2(cmd, &di);
-			struct rnd_moments_push push = {
-				.info = {(uint32_t)rect[0], (uint32_t)rect[1], pass, (uint32_t)ceilf(blur)},
-				.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), (float)res, 0},
-				.proj = {sp->views[v].params[2], sp->views[v].params[3], sp->views[v].params[1], 0},
-			};
-			vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-			vkCmdDispatch(cmd, groups, groups, 1);
-		}
+	for (uint32_t pass = 0; pass < 2; pass++) {
+		/* The blur temporary is shared by every view: each pass waits for the last use. */
+		vkCmdPipelineBarrier2(cmd, &di);
+		push.info[2] = pass;
+		vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+		vkCmdDispatch(cmd, groups, groups, 1);
 	}
-	/* The main and AOV passes sample the moment atlas. */
-	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-	vkCmdPipelineBarrier2(cmd, &di);
 }

@@ -1,7 +1,7 @@
 /*
- * renderer/moments.h — VSM / EVSM2 moment maps (see moments.c). The context owns the compute
- * pipeline; each slot owns its moment images (slot.c). Recording happens after the shadow
- * passes of a render, for every shadow view of a light whose filter is vsm or evsm.
+ * renderer/moments.h — the compute side of shadow maps (see moments.c): copying a map into
+ * the depth atlas, and VSM / EVSM2 moment maps. The context owns the compute pipelines; each
+ * slot owns its scratch and blur images (slot.c).
  */
 #ifndef UMBRA_RENDERER_MOMENTS_H
 #define UMBRA_RENDERER_MOMENTS_H
@@ -20,10 +20,11 @@ void rnd_moments_release(struct rnd_context *ctx);
 /* The moment format for a request (fp16 when asked or when fp32 cannot be filtered). */
 VkFormat rnd_moments_format(const struct rnd_context *ctx, bool want_fp16);
 float rnd_moments_max_exponent(VkFormat f);
-/* Records both blur passes for every rendered moment view of the plan into s->cmd: depth
- * tile -> moments -> the same tile of the moment atlas. s->moments_set must point at the
- * atlases and a blur temporary as large as the largest tile. */
-void rnd_moments_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
-                        const struct rnd_scene *sc);
+/* After shadow view v was drawn in s->shadow_scratch (in SHADER_READ_ONLY layout now):
+ * copies it into its tile of the depth atlas and, for VSM / EVSM lights, blurs its moments into
+ * the same tile of the moment atlas. s->moments_set must point at the scratch, the blur
+ * temporary and both atlases. */
+void rnd_tile_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v,
+                     const struct rnd_scene *sc);
 
 #endif

@@ -3,6 +3,7 @@
  */
 #include <math.h>
 #include <string.h>
+#include "moments.h"
 #include "record.h"
 
 /* Culling back faces of a closed primitive changes nothing in the picture as long as the
@@ -59,10 +60,9 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 	VkMemoryBarrier2 mb = {
 		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
 		.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, .srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT,
-		.dstStageMask = VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT |
-		                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-		.dstAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-		                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
+		                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
 	vkCmdPipelineBarrier2(cmd, &di);
@@ -71,21 +71,29 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		if (sp->view_skip[v]) continue;
 		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
 		const float *rect = sp->views[v].rect;
-		int32_t x = (int32_t)rect[0], y = (int32_t)rect[1];
 		uint32_t res = (uint32_t)rect[2];
+		/* Each map is drawn at the origin of the slot's scratch depth image and then copied
+		 * into its tile: rasterisation snaps to a grid relative to the framebuffer, so drawing
+		 * at the tile's own offset would make a map (and the image) depend on where the atlas
+		 * happened to place it. The same request then gives the same bytes whatever the cache
+		 * held before. */
+		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 		VkRenderingAttachmentInfo da = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = ctx->atlas_depth.view,
-			.imageLayout = VK_IMAGE_LAYOUT_GENERAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->shadow_scratch.view,
+			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
 			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
 		};
-		/* Clearing and drawing stay inside the tile: the render area is the tile. */
 		VkRenderingInfo ri = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{x, y}, {res, res}}, .layerCount = 1,
+			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {res, res}}, .layerCount = 1,
 			.pDepthAttachment = &da,
 		};
 		vkCmdBeginRendering(cmd, &ri);
-		VkViewport vp = {(float)x, (float)y, (float)res, (float)res, 0, 1};
-		VkRect2D scissor = {{x, y}, {res, res}};
+		VkViewport vp = {0, 0, (float)res, (float)res, 0, 1};
+		VkRect2D scissor = {{0, 0}, {res, res}};
 		vkCmdSetViewport(cmd, 0, 1, &vp);
 		vkCmdSetScissor(cmd, 0, 1, &scissor);
 		vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
@@ -123,10 +131,16 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 			(*casters_drawn)++;
 		}
 		vkCmdEndRendering(cmd);
+		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1,
+		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+		rnd_tile_record(ctx, s, sp, v, sc);
 	}
-	/* The maps are read by the moment blur and the main and AOV passes. */
-	mb.srcStageMask = VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-	mb.srcAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+	/* The atlas tiles (depth and moments) are read by the main and AOV passes. */
+	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 	vkCmdPipelineBarrier2(cmd, &di);

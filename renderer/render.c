@@ -220,23 +220,26 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		};
 	}
 	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
-	if (s->moments_tmp.img && ctx->atlas_moments.view) {
-		/* moments.comp: depth in, blur temporary, moments out */
-		VkDescriptorImageInfo ci[3] = {
-			{ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL},
-			{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
-			{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
+	/* tile_copy.comp and moments.comp: the scratch map in, the blur temporary, both atlases
+	 * out. Bindings a pipeline does not use may stay unwritten. */
+	VkDescriptorImageInfo ci[4] = {
+		{ctx->pipes.shadow_sampler, s->shadow_scratch.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
+		{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
+		{VK_NULL_HANDLE, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL},
+	};
+	VkWriteDescriptorSet cw[4];
+	uint32_t ncw = 0;
+	for (uint32_t i = 0; i < 4; i++) {
+		if (!ci[i].imageView) continue;
+		cw[ncw++] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
+			.descriptorCount = 1,
+			.descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+			.pImageInfo = &ci[i],
 		};
-		VkWriteDescriptorSet cw[3];
-		for (uint32_t i = 0; i < 3; i++)
-			cw[i] = (VkWriteDescriptorSet){
-				.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
-				.descriptorCount = 1,
-				.descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-				.pImageInfo = &ci[i],
-			};
-		vkUpdateDescriptorSets(ctx->device, 3, cw, 0, NULL);
 	}
+	vkUpdateDescriptorSets(ctx->device, ncw, cw, 0, NULL);
 	return RND_OK;
 }
 
@@ -600,6 +603,10 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 			if (lp->moments && !skip && grants[k].res > max_moment_res) max_moment_res = grants[k].res;
 		}
 		if (max_moment_res && (r = rnd_slot_moments_tmp(ctx, s, max_moment_res, err)) != RND_OK) goto done;
+		uint32_t max_res = 64;
+		for (uint32_t k = 0; k < ngrant; k++)
+			if (grants[k].res > max_res) max_res = grants[k].res;
+		if ((r = rnd_slot_shadow_scratch(ctx, s, max_res, err)) != RND_OK) goto done;
 		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, camera->exposure, err)) != RND_OK) goto done;
 
 		uint32_t col = v % cols, row = v / cols;
@@ -625,7 +632,6 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		}
 		uint32_t casters = 0;
 		record_shadows(ctx, s, &rv, &casters);
-		if (max_moment_res) rnd_moments_record(ctx, s, sp, sc);
 		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_SHADOW_END);
 		if ((r = record_main(ctx, s, &rv, err)) != RND_OK || (passes && (r = record_aov(ctx, s, &rv, err)) != RND_OK)) {
 			vkEndCommandBuffer(s->cmd);

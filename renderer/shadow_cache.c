@@ -44,41 +44,48 @@ uint64_t rnd_hash(uint64_t h, const void *data, size_t len)
 	return h;
 }
 
-/* One-time layout transition of both atlases to GENERAL, on slot 0's command buffer. */
+/* One-time set-up of both atlases on slot 0's command buffer: the depth atlas cleared to 1
+ * (empty texels read "nothing here"), then both in GENERAL layout for good. */
 static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_slot *s = ctx->slots[0];
 	VkResult vr;
 	VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
 	if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkBeginCommandBuffer (atlas init)");
-	VkImageMemoryBarrier2 b[2];
-	struct rnd_image_res *imgs[2] = {&ctx->atlas_depth, &ctx->atlas_moments};
+	VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+	VkImageMemoryBarrier2 b = {
+		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_NONE,
+		.dstStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT, .dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT,
+		.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, .newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+		.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+		.image = ctx->atlas_depth.img, .subresourceRange = range,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
+	vkCmdPipelineBarrier2(s->cmd, &di);
+	VkClearColorValue one = {{1.0f, 1.0f, 1.0f, 1.0f}};
+	vkCmdClearColorImage(s->cmd, ctx->atlas_depth.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &one, 1, &range);
+	VkImageMemoryBarrier2 g[2];
 	uint32_t n = 0;
-	for (int i = 0; i < 2; i++) {
-		if (!imgs[i]->img) continue;
-		b[n++] = (VkImageMemoryBarrier2){
+	g[n++] = (VkImageMemoryBarrier2){
+		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT,
+		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+		.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+		.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, .newLayout = VK_IMAGE_LAYOUT_GENERAL,
+		.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+		.image = ctx->atlas_depth.img, .subresourceRange = range,
+	};
+	if (ctx->atlas_moments.img)
+		g[n++] = (VkImageMemoryBarrier2){
 			.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_NONE,
 			.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
 			.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
 			.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, .newLayout = VK_IMAGE_LAYOUT_GENERAL,
 			.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-			.image = imgs[i]->img,
-			.subresourceRange = {i == 0 ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1},
+			.image = ctx->atlas_moments.img, .subresourceRange = range,
 		};
-	}
-	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = n, .pImageMemoryBarriers = b};
+	di.imageMemoryBarrierCount = n;
+	di.pImageMemoryBarriers = g;
 	vkCmdPipelineBarrier2(s->cmd, &di);
-	/* Empty texels read as "nothing here" (depth 1) in the atlas debug view. */
-	VkClearDepthStencilValue one = {1.0f, 0};
-	VkImageSubresourceRange range = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-	vkCmdClearDepthStencilImage(s->cmd, ctx->atlas_depth.img, VK_IMAGE_LAYOUT_GENERAL, &one, 1, &range);
-	VkMemoryBarrier2 mb = {
-		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT,
-		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-		.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
-	};
-	VkDependencyInfo dm = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
-	vkCmdPipelineBarrier2(s->cmd, &dm);
 	if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkEndCommandBuffer (atlas init)");
 	VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &s->cmd};
 	if ((vr = vkQueueSubmit(ctx->queue, 1, &si, s->fence)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkQueueSubmit (atlas init)");
@@ -100,10 +107,11 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 	}
 	pthread_mutex_init(&c->mu, NULL);
 	ctx->cache = c;
-	if ((r = rnd_image_create(ctx, RND_SHADOW_FORMAT, size, size, 1, 1,
-	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-	                          VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-	                          VK_IMAGE_ASPECT_DEPTH_BIT, "shadow depth atlas", &ctx->atlas_depth, err)) != RND_OK)
+	/* R32F, not D32: maps are drawn in a slot's scratch depth image and copied in by a compute
+	 * shader, and a storage image is at home in the GENERAL layout the shared atlas needs. */
+	if ((r = rnd_image_create(ctx, VK_FORMAT_R32_SFLOAT, size, size, 1, 1,
+	                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+	                          VK_IMAGE_ASPECT_COLOR_BIT, "shadow depth atlas", &ctx->atlas_depth, err)) != RND_OK)
 		goto fail;
 	if (ctx->moments.available &&
 	    (r = rnd_image_create(ctx, rnd_moments_format(ctx, false), size, size, 1, 1,

@@ -99,7 +99,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 	};
 	vkUpdateDescriptorSets(ctx->device, 1, &ww, 0, NULL);
-	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
+	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 3}};
 	VkDescriptorPoolCreateInfo mpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = msizes,
 	};
@@ -146,6 +146,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_image_destroy(ctx, &s->white);
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
 	rnd_image_destroy(ctx, &s->moments_tmp);
+	rnd_image_destroy(ctx, &s->shadow_scratch);
 	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
 	rnd_image_destroy(ctx, &s->aov_depth);
@@ -291,4 +292,15 @@ enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s
 	snprintf(name, sizeof name, "slot %u moments blur", s->index);
 	return rnd_image_create(ctx, VK_FORMAT_R32G32_SFLOAT, res, res, 1, 1, VK_IMAGE_USAGE_STORAGE_BIT,
 	                        VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments_tmp, err);
+}
+
+enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err)
+{
+	if (s->shadow_scratch.img && s->shadow_scratch.width >= res) return RND_OK;
+	rnd_image_destroy(ctx, &s->shadow_scratch);
+	char name[48];
+	snprintf(name, sizeof name, "slot %u shadow scratch", s->index);
+	return rnd_image_create(ctx, RND_SHADOW_FORMAT, res, res, 1, 1,
+	                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                        VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->shadow_scratch, err);
 }

@@ -36,6 +36,8 @@ struct rnd_slot {
 	struct rnd_image_res aov[UMBRA_AOV_ATTACHMENTS], aov_depth;
 	/* moment maps (VSM / EVSM) are blurred through this tile-sized temporary (GENERAL layout) */
 	struct rnd_image_res moments_tmp;
+	/* shadow maps are drawn here at the origin, then copied into their atlas tile */
+	struct rnd_image_res shadow_scratch;
 	bool moments_initialised;     /* moments_tmp is in GENERAL layout */
 	VkDescriptorPool moments_pool;
 	VkDescriptorSet moments_set;
@@ -47,6 +49,8 @@ enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, Vk
                                  uint32_t samples, struct rnd_error *err);
 /* Makes the AOV targets match w x h. */
 enum rnd_result rnd_slot_aov(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, struct rnd_error *err);
+/* Makes the shadow scratch depth image at least res x res. */
+enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err);
 /* Makes the moment blur temporary at least res x res. */
 enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err);
 /* Destroys the previous render's textures. */

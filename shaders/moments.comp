@@ -1,11 +1,12 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "umbra_shared.h"
-// Moment shadow maps (VSM, EVSM2) from one depth-atlas tile, with a separable Gaussian blur.
-// Pass 0: depth -> moments, horizontal blur -> tmp (tile-local). Pass 1: vertical blur tmp ->
-// the same tile of the moment atlas. One implementation for every light type.
+// Moment shadow maps (VSM, EVSM2) from a shadow map just drawn in the slot's scratch depth
+// image, with a separable Gaussian blur. Pass 0: depth -> moments, horizontal blur -> tmp.
+// Pass 1: vertical blur tmp -> the map's tile of the moment atlas. One implementation for
+// every light type.
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) uniform sampler2D depth_atlas;
+layout(set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) uniform sampler2D scratch;
 layout(set = 0, binding = UMBRA_MOMENTS_BINDING_TMP, rg32f) uniform image2D tmp_img;
 layout(set = 0, binding = UMBRA_MOMENTS_BINDING_OUT) writeonly uniform image2D out_img;
 layout(push_constant) uniform Push {
@@ -42,7 +43,7 @@ void main()
 		vec2 m;
 		if (pc.info.z == 0u) {
 			ivec2 q = ivec2(clamp(p.x + k, 0, res - 1), p.y);
-			m = to_moments(texelFetch(depth_atlas, origin + q, 0).r);
+			m = to_moments(texelFetch(scratch, q, 0).r);
 		} else {
 			ivec2 q = ivec2(p.x, clamp(p.y + k, 0, res - 1));
 			m = imageLoad(tmp_img, q).xy;

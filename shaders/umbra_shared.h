@@ -14,13 +14,14 @@
 #define UMBRA_BINDING_MATERIALS      1  /* storage  umbra_material[] */
 #define UMBRA_BINDING_LIGHTS         2  /* uniform  umbra_light[UMBRA_MAX_LIGHTS] */
 #define UMBRA_BINDING_SHADOW_VIEWS   3  /* uniform  umbra_shadow_view[UMBRA_MAX_SHADOW_VIEWS] */
-#define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2D, the depth atlas: one tile per shadow view */
+#define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2D, the depth atlas (R32F): one tile per shadow view */
 #define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
 #define UMBRA_BINDING_COUNT          6
 /* moments.comp's own set 0 */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0
 #define UMBRA_MOMENTS_BINDING_TMP    1
 #define UMBRA_MOMENTS_BINDING_OUT    2
+#define UMBRA_MOMENTS_BINDING_ATLAS  3  /* tile_copy.comp: the depth atlas (R32F storage) */
 /* Set 1: the material's base-colour texture (sRGB), bound per draw; a white 1x1 when none. */
 #define UMBRA_SET_MATERIAL           1
 #define UMBRA_BINDING_BASE_TEXTURE   0
