@@ -33,7 +33,7 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 	m->available = f.shaderStorageImageWriteWithoutFormat && f.shaderStorageImageExtendedFormats &&
 	               (format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) || format_ok(ctx, VK_FORMAT_R16G16_SFLOAT));
 	VkDescriptorSetLayoutBinding b[4] = {
-		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
+		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_TMP, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_ATLAS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
@@ -122,7 +122,7 @@ void rnd_tile_record(struct rnd_context *ctx, struct rnd_slot *s, const struct r
 	VkCommandBuffer cmd = s->cmd;
 	const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
 	const float *rect = sp->views[v].rect;
-	uint32_t res = (uint32_t)rect[2], groups = (res + 7) / 8;
+	uint32_t res = (uint32_t)rect[2], groups = (res + 127) / 128;   /* 8x8 invocations of 16x16 texels */
 	float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
 	struct rnd_moments_push push = {
 		.info = {(uint32_t)rect[0], (uint32_t)rect[1], 0, (uint32_t)ceilf(blur)},

@@ -78,8 +78,8 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		 * happened to place it. The same request then gives the same bytes whatever the cache
 		 * held before. */
 		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+		                     VK_ACCESS_2_TRANSFER_READ_BIT,
 		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 		VkRenderingAttachmentInfo da = {
@@ -132,10 +132,29 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		}
 		vkCmdEndRendering(cmd);
 		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1,
-		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
 		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+		                     VK_ACCESS_2_TRANSFER_READ_BIT);
+		/* The previous view's compute passes must be done reading the buffer. */
+		VkBufferMemoryBarrier2 bb = {
+			.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+			.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
+			.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+			.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->scratch_buf.buf, .size = VK_WHOLE_SIZE,
+		};
+		VkDependencyInfo bdi = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
+		vkCmdPipelineBarrier2(cmd, &bdi);
+		VkBufferImageCopy region = {
+			.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1}, .imageExtent = {res, res, 1},
+		};
+		vkCmdCopyImageToBuffer(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->scratch_buf.buf, 1,
+		                       &region);
+		bb.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+		bb.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+		bb.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+		bb.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+		vkCmdPipelineBarrier2(cmd, &bdi);
 		rnd_tile_record(ctx, s, sp, v, sc);
 	}
 	/* The atlas tiles (depth and moments) are read by the main and AOV passes. */

@@ -222,21 +222,26 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
 	/* tile_copy.comp and moments.comp: the scratch map in, the blur temporary, both atlases
 	 * out. Bindings a pipeline does not use may stay unwritten. */
+	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, VK_WHOLE_SIZE};
 	VkDescriptorImageInfo ci[4] = {
-		{ctx->pipes.shadow_sampler, s->shadow_scratch.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{VK_NULL_HANDLE, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED},
 		{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
 		{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
 		{VK_NULL_HANDLE, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
 	VkWriteDescriptorSet cw[4];
 	uint32_t ncw = 0;
-	for (uint32_t i = 0; i < 4; i++) {
+	if (s->scratch_buf.buf)
+		cw[ncw++] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set,
+			.dstBinding = UMBRA_MOMENTS_BINDING_DEPTH, .descriptorCount = 1,
+			.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &sbi,
+		};
+	for (uint32_t i = 1; i < 4; i++) {
 		if (!ci[i].imageView) continue;
 		cw[ncw++] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
-			.descriptorCount = 1,
-			.descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-			.pImageInfo = &ci[i],
+			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &ci[i],
 		};
 	}
 	vkUpdateDescriptorSets(ctx->device, ncw, cw, 0, NULL);

@@ -99,7 +99,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 	};
 	vkUpdateDescriptorSets(ctx->device, 1, &ww, 0, NULL);
-	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 3}};
+	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 3}};
 	VkDescriptorPoolCreateInfo mpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = msizes,
 	};
@@ -147,6 +147,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
 	rnd_image_destroy(ctx, &s->moments_tmp);
 	rnd_image_destroy(ctx, &s->shadow_scratch);
+	rnd_buffer_destroy(ctx, &s->scratch_buf);
 	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
 	rnd_image_destroy(ctx, &s->aov_depth);
@@ -296,11 +297,15 @@ enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s
 
 enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err)
 {
+	enum rnd_result r = rnd_buffer_reserve(ctx, &s->scratch_buf, (VkDeviceSize)res * res * 4,
+	                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+	                                       "slot shadow scratch buffer", err);
+	if (r != RND_OK) return r;
 	if (s->shadow_scratch.img && s->shadow_scratch.width >= res) return RND_OK;
 	rnd_image_destroy(ctx, &s->shadow_scratch);
 	char name[48];
 	snprintf(name, sizeof name, "slot %u shadow scratch", s->index);
 	return rnd_image_create(ctx, RND_SHADOW_FORMAT, res, res, 1, 1,
-	                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
 	                        VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->shadow_scratch, err);
 }

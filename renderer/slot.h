@@ -38,6 +38,7 @@ struct rnd_slot {
 	struct rnd_image_res moments_tmp;
 	/* shadow maps are drawn here at the origin, then copied into their atlas tile */
 	struct rnd_image_res shadow_scratch;
+	struct rnd_buffer scratch_buf;    /* the scratch map as floats, read by the compute passes */
 	bool moments_initialised;     /* moments_tmp is in GENERAL layout */
 	VkDescriptorPool moments_pool;
 	VkDescriptorSet moments_set;

@@ -2,11 +2,11 @@
 #extension GL_GOOGLE_include_directive : require
 #include "umbra_shared.h"
 // Moment shadow maps (VSM, EVSM2) from a shadow map just drawn in the slot's scratch depth
-// image, with a separable Gaussian blur. Pass 0: depth -> moments, horizontal blur -> tmp.
+// image (and copied to the scratch buffer), with a separable Gaussian blur. Pass 0: depth -> moments, horizontal blur -> tmp.
 // Pass 1: vertical blur tmp -> the map's tile of the moment atlas. One implementation for
 // every light type.
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) uniform sampler2D scratch;
+layout(std430, set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) readonly buffer Scratch { float scratch[]; };
 layout(set = 0, binding = UMBRA_MOMENTS_BINDING_TMP, rg32f) uniform image2D tmp_img;
 layout(set = 0, binding = UMBRA_MOMENTS_BINDING_OUT) writeonly uniform image2D out_img;
 layout(push_constant) uniform Push {
@@ -28,11 +28,23 @@ vec2 to_moments(float d)
 	return vec2(e, e * e);
 }
 
+void blur(ivec2 p);
+
+// Each invocation blurs a 16x16 block: few, large workgroups (lavapipe's per-dispatch cost
+// grows with the workgroup count).
 void main()
 {
-	ivec2 p = ivec2(gl_GlobalInvocationID.xy);
 	int res = int(pc.params.z);
-	if (p.x >= res || p.y >= res) return;
+	for (int by = 0; by < 16; by++)
+		for (int bx = 0; bx < 16; bx++) {
+			ivec2 p = ivec2(gl_GlobalInvocationID.xy) * 16 + ivec2(bx, by);
+			if (p.x < res && p.y < res) blur(p);
+		}
+}
+
+void blur(ivec2 p)
+{
+	int res = int(pc.params.z);
 	ivec2 origin = ivec2(pc.info.xy);
 	int r = int(pc.info.w);
 	float sigma = max(pc.params.y, 0.5);
@@ -43,7 +55,7 @@ void main()
 		vec2 m;
 		if (pc.info.z == 0u) {
 			ivec2 q = ivec2(clamp(p.x + k, 0, res - 1), p.y);
-			m = to_moments(texelFetch(scratch, q, 0).r);
+			m = to_moments(scratch[q.y * res + q.x]);
 		} else {
 			ivec2 q = ivec2(p.x, clamp(p.y + k, 0, res - 1));
 			m = imageLoad(tmp_img, q).xy;

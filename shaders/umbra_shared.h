@@ -18,7 +18,7 @@
 #define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
 #define UMBRA_BINDING_COUNT          6
 /* moments.comp's own set 0 */
-#define UMBRA_MOMENTS_BINDING_DEPTH  0
+#define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
 #define UMBRA_MOMENTS_BINDING_TMP    1
 #define UMBRA_MOMENTS_BINDING_OUT    2
 #define UMBRA_MOMENTS_BINDING_ATLAS  3  /* tile_copy.comp: the depth atlas (R32F storage) */
