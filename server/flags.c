@@ -41,7 +41,7 @@ static const struct opt_def opts[] = {
 	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", LIM(model_cache_bytes), 0, UINT64_MAX },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
-	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (4096)", CFG(atlas_size), 0, 16384 },
+	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (8192)", CFG(atlas_size), 0, 16384 },
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
 	{ "max-connections", OPT_UINT, "N", "concurrent connections (1024)", CFG(max_connections), 1, 1000000 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
@@ -143,6 +143,9 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
 	cfg->workers = ncpu > 0 ? (unsigned)(ncpu > 256 ? 256 : ncpu) : 1;
 	cfg->queue = 64;
+	/* Room for four concurrent renders of four 2048 cascades each: under that load no request
+	 * has its shadow resolution lowered (which would change its bytes). */
+	cfg->atlas_size = 8192;
 	cfg->max_body = 64ull << 20;
 	api_limits_defaults(&cfg->limits);
 	cfg->deadline_ms = 30000;
