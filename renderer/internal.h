@@ -78,7 +78,6 @@ struct rnd_moments {
 	VkDescriptorSetLayout set_layout;
 	VkPipelineLayout layout;
 	VkPipeline pipeline;                 /* moments.comp */
-	VkPipeline copy_pipeline;            /* tile_copy.comp: scratch depth -> depth atlas tile */
 	VkSampler sampler;                   /* linear, clamp to edge */
 	bool fp32;                           /* R32G32_SFLOAT filterable + storable */
 	bool available;                      /* VSM / EVSM can be offered at all */

@@ -12,7 +12,6 @@
 #include "moments.h"
 #include "record.h"
 #include "moments.comp.spv.h"
-#include "tile_copy.comp.spv.h"
 
 static bool format_ok(const struct rnd_context *ctx, VkFormat f)
 {
@@ -32,13 +31,12 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 	m->fp32 = format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) && f.shaderStorageImageExtendedFormats;
 	m->available = f.shaderStorageImageWriteWithoutFormat && f.shaderStorageImageExtendedFormats &&
 	               (format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) || format_ok(ctx, VK_FORMAT_R16G16_SFLOAT));
-	VkDescriptorSetLayoutBinding b[4] = {
+	VkDescriptorSetLayoutBinding b[3] = {
 		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_TMP, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
-		{UMBRA_MOMENTS_BINDING_ATLAS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 	};
-	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 4, .pBindings = b};
+	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 3, .pBindings = b};
 	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &m->set_layout)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (moments)");
 	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, m->set_layout, "moments set layout");
@@ -52,11 +50,10 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 		goto fail;
 	}
 	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, m->layout, "moments pipeline layout");
-	const struct { const uint32_t *code; size_t size; VkPipeline *out; const char *name; } progs[2] = {
+	const struct { const uint32_t *code; size_t size; VkPipeline *out; const char *name; } progs[1] = {
 		{spv_moments_comp, sizeof spv_moments_comp, &m->pipeline, "moments blur"},
-		{spv_tile_copy_comp, sizeof spv_tile_copy_comp, &m->copy_pipeline, "shadow tile copy"},
 	};
-	for (int i = 0; i < 2; i++) {
+	for (int i = 0; i < 1; i++) {
 		VkShaderModule mod;
 		VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = progs[i].size, .pCode = progs[i].code};
 		if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &mod)) != VK_SUCCESS) {
@@ -98,7 +95,6 @@ void rnd_moments_release(struct rnd_context *ctx)
 	if (!ctx->device) return;
 	if (m->sampler) vkDestroySampler(ctx->device, m->sampler, NULL);
 	if (m->pipeline) vkDestroyPipeline(ctx->device, m->pipeline, NULL);
-	if (m->copy_pipeline) vkDestroyPipeline(ctx->device, m->copy_pipeline, NULL);
 	if (m->layout) vkDestroyPipelineLayout(ctx->device, m->layout, NULL);
 	if (m->set_layout) vkDestroyDescriptorSetLayout(ctx->device, m->set_layout, NULL);
 	memset(m, 0, sizeof *m);
@@ -115,25 +111,22 @@ float rnd_moments_max_exponent(VkFormat f)
 	return f == VK_FORMAT_R32G32_SFLOAT ? 42.0f : 5.54f;
 }
 
-void rnd_tile_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v,
-                     const struct rnd_scene *sc)
+void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
+                             uint32_t v, const struct rnd_scene *sc)
 {
 	struct rnd_moments *m = &ctx->moments;
 	VkCommandBuffer cmd = s->cmd;
 	const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
 	const float *rect = sp->views[v].rect;
-	uint32_t res = (uint32_t)rect[2], groups = (res + 127) / 128;   /* 8x8 invocations of 16x16 texels */
+	uint32_t res = (uint32_t)rect[2], groups = (res + 63) / 64;   /* 8x8 invocations of 8x8 texels */
 	float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
 	struct rnd_moments_push push = {
 		.info = {(uint32_t)rect[0], (uint32_t)rect[1], 0, (uint32_t)ceilf(blur)},
 		.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), (float)res, 0},
 		.proj = {sp->views[v].params[2], sp->views[v].params[3], sp->views[v].params[1], 0},
 	};
-	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
-	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->copy_pipeline);
-	vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-	vkCmdDispatch(cmd, groups, groups, 1);
 	if (!lp->moments) return;
+	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
 	VkMemoryBarrier2 mb = {
 		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
 		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

@@ -20,11 +20,10 @@ void rnd_moments_release(struct rnd_context *ctx);
 /* The moment format for a request (fp16 when asked or when fp32 cannot be filtered). */
 VkFormat rnd_moments_format(const struct rnd_context *ctx, bool want_fp16);
 float rnd_moments_max_exponent(VkFormat f);
-/* After shadow view v was drawn in s->shadow_scratch and copied to s->scratch_buf:
- * copies it into its tile of the depth atlas and, for VSM / EVSM lights, blurs its moments into
- * the same tile of the moment atlas. s->moments_set must point at the scratch, the blur
- * temporary and both atlases. */
-void rnd_tile_record(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v,
-                     const struct rnd_scene *sc);
+/* After shadow view v (of a VSM / EVSM light) was drawn in s->shadow_scratch and copied to
+ * s->scratch_buf: blurs its moments into the view's tile of the moment atlas. s->moments_set
+ * must point at the scratch buffer, the blur temporary and the moment atlas. */
+void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
+                             uint32_t v, const struct rnd_scene *sc);
 
 #endif

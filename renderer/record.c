@@ -136,10 +136,23 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
 		                     VK_ACCESS_2_TRANSFER_READ_BIT);
-		/* The previous view's compute passes must be done reading the buffer. */
+		/* Into the depth atlas: a same-format image copy, which lavapipe does as a memcpy. */
+		VkImageCopy copy = {
+			.srcSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
+			.dstSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
+			.dstOffset = {(int32_t)sp->views[v].rect[0], (int32_t)sp->views[v].rect[1], 0}, .extent = {res, res, 1},
+		};
+		vkCmdCopyImage(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, ctx->atlas_depth.img,
+		               VK_IMAGE_LAYOUT_GENERAL, 1, &copy);
+		if (!lp->moments) continue;
+		/* VSM / EVSM: the map as floats for the moment blur (compute shaders cannot read a
+		 * depth image on lavapipe without it copying the image on every dispatch). The
+		 * previous view's compute passes must be done reading the buffer. */
 		VkBufferMemoryBarrier2 bb = {
-			.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-			.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
+			.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2,
+			.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+			.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+			.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
 			.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
 			.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->scratch_buf.buf, .size = VK_WHOLE_SIZE,
 		};
@@ -155,11 +168,12 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		bb.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 		bb.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 		vkCmdPipelineBarrier2(cmd, &bdi);
-		rnd_tile_record(ctx, s, sp, v, sc);
+		rnd_moments_record_view(ctx, s, sp, v, sc);
 	}
-	/* The atlas tiles (depth and moments) are read by the main and AOV passes. */
-	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+	/* The atlas tiles (depth copied in, moments from compute) are read by the main and AOV
+	 * passes. */
+	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
+	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
 	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 	vkCmdPipelineBarrier2(cmd, &di);

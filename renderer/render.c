@@ -220,16 +220,14 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		};
 	}
 	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
-	/* tile_copy.comp and moments.comp: the scratch map in, the blur temporary, both atlases
-	 * out. Bindings a pipeline does not use may stay unwritten. */
+	/* moments.comp: the scratch map in, the blur temporary, the moment atlas out. */
 	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, VK_WHOLE_SIZE};
-	VkDescriptorImageInfo ci[4] = {
+	VkDescriptorImageInfo ci[3] = {
 		{VK_NULL_HANDLE, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED},
 		{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
 		{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
-		{VK_NULL_HANDLE, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
-	VkWriteDescriptorSet cw[4];
+	VkWriteDescriptorSet cw[3];
 	uint32_t ncw = 0;
 	if (s->scratch_buf.buf)
 		cw[ncw++] = (VkWriteDescriptorSet){
@@ -237,7 +235,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 			.dstBinding = UMBRA_MOMENTS_BINDING_DEPTH, .descriptorCount = 1,
 			.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &sbi,
 		};
-	for (uint32_t i = 1; i < 4; i++) {
+	for (uint32_t i = 1; i < 3; i++) {
 		if (!ci[i].imageView) continue;
 		cw[ncw++] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,

@@ -52,7 +52,7 @@ static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *e
 	VkResult vr;
 	VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
 	if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkBeginCommandBuffer (atlas init)");
-	VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+	VkImageSubresourceRange range = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
 	VkImageMemoryBarrier2 b = {
 		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_NONE,
 		.dstStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT, .dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -62,8 +62,8 @@ static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *e
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
 	vkCmdPipelineBarrier2(s->cmd, &di);
-	VkClearColorValue one = {{1.0f, 1.0f, 1.0f, 1.0f}};
-	vkCmdClearColorImage(s->cmd, ctx->atlas_depth.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &one, 1, &range);
+	VkClearDepthStencilValue one = {1.0f, 0};
+	vkCmdClearDepthStencilImage(s->cmd, ctx->atlas_depth.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &one, 1, &range);
 	VkImageMemoryBarrier2 g[2];
 	uint32_t n = 0;
 	g[n++] = (VkImageMemoryBarrier2){
@@ -81,7 +81,7 @@ static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *e
 			.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
 			.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, .newLayout = VK_IMAGE_LAYOUT_GENERAL,
 			.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-			.image = ctx->atlas_moments.img, .subresourceRange = range,
+			.image = ctx->atlas_moments.img, .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1},
 		};
 	di.imageMemoryBarrierCount = n;
 	di.pImageMemoryBarriers = g;
@@ -107,11 +107,11 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 	}
 	pthread_mutex_init(&c->mu, NULL);
 	ctx->cache = c;
-	/* R32F, not D32: maps are drawn in a slot's scratch depth image and copied in by a compute
-	 * shader, and a storage image is at home in the GENERAL layout the shared atlas needs. */
-	if ((r = rnd_image_create(ctx, VK_FORMAT_R32_SFLOAT, size, size, 1, 1,
-	                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-	                          VK_IMAGE_ASPECT_COLOR_BIT, "shadow depth atlas", &ctx->atlas_depth, err)) != RND_OK)
+	/* Maps are drawn at the origin of a slot's scratch depth image and copied into their tile;
+	 * the atlas itself is never a render target. */
+	if ((r = rnd_image_create(ctx, RND_SHADOW_FORMAT, size, size, 1, 1,
+	                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+	                          VK_IMAGE_ASPECT_DEPTH_BIT, "shadow depth atlas", &ctx->atlas_depth, err)) != RND_OK)
 		goto fail;
 	if (ctx->moments.available &&
 	    (r = rnd_image_create(ctx, rnd_moments_format(ctx, false), size, size, 1, 1,

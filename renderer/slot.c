@@ -99,7 +99,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 	};
 	vkUpdateDescriptorSets(ctx->device, 1, &ww, 0, NULL);
-	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 3}};
+	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
 	VkDescriptorPoolCreateInfo mpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = msizes,
 	};
@@ -298,7 +298,8 @@ enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s
 enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err)
 {
 	enum rnd_result r = rnd_buffer_reserve(ctx, &s->scratch_buf, (VkDeviceSize)res * res * 4,
-	                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+	                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+	                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
 	                                       "slot shadow scratch buffer", err);
 	if (r != RND_OK) return r;
 	if (s->shadow_scratch.img && s->shadow_scratch.width >= res) return RND_OK;

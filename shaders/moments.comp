@@ -35,9 +35,9 @@ void blur(ivec2 p);
 void main()
 {
 	int res = int(pc.params.z);
-	for (int by = 0; by < 16; by++)
-		for (int bx = 0; bx < 16; bx++) {
-			ivec2 p = ivec2(gl_GlobalInvocationID.xy) * 16 + ivec2(bx, by);
+	for (int by = 0; by < 8; by++)
+		for (int bx = 0; bx < 8; bx++) {
+			ivec2 p = ivec2(gl_GlobalInvocationID.xy) * 8 + ivec2(bx, by);
 			if (p.x < res && p.y < res) blur(p);
 		}
 }

@@ -21,7 +21,6 @@
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
 #define UMBRA_MOMENTS_BINDING_TMP    1
 #define UMBRA_MOMENTS_BINDING_OUT    2
-#define UMBRA_MOMENTS_BINDING_ATLAS  3  /* tile_copy.comp: the depth atlas (R32F storage) */
 /* Set 1: the material's base-colour texture (sRGB), bound per draw; a white 1x1 when none. */
 #define UMBRA_SET_MATERIAL           1
 #define UMBRA_BINDING_BASE_TEXTURE   0
