@@ -65,11 +65,8 @@ void rnd_log(const struct rnd_context *ctx, int level, const char *fmt, ...)
 
 void rnd_name(const struct rnd_context *ctx, VkObjectType type, uint64_t handle, const char *fmt, ...)
 {
-	if (!ctx->has_debug_utils || !handle) return;
-	static PFN_vkSetDebugUtilsObjectNameEXT set_name;
-	if (!set_name)
-		set_name = (PFN_vkSetDebugUtilsObjectNameEXT)vkGetDeviceProcAddr(ctx->device, "vkSetDebugUtilsObjectNameEXT");
-	if (!set_name) return;
+	PFN_vkSetDebugUtilsObjectNameEXT set_name = ctx->set_object_name;
+	if (!set_name || !handle) return;
 	char name[128];
 	va_list ap;
 	va_start(ap, fmt);
@@ -275,6 +272,8 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 	VkResult vr = vkCreateDevice(ctx->phys, &ci, NULL, &ctx->device);
 	if (vr != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkCreateDevice");
 	vkGetDeviceQueue(ctx->device, ctx->queue_family, 0, &ctx->queue);
+	if (ctx->has_debug_utils)
+		ctx->set_object_name = (PFN_vkSetDebugUtilsObjectNameEXT)vkGetDeviceProcAddr(ctx->device, "vkSetDebugUtilsObjectNameEXT");
 	RND_NAME(ctx, VK_OBJECT_TYPE_DEVICE, ctx->device, "umbra device");
 	RND_NAME(ctx, VK_OBJECT_TYPE_QUEUE, ctx->queue, "umbra graphics queue");
 
@@ -350,8 +349,10 @@ enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error
 enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct rnd_context **out, struct rnd_error *err)
 {
 	enum rnd_result r;
+	struct rnd_error scratch_err;
+	if (!err) err = &scratch_err;   /* failure paths below always fill it */
 	*out = NULL;
-	if (err) memset(err, 0, sizeof *err);
+	memset(err, 0, sizeof *err);
 	struct rnd_context *ctx = calloc(1, sizeof *ctx);
 	if (!ctx) return rnd_fail(err, RND_ERR_OOM, "out of memory for the context");
 	if (desc) ctx->desc = *desc;
@@ -427,7 +428,7 @@ void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info)
 	info->is_cpu = ctx->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
 	info->max_image_dimension = ctx->props.limits.maxImageDimension2D;
 	info->max_shadow_resolution = ctx->props.limits.maxImageDimension2D < 8192 ? ctx->props.limits.maxImageDimension2D : 8192;
-	info->moments_fp32_filterable = false;
+	info->moments_fp32_filterable = ctx->moments.fp32;
 }
 
 uint32_t rnd_context_validation_messages(const struct rnd_context *ctx)

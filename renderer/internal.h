@@ -106,9 +106,9 @@ struct rnd_context {
 	struct rnd_image_res atlas_moments;  /* VSM / EVSM moments, same tiles */
 	uint64_t stats_hits, stats_misses;
 	bool has_debug_utils;
+	PFN_vkSetDebugUtilsObjectNameEXT set_object_name;   /* NULL without VK_EXT_debug_utils */
 	bool timestamps;                     /* queue supports timestamps */
 	float timestamp_period;              /* ns per tick */
-	bool gather_ok;                      /* shadow format supports textureGather (sampled) */
 	VkFormat color_formats[RND_COLOR_FORMAT_COUNT];
 
 	pthread_mutex_t queue_mu;
@@ -116,7 +116,6 @@ struct rnd_context {
 	pthread_cond_t slot_cv;
 	struct rnd_slot **slots;
 	uint32_t slot_count;
-	uint32_t slot_free_mask_unused;
 	bool *slot_busy;
 
 	volatile int validation_count;       /* atomically incremented by the messenger */

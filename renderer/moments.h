@@ -1,6 +1,6 @@
 /*
- * renderer/moments.h — the compute side of shadow maps (see moments.c): copying a map into
- * the depth atlas, and VSM / EVSM2 moment maps. The context owns the compute pipelines; each
+ * renderer/moments.h — VSM / EVSM2 moment maps (see moments.c), computed from each map just
+ * drawn in a slot's scratch image. The context owns the compute pipelines; each
  * slot owns its scratch and blur images (slot.c).
  */
 #ifndef UMBRA_RENDERER_MOMENTS_H

@@ -249,6 +249,13 @@ static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, c
 enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                 const struct rnd_camera_plan *cam, struct rnd_shadow_plan *out, struct rnd_error *err)
 {
+	return rnd_shadow_plan_with(scene, bounds, cam, NULL, out, err);
+}
+
+enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
+                                     const struct rnd_camera_plan *cam, const uint8_t *forced,
+                                     struct rnd_shadow_plan *out, struct rnd_error *err)
+{
 	memset(out, 0, sizeof *out);
 	if (scene->light_count > UMBRA_MAX_LIGHTS)
 		return rnd_fail(err, RND_ERR_LIMIT, "%u lights: the renderer takes at most %d", scene->light_count, UMBRA_MAX_LIGHTS);
@@ -297,10 +304,12 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 		if (L->type == RND_LIGHT_DIRECTIONAL && s->dir_mode == RND_DIR_CLIPMAP) {
 			clipmap = true;
 			ncasc = s->clipmap_levels ? s->clipmap_levels : 6;
+			if (ncasc > 8) ncasc = 8;
 			need = ncasc;
-		} else if (L->type == RND_LIGHT_DIRECTIONAL && use_cascades(s, bounds, cam)) {
+		} else if (L->type == RND_LIGHT_DIRECTIONAL && (forced ? forced[i] != 0 : use_cascades(s, bounds, cam))) {
 			cascades = true;
 			ncasc = s->cascades ? s->cascades : 4;
+			if (ncasc > 4) ncasc = 4;
 			need = ncasc;
 		}
 		if (out->view_count + need > UMBRA_MAX_SHADOW_VIEWS)

@@ -56,6 +56,11 @@ struct rnd_shadow_plan {
  * renderer cannot honour, saying which light and why. */
 enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                 const struct rnd_camera_plan *cam, struct rnd_shadow_plan *out, struct rnd_error *err);
+/* The same, with the `auto` directional choice made by the caller: cascades[i] 1 = cascades,
+ * 0 = fit (later views of a request keep view 0's choice, so they need the same tiles). */
+enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
+                                     const struct rnd_camera_plan *cam, const uint8_t *cascades,
+                                     struct rnd_shadow_plan *out, struct rnd_error *err);
 
 /* Practical split scheme: far distance of each of n cascades between znear and zfar,
  * lambda 0 = uniform, 1 = logarithmic. */

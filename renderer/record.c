@@ -60,9 +60,10 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 	VkMemoryBarrier2 mb = {
 		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
 		.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, .srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT,
-		.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
+		                VK_PIPELINE_STAGE_2_COPY_BIT,
 		.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-		                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+		                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
 	vkCmdPipelineBarrier2(cmd, &di);
@@ -359,6 +360,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	key.format = RND_PIXELS_RGBA32F;
 	key.samples = 1;
 	key.aov = 1;
+	key.atlas_view = 0;
 	key.prepass = 0;
 	for (uint32_t i = 0; i < rv->ndraw; i++) {
 		uint32_t c = rv->draws[i].cull_back;
@@ -445,7 +447,7 @@ void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, u
 {
 	VkCommandBuffer cmd = s->cmd;
 	VkDeviceSize off = 0;
-	if (!s->white_ready) {
+	if (!s->white_ready) {   /* set by render.c once this command buffer has run */
 		/* The slot's 1x1 white texture, bound for untextured draws. */
 		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
 		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
@@ -457,7 +459,6 @@ void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, u
 		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
 		                     VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-		s->white_ready = true;
 	}
 	for (uint32_t i = 0; i < n; i++) {
 		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,

@@ -53,8 +53,7 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 	if (planes > RND_MAX_AOV_PLANES)
 		return rnd_fail(err, RND_ERR_LIMIT, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)", planes,
 		                RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
-	for (uint32_t i = 0; i < sc->view_count; i++)
-		if (!sc->views) return rnd_fail(err, RND_ERR_INVALID, "view_count %u with no views", sc->view_count);
+	if (sc->view_count && !sc->views) return rnd_fail(err, RND_ERR_INVALID, "view_count %u with no views", sc->view_count);
 	if (sc->view_count > 1024) return rnd_fail(err, RND_ERR_LIMIT, "%u views: at most 1024", sc->view_count);
 	return RND_OK;
 }
@@ -76,7 +75,7 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 /* Fills the uniform/storage regions and points the slot's descriptor set at them. */
 static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                     const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                    const struct rnd_texture *const *tex, uint32_t ntex, float exposure,
+                                    uint32_t ntex, float exposure,
                                     struct rnd_error *err)
 {
 	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
@@ -142,7 +141,6 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		m[i].params[1] = in->alpha_mode == RND_ALPHA_MASK ? in->alpha_cutoff : -1.0f;
 		m[i].tex[1] = in->alpha_mode == RND_ALPHA_MASK;
 		m[i].tex[0] = in->base_color_texture != NULL;
-		(void)tex; (void)ntex;
 	}
 
 	struct umbra_light *l = (struct umbra_light *)(base + off_light);
@@ -435,7 +433,8 @@ static enum rnd_result submit_and_wait(struct rnd_context *ctx, struct rnd_slot 
 	vr = vkWaitForFences(ctx->device, 1, &s->fence, VK_TRUE, RND_FENCE_TIMEOUT_NS);
 	if (vr != VK_SUCCESS)
 		/* A render that does not finish in minutes means a hung or lost device. */
-		return rnd_fail_vk(err, vr == VK_TIMEOUT ? VK_ERROR_DEVICE_LOST : vr, "vkWaitForFences (render)");
+		return rnd_fail_vk(err, vr == VK_TIMEOUT ? VK_ERROR_DEVICE_LOST : vr,
+		                   vr == VK_TIMEOUT ? "render did not finish within 120 s (device hung)" : "vkWaitForFences (render)");
 	vkResetFences(ctx->device, 1, &s->fence);
 	double t1 = now_ms();
 	uint64_t ts[RND_TS_COUNT];
@@ -457,8 +456,10 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	enum rnd_result r;
 	VkResult vr;
 	struct rnd_timings tm = {0};
+	struct rnd_error scratch_err;
+	if (!err) err = &scratch_err;   /* failure paths below always fill it */
 	memset(out, 0, sizeof *out);
-	if (err) memset(err, 0, sizeof *err);
+	memset(err, 0, sizeof *err);
 	if (__atomic_load_n(&ctx->failed, __ATOMIC_RELAXED))
 		return rnd_fail(err, RND_ERR_DEVICE_LOST, "the Vulkan device was lost earlier; the context must be recreated");
 	if ((r = validate(ctx, sc, err)) != RND_OK) return r;
@@ -473,9 +474,11 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		                (unsigned long long)sheet_w, (unsigned long long)sheet_h);
 
 	struct rnd_cache_grant grants[UMBRA_MAX_LIGHTS];
-	uint32_t grant_light[UMBRA_MAX_LIGHTS];
+	uint32_t grant_light[UMBRA_MAX_LIGHTS], req_tiles[UMBRA_MAX_LIGHTS];
 	uint32_t ngrant = 0;
 	bool granted = false;
+	bool gpu_busy = false;        /* a submit did not finish: keep its resources alive */
+	uint8_t cascades[UMBRA_MAX_LIGHTS] = {0};
 
 	/* Per-request memory: one block for the draw list and the shadow plan. */
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
@@ -550,7 +553,11 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		for (uint32_t i = 0; i < sc->object_count; i++)
 			draws[i].cull_back = draws[i].single_sided ||
 			                     (draws[i].closed && record_camera_outside(&cam, &draws[i].bounds));
-		if ((r = rnd_shadow_plan(sc, &bounds, &cam, sp, err)) != RND_OK) goto done;
+		if ((r = rnd_shadow_plan_with(sc, &bounds, &cam, v ? cascades : NULL, sp, err)) != RND_OK) goto done;
+		if (v == 0)
+			for (uint32_t i = 0; i < sc->light_count && i < UMBRA_MAX_LIGHTS; i++)
+				cascades[i] = sc->lights[i].type == RND_LIGHT_DIRECTIONAL && sp->lights[i].view_count > 1 &&
+				              !sp->lights[i].clipmap;
 		bool any_moments = false;
 		for (uint32_t i = 0; i < sc->light_count; i++)
 			if (sp->lights[i].moments && sp->lights[i].view_count) any_moments = true;
@@ -583,6 +590,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 					if (!key) key = 1;
 				}
 				grant_light[ngrant] = i;
+				req_tiles[ngrant] = lp->view_count;
 				req[ngrant++] = (struct rnd_cache_request){key, lp->view_count, lp->resolution};
 			}
 			if ((r = rnd_cache_acquire(ctx, req, ngrant, grants, err)) != RND_OK) { ngrant = 0; goto done; }
@@ -591,6 +599,11 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		uint32_t max_moment_res = 0;
 		for (uint32_t k = 0; k < ngrant; k++) {
 			const struct rnd_light_plan *lp = &sp->lights[grant_light[k]];
+			if (lp->view_count != req_tiles[k]) {
+				r = rnd_fail(err, RND_ERR_INVALID, "light %u: view %u needs %u shadow tiles, view 0 had %u",
+				             grant_light[k], v, lp->view_count, req_tiles[k]);
+				goto done;
+			}
 			bool follows_camera = sc->lights[grant_light[k]].type == RND_LIGHT_DIRECTIONAL && lp->view_count > 1;
 			bool skip = grants[k].hit || (v > 0 && !follows_camera);
 			for (uint32_t t = 0; t < lp->view_count; t++) {
@@ -610,7 +623,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		for (uint32_t k = 0; k < ngrant; k++)
 			if (grants[k].res > max_res) max_res = grants[k].res;
 		if ((r = rnd_slot_shadow_scratch(ctx, s, max_res, err)) != RND_OK) goto done;
-		if ((r = write_params(ctx, s, sc, &cam, sp, tex, ntex, camera->exposure, err)) != RND_OK) goto done;
+		if ((r = write_params(ctx, s, sc, &cam, sp, ntex, camera->exposure, err)) != RND_OK) goto done;
 
 		uint32_t col = v % cols, row = v / cols;
 		VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sheet_w + (VkDeviceSize)col * sc->width);
@@ -627,12 +640,12 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 			vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, s->queries, RND_TS_START);
 		}
 		if (v == 0) record_textures(s, tex, ntex);
-		if (!s->moments_initialised && s->moments_tmp.img) {
+		/* The blur temporary's contents never carry over: take it from UNDEFINED each time. */
+		if (s->moments_tmp.img)
 			record_image_barrier(s->cmd, s->moments_tmp.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+			                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
 			                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-			s->moments_initialised = true;
-		}
 		uint32_t casters = 0;
 		record_shadows(ctx, s, &rv, &casters);
 		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_SHADOW_END);
@@ -644,7 +657,11 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		record_readback(s, &rv);
 		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_COPY_END);
 		if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkEndCommandBuffer"); goto done; }
-		if ((r = submit_and_wait(ctx, s, &tm, err)) != RND_OK) goto lost_check;
+		if ((r = submit_and_wait(ctx, s, &tm, err)) != RND_OK) {
+			gpu_busy = true;
+			goto lost_check;
+		}
+		s->white_ready = true;   /* its clear (recorded while false) has run */
 	}
 
 	double t_copy = now_ms();
@@ -671,14 +688,18 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	goto done;
 
 lost_check:
+done:
 	if (r == RND_ERR_DEVICE_LOST) {
 		__atomic_store_n(&ctx->failed, 1, __ATOMIC_RELAXED);
-		rnd_log(ctx, 0, "device lost: %s", err ? err->msg : "");
+		rnd_log(ctx, 0, "device lost: %s", err->msg);
 	}
-done:
-	/* Everything this render submitted has completed (each submit is waited on). */
-	if (granted) rnd_cache_release(ctx, grants, ngrant, r == RND_OK);
-	rnd_slot_drop_textures(ctx, s);
+	/* Everything this render submitted has completed (each submit is waited on) — unless a
+	 * wait failed: then the GPU may still use the tiles and textures, and they stay held (the
+	 * context is failed and must be recreated, which waits for the device first). */
+	if (!gpu_busy) {
+		if (granted) rnd_cache_release(ctx, grants, ngrant, r == RND_OK);
+		rnd_slot_drop_textures(ctx, s);
+	}
 	rnd_slot_release(ctx, s);
 	free(arena);
 	if (timings) *timings = tm;

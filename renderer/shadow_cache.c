@@ -198,7 +198,11 @@ enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cach
 		if (q->tiles == 0 || q->tiles > 8) { r = rnd_fail(err, RND_ERR_LIMIT, "%u tiles for one light", q->tiles); goto fail; }
 		for (uint32_t i = 0; q->key && i < MAX_ENTRIES; i++) {
 			struct rnd_cache_entry *e = &c->entries[i];
-			if (e->live && e->valid && e->key == q->key && e->ntiles == q->tiles) {
+			/* Only at the resolution asked for: a map made smaller under atlas pressure is not
+			 * what this request would draw, and reusing it would make its bytes depend on
+			 * what the cache held. */
+			uint32_t want = q->res < 64 ? 64 : q->res > c->atlas.size ? c->atlas.size : q->res;
+			if (e->live && e->valid && e->key == q->key && e->ntiles == q->tiles && e->res == want) {
 				e->refs++;
 				e->last_use = c->clock;
 				g->entry = i; g->res = e->res; g->hit = true;

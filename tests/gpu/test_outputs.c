@@ -559,3 +559,27 @@ TEST(outputs_textured_plane_checker)
 	CHECK(plane > 1500 && red > plane / 3 && blue > plane / 3, "red %ld, blue %ld of %ld pixels", red, blue, plane);
 	rnd_image_release(&img);
 }
+
+TEST(outputs_views_keep_view0_shadow_layout)
+{
+	/* `auto` picks cascades for a camera close to a big scene and one fitted map for a camera
+	 * far away. In one request the views share their shadow tiles, so every view keeps view
+	 * 0's choice: the far view must render (and show the box's shadow) without touching tiles
+	 * it was not given. */
+	struct rnd_image img;
+	REQUIRE(gpu_render(&img, "{'width':48,'height':48,'views':["
+	                         "{'position':[3,2,3],'target':[0,0,0]},{'position':[600,400,600],'target':[0,0,0]}],"
+	                         "'objects':[{'shape':'plane','size':[400,400]},{'shape':'box','size':[1,1,1],"
+	                         "'transform':{'translation':[0,0.5,0]}}],"
+	                         "'lights':[{'type':'directional','direction':[0.6,-1,0.5]}],"
+	                         "'output':{'debug':'shadow','msaa':1}}"));
+	CHECK(img.view_count == 2 && img.width == 96 && img.height == 48, "sheet %ux%u of %u views", img.width, img.height,
+	      img.view_count);
+	/* The near view sees the box's shadow on the ground: some pixels read 0. */
+	long dark = 0;
+	for (uint32_t j = 0; j < 48; j++)
+		for (uint32_t i = 0; i < 48; i++)
+			dark += ((const uint8_t *)img.pixels)[j * img.stride + i * 4] < 64;
+	CHECK(dark > 20, "near view: %ld shadowed px", dark);
+	rnd_image_release(&img);
+}
