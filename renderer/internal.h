@@ -22,7 +22,7 @@
 #define RND_COLOR_FORMAT_COUNT 3   /* enum rnd_pixel_format */
 #define RND_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
 #define RND_SHADOW_FORMAT VK_FORMAT_D32_SFLOAT
-#define RND_MAX_VARIANTS 256
+#define RND_MAX_VARIANTS 1024
 
 /* Map a VkResult to a result + message "what: VK_ERROR_..." */
 enum rnd_result rnd_fail_vk(struct rnd_error *err, VkResult vr, const char *what);

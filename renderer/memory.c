@@ -33,7 +33,9 @@ enum rnd_result rnd_buffer_create(struct rnd_context *ctx, VkDeviceSize size, Vk
 	/* Readback wants cached memory (CPU reads), everything else write-combined is fine. */
 	VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 	int type = -1;
-	if (usage & VK_BUFFER_USAGE_TRANSFER_DST_BIT) type = find_memory_type(ctx, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+	/* Only the readback buffers (copy targets the CPU reads, never bound as storage) */
+	bool readback = (usage & VK_BUFFER_USAGE_TRANSFER_DST_BIT) && !(usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+	if (readback) type = find_memory_type(ctx, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
 	else type = find_memory_type(ctx, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
 	if (type < 0) type = find_memory_type(ctx, req.memoryTypeBits, host);
 	if (type < 0) {

@@ -259,6 +259,8 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 {
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r = RND_OK;
+	/* Look up under the lock; compile outside it (lavapipe compiles for 0.1 s or more, and
+	 * other renders' look-ups must not wait behind that); insert under the lock again. */
 	pthread_mutex_lock(&p->mu);
 	for (uint32_t i = 0; i < p->variant_count; i++) {
 		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
@@ -267,10 +269,9 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 			return RND_OK;
 		}
 	}
-	if (p->variant_count == RND_MAX_VARIANTS) {
-		r = rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
-		goto out;
-	}
+	bool full = p->variant_count == RND_MAX_VARIANTS;
+	pthread_mutex_unlock(&p->mu);
+	if (full) return rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
 	VkSpecializationMapEntry entries[UMBRA_SC_COUNT];
 	for (uint32_t i = 0; i < UMBRA_SC_COUNT; i++)
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
@@ -309,14 +310,28 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 out_modules:
 	if (fs_fs) vkDestroyShaderModule(ctx->device, fs_fs, NULL);
 	if (fs_vs) vkDestroyShaderModule(ctx->device, fs_vs, NULL);
-	if (r != RND_OK) goto out;
+	if (r != RND_OK) return r;
+	pthread_mutex_lock(&p->mu);
+	/* Another render may have made the same variant meanwhile: keep the first. */
+	for (uint32_t i = 0; i < p->variant_count; i++) {
+		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
+			*out = p->variants[i].pipeline;
+			pthread_mutex_unlock(&p->mu);
+			vkDestroyPipeline(ctx->device, pipe, NULL);
+			return RND_OK;
+		}
+	}
+	if (p->variant_count == RND_MAX_VARIANTS) {
+		pthread_mutex_unlock(&p->mu);
+		vkDestroyPipeline(ctx->device, pipe, NULL);
+		return rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
+	}
 	p->variants[p->variant_count].key = *key;
 	p->variants[p->variant_count].pipeline = pipe;
 	p->variant_count++;
 	*out = pipe;
-out:
 	pthread_mutex_unlock(&p->mu);
-	return r;
+	return RND_OK;
 }
 
 uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx)
