@@ -180,6 +180,28 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 	vkCmdPipelineBarrier2(cmd, &di);
 }
 
+uint32_t record_light_type(enum rnd_light_type t)
+{
+	return t == RND_LIGHT_DIRECTIONAL ? UMBRA_LIGHT_DIRECTIONAL : t == RND_LIGHT_SPOT ? UMBRA_LIGHT_SPOT : UMBRA_LIGHT_POINT;
+}
+
+uint32_t record_tonemap(enum rnd_tonemap t)
+{
+	return t == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES : t == RND_TONEMAP_NONE ? UMBRA_TONEMAP_NONE : UMBRA_TONEMAP_NEUTRAL;
+}
+
+/* `atlas` is not a mode of mesh.frag (it has its own pipeline): NONE here. */
+uint32_t record_debug(enum rnd_debug d)
+{
+	switch (d) {
+	case RND_DEBUG_SHADOW: return UMBRA_DEBUG_SHADOW;
+	case RND_DEBUG_CASCADES: return UMBRA_DEBUG_CASCADES;
+	case RND_DEBUG_NORMALS: return UMBRA_DEBUG_NORMALS;
+	case RND_DEBUG_DEPTH: return UMBRA_DEBUG_DEPTH;
+	default: return UMBRA_DEBUG_NONE;
+	}
+}
+
 /* The specialization key of this scene's main pass (see mesh.frag). */
 static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
                      uint32_t ndraw, struct rnd_main_key *k)
@@ -189,23 +211,14 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	k->samples = sc->output.msaa > 1 ? 4 : 1;
 	for (uint32_t i = 0; i < sc->light_count; i++) {
 		const struct rnd_light_plan *lp = &sp->lights[i];
-		uint32_t type = sc->lights[i].type == RND_LIGHT_DIRECTIONAL ? UMBRA_LIGHT_DIRECTIONAL
-		              : sc->lights[i].type == RND_LIGHT_SPOT ? UMBRA_LIGHT_SPOT : UMBRA_LIGHT_POINT;
+		uint32_t type = record_light_type(sc->lights[i].type);
 		k->sc[UMBRA_SC_LIGHT_TYPES] |= 1u << type;
 		if (lp->view_count) k->sc[UMBRA_SC_FILTERS] |= 1u << lp->filter;
 		if (type == UMBRA_LIGHT_DIRECTIONAL && lp->view_count > 1) k->sc[UMBRA_SC_CASCADES] = 1;
 	}
-	switch (sc->output.debug) {
-	case RND_DEBUG_SHADOW: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_SHADOW; break;
-	case RND_DEBUG_CASCADES: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_CASCADES; break;
-	case RND_DEBUG_NORMALS: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_NORMALS; break;
-	case RND_DEBUG_DEPTH: k->sc[UMBRA_SC_DEBUG] = UMBRA_DEBUG_DEPTH; break;
-	default: break;
-	}
+	k->sc[UMBRA_SC_DEBUG] = record_debug(sc->output.debug);
 	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;
-	k->sc[UMBRA_SC_TONEMAP] = k->sc[UMBRA_SC_LINEAR] ? 0
-	                        : sc->output.tonemap == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES
-	                        : sc->output.tonemap == RND_TONEMAP_NONE ? UMBRA_TONEMAP_NONE : UMBRA_TONEMAP_NEUTRAL;
+	k->sc[UMBRA_SC_TONEMAP] = k->sc[UMBRA_SC_LINEAR] ? 0 : record_tonemap(sc->output.tonemap);
 	uint64_t dense = 0;
 	for (uint32_t i = 0; i < ndraw; i++) {
 		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;

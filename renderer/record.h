@@ -51,6 +51,12 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 /* Copies the resolved colour (and AOV targets) into the readback buffer, then makes it host-visible. */
 void record_readback(struct rnd_slot *s, const struct record_view *v);
 
+/* The public enums as the shaders spell them (umbra_shared.h); the uniforms (render.c) and
+ * the specialization key (record.c) both use these, so they cannot drift apart. */
+uint32_t record_light_type(enum rnd_light_type t);
+uint32_t record_tonemap(enum rnd_tonemap t);
+uint32_t record_debug(enum rnd_debug d);
+
 /* Culling helpers shared with render.c. */
 bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b);
 

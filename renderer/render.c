@@ -110,15 +110,8 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	f->params[0] = exp2f(exposure);
 	f->params[1] = cam->znear;
 	f->params[2] = cam->zfar;
-	f->mode[0] = sc->output.tonemap == RND_TONEMAP_ACES ? UMBRA_TONEMAP_ACES
-	           : sc->output.tonemap == RND_TONEMAP_NONE ? UMBRA_TONEMAP_NONE : UMBRA_TONEMAP_NEUTRAL;
-	switch (sc->output.debug) {
-	case RND_DEBUG_SHADOW: f->mode[1] = UMBRA_DEBUG_SHADOW; break;
-	case RND_DEBUG_CASCADES: f->mode[1] = UMBRA_DEBUG_CASCADES; break;
-	case RND_DEBUG_NORMALS: f->mode[1] = UMBRA_DEBUG_NORMALS; break;
-	case RND_DEBUG_DEPTH: f->mode[1] = UMBRA_DEBUG_DEPTH; break;
-	default: f->mode[1] = UMBRA_DEBUG_NONE; break;
-	}
+	f->mode[0] = record_tonemap(sc->output.tonemap);
+	f->mode[1] = record_debug(sc->output.debug);
 	f->mode[2] = sc->output.debug_light;
 	f->mode[3] = sc->light_count;
 	f->mode2[0] = sc->output.pixels == RND_PIXELS_RGBA32F ? 1u : 0u;
@@ -148,8 +141,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		const struct rnd_light *in = &sc->lights[i];
 		const struct rnd_light_plan *lp = &sp->lights[i];
 		for (int k = 0; k < 3; k++) l[i].color[k] = in->color[k] * in->intensity;
-		l[i].color[3] = in->type == RND_LIGHT_DIRECTIONAL ? UMBRA_LIGHT_DIRECTIONAL
-		              : in->type == RND_LIGHT_SPOT ? UMBRA_LIGHT_SPOT : UMBRA_LIGHT_POINT;
+		l[i].color[3] = (float)record_light_type(in->type);
 		memcpy(l[i].position, in->position, sizeof in->position);
 		l[i].position[3] = in->range;
 		float d[3] = {0, -1, 0};
