@@ -69,6 +69,8 @@ struct api_scene {
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;
+	const uint32_t *object_source_; /* document object index of each scene.objects[i] (NULL: i) */
+	const char *views_key_;         /* "views" / "turntable" / NULL */
 };
 
 /* Parses and validates a scene document. On failure fills p (400: malformed / wrong type /
@@ -113,6 +115,17 @@ void api_model_cache_clear(void);
 /* Switches the output to the given format as if output.format had said so (Accept header,
  * CLI -o extension): adjusts scene.output.pixels. Fails (400) for PNG with AOVs. */
 enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, struct api_problem *p);
+
+/* After the format is settled (output.format, then the Accept header or the CLI's output name
+ * through api_scene_set_format): 400 at /output/aovs when AOVs were asked for and the answer is
+ * still the default PNG. Call it before rendering; api_encode() refuses such a scene too. */
+enum api_result api_scene_check_output(const struct api_scene *s, struct api_problem *p);
+
+/* The problem for a render of s that failed with e: status (422 for RND_ERR_LIMIT, ...) and the
+ * JSON Pointer of the member e->at names (/width, /output/aovs, /lights/3, the document object
+ * a model's mesh came from, ...), detail = e->msg. Returns API_ERR. */
+enum api_result api_problem_from_render(struct api_problem *p, const struct api_scene *s, const struct rnd_error *e,
+                                        int status);
 
 /* Encodes a rendered image as the scene asks (PNG 8/16-bit or EXR with AOVs). Several views:
  * the PNG is the sheet as rendered; the EXR is multi-part (see api_exr_encode). */

@@ -115,3 +115,27 @@ const char *api_format_mime(enum api_format f)
 {
 	return f == API_FORMAT_EXR ? "image/x-exr" : "image/png";
 }
+
+enum api_result api_problem_from_render(struct api_problem *p, const struct api_scene *s, const struct rnd_error *e,
+                                        int status)
+{
+	char ptr[64] = "";
+	uint32_t i = e->at_index;
+	switch (e->at) {
+	case RND_AT_NONE: break;
+	case RND_AT_SIZE:
+		snprintf(ptr, sizeof ptr, "/%s", s && s->scene.height > s->scene.width ? "height" : "width");
+		break;
+	case RND_AT_VIEWS: snprintf(ptr, sizeof ptr, "/%s", s && s->views_key_ ? s->views_key_ : "width"); break;
+	case RND_AT_AOVS: snprintf(ptr, sizeof ptr, "/output/aovs"); break;
+	case RND_AT_LIGHTS: snprintf(ptr, sizeof ptr, "/lights"); break;
+	case RND_AT_LIGHT: snprintf(ptr, sizeof ptr, "/lights/%u", i); break;
+	case RND_AT_OBJECTS: snprintf(ptr, sizeof ptr, "/objects"); break;
+	case RND_AT_OBJECT:
+		if (s && s->object_source_ && i < s->scene.object_count) i = s->object_source_[i];
+		snprintf(ptr, sizeof ptr, "/objects/%u", i);
+		break;
+	case RND_AT_MATERIALS: snprintf(ptr, sizeof ptr, "/materials"); break;
+	}
+	return api_problem_set(p, status, ptr, "%s", e->msg[0] ? e->msg : rnd_result_str(e->code));
+}

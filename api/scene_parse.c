@@ -56,6 +56,8 @@ struct pctx {
 	const struct api_part *parts;
 	size_t nparts;
 	struct model_ref *models;
+	const uint32_t *object_source;  /* document object of each rnd object (NULL: the same index) */
+	const char *views_key;          /* "views" or "turntable" when the document has either */
 	struct api_model *cur_model;
 };
 
@@ -1275,12 +1277,11 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 			if (o->aovs & aov_bits[e]) rc = fail(c, "aovs lists \"%s\" twice", aovs[e]);
 			o->aovs |= aov_bits[e];
 		}
-		if (!rc && o->aovs) {
-			if (s->format_explicit && s->format == API_FORMAT_PNG)
-				rc = fail(c, "aovs need format \"exr\": a PNG has no room for AOV channels");
-			else
-				s->format = API_FORMAT_EXR; /* aovs imply EXR when no format is given */
-		}
+		/* The default format is PNG, which has no room for AOVs. Without an explicit format the
+		 * request may still choose EXR (Accept, the CLI's -o name): api_scene_check_output()
+		 * decides once that choice is made. */
+		if (!rc && o->aovs && s->format_explicit && s->format == API_FORMAT_PNG)
+			rc = fail(c, "aovs need format \"exr\": a PNG has no room for AOV channels");
 		ptr_pop(c, old);
 		if (rc) return -1;
 	}
@@ -1306,12 +1307,15 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 	if (nobj > UINT32_MAX / 2 || nmat > UINT32_MAX / 2) return fail(c, "the scene has too many objects");
 	struct rnd_object *objects = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *objects);
 	struct rnd_material *mats = api_arena_calloc(c->arena, nmat ? nmat : 1, sizeof *mats);
-	if (!objects || !mats) return fail(c, "out of memory");
+	uint32_t *source = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *source);
+	if (!objects || !mats || !source) return fail(c, "out of memory");
+	c->object_source = source;
 	memcpy(mats, c->mats, c->mat_count * sizeof *mats);
 	uint32_t no = 0, nm = c->mat_count;
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		const struct api_model *m = models[i];
 		if (!m) {
+			source[no] = i;
 			objects[no++] = sc->objects[i];
 			continue;
 		}
@@ -1324,6 +1328,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 		for (uint32_t k = 0; k < m->instance_count; k++) {
 			const struct api_model_instance *in = &m->instances[k];
 			const struct api_model_mesh *me = &m->meshes[in->mesh];
+			source[no] = i;
 			struct rnd_object *o = &objects[no++];
 			*o = sc->objects[i];   /* shadows, sidedness, material override */
 			o->shape = RND_SHAPE_MESH;
@@ -1679,6 +1684,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		uint32_t rows = (n + cols - 1) / cols;
 		uint64_t sw = (uint64_t)cols * sc->width, sh = (uint64_t)rows * sc->height, sheet = sw * sh;
 		const char *key = views ? "views" : "turntable";
+		c->views_key = key;
 		if (c->lim->max_pixels && sheet > c->lim->max_pixels)
 			defer(c, false, key, "%u views of %ux%u make a %llux%llu sheet (%llu pixels), over this server's "
 			      "limit of %llu", n, sc->width, sc->height, (unsigned long long)sw, (unsigned long long)sh,
@@ -1764,6 +1770,8 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 		return API_ERR;
 	}
 	s->models_ = c.models;
+	s->object_source_ = c.object_source;
+	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
 	*out = s;
 	return API_OK;
@@ -1775,6 +1783,17 @@ void api_scene_free(struct api_scene *s)
 	if (!s) return;
 	model_refs_release(s->models_);
 	api_arena_destroy(s->arena_);
+}
+
+enum api_result api_scene_check_output(const struct api_scene *s, struct api_problem *p)
+{
+	struct api_problem scratch;
+	if (!p) p = &scratch;
+	if (s && s->format == API_FORMAT_PNG && s->scene.output.aovs)
+		return api_problem_set(p, 400, "/output/aovs", "aovs need an EXR answer (output.format \"exr\", "
+		                       "Accept: image/x-exr, or an .exr output file): the default format PNG has no room "
+		                       "for AOV channels");
+	return API_OK;
 }
 
 enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, struct api_problem *p)

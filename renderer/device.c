@@ -36,6 +36,24 @@ enum rnd_result rnd_fail(struct rnd_error *err, enum rnd_result code, const char
 		va_end(ap);
 		err->code = code;
 		err->vk_result = 0;
+		err->at = RND_AT_NONE;
+		err->at_index = 0;
+	}
+	return code;
+}
+
+enum rnd_result rnd_fail_at(struct rnd_error *err, enum rnd_result code, enum rnd_error_at at, uint32_t index,
+                            const char *fmt, ...)
+{
+	if (err) {
+		va_list ap;
+		va_start(ap, fmt);
+		vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+		va_end(ap);
+		err->code = code;
+		err->vk_result = 0;
+		err->at = at;
+		err->at_index = index;
 	}
 	return code;
 }
@@ -223,6 +241,15 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 		return rnd_fail(err, RND_ERR_NO_DEVICE, "no Vulkan 1.3 device%s%s%s (found %s)",
 		                want && *want ? " named like '" : "", want && *want ? want : "", want && *want ? "'" : "", names);
 	vkGetPhysicalDeviceMemoryProperties(ctx->phys, &ctx->mem_props);
+	/* The largest single allocation and buffer: renders that would need more are refused
+	 * up front (estimate.c) rather than failing as out-of-memory. */
+	VkPhysicalDeviceMaintenance4Properties m4 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES};
+	VkPhysicalDeviceMaintenance3Properties m3 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES,
+	                                             .pNext = &m4};
+	VkPhysicalDeviceProperties2 lim2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &m3};
+	vkGetPhysicalDeviceProperties2(ctx->phys, &lim2);
+	ctx->max_allocation = m3.maxMemoryAllocationSize;
+	if (m4.maxBufferSize && m4.maxBufferSize < ctx->max_allocation) ctx->max_allocation = m4.maxBufferSize;
 
 	VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
 	VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &drv};
@@ -426,6 +453,7 @@ void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info)
 	snprintf(info->driver_info, sizeof info->driver_info, "%s", ctx->driver_info);
 	info->api_version = ctx->props.apiVersion;
 	info->is_cpu = ctx->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+	info->max_allocation = ctx->max_allocation;
 	info->max_image_dimension = ctx->props.limits.maxImageDimension2D;
 	info->max_shadow_resolution = ctx->props.limits.maxImageDimension2D < 8192 ? ctx->props.limits.maxImageDimension2D : 8192;
 	info->moments_fp32_filterable = ctx->moments.fp32;

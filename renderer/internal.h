@@ -94,6 +94,7 @@ struct rnd_context {
 	VkPhysicalDevice phys;
 	VkPhysicalDeviceProperties props;
 	VkPhysicalDeviceMemoryProperties mem_props;
+	VkDeviceSize max_allocation;         /* maxMemoryAllocationSize (Vulkan 1.1), min maxBufferSize (1.3) */
 	char driver_name[256], driver_info[256];
 	VkDevice device;
 	VkQueue queue;

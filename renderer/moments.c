@@ -144,3 +144,11 @@ void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const 
 		vkCmdDispatch(cmd, groups, groups, 1);
 	}
 }
+
+uint32_t rnd_moments_max_res(const struct rnd_context *ctx)
+{
+	uint64_t range = ctx->props.limits.maxStorageBufferRange;
+	uint32_t r = 16384;
+	while (r > 64 && (uint64_t)r * r * 4 > range) r /= 2;
+	return r;
+}

@@ -20,6 +20,9 @@ void rnd_moments_release(struct rnd_context *ctx);
 /* The moment format for a request (fp16 when asked or when fp32 cannot be filtered). */
 VkFormat rnd_moments_format(const struct rnd_context *ctx, bool want_fp16);
 float rnd_moments_max_exponent(VkFormat f);
+/* Largest moment-map side the blur can read: the depth scratch (res² floats) is bound as one
+ * storage buffer, at most maxStorageBufferRange bytes (128 MiB on lavapipe: 4096). */
+uint32_t rnd_moments_max_res(const struct rnd_context *ctx);
 /* After shadow view v (of a VSM / EVSM light) was drawn in s->shadow_scratch and copied to
  * s->scratch_buf: blurs its moments into the view's tile of the moment atlas. s->moments_set
  * must point at the scratch buffer, the blur temporary and the moment atlas. */

@@ -258,7 +258,8 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 {
 	memset(out, 0, sizeof *out);
 	if (scene->light_count > UMBRA_MAX_LIGHTS)
-		return rnd_fail(err, RND_ERR_LIMIT, "%u lights: the renderer takes at most %d", scene->light_count, UMBRA_MAX_LIGHTS);
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0, "%u lights: the renderer takes at most %d",
+		                   scene->light_count, UMBRA_MAX_LIGHTS);
 	bool empty = rnd_aabb_is_empty(bounds);
 	out->resolution = 0;
 
@@ -313,7 +314,8 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 			need = ncasc;
 		}
 		if (out->view_count + need > UMBRA_MAX_SHADOW_VIEWS)
-			return rnd_fail(err, RND_ERR_LIMIT, "light %u: more than %d shadow views in one scene", i, UMBRA_MAX_SHADOW_VIEWS);
+			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHT, i, "light %u: more than %d shadow views in one scene", i,
+			                   UMBRA_MAX_SHADOW_VIEWS);
 		lp->first_view = out->view_count;
 		lp->view_count = need;
 

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "estimate.h"
 #include "mesh.h"
 #include "plan.h"
 #include "moments.h"
@@ -33,14 +34,15 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 {
 	if (sc->width < 1 || sc->height < 1 || sc->width > ctx->desc.max_width || sc->height > ctx->desc.max_height ||
 	    sc->width > ctx->props.limits.maxImageDimension2D || sc->height > ctx->props.limits.maxImageDimension2D)
-		return rnd_fail(err, RND_ERR_LIMIT, "image %ux%u is outside 1..%u x 1..%u", sc->width, sc->height,
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_SIZE, 0, "image %ux%u is outside 1..%u x 1..%u", sc->width, sc->height,
 		                ctx->desc.max_width, ctx->desc.max_height);
 	if (sc->output.msaa != 1 && sc->output.msaa != 4)
 		return rnd_fail(err, RND_ERR_INVALID, "msaa %u: must be 1 or 4", sc->output.msaa);
 	if ((unsigned)sc->output.pixels >= RND_COLOR_FORMAT_COUNT)
 		return rnd_fail(err, RND_ERR_INVALID, "unknown pixel format %d", (int)sc->output.pixels);
 	if (sc->material_count > UMBRA_MAX_MATERIALS)
-		return rnd_fail(err, RND_ERR_LIMIT, "%u materials: at most %d", sc->material_count, UMBRA_MAX_MATERIALS);
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_MATERIALS, 0, "%u materials: at most %d", sc->material_count,
+		                   UMBRA_MAX_MATERIALS);
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		if (sc->objects[i].material >= sc->material_count && sc->material_count > 0)
 			return rnd_fail(err, RND_ERR_INVALID, "object %u: material %u does not exist", i, sc->objects[i].material);
@@ -51,10 +53,10 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 	uint32_t planes = (sc->output.aovs & RND_AOV_DEPTH ? 1 : 0) + (sc->output.aovs & RND_AOV_NORMAL ? 3 : 0) +
 	                  (sc->output.aovs & RND_AOV_ALBEDO ? 3 : 0) + (sc->output.aovs & RND_AOV_SHADOW ? sc->light_count : 0);
 	if (planes > RND_MAX_AOV_PLANES)
-		return rnd_fail(err, RND_ERR_LIMIT, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)", planes,
-		                RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_AOVS, 0, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)",
+		                   planes, RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
 	if (sc->view_count && !sc->views) return rnd_fail(err, RND_ERR_INVALID, "view_count %u with no views", sc->view_count);
-	if (sc->view_count > 1024) return rnd_fail(err, RND_ERR_LIMIT, "%u views: at most 1024", sc->view_count);
+	if (sc->view_count > 1024) return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "%u views: at most 1024", sc->view_count);
 	return RND_OK;
 }
 
@@ -211,7 +213,11 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	}
 	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
 	/* moments.comp: the scratch map in, the blur temporary, the moment atlas out. */
-	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, VK_WHOLE_SIZE};
+	/* Moment maps read at most maxStorageBufferRange bytes of it (their resolution is capped to
+	 * fit: rnd_moments_max_res); a larger depth-only scratch is never read through this. */
+	VkDeviceSize sb_range = s->scratch_buf.size < ctx->props.limits.maxStorageBufferRange
+	                      ? s->scratch_buf.size : ctx->props.limits.maxStorageBufferRange;
+	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, sb_range};
 	VkDescriptorImageInfo ci[3] = {
 		{VK_NULL_HANDLE, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED},
 		{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
@@ -252,7 +258,7 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		nv += v; ni += x;
 	}
 	if (nv > UINT32_MAX || ni > UINT32_MAX)
-		return rnd_fail(err, RND_ERR_LIMIT, "scene too large: %llu vertices, %llu indices",
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECTS, 0, "scene too large: %llu vertices, %llu indices",
 		                (unsigned long long)nv, (unsigned long long)ni);
 	enum rnd_result r;
 	VkDeviceSize vbytes = (nv ? nv : 1) * sizeof(struct rnd_vertex), ibytes = (ni ? ni : 1) * sizeof(uint32_t);
@@ -310,7 +316,8 @@ static enum rnd_result textures(struct rnd_context *ctx, struct rnd_slot *s, con
 		while (k < n && tex[k] != t) k++;
 		if (k < n) continue;
 		if (n == UMBRA_MAX_TEXTURES)
-			return rnd_fail(err, RND_ERR_LIMIT, "more than %d distinct textures in one scene", UMBRA_MAX_TEXTURES);
+			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_MATERIALS, 0, "more than %d distinct textures in one scene",
+			                   UMBRA_MAX_TEXTURES);
 		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", i, t->width, t->height);
 		tex[n++] = t;
@@ -342,13 +349,6 @@ static enum rnd_result textures(struct rnd_context *ctx, struct rnd_slot *s, con
 }
 
 /* Number of AOV passes the scene's AOVs need (see aov.frag). */
-static uint32_t aov_passes(const struct rnd_scene *sc)
-{
-	if (!sc->output.aovs) return 0;
-	uint32_t n = (sc->output.aovs & RND_AOV_SHADOW) ? sc->light_count : 0;
-	return n <= 8 ? 1 : 1 + (n - 8 + 15) / 16;
-}
-
 /* Turns the AOV attachments in the readback buffer (RGBA32F, sheet-sized each) into named
  * float planes. */
 static enum rnd_result split_aovs(const struct rnd_scene *sc, const float *rb, size_t att_floats, uint32_t npix,
@@ -457,13 +457,14 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if ((r = validate(ctx, sc, err)) != RND_OK) return r;
 
 	uint32_t nviews = sc->view_count ? sc->view_count : 1;
-	uint32_t cols = 1;
-	while (cols * cols < nviews) cols++;
-	uint32_t rows = (nviews + cols - 1) / cols;
+	uint32_t cols, rows;
+	rnd_sheet_layout(nviews, &cols, &rows);
 	uint64_t sheet_w = (uint64_t)cols * sc->width, sheet_h = (uint64_t)rows * sc->height;
 	if (sheet_w > 65536 || sheet_h > 65536 || sheet_w * sheet_h > (1ull << 28))
-		return rnd_fail(err, RND_ERR_LIMIT, "a sheet of %u views is %llux%llu pixels: too large", nviews,
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "a sheet of %u views is %llux%llu pixels: too large", nviews,
 		                (unsigned long long)sheet_w, (unsigned long long)sheet_h);
+	struct rnd_estimate est;
+	if ((r = rnd_render_estimate(ctx, sc, &est, err)) != RND_OK) return r;
 
 	struct rnd_cache_grant grants[UMBRA_MAX_LIGHTS];
 	uint32_t grant_light[UMBRA_MAX_LIGHTS], req_tiles[UMBRA_MAX_LIGHTS];
@@ -498,7 +499,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 
 	VkFormat fmt = ctx->color_formats[sc->output.pixels];
 	if ((r = rnd_slot_targets(ctx, s, fmt, sc->width, sc->height, sc->output.msaa, err)) != RND_OK) goto done;
-	uint32_t passes = aov_passes(sc);
+	uint32_t passes = rnd_aov_passes(sc);
 	if (passes && (r = rnd_slot_aov(ctx, s, sc->width, sc->height, err)) != RND_OK) goto done;
 	size_t px = pixel_size(sc->output.pixels);
 	VkDeviceSize color_bytes = sheet_w * sheet_h * px;
@@ -583,9 +584,12 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 				}
 				grant_light[ngrant] = i;
 				req_tiles[ngrant] = lp->view_count;
-				req[ngrant++] = (struct rnd_cache_request){key, lp->view_count, lp->resolution};
+				/* Moment maps are read as a storage buffer: at most the device's range. */
+				uint32_t res = lp->resolution, mmax = rnd_moments_max_res(ctx);
+				if (lp->moments && res > mmax) res = mmax;
+				req[ngrant++] = (struct rnd_cache_request){key, lp->view_count, res};
 			}
-			if ((r = rnd_cache_acquire(ctx, req, ngrant, grants, err)) != RND_OK) { ngrant = 0; goto done; }
+			if ((r = rnd_cache_acquire(ctx, req, ngrant, 0, grants, err)) != RND_OK) { ngrant = 0; goto done; }
 			granted = true;
 		}
 		uint32_t max_moment_res = 0;
@@ -691,6 +695,7 @@ done:
 	if (!gpu_busy) {
 		if (granted) rnd_cache_release(ctx, grants, ngrant, r == RND_OK);
 		rnd_slot_drop_textures(ctx, s);
+		rnd_slot_trim(ctx, s);
 	}
 	rnd_slot_release(ctx, s);
 	free(arena);

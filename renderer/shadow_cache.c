@@ -2,7 +2,10 @@
  * renderer/shadow_cache.c — persistent shadow atlases and the shadow-map cache (see
  * shadow_cache.h).
  */
+#include <errno.h>
+#include <math.h>
 #include <stdlib.h>
+#include <time.h>
 #include <string.h>
 #include "moments.h"
 #include "shadow_cache.h"
@@ -21,6 +24,7 @@ struct rnd_cache_entry {
 
 struct rnd_shadow_cache {
 	pthread_mutex_t mu;
+	pthread_cond_t released;  /* broadcast whenever a render gives tiles back */
 	struct rnd_atlas atlas;
 	struct rnd_cache_entry entries[MAX_ENTRIES];
 	uint64_t clock;
@@ -106,6 +110,11 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 		return rnd_fail(err, RND_ERR_INVALID, "atlas size %u: must be a power of two between 64 and 16384", size);
 	}
 	pthread_mutex_init(&c->mu, NULL);
+	pthread_condattr_t ca;
+	pthread_condattr_init(&ca);
+	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+	pthread_cond_init(&c->released, &ca);
+	pthread_condattr_destroy(&ca);
 	ctx->cache = c;
 	/* Maps are drawn at the origin of a slot's scratch depth image and copied into their tile;
 	 * the atlas itself is never a render target. */
@@ -132,6 +141,7 @@ void rnd_cache_release_all(struct rnd_context *ctx)
 	rnd_image_destroy(ctx, &ctx->atlas_depth);
 	if (!c) return;
 	rnd_atlas_release(&c->atlas);
+	pthread_cond_destroy(&c->released);
 	pthread_mutex_destroy(&c->mu);
 	free(c);
 	ctx->cache = NULL;
@@ -180,96 +190,143 @@ static uint32_t free_slot(struct rnd_shadow_cache *c)
 	return MAX_ENTRIES;
 }
 
-enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cache_request *req, uint32_t n,
-                                  struct rnd_cache_grant *out, struct rnd_error *err)
+/* The resolution of every request's tiles, a function of the request alone (not of what the
+ * cache holds or what other renders use), so the same request always draws the same maps:
+ * each clamped to 64..atlas size, then the largest (the first of equals) halved until all
+ * tiles together fit in the atlas. False when even 64² tiles do not fit. */
+static bool plan_resolutions(const struct rnd_cache_request *req, uint32_t n, uint32_t atlas, uint32_t res[])
 {
-	struct rnd_shadow_cache *c = ctx->cache;
-	enum rnd_result r = RND_OK;
-	uint32_t res[UMBRA_MAX_LIGHTS], order[UMBRA_MAX_LIGHTS], nmiss = 0;
-	bool granted[UMBRA_MAX_LIGHTS] = {false};
-	if (n > UMBRA_MAX_LIGHTS) return rnd_fail(err, RND_ERR_LIMIT, "%u shadowed lights: at most %d", n, UMBRA_MAX_LIGHTS);
-	pthread_mutex_lock(&c->mu);
-	c->clock++;
-	/* 1. Completed maps with the same key are reused as they are. */
+	for (uint32_t k = 0; k < n; k++) res[k] = req[k].res < 64 ? 64 : req[k].res > atlas ? atlas : req[k].res;
+	for (;;) {
+		uint64_t need = 0;
+		uint32_t big = n;
+		for (uint32_t k = 0; k < n; k++) {
+			need += (uint64_t)req[k].tiles * res[k] * res[k];
+			if (res[k] > 64 && (big == n || res[k] > res[big])) big = k;
+		}
+		if (need <= (uint64_t)atlas * atlas) return true;
+		if (big == n) return false;
+		res[big] /= 2;
+	}
+}
+
+/* Gives back what one attempt took (hits referenced, new entries allocated). */
+static void undo_attempt(struct rnd_shadow_cache *c, struct rnd_cache_grant *out, const bool *granted, uint32_t n)
+{
 	for (uint32_t k = 0; k < n; k++) {
-		const struct rnd_cache_request *q = &req[k];
+		if (!granted[k]) continue;
+		struct rnd_cache_entry *e = &c->entries[out[k].entry];
+		if (out[k].hit) e->refs--;
+		else entry_free(c, e);
+	}
+}
+
+/* One try at granting every request at its planned resolution: completed maps with the same
+ * key and resolution are reused when use_hits, the rest allocated largest first, evicting
+ * maps nobody uses. All or nothing: false (with nothing held) when the atlas has no room now. */
+static bool attempt(struct rnd_shadow_cache *c, const struct rnd_cache_request *req, uint32_t n, const uint32_t *res,
+                    bool use_hits, struct rnd_cache_grant *out)
+{
+	bool granted[UMBRA_MAX_LIGHTS] = {false};
+	uint32_t order[UMBRA_MAX_LIGHTS], nmiss = 0;
+	for (uint32_t k = 0; k < n; k++) {
 		struct rnd_cache_grant *g = &out[k];
 		memset(g, 0, sizeof *g);
-		if (q->tiles == 0 || q->tiles > 8) { r = rnd_fail(err, RND_ERR_LIMIT, "%u tiles for one light", q->tiles); goto fail; }
-		for (uint32_t i = 0; q->key && i < MAX_ENTRIES; i++) {
+		for (uint32_t i = 0; use_hits && req[k].key && i < MAX_ENTRIES; i++) {
 			struct rnd_cache_entry *e = &c->entries[i];
-			/* Only at the resolution asked for: a map made smaller under atlas pressure is not
-			 * what this request would draw, and reusing it would make its bytes depend on
-			 * what the cache held. */
-			uint32_t want = q->res < 64 ? 64 : q->res > c->atlas.size ? c->atlas.size : q->res;
-			if (e->live && e->valid && e->key == q->key && e->ntiles == q->tiles && e->res == want) {
+			if (e->live && e->valid && e->key == req[k].key && e->ntiles == req[k].tiles && e->res == res[k]) {
 				e->refs++;
 				e->last_use = c->clock;
 				g->entry = i; g->res = e->res; g->hit = true;
 				memcpy(g->tile, e->tile, sizeof e->tile);
 				granted[k] = true;
-				__atomic_add_fetch(&ctx->stats_hits, 1, __ATOMIC_RELAXED);
 				break;
 			}
 		}
-		if (granted[k]) continue;
-		res[k] = q->res < 64 ? 64 : q->res > c->atlas.size ? c->atlas.size : q->res;
-		order[nmiss++] = k;
+		if (!granted[k]) order[nmiss++] = k;
 	}
-	/* 2. Budget: what is not held by maps in use (by this or other renders) can be had,
-	 * evicting unused maps. Over budget, the largest maps give up resolution first. */
-	uint64_t held = 0;
-	for (uint32_t i = 0; i < MAX_ENTRIES; i++)
-		if (c->entries[i].live && c->entries[i].refs)
-			held += (uint64_t)c->entries[i].ntiles * c->entries[i].res * c->entries[i].res;
-	uint64_t budget = (uint64_t)c->atlas.size * c->atlas.size - held;
-	for (;;) {
-		uint64_t need = 0;
-		uint32_t big = n;
-		for (uint32_t m = 0; m < nmiss; m++) {
-			uint32_t k = order[m];
-			need += (uint64_t)req[k].tiles * res[k] * res[k];
-			if (res[k] > 64 && (big == n || res[k] > res[big])) big = k;
-		}
-		if (need <= budget || big == n) break;
-		res[big] /= 2;
-	}
-	/* 3. Allocate the largest first (fewest holes), evicting unused maps as needed; where
-	 * fragmentation still leaves no room, that light goes down one more step. */
+	/* Largest first: in a buddy quadtree, power-of-two squares placed in decreasing size
+	 * always fit when their area does. */
 	for (uint32_t a = 0; a < nmiss; a++)
-		for (uint32_t b2 = a + 1; b2 < nmiss; b2++)
-			if (res[order[b2]] > res[order[a]]) { uint32_t t = order[a]; order[a] = order[b2]; order[b2] = t; }
+		for (uint32_t b = a + 1; b < nmiss; b++)
+			if (res[order[b]] > res[order[a]]) { uint32_t t = order[a]; order[a] = order[b]; order[b] = t; }
 	for (uint32_t m = 0; m < nmiss; m++) {
 		uint32_t k = order[m];
-		const struct rnd_cache_request *q = &req[k];
-		struct rnd_cache_grant *g = &out[k];
 		uint32_t slot = free_slot(c);
-		if (slot == MAX_ENTRIES) { r = rnd_fail(err, RND_ERR_LIMIT, "shadow cache: all %d entries in use", MAX_ENTRIES); goto fail; }
-		struct rnd_cache_entry *e = &c->entries[slot];
+		struct rnd_cache_entry *e = slot < MAX_ENTRIES ? &c->entries[slot] : NULL;
 		bool ok = false;
-		while (!ok) {
-			ok = alloc_tiles(c, e, q->tiles, res[k]);
-			if (ok || evict_one(c)) continue;
-			if (res[k] <= 64) break;
-			res[k] /= 2;
-		}
+		while (e && !(ok = alloc_tiles(c, e, req[k].tiles, res[k])) && evict_one(c)) {}
 		if (!ok) {
-			r = rnd_fail(err, RND_ERR_LIMIT, "shadow atlas (%ux%u) is full: %u tiles of 64 do not fit next to the "
-			             "maps in use (raise the atlas size)", c->atlas.size, c->atlas.size, q->tiles);
-			goto fail;
+			undo_attempt(c, out, granted, n);
+			return false;
 		}
-		e->live = true; e->valid = false; e->key = q->key; e->refs = 1; e->last_use = c->clock;
-		g->entry = slot; g->res = e->res; g->hit = false;
-		memcpy(g->tile, e->tile, sizeof e->tile);
+		e->live = true; e->valid = false; e->key = req[k].key; e->refs = 1; e->last_use = c->clock;
+		out[k].entry = slot; out[k].res = e->res; out[k].hit = false;
+		memcpy(out[k].tile, e->tile, sizeof e->tile);
 		granted[k] = true;
-		if (q->key) __atomic_add_fetch(&ctx->stats_misses, 1, __ATOMIC_RELAXED);
 	}
+	return true;
+}
+
+static bool others_hold_tiles(const struct rnd_shadow_cache *c)
+{
+	for (uint32_t i = 0; i < MAX_ENTRIES; i++)
+		if (c->entries[i].live && c->entries[i].refs) return true;
+	return false;
+}
+
+enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cache_request *req, uint32_t n,
+                                  double deadline, struct rnd_cache_grant *out, struct rnd_error *err)
+{
+	struct rnd_shadow_cache *c = ctx->cache;
+	uint32_t res[UMBRA_MAX_LIGHTS];
+	if (n > UMBRA_MAX_LIGHTS)
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0, "%u shadowed lights: at most %d", n, UMBRA_MAX_LIGHTS);
+	uint64_t min_texels = 0;
+	for (uint32_t k = 0; k < n; k++) {
+		if (req[k].tiles == 0 || req[k].tiles > 8)
+			return rnd_fail(err, RND_ERR_INVALID, "%u shadow tiles for one light", req[k].tiles);
+		min_texels += (uint64_t)req[k].tiles * 64 * 64;
+	}
+	if (!plan_resolutions(req, n, c->atlas.size, res))
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0,
+		                   "the lights need %llu shadow tiles; even at 64x64 texels they do not fit in the "
+		                   "%ux%u shadow atlas (raise --atlas-size or use fewer shadowed lights)",
+		                   (unsigned long long)(min_texels / 4096), c->atlas.size, c->atlas.size);
+	pthread_mutex_lock(&c->mu);
+	c->clock++;
+	enum rnd_result r = RND_OK;
+	/* Reusing completed maps first; when they leave no room, drawing everything again (the
+	 * request's own maps are then evictable). When other renders hold the room, wait for them:
+	 * each render holds its tiles only while it runs, and a waiting render holds none, so the
+	 * wait ends. */
+	while (!attempt(c, req, n, res, true, out) && !attempt(c, req, n, res, false, out)) {
+		if (!others_hold_tiles(c)) {
+			r = rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0, "the shadow maps do not fit in the %ux%u atlas",
+			                c->atlas.size, c->atlas.size);
+			break;
+		}
+		if (deadline > 0) {
+			struct timespec ts;
+			double whole;
+			double frac = modf(deadline, &whole);
+			ts.tv_sec = (time_t)whole;
+			ts.tv_nsec = (long)(frac * 1e9);
+			if (pthread_cond_timedwait(&c->released, &c->mu, &ts) == ETIMEDOUT) {
+				r = rnd_fail(err, RND_ERR_TIMEOUT, "the render passed its deadline waiting for room in the shadow atlas");
+				break;
+			}
+		} else {
+			pthread_cond_wait(&c->released, &c->mu);
+		}
+	}
+	if (r == RND_OK)
+		for (uint32_t k = 0; k < n; k++) {
+			if (!req[k].key) continue;
+			if (out[k].hit) __atomic_add_fetch(&ctx->stats_hits, 1, __ATOMIC_RELAXED);
+			else __atomic_add_fetch(&ctx->stats_misses, 1, __ATOMIC_RELAXED);
+		}
 	pthread_mutex_unlock(&c->mu);
-	return RND_OK;
-fail:
-	pthread_mutex_unlock(&c->mu);
-	for (uint32_t k = 0; k < n; k++)
-		if (granted[k]) rnd_cache_release(ctx, &out[k], 1, false);
 	return r;
 }
 
@@ -290,6 +347,7 @@ void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g,
 		if (!e->key || !ok || dup) { if (!e->refs) entry_free(c, e); }
 		else e->valid = true;
 	}
+	pthread_cond_broadcast(&c->released);
 	pthread_mutex_unlock(&c->mu);
 }
 

@@ -10,8 +10,10 @@
  *     a later request with the same key reuses the tiles and skips their shadow passes;
  *   - directional lights get transient tiles (their maps follow the camera), freed at the end
  *     of the render.
- * When the atlas is full, unreferenced entries are evicted oldest first, then resolutions go
- * down (never below 64): shadows are never dropped.
+ * A request's tile sizes are planned against the whole atlas (largest halved first, never below
+ * 64), so they never depend on the cache's history; unreferenced entries are evicted oldest
+ * first to make room, and a request that does not fit next to other running renders waits for
+ * them: shadows are never dropped.
  *
  * Threading: every call takes the cache mutex. An entry in use by a render (refs > 0) is
  * never evicted; a new entry is only visible to other renders after its render completed
@@ -38,9 +40,14 @@ struct rnd_cache_grant {
 
 enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err);
 void rnd_cache_release_all(struct rnd_context *ctx);
-/* Grants tiles for n requests at once (all or none). */
+/* Grants tiles for n requests at once (all or none). Tile sizes depend on the requests alone:
+ * the largest are halved until all fit in the whole atlas, so the same request always gets the
+ * same resolutions; a hit is a completed map of the same key at that resolution. When maps of
+ * other running renders leave no room, waits for them to finish, until `deadline` (CLOCK_MONOTONIC
+ * seconds, 0 = no limit: RND_ERR_TIMEOUT). RND_ERR_LIMIT (at RND_AT_LIGHTS) only when the lights
+ * cannot fit even alone at 64² texels a tile. */
 enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cache_request *req, uint32_t n,
-                                  struct rnd_cache_grant *out, struct rnd_error *err);
+                                  double deadline, struct rnd_cache_grant *out, struct rnd_error *err);
 /* Ends a render's use: ok = the render completed, so new entries become reusable. */
 void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g, uint32_t n, bool ok);
 

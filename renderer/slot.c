@@ -310,3 +310,39 @@ enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot
 	                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
 	                        VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->shadow_scratch, err);
 }
+
+/* Bytes the image's memory takes (0 for none). */
+static VkDeviceSize image_bytes(const struct rnd_context *ctx, const struct rnd_image_res *im)
+{
+	if (!im->img) return 0;
+	VkMemoryRequirements mr;
+	vkGetImageMemoryRequirements(ctx->device, im->img, &mr);
+	return mr.size;
+}
+
+void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	const VkDeviceSize keep = RND_SLOT_KEEP_BYTES;
+	VkDeviceSize aov = image_bytes(ctx, &s->aov_depth);
+	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) aov += image_bytes(ctx, &s->aov[i]);
+	if (aov > keep) {
+		for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
+		rnd_image_destroy(ctx, &s->aov_depth);
+	}
+	if (image_bytes(ctx, &s->resolve) + image_bytes(ctx, &s->color_ms) + image_bytes(ctx, &s->depth) > keep) {
+		rnd_image_destroy(ctx, &s->color_ms);
+		rnd_image_destroy(ctx, &s->depth);
+		rnd_image_destroy(ctx, &s->resolve);
+	}
+	if (image_bytes(ctx, &s->shadow_scratch) + s->scratch_buf.size > keep) {
+		rnd_image_destroy(ctx, &s->shadow_scratch);
+		rnd_buffer_destroy(ctx, &s->scratch_buf);
+	}
+	if (image_bytes(ctx, &s->moments_tmp) > keep) {
+		rnd_image_destroy(ctx, &s->moments_tmp);
+		s->moments_initialised = false;
+	}
+	struct rnd_buffer *bufs[] = {&s->readback, &s->vertices, &s->indices, &s->staging};
+	for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
+		if (bufs[i]->size > keep) rnd_buffer_destroy(ctx, bufs[i]);
+}

@@ -57,4 +57,11 @@ enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s
 /* Destroys the previous render's textures. */
 void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 
+/* What a slot keeps for the next render: each group of targets or buffer over this is freed
+ * when its render ends, so one enormous request does not hold its memory for the life of the
+ * process, while the targets of ordinary renders (a 1024² MSAA target is 16 MiB) stay. */
+#define RND_SLOT_KEEP_BYTES (64ull << 20)
+/* Frees what is over RND_SLOT_KEEP_BYTES. Only after the slot's work has completed. */
+void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s);
+
 #endif

@@ -9,6 +9,7 @@
  * UMBRA_VALIDATION=1 turns the Vulkan validation layer on; any message then fails the run.
  */
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -108,6 +109,12 @@ int main(int argc, char **argv)
 			return 2;
 		}
 	}
+	if (api_scene_check_output(scene, &prob) != API_OK) {
+		api_problem_format(&prob, line, sizeof line);
+		fprintf(stderr, "umbra-render: %s\n", line);
+		api_scene_free(scene);
+		return 2;
+	}
 	double t_parse = now_ms() - t0;
 
 	const char *v = getenv("UMBRA_VALIDATION");
@@ -127,8 +134,15 @@ int main(int argc, char **argv)
 	struct rnd_timings tm;
 	enum rnd_result r = rnd_render(ctx, &scene->scene, &img, &tm, &err);
 	if (r != RND_OK) {
-		fprintf(stderr, "umbra-render: %s: %s\n", r == RND_ERR_INVALID || r == RND_ERR_LIMIT ? "422 scene not renderable" : "render failed", err.msg);
-		rc = r == RND_ERR_INVALID || r == RND_ERR_LIMIT ? 2 : 1;
+		bool scene_fault = r == RND_ERR_INVALID || r == RND_ERR_LIMIT;
+		if (scene_fault) {
+			api_problem_from_render(&prob, scene, &err, r == RND_ERR_LIMIT ? 422 : 400);
+			api_problem_format(&prob, line, sizeof line);
+			fprintf(stderr, "umbra-render: %s\n", line);
+		} else {
+			fprintf(stderr, "umbra-render: render failed: %s\n", err.msg);
+		}
+		rc = scene_fault ? 2 : 1;
 		goto out_ctx;
 	}
 	double t_enc = now_ms();

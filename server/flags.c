@@ -45,6 +45,7 @@ static const struct opt_def opts[] = {
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
 	{ "max-connections", OPT_UINT, "N", "concurrent connections (1024)", CFG(max_connections), 1, 1000000 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
+	{ "max-memory", OPT_SIZE, "BYTES", "memory renders in flight may need together; a render estimated over it is a 422, others wait (half the machine's or container's memory)", CFG(max_memory), 0, UINT64_MAX },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
 };
 #define OPT_COUNT (sizeof opts / sizeof opts[0])
@@ -126,7 +127,7 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 		}
 		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
 		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles) ||
-		    o->offset == LIM(model_cache_bytes))
+		    o->offset == LIM(model_cache_bytes) || o->offset == CFG(max_memory))
 			*(uint64_t *)(base + o->offset) = v;
 		else
 			*(uint32_t *)(base + o->offset) = (uint32_t)v;
@@ -207,5 +208,6 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		return -1;
 	}
 	cfg->limits.asset_root = cfg->asset_root;
+	if (!cfg->max_memory) cfg->max_memory = srv_admit_default_budget();
 	return 0;
 }

@@ -96,6 +96,7 @@ int main(int argc, char **argv)
 
 	s->metrics = srv_metrics_create();
 	s->queue = srv_queue_create(s->cfg.queue);
+	srv_admit_init(&s->admit, s->cfg.max_memory);
 	if (!s->metrics || !s->queue) {
 		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
 		goto out_free;
@@ -144,6 +145,7 @@ out_free:
 	api_model_cache_clear();
 	srv_queue_destroy(s->queue);
 	srv_metrics_destroy(s->metrics);
+	srv_admit_destroy(&s->admit);
 	pthread_rwlock_destroy(&s->ctx_lock);
 	if (exit_code == 0)
 		srv_log(SRV_LOG_INFO, "stopped");

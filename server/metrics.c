@@ -295,6 +295,14 @@ char *srv_metrics_text(struct srv_server *s, size_t *len)
 	srv_buf_printf(&b, "# HELP umbra_build_info Build and device.\n# TYPE umbra_build_info gauge\n"
 	                   "umbra_build_info{version=\"%s\",device=\"%s\",driver=\"%s\"} 1\n",
 	               UMBRA_VERSION, dev, drv);
+	uint64_t adm_in_use, adm_budget, adm_peak;
+	srv_admit_stats(&s->admit, &adm_in_use, &adm_budget, &adm_peak);
+	write_gauge(&b, "umbra_memory_admitted_bytes", "Estimated memory of the renders admitted now (--max-memory).",
+	            (double)adm_in_use);
+	write_gauge(&b, "umbra_memory_admitted_peak_bytes", "Largest estimated memory of renders in flight at once.",
+	            (double)adm_peak);
+	write_gauge(&b, "umbra_memory_budget_bytes", "--max-memory: what renders in flight may need together.",
+	            (double)adm_budget);
 	write_gauge(&b, "process_resident_memory_bytes", "Resident set size.", (double)process_rss_bytes());
 	write_gauge(&b, "process_open_fds", "Open file descriptors.", (double)process_open_fds());
 	return srv_buf_detach(&b, len);

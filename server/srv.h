@@ -32,6 +32,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "admit.h"
 #include "api.h"
 #include "umbra/rnd.h"
 
@@ -64,6 +65,7 @@ struct srv_config {
 	unsigned max_connections;      /* concurrent TCP connections, default 1024 */
 	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
+	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
 };
 
@@ -87,6 +89,7 @@ struct srv_server {
 	uint16_t port;
 	struct srv_queue *queue;
 	struct srv_metrics *metrics;
+	struct srv_admit admit;        /* renders admitted by estimated memory (--max-memory) */
 
 	/* The shared renderer. Renders hold ctx_lock for reading; recovery after a lost device
 	 * takes it for writing, destroys and recreates the context (ctx_gen counts recreations). */

@@ -257,6 +257,33 @@ static void job_deadline(struct srv_server *s, struct srv_request *req, const ch
 	job_problem(req, &p);
 }
 
+/* Admission by memory: the renderer's estimate of what the scene allocates, against
+ * --max-memory (admit.h). Limits no retry can cure (one allocation over the device's limit)
+ * answer 422 here, before the render. 0 admitted (*need to release), else p is filled. */
+static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t *need,
+                 struct api_problem *p)
+{
+	struct rnd_estimate est;
+	struct rnd_error err = {0};
+	enum rnd_result r = RND_ERR_DEVICE_LOST;
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	if (s->ctx) r = rnd_render_estimate(s->ctx, &sc->scene, &est, &err);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	if (r == RND_ERR_DEVICE_LOST) return 0; /* the render itself reports it */
+	if (r != RND_OK) {
+		api_problem_from_render(p, sc, &err, r == RND_ERR_LIMIT ? 422 : 400);
+		return -1;
+	}
+	uint64_t n = est.device_bytes + est.host_bytes;
+	double deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0;
+	if (srv_admit_request(&s->admit, sc, n, deadline, p) != 0) {
+		if (p->status == 504) srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
+		return -1;
+	}
+	*need = n;
+	return 0;
+}
+
 static int render_status(enum rnd_result r)
 {
 	switch (r) {
@@ -284,6 +311,7 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 	struct rnd_error err = { 0 };
 	uint8_t *bytes = NULL;
 	size_t len = 0;
+	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
 
 	double t0 = srv_now();
 	struct api_part parts[64];
@@ -306,7 +334,8 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 			goto out;
 		}
 	}
-	if (req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) {
+	if ((req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) ||
+	    api_scene_check_output(sc, &p) != API_OK) {
 		job_problem(req, &p);
 		goto out;
 	}
@@ -318,12 +347,16 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 		job_deadline(s, req, "before rendering", t1);
 		goto out;
 	}
+	if (admit(s, req, sc, &admitted, &p) != 0) {
+		job_problem(req, &p);
+		goto out;
+	}
 	enum rnd_result r = render(s, &sc->scene, &img, &t, &err);
 	if (r != RND_OK) {
 		srv_metrics_add(s->metrics, SRV_CTR_RENDER_FAILED, 1);
 		if (r == RND_ERR_TIMEOUT)
 			srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
-		api_problem_set(&p, render_status(r), "", "%s", err.msg[0] ? err.msg : rnd_result_str(r));
+		api_problem_from_render(&p, sc, &err, render_status(r));
 		srv_log(SRV_LOG_WARN, "request %s: render failed: %s (%s)", req->id, err.msg, rnd_result_str(r));
 		job_problem(req, &p);
 		goto out;
@@ -362,6 +395,7 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 out:
 	rnd_image_release(&img);
 	api_scene_free(sc);
+	srv_admit_release(&s->admit, admitted);
 }
 
 static void *worker_main(void *arg)

@@ -633,10 +633,16 @@ TEST(parse_output_variants)
 	CHECK(api_scene_set_format(s, API_FORMAT_PNG, &p) == API_OK && s->scene.output.pixels == RND_PIXELS_RGBA16);
 	api_scene_free(s);
 
-	/* aovs with no format imply EXR (the default PNG could not carry them). */
+	/* aovs with no format: the answer is still the default PNG, which cannot carry them, until
+	 * something chooses EXR (Accept, the CLI's -o name); before that it is a 400 at /output/aovs. */
 	s = PARSE_OK(BASE ",'output':{'aovs':['depth']}}");
 	REQUIRE(s);
-	CHECK(s->format == API_FORMAT_EXR && !s->format_explicit && s->scene.output.pixels == RND_PIXELS_RGBA32F);
+	CHECK(s->format == API_FORMAT_PNG && !s->format_explicit);
+	memset(&p, 0, sizeof p);
+	CHECK(api_scene_check_output(s, &p) == API_ERR && p.status == 400 && !strcmp(p.pointer, "/output/aovs"),
+	      "%d %s", p.status, p.pointer);
+	CHECK(api_scene_set_format(s, API_FORMAT_EXR, &p) == API_OK && s->scene.output.pixels == RND_PIXELS_RGBA32F);
+	CHECK(api_scene_check_output(s, &p) == API_OK);
 	api_scene_free(s);
 
 	s = PARSE_OK(BASE ",'environment':{'background':[0.1,0.2,0.3,0]}}");

@@ -44,9 +44,25 @@ enum rnd_result {
 	RND_ERR_IO,          /* a file (pipeline cache) could not be read or written */
 };
 
+/* Which part of the scene an error is about, so a caller can name the member (api/ turns it
+ * into a JSON Pointer). RND_AT_NONE: the scene as a whole or nothing in it (device failures). */
+enum rnd_error_at {
+	RND_AT_NONE,
+	RND_AT_SIZE,         /* width / height (the image, or the sheet of several views) */
+	RND_AT_VIEWS,        /* the number of views */
+	RND_AT_AOVS,         /* output.aovs (with the size: the AOV planes' memory) */
+	RND_AT_LIGHTS,       /* the lights as a whole (index unused): e.g. too many shadow maps */
+	RND_AT_LIGHT,        /* lights[index] */
+	RND_AT_OBJECTS,      /* the objects as a whole (their total size) */
+	RND_AT_OBJECT,       /* objects[index] of the rnd_scene */
+	RND_AT_MATERIALS,    /* the materials / textures as a whole */
+};
+
 struct rnd_error {
 	enum rnd_result code;
 	int vk_result;       /* VkResult when code == RND_ERR_VULKAN/DEVICE_LOST, else 0 */
+	enum rnd_error_at at; /* what the error is about (RND_AT_NONE when nothing in particular) */
+	uint32_t at_index;   /* light or object index for RND_AT_LIGHT / RND_AT_OBJECT */
 	char msg[256];       /* what failed first, e.g. "vkCreateImage (shadow map 4096x4096): ..." */
 };
 
@@ -262,6 +278,7 @@ struct rnd_info {
 	bool is_cpu;               /* lavapipe / software rasteriser */
 	uint32_t max_image_dimension;
 	uint32_t max_shadow_resolution;
+	uint64_t max_allocation;   /* largest single buffer/allocation (an image with its AOVs must fit) */
 	bool moments_fp32_filterable;
 };
 
@@ -271,6 +288,21 @@ void rnd_context_destroy(struct rnd_context *ctx);
 void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info);
 /* Validation-layer messages (warnings and errors) seen since create. Tests require 0. */
 uint32_t rnd_context_validation_messages(const struct rnd_context *ctx);
+
+/* What a render of a scene will allocate, from the scene alone (before any allocation): for
+ * admission by memory (umbrad --max-memory) and for limits that no retry can cure. Bytes are
+ * upper estimates of what the render holds at its peak. */
+struct rnd_estimate {
+	uint64_t device_bytes;        /* targets, AOV images, readback buffer, geometry, shadow scratch
+	                                 (device memory; on a CPU driver such as lavapipe, host memory) */
+	uint64_t host_bytes;          /* the returned image (colour + AOV planes) and its encoding */
+	uint64_t largest_allocation;  /* the largest single buffer or image */
+	uint64_t readback_bytes;      /* the readback buffer (colour + AOV attachments of the sheet) */
+};
+/* Fills *est; RND_ERR_LIMIT (err->at names the AOVs, views or size) when a single allocation
+ * would be over the device's limit, which rnd_render() would refuse the same way. Thread-safe. */
+enum rnd_result rnd_render_estimate(const struct rnd_context *ctx, const struct rnd_scene *scene,
+                                    struct rnd_estimate *est, struct rnd_error *err);
 
 /* Counters for metrics; thread-safe. */
 struct rnd_stats {

@@ -1,0 +1,227 @@
+/* tests/gpu — limits that tell the truth (issue 10): the shadow atlas plans every request's
+ * tile sizes from the request alone, so a cached map never crowds out the request's other
+ * lights and the same request gives the same bytes whatever the cache or other renders hold
+ * (renders that do not fit next to each other wait); moment maps stay within the device's
+ * storage-buffer range; a render whose single allocation is over the device's limit is refused
+ * up front with the member at fault (rnd_error.at), before anything is allocated. */
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "api.h"
+#include "gpu_util.h"
+#include "../unit/test.h"
+
+/* A context of our own (validation as the binary's). */
+static struct rnd_context *limits_ctx(uint32_t atlas_size, uint32_t slots)
+{
+	const char *v = getenv("UMBRA_VALIDATION");
+	struct rnd_context_desc cd = {0};
+	cd.validation = v && strcmp(v, "1") == 0;
+	cd.atlas_size = atlas_size;
+	cd.slots = slots;
+	struct rnd_context *ctx = NULL;
+	struct rnd_error err = {0};
+	CHECK(rnd_context_create(&cd, &ctx, &err) == RND_OK, "rnd_context_create: %s", err.msg);
+	return ctx;
+}
+
+/* Parses doc (single quotes allowed) and renders it on ctx; the result, not a test failure, so
+ * errors can be checked. *img is released by the caller (zeroed on failure). */
+static enum rnd_result render_doc(struct rnd_context *ctx, const char *doc_in, struct rnd_image *img,
+                                  struct rnd_error *err)
+{
+	memset(img, 0, sizeof *img);
+	memset(err, 0, sizeof *err);
+	char *doc = strdup(doc_in);
+	if (!doc) return RND_ERR_OOM;
+	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
+	struct api_limits lim;
+	api_limits_defaults(&lim);
+	struct api_scene *s = NULL;
+	struct api_problem prob = {0};
+	enum rnd_result r = RND_ERR_INVALID;
+	if (api_scene_parse(doc, strlen(doc), &lim, &s, &prob) == API_OK) {
+		r = rnd_render(ctx, &s->scene, img, NULL, err);
+		api_scene_free(s);
+	} else {
+		snprintf(err->msg, sizeof err->msg, "parse: %d %.60s: %.160s", prob.status, prob.pointer, prob.detail);
+	}
+	free(doc);
+	return r;
+}
+
+static bool same_pixels(const struct rnd_image *a, const struct rnd_image *b)
+{
+	return a->pixels && b->pixels && a->width == b->width && a->height == b->height && a->format == b->format &&
+	       !memcmp(a->pixels, b->pixels, (size_t)a->width * a->height * 4);
+}
+
+#define SPOT(x, z, res) "{'type':'spot','position':[" #x ",5," #z "],'direction':[0,-1,0],'outer_angle':50," \
+                        "'shadow':{'resolution':" #res "}}"
+#define SCENE(lights) "{'width':96,'height':96,'camera':{'position':[5,6,7],'target':[0,0,0]}," \
+	"'objects':[{'shape':'plane','size':[12,12]},{'shape':'box','transform':{'translation':[0,0.5,0]}}]," \
+	"'lights':[" lights "]}"
+
+/* A map cached at the whole atlas used to leave no room for the request's second light (422
+ * "atlas full"); now both are planned together and drawn at half size, to the same bytes as
+ * on a fresh context. */
+TEST(limits_atlas_cached_map_never_refuses_the_others)
+{
+	struct rnd_context *warm = limits_ctx(1024, 1), *fresh = limits_ctx(1024, 1);
+	if (!warm || !fresh) goto out;
+	struct rnd_image one, two, two_fresh;
+	struct rnd_error err;
+	CHECK(render_doc(warm, SCENE(SPOT(-2, 0, 1024)), &one, &err) == RND_OK, "%s", err.msg);
+	enum rnd_result r = render_doc(warm, SCENE(SPOT(-2, 0, 1024) "," SPOT(2, 0, 1024)), &two, &err);
+	CHECK(r == RND_OK, "two lights after one filled the atlas: %s (%s)", rnd_result_str(r), err.msg);
+	CHECK(render_doc(fresh, SCENE(SPOT(-2, 0, 1024) "," SPOT(2, 0, 1024)), &two_fresh, &err) == RND_OK, "%s", err.msg);
+	CHECK(same_pixels(&two, &two_fresh), "the two-light render differs after the cache held a larger map");
+	struct rnd_stats st;
+	rnd_context_stats(warm, &st);
+	CHECK(st.atlas_occupancy <= 1.0, "occupancy %.3f", st.atlas_occupancy);
+	rnd_image_release(&one);
+	rnd_image_release(&two);
+	rnd_image_release(&two_fresh);
+	CHECK(rnd_context_validation_messages(warm) == 0 && rnd_context_validation_messages(fresh) == 0);
+out:
+	rnd_context_destroy(warm);
+	rnd_context_destroy(fresh);
+}
+
+/* Lights that cannot fit even at 64² tiles: 422-class with the lights named, before any work. */
+TEST(limits_atlas_too_small_names_the_lights)
+{
+	struct rnd_context *ctx = limits_ctx(128, 1);
+	if (!ctx) return;
+	struct rnd_image img;
+	struct rnd_error err;
+	/* five spots of at least 64² do not fit in 128² (four do) */
+	enum rnd_result r = render_doc(ctx, SCENE(SPOT(-2, -2, 64) "," SPOT(2, -2, 64) "," SPOT(-2, 2, 64) ","
+	                                          SPOT(2, 2, 64) "," SPOT(0, 0, 64)), &img, &err);
+	CHECK(r == RND_ERR_LIMIT && err.at == RND_AT_LIGHTS, "%s at %d: %s", rnd_result_str(r), (int)err.at, err.msg);
+	rnd_image_release(&img);
+	r = render_doc(ctx, SCENE(SPOT(-2, -2, 64) "," SPOT(2, -2, 64) "," SPOT(-2, 2, 64) "," SPOT(2, 2, 64)), &img, &err);
+	CHECK(r == RND_OK, "four 64² spots in a 128² atlas: %s", err.msg);
+	rnd_image_release(&img);
+	rnd_context_destroy(ctx);
+}
+
+struct job {
+	struct rnd_context *ctx;
+	const char *doc;
+	struct rnd_image img;
+	enum rnd_result r;
+	struct rnd_error err;
+};
+
+static void *job_main(void *arg)
+{
+	struct job *j = arg;
+	j->r = render_doc(j->ctx, j->doc, &j->img, &j->err);
+	return NULL;
+}
+
+/* Two renders that each need the whole atlas, at once: the second waits for the first instead
+ * of drawing smaller maps (which would change its bytes) or failing. */
+TEST(limits_atlas_concurrent_renders_wait_for_room)
+{
+	struct rnd_context *ctx = limits_ctx(1024, 2);
+	if (!ctx) return;
+	const char *a = SCENE(SPOT(-2, 0, 1024)), *b = SCENE(SPOT(2, 1, 1024)), *filler = SCENE(SPOT(0, 3, 1024));
+	struct rnd_image ref_a, ref_b, fill;
+	struct rnd_error err;
+	CHECK(render_doc(ctx, a, &ref_a, &err) == RND_OK, "%s", err.msg);
+	CHECK(render_doc(ctx, b, &ref_b, &err) == RND_OK, "%s", err.msg);
+	int same = 0;
+	for (int round = 0; round < 3; round++) {
+		/* the filler's map evicts both, so both renders below draw their maps at once */
+		CHECK(render_doc(ctx, filler, &fill, &err) == RND_OK, "%s", err.msg);
+		rnd_image_release(&fill);
+		struct job ja = {ctx, a}, jb = {ctx, b};
+		pthread_t ta, tb;
+		pthread_create(&ta, NULL, job_main, &ja);
+		pthread_create(&tb, NULL, job_main, &jb);
+		pthread_join(ta, NULL);
+		pthread_join(tb, NULL);
+		CHECK(ja.r == RND_OK && jb.r == RND_OK, "round %d: %s / %s", round, ja.err.msg, jb.err.msg);
+		same += same_pixels(&ja.img, &ref_a) && same_pixels(&jb.img, &ref_b);
+		rnd_image_release(&ja.img);
+		rnd_image_release(&jb.img);
+	}
+	printf("    [atlas 1024, two whole-atlas renders at once] %d of 3 rounds byte-identical to the renders alone\n", same);
+	CHECK(same == 3, "only %d of 3 concurrent rounds match the renders made alone", same);
+	struct rnd_stats st;
+	rnd_context_stats(ctx, &st);
+	CHECK(st.atlas_occupancy <= 1.0);
+	rnd_image_release(&ref_a);
+	rnd_image_release(&ref_b);
+	CHECK(rnd_context_validation_messages(ctx) == 0);
+	rnd_context_destroy(ctx);
+}
+
+/* An 8192 VSM map would bind a 256 MiB storage buffer for its blur (over lavapipe's 128 MiB
+ * range: a validation error); moment maps are capped to what the device can read. */
+TEST(limits_vsm_8192_within_storage_range)
+{
+	struct rnd_context *ctx = limits_ctx(8192, 1);
+	if (!ctx) return;
+	struct rnd_image img;
+	struct rnd_error err;
+	enum rnd_result r = render_doc(ctx, "{'width':64,'height':64,'camera':{'position':[5,6,7],'target':[0,0,0]},"
+	                               "'objects':[{'shape':'plane','size':[12,12]},{'shape':'box'}],"
+	                               "'lights':[{'type':'spot','position':[0,5,0],'direction':[0,-1,0],"
+	                               "'shadow':{'filter':'vsm','resolution':8192}}]}", &img, &err);
+	CHECK(r == RND_OK, "%s", err.msg);
+	CHECK(rnd_context_validation_messages(ctx) == 0, "%u validation messages", rnd_context_validation_messages(ctx));
+	rnd_image_release(&img);
+	rnd_context_destroy(ctx);
+}
+
+/* A render whose readback buffer is over the device's largest allocation is refused before it
+ * allocates anything, naming the AOVs; the estimate says the same thing rnd_render does. */
+TEST(limits_allocation_over_device_limit_names_aovs)
+{
+	struct rnd_context *ctx = gpu_ctx();
+	if (!ctx) return;
+	struct rnd_info info;
+	rnd_context_info(ctx, &info);
+	/* 33 shadow planes + depth, normal, albedo = 40 planes: 3 AOV passes of 4 RGBA32F targets */
+	char doc[8192];
+	int n = snprintf(doc, sizeof doc, "{'width':4096,'height':4096,'camera':{'position':[5,6,7],'target':[0,0,0]},"
+	                 "'objects':[{'shape':'plane','size':[12,12]}],'output':{'format':'exr',"
+	                 "'aovs':['shadow','depth','normal','albedo']},'lights':[");
+	for (int i = 0; i < 33; i++)
+		n += snprintf(doc + n, sizeof doc - (size_t)n, "%s{'type':'point','position':[%d,3,%d],'shadow':{'enabled':false}}",
+		              i ? "," : "", i % 6 - 3, i / 6 - 3);
+	snprintf(doc + n, sizeof doc - (size_t)n, "]}");
+	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
+	struct api_limits lim;
+	api_limits_defaults(&lim);
+	struct api_scene *s = NULL;
+	struct api_problem prob = {0};
+	REQUIRE(api_scene_parse(doc, strlen(doc), &lim, &s, &prob) == API_OK, "%s %s", prob.pointer, prob.detail);
+	struct rnd_estimate est;
+	struct rnd_error err = {0};
+	enum rnd_result re = rnd_render_estimate(ctx, &s->scene, &est, &err);
+	printf("    [4096², 40 AOV planes] readback %.2f GB, largest allocation %.2f GB, device allows %.2f GB; "
+	       "estimate %.2f GB device + %.2f GB host\n", est.readback_bytes / 1e9, est.largest_allocation / 1e9,
+	       info.max_allocation / 1e9, est.device_bytes / 1e9, est.host_bytes / 1e9);
+	/* readback: 16 B colour + 3 passes x 4 x 16 B per pixel */
+	CHECK(est.readback_bytes == 4096ull * 4096 * (16 + 3 * 4 * 16), "readback %llu", (unsigned long long)est.readback_bytes);
+	if (est.largest_allocation > info.max_allocation) {
+		CHECK(re == RND_ERR_LIMIT && err.at == RND_AT_AOVS, "estimate: %s at %d", rnd_result_str(re), (int)err.at);
+		struct rnd_image img = {0};
+		memset(&err, 0, sizeof err);
+		enum rnd_result r = rnd_render(ctx, &s->scene, &img, NULL, &err);
+		CHECK(r == RND_ERR_LIMIT && err.at == RND_AT_AOVS, "render: %s at %d: %s", rnd_result_str(r), (int)err.at, err.msg);
+		struct api_problem p = {0};
+		api_problem_from_render(&p, s, &err, 422);
+		CHECK(p.status == 422 && !strcmp(p.pointer, "/output/aovs"), "%d %s", p.status, p.pointer);
+		rnd_image_release(&img);
+	} else {
+		printf("    note: this device allows the allocation; nothing to refuse\n");
+		CHECK(re == RND_OK, "%s", err.msg);
+	}
+	api_scene_free(s);
+}
