@@ -110,18 +110,29 @@ float view_distance(umbra_shadow_view v, float d)
 	return n + d * (f - n);                                   // orthographic: linear
 }
 
+// Penumbra half-width, in texels at the receiver, that a blocker at distance zb casts on a
+// receiver at zr, by similar triangles in the light's own projection: a sphere light of radius
+// `size` seen through a perspective view, or a sun of angular radius atan(size) through an
+// orthographic one.
+vec4 penumbra_texels(umbra_shadow_view v, float size, vec4 zb, float zr, float texel)
+{
+	if (v.params.y > 0.5) return size * (zr - zb) / (max(zb, vec4(1e-4)) * texel);
+	return size * (zr - zb) / texel;
+}
+
 // PCSS: blocker search over the region that could shade this point, penumbra from the
 // light's size by similar triangles, then a rotated Poisson PCF of that width.
+// A texel counts as a blocker only when this point lies inside the penumbra it casts (its
+// offset within its own penumbra half-width): distant parts of a caster (the top of a pole
+// seen from the pole's foot) would otherwise widen the penumbra where the caster touches the
+// receiver.
 float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, float res, vec2 grad)
 {
 	float zr = view_distance(v, ref);
 	float texel = v.params.y > 0.5 ? v.params.x * zr : v.params.x;   // world size of a texel at the receiver
 	float size = L.params.y;                                          // tan(angular radius) or radius (m)
-	bool persp = v.params.y > 0.5;
-	// Search radius: the widest penumbra a blocker between the light's near plane and the
-	// receiver could cast here, capped.
-	float zn = v.params.z;
-	float search = persp ? size * (zr - zn) / (zr * v.params.x * max(zn, 1e-3)) : size * (zr - zn) / texel;
+	// Search radius: the widest penumbra a blocker at the light's near plane could cast here, capped.
+	float search = penumbra_texels(v, size, vec4(v.params.z), zr, texel).x;
 	search = clamp(search, 1.0, L.shadow_params.y);
 	float a = ign(gl_FragCoord.xy) * 2.0 * PI;
 	mat2 rot = mat2(cos(a), sin(a), -sin(a), cos(a));
@@ -129,19 +140,21 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// Texels of the receiver's own plane must not count as blockers: compare against the
 	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
 	float slack = abs(grad.x) + abs(grad.y) + 1e-6;
-	for (int i = 0; i < 16; i++) {
-		vec2 off = rot * poisson(i * 2) * search;
-		vec2 q = p + off;
-		vec4 d = gather_tile(rect, q);
-		vec4 b = step(d, vec4(ref + dot(grad, off) - slack));   // 1 where the texel is a blocker
+	// Tap 0 is the point itself: where the penumbra is narrower than the spacing of the
+	// search taps (near contact), it alone finds the blocker.
+	for (int i = 0; i < 17; i++) {
+		vec2 off = i == 0 ? vec2(0.0) : rot * poisson(i * 2 - 2) * search;
+		vec4 d = gather_tile(rect, p + off);
+		vec4 zb = vec4(view_distance(v, d.x), view_distance(v, d.y), view_distance(v, d.z), view_distance(v, d.w));
+		vec4 reach = penumbra_texels(v, size, zb, zr, texel) + 1.5;
+		vec4 b = step(d, vec4(ref + dot(grad, off) - slack)) * step(vec4(length(off)), reach);
 		blockers += dot(b, vec4(1.0));
 		sum_d += dot(b, d);
 	}
 	if (blockers < 0.5) return 1.0;
 	float zb = view_distance(v, sum_d / blockers);
-	// Penumbra width in world units at the receiver.
-	float w = persp ? 2.0 * size * (zr - zb) / max(zb, 1e-4) : 2.0 * size * (zr - zb);
-	float radius = max(0.5 * w / texel, 1.0);
+	// Capped like the search: views are widened by that many texels, so taps stay in the view.
+	float radius = clamp(penumbra_texels(v, size, vec4(zb), zr, texel).x, 1.0, L.shadow_params.y);
 	float sum = 0.0;
 	for (int i = 0; i < 32; i++) {
 		vec2 off = rot * poisson(i) * radius;
@@ -150,12 +163,27 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	return sum / 32.0;
 }
 
-// Receiver plane: how the receiver's light-space depth changes per shadow-map texel, from its
-// normal. Orthographic views only (their transform is affine: the plane stays a plane);
-// perspective views rely on the normal offset alone.
-vec2 receiver_gradient(umbra_shadow_view v, vec3 n, float res)
+// Receiver plane: how the receiver's light-space depth changes per shadow-map texel, so that
+// wide kernels compare each tap with the receiver's own plane there, not with the depth at the
+// centre (which shadows a sloped receiver by itself). Orthographic views: from the normal
+// (the transform is affine). Perspective views (spot, point faces): a plane stays a plane under
+// a projective map, so NDC depth is affine in NDC x, y on it; the gradient comes from projecting
+// two points of the tangent plane (lc0: pos in clip space, h: a texel in world units at pos).
+vec2 receiver_gradient(umbra_shadow_view v, vec3 pos, vec3 n, vec4 lc0, float h, float res)
 {
-	if (v.params.y > 0.5) return vec2(0.0);
+	if (v.params.y > 0.5) {
+		vec3 t1 = normalize(cross(n, abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
+		vec3 t2 = cross(n, t1);
+		vec4 c1 = v.view_proj * vec4(pos + t1 * h, 1.0), c2 = v.view_proj * vec4(pos + t2 * h, 1.0);
+		vec3 p0 = lc0.xyz / lc0.w, p1 = c1.xyz / c1.w, p2 = c2.xyz / c2.w;
+		vec2 e1 = (p1.xy - p0.xy) * (0.5 * res), e2 = (p2.xy - p0.xy) * (0.5 * res);   // texels
+		float det = e1.x * e2.y - e1.y * e2.x;
+		if (abs(det) < 1e-12) return vec2(0.0);
+		// g with dot(g, e1) = dz1 and dot(g, e2) = dz2
+		float dz1 = p1.z - p0.z, dz2 = p2.z - p0.z;
+		vec2 g = vec2(dz1 * e2.y - dz2 * e1.y, dz2 * e1.x - dz1 * e2.x) / det;
+		return clamp(g, vec2(-0.01), vec2(0.01));
+	}
 	mat3 a = mat3(v.view_proj);
 	vec3 r0 = vec3(a[0][0], a[1][0], a[2][0]), r1 = vec3(a[0][1], a[1][1], a[2][1]), r2 = vec3(a[0][2], a[1][2], a[2][2]);
 	// Normal of the plane in light clip space: (A^-T) n = S^-2 A n for A = S R.
@@ -206,9 +234,9 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 	vec4 rect = v.rect;
 	uint filt = L.shadow.z;
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, rect, ref, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, receiver_gradient(v, n, res));
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, receiver_gradient(v, pos, n, lc0, texel, res));
 	if ((SC_FILTERS & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, rect, ref);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, rect, ref, res, int(L.shadow.w), receiver_gradient(v, n, res));
+	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u) return pcf(tp, rect, ref, res, int(L.shadow.w), receiver_gradient(v, pos, n, lc0, texel, res));
 	return 1.0;
 }
 

@@ -265,7 +265,9 @@ if [ $ok_flood -eq 0 ]; then
 	check "flood: every request answered 200 or 503, none hung" [ $other -eq 0 ]
 	check "flood: queue full answered 503" [ $n503 -ge 1 ]
 	check "flood: 503 carries Retry-After" [ $noretry -eq 0 ]
-	check "flood: the accepted ones rendered" [ $n200 -ge 3 ]
+	# 1 rendering + 2 queued, or 2 when the 16 arrive before the worker took the first one off
+	# the queue (a loaded machine): either way every accepted request rendered.
+	check "flood: the accepted ones rendered" [ $n200 -ge 2 ]
 	[ -n "${f503:-}" ] && check "flood: 503 is problem+json" problem $f503 503 -
 	c=$(get metrics /metrics)
 	check "metrics count queue rejections" [ "$(metric umbra_queue_rejected_total)" -ge 1 ]
