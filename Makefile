@@ -8,7 +8,7 @@ BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
 GLSLANG ?= glslangValidator
-PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib assimp libjpeg
+PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib assimp libjpeg libseccomp
 
 OPT ?= -O2
 SAN ?=
@@ -39,7 +39,7 @@ SRV_OBJ := $(SRV_SRC:%.c=$(BUILD)/obj/%.o)
 UNIT_OBJ := $(UNIT_SRC:%.c=$(BUILD)/obj/%.o)
 GPU_OBJ := $(GPU_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/tests/unit/test_main.o
 
-BINS := $(BUILD)/librenderer.a $(BUILD)/libapi.a $(BUILD)/umbra-render $(BUILD)/tests/unit_tests
+BINS := $(BUILD)/librenderer.a $(BUILD)/libapi.a $(BUILD)/umbra-render $(BUILD)/umbra-import $(BUILD)/tests/unit_tests
 ifneq ($(SRV_SRC),)
 BINS += $(BUILD)/umbrad
 endif
@@ -73,6 +73,10 @@ $(BUILD)/libapi.a: $(API_OBJ)
 
 $(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+# The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
+# them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).
+$(BUILD)/umbra-import: $(BUILD)/obj/api/helper/umbra_import.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+	$(CC) $(LDFLAGS) -Wl,--as-needed -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
