@@ -100,22 +100,32 @@ test-asan: deps
 	@BUILD=build/asan SHARED=$(SHARED) ASAN=1 sh tests/run.sh
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench
 	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/bench.sh
 
 $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
 
-# libFuzzer target for the scene parser (clang): build/fuzz/fuzz_scene tests/fuzz/corpus
+# libFuzzer targets (clang): build/fuzz/fuzz_scene tests/fuzz/corpus; fuzz_model_<fmt> and
+# fuzz_import_reply with tests/fuzz/corpus/<target> (see tests/fuzz/fuzz_model.h)
 fuzz:
 	@$(MAKE) --no-print-directory BUILD=build/fuzz CC=clang OPT=-O1 \
-	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a
+	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a \
+	  build/fuzz/umbra-import
 	clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
 	  -o build/fuzz/fuzz_scene tests/fuzz/fuzz_scene.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS)
+	@# Model import (one target per format, through the sandbox: build/fuzz/umbra-import above) and
+	@# the decoder of the importer's replies.
+	for t in $(basename $(notdir $(wildcard tests/fuzz/fuzz_model_*.c tests/fuzz/fuzz_import_*.c))); do \
+	  clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
+	    -o build/fuzz/$$t tests/fuzz/$$t.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS) || exit 1; done
 
 clean:
 	rm -rf $(BUILD)
