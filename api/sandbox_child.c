@@ -57,7 +57,7 @@ static int apply_filter(void)
 		SCMP_SYS(madvise), SCMP_SYS(futex), SCMP_SYS(exit), SCMP_SYS(exit_group),
 		SCMP_SYS(rt_sigreturn), SCMP_SYS(rt_sigaction), SCMP_SYS(rt_sigprocmask), SCMP_SYS(getpid),
 		SCMP_SYS(gettid), SCMP_SYS(clock_gettime), SCMP_SYS(gettimeofday), SCMP_SYS(getrandom),
-		SCMP_SYS(sched_yield),
+		SCMP_SYS(sched_yield), SCMP_SYS(sigaltstack),
 	};
 	int rc = 0;
 	for (size_t i = 0; i < sizeof allow / sizeof allow[0] && !rc; i++)
