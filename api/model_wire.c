@@ -10,9 +10,6 @@
 #include <string.h>
 #include "model_wire.h"
 
-#define HEADER_BYTES (8 + 4 * 4)
-#define MATERIAL_BYTES (11 * 4 + 2 * 4)
-#define INSTANCE_BYTES (4 + 16 * 4)
 #define MAX_TEXTURES 4096u
 
 /* ---- writer ---- */
@@ -89,8 +86,7 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 		const struct rnd_material *mt = &m->materials[i];
 		float f[11] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
 		               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff, 0};
-		put(b, f, 10 * 4);
-		put(b, &f[10], 4); /* reserved, zero */
+		put(b, f, sizeof f); /* the last one reserved, zero */
 		put_u32(b, (uint32_t)mt->alpha_mode);
 		int32_t ti = -1;
 		for (uint32_t k = 0; mt->base_color_texture && k < ntex; k++)

@@ -17,8 +17,8 @@
  *   image    width height, width*height*4 bytes RGBA8
  *   model    texture_count material_count mesh_count instance_count
  *            textures:  width height, width*height*4 bytes RGBA8
- *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff (f32)
- *                       alpha_mode (u32) texture (i32, -1 = none)
+ *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff reserved
+ *                       (f32, reserved = 0), alpha_mode (u32), texture (i32, -1 = none)
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs),
  *                       positions f32[3v], normals f32[3v], uvs f32[2v], indices u32[i]
  *            instances: mesh (u32), model matrix f32[16] (column-major)
