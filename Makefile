@@ -8,7 +8,7 @@ BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
 GLSLANG ?= glslangValidator
-PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib assimp libjpeg
+PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib assimp libjpeg libseccomp
 
 OPT ?= -O2
 SAN ?=
@@ -39,7 +39,7 @@ SRV_OBJ := $(SRV_SRC:%.c=$(BUILD)/obj/%.o)
 UNIT_OBJ := $(UNIT_SRC:%.c=$(BUILD)/obj/%.o)
 GPU_OBJ := $(GPU_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/tests/unit/test_main.o
 
-BINS := $(BUILD)/librenderer.a $(BUILD)/libapi.a $(BUILD)/umbra-render $(BUILD)/tests/unit_tests
+BINS := $(BUILD)/librenderer.a $(BUILD)/libapi.a $(BUILD)/umbra-render $(BUILD)/umbra-import $(BUILD)/tests/unit_tests
 ifneq ($(SRV_SRC),)
 BINS += $(BUILD)/umbrad
 endif
@@ -73,6 +73,10 @@ $(BUILD)/libapi.a: $(API_OBJ)
 
 $(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+# The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
+# them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).
+$(BUILD)/umbra-import: $(BUILD)/obj/api/helper/umbra_import.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+	$(CC) $(LDFLAGS) -Wl,--as-needed -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
@@ -96,22 +100,32 @@ test-asan: deps
 	@BUILD=build/asan SHARED=$(SHARED) ASAN=1 sh tests/run.sh
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench
 	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/bench.sh
 
 $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
 
-# libFuzzer target for the scene parser (clang): build/fuzz/fuzz_scene tests/fuzz/corpus
+# libFuzzer targets (clang): build/fuzz/fuzz_scene tests/fuzz/corpus; fuzz_model_<fmt> and
+# fuzz_import_reply with tests/fuzz/corpus/<target> (see tests/fuzz/fuzz_model.h)
 fuzz:
 	@$(MAKE) --no-print-directory BUILD=build/fuzz CC=clang OPT=-O1 \
-	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a
+	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a \
+	  build/fuzz/umbra-import
 	clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
 	  -o build/fuzz/fuzz_scene tests/fuzz/fuzz_scene.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS)
+	@# Model import (one target per format, through the sandbox: build/fuzz/umbra-import above) and
+	@# the decoder of the importer's replies.
+	for t in $(basename $(notdir $(wildcard tests/fuzz/fuzz_model_*.c tests/fuzz/fuzz_import_*.c))); do \
+	  clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
+	    -o build/fuzz/$$t tests/fuzz/$$t.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS) || exit 1; done
 
 clean:
 	rm -rf $(BUILD)

@@ -52,6 +52,11 @@ struct api_limits {
 	const char *asset_root;          /* default NULL */
 	/* Bound of the process-wide cache of imported models (bytes; 0 = do not cache). */
 	uint64_t model_cache_bytes;      /* default 268435456 (256 MiB) */
+	/* Bounds of one sandboxed model import or texture decode (api/sandbox.h): wall clock (the CPU
+	 * time limit is the same, rounded up to seconds) and address space of the importer process.
+	 * Over either is a 422 at the member that carried the bytes. */
+	uint32_t import_timeout_ms;      /* default 10000; 0 = the default */
+	uint64_t import_memory;          /* bytes, default 2147483648 (2 GiB); 0 = no memory limit */
 };
 void api_limits_defaults(struct api_limits *l);
 

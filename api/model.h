@@ -3,9 +3,19 @@
  * ply through the Assimp C API, base-colour textures through api/image_decode.c, and a bounded
  * LRU cache of imported models keyed by their bytes.
  *
+ * Isolation: model files are untrusted, and Assimp has crashed and looped on small malformed
+ * ones. api_model_get() therefore never parses in the calling process: Assimp (and the decoding
+ * of embedded textures) runs in a child of the `umbra-import` fork server (api/sandbox.h), under
+ * a CPU-time limit, a memory limit (RLIMIT_AS), a wall-clock timeout and a seccomp filter that
+ * allows no file access; the child sends back a compact serialized model (api/model_wire.h)
+ * that this process validates like any request input. A crash there is a 400, running over the
+ * time or memory limit a 422, and this process and every other request carry on. What it costs
+ * per model is in `make bench` ("import" lines).
+ *
  * Usage (api/scene_parse.c does this for every model object):
- *   struct api_model *m; char err[400];
- *   if (api_model_get(bytes, len, API_MODEL_SNIFF, cache_bytes, &m, err, sizeof err) != API_OK) 400 with err;
+ *   struct api_model *m; char err[400]; int status;
+ *   if (api_model_get(bytes, len, API_MODEL_SNIFF, &limits, &m, &status, err, sizeof err) != API_OK)
+ *           answer `status` (400/422/500) with err at the member that carried the bytes;
  *   ...m->instances[i] -> one rnd_object each, m->materials[...] appended to the scene...
  *   api_model_release(m);          // when the scene that uses it is freed
  *
@@ -15,8 +25,7 @@
  * reference, even after the cache has evicted the entry.
  *
  * Threading: every function is safe to call from several threads. The cache is guarded by one
- * mutex; imports of different bytes run in parallel except for the Assimp call itself, which
- * is serialised because Assimp's C API keeps its last error in one global string.
+ * mutex that is never held across an import; imports run in parallel, one child process each.
  */
 #ifndef UMBRA_API_MODEL_H
 #define UMBRA_API_MODEL_H
@@ -58,11 +67,15 @@ struct api_model {
 };
 
 /* Imports (or finds in the cache) the model in data[0..len). format API_MODEL_SNIFF tells it
- * from the bytes. cache_bytes bounds the cache after this insertion (0 = do not cache this
- * one). Returns API_OK with *out (one reference), or API_ERR with a sentence in err (Assimp's
- * message or what was wrong with the bytes; never mentions the caller's member names). */
-enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format, uint64_t cache_bytes,
-                              struct api_model **out, char *err, size_t errsize);
+ * from the bytes. From lim (NULL = api_limits_defaults): model_cache_bytes bounds the cache
+ * after this insertion (0 = do not cache this one); import_timeout_ms and import_memory bound
+ * the importer. Returns API_OK with *out (one reference), or API_ERR with *status 400 (bad
+ * file: refused, crashed the importer), 422 (over the import time or memory limit) or 500 (the
+ * importer could not run) and a sentence in err (Assimp's message or what was wrong with the
+ * bytes; never mentions the caller's member names). */
+enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format,
+                              const struct api_limits *lim, struct api_model **out, int *status, char *err,
+                              size_t errsize);
 void api_model_release(struct api_model *m);
 
 /* Tells the format from the bytes; API_MODEL_SNIFF when it cannot. */
@@ -71,7 +84,8 @@ const char *api_model_format_name(enum api_model_format f);
 
 /* ---- image decoding (api/image_decode.c) ---- */
 
-/* Decodes a PNG or JPEG into malloc'd RGBA8 (rows top to bottom, colour as stored, i.e. sRGB).
+/* Decodes a PNG or JPEG in the calling process (the sandboxed importer calls this; request
+ * input goes through api_sandbox_decode_image() in api/sandbox.h) into malloc'd RGBA8 (rows top to bottom, colour as stored, i.e. sRGB).
  * At most max_pixels pixels (0 = 64 Mi). Returns API_OK with *rgba (you free it), or API_ERR
  * with a sentence in err. */
 enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,

@@ -31,6 +31,7 @@
 #include "api.h"
 #include "arena.h"
 #include "model.h"
+#include "sandbox.h"
 #include "umbra/rnd_math.h"
 
 #define DEG2RAD (3.14159265358979323846 / 180.0)
@@ -629,9 +630,12 @@ static int parse_material(struct pctx *c, json_t *j, struct rnd_material *m, con
 		 * copied into the arena, which owns it with the rest of the scene. */
 		uint8_t *rgba = NULL;
 		uint32_t w = 0, h = 0;
-		char err[200];
-		if (api_image_decode(b, len, MAX_TEXTURE_PIXELS, &rgba, &w, &h, err, sizeof err) != API_OK) {
-			fail(c, "base_color_texture could not be decoded: %s", err);
+		char err[300];
+		int status;
+		/* In a sandboxed helper process (api/sandbox.h): libpng/libjpeg never see request bytes here. */
+		if (api_sandbox_decode_image(b, len, MAX_TEXTURE_PIXELS, c->lim, &rgba, &w, &h, &status, err, sizeof err) !=
+		    API_OK) {
+			api_problem_set(c->p, status, c->ptr, "base_color_texture could not be decoded: %s", err);
 			ptr_pop(c, old);
 			return -1;
 		}
@@ -779,7 +783,9 @@ static int read_asset(struct pctx *c, const char *path, unsigned char **out, siz
 	size_t n = strlen(rroot);
 	bool inside = !strcmp(rroot, "/") || (!strncmp(real, rroot, n) && real[n] == '/');
 	if (!inside) return fail(c, "path \"%.128s\" leaves the asset root (through a symbolic link)", path);
-	int fd = open(real, O_RDONLY | O_CLOEXEC);
+	/* O_NONBLOCK: opening a FIFO (or a device) must not wait for a writer; anything but a
+	 * regular file is refused right after, before a read could block. */
+	int fd = open(real, O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
 	if (fd < 0) return fail(c, "path \"%.128s\" cannot be opened: %s", path, strerror(errno));
 	struct stat st;
 	int rc = 0;
@@ -870,17 +876,22 @@ static int parse_model(struct pctx *c, json_t *j)
 	if (rc == 0) {
 		struct api_model *m = NULL;
 		char err[400];
+		int status;
 		struct model_ref *ref = api_arena_alloc(c->arena, sizeof *ref);
 		if (!ref) {
 			rc = fail(c, "out of memory");
-		} else if (api_model_get(b, len, given ? (enum api_model_format)f : API_MODEL_SNIFF,
-		                         c->lim->model_cache_bytes, &m, err, sizeof err) != API_OK) {
-			/* Named by the object's name, else by its path, else by its source member. */
+		} else if (api_model_get(b, len, given ? (enum api_model_format)f : API_MODEL_SNIFF, c->lim, &m, &status,
+		                         err, sizeof err) != API_OK) {
+			/* Named by the object's name, else by its path, else by its source member; 400 for a bad
+			 * file, 422 over the import time/memory limit, 500 when the importer cannot run. */
 			json_t *nm = json_object_get(j, "name");
 			const char *what = json_is_string(nm) ? json_string_value(nm)
 			                   : !strcmp(first, "path") ? json_string_value(v) : NULL;
-			if (what) rc = fail(c, "model \"%.128s\" (%s) could not be imported: %s", what, first, err);
-			else rc = fail(c, "the model in %s could not be imported: %s", first, err);
+			if (what)
+				api_problem_set(c->p, status, c->ptr, "model \"%.128s\" (%s) could not be imported: %s", what, first,
+				                err);
+			else api_problem_set(c->p, status, c->ptr, "the model in %s could not be imported: %s", first, err);
+			rc = -1;
 		} else {
 			ref->model = m;
 			ref->next = c->models;

@@ -39,6 +39,8 @@ static const struct opt_def opts[] = {
 	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
 	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to (none: `path` is a 400)", CFG(asset_root), 0, 0 },
 	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", LIM(model_cache_bytes), 0, UINT64_MAX },
+	{ "import-timeout-ms", OPT_UINT, "MS", "wall-clock and CPU limit of one sandboxed model import (10000)", LIM(import_timeout_ms), 1, 3600000 },
+	{ "import-memory", OPT_SIZE, "BYTES", "memory limit of one sandboxed model import, 0 = none (2G)", LIM(import_memory), 0, UINT64_MAX },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
 	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (8192)", CFG(atlas_size), 0, 16384 },
@@ -55,7 +57,10 @@ static void usage(FILE *f)
 	fprintf(f, "usage: umbrad [FLAGS]\n"
 	           "HTTP render daemon: POST /v1/render (scene JSON -> PNG/EXR), GET /healthz, /readyz,\n"
 	           "/metrics, /v1/info. Every flag can also be set as UMBRA_<FLAG> (e.g. UMBRA_MAX_BODY);\n"
-	           "a flag wins over its variable. UMBRA_VALIDATION=1 enables the Vulkan validation layer.\n\n");
+	           "a flag wins over its variable. UMBRA_VALIDATION=1 enables the Vulkan validation layer.\n"
+	           "Models and textures are parsed in sandboxed child processes of umbra-import (found next to\n"
+	           "umbrad, or UMBRA_IMPORT_HELPER=PATH): over --import-timeout-ms / --import-memory is a 422,\n"
+	           "a crash of the parser a 400, for that request only.\n\n");
 	for (size_t i = 0; i < OPT_COUNT; i++) {
 		char left[64];
 		snprintf(left, sizeof left, "--%s %s", opts[i].name, opts[i].arg);
@@ -127,7 +132,8 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 		}
 		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
 		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles) ||
-		    o->offset == LIM(model_cache_bytes) || o->offset == CFG(max_memory))
+		    o->offset == LIM(model_cache_bytes) || o->offset == CFG(max_memory) ||
+		    o->offset == LIM(import_memory))
 			*(uint64_t *)(base + o->offset) = v;
 		else
 			*(uint32_t *)(base + o->offset) = (uint32_t)v;

@@ -186,12 +186,13 @@ static enum MHD_Result answer_info(struct srv_request *req)
 	srv_buf_printf(&b, ",\"limits\":{\"max_body\":%llu,\"max_pixels\":%llu,\"max_triangles\":%llu,"
 	                   "\"max_lights\":%u,\"max_shadow_resolution\":%u,\"max_dimension\":%u,"
 	                   "\"device_max_shadow_resolution\":%u,\"deadline_ms\":%u,\"queue\":%u,\"workers\":%u,"
-	                   "\"max_memory\":%llu,\"device_max_allocation\":%llu}",
+	                   "\"max_memory\":%llu,\"device_max_allocation\":%llu,\"import_timeout_ms\":%u,\"import_memory\":%llu}",
 	               (unsigned long long)c->max_body, (unsigned long long)c->limits.max_pixels,
 	               (unsigned long long)c->limits.max_triangles, c->limits.max_lights,
 	               c->limits.max_shadow_resolution, info.max_image_dimension < 8192 ? info.max_image_dimension : 8192,
 	               info.max_shadow_resolution, c->deadline_ms, c->queue, c->workers,
-	               (unsigned long long)c->max_memory, (unsigned long long)info.max_allocation);
+	               (unsigned long long)c->max_memory, (unsigned long long)info.max_allocation, c->limits.import_timeout_ms,
+	               (unsigned long long)c->limits.import_memory);
 	srv_buf_puts(&b, ",\"filters\":[\"hard\",\"pcf\",\"pcss\",\"vsm\",\"evsm\"]"
 	                 ",\"formats\":[\"png\",\"exr\"],\"media_types\":[\"image/png\",\"image/x-exr\"]"
 	                 ",\"priorities\":[\"interactive\",\"bulk\"]}\n");

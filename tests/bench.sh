@@ -31,6 +31,9 @@ echo "== imported models (binary STL, inline base64): cold import every run, the
 "$BUILD/tests/bench" -n 3 -c "$tmp"/v/model-10k.json "$tmp"/v/model-100k.json "$tmp"/v/model-1m.json
 "$BUILD/tests/bench" -n 3 "$tmp"/v/model-10k.json "$tmp"/v/model-100k.json "$tmp"/v/model-1m.json
 echo
+echo "== model import isolation: the same STL imported cold in-process and in the sandbox (api/sandbox.h)"
+"$BUILD/tests/import_bench" -n "${BENCH_RUNS_SMALL:-7}" 1000 100000
+echo
 echo "== cold CLI (new process each: device + pipelines + first-use JIT), thumb-512"
 for i in 1 2 3; do
 	s=$(date +%s%N)

@@ -487,15 +487,18 @@ TEST(model_cache)
 	snprintf(obj2, sizeof obj2, "# another\n%s", obj);
 	struct api_model *m_a, *m_b, *m_c;
 	char err[256];
-	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, 1u << 20, &m_a, err, sizeof err) == API_OK);
+	int st;
+	lim.model_cache_bytes = 1u << 20;
+	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, &lim, &m_a, &st, err, sizeof err) == API_OK);
 	uint64_t one;
 	api_model_cache_stats(NULL, NULL, &one);
-	REQUIRE(api_model_get((const uint8_t *)obj2, strlen(obj2), API_MODEL_OBJ, one + one / 2, &m_b, err,
-	                      sizeof err) == API_OK);
+	lim.model_cache_bytes = one + one / 2;
+	REQUIRE(api_model_get((const uint8_t *)obj2, strlen(obj2), API_MODEL_OBJ, &lim, &m_b, &st, err, sizeof err) ==
+	        API_OK);
 	api_model_cache_stats(&h0, &m0, &bytes);
 	CHECK(bytes < 2 * one && bytes >= one, "bytes %llu one %llu", (unsigned long long)bytes, (unsigned long long)one);
-	REQUIRE(api_model_get((const uint8_t *)obj2, strlen(obj2), API_MODEL_OBJ, one + one / 2, &m_c, err,
-	                      sizeof err) == API_OK);
+	REQUIRE(api_model_get((const uint8_t *)obj2, strlen(obj2), API_MODEL_OBJ, &lim, &m_c, &st, err, sizeof err) ==
+	        API_OK);
 	api_model_cache_stats(&h1, NULL, NULL);
 	CHECK(h1 == h0 + 1 && m_c == m_b);
 	CHECK(m_a->triangles == 12);   /* evicted, still ours */

@@ -1,0 +1,334 @@
+/*
+ * api/model_wire — writer (sandboxed child) and validating reader (daemon) of the importer's
+ * reply. See model_wire.h for the layout and why the reader trusts nothing.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "model_wire.h"
+
+#define MAX_TEXTURES 4096u
+
+/* ---- writer ---- */
+
+void api_wire_buf_release(struct api_wire_buf *b)
+{
+	if (!b) return;
+	free(b->data);
+	memset(b, 0, sizeof *b);
+}
+
+static void put(struct api_wire_buf *b, const void *p, size_t n)
+{
+	if (b->failed || !n) return;
+	if (n > b->cap - b->len) {
+		size_t cap = b->cap ? b->cap : 4096;
+		while (cap - b->len < n) {
+			if (cap > SIZE_MAX / 2) { b->failed = 1; return; }
+			cap *= 2;
+		}
+		uint8_t *d = realloc(b->data, cap);
+		if (!d) { b->failed = 1; return; }
+		b->data = d;
+		b->cap = cap;
+	}
+	memcpy(b->data + b->len, p, n);
+	b->len += n;
+}
+
+static void put_u32(struct api_wire_buf *b, uint32_t v)
+{
+	put(b, &v, 4);
+}
+
+void api_wire_put_header(struct api_wire_buf *b, enum api_wire_kind kind, enum api_wire_status st, const char *msg)
+{
+	size_t n = msg ? strlen(msg) : 0;
+	if (n > API_WIRE_MAX_MESSAGE) n = API_WIRE_MAX_MESSAGE;
+	put(b, API_WIRE_MAGIC, 8);
+	put_u32(b, API_WIRE_VERSION);
+	put_u32(b, (uint32_t)kind);
+	put_u32(b, (uint32_t)st);
+	put_u32(b, (uint32_t)n);
+	put(b, msg, n);
+}
+
+void api_wire_put_image(struct api_wire_buf *b, const uint8_t *rgba, uint32_t w, uint32_t h)
+{
+	put_u32(b, w);
+	put_u32(b, h);
+	put(b, rgba, (size_t)w * h * 4);
+}
+
+void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
+{
+	/* Textures are shared between materials by pointer: each goes once, by its first index. */
+	const struct rnd_texture *tex[MAX_TEXTURES];
+	uint32_t ntex = 0;
+	for (uint32_t i = 0; i < m->material_count; i++) {
+		const struct rnd_texture *t = m->materials[i].base_color_texture;
+		uint32_t k = 0;
+		while (t && k < ntex && tex[k] != t) k++;
+		if (t && k == ntex) {
+			if (ntex == MAX_TEXTURES) { b->failed = 1; return; }
+			tex[ntex++] = t;
+		}
+	}
+	put_u32(b, ntex);
+	put_u32(b, m->material_count);
+	put_u32(b, m->mesh_count);
+	put_u32(b, m->instance_count);
+	for (uint32_t i = 0; i < ntex; i++) api_wire_put_image(b, tex[i]->rgba, tex[i]->width, tex[i]->height);
+	for (uint32_t i = 0; i < m->material_count; i++) {
+		const struct rnd_material *mt = &m->materials[i];
+		float f[11] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
+		               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff, 0};
+		put(b, f, sizeof f); /* the last one reserved, zero */
+		put_u32(b, (uint32_t)mt->alpha_mode);
+		int32_t ti = -1;
+		for (uint32_t k = 0; mt->base_color_texture && k < ntex; k++)
+			if (tex[k] == mt->base_color_texture) ti = (int32_t)k;
+		put(b, &ti, 4);
+	}
+	for (uint32_t i = 0; i < m->mesh_count; i++) {
+		const struct api_model_mesh *me = &m->meshes[i];
+		put_u32(b, me->vertex_count);
+		put_u32(b, me->index_count);
+		put_u32(b, me->material);
+		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u));
+		put(b, me->positions, (size_t)me->vertex_count * 12);
+		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
+		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
+		put(b, me->indices, (size_t)me->index_count * 4);
+	}
+	for (uint32_t i = 0; i < m->instance_count; i++) {
+		put_u32(b, m->instances[i].mesh);
+		put(b, m->instances[i].model, 64);
+	}
+}
+
+/* ---- reader ---- */
+
+struct rd {
+	const uint8_t *p;
+	size_t left;
+	char *err;
+	size_t errsize;
+};
+
+__attribute__((format(printf, 2, 3)))
+static enum api_result bad(struct rd *r, const char *fmt, ...)
+{
+	if (r->err && r->errsize) {
+		int n = snprintf(r->err, r->errsize, "the importer's reply is malformed: ");
+		va_list ap;
+		va_start(ap, fmt);
+		if (n > 0 && (size_t)n < r->errsize) vsnprintf(r->err + n, r->errsize - (size_t)n, fmt, ap);
+		va_end(ap);
+	}
+	return API_ERR;
+}
+
+static bool take(struct rd *r, void *out, size_t n)
+{
+	if (n > r->left) return false;
+	memcpy(out, r->p, n);
+	r->p += n;
+	r->left -= n;
+	return true;
+}
+
+static bool take_u32(struct rd *r, uint32_t *v)
+{
+	return take(r, v, 4);
+}
+
+/* n items of `size` bytes must remain: checked before anything of that size is allocated. */
+static bool fits(const struct rd *r, uint64_t n, uint64_t size)
+{
+	return size && n <= r->left / size;
+}
+
+static bool finite_all(const float *f, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (!isfinite(f[i])) return false;
+	return true;
+}
+
+enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_kind *kind,
+                                enum api_wire_status *status, char *msg, size_t msgsize,
+                                const uint8_t **body, size_t *body_len, char *err, size_t errsize)
+{
+	struct rd r = {data, data ? len : 0, err, errsize};
+	char magic[8];
+	uint32_t ver, k, st, n;
+	if (!take(&r, magic, 8) || memcmp(magic, API_WIRE_MAGIC, 8)) return bad(&r, "no header");
+	if (!take_u32(&r, &ver) || !take_u32(&r, &k) || !take_u32(&r, &st) || !take_u32(&r, &n))
+		return bad(&r, "the header is cut short");
+	if (ver != API_WIRE_VERSION) return bad(&r, "version %u", ver);
+	if (k != API_WIRE_MODEL && k != API_WIRE_IMAGE) return bad(&r, "kind %u", k);
+	if (st > API_WIRE_OVER_MEMORY) return bad(&r, "status %u", st);
+	if (n > API_WIRE_MAX_MESSAGE || n > r.left) return bad(&r, "message of %u bytes", n);
+	if (st != API_WIRE_OK && (n != r.left || !n)) return bad(&r, "a failure without (only) a message");
+	if (msg && msgsize) {
+		size_t c = n < msgsize - 1 ? n : msgsize - 1;
+		/* Printable ASCII only: the message ends up in a JSON problem and a log line. */
+		for (size_t i = 0; i < c; i++) msg[i] = r.p[i] >= 0x20 && r.p[i] < 0x7f ? (char)r.p[i] : '?';
+		msg[c] = 0;
+	}
+	r.p += n;
+	r.left -= n;
+	*kind = (enum api_wire_kind)k;
+	*status = (enum api_wire_status)st;
+	*body = r.p;
+	*body_len = r.left;
+	return API_OK;
+}
+
+static enum api_result read_image(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h, const uint8_t **px)
+{
+	if (!take_u32(r, w) || !take_u32(r, h)) return bad(r, "an image size is cut short");
+	uint64_t n = (uint64_t)*w * *h;
+	if (!n || n > max_pixels) return bad(r, "an image of %ux%u pixels", *w, *h);
+	if (!fits(r, n, 4)) return bad(r, "an image's pixels are cut short");
+	*px = r->p;
+	r->p += n * 4;
+	r->left -= n * 4;
+	return API_OK;
+}
+
+enum api_result api_wire_decode_image(const uint8_t *body, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                      uint32_t *w, uint32_t *h, char *err, size_t errsize)
+{
+	struct rd r = {body, body ? len : 0, err, errsize};
+	const uint8_t *px;
+	*rgba = NULL;
+	if (read_image(&r, max_pixels, w, h, &px) != API_OK) return API_ERR;
+	if (r.left) return bad(&r, "%zu bytes after the image", r.left);
+	size_t n = (size_t)*w * *h * 4;
+	if (!(*rgba = malloc(n))) {
+		snprintf(err, errsize, "out of memory");
+		return API_ERR;
+	}
+	memcpy(*rgba, px, n);
+	return API_OK;
+}
+
+struct dec {
+	struct rd r;
+	struct api_arena *arena;
+	size_t bytes;
+};
+
+static void *dec_alloc(struct dec *d, size_t n, size_t size)
+{
+	void *p = api_arena_calloc(d->arena, n ? n : 1, size);
+	if (p) d->bytes += (n ? n : 1) * size;
+	return p;
+}
+
+static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd_texture *tex, uint32_t ntex,
+                                        struct rnd_material *mats)
+{
+	for (uint32_t i = 0; i < nmat; i++) {
+		float f[11];
+		uint32_t mode;
+		int32_t ti;
+		if (!take(&d->r, f, sizeof f) || !take_u32(&d->r, &mode) || !take(&d->r, &ti, 4))
+			return bad(&d->r, "material %u is cut short", i);
+		bool ok = finite_all(f, 11) && f[10] == 0;
+		for (int k = 0; k < 3; k++) ok = ok && f[k] >= 0 && f[k] <= 1e6f && f[6 + k] >= 0 && f[6 + k] <= 1e6f;
+		ok = ok && f[3] >= 0 && f[3] <= 1 && f[4] >= 0 && f[4] <= 1 && f[5] >= 0 && f[5] <= 1 && f[9] >= 0 &&
+		     f[9] <= 1;
+		if (!ok) return bad(&d->r, "material %u has a value out of range", i);
+		if (mode != RND_ALPHA_OPAQUE && mode != RND_ALPHA_MASK) return bad(&d->r, "material %u alpha mode", i);
+		if (ti < -1 || (ti >= 0 && (uint32_t)ti >= ntex)) return bad(&d->r, "material %u texture %d", i, ti);
+		struct rnd_material *m = &mats[i];
+		rnd_material_defaults(m);
+		memcpy(m->base_color, f, 4 * sizeof(float));
+		m->roughness = f[4];
+		m->metallic = f[5];
+		memcpy(m->emissive, f + 6, 3 * sizeof(float));
+		m->alpha_cutoff = f[9];
+		m->alpha_mode = (enum rnd_alpha_mode)mode;
+		m->base_color_texture = ti >= 0 ? &tex[ti] : NULL;
+	}
+	return API_OK;
+}
+
+static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, struct api_model_mesh *me)
+{
+	uint32_t nv, ni, mat, flags;
+	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &mat) || !take_u32(&d->r, &flags))
+		return bad(&d->r, "mesh %u is cut short", i);
+	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 3)
+		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
+	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0);
+	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u is cut short", i);
+	float *pos = dec_alloc(d, nv, 12), *nrm = flags & 1 ? dec_alloc(d, nv, 12) : NULL;
+	float *uv = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
+	uint32_t *idx = dec_alloc(d, ni, 4);
+	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || !idx) return bad(&d->r, "out of memory");
+	take(&d->r, pos, (size_t)nv * 12);
+	if (nrm) take(&d->r, nrm, (size_t)nv * 12);
+	if (uv) take(&d->r, uv, (size_t)nv * 8);
+	if (!take(&d->r, idx, (size_t)ni * 4)) return bad(&d->r, "mesh %u is cut short", i);
+	if (!finite_all(pos, (size_t)nv * 3) || (nrm && !finite_all(nrm, (size_t)nv * 3)) ||
+	    (uv && !finite_all(uv, (size_t)nv * 2)))
+		return bad(&d->r, "mesh %u has a value that is not finite", i);
+	for (uint32_t k = 0; k < ni; k++)
+		if (idx[k] >= nv) return bad(&d->r, "mesh %u: index %u refers to vertex %u of %u", i, k, idx[k], nv);
+	*me = (struct api_model_mesh){pos, nrm, uv, idx, nv, ni, mat};
+	return API_OK;
+}
+
+enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct api_arena *arena,
+                                      uint64_t max_texture_pixels, struct api_model *out, size_t *bytes,
+                                      char *err, size_t errsize)
+{
+	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
+	uint32_t ntex, nmat, nmesh, ninst;
+	if (!take_u32(&d.r, &ntex) || !take_u32(&d.r, &nmat) || !take_u32(&d.r, &nmesh) || !take_u32(&d.r, &ninst))
+		return bad(&d.r, "the counts are cut short");
+	/* Each item needs at least 8 bytes, so counts beyond that are lies caught before allocating. */
+	if (ntex > MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, (uint64_t)ntex + nmat + nmesh + ninst, 8))
+		return bad(&d.r, "%u textures, %u materials, %u meshes, %u instances", ntex, nmat, nmesh, ninst);
+	struct rnd_texture *tex = dec_alloc(&d, ntex, sizeof *tex);
+	struct rnd_material *mats = dec_alloc(&d, nmat, sizeof *mats);
+	struct api_model_mesh *meshes = dec_alloc(&d, nmesh, sizeof *meshes);
+	struct api_model_instance *inst = dec_alloc(&d, ninst, sizeof *inst);
+	if (!tex || !mats || !meshes || !inst) return bad(&d.r, "out of memory");
+	for (uint32_t i = 0; i < ntex; i++) {
+		const uint8_t *px;
+		if (read_image(&d.r, max_texture_pixels, &tex[i].width, &tex[i].height, &px) != API_OK) return API_ERR;
+		uint8_t *copy = dec_alloc(&d, (size_t)tex[i].width * tex[i].height, 4);
+		if (!copy) return bad(&d.r, "out of memory");
+		memcpy(copy, px, (size_t)tex[i].width * tex[i].height * 4);
+		tex[i].rgba = copy;
+	}
+	if (decode_materials(&d, nmat, tex, ntex, mats) != API_OK) return API_ERR;
+	for (uint32_t i = 0; i < nmesh; i++)
+		if (decode_mesh(&d, i, nmat, &meshes[i]) != API_OK) return API_ERR;
+	uint64_t tris = 0;
+	for (uint32_t i = 0; i < ninst; i++) {
+		if (!take_u32(&d.r, &inst[i].mesh) || !take(&d.r, inst[i].model, 64))
+			return bad(&d.r, "instance %u is cut short", i);
+		if (inst[i].mesh >= nmesh || !finite_all(inst[i].model, 16))
+			return bad(&d.r, "instance %u: mesh %u, or a matrix that is not finite", i, inst[i].mesh);
+		tris += meshes[inst[i].mesh].index_count / 3;
+	}
+	if (d.r.left) return bad(&d.r, "%zu bytes after the last instance", d.r.left);
+	out->meshes = meshes;
+	out->mesh_count = nmesh;
+	out->instances = inst;
+	out->instance_count = ninst;
+	out->materials = mats;
+	out->material_count = nmat;
+	out->triangles = tris;
+	*bytes = d.bytes;
+	return API_OK;
+}

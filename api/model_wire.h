@@ -1,0 +1,77 @@
+/*
+ * api/model_wire — the byte format in which the sandboxed importer (api/sandbox_child.c)
+ * hands an imported model or a decoded image back to the daemon (api/sandbox.c), and the
+ * daemon's decoder of it.
+ *
+ * The importer runs untrusted parsers (Assimp, libpng, libjpeg) on untrusted bytes: whatever
+ * it writes back may have been shaped by an attacker who took it over. So the decoder treats a
+ * reply exactly like request input: every count is checked against the bytes that remain
+ * before anything is allocated, every size multiplication is overflow-checked, every index is
+ * bounded, every float is finite and in its range. A reply either decodes completely into the
+ * caller's arena or is refused with a sentence; it never reads outside [data, data + len).
+ *
+ * Layout (host byte order: both ends are the same build on the same machine), all fields
+ * 4 bytes:
+ *   header   "UMBRAIMP" version kind status msg_len, then msg_len bytes of message
+ *            (status != OK: the reply ends there)
+ *   image    width height, width*height*4 bytes RGBA8
+ *   model    texture_count material_count mesh_count instance_count
+ *            textures:  width height, width*height*4 bytes RGBA8
+ *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff reserved
+ *                       (f32, reserved = 0), alpha_mode (u32), texture (i32, -1 = none)
+ *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs),
+ *                       positions f32[3v], normals f32[3v], uvs f32[2v], indices u32[i]
+ *            instances: mesh (u32), model matrix f32[16] (column-major)
+ *   Nothing may follow the last instance.
+ *
+ * Usage (parent): api_wire_header(); then api_wire_decode_model() / _image() on the body.
+ * Usage (child):  struct api_wire_buf b = {0}; api_wire_put_model(&b, model); write b.data.
+ * Threading: no shared state.
+ */
+#ifndef UMBRA_API_MODEL_WIRE_H
+#define UMBRA_API_MODEL_WIRE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "arena.h"
+#include "model.h"
+
+#define API_WIRE_MAGIC "UMBRAIMP"
+#define API_WIRE_VERSION 1u
+#define API_WIRE_MAX_MESSAGE 1024u
+
+enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2 };
+/* What the importer says about the input (a crash says nothing: see api/sandbox.h). */
+enum api_wire_status { API_WIRE_OK = 0, API_WIRE_BAD_INPUT = 1, API_WIRE_OVER_MEMORY = 2 };
+
+/* A growable output buffer (child side). Any failed put leaves failed set and keeps data. */
+struct api_wire_buf {
+	uint8_t *data;
+	size_t len, cap;
+	int failed;
+};
+void api_wire_buf_release(struct api_wire_buf *b);
+/* Header with a message (status != OK) or with none (OK; the body follows). */
+void api_wire_put_header(struct api_wire_buf *b, enum api_wire_kind kind, enum api_wire_status st,
+                         const char *msg);
+void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m);
+void api_wire_put_image(struct api_wire_buf *b, const uint8_t *rgba, uint32_t w, uint32_t h);
+
+/* Parses the header. On API_OK: *kind, *status, the message (NUL-terminated copy in msg) and
+ * the body (what follows the header). API_ERR with a sentence in err when it is malformed. */
+enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_kind *kind,
+                                enum api_wire_status *status, char *msg, size_t msgsize,
+                                const uint8_t **body, size_t *body_len, char *err, size_t errsize);
+
+/* Decodes a model body into arena memory: fills the public part of *out (meshes, instances,
+ * materials with their textures, triangles) and *bytes (what it allocated). max_texture_pixels
+ * bounds each texture. API_ERR with a sentence in err: nothing of *out is valid then (the
+ * arena still owns whatever was allocated). */
+enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct api_arena *arena,
+                                      uint64_t max_texture_pixels, struct api_model *out, size_t *bytes,
+                                      char *err, size_t errsize);
+/* Decodes an image body into malloc'd RGBA8 (*rgba, you free it). */
+enum api_result api_wire_decode_image(const uint8_t *body, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                      uint32_t *w, uint32_t *h, char *err, size_t errsize);
+
+#endif

@@ -1,0 +1,384 @@
+/*
+ * api/sandbox — the daemon's side of the sandboxed importer (see sandbox.h): starts the fork
+ * server, hands it one job at a time per calling thread, and turns how the job ended into an
+ * answer. The helper's side is api/sandbox_child.c.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include "model_wire.h"
+#include "sandbox.h"
+
+extern char **environ;
+
+/* The daemon waits this long past the job's timeout for the fork server to report: it kills
+ * the child at the timeout, so only a stuck fork server could make the daemon wait longer. */
+#define GRACE_MS 2000
+#define CTL_SEND_MS 2000
+#define MAX_TEXTURE_PIXELS (64ull << 20)
+
+static pthread_mutex_t start_mu = PTHREAD_MUTEX_INITIALIZER;
+static int ctl_fd = -1;
+static pid_t server_pid = -1;
+static char helper[PATH_MAX];
+
+__attribute__((format(printf, 5, 6)))
+static enum api_result fail(int *status, int code, char *err, size_t errsize, const char *fmt, ...)
+{
+	*status = code;
+	if (err && errsize) {
+		va_list ap;
+		va_start(ap, fmt);
+		vsnprintf(err, errsize, fmt, ap);
+		va_end(ap);
+	}
+	return API_ERR;
+}
+
+static int64_t now_ms(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
+}
+
+/* UMBRA_IMPORT_HELPER, else umbra-import next to the running executable, else one directory
+ * up (the test binaries live in build/tests/). With start_mu held. */
+static void find_helper(void)
+{
+	const char *env = getenv("UMBRA_IMPORT_HELPER");
+	if (env && env[0]) {
+		snprintf(helper, sizeof helper, "%s", env);
+		return;
+	}
+	char exe[PATH_MAX];
+	ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+	if (n <= 0) {
+		snprintf(helper, sizeof helper, "umbra-import");
+		return;
+	}
+	exe[n] = 0;
+	char *slash = strrchr(exe, '/');
+	if (slash) *slash = 0;
+	snprintf(helper, sizeof helper, "%.*s/umbra-import", PATH_MAX - 16, exe);
+	if (access(helper, X_OK) == 0 || !(slash = strrchr(exe, '/'))) return;
+	*slash = 0;
+	char up[PATH_MAX];
+	snprintf(up, sizeof up, "%.*s/umbra-import", PATH_MAX - 16, exe);
+	if (access(up, X_OK) == 0) memcpy(helper, up, sizeof up);
+}
+
+const char *api_sandbox_helper_path(void)
+{
+	pthread_mutex_lock(&start_mu);
+	if (!helper[0]) find_helper();
+	pthread_mutex_unlock(&start_mu);
+	return helper;
+}
+
+/* With start_mu held. */
+static void stop_server(void)
+{
+	if (ctl_fd >= 0) close(ctl_fd);
+	ctl_fd = -1;
+	if (server_pid > 0) {
+		/* Closing the control socket ends it; SIGKILL in case it is what went wrong. */
+		kill(server_pid, SIGKILL);
+		waitpid(server_pid, NULL, 0);
+	}
+	server_pid = -1;
+}
+
+/* With start_mu held. posix_spawn (vfork-like) is safe in a multithreaded process. */
+static int start_server(char *err, size_t errsize)
+{
+	if (!helper[0]) find_helper();
+	int sv[2];
+	if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) < 0) {
+		snprintf(err, errsize, "cannot create the importer's socket: %s", strerror(errno));
+		return -1;
+	}
+	/* Above fd 3, so the dup2 to 3 below always happens and clears close-on-exec. */
+	int child_end = fcntl(sv[1], F_DUPFD_CLOEXEC, 10);
+	posix_spawn_file_actions_t fa;
+	posix_spawnattr_t at;
+	posix_spawn_file_actions_init(&fa);
+	posix_spawnattr_init(&at);
+	posix_spawn_file_actions_adddup2(&fa, child_end, API_SBX_CTL_FD);
+	posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+	sigset_t none, all;
+	sigemptyset(&none);
+	sigfillset(&all);
+	sigdelset(&all, SIGKILL);
+	sigdelset(&all, SIGSTOP);
+	posix_spawnattr_setsigmask(&at, &none);
+	posix_spawnattr_setsigdefault(&at, &all);
+	posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+	char *argv[] = {helper, "--fork-server", NULL};
+	pid_t pid;
+	int rc = child_end < 0 ? errno : posix_spawn(&pid, helper, &fa, &at, argv, environ);
+	posix_spawn_file_actions_destroy(&fa);
+	posix_spawnattr_destroy(&at);
+	if (child_end >= 0) close(child_end);
+	close(sv[1]);
+	if (rc) {
+		close(sv[0]);
+		snprintf(err, errsize, "cannot start the model importer (umbra-import): %s", strerror(rc));
+		return -1;
+	}
+	ctl_fd = sv[0];
+	server_pid = pid;
+	return 0;
+}
+
+/* Sends the request and the two fds; restarts the fork server once when it is gone. The lock
+ * covers one sendmsg on a socket the fork server drains at once, bounded by CTL_SEND_MS. */
+static int send_request(const struct api_sbx_request *rq, int data_fd, int status_fd, char *err, size_t errsize)
+{
+	int fds[2] = {data_fd, status_fd};
+	union { struct cmsghdr h; char buf[CMSG_SPACE(sizeof fds)]; } cm;
+	memset(&cm, 0, sizeof cm);
+	struct iovec iov = {(void *)rq, sizeof *rq};
+	struct msghdr msg = {.msg_iov = &iov, .msg_iovlen = 1, .msg_control = cm.buf, .msg_controllen = sizeof cm.buf};
+	struct cmsghdr *c = CMSG_FIRSTHDR(&msg);
+	c->cmsg_level = SOL_SOCKET;
+	c->cmsg_type = SCM_RIGHTS;
+	c->cmsg_len = CMSG_LEN(sizeof fds);
+	memcpy(CMSG_DATA(c), fds, sizeof fds);
+	int rc = -1;
+	pthread_mutex_lock(&start_mu);
+	for (int attempt = 0; attempt < 2 && rc < 0; attempt++) {
+		if (ctl_fd < 0 && start_server(err, errsize) < 0) break;
+		int64_t until = now_ms() + CTL_SEND_MS;
+		for (;;) {
+			if (sendmsg(ctl_fd, &msg, MSG_NOSIGNAL | MSG_DONTWAIT) == (ssize_t)sizeof *rq) { rc = 0; break; }
+			if (errno == EINTR) continue;
+			if (errno != EAGAIN || now_ms() >= until) {
+				snprintf(err, errsize, "the model importer does not answer (%s)", strerror(errno));
+				stop_server(); /* dead or stuck: the next attempt starts a fresh one */
+				break;
+			}
+			struct pollfd p = {ctl_fd, POLLOUT, 0};
+			poll(&p, 1, 50);
+		}
+	}
+	pthread_mutex_unlock(&start_mu);
+	return rc;
+}
+
+/* Writes the input and reads the reply at the same time until EOF or the deadline. */
+static int exchange(int fd, const uint8_t *in, size_t len, int64_t deadline, size_t max_reply, uint8_t **reply,
+                    size_t *rlen)
+{
+	size_t sent = 0, got = 0, cap = 0;
+	uint8_t *buf = NULL;
+	fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+	if (!len) shutdown(fd, SHUT_WR);
+	for (;;) {
+		int64_t left = deadline - now_ms();
+		if (left <= 0) break;
+		struct pollfd p = {fd, (short)(POLLIN | (sent < len ? POLLOUT : 0)), 0};
+		if (poll(&p, 1, (int)(left > 1000 ? 1000 : left)) < 0 && errno != EINTR) break;
+		if (sent < len && (p.revents & (POLLOUT | POLLERR))) {
+			ssize_t w = send(fd, in + sent, len - sent, MSG_NOSIGNAL);
+			if (w > 0 && (sent += (size_t)w) == len) shutdown(fd, SHUT_WR);
+			if (w < 0 && errno != EAGAIN && errno != EINTR) sent = len; /* the child is gone: read what it said */
+		}
+		if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
+		if (got == cap) {
+			size_t ncap = cap ? cap * 2 : 65536;
+			if (ncap > max_reply) ncap = max_reply;
+			uint8_t *n = ncap > cap ? realloc(buf, ncap) : NULL;
+			if (!n) break; /* over the cap: refused below as incomplete */
+			buf = n;
+			cap = ncap;
+		}
+		ssize_t r = recv(fd, buf + got, cap - got, 0);
+		if (r == 0) {
+			*reply = buf;
+			*rlen = got;
+			return 0;
+		}
+		if (r > 0) got += (size_t)r;
+		else if (errno != EAGAIN && errno != EINTR) break;
+	}
+	free(buf);
+	return -1;
+}
+
+static int read_status(int fd, int64_t deadline, struct api_sbx_status *st)
+{
+	size_t got = 0;
+	while (got < sizeof *st) {
+		int64_t left = deadline - now_ms();
+		struct pollfd p = {fd, POLLIN, 0};
+		if (left <= 0 || poll(&p, 1, (int)left) == 0) return -1;
+		ssize_t r = read(fd, (char *)st + got, sizeof *st - got);
+		if (r < 0 && errno == EINTR) continue;
+		if (r <= 0) return -1;
+		got += (size_t)r;
+	}
+	return st->magic == API_SBX_MAGIC ? 0 : -1;
+}
+
+static const char *signal_name(int sig)
+{
+	switch (sig) {
+	case SIGSEGV: return "segmentation fault";
+	case SIGABRT: return "abort";
+	case SIGBUS: return "bus error";
+	case SIGFPE: return "arithmetic exception";
+	case SIGILL: return "illegal instruction";
+	default: return "signal";
+	}
+}
+
+/* How the child ended, when it did not end well; 0 when it exited 0 (the reply decides). */
+static int classify(const struct api_sbx_status *st, bool got_reply, const struct api_sbx_request *rq, int *status,
+                    char *err, size_t errsize)
+{
+	unsigned cpu_s = (rq->timeout_ms + 999) / 1000;
+	switch (st->how) {
+	case API_SBX_TIMED_OUT:
+		return fail(status, 422, err, errsize, "took longer than the import time limit of %u ms", rq->timeout_ms), -1;
+	case API_SBX_REFUSED:
+		return fail(status, 500, err, errsize, "the model importer could not start a process (%s)",
+		            strerror(st->code)), -1;
+	case API_SBX_SIGNALED:
+		if (st->code == SIGXCPU || st->code == SIGKILL)
+			return fail(status, 422, err, errsize, "used more than the import CPU time limit of %u s", cpu_s), -1;
+		if (st->code == SIGSYS)
+			return fail(status, 400, err, errsize, "the importer was stopped by its sandbox (a forbidden system "
+			            "call) while reading it"), -1;
+		return fail(status, 400, err, errsize, "the importer crashed reading it (%s, signal %d)",
+		            signal_name(st->code), st->code), -1;
+	case API_SBX_EXITED:
+		if (st->code == 0 && got_reply) return 0;
+		if (st->code == API_SBX_EXIT_OOM)
+			return fail(status, 422, err, errsize, "needed more than the import memory limit of %llu MiB",
+			            (unsigned long long)(rq->memory >> 20)), -1;
+		if (st->code == API_SBX_EXIT_SETUP)
+			return fail(status, 500, err, errsize, "the model importer could not set up its sandbox"), -1;
+		return fail(status, 400, err, errsize, "the importer failed reading it (exit status %d)", st->code), -1;
+	default:
+		return fail(status, 500, err, errsize, "the model importer sent an unknown status"), -1;
+	}
+}
+
+/* One job: its reply (malloc'd, header checked) or a classified failure. */
+static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, const struct api_limits *lim,
+                               uint8_t **reply, const uint8_t **body, size_t *body_len, int *status, char *err,
+                               size_t errsize)
+{
+	struct api_limits def;
+	if (!lim) {
+		api_limits_defaults(&def);
+		lim = &def;
+	}
+	rq->magic = API_SBX_MAGIC;
+	rq->timeout_ms = lim->import_timeout_ms ? lim->import_timeout_ms : 10000;
+	rq->memory = lim->import_memory;
+	*reply = NULL;
+	int ds[2], ps[2];
+	if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ds) < 0)
+		return fail(status, 500, err, errsize, "cannot create a socket for the importer: %s", strerror(errno));
+	if (pipe2(ps, O_CLOEXEC) < 0) {
+		close(ds[0]);
+		close(ds[1]);
+		return fail(status, 500, err, errsize, "cannot create a pipe for the importer: %s", strerror(errno));
+	}
+	char serr[200];
+	int sent = send_request(rq, ds[1], ps[1], serr, sizeof serr);
+	close(ds[1]);
+	close(ps[1]);
+	enum api_result rc = API_ERR;
+	if (sent < 0) {
+		fail(status, 500, err, errsize, "%s", serr);
+		goto out;
+	}
+	int64_t deadline = now_ms() + rq->timeout_ms + GRACE_MS;
+	/* A reply is never bigger than the child's memory; without a limit, 4 GiB. */
+	size_t max_reply = rq->memory ? (size_t)rq->memory : (size_t)4 << 30;
+	size_t rlen = 0;
+	bool got = exchange(ds[0], data, rq->input_len, deadline, max_reply, reply, &rlen) == 0;
+	struct api_sbx_status st;
+	if (read_status(ps[0], deadline, &st) < 0) {
+		if (now_ms() >= deadline) fail(status, 422, err, errsize, "took longer than the import time limit of %u ms",
+		                               rq->timeout_ms);
+		else fail(status, 500, err, errsize, "the model importer stopped before reporting");
+		goto out;
+	}
+	if (classify(&st, got, rq, status, err, errsize) < 0) goto out;
+	enum api_wire_kind kind;
+	enum api_wire_status ws;
+	char msg[API_WIRE_MAX_MESSAGE + 1], werr[200];
+	if (api_wire_header(*reply, rlen, &kind, &ws, msg, sizeof msg, body, body_len, werr, sizeof werr) != API_OK ||
+	    kind != rq->kind) {
+		fail(status, 400, err, errsize, "%s", kind != rq->kind ? "the importer's reply is of the wrong kind" : werr);
+		goto out;
+	}
+	if (ws == API_WIRE_BAD_INPUT) fail(status, 400, err, errsize, "%s", msg);
+	else if (ws == API_WIRE_OVER_MEMORY)
+		fail(status, 422, err, errsize, "needed more than the import memory limit of %llu MiB (%s)",
+		     (unsigned long long)(rq->memory >> 20), msg);
+	else rc = API_OK;
+out:
+	close(ds[0]);
+	close(ps[0]);
+	if (rc != API_OK) {
+		free(*reply);
+		*reply = NULL;
+	}
+	return rc;
+}
+
+enum api_result api_sandbox_import_model(const uint8_t *data, size_t len, enum api_model_format format,
+                                         const struct api_limits *lim, struct api_arena *arena,
+                                         struct api_model *out, size_t *bytes, int *status, char *err,
+                                         size_t errsize)
+{
+	*status = 0;
+	struct api_sbx_request rq = {.kind = API_WIRE_MODEL, .format = (uint32_t)format,
+	                             .max_pixels = MAX_TEXTURE_PIXELS, .input_len = len};
+	uint8_t *reply;
+	const uint8_t *body;
+	size_t blen;
+	if (run_job(&rq, data, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
+	enum api_result rc = api_wire_decode_model(body, blen, arena, MAX_TEXTURE_PIXELS, out, bytes, err, errsize);
+	if (rc != API_OK) *status = 400;
+	out->format = format;
+	free(reply);
+	return rc;
+}
+
+enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64_t max_pixels,
+                                         const struct api_limits *lim, uint8_t **rgba, uint32_t *w, uint32_t *h,
+                                         int *status, char *err, size_t errsize)
+{
+	*status = 0;
+	*rgba = NULL;
+	if (!max_pixels) max_pixels = MAX_TEXTURE_PIXELS;
+	struct api_sbx_request rq = {.kind = API_WIRE_IMAGE, .max_pixels = max_pixels, .input_len = len};
+	uint8_t *reply;
+	const uint8_t *body;
+	size_t blen;
+	if (run_job(&rq, data, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
+	enum api_result rc = api_wire_decode_image(body, blen, max_pixels, rgba, w, h, err, errsize);
+	if (rc != API_OK) *status = 400;
+	free(reply);
+	return rc;
+}

@@ -1,0 +1,108 @@
+/*
+ * api/sandbox — model import and image decoding of untrusted bytes in helper processes.
+ *
+ * Why: Assimp, libpng and libjpeg are big parsers of attacker-controlled bytes. A malformed PLY
+ * of 500 bytes crashed the whole daemon (SIGSEGV inside Assimp), another looped for ever while
+ * holding the import lock. Parsing happens in a child process instead, under limits the daemon
+ * chose; what can go wrong there (a crash, a loop, a runaway allocation) ends that child and
+ * becomes a 400/422 for that one object.
+ *
+ * Design (a "fork server"):
+ *   - `build/umbra-import` (api/helper/umbra_import.c) is a small single-threaded executable
+ *     started once per process with posix_spawn (found next to the running executable through
+ *     /proc/self/exe, or its parent directory for the test binaries in build/tests, or env UMBRA_IMPORT_HELPER).
+ *     Forking the daemon itself is not an option: it is multithreaded and holds a Vulkan
+ *     device; a fork of it would copy locks held by other threads and driver state. Spawning a
+ *     fresh executable per import would cost a dynamic link of Assimp (~10 ms) each time; the
+ *     fork server pays that once and forks a clean, single-threaded copy of itself per job.
+ *   - One job = one child. The daemon makes a socketpair (data) and a pipe (status), sends the
+ *     request and the two fds over the control socket (SOCK_SEQPACKET: each request is one
+ *     atomic message, so threads send concurrently without a lock), writes the input into the
+ *     data socket and reads the reply back until EOF. Nothing global is held meanwhile: imports
+ *     of different requests run in parallel, each in its own child.
+ *   - The child, before it reads a byte: closes every other fd, sets RLIMIT_CPU (the timeout,
+ *     rounded up to seconds), RLIMIT_AS (the memory limit), RLIMIT_FSIZE/NOFILE/CORE/NPROC,
+ *     PR_SET_NO_NEW_PRIVS and a seccomp filter (libseccomp) that allows only what parsing needs
+ *     (read/write on its fds, memory management without PROT_EXEC, futex, exit, signals to
+ *     itself). No open, no socket, no exec: the child can touch no file beyond its fds.
+ *   - The fork server kills a child at its wall-clock timeout (it is the child's parent, so
+ *     the pid cannot have been reused) and writes how the child ended into the status pipe.
+ *   - The daemon validates everything it reads back (api/model_wire.h) as untrusted.
+ *
+ * Outcomes: API_OK; else *status says 400 (the bytes are bad: the parser refused them, crashed,
+ * or was stopped by the filter), 422 (over the time or memory limit) or 500 (the helper could
+ * not be started), with a sentence in err that names no member (the caller adds the pointer).
+ *
+ * Threading: every function is thread-safe. The fork server is started on first use and
+ * restarted when it died; a mutex guards only that start, never a job.
+ */
+#ifndef UMBRA_API_SANDBOX_H
+#define UMBRA_API_SANDBOX_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "api.h"
+#include "arena.h"
+#include "model.h"
+
+/* Imports a model (format not SNIFF) under the limits' import_timeout_ms / import_memory
+ * (NULL = defaults) into *out, its arrays in `arena`; *bytes = what the arena holds for it. */
+enum api_result api_sandbox_import_model(const uint8_t *data, size_t len, enum api_model_format format,
+                                         const struct api_limits *lim, struct api_arena *arena,
+                                         struct api_model *out, size_t *bytes, int *status, char *err,
+                                         size_t errsize);
+/* Decodes a PNG or JPEG (at most max_pixels) into malloc'd RGBA8 (*rgba, you free it). */
+enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64_t max_pixels,
+                                         const struct api_limits *lim, uint8_t **rgba, uint32_t *w, uint32_t *h,
+                                         int *status, char *err, size_t errsize);
+/* Path of the helper executable that will be (or was) started. */
+const char *api_sandbox_helper_path(void);
+
+/* ---- protocol between api/sandbox.c and api/sandbox_child.c (private) ---- */
+
+/* Sanitizer builds (make test-asan, fuzzing) reserve terabytes of address space and make
+ * system calls of their own: they get no RLIMIT_AS and a filter that fails calls instead of
+ * killing (api/sandbox_child.c). */
+#if defined(__SANITIZE_ADDRESS__)
+#define API_SBX_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define API_SBX_SANITIZED 1
+#endif
+#endif
+#ifndef API_SBX_SANITIZED
+#define API_SBX_SANITIZED 0
+#endif
+
+#define API_SBX_MAGIC 0x756d6272u      /* "umbr" */
+#define API_SBX_CTL_FD 3               /* the fork server's control socket */
+#define API_SBX_DATA_FD 3              /* a child's data socket */
+#define API_SBX_MAX_CHILDREN 1024
+
+/* Sent over the control socket with SCM_RIGHTS {data socket, status pipe's write end}. */
+struct api_sbx_request {
+	uint32_t magic;
+	uint32_t kind;          /* enum api_wire_kind */
+	uint32_t format;        /* model: enum api_model_format */
+	uint32_t timeout_ms;    /* wall clock, killed by the fork server; CPU limit derived */
+	uint64_t memory;        /* RLIMIT_AS bytes */
+	uint64_t max_pixels;    /* per image / texture */
+	uint64_t input_len;     /* bytes that follow on the data socket */
+};
+
+enum api_sbx_how { API_SBX_EXITED = 1, API_SBX_SIGNALED, API_SBX_TIMED_OUT, API_SBX_REFUSED };
+/* Child exit codes besides 0. */
+enum { API_SBX_EXIT_OOM = 3, API_SBX_EXIT_SETUP = 4, API_SBX_EXIT_IO = 5 };
+
+/* Written by the fork server into the status pipe once the child is reaped. */
+struct api_sbx_status {
+	uint32_t magic;
+	uint32_t how;           /* enum api_sbx_how */
+	int32_t code;           /* exit code or signal */
+	uint32_t reserved;
+};
+
+/* The helper's main (api/helper/umbra_import.c calls it): `umbra-import --fork-server`. */
+int api_sandbox_helper_main(int argc, char **argv);
+
+#endif

@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""tests/fuzz/make_seeds.py — writes the seed corpora of the model-import fuzz targets into
+tests/fuzz/corpus/<target>/: small models built here (no fetched files). Run from the repository
+root; the files it writes are committed."""
+import base64, json, os, struct
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus")
+
+def put(target, name, data):
+    d = os.path.join(ROOT, target)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+
+QUAD_V = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+QUAD_F = [(0, 1, 2), (0, 2, 3)]
+
+# obj
+put("fuzz_model_obj", "tri.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n")
+put("fuzz_model_obj", "quad-uv-normals.obj",
+    "o quad\n" + "".join("v %g %g %g\n" % v for v in QUAD_V) + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+    "usemtl none\ns 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n")
+# stl
+put("fuzz_model_stl", "tetra-ascii.stl",
+    "solid t\n" + "".join("facet normal 0 0 0\nouter loop\n" + "".join("vertex %g %g %g\n" % p for p in tri) +
+                          "endloop\nendfacet\n" for tri in [((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((0, 0, 0), (0, 1, 0), (0, 0, 1)),
+                                                             ((0, 0, 0), (0, 0, 1), (1, 0, 0)), ((1, 0, 0), (0, 0, 1), (0, 1, 0))]) + "endsolid t\n")
+stl = bytearray(80) + struct.pack("<I", 2)
+for f in QUAD_F:
+    stl += struct.pack("<3f", 0, 0, 1) + b"".join(struct.pack("<3f", *QUAD_V[i]) for i in f) + b"\0\0"
+put("fuzz_model_stl", "quad-binary.stl", bytes(stl))
+# ply
+hdr = ("ply\nformat %s 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 2\nproperty list uchar int vertex_indices\nend_header\n")
+put("fuzz_model_ply", "quad-ascii.ply", hdr % "ascii" + "".join("%g %g %g\n" % v for v in QUAD_V) +
+    "".join("3 %d %d %d\n" % f for f in QUAD_F))
+put("fuzz_model_ply", "quad-binary.ply", (hdr % "binary_little_endian").encode() +
+    b"".join(struct.pack("<3f", *v) for v in QUAD_V) + b"".join(struct.pack("<B3i", 3, *f) for f in QUAD_F))
+# gltf / glb: one triangle, positions + indices in one buffer
+pos = b"".join(struct.pack("<3f", *v) for v in [(0, 0, 0), (1, 0, 0), (0, 1, 0)])
+idx = struct.pack("<3H", 0, 1, 2) + b"\0\0"
+buf = pos + idx
+def gltf(uri):
+    b = {"byteLength": len(buf)}
+    if uri: b["uri"] = uri
+    return {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0, "translation": [0, 0.5, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0.25, 1], "metallicFactor": 0}}],
+            "buffers": [b],
+            "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                          {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]}
+put("fuzz_model_gltf", "tri.gltf", json.dumps(gltf("data:application/octet-stream;base64," + base64.b64encode(buf).decode())))
+j = json.dumps(gltf(None)).encode()
+j += b" " * (-len(j) % 4)
+glb = b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(buf)) + struct.pack("<I", len(j)) + b"JSON" + j + \
+      struct.pack("<I", len(buf)) + b"BIN\0" + buf
+put("fuzz_model_glb", "tri.glb", glb)
+# replies of the importer (api/model_wire.h)
+def header(kind, status, msg=b""):
+    return b"UMBRAIMP" + struct.pack("<IIII", 1, kind, status, len(msg)) + msg
+tex = struct.pack("<II", 2, 1) + bytes([255, 0, 0, 255, 0, 255, 0, 255])
+mat = struct.pack("<11f", 1, 1, 1, 1, 0.5, 0, 0, 0, 0, 0.5, 0) + struct.pack("<Ii", 0, 0)
+mesh = struct.pack("<4I", 3, 3, 0, 3) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0, 0, 1, 0, 0, 1) + \
+       struct.pack("<3I", 0, 1, 2)
+inst = struct.pack("<I", 0) + struct.pack("<16f", 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1)
+put("fuzz_import_reply", "model.bin", header(1, 0) + struct.pack("<4I", 1, 1, 1, 1) + tex + mat + mesh + inst)
+put("fuzz_import_reply", "image.bin", header(2, 0) + tex)
+put("fuzz_import_reply", "error.bin", header(1, 1, b"PLY: bad header"))
