@@ -75,7 +75,8 @@ $(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/libapi.a $(BUILD)/libr
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
+# flags.o: the unit tests cover srv_default_workers() (cgroup CPU quota).
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
