@@ -4,6 +4,10 @@
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench
+#   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
+#   make test-cluster   the HAProxy fail-over test alone (also part of make test)
+#   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
+#   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
 BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
@@ -21,7 +25,10 @@ PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 CFLAGS += $(PKG_CFLAGS)
 # The build's version (in /v1/info and the ETag): the commit, "-dirty" with local changes.
-UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || echo unknown)
+# Without .git (a container build, a tarball): `make UMBRA_VERSION=...` or a VERSION file.
+ifeq ($(UMBRA_VERSION),)
+UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || cat VERSION 2>/dev/null || echo unknown)
+endif
 CFLAGS += -DUMBRA_VERSION=\"$(UMBRA_VERSION)\"
 LIBS := $(PKG_LIBS) -lm
 
@@ -47,7 +54,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz clean
+.PHONY: all deps run test test-asan bench fuzz clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -106,6 +113,24 @@ $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
+
+cluster: deps
+	@$(MAKE) --no-print-directory all
+	python3 deploy/cluster.py up --build $(BUILD)
+
+test-cluster: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) UMBRA_VALIDATION=1 python3 tests/cluster/test_cluster.py
+
+bench-cluster: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) python3 tests/cluster/bench_cluster.py
+
+check-deploy:
+	@sh deploy/check.sh
+
+print-version:
+	@echo $(UMBRA_VERSION)
 
 # libFuzzer target for the scene parser (clang): build/fuzz/fuzz_scene tests/fuzz/corpus
 fuzz:

@@ -28,6 +28,11 @@ sys.path.insert(0, os.path.join(ROOT, "deploy"))
 import cluster  # noqa: E402
 
 BUILD = os.environ.get("BUILD", "build")
+# Under make test-asan, tests/run.sh passes the ASan runtime + Vulkan driver to preload into
+# the daemons and umbra-render only (see tests/http/run.sh for why).
+DAEMON_ENV = dict(os.environ)
+if os.environ.get("DAEMON_PRELOAD"):
+    DAEMON_ENV["LD_PRELOAD"] = os.environ["DAEMON_PRELOAD"]
 CONCURRENCY = 6
 MIN_REQUESTS = 300      # the load goes on until every phase is done and this many were sent
 MAX_REQUESTS = 1500     # hard bound on the loop
@@ -83,7 +88,7 @@ def references(tmp, n):
             json.dump(scene(k), f)
         out = os.path.join(tmp, "ref%d.png" % k)
         subprocess.run([os.path.join(BUILD, "umbra-render"), path, "-o", out], check=True,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120, env=DAEMON_ENV)
         with open(path, "rb") as f:
             bodies.append(f.read())
         with open(out, "rb") as f:
@@ -231,7 +236,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="umbra-cluster-test.")
     bodies, refs = references(tmp, 4)
     ok("reference renders are %dx%d PNGs" % (SIZE, SIZE), all(png_size(r) == (SIZE, SIZE) for r in refs))
-    c = cluster.Cluster(build=BUILD, daemons=3, port=0, stats_port=0, workdir=tmp)
+    c = cluster.Cluster(build=BUILD, daemons=3, port=0, stats_port=0, workdir=tmp, env=DAEMON_ENV)
     log = {}
     try:
         try:
