@@ -126,7 +126,9 @@ class Cluster:
         self.umbrad = os.path.join(build, "umbrad")
         self.flags = list(flags or [])
         self.port, self.stats_port = port, stats_port
-        self.deadline_ms = deadline_ms
+        # The balancer's timeouts follow the daemons' deadline, also when given as a flag.
+        fl = self.flags
+        self.deadline_ms = int(fl[fl.index("--deadline-ms") + 1]) if "--deadline-ms" in fl[:-1] else deadline_ms
         self.maxconn = maxconn
         self.haproxy = haproxy
         self.env = dict(os.environ if env is None else env)
@@ -148,7 +150,8 @@ class Cluster:
         servers = "".join("    server %s 127.0.0.1:%d\n" % (d.name, d.port) for d in self.daemons)
         affinity = "".join("    server %s 127.0.0.1:%d track umbrad/%s\n" % (d.name, d.port, d.name)
                            for d in self.daemons)
-        deadline_s = max(1, (self.deadline_ms + 999) // 1000)
+        # --deadline-ms 0 (none): give renders five minutes at the balancer.
+        deadline_s = (self.deadline_ms + 999) // 1000 if self.deadline_ms > 0 else 300
         text = string.Template(open(TEMPLATE).read()).substitute(
             bind="127.0.0.1:%d" % self.port, stats_bind="127.0.0.1:%d" % self.stats_port,
             servers=servers.rstrip("\n"), affinity_servers=affinity.rstrip("\n"), maxconn=self.maxconn or self._workers(),
@@ -287,7 +290,10 @@ def main(argv):
         return 1
     c = Cluster(build=a.build, daemons=a.daemons, flags=a.flags, port=a.port, stats_port=a.stats_port)
     stop = []
-    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+    # Ctrl-C in a terminal also reaches the daemons (same process group): they drain by
+    # themselves; stop() then collects them. Both signals end the wait loop.
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        signal.signal(sig, lambda *_: stop.append(1))
     try:
         c.start()
         print("umbra: %d daemons behind %s  (POST /v1/render; optional header X-Umbra-Affinity)" %
