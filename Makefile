@@ -4,6 +4,10 @@
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench
+#   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
+#   make test-cluster   the HAProxy fail-over test alone (also part of make test)
+#   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
+#   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
 BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
@@ -21,7 +25,10 @@ PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 CFLAGS += $(PKG_CFLAGS)
 # The build's version (in /v1/info and the ETag): the commit, "-dirty" with local changes.
-UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || echo unknown)
+# Without .git (a container build, a tarball): `make UMBRA_VERSION=...` or a VERSION file.
+ifeq ($(UMBRA_VERSION),)
+UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || cat VERSION 2>/dev/null || echo unknown)
+endif
 CFLAGS += -DUMBRA_VERSION=\"$(UMBRA_VERSION)\"
 LIBS := $(PKG_LIBS) -lm
 
@@ -47,7 +54,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz clean
+.PHONY: all deps run test test-asan bench fuzz clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -79,7 +86,8 @@ $(BUILD)/umbra-import: $(BUILD)/obj/api/helper/umbra_import.o $(BUILD)/libapi.a 
 	$(CC) $(LDFLAGS) -Wl,--as-needed -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
+# flags.o: the unit tests cover srv_default_workers() (cgroup CPU quota).
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
@@ -112,6 +120,24 @@ $(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/li
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
+
+cluster: deps
+	@$(MAKE) --no-print-directory all
+	python3 deploy/cluster.py up --build $(BUILD)
+
+test-cluster: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) UMBRA_VALIDATION=1 python3 tests/cluster/test_cluster.py
+
+bench-cluster: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) python3 tests/cluster/bench_cluster.py
+
+check-deploy:
+	@sh deploy/check.sh
+
+print-version:
+	@echo $(UMBRA_VERSION)
 
 # libFuzzer targets (clang): build/fuzz/fuzz_scene tests/fuzz/corpus; fuzz_model_<fmt> and
 # fuzz_import_reply with tests/fuzz/corpus/<target> (see tests/fuzz/fuzz_model.h)

@@ -7,7 +7,8 @@ set -eu
 PKGS="build-essential pkg-config ca-certificates curl python3
 libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
 glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
-libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev"
+libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev
+haproxy python3-yaml"
 
 missing=""
 for p in $PKGS; do

@@ -29,7 +29,7 @@ struct opt_def {
 static const struct opt_def opts[] = {
 	{ "listen", OPT_STR, "ADDR:PORT", "address to listen on (127.0.0.1:8080; port 0 = any free port)", CFG(listen), 0, 0 },
 	{ "port-file", OPT_STR, "PATH", "write the bound port to PATH once listening", CFG(port_file), 0, 0 },
-	{ "workers", OPT_UINT, "N", "render threads and context slots (default: online CPUs)", CFG(workers), 1, 256 },
+	{ "workers", OPT_UINT, "N", "render threads and context slots (default: online CPUs, at most the cgroup CPU quota)", CFG(workers), 1, 256 },
 	{ "queue", OPT_UINT, "N", "renders that may wait for a worker before 503 (64)", CFG(queue), 1, 1000000 },
 	{ "max-body", OPT_SIZE, "BYTES", "largest request body, K/M/G suffixes (64M)", CFG(max_body), 1, UINT64_MAX },
 	{ "max-pixels", OPT_SIZE, "N", "largest width*height, 0 = no limit (16777216)", LIM(max_pixels), 0, UINT64_MAX },
@@ -142,13 +142,61 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 	return -1;
 }
 
+/* The default --workers: `cpus` (the CPUs this process may run on) lowered to its cgroup's CPU
+ * quota, rounded up. A container sees the host's cores in sysconf() but gets only its quota:
+ * one render thread per host core would then fight over a fraction of them. Reads cgroup v2
+ * `cpu.max` ("QUOTA PERIOD" or "max PERIOD") in the process's own cgroup (the "0::PATH" line of
+ * `self_cgroup`, e.g. /proc/self/cgroup; a systemd CPUQuota= lands there), then at `root`
+ * itself (a container's cgroup namespace), else cgroup v1 cpu/cpu.cfs_quota_us and
+ * cpu.cfs_period_us (-1 = no quota). `root` is the cgroup mount (/sys/fs/cgroup); the unit
+ * tests pass a fake tree. Never returns 0. */
+unsigned srv_default_workers(const char *root, const char *self_cgroup, unsigned cpus)
+{
+	char path[4096], line[4096], rel[4096] = "";
+	long long quota = 0, period = 0;
+	bool found = false;
+	FILE *f = self_cgroup ? fopen(self_cgroup, "r") : NULL;
+	while (f && fgets(line, sizeof line, f))
+		if (!strncmp(line, "0::", 3) && (sscanf(line + 3, "%4095s", rel) != 1 || !strcmp(rel, "/")))
+			rel[0] = 0;
+	if (f)
+		fclose(f);
+	/* v2: the own cgroup first, then the mount's root. "max PERIOD" = no quota. */
+	const char *dirs[2] = { rel, "" };
+	for (int i = 0; i < 2 && !found; i++) {
+		snprintf(path, sizeof path, "%s%s/cpu.max", root, dirs[i]);
+		if (!(f = fopen(path, "r")))
+			continue;
+		found = true;
+		if (fscanf(f, "%lld %lld", &quota, &period) != 2)
+			quota = 0;
+		fclose(f);
+	}
+	/* v1: quota -1 = none. */
+	for (int i = 0; i < 2 && !found; i++) {
+		snprintf(path, sizeof path, "%s/cpu/cpu.cfs_%s_us", root, i ? "period" : "quota");
+		if ((f = fopen(path, "r"))) {
+			if (fscanf(f, "%lld", i ? &period : &quota) != 1)
+				quota = 0;
+			fclose(f);
+		}
+	}
+	if (cpus == 0)
+		cpus = 1;
+	if (quota <= 0 || period <= 0)
+		return cpus;
+	long long n = (quota + period - 1) / period;
+	return n < (long long)cpus ? (unsigned)n : cpus;
+}
+
 int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 {
 	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
 	memset(cfg, 0, sizeof *cfg);
 	cfg->listen = "127.0.0.1:8080";
 	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-	cfg->workers = ncpu > 0 ? (unsigned)(ncpu > 256 ? 256 : ncpu) : 1;
+	cfg->workers = srv_default_workers("/sys/fs/cgroup", "/proc/self/cgroup",
+	                                   ncpu > 0 ? (unsigned)(ncpu > 256 ? 256 : ncpu) : 1);
 	cfg->queue = 64;
 	/* Room for four concurrent renders of four 2048 cascades each: under that load no request
 	 * has its shadow resolution lowered (which would change its bytes). */

@@ -52,7 +52,7 @@ enum srv_log_format { SRV_LOG_TEXT, SRV_LOG_JSON };
 struct srv_config {
 	const char *listen;            /* ADDR:PORT, default 127.0.0.1:8080; port 0 = ephemeral */
 	const char *port_file;         /* written with the bound port once listening */
-	unsigned workers;              /* render threads = context slots, default: online CPUs */
+	unsigned workers;              /* render threads = context slots, default: online CPUs, capped by the CPU quota */
 	unsigned queue;                /* queued renders (not counting those rendering), default 64 */
 	uint64_t max_body;             /* bytes, default 64 MiB */
 	struct api_limits limits;      /* 422 limits */
@@ -176,6 +176,8 @@ int srv_context_close(struct srv_server *s);        /* saves the cache; returns 
 /* flags.c: 0 ok, 1 --help printed (exit 0), -1 error printed (exit 2). The strings in cfg
  * point into argv or the environment: nothing to free. */
 int srv_config_load(struct srv_config *cfg, int argc, char **argv);
+/* Default worker count: `cpus` capped by the cgroup CPU quota found under `root` (see flags.c). */
+unsigned srv_default_workers(const char *root, const char *self_cgroup, unsigned cpus);
 
 /* Small shared helpers (main.c). */
 double srv_now(void);                               /* monotonic seconds */
