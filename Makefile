@@ -27,7 +27,7 @@ LIBS := $(PKG_LIBS) -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
-SRV_SRC := $(filter-out server/cli.c,$(wildcard server/*.c))
+SRV_SRC := $(filter-out server/cli.c server/farm.c,$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)
 SHADERS := $(wildcard shaders/*.vert shaders/*.frag shaders/*.comp)
@@ -71,7 +71,7 @@ $(BUILD)/librenderer.a: $(RND_OBJ)
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
-$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
