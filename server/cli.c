@@ -223,7 +223,7 @@ static bool is_dir(const char *path)
 	return (n && path[n - 1] == '/') || (stat(path, &st) == 0 && S_ISDIR(st.st_mode));
 }
 
-/* Manifest lines become jobs; their strings stay allocated until exit (the process ends). */
+/* Manifest lines become jobs (*n of them, also on failure) that own their strings. */
 static int manifest_jobs(const char *path, const char *dir, struct farm_job **jobs, size_t *n)
 {
 	size_t len = 0;
@@ -305,6 +305,7 @@ int main(int argc, char **argv)
 	struct farm_job *jobs = NULL;
 	size_t n = 0;
 	if (a.manifest) rc = manifest_jobs(a.manifest, dir, &jobs, &n);
+	size_t nman = n;
 	if (!rc && a.ninputs) {
 		struct farm_job *nj = realloc(jobs, (n + a.ninputs) * sizeof *nj);
 		if (!nj) rc = 1;
@@ -313,7 +314,12 @@ int main(int argc, char **argv)
 			jobs[n++] = (struct farm_job){.input = a.inputs[k], .model = a.thumb};
 	}
 	if (!rc) rc = farm_run(jobs, n, &a.farm);
-	/* Manifest strings are left to the process exit: nothing else runs after this. */
+	for (size_t k = 0; k < nman; k++) {  /* the manifest's jobs own their strings */
+		if (jobs[k].label != jobs[k].input) free((char *)jobs[k].label);
+		free((char *)jobs[k].input);
+		free((char *)jobs[k].json);
+		free((char *)jobs[k].out);
+	}
 	free(jobs);
 	free(a.inputs);
 	return rc;
