@@ -15,7 +15,7 @@ SAN ?=
 CFLAGS ?= $(OPT) -g
 CFLAGS += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror -Wno-missing-field-initializers \
           -fno-strict-aliasing -pthread -MMD -MP $(SAN) \
-          -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders
+          -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders -I$(BUILD)/www
 LDFLAGS += -pthread $(SAN)
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
@@ -68,6 +68,13 @@ $(RND_OBJ): $(SHADER_HDRS)
 
 $(BUILD)/librenderer.a: $(RND_OBJ)
 	@rm -f $@; ar rcs $@ $^
+# The playground page (server/www/) inlined into one HTML document, with the bench scenes of
+# $(SHARED)/bench when present, and embedded in umbrad as a C array (xxd -i).
+BENCH_JSON := $(wildcard $(SHARED)/bench/*.json)
+$(BUILD)/www/playground_page.h: $(wildcard server/www/*) $(BENCH_JSON)
+	@mkdir -p $(dir $@)
+	sh server/www/embed.sh server/www $(BUILD)/www $(BENCH_JSON)
+$(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
