@@ -311,6 +311,10 @@ async function renderNow() {
     if (bad) {
       const p = bad.problem, ptr = p.pointer || '';
       showError(lineOf(parsed.lines, ptr), (p.status || bad.status) + ' ' + (p.title || '') + ': ' + (ptr ? ptr + ': ' : '') + (p.detail || ''));
+      // The image shown is no longer this text's: dim it and clear its facts.
+      $('images').classList.add('stale');
+      $('size').textContent = $('etag').textContent = '—';
+      $('timing').innerHTML = $('timing-legend').innerHTML = '';
       $('status').textContent = again ? 'rendering…' : 'error ' + bad.status;
       return;
     }
@@ -318,6 +322,7 @@ async function renderNow() {
       $('cap-a').textContent += ' · ' + $('filter-a').value;
       $('cap-b').textContent += ' · ' + $('filter-b').value;
     }
+    $('images').classList.remove('stale');
     $('size').textContent = res.map((x) => x.size.toLocaleString('en') + ' bytes').join(', ');
     $('etag').textContent = res.map((x) => x.etag || '').join(', ');
     showTiming(a.timing);

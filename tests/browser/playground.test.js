@@ -138,6 +138,7 @@ async function main() {
     const bad = await page.$eval('#gutter .bad', (e) => +e.textContent).catch(() => 0);
     check('problem: shown', st.startsWith('error 400') && !err.hidden && /\/lights\/0\/direction/.test(err.text), st + ' ' + err.text);
     check('problem: at the line of /lights/0/direction (' + li + ')', err.line === li && bad === li, 'at ' + err.line + ', gutter ' + bad);
+    if (process.env.SHOT) await page.screenshot({ path: process.env.SHOT.replace(/\.png$/, '-error.png') });
 
     // A JSON syntax error points at its line before anything is sent.
     const n0 = sent.length;

@@ -56,4 +56,5 @@ def main():
         print(len({bytes(r[i:i + bpp]) for r in rows for i in range(0, w * bpp, bpp)}))
 
 
-main()
+if __name__ == '__main__':
+    main()
