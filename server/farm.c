@@ -71,9 +71,9 @@ char *farm_read_file(const char *path, size_t *len)
 		if (!nb) { free(buf); buf = NULL; errno = ENOMEM; }
 		else buf = nb;
 	}
-	int bad = ferror(f);
+	int bad = ferror(f), err = errno;
 	if (f != stdin) fclose(f);
-	if (bad) { free(buf); errno = EIO; return NULL; }
+	if (bad) { free(buf); errno = err ? err : EIO; return NULL; }
 	if (buf) buf[n] = 0;
 	*len = n;
 	return buf;

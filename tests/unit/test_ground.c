@@ -3,6 +3,8 @@
  * transformed corners of a box, the transformed vertices of a mesh, the lowest point of a
  * scaled sphere), through api_ground_place and through the scene parser. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "api.h"
 #include "ground.h"
@@ -91,7 +93,7 @@ TEST(ground_sits_at_lowest_vertex_of_rotated_mesh)
 	CHECK(near_d(o[1].size[0], 6), "side %g, expected margin 3 x extent 2", o[1].size[0]);
 }
 
-TEST(ground_under_scaled_sphere_and_models_through_the_parser)
+TEST(ground_under_scaled_sphere_and_rotated_mesh_through_the_parser)
 {
 	/* A sphere of radius 1 scaled by 0.5 in y at height 3: lowest point 3 - 0.5 = 2.5 (a shadow
 	 * catcher far below does not count). Then an inline mesh turned 90° about +X whose (0, 0, 2)
@@ -201,4 +203,52 @@ TEST(preset_problems_keep_the_scene_pointers)
 	               "/objects/0/size");
 	expect_problem("{\"preset\":\"thumbnail\",\"objects\":[{\"shape\":\"box\"}],\"camera\":{\"fov_y\":-3}}", 400,
 	               "/camera/fov_y");
+}
+
+static char *b64(const char *s)
+{
+	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+	size_t n = strlen(s), i = 0;
+	char *o = malloc(n / 3 * 4 + 8), *p = o;
+	const unsigned char *d = (const unsigned char *)s;
+	for (; i + 2 < n; i += 3) {
+		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
+		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
+	}
+	if (i < n) {
+		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
+		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
+		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
+		*p++ = '=';
+	}
+	*p = 0;
+	return o;
+}
+
+TEST(ground_under_an_imported_model_with_two_meshes)
+{
+	/* An OBJ of two separate triangles (two objects: the model expands into two mesh objects,
+	 * so the ground, after it in the document, moves in the scene's object list). Scaled by 2
+	 * and lifted by 1: its lowest vertex y = -0.5 becomes 2 x -0.5 + 1 = 0. */
+	char *data = b64("o a\nv 0 -0.5 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 2 0 0\nv 3 0 0\nv 2 2 1\nf 4 5 6\n");
+	char doc[1024];
+	snprintf(doc, sizeof doc,
+	         "{\"camera\":{\"position\":[0,2,8],\"target\":[0,0,0]},\"objects\":["
+	         "{\"shape\":\"model\",\"format\":\"obj\",\"data\":\"%s\",\"transform\":{\"translation\":[0,1,0],"
+	         "\"scale\":[2,2,2]}},{\"shape\":\"plane\",\"placement\":\"ground\",\"margin\":1}]}", data);
+	free(data);
+	struct api_problem p;
+	struct api_scene *s = NULL;
+	REQUIRE(api_scene_parse(doc, strlen(doc), NULL, &s, &p) == API_OK, "%s: %s", p.pointer, p.detail);
+	const struct rnd_scene *sc = &s->scene;
+	REQUIRE(sc->object_count >= 3, "two meshes and the ground, got %u objects", sc->object_count);
+	const struct rnd_object *g = &sc->objects[sc->object_count - 1];
+	CHECK(g->shape == RND_SHAPE_PLANE, "the ground is last");
+	CHECK(near_d(g->model[13], 0.0), "ground at %g, expected 2 x -0.5 + 1 = 0", g->model[13]);
+	/* x spans 0..6 after the scale: centre 3, largest extent 6 (y: 0..5). */
+	CHECK(near_d(g->model[12], 3.0) && near_d(g->size[0], 6.0), "centre x %g (3), side %g (6)", g->model[12],
+	      g->size[0]);
+	for (uint32_t i = 0; i + 1 < sc->object_count; i++)
+		CHECK(sc->objects[i].shape == RND_SHAPE_MESH, "object %u is one of the model's meshes", i);
+	api_scene_free(s);
 }
