@@ -57,10 +57,10 @@ static void log_cb(void *user, int level, const char *msg)
 	if (level <= 1) fprintf(stderr, "umbra-render: %s\n", msg);
 }
 
-/* One scene, as before the batch runner: stdout or one file, --timings. */
-static int render_one(const char *in, const char *out, const char *device, int timings)
+/* Reads and parses one scene and settles its format (the output name's extension wins).
+ * 0 with *scene set, or the exit status (problem on stderr). */
+static int load_scene(const char *in, const char *out, struct api_scene **scene)
 {
-	double t0 = farm_now_ms();
 	size_t len = 0;
 	char *json = farm_read_file(in, &len);
 	if (!json) {
@@ -69,35 +69,36 @@ static int render_one(const char *in, const char *out, const char *device, int t
 	}
 	struct api_limits lim;
 	api_limits_defaults(&lim);
+	struct api_problem prob;
+	char line[1024];
+	enum api_result r = api_scene_parse(json, len, &lim, scene, &prob);
+	free(json);
+	if (r == API_OK && out) {
+		const char *dot = strrchr(out, '.');
+		enum api_format f = (*scene)->format;
+		if (dot && !strcasecmp(dot, ".png")) f = API_FORMAT_PNG;
+		else if (dot && !strcasecmp(dot, ".exr")) f = API_FORMAT_EXR;
+		r = api_scene_set_format(*scene, f, &prob);
+	}
+	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
+	if (r == API_OK) return 0;
+	api_problem_format(&prob, line, sizeof line);
+	fprintf(stderr, "umbra-render: %s\n", line);
+	api_scene_free(*scene);
+	*scene = NULL;
+	return 2;
+}
+
+/* One scene, as before the batch runner: stdout or one file, --timings. */
+static int render_one(const char *in, const char *out, const char *device, int timings)
+{
+	double t0 = farm_now_ms();
 	struct api_scene *scene = NULL;
 	struct api_problem prob;
 	char line[1024];
-	int rc = 1;
-	if (api_scene_parse(json, len, &lim, &scene, &prob) != API_OK) {
-		api_problem_format(&prob, line, sizeof line);
-		fprintf(stderr, "umbra-render: %s\n", line);
-		free(json);
-		return 2;
-	}
-	free(json);
-	if (out) {
-		const char *dot = strrchr(out, '.');
-		enum api_format f = scene->format;
-		if (dot && !strcasecmp(dot, ".png")) f = API_FORMAT_PNG;
-		else if (dot && !strcasecmp(dot, ".exr")) f = API_FORMAT_EXR;
-		if (api_scene_set_format(scene, f, &prob) != API_OK) {
-			api_problem_format(&prob, line, sizeof line);
-			fprintf(stderr, "umbra-render: %s\n", line);
-			api_scene_free(scene);
-			return 2;
-		}
-	}
-	if (api_scene_check_output(scene, &prob) != API_OK) {
-		api_problem_format(&prob, line, sizeof line);
-		fprintf(stderr, "umbra-render: %s\n", line);
-		api_scene_free(scene);
-		return 2;
-	}
+	int rc = load_scene(in, out, &scene);
+	if (rc) return rc;
+	rc = 1;
 	double t_parse = farm_now_ms() - t0;
 
 	const char *v = getenv("UMBRA_VALIDATION");

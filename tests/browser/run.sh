@@ -47,7 +47,10 @@ while :; do
 	sleep 0.1
 done
 URL="http://127.0.0.1:$(cat "$T/port")"
-UMBRA_URL=$URL CHROMIUM=$CHROMIUM node "$dir/playground.test.js" >"$T/node.out" 2>&1
+# The bench examples are in the page when the build found them (Makefile: BENCH_JSON).
+BENCH=""
+[ -f "${SHARED:-../shared}/bench/thumb-512.json" ] && BENCH=1
+BENCH=$BENCH UMBRA_URL=$URL CHROMIUM=$CHROMIUM node "$dir/playground.test.js" >"$T/node.out" 2>&1
 grep -v -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out"
 line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out" | tail -n 1)
 pass=${line%% passed*}; fail=${line#*passed, }; fail=${fail%% failed*}

@@ -117,6 +117,11 @@ check "thumb: report is in input order" sh -c "head -n 1 '$T/thumbs/report.jsonl
 check "thumb: plain progress lines when stderr is not a terminal" grep -q '^umbra-render: \[4/4\]' "$T/thumb.err"
 check "thumb: summary line" grep -q '3 ok, 1 invalid, 0 failed, 0 skipped of 4' "$T/thumb.err"
 
+# --progress forces the bar (as on a terminal): done/total, images/s, ETA, on one line.
+cli thumb "$T/models/cube.obj" "$T/models/tetra.stl" -o "$T/bar" --size 32 --progress 2>"$T/bar.err"
+check "thumb --progress: a bar with done/total, images/s and ETA" \
+	sh -c "grep -q '\[#*\] 2/2  [0-9.]* images/s  ETA' '$T/bar.err' && ! grep -q '^umbra-render: \[' '$T/bar.err'"
+
 # The thumbnail's ground: the model's base is on it and its shadow darkens the white background
 # below the model; transparent: the corners are alpha 0 and the shadow has alpha.
 cli thumb "$T/models/cube.obj" -o "$T/tr" --size 64 --transparent --no-progress 2>/dev/null
