@@ -261,7 +261,7 @@ static int manifest_jobs(const char *path, const char *dir, struct farm_job **jo
 		/* A relative scene path is relative to the manifest's directory. */
 		int pre = e.scene_path && e.scene_path[0] != '/' ? dlen : 0;
 		if (e.scene_path && asprintf(&in, "%.*s%s", pre, path, e.scene_path) < 0) in = NULL;
-		if (asprintf(&lbl, "%s:%zu", path, line_no) < 0) lbl = NULL;
+		if (!e.scene_path && asprintf(&lbl, "%s:%zu", path, line_no) < 0) lbl = NULL;
 		if (e.output && asprintf(&out, "%s/%s", dir, e.output) < 0) out = NULL;
 		j->input = in;
 		j->json = e.scene_json;
