@@ -51,6 +51,7 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/tests/gpu_tests" ] && run_suite gpu env LD_PRELOAD="$PRELOAD" "$BUILD/tests/gpu_tests"
 [ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-limits sh tests/http/limits.sh
+[ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
 # The playground in a real browser, when Debian's chromium is installed (install-deps does).
 [ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh
