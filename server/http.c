@@ -594,9 +594,11 @@ static enum MHD_Result answer_get(struct srv_request *req)
 		return answer_info(req);
 	case SRV_ROUTE_PLAYGROUND: {
 		size_t len = 0;
-		char *page = s->cfg.no_playground ? NULL : srv_playground_page(&len);
+		if (s->cfg.no_playground)
+			return respond_problem(req, 404, NULL, "", "no route %s (--no-playground)", req->path);
+		char *page = srv_playground_page(&len);
 		if (!page)
-			return respond_problem(req, s->cfg.no_playground ? 404 : 503, NULL, "", "no route %s", req->path);
+			return respond_problem(req, 503, NULL, "", "out of memory for the playground page");
 		return respond(req, 200, "text/html; charset=utf-8", page, len, NULL);
 	}
 	default:
