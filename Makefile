@@ -19,7 +19,7 @@ SAN ?=
 CFLAGS ?= $(OPT) -g
 CFLAGS += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror -Wno-missing-field-initializers \
           -fno-strict-aliasing -pthread -MMD -MP $(SAN) \
-          -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders
+          -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders -I$(BUILD)/www
 LDFLAGS += -pthread $(SAN)
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
@@ -34,7 +34,7 @@ LIBS := $(PKG_LIBS) -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
-SRV_SRC := $(filter-out server/cli.c,$(wildcard server/*.c))
+SRV_SRC := $(filter-out server/cli.c server/farm.c,$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)
 SHADERS := $(wildcard shaders/*.vert shaders/*.frag shaders/*.comp)
@@ -75,10 +75,17 @@ $(RND_OBJ): $(SHADER_HDRS)
 
 $(BUILD)/librenderer.a: $(RND_OBJ)
 	@rm -f $@; ar rcs $@ $^
+# The playground page (server/www/) inlined into one HTML document, with the bench scenes of
+# $(SHARED)/bench when present, and embedded in umbrad as a C array (xxd -i).
+BENCH_JSON := $(wildcard $(SHARED)/bench/*.json)
+$(BUILD)/www/playground_page.h: $(wildcard server/www/*) $(BENCH_JSON)
+	@mkdir -p $(dir $@)
+	sh server/www/embed.sh server/www $(BUILD)/www $(BENCH_JSON)
+$(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
-$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 # The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
 # them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).

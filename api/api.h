@@ -147,4 +147,16 @@ enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_
 
 const char *api_format_mime(enum api_format f);
 
+/* One line of a JSON-lines render manifest (umbra-render --manifest), api/manifest.c:
+ * {"scene": "path.json" | {document}, "output": "name.png"}; output optional, a bare file name.
+ * On API_OK exactly one of scene_path / scene_json is set (malloc'd, as is output); release with
+ * api_manifest_entry_release() (NULL-safe, also after a failure). */
+struct api_manifest_entry {
+	char *scene_path;
+	char *scene_json;
+	char *output;
+};
+enum api_result api_manifest_line(const char *line, size_t len, struct api_manifest_entry *e, struct api_problem *p);
+void api_manifest_entry_release(struct api_manifest_entry *e);
+
 #endif

@@ -30,6 +30,8 @@
 #include <jansson.h>
 #include "api.h"
 #include "arena.h"
+#include "ground.h"
+#include "preset.h"
 #include "model.h"
 #include "sandbox.h"
 #include "umbra/rnd_math.h"
@@ -60,6 +62,9 @@ struct pctx {
 	const uint32_t *object_source;  /* document object of each rnd object (NULL: the same index) */
 	const char *views_key;          /* "views" or "turntable" when the document has either */
 	struct api_model *cur_model;
+	/* Ground placement (api/ground.h): margin per document object, > 0 for placement "ground". */
+	float *ground_margin;
+	size_t cur_object;
 };
 
 /* A reference to an imported model, released in api_scene_free() (the node is in the arena). */
@@ -714,7 +719,7 @@ static const char *const OBJECT_COMMON[] = {"shape", "name", "transform", "mater
 static const char *const SHAPES[] = {"plane", "box", "sphere", "cylinder", "mesh", "model", NULL};
 enum { SHAPE_MODEL = 5 };
 static const char *const SHAPE_MEMBERS[][5] = {
-	{"size", NULL},
+	{"size", "placement", "margin", NULL},
 	{"size", NULL},
 	{"radius", "segments", NULL},
 	{"radius", "height", "segments", NULL},
@@ -904,6 +909,25 @@ static int parse_model(struct pctx *c, json_t *j)
 	return rc < 0 ? -1 : 0;
 }
 
+/* A plane's `placement: "ground"` (and `margin`, default 3): placed under the other objects
+ * once they are all known (api/ground.h), so it takes neither a transform nor a size. */
+static int parse_placement(struct pctx *c, json_t *j)
+{
+	static const char *const placements[] = {"ground", NULL};
+	static const struct range mr = {0, 1000, true, false};
+	int pl = -1;
+	float margin = 3;
+	if (get_enum(c, j, "placement", placements, &pl) < 0 || get_float(c, j, "margin", &mr, &margin) < 0) return -1;
+	if (pl < 0 && json_object_get(j, "margin")) return fail_at(c, "margin", "margin is only used with placement");
+	if (pl < 0) return 0;
+	if (json_object_get(j, "transform"))
+		return fail_at(c, "transform", "a plane with placement \"ground\" places itself: it takes no transform");
+	if (json_object_get(j, "size"))
+		return fail_at(c, "size", "a plane with placement \"ground\" is sized by margin, not size");
+	c->ground_margin[c->cur_object] = margin;
+	return 0;
+}
+
 static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 {
 	if (require_object(c, j, "each entry of objects") < 0) return -1;
@@ -921,7 +945,7 @@ static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 	switch (shape) {
 	case 0: { /* plane */
 		float sz[2] = {1, 1};
-		if (get_vec(c, j, "size", sz, 2, 2, V_POS) < 0) return -1;
+		if (get_vec(c, j, "size", sz, 2, 2, V_POS) < 0 || parse_placement(c, j) < 0) return -1;
 		o->shape = RND_SHAPE_PLANE;
 		o->size[0] = sz[0]; o->size[1] = 0; o->size[2] = sz[1];
 		break;
@@ -1217,7 +1241,7 @@ static int parse_camera(struct pctx *c, json_t *j, struct rnd_camera *cam)
 /* ---- root ---- */
 
 static const char *const ROOT_MEMBERS[] = {"width", "height", "camera", "environment", "materials", "objects",
-                                           "lights", "shadows", "output", "views", "turntable", NULL};
+                                           "lights", "shadows", "output", "views", "turntable", "preset", NULL};
 static const char *const ENV_MEMBERS[] = {"background", "ambient", NULL};
 static const char *const AMBIENT_MEMBERS[] = {"sky", "ground", "intensity", NULL};
 static const char *const OUTPUT_MEMBERS[] = {"format", "bit_depth", "transparent", "tonemap", "msaa", "aovs",
@@ -1378,48 +1402,6 @@ struct turntable {
 	double distance;      /* 0 = fitted */
 };
 
-/* Grows [lo, hi] by the object's object-space bounds under its model matrix. */
-static void object_bounds(const struct rnd_object *o, double lo[3], double hi[3])
-{
-	float a[3], b[3];
-	switch (o->shape) {
-	case RND_SHAPE_PLANE:
-		a[0] = -0.5f * o->size[0]; a[1] = 0; a[2] = -0.5f * o->size[2];
-		break;
-	case RND_SHAPE_BOX:
-		for (int k = 0; k < 3; k++) a[k] = -0.5f * o->size[k];
-		break;
-	case RND_SHAPE_SPHERE:
-		a[0] = a[1] = a[2] = -o->radius;
-		break;
-	case RND_SHAPE_CYLINDER:
-		a[0] = a[2] = -o->radius; a[1] = -0.5f * o->height;
-		break;
-	default: { /* mesh: the vertices it draws */
-		if (!o->vertex_count || !o->positions) return;
-		for (int k = 0; k < 3; k++) { a[k] = FLT_MAX; b[k] = -FLT_MAX; }
-		for (uint32_t v = 0; v < o->vertex_count; v++)
-			for (int k = 0; k < 3; k++) {
-				float x = o->positions[3 * v + k];
-				if (x < a[k]) a[k] = x;
-				if (x > b[k]) b[k] = x;
-			}
-		goto corners;
-	}
-	}
-	for (int k = 0; k < 3; k++) b[k] = -a[k];
-corners:
-	for (int i = 0; i < 8; i++) {
-		double p[3] = {i & 1 ? b[0] : a[0], i & 2 ? b[1] : a[1], i & 4 ? b[2] : a[2]};
-		for (int k = 0; k < 3; k++) {
-			const float *m = o->model;
-			double w = m[k] * p[0] + m[4 + k] * p[1] + m[8 + k] * p[2] + m[12 + k];
-			if (w < lo[k]) lo[k] = w;
-			if (w > hi[k]) hi[k] = w;
-		}
-	}
-}
-
 /* Centre and radius of the scene's "objects" bounds: every object except planes and shadow
  * catchers (all objects when that leaves none; the unit sphere at the origin when empty). */
 static void objects_sphere(const struct rnd_scene *sc, const struct rnd_material *mats, double centre[3],
@@ -1430,7 +1412,7 @@ static void objects_sphere(const struct rnd_scene *sc, const struct rnd_material
 		for (uint32_t i = 0; i < sc->object_count; i++) {
 			const struct rnd_object *o = &sc->objects[i];
 			if (!pass && (o->shape == RND_SHAPE_PLANE || mats[o->material].shadow_catcher)) continue;
-			object_bounds(o, lo, hi);
+			api_object_bounds(o, lo, hi);
 		}
 	if (lo[0] > hi[0]) {
 		centre[0] = centre[1] = centre[2] = 0;
@@ -1489,6 +1471,17 @@ static int turntable_views(struct pctx *c, const struct turntable *tt, struct rn
 	return 0;
 }
 
+/* Places the planes with placement "ground" under the other objects (models expanded). */
+static int place_ground(struct pctx *c, struct rnd_scene *sc)
+{
+	float *margin = api_arena_calloc(c->arena, sc->object_count ? sc->object_count : 1, sizeof *margin);
+	if (!margin) return fail(c, "out of memory");
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		margin[i] = c->ground_margin[c->object_source ? c->object_source[i] : i];
+	api_ground_place((struct rnd_object *)sc->objects, sc->object_count, c->mats, margin);
+	return 0;
+}
+
 static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 {
 	struct rnd_scene *sc = &s->scene;
@@ -1515,8 +1508,9 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 	c->mat_cap = (uint32_t)(nmat + nobj + 1);
 	c->mats = api_arena_calloc(c->arena, c->mat_cap, sizeof *c->mats);
 	struct rnd_object *objects = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *objects);
+	c->ground_margin = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *c->ground_margin);
 	c->mat_index = json_object();
-	if (!c->mats || !objects || !c->mat_index) return fail(c, "out of memory");
+	if (!c->mats || !objects || !c->ground_margin || !c->mat_index) return fail(c, "out of memory");
 	if (mats) {
 		size_t old = ptr_push(c, "materials");
 		const char *name;
@@ -1605,6 +1599,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		for (size_t i = 0; i < nobj; i++) {
 			size_t o2 = ptr_index(c, i);
 			c->cur_model = NULL;
+			c->cur_object = i;
 			rc = parse_object(c, json_array_get(objs, i), &objects[i]);
 			models[i] = c->cur_model;
 			if (!rc) {
@@ -1629,6 +1624,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 		sc->objects = objects;
 		sc->object_count = (uint32_t)nobj;
 		if (c->models && expand_models(c, objs, models, sc) < 0) return -1;
+		if (place_ground(c, sc) < 0) return -1;
 	}
 	if (tt.frames && turntable_views(c, &tt, sc) < 0) return -1;
 	/* `fit` (scene or objects) stays for the renderer: it frames the bounds tightly to the
@@ -1757,6 +1753,10 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 		api_problem_set(p, 400, "", "malformed JSON at line %d, column %d: %s", je.line, je.column, je.text);
 		snprintf(p->type, sizeof p->type, PROBLEMS "malformed-json");
 		snprintf(p->title, sizeof p->title, "Malformed JSON");
+		return API_ERR;
+	}
+	if (api_preset_apply(&root, p) < 0) {
+		json_decref(root);
 		return API_ERR;
 	}
 	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts};

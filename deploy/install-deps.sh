@@ -2,13 +2,22 @@
 # Installs the Debian 12 packages umbra builds, runs and tests with.
 # Idempotent: does nothing (and needs no root) when every package is present.
 # Usage: deploy/install-deps.sh            (make run / make test call it)
+#        deploy/install-deps.sh --no-test-tools   (no browser test tools: deploy/Dockerfile)
+# Test tools: Debian's chromium for the playground's browser test (tests/browser/, driven by
+# puppeteer-core from npm), and nodejs/npm when no node or npm is on the PATH.
 set -eu
 
 PKGS="build-essential pkg-config ca-certificates curl python3
 libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
 glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
-libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev
-haproxy python3-yaml"
+libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev xxd"
+# Test tools (make test): the load balancer of the cluster test, YAML for the deploy checks,
+# chromium and node for the playground's browser test.
+if [ "${1:-}" != "--no-test-tools" ]; then
+  PKGS="$PKGS haproxy python3-yaml chromium"
+  command -v node >/dev/null 2>&1 || PKGS="$PKGS nodejs"
+  command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
+fi
 
 missing=""
 for p in $PKGS; do

@@ -1,59 +1,54 @@
 /*
- * server/cli.c — umbra-render: renders one scene with the renderer library, no server.
+ * server/cli.c — umbra-render: renders scenes with the renderer library, no server.
  *
  *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr] [--timings] [--device NAME]
+ *   umbra-render SCENE.json... -o DIR/ [batch options]            many scenes, one process
+ *   umbra-render --manifest LIST.jsonl -o DIR/ [batch options]    {"scene": ..., "output": ...} per line
+ *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [batch options]
+ *   batch options: -j N (threads and render slots, default one per core), --report FILE (JSON lines,
+ *                  default DIR/report.jsonl), --progress | --no-progress (default: bar on a tty)
  *
- * Exit 0 on success; 2 on an invalid scene (the problem text on stderr, as the server's
- * problem+json would say it); 1 otherwise. The extension of -o picks the format, overriding
- * output.format. Without -o the image goes to standard output.
+ * One scene: exit 0 on success; 2 on an invalid scene (the problem text on stderr, as the
+ * server's problem+json would say it); 1 otherwise. The extension of -o picks the format,
+ * overriding output.format. Without -o the image goes to standard output.
+ * Batch (server/farm.c; any of: thumb, --manifest, several scenes, -o naming a directory):
+ * exit 0 only when every input rendered; 2 when the only failures are invalid inputs; 1 when
+ * another failure happened; 130 when stopped by Ctrl-C (the renders in flight are finished).
  * UMBRA_VALIDATION=1 turns the Vulkan validation layer on; any message then fails the run.
  */
 #include <errno.h>
+#include <limits.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <time.h>
 #include "api.h"
+#include "farm.h"
 #include "umbra/rnd.h"
-
-static double now_ms(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
 
 static int usage(FILE *f, int code)
 {
 	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr] [--timings] [--device NAME]\n"
-	           "  Renders one scene (contract: scene-v1). Exit 0 ok, 2 invalid scene, 1 other failure.\n"
+	           "       umbra-render SCENE.json... -o DIR/ [batch options]\n"
+	           "       umbra-render --manifest LIST.jsonl -o DIR/ [batch options]\n"
+	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [batch options]\n"
+	           "  Renders scenes (contract: scene-v1). Exit 0 ok, 2 invalid input, 1 other failure, 130 interrupted.\n"
 	           "  -o FILE      output file; .png or .exr picks the format (default: stdout, output.format)\n"
-	           "  --timings    print per-stage milliseconds to stderr\n"
-	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n");
+	           "  -o DIR/      batch: one image per input in DIR (name of the input, extension of the format)\n"
+	           "  --timings    print per-stage milliseconds to stderr (one scene)\n"
+	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n"
+	           "  thumb        MODEL files (.glb .gltf .obj .stl .ply) as thumbnails: \"preset\": \"thumbnail\"\n"
+	           "               (framed, soft sun and sky light, a ground shadow catcher under the model)\n"
+	           "  --size N     thumbnail width and height (default 512)\n"
+	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
+	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
+	           "  -j N         batch: threads and render slots (default: one per core)\n"
+	           "  --report F   batch: JSON-lines report (file, output, status, ms, error); default DIR/report.jsonl\n"
+	           "  --progress, --no-progress  batch: progress bar / plain lines on stderr (default: bar on a tty)\n");
 	return code;
-}
-
-static char *read_all(const char *path, size_t *len)
-{
-	FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
-	if (!f) return NULL;
-	size_t cap = 1 << 16, n = 0;
-	char *buf = malloc(cap);
-	while (buf) {
-		size_t got = fread(buf + n, 1, cap - n, f);
-		n += got;
-		if (n < cap) break;
-		char *nb = realloc(buf, cap *= 2);
-		if (!nb) { free(buf); buf = NULL; }
-		else buf = nb;
-	}
-	int bad = ferror(f);
-	if (f != stdin) fclose(f);
-	if (bad) { free(buf); return NULL; }
-	*len = n;
-	return buf;
 }
 
 static void log_cb(void *user, int level, const char *msg)
@@ -62,60 +57,49 @@ static void log_cb(void *user, int level, const char *msg)
 	if (level <= 1) fprintf(stderr, "umbra-render: %s\n", msg);
 }
 
-int main(int argc, char **argv)
+/* Reads and parses one scene and settles its format (the output name's extension wins).
+ * 0 with *scene set, or the exit status (problem on stderr). */
+static int load_scene(const char *in, const char *out, struct api_scene **scene)
 {
-	const char *in = NULL, *out = NULL, *device = NULL;
-	int timings = 0;
-	for (int i = 1; i < argc; i++) {
-		if (!strcmp(argv[i], "-o") && i + 1 < argc) out = argv[++i];
-		else if (!strcmp(argv[i], "--timings")) timings = 1;
-		else if (!strcmp(argv[i], "--device") && i + 1 < argc) device = argv[++i];
-		else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) return usage(stdout, 0);
-		else if (argv[i][0] == '-' && argv[i][1]) return usage(stderr, 1);
-		else if (!in) in = argv[i];
-		else return usage(stderr, 1);
-	}
-	if (!in) return usage(stderr, 1);
-
-	double t0 = now_ms();
 	size_t len = 0;
-	char *json = read_all(in, &len);
+	char *json = farm_read_file(in, &len);
 	if (!json) {
 		fprintf(stderr, "umbra-render: cannot read '%s': %s\n", in, strerror(errno));
 		return 1;
 	}
 	struct api_limits lim;
 	api_limits_defaults(&lim);
+	struct api_problem prob;
+	char line[1024];
+	enum api_result r = api_scene_parse(json, len, &lim, scene, &prob);
+	free(json);
+	if (r == API_OK && out) {
+		const char *dot = strrchr(out, '.');
+		enum api_format f = (*scene)->format;
+		if (dot && !strcasecmp(dot, ".png")) f = API_FORMAT_PNG;
+		else if (dot && !strcasecmp(dot, ".exr")) f = API_FORMAT_EXR;
+		r = api_scene_set_format(*scene, f, &prob);
+	}
+	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
+	if (r == API_OK) return 0;
+	api_problem_format(&prob, line, sizeof line);
+	fprintf(stderr, "umbra-render: %s\n", line);
+	api_scene_free(*scene);
+	*scene = NULL;
+	return 2;
+}
+
+/* One scene, as before the batch runner: stdout or one file, --timings. */
+static int render_one(const char *in, const char *out, const char *device, int timings)
+{
+	double t0 = farm_now_ms();
 	struct api_scene *scene = NULL;
 	struct api_problem prob;
 	char line[1024];
-	int rc = 1;
-	if (api_scene_parse(json, len, &lim, &scene, &prob) != API_OK) {
-		api_problem_format(&prob, line, sizeof line);
-		fprintf(stderr, "umbra-render: %s\n", line);
-		free(json);
-		return 2;
-	}
-	free(json);
-	if (out) {
-		const char *dot = strrchr(out, '.');
-		enum api_format f = scene->format;
-		if (dot && !strcasecmp(dot, ".png")) f = API_FORMAT_PNG;
-		else if (dot && !strcasecmp(dot, ".exr")) f = API_FORMAT_EXR;
-		if (api_scene_set_format(scene, f, &prob) != API_OK) {
-			api_problem_format(&prob, line, sizeof line);
-			fprintf(stderr, "umbra-render: %s\n", line);
-			api_scene_free(scene);
-			return 2;
-		}
-	}
-	if (api_scene_check_output(scene, &prob) != API_OK) {
-		api_problem_format(&prob, line, sizeof line);
-		fprintf(stderr, "umbra-render: %s\n", line);
-		api_scene_free(scene);
-		return 2;
-	}
-	double t_parse = now_ms() - t0;
+	int rc = load_scene(in, out, &scene);
+	if (rc) return rc;
+	rc = 1;
+	double t_parse = farm_now_ms() - t0;
 
 	const char *v = getenv("UMBRA_VALIDATION");
 	struct rnd_context_desc cd = {
@@ -123,13 +107,13 @@ int main(int argc, char **argv)
 	};
 	struct rnd_context *ctx = NULL;
 	struct rnd_error err;
-	double t_ctx = now_ms();
+	double t_ctx = farm_now_ms();
 	if (rnd_context_create(&cd, &ctx, &err) != RND_OK) {
 		fprintf(stderr, "umbra-render: %s\n", err.msg);
 		api_scene_free(scene);
 		return 1;
 	}
-	t_ctx = now_ms() - t_ctx;
+	t_ctx = farm_now_ms() - t_ctx;
 	struct rnd_image img;
 	struct rnd_timings tm;
 	enum rnd_result r = rnd_render(ctx, &scene->scene, &img, &tm, &err);
@@ -145,7 +129,7 @@ int main(int argc, char **argv)
 		rc = scene_fault ? 2 : 1;
 		goto out_ctx;
 	}
-	double t_enc = now_ms();
+	double t_enc = farm_now_ms();
 	uint8_t *bytes = NULL;
 	size_t nbytes = 0;
 	if (api_encode(scene, &img, &bytes, &nbytes, &prob) != API_OK) {
@@ -153,7 +137,7 @@ int main(int argc, char **argv)
 		fprintf(stderr, "umbra-render: %s\n", line);
 		goto out_img;
 	}
-	t_enc = now_ms() - t_enc;
+	t_enc = farm_now_ms() - t_enc;
 	FILE *f = out ? fopen(out, "wb") : stdout;
 	if (!f) {
 		fprintf(stderr, "umbra-render: cannot write '%s': %s\n", out, strerror(errno));
@@ -167,7 +151,7 @@ int main(int argc, char **argv)
 	if (timings)
 		fprintf(stderr, "parse %.2f ms, device %.2f ms, upload %.2f ms, shadow %.2f ms, main %.2f ms, readback %.2f ms, "
 		        "encode %.2f ms, total %.2f ms, %u shadow maps\n", t_parse, t_ctx, tm.upload_ms, tm.shadow_ms, tm.main_ms,
-		        tm.readback_ms, t_enc, now_ms() - t0, tm.shadow_maps_rendered);
+		        tm.readback_ms, t_enc, farm_now_ms() - t0, tm.shadow_maps_rendered);
 	rc = 0;
 out_bytes:
 	free(bytes);
@@ -180,5 +164,164 @@ out_ctx:
 	}
 	rnd_context_destroy(ctx);
 	api_scene_free(scene);
+	return rc;
+}
+
+/* ---- arguments ---- */
+
+struct args {
+	const char *out, *device, *manifest, *report;
+	const char **inputs;
+	size_t ninputs;
+	bool thumb;
+	int timings;
+	struct farm_opts farm;
+};
+
+/* Parses a positive integer option value; 0 when it is not one. */
+static unsigned uint_arg(const char *s, unsigned max)
+{
+	char *end;
+	unsigned long v = strtoul(s, &end, 10);
+	return *s && !*end && v > 0 && v <= max ? (unsigned)v : 0;
+}
+
+static int parse_args(int argc, char **argv, struct args *a)
+{
+	a->farm.progress = -1;
+	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
+	if (!a->inputs) return 1;
+	int i = 1;
+	if (argc > 1 && !strcmp(argv[1], "thumb")) a->thumb = true, i = 2;
+	for (; i < argc; i++) {
+		const char *s = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+		if (!strcmp(s, "-h") || !strcmp(s, "--help")) return usage(stdout, 0) - 1;
+		if (!strcmp(s, "--timings")) { a->timings = 1; continue; }
+		if (!strcmp(s, "--transparent")) { a->farm.transparent = true; continue; }
+		if (!strcmp(s, "--progress") || !strcmp(s, "--no-progress")) { a->farm.progress = s[2] == 'p'; continue; }
+		if (s[0] != '-' || !s[1]) { a->inputs[a->ninputs++] = s; continue; }
+		if (!v) return usage(stderr, 1);
+		i++;
+		if (!strcmp(s, "-o")) a->out = v;
+		else if (!strcmp(s, "--device")) a->device = v;
+		else if (!strcmp(s, "--manifest")) a->manifest = v;
+		else if (!strcmp(s, "--report")) a->report = v;
+		else if (!strcmp(s, "-j") && (a->farm.threads = uint_arg(v, 64))) continue;
+		else if (!strcmp(s, "--size") && (a->farm.size = uint_arg(v, 8192))) continue;
+		else {
+			fprintf(stderr, "umbra-render: bad option %s %s\n", s, v);
+			return usage(stderr, 1);
+		}
+	}
+	if (!a->ninputs && !a->manifest) return usage(stderr, 1);
+	return 0;
+}
+
+static bool is_dir(const char *path)
+{
+	struct stat st;
+	size_t n = strlen(path);
+	return (n && path[n - 1] == '/') || (stat(path, &st) == 0 && S_ISDIR(st.st_mode));
+}
+
+/* Manifest lines become jobs (*n of them, also on failure) that own their strings. */
+static int manifest_jobs(const char *path, const char *dir, struct farm_job **jobs, size_t *n)
+{
+	size_t len = 0;
+	char *text = farm_read_file(path, &len);
+	if (!text) {
+		fprintf(stderr, "umbra-render: cannot read '%s': %s\n", path, strerror(errno));
+		return 1;
+	}
+	const char *slash = strrchr(path, '/');
+	int dlen = slash ? (int)(slash - path + 1) : 0;
+	size_t cap = 16, line_no = 0;
+	*jobs = calloc(cap, sizeof **jobs);
+	for (char *line = text, *next; *jobs && line && *line; line = next) {
+		next = strchr(line, '\n');
+		if (next) *next++ = 0;
+		line_no++;
+		if (!line[strspn(line, " \t\r")]) continue;
+		struct api_manifest_entry e;
+		struct api_problem prob;
+		if (api_manifest_line(line, strlen(line), &e, &prob) != API_OK) {
+			fprintf(stderr, "umbra-render: %s:%zu: %s%s%s\n", path, line_no, prob.pointer, prob.pointer[0] ? ": " : "",
+			        prob.detail);
+			free(text);
+			return 2;
+		}
+		if (*n == cap) {
+			struct farm_job *nj = realloc(*jobs, (cap *= 2) * sizeof *nj);
+			if (!nj) break;
+			*jobs = nj;
+		}
+		struct farm_job *j = &(*jobs)[(*n)++];
+		memset(j, 0, sizeof *j);
+		char *lbl = NULL, *in = NULL, *out = NULL;
+		/* A relative scene path is relative to the manifest's directory. */
+		int pre = e.scene_path && e.scene_path[0] != '/' ? dlen : 0;
+		if (e.scene_path && asprintf(&in, "%.*s%s", pre, path, e.scene_path) < 0) in = NULL;
+		if (!e.scene_path && asprintf(&lbl, "%s:%zu", path, line_no) < 0) lbl = NULL;
+		if (e.output && asprintf(&out, "%s/%s", dir, e.output) < 0) out = NULL;
+		j->input = in;
+		j->json = e.scene_json;
+		j->label = e.scene_path ? in : lbl;
+		j->out = out;
+		e.scene_json = NULL;
+		api_manifest_entry_release(&e);
+	}
+	free(text);
+	if (!*jobs) return 1;
+	return 0;
+}
+
+int main(int argc, char **argv)
+{
+	struct args a = {0};
+	int rc = parse_args(argc, argv, &a);
+	if (rc) {
+		free(a.inputs);
+		return rc < 0 ? 0 : rc;
+	}
+	bool batch = a.thumb || a.manifest || a.ninputs > 1 || (a.out && is_dir(a.out));
+	if (!batch) {
+		rc = render_one(a.inputs[0], a.out, a.device, a.timings);
+		free(a.inputs);
+		return rc;
+	}
+	if (!a.out) {
+		fprintf(stderr, "umbra-render: several images need an output directory: -o DIR/\n");
+		free(a.inputs);
+		return 1;
+	}
+	/* "DIR/" and "DIR" name the same directory; paths inside it get one slash. */
+	char dir[PATH_MAX];
+	snprintf(dir, sizeof dir, "%s", a.out);
+	for (size_t l = strlen(dir); l > 1 && dir[l - 1] == '/'; l--) dir[l - 1] = 0;
+	char report[PATH_MAX + 16];
+	snprintf(report, sizeof report, "%s/report.jsonl", dir);
+	a.farm.dir = dir;
+	a.farm.report = a.report ? a.report : report;
+	a.farm.device = a.device;
+	struct farm_job *jobs = NULL;
+	size_t n = 0;
+	if (a.manifest) rc = manifest_jobs(a.manifest, dir, &jobs, &n);
+	size_t nman = n;
+	if (!rc && a.ninputs) {
+		struct farm_job *nj = realloc(jobs, (n + a.ninputs) * sizeof *nj);
+		if (!nj) rc = 1;
+		else jobs = nj;
+		for (size_t k = 0; !rc && k < a.ninputs; k++)
+			jobs[n++] = (struct farm_job){.input = a.inputs[k], .model = a.thumb};
+	}
+	if (!rc) rc = farm_run(jobs, n, &a.farm);
+	for (size_t k = 0; k < nman; k++) {  /* the manifest's jobs own their strings */
+		if (jobs[k].label != jobs[k].input) free((char *)jobs[k].label);
+		free((char *)jobs[k].input);
+		free((char *)jobs[k].json);
+		free((char *)jobs[k].out);
+	}
+	free(jobs);
+	free(a.inputs);
 	return rc;
 }

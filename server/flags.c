@@ -66,6 +66,7 @@ static void usage(FILE *f)
 		snprintf(left, sizeof left, "--%s %s", opts[i].name, opts[i].arg);
 		fprintf(f, "  %-34s %s\n", left, opts[i].help);
 	}
+	fprintf(f, "  %-34s %s\n", "--no-playground", "no playground page at / and /playground (UMBRA_NO_PLAYGROUND=1)");
 	fprintf(f, "  %-34s %s\n", "--help", "this text");
 }
 
@@ -210,6 +211,8 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	cfg->drain_timeout_s = 60;
 	const char *v = getenv("UMBRA_VALIDATION");
 	cfg->validation = v && *v && strcmp(v, "0") != 0;
+	v = getenv("UMBRA_NO_PLAYGROUND");
+	cfg->no_playground = v && *v && strcmp(v, "0") != 0;
 
 	/* Environment first. */
 	for (size_t i = 0; i < OPT_COUNT; i++) {
@@ -224,11 +227,12 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	}
 
 	/* Then flags. */
-	struct option lopts[OPT_COUNT + 2];
+	struct option lopts[OPT_COUNT + 3];
 	for (size_t i = 0; i < OPT_COUNT; i++)
 		lopts[i] = (struct option){ opts[i].name, required_argument, NULL, (int)(i + 1000) };
 	lopts[OPT_COUNT] = (struct option){ "help", no_argument, NULL, 'h' };
-	lopts[OPT_COUNT + 1] = (struct option){ 0 };
+	lopts[OPT_COUNT + 1] = (struct option){ "no-playground", no_argument, NULL, 'P' };
+	lopts[OPT_COUNT + 2] = (struct option){ 0 };
 	optind = 1;
 	for (;;) {
 		int c = getopt_long(argc, argv, "h", lopts, NULL);
@@ -237,6 +241,10 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		if (c == 'h') {
 			usage(stdout);
 			return 1;
+		}
+		if (c == 'P') {
+			cfg->no_playground = true;
+			continue;
 		}
 		if (c < 1000) {
 			usage(stderr);

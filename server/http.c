@@ -45,7 +45,7 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t len)
 const char *srv_route_name(enum srv_route r)
 {
 	static const char *const names[SRV_ROUTE_COUNT] = { "/v1/render", "/healthz", "/readyz",
-		"/metrics", "/v1/info", "other" };
+		"/metrics", "/v1/info", "/playground", "other" };
 	return (unsigned)r < SRV_ROUTE_COUNT ? names[r] : "other";
 }
 
@@ -66,6 +66,8 @@ static enum srv_route route_of(const char *url)
 	for (size_t i = 0; i < sizeof routes / sizeof routes[0]; i++)
 		if (!strcmp(url, routes[i].path))
 			return routes[i].r;
+	if (srv_playground_path(url))
+		return SRV_ROUTE_PLAYGROUND;
 	return SRV_ROUTE_OTHER;
 }
 
@@ -591,6 +593,15 @@ static enum MHD_Result answer_get(struct srv_request *req)
 		if (!atomic_load(&s->ready))
 			return answer_not_ready(req);
 		return answer_info(req);
+	case SRV_ROUTE_PLAYGROUND: {
+		size_t len = 0;
+		if (s->cfg.no_playground)
+			return respond_problem(req, 404, NULL, "", "no route %s (--no-playground)", req->path);
+		char *page = srv_playground_page(&len);
+		if (!page)
+			return respond_problem(req, 503, NULL, "", "out of memory for the playground page");
+		return respond(req, 200, "text/html; charset=utf-8", page, len, NULL);
+	}
 	default:
 		return MHD_NO;
 	}

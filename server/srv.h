@@ -67,10 +67,12 @@ struct srv_config {
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
+	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */
 };
 
 enum srv_route {
 	SRV_ROUTE_RENDER, SRV_ROUTE_HEALTHZ, SRV_ROUTE_READYZ, SRV_ROUTE_METRICS, SRV_ROUTE_INFO,
+	SRV_ROUTE_PLAYGROUND,          /* GET / and /playground (server/playground.c) */
 	SRV_ROUTE_OTHER,
 	SRV_ROUTE_COUNT
 };
@@ -178,6 +180,11 @@ int srv_context_close(struct srv_server *s);        /* saves the cache; returns 
 int srv_config_load(struct srv_config *cfg, int argc, char **argv);
 /* Default worker count: `cpus` capped by the cgroup CPU quota found under `root` (see flags.c). */
 unsigned srv_default_workers(const char *root, const char *self_cgroup, unsigned cpus);
+
+/* server/playground.c: whether url is the playground's (/ or /playground); the page as a
+ * malloc'd copy (NULL when out of memory). */
+bool srv_playground_path(const char *url);
+char *srv_playground_page(size_t *len);
 
 /* Small shared helpers (main.c). */
 double srv_now(void);                               /* monotonic seconds */

@@ -52,8 +52,11 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-limits sh tests/http/limits.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-sandbox sh tests/http/sandbox.sh
-[ -f tests/cli.sh ] && run_suite cli sh tests/cli.sh
 [ -z "${ASAN:-}" ] && run_suite deploy sh deploy/check.sh
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
+[ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
+[ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
+# The playground in a real browser, when Debian's chromium is installed (install-deps does).
+[ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

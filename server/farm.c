@@ -1,0 +1,389 @@
+/*
+ * server/farm — the batch runner of umbra-render (see farm.h): worker threads on one renderer
+ * context, progress on stderr, a JSON-lines report, a clean stop on Ctrl-C.
+ */
+#include <errno.h>
+#include <limits.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+#include "api.h"
+#include "farm.h"
+#include "umbra/rnd.h"
+
+enum job_status { JOB_PENDING, JOB_OK, JOB_INVALID, JOB_FAILED, JOB_SKIPPED };
+static const char *const STATUS[] = {"pending", "ok", "invalid", "failed", "skipped"};
+
+struct job_result {
+	enum job_status status;
+	double ms;
+	char stem[PATH_MAX - 8];  /* output path without extension (default names) */
+	char out[PATH_MAX];
+	char error[640];
+};
+
+struct farm {
+	struct farm_job *jobs;
+	struct job_result *res;
+	size_t n;
+	const struct farm_opts *o;
+	struct rnd_context *ctx;
+	atomic_size_t next;
+	pthread_mutex_t mu;       /* guards done, failed and the progress output */
+	size_t done, failed;
+	double t0;
+	bool bar;
+};
+
+/* Set by SIGINT/SIGTERM: workers take no new job. */
+static volatile sig_atomic_t g_stop;
+
+static void on_signal(int sig)
+{
+	(void)sig;
+	g_stop = 1;
+}
+
+double farm_now_ms(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+char *farm_read_file(const char *path, size_t *len)
+{
+	FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
+	if (!f) return NULL;
+	size_t cap = 1 << 16, n = 0;
+	char *buf = malloc(cap + 1);
+	while (buf) {
+		n += fread(buf + n, 1, cap - n, f);
+		if (n < cap) break;
+		char *nb = realloc(buf, (cap *= 2) + 1);
+		if (!nb) { free(buf); buf = NULL; errno = ENOMEM; }
+		else buf = nb;
+	}
+	int bad = ferror(f), err = errno;
+	if (f != stdin) fclose(f);
+	if (bad) { free(buf); errno = err ? err : EIO; return NULL; }
+	if (buf) buf[n] = 0;
+	*len = n;
+	return buf;
+}
+
+static const char *label(const struct farm_job *j)
+{
+	return j->label ? j->label : j->input ? j->input : "(inline)";
+}
+
+/* ---- one job ---- */
+
+static const char *const MODEL_EXT[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
+
+/* The thumbnail document for a model file: the preset, the size, the model as part "model". */
+static int thumb_doc(const struct farm_job *j, const struct farm_opts *o, char *doc, size_t size, char *err,
+                     size_t esize)
+{
+	const char *dot = strrchr(j->input, '.'), *fmt = NULL;
+	for (int i = 0; dot && !strchr(dot, '/') && MODEL_EXT[i]; i++)
+		if (!strcasecmp(dot + 1, MODEL_EXT[i])) fmt = MODEL_EXT[i];
+	if (!fmt) {
+		snprintf(err, esize, "not a model file name (.glb, .gltf, .obj, .stl or .ply): %s", j->input);
+		return -1;
+	}
+	char dims[64] = "";
+	if (o->size) snprintf(dims, sizeof dims, "\"width\":%u,\"height\":%u,", o->size, o->size);
+	snprintf(doc, size, "{\"preset\":\"thumbnail\",%s%s\"objects\":[{\"shape\":\"model\",\"part\":\"model\","
+	         "\"format\":\"%s\"}]}", dims, o->transparent ? "\"output\":{\"transparent\":true}," : "", fmt);
+	return 0;
+}
+
+/* Parses the job's document into *s and settles its output path. JOB_OK or the failure. */
+static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
+{
+	const struct farm_job *j = &f->jobs[i];
+	struct job_result *r = &f->res[i];
+	struct api_limits lim;
+	api_limits_defaults(&lim);
+	struct api_problem prob;
+	char doc[512];
+	size_t len = 0;
+	char *bytes = NULL;
+	if (!j->json && !(bytes = farm_read_file(j->input, &len))) {
+		snprintf(r->error, sizeof r->error, "cannot read '%s': %s", j->input, strerror(errno));
+		return JOB_FAILED;
+	}
+	enum api_result ar;
+	if (j->model) {
+		if (thumb_doc(j, f->o, doc, sizeof doc, r->error, sizeof r->error) < 0) {
+			free(bytes);
+			return JOB_INVALID;
+		}
+		struct api_part part = {.name = "model", .data = (const uint8_t *)bytes, .len = len};
+		ar = api_scene_parse_parts(doc, strlen(doc), &lim, &part, 1, s, &prob);
+	} else {
+		const char *text = j->json ? j->json : bytes;
+		ar = api_scene_parse(text, j->json ? strlen(j->json) : len, &lim, s, &prob);
+	}
+	free(bytes);
+	if (ar != API_OK) goto invalid;
+	/* An explicit output name picks the format by extension; else the scene's format names it. */
+	const char *dot = j->out ? strrchr(j->out, '.') : NULL;
+	enum api_format fmt = (*s)->format;
+	if (j->out) {
+		if (dot && !strcasecmp(dot, ".png")) fmt = API_FORMAT_PNG;
+		else if (dot && !strcasecmp(dot, ".exr")) fmt = API_FORMAT_EXR;
+		else {
+			snprintf(r->error, sizeof r->error, "output '%s' must end in .png or .exr", j->out);
+			return JOB_INVALID;
+		}
+		snprintf(r->out, sizeof r->out, "%s", j->out);
+	} else {
+		snprintf(r->out, sizeof r->out, "%s.%s", r->stem, fmt == API_FORMAT_EXR ? "exr" : "png");
+	}
+	if (api_scene_set_format(*s, fmt, &prob) != API_OK || api_scene_check_output(*s, &prob) != API_OK)
+		goto invalid;
+	return JOB_OK;
+invalid:
+	api_problem_format(&prob, r->error, sizeof r->error);
+	return JOB_INVALID;
+}
+
+/* Writes bytes to path through a temporary name, so a stopped run never leaves half a file. */
+static int write_file(const char *path, const uint8_t *b, size_t n, char *err, size_t esize)
+{
+	char tmp[PATH_MAX + 32];
+	snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+	FILE *fp = fopen(tmp, "wb");
+	if (!fp) {
+		snprintf(err, esize, "cannot write '%.400s': %s", tmp, strerror(errno));
+		return -1;
+	}
+	size_t w = fwrite(b, 1, n, fp);
+	if (fclose(fp) != 0 || w != n || rename(tmp, path) != 0) {
+		snprintf(err, esize, "cannot write '%.400s': %s", path, strerror(errno));
+		unlink(tmp);
+		return -1;
+	}
+	return 0;
+}
+
+static enum job_status run_job(struct farm *f, size_t i)
+{
+	struct job_result *r = &f->res[i];
+	struct api_scene *s = NULL;
+	enum job_status st = job_scene(f, i, &s);
+	if (st != JOB_OK) return st;
+	struct rnd_image img = {0};
+	struct rnd_timings tm;
+	struct rnd_error err;
+	enum rnd_result rr = rnd_render(f->ctx, &s->scene, &img, &tm, &err);
+	if (rr != RND_OK) {
+		bool fault = rr == RND_ERR_INVALID || rr == RND_ERR_LIMIT;
+		if (fault) {
+			struct api_problem prob;
+			api_problem_from_render(&prob, s, &err, rr == RND_ERR_LIMIT ? 422 : 400);
+			api_problem_format(&prob, r->error, sizeof r->error);
+		} else {
+			snprintf(r->error, sizeof r->error, "render failed: %s", err.msg);
+		}
+		api_scene_free(s);
+		return fault ? JOB_INVALID : JOB_FAILED;
+	}
+	uint8_t *bytes = NULL;
+	size_t n = 0;
+	struct api_problem prob;
+	st = JOB_FAILED;
+	if (api_encode(s, &img, &bytes, &n, &prob) != API_OK) api_problem_format(&prob, r->error, sizeof r->error);
+	else if (write_file(r->out, bytes, n, r->error, sizeof r->error) == 0) st = JOB_OK;
+	free(bytes);
+	rnd_image_release(&img);
+	api_scene_free(s);
+	return st;
+}
+
+/* ---- progress ---- */
+
+/* Called with f->mu held after job i finished. */
+static void progress(struct farm *f, size_t i)
+{
+	double el = (farm_now_ms() - f->t0) / 1e3, rate = el > 0 ? f->done / el : 0;
+	double eta = rate > 0 ? (f->n - f->done) / rate : 0;
+	if (!f->bar) {
+		fprintf(stderr, "umbra-render: [%zu/%zu] %s %s (%.0f ms)%s%s\n", f->done, f->n, label(&f->jobs[i]),
+		        STATUS[f->res[i].status], f->res[i].ms, f->res[i].error[0] ? ": " : "", f->res[i].error);
+		return;
+	}
+	if (f->res[i].status != JOB_OK)  /* failures stay on screen above the bar */
+		fprintf(stderr, "\r\033[K%s: %s: %s\n", label(&f->jobs[i]), STATUS[f->res[i].status], f->res[i].error);
+	char bar[31];
+	size_t fill = f->n ? f->done * 30 / f->n : 30;
+	for (size_t k = 0; k < 30; k++) bar[k] = k < fill ? '#' : '.';
+	bar[30] = 0;
+	fprintf(stderr, "\r\033[K[%s] %zu/%zu  %.2f images/s  ETA %.0fs%s", bar, f->done, f->n, rate, eta,
+	        f->failed ? "  (failures above)" : "");
+	if (f->done == f->n) fputc('\n', stderr);
+}
+
+static void *worker(void *arg)
+{
+	struct farm *f = arg;
+	for (;;) {
+		if (g_stop) break;
+		size_t i = atomic_fetch_add(&f->next, 1);
+		if (i >= f->n) break;
+		double t = farm_now_ms();
+		enum job_status st = run_job(f, i);
+		pthread_mutex_lock(&f->mu);
+		f->res[i].status = st;
+		f->res[i].ms = farm_now_ms() - t;
+		f->done++;
+		if (st != JOB_OK) f->failed++;
+		progress(f, i);
+		pthread_mutex_unlock(&f->mu);
+	}
+	return NULL;
+}
+
+/* ---- report ---- */
+
+static void json_str(FILE *fp, const char *s)
+{
+	fputc('"', fp);
+	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+		if (*p == '"' || *p == '\\') fprintf(fp, "\\%c", *p);
+		else if (*p == '\n') fputs("\\n", fp);
+		else if (*p < 0x20) fprintf(fp, "\\u%04x", *p);
+		else fputc(*p, fp);
+	}
+	fputc('"', fp);
+}
+
+static int write_report(const struct farm *f, const char *path)
+{
+	FILE *fp = fopen(path, "w");
+	if (!fp) {
+		fprintf(stderr, "umbra-render: cannot write report '%s': %s\n", path, strerror(errno));
+		return -1;
+	}
+	for (size_t i = 0; i < f->n; i++) {
+		const struct job_result *r = &f->res[i];
+		fputs("{\"file\":", fp);
+		json_str(fp, label(&f->jobs[i]));
+		fputs(",\"output\":", fp);
+		if (r->status == JOB_OK) json_str(fp, r->out);
+		else fputs("null", fp);
+		fprintf(fp, ",\"status\":\"%s\",\"ms\":%.1f,\"error\":", STATUS[r->status], r->ms);
+		if (r->error[0]) json_str(fp, r->error);
+		else fputs("null", fp);
+		fputs("}\n", fp);
+	}
+	return fclose(fp) == 0 ? 0 : -1;
+}
+
+/* ---- the run ---- */
+
+static void log_cb(void *user, int level, const char *msg)
+{
+	(void)user;
+	if (level <= 1) fprintf(stderr, "umbra-render: %s\n", msg);
+}
+
+/* Default output stems: DIR/<file name without extension>, "-<k>" added when two inputs share one. */
+static void name_outputs(struct farm *f)
+{
+	for (size_t i = 0; i < f->n; i++) {
+		const char *in = f->jobs[i].input ? f->jobs[i].input : "scene";
+		const char *base = strrchr(in, '/') ? strrchr(in, '/') + 1 : in;
+		if (!strcmp(in, "-")) base = "stdin";
+		const char *dot = strrchr(base, '.');
+		int blen = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+		snprintf(f->res[i].stem, sizeof f->res[i].stem, "%s/%.*s", f->o->dir ? f->o->dir : ".", blen, base);
+		for (size_t k = 0; k < i; k++)
+			if (!strcmp(f->res[k].stem, f->res[i].stem)) {
+				size_t l = strlen(f->res[i].stem);
+				snprintf(f->res[i].stem + l, sizeof f->res[i].stem - l, "-%zu", i);
+				break;
+			}
+	}
+}
+
+static unsigned thread_count(const struct farm_opts *o, size_t n)
+{
+	long cores = sysconf(_SC_NPROCESSORS_ONLN);
+	unsigned t = o->threads ? o->threads : cores > 0 ? (unsigned)cores : 1;
+	if (t > 64) t = 64;
+	if (t > n) t = (unsigned)n;
+	return t ? t : 1;
+}
+
+static int summary(const struct farm *f, unsigned threads)
+{
+	size_t cnt[5] = {0};
+	for (size_t i = 0; i < f->n; i++) cnt[f->res[i].status]++;
+	cnt[JOB_SKIPPED] += cnt[JOB_PENDING];
+	double s = (farm_now_ms() - f->t0) / 1e3;
+	fprintf(stderr, "umbra-render: %zu ok, %zu invalid, %zu failed, %zu skipped of %zu in %.1f s (%.2f images/s, "
+	        "%u threads)%s\n", cnt[JOB_OK], cnt[JOB_INVALID], cnt[JOB_FAILED], cnt[JOB_SKIPPED], f->n, s,
+	        s > 0 ? cnt[JOB_OK] / s : 0.0, threads, g_stop ? ", interrupted" : "");
+	if (g_stop) return 130;
+	if (cnt[JOB_FAILED]) return 1;
+	return cnt[JOB_INVALID] ? 2 : 0;
+}
+
+int farm_run(struct farm_job *jobs, size_t n, const struct farm_opts *o)
+{
+	if (o->dir && mkdir(o->dir, 0777) != 0 && errno != EEXIST) {
+		fprintf(stderr, "umbra-render: cannot create '%s': %s\n", o->dir, strerror(errno));
+		return 1;
+	}
+	struct farm f = {.jobs = jobs, .n = n, .o = o, .t0 = farm_now_ms()};
+	f.res = calloc(n ? n : 1, sizeof *f.res);
+	if (!f.res) return 1;
+	f.bar = o->progress > 0 || (o->progress < 0 && isatty(2));
+	name_outputs(&f);
+	unsigned threads = thread_count(o, n);
+	const char *v = getenv("UMBRA_VALIDATION");
+	struct rnd_context_desc cd = {.device_name = o->device, .validation = v && *v == '1', .slots = threads,
+	                              .log = log_cb};
+	struct rnd_error err;
+	int rc = 1;
+	if (rnd_context_create(&cd, &f.ctx, &err) != RND_OK) {
+		fprintf(stderr, "umbra-render: %s\n", err.msg);
+		goto out_res;
+	}
+	pthread_mutex_init(&f.mu, NULL);
+	struct sigaction sa = {.sa_handler = on_signal}, old_int, old_term;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGINT, &sa, &old_int);
+	sigaction(SIGTERM, &sa, &old_term);
+	pthread_t tids[64];
+	unsigned started = 0;
+	while (started < threads && pthread_create(&tids[started], NULL, worker, &f) == 0) started++;
+	if (!started) worker(&f);   /* no thread could start: work on this one */
+	for (unsigned k = 0; k < started; k++) pthread_join(tids[k], NULL);
+	sigaction(SIGINT, &old_int, NULL);
+	sigaction(SIGTERM, &old_term, NULL);
+	if (f.bar && f.done < f.n) fputc('\n', stderr);
+	for (size_t i = 0; i < n; i++)
+		if (f.res[i].status == JOB_PENDING) f.res[i].status = JOB_SKIPPED;
+	rc = summary(&f, threads);
+	if (o->report && write_report(&f, o->report) < 0 && rc == 0) rc = 1;
+	if (rnd_context_validation_messages(f.ctx)) {
+		fprintf(stderr, "umbra-render: %u Vulkan validation messages\n", rnd_context_validation_messages(f.ctx));
+		if (rc == 0) rc = 1;
+	}
+	rnd_context_destroy(f.ctx);
+	pthread_mutex_destroy(&f.mu);
+out_res:
+	free(f.res);
+	return rc;
+}

@@ -1,0 +1,51 @@
+/*
+ * server/farm — umbra-render's batch runner: many scenes or models in one warm process.
+ *
+ * Usage (server/cli.c):
+ *   struct farm_job jobs[n] = {{.input = "a.json", .out = "DIR/a.png"}, ...};  // or .model = true
+ *   struct farm_opts o = {.threads = 0, .report = "DIR/report.jsonl"};
+ *   int code = farm_run(jobs, n, &o);    // exit status: 0 all rendered, 1 some failed, 130 interrupted
+ *
+ * One renderer context with `threads` render slots and as many worker threads, each taking the
+ * next job, rendering it and writing its file (renamed into place when complete), so every core
+ * is busy and the device, pipelines and shadow atlas are set up once. A model job renders the
+ * file with `"preset": "thumbnail"` (api/preset.h) as a multipart part. Progress goes to
+ * stderr: a bar (done/total, images/s, ETA) on a terminal, one line per finished job otherwise.
+ * SIGINT / SIGTERM: no new job starts; the renders in flight finish and are written; the rest
+ * are reported "skipped". The report (JSON lines, input order) has file, output, status (ok,
+ * invalid, failed, skipped), ms, error.
+ *
+ * Ownership: jobs and their strings belong to the caller. farm_run() is not reentrant (signal
+ * handlers); call it once per process.
+ */
+#ifndef UMBRA_FARM_H
+#define UMBRA_FARM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+struct farm_job {
+	const char *input;       /* scene file (or "-"), or model file when model is set */
+	const char *json;        /* inline scene document instead of input's bytes (manifest), or NULL */
+	const char *label;       /* name in progress and report (NULL: input) */
+	const char *out;         /* output path; NULL: from input's name in opts.dir with the scene's format */
+	bool model;
+};
+
+struct farm_opts {
+	const char *dir;          /* output directory (created if missing) */
+	const char *report;       /* JSON-lines report path, NULL: none */
+	const char *device;       /* Vulkan device name filter, NULL: first */
+	unsigned threads;         /* 0: one per core */
+	unsigned size;            /* thumbnails: width = height (0: the preset's 512) */
+	bool transparent;         /* thumbnails: transparent background */
+	int progress;             /* -1 auto (bar on a tty), 0 plain lines, 1 bar */
+};
+
+int farm_run(struct farm_job *jobs, size_t n, const struct farm_opts *o);
+
+/* Whole file (or stdin for "-"), malloc'd; NULL with errno set. */
+char *farm_read_file(const char *path, size_t *len);
+double farm_now_ms(void);
+
+#endif

@@ -1,0 +1,68 @@
+#!/bin/sh
+# tests/browser/run.sh — the playground page in Debian's chromium (headless), driven by
+# puppeteer-core (tests/browser/package.json; `npm ci` here when node_modules is missing).
+# Starts its own umbrad on loopback (ephemeral port) and ends with "N passed, N failed".
+# Without chromium or node the suite says so and counts nothing (tests/run.sh runs it only
+# when chromium is installed). Env: BUILD, SHARED; SHOT=FILE also saves a screenshot.
+BUILD=${BUILD:-build}
+CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
+dir=$(dirname "$0")
+if [ ! -x "$CHROMIUM" ] || ! command -v node >/dev/null 2>&1; then
+	echo "# skipped: needs $CHROMIUM and node (deploy/install-deps.sh installs them)"
+	echo "0 passed, 0 failed"
+	exit 0
+fi
+if [ ! -d "$dir/node_modules/puppeteer-core" ]; then
+	echo "# npm ci (puppeteer-core, test tooling only)"
+	if ! (cd "$dir" && npm ci --no-audit --no-fund >/dev/null 2>&1); then
+		echo "FAIL - npm ci in tests/browser"
+		echo "0 passed, 1 failed"
+		exit 1
+	fi
+fi
+T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-browser.XXXXXX")
+PID=""
+cleanup() { [ -n "$PID" ] && kill "$PID" 2>/dev/null && wait "$PID" 2>/dev/null; rm -rf "$T"; }
+trap cleanup EXIT
+trap 'exit 1' INT TERM
+# ASan builds: the daemon needs the driver preloaded after the ASan runtime (tests/run.sh).
+PRELOAD=""
+asan_rt=$(ldd "$BUILD/umbrad" 2>/dev/null | awk '/libasan/ { print $3; exit }')
+if [ -n "$asan_rt" ]; then
+	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
+		[ -f "$lvp" ] && PRELOAD="$asan_rt $lvp" && break
+	done
+fi
+LD_PRELOAD="$PRELOAD" "$BUILD/umbrad" --listen 127.0.0.1:0 --port-file "$T/port" --workers 2 2>"$T/umbrad.log" &
+PID=$!
+i=0
+while :; do
+	if [ -s "$T/port" ] && curl -sf -o /dev/null --max-time 5 "http://127.0.0.1:$(cat "$T/port")/readyz"; then break; fi
+	i=$((i + 1))
+	if [ $i -gt 2400 ] || ! kill -0 "$PID" 2>/dev/null; then
+		echo "FAIL - umbrad did not become ready"; tail -n 20 "$T/umbrad.log" | sed 's/^/# /'
+		echo "0 passed, 1 failed"
+		exit 1
+	fi
+	sleep 0.1
+done
+URL="http://127.0.0.1:$(cat "$T/port")"
+# The bench examples are in the page when the build found them (Makefile: BENCH_JSON).
+BENCH=""
+[ -f "${SHARED:-../shared}/bench/thumb-512.json" ] && BENCH=1
+BENCH=$BENCH UMBRA_URL=$URL CHROMIUM=$CHROMIUM node "$dir/playground.test.js" >"$T/node.out" 2>&1
+grep -v -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out"
+line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out" | tail -n 1)
+pass=${line%% passed*}; fail=${line#*passed, }; fail=${fail%% failed*}
+[ -n "$line" ] || { echo "FAIL - the browser test gave no result line"; pass=0; fail=1; }
+# The playground can be switched off.
+kill "$PID"; wait "$PID" 2>/dev/null; PID=""
+LD_PRELOAD="$PRELOAD" "$BUILD/umbrad" --listen 127.0.0.1:0 --port-file "$T/port2" --workers 1 --no-playground 2>"$T/umbrad2.log" &
+PID=$!
+i=0
+while [ ! -s "$T/port2" ] && [ $i -lt 2400 ] && kill -0 "$PID" 2>/dev/null; do sleep 0.1; i=$((i + 1)); done
+code=$(curl -s -o /dev/null -w '%{http_code}' --max-time 10 "http://127.0.0.1:$(cat "$T/port2" 2>/dev/null)/")
+if [ "$code" = 404 ]; then echo "ok - --no-playground: GET / is 404"; pass=$((pass + 1))
+else echo "FAIL - --no-playground: GET / is $code"; fail=$((fail + 1)); fi
+echo "$pass passed, $fail failed"
+[ "$fail" = 0 ]

@@ -1,0 +1,209 @@
+#!/bin/sh
+# tests/cli/run.sh — umbra-render as a user runs it: the thumbnail farm (thumb MODEL...), several
+# scenes and a manifest in one process, the JSON-lines report, exit codes, Ctrl-C, and the
+# self-placing ground's shadow seen in the image. Models are written here (OBJ, ASCII STL and
+# PLY). Prints "ok - x" / "FAIL - x" and, last, "N passed, N failed".
+# Env: BUILD (build dir); UMBRA_VALIDATION (tests/run.sh sets 1: any message fails a run).
+BUILD=${BUILD:-build}
+CLI=$BUILD/umbra-render
+PNG="python3 tests/cli/png.py"
+T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-cli.XXXXXX")
+pass=0
+fail=0
+ok() { echo "ok - $1"; pass=$((pass + 1)); }
+nok() { echo "FAIL - $1${2:+: $2}"; fail=$((fail + 1)); }
+check() { n=$1; shift; if "$@"; then ok "$n"; else nok "$n"; fi; }
+trap 'rm -rf "$T"' EXIT
+# ASan builds: preload the driver after the ASan runtime (see tests/run.sh).
+PRELOAD=""
+asan_rt=$(ldd "$CLI" 2>/dev/null | awk '/libasan/ { print $3; exit }')
+if [ -n "$asan_rt" ]; then
+	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
+		[ -f "$lvp" ] && PRELOAD="$asan_rt $lvp" && break
+	done
+fi
+cli() { LD_PRELOAD="$PRELOAD" "$CLI" "$@"; }
+if [ ! -x "$CLI" ]; then nok "umbra-render built"; echo "$pass passed, $fail failed"; exit 1; fi
+
+# ---- models ----
+mkdir -p "$T/models"
+cat >"$T/models/cube.obj" <<'EOF2'
+v -1 0 -1
+v 1 0 -1
+v 1 2 -1
+v -1 2 -1
+v -1 0 1
+v 1 0 1
+v 1 2 1
+v -1 2 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 4 8 7 3
+f 1 5 8 4
+f 2 3 7 6
+EOF2
+cat >"$T/models/tetra.stl" <<'EOF2'
+solid tetra
+facet normal 0 0 -1
+ outer loop
+  vertex 0 0 0
+  vertex 0 1 0
+  vertex 1 0 0
+ endloop
+endfacet
+facet normal 0 -1 0
+ outer loop
+  vertex 0 0 0
+  vertex 1 0 0
+  vertex 0 0 1
+ endloop
+endfacet
+facet normal -1 0 0
+ outer loop
+  vertex 0 0 0
+  vertex 0 0 1
+  vertex 0 1 0
+ endloop
+endfacet
+facet normal 0.577 0.577 0.577
+ outer loop
+  vertex 1 0 0
+  vertex 0 1 0
+  vertex 0 0 1
+ endloop
+endfacet
+endsolid tetra
+EOF2
+cat >"$T/models/pyramid.ply" <<'EOF2'
+ply
+format ascii 1.0
+element vertex 5
+property float x
+property float y
+property float z
+element face 6
+property list uchar int vertex_indices
+end_header
+-1 0 -1
+1 0 -1
+1 0 1
+-1 0 1
+0 1.5 0
+3 0 1 2
+3 0 2 3
+3 0 4 1
+3 1 4 2
+3 2 4 3
+3 3 4 0
+EOF2
+printf 'this is not an STL file\n' >"$T/models/broken.stl"
+
+# ---- thumb: three models and a broken one ----
+cli thumb "$T/models/cube.obj" "$T/models/tetra.stl" "$T/models/pyramid.ply" "$T/models/broken.stl" \
+	-o "$T/thumbs/" --size 96 -j 2 --no-progress 2>"$T/thumb.err"
+rc=$?
+check "thumb: one broken model -> exit 2 (invalid input)" [ $rc = 2 ]
+for m in cube tetra pyramid; do
+	check "thumb: $m.png is a 96x96 PNG" [ "$($PNG size "$T/thumbs/$m.png" 2>/dev/null)" = "96 96" ]
+	check "thumb: $m.png has content (>8 colours)" [ "$($PNG distinct "$T/thumbs/$m.png" 2>/dev/null || echo 0)" -gt 8 ]
+done
+check "thumb: nothing written for the broken model" [ ! -e "$T/thumbs/broken.png" ]
+check "thumb: report has one line per model" [ "$(wc -l <"$T/thumbs/report.jsonl")" = 4 ]
+check "thumb: report says ok for the good ones" [ "$(grep -c '"status":"ok"' "$T/thumbs/report.jsonl")" = 3 ]
+check "thumb: report names the broken model, its status and error" \
+	grep -q '"file":"[^"]*broken.stl","output":null,"status":"invalid","ms":[0-9.]*,"error":"400 ' "$T/thumbs/report.jsonl"
+check "thumb: report is in input order" sh -c "head -n 1 '$T/thumbs/report.jsonl' | grep -q cube.obj"
+check "thumb: plain progress lines when stderr is not a terminal" grep -q '^umbra-render: \[4/4\]' "$T/thumb.err"
+check "thumb: summary line" grep -q '3 ok, 1 invalid, 0 failed, 0 skipped of 4' "$T/thumb.err"
+
+# --progress forces the bar (as on a terminal): done/total, images/s, ETA, on one line.
+cli thumb "$T/models/cube.obj" "$T/models/tetra.stl" -o "$T/bar" --size 32 --progress 2>"$T/bar.err"
+check "thumb --progress: a bar with done/total, images/s and ETA" \
+	sh -c "grep -q '\[#*\] 2/2  [0-9.]* images/s  ETA' '$T/bar.err' && ! grep -q '^umbra-render: \[' '$T/bar.err'"
+
+# The thumbnail's ground: the model's base is on it and its shadow darkens the white background
+# below the model; transparent: the corners are alpha 0 and the shadow has alpha.
+cli thumb "$T/models/cube.obj" -o "$T/tr" --size 64 --transparent --no-progress 2>/dev/null
+rc=$?
+check "thumb --transparent: exit 0" [ $rc = 0 ]
+a=$($PNG px "$T/tr/cube.png" 0 0 2>/dev/null | cut -d' ' -f4)
+check "thumb --transparent: corner alpha 0" [ "$a" = 0 ]
+
+# ---- the self-placing ground: its shadow appears under a floating box ----
+# Orthographic view straight down (+x right, -z up) over x, z in [-3, 3] at 96 px: 16 px per
+# unit. A unit box floats at y 3; the ground places itself at the box's base (y 2.5); the light
+# travels along (1, -1, 0), so the shadow of the box (x -0.5..0.5, top at 3.5) covers x 0.5..1.5
+# beyond the box: x = 1 is column 64. x = -2 (column 16) stays background.
+ground_scene() { # $1: extra output members
+	cat <<EOF2
+{"width": 96, "height": 96,
+ "camera": {"type": "orthographic", "position": [0, 10, 0], "target": [0, 0, 0], "up": [0, 0, -1], "height": 6},
+ "environment": {"background": [1, 1, 1]},
+ "objects": [
+  {"shape": "plane", "placement": "ground", "material": {"shadow_catcher": true}},
+  {"shape": "box", "transform": {"translation": [0, 3, 0]}}],
+ "lights": [{"type": "directional", "direction": [1, -1, 0], "shadow": {"filter": "pcf"}}],
+ "output": {"msaa": 1$1}}
+EOF2
+}
+ground_scene "" >"$T/ground.json"
+ground_scene ', "transparent": true' >"$T/ground-t.json"
+cli "$T/ground.json" -o "$T/ground.png" 2>"$T/ground.err"
+check "ground scene renders" [ $? = 0 ]
+shadow=$($PNG px "$T/ground.png" 64 48 2>/dev/null | cut -d' ' -f1)
+bg=$($PNG px "$T/ground.png" 16 48 2>/dev/null | cut -d' ' -f1)
+check "ground: background stays white away from the box ($bg)" [ "${bg:-0}" = 255 ]
+check "ground: the box's shadow darkens the ground next to it ($shadow)" [ "${shadow:-255}" -lt 200 ]
+cli "$T/ground-t.json" -o "$T/ground-t.png" 2>/dev/null
+sa=$($PNG px "$T/ground-t.png" 64 48 2>/dev/null | cut -d' ' -f4)
+ba=$($PNG px "$T/ground-t.png" 16 48 2>/dev/null | cut -d' ' -f4)
+check "ground, transparent: shadow has alpha ($sa), background none ($ba)" sh -c "[ '${sa:-0}' -gt 60 ] && [ '$ba' = 0 ]"
+
+# ---- several scenes and a manifest in one process ----
+mkdir -p "$T/scenes"
+cp "$T/ground.json" "$T/scenes/a.json"
+sed 's/"width": 96/"width": 80/' "$T/ground.json" >"$T/scenes/b.json"
+sed 's/"direction": \[1, -1, 0\]/"direction": [0, 0, 0]/' "$T/ground.json" >"$T/scenes/bad.json"
+cli "$T/scenes/a.json" "$T/scenes/b.json" -o "$T/out1" --no-progress 2>"$T/out1.err"
+check "scenes: exit 0 when all render" [ $? = 0 ]
+check "scenes: a.png 96x96" [ "$($PNG size "$T/out1/a.png" 2>/dev/null)" = "96 96" ]
+check "scenes: b.png 80x96" [ "$($PNG size "$T/out1/b.png" 2>/dev/null)" = "80 96" ]
+cli "$T/scenes/a.json" "$T/scenes/bad.json" "$T/scenes/b.json" -o "$T/out2/" --report "$T/out2.jsonl" --no-progress 2>/dev/null
+check "scenes: one bad scene -> exit 2" [ $? = 2 ]
+check "scenes: the others still rendered" sh -c "[ -s '$T/out2/a.png' ] && [ -s '$T/out2/b.png' ]"
+check "scenes: --report names the problem's pointer" \
+	grep -q '"status":"invalid".*/lights/0/direction' "$T/out2.jsonl"
+printf '{"scene": "a.json", "output": "first.png"}\n\n{"scene": {"width": 32, "height": 16, "camera": {"position": [0, 0, 5]}, "objects": [{"shape": "sphere"}]}, "output": "inline.png"}\n' \
+	>"$T/scenes/list.jsonl"
+cli --manifest "$T/scenes/list.jsonl" -o "$T/out3" --no-progress 2>/dev/null
+check "manifest: exit 0" [ $? = 0 ]
+check "manifest: path scene relative to the manifest, named by output" [ "$($PNG size "$T/out3/first.png" 2>/dev/null)" = "96 96" ]
+check "manifest: inline scene" [ "$($PNG size "$T/out3/inline.png" 2>/dev/null)" = "32 16" ]
+check "manifest: report labels the inline line by its line number" grep -q 'list.jsonl:3' "$T/out3/report.jsonl"
+printf '{"scene": "a.json", "outptu": "x.png"}\n' >"$T/scenes/badlist.jsonl"
+cli --manifest "$T/scenes/badlist.jsonl" -o "$T/out4" --no-progress 2>"$T/out4.err"
+check "manifest: a bad line -> exit 2 naming the line" sh -c "[ $? = 2 ] && grep -q 'badlist.jsonl:1' '$T/out4.err'"
+cli "$T/scenes/a.json" "$T/scenes/b.json" 2>/dev/null
+check "several scenes without -o DIR -> exit 1" [ $? = 1 ]
+
+# ---- Ctrl-C: the renders in flight finish, the rest are skipped, no partial files ----
+mkdir -p "$T/many"
+i=0
+while [ $i -lt 40 ]; do cp "$T/models/cube.obj" "$T/many/m$i.obj"; i=$((i + 1)); done
+LD_PRELOAD="$PRELOAD" "$CLI" thumb "$T"/many/*.obj -o "$T/intr" --size 512 -j 1 --no-progress 2>"$T/intr.err" &
+pid=$!
+i=0
+while ! grep -q '^umbra-render: \[1/40\]' "$T/intr.err" 2>/dev/null && [ $i -lt 1200 ]; do sleep 0.1; i=$((i + 1)); done
+kill -INT $pid
+wait $pid
+rc=$?
+okn=$(grep -c '"status":"ok"' "$T/intr/report.jsonl" 2>/dev/null || echo 0)
+check "Ctrl-C: exit 130" [ $rc = 130 ]
+check "Ctrl-C: some rendered, the rest skipped" sh -c "[ $okn -ge 1 ] && grep -q '\"status\":\"skipped\"' '$T/intr/report.jsonl'"
+check "Ctrl-C: every ok line has its complete PNG, nothing else" \
+	sh -c "[ \$(ls '$T/intr' | grep -c '\\.png\$') = $okn ] && ! ls '$T/intr' | grep -q tmp"
+check "Ctrl-C: report lists all 40" [ "$(wc -l <"$T/intr/report.jsonl")" = 40 ]
+
+echo "$pass passed, $fail failed"
+[ "$fail" = 0 ]
