@@ -173,7 +173,9 @@ async function main() {
     const ctype = mr ? mr.headers()['content-type'] || '' : '';
     const d = await imageFacts(page, 'image');
     check('drop: sent as multipart/form-data', /^multipart\/form-data/.test(ctype), ctype);
-    check('drop: the model renders (512x512, content)', st === 'done' && d.w === 512 && d.h === 512 && d.colours > 20,
+    // The tetrahedron's visible face is evenly lit: beyond the white background, its grey and the
+    // anti-aliased edges make a handful of colours (an empty image has 1).
+    check('drop: the model renders (512x512, content)', st === 'done' && d.w === 512 && d.h === 512 && d.colours > 5,
       st + ' ' + d.w + 'x' + d.h + ' ' + d.colours);
     check('no script errors', errors.length === 0, errors.join('; '));
 
