@@ -3,6 +3,7 @@
 #   make run        install deps, build, start umbrad on 127.0.0.1:8080
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
+#   make fuzz       libFuzzer targets in build/fuzz (clang); make test runs each briefly
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench
 BUILD ?= build
 SHARED ?= ../shared
@@ -47,7 +48,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz clean
+.PHONY: all deps run test test-asan bench fuzz fuzz-long fuzz-targets clean
 all: $(BINS)
 
 deps:
@@ -88,7 +89,8 @@ run: deps
 
 test: deps
 	@$(MAKE) --no-print-directory all
-	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/run.sh
+	@$(MAKE) --no-print-directory fuzz
+	@BUILD=$(BUILD) SHARED=$(SHARED) FUZZ_BUILD=$(FUZZ_BUILD) sh tests/run.sh
 
 test-asan: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan OPT=-O1 \
@@ -106,12 +108,28 @@ $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
 
-# libFuzzer target for the scene parser (clang): build/fuzz/fuzz_scene tests/fuzz/corpus
-fuzz:
-	@$(MAKE) --no-print-directory BUILD=build/fuzz CC=clang OPT=-O1 \
-	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a
-	clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
-	  -o build/fuzz/fuzz_scene tests/fuzz/fuzz_scene.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS)
+# libFuzzer targets (clang, ASan + UBSan; tests/fuzz/run.sh has the conventions): every
+# tests/fuzz/fuzz_*.c becomes build/fuzz/fuzz_*, linked with the api, renderer and server
+# (without main.c) libraries built with fuzzer instrumentation. Seeds: tests/fuzz/corpus/<name>/.
+#   make fuzz                      build them all
+#   make fuzz-long FUZZ_RUNS=1e6   run each for FUZZ_RUNS executions, one at a time; prints a table
+FUZZ_BUILD := build/fuzz
+FUZZ_SRC := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_SAN := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_RUNS ?= 1000000
+fuzz: deps
+	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang OPT=-O1 SAN="$(FUZZ_SAN)" fuzz-targets
+
+fuzz-long: fuzz
+	@FUZZ_BUILD=$(FUZZ_BUILD) sh tests/fuzz/long.sh $(FUZZ_RUNS)
+
+# Inside the sub-make above (BUILD = build/fuzz).
+fuzz-targets: $(FUZZ_SRC:tests/fuzz/%.c=$(BUILD)/%)
+$(BUILD)/libsrv.a: $(filter-out $(BUILD)/obj/server/main.o,$(SRV_OBJ))
+	@rm -f $@; ar rcs $@ $^
+.PRECIOUS: $(BUILD)/obj/tests/fuzz/%.o
+$(BUILD)/fuzz_%: $(BUILD)/obj/tests/fuzz/fuzz_%.o $(BUILD)/libsrv.a $(BUILD)/libapi.a $(BUILD)/librenderer.a
+	$(CC) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(LIBS)
 
 clean:
 	rm -rf $(BUILD)

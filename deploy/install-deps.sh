@@ -4,10 +4,14 @@
 # Usage: deploy/install-deps.sh            (make run / make test call it)
 set -eu
 
+# clang + libclang-rt-14-dev: make fuzz (libFuzzer's libclang_rt.fuzzer*.a and the sanitizer
+# runtimes for Debian 12's clang 14 are in libclang-rt-14-dev, which clang does not pull in).
+
 PKGS="build-essential pkg-config ca-certificates curl python3
 libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
 glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
-libopenexr-dev libassimp-dev libjpeg-dev"
+libopenexr-dev libassimp-dev libjpeg-dev
+clang libclang-rt-14-dev"
 
 missing=""
 for p in $PKGS; do

@@ -51,5 +51,7 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/tests/gpu_tests" ] && run_suite gpu env LD_PRELOAD="$PRELOAD" "$BUILD/tests/gpu_tests"
 [ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
 [ -f tests/cli.sh ] && run_suite cli sh tests/cli.sh
+# libFuzzer targets, a few seconds each (make test builds them into FUZZ_BUILD).
+[ -n "${FUZZ_BUILD:-}" ] && run_suite fuzz sh tests/fuzz/run.sh
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]
