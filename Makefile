@@ -125,7 +125,12 @@ fuzz-long: fuzz
 
 # Inside the sub-make above (BUILD = build/fuzz).
 fuzz-targets: $(FUZZ_SRC:tests/fuzz/%.c=$(BUILD)/%)
-$(BUILD)/libsrv.a: $(filter-out $(BUILD)/obj/server/main.o,$(SRV_OBJ))
+# server/main.c goes in with its main() renamed: targets get srv_now() and the other helpers it
+# defines, and libFuzzer keeps its own main().
+$(BUILD)/obj/server/main_fuzz.o: server/main.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Dmain=srv_main_unused -c -o $@ $<
+$(BUILD)/libsrv.a: $(filter-out $(BUILD)/obj/server/main.o,$(SRV_OBJ)) $(BUILD)/obj/server/main_fuzz.o
 	@rm -f $@; ar rcs $@ $^
 .PRECIOUS: $(BUILD)/obj/tests/fuzz/%.o
 $(BUILD)/fuzz_%: $(BUILD)/obj/tests/fuzz/fuzz_%.o $(BUILD)/libsrv.a $(BUILD)/libapi.a $(BUILD)/librenderer.a

@@ -6,12 +6,20 @@
  *
  * Each input is the raw bytes a client sends on one connection (request line, headers, body,
  * possibly several pipelined requests). The daemon is started once with srv_http_start() as
- * umbrad starts it (127.0.0.1:0, never used: no TCP traffic); each input gets a fresh
- * socketpair handed to the daemon with MHD_add_connection(), is written to it, the write side is
- * shut, and the answer is read until the daemon closes. A stub worker thread stands in for
+ * umbrad starts it, listening on 127.0.0.1:0 but never connected to: each input gets a fresh
+ * socketpair handed to the daemon with MHD_add_connection() (no TCP, so a million inputs use no
+ * ephemeral ports on a shared machine), is written to it, the write side is shut, and the
+ * answer is read until the daemon closes. A stub worker thread stands in for
  * server/worker.c: it takes each queued request off the real queue (server/queue.c), checks
  * what http.c handed over (a NUL-terminated scene body, named parts), and answers 200 without
  * parsing or rendering. No change to server/http.c is needed for this.
+ *
+ * Everything linked is umbrad's own code: server/main.c comes in with main() renamed (see the
+ * Makefile) for srv_now(), and server/log.c writes the access log to stderr, which
+ * tests/fuzz/fuzz_http.options discards with -close_fd_mask=2 (libFuzzer keeps its own output
+ * and sanitizer reports on a copy of stderr; drop the flag to see the daemon's log lines).
+ * With a socketpair instead of TCP, libmicrohttpd logs that TCP_NODELAY/TCP_CORK failed:
+ * expected, harmless.
  *
  * What counts as a failure: a sanitizer report, a hang (libFuzzer's -timeout), a request
  * still pending after its connection closed (a leak of the request), or a queued request that
@@ -47,41 +55,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static struct srv_server srv;
 static pthread_t worker;
-
-/* ---- what server/main.c and server/log.c provide to umbrad (not linked: quiet and fast) ---- */
-
-double srv_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-void srv_log_init(enum srv_log_format format)
-{
-	(void)format;
-}
-
-/* FUZZ_HTTP_LOG=1 in the environment prints the daemon's log lines (to debug an input). */
-static int log_on;
-
-void srv_log(enum srv_log_level level, const char *fmt, ...)
-{
-	(void)level;
-	if (!log_on) return;
-	va_list ap;
-	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
-	va_end(ap);
-	fputc('\n', stderr);
-}
-
-void srv_log_request(const char *method, const char *path, const char *route, int status, uint64_t bytes,
-                     double ms, const char *request_id)
-{
-	(void)route; (void)bytes; (void)request_id;
-	if (log_on) fprintf(stderr, "%s %s -> %d (%.1f ms)\n", method, path, status, ms);
-}
 
 /* ---- the stub worker ---- */
 
@@ -120,7 +93,6 @@ static void start_once(void)
 	static int started;
 	if (started) return;
 	started = 1;
-	log_on = getenv("FUZZ_HTTP_LOG") != NULL;
 	srv.cfg.listen = "127.0.0.1:0";
 	srv.cfg.queue = 2;
 	srv.cfg.max_body = 16 << 10;
