@@ -8,11 +8,11 @@
 #   tests/fuzz/fuzz_NAME.dict     optional libFuzzer dictionary
 #   tests/fuzz/fuzz_NAME.options  optional extra libFuzzer flags, one line (e.g. -max_len=65536)
 #
-# Env: FUZZ_BUILD (build/fuzz), FUZZ_RUNS (executions per target, default 3000),
+# Env: FUZZ_BUILD (build/fuzz), FUZZ_RUNS (executions per target, default 20000),
 # FUZZ_SECONDS (a cap per target so a slow target cannot hold up make test, default 5).
 # Runs use -seed=1, so a failure reproduces; its input is kept in $FUZZ_BUILD/artifacts/NAME/.
 FUZZ_BUILD=${FUZZ_BUILD:-build/fuzz}
-FUZZ_RUNS=${FUZZ_RUNS:-3000}
+FUZZ_RUNS=${FUZZ_RUNS:-20000}
 FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 dir=$(dirname "$0")
 pass=0; fail=0
