@@ -110,9 +110,10 @@ $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 
 # libFuzzer targets (clang, ASan + UBSan; tests/fuzz/run.sh has the conventions): every
 # tests/fuzz/fuzz_*.c becomes build/fuzz/fuzz_*, linked with the api, renderer and server
-# (without main.c) libraries built with fuzzer instrumentation. Seeds: tests/fuzz/corpus/<name>/.
+# (server/main.c with its main() renamed) libraries built with fuzzer instrumentation. Seeds:
+# tests/fuzz/corpus/<name>/; optional <name>.dict and <name>.options next to the source.
 #   make fuzz                      build them all
-#   make fuzz-long FUZZ_RUNS=1e6   run each for FUZZ_RUNS executions, one at a time; prints a table
+#   make fuzz-long FUZZ_RUNS=N  run each for FUZZ_RUNS executions, one at a time; prints a table
 FUZZ_BUILD := build/fuzz
 FUZZ_SRC := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_SAN := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
