@@ -3,6 +3,7 @@
 #   make run        install deps, build, start umbrad on 127.0.0.1:8080
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
+#   make fuzz       libFuzzer targets in build/fuzz (clang); make test runs each briefly
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench
 #   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
@@ -54,7 +55,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: all deps run test test-asan bench fuzz fuzz-long fuzz-targets clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -107,7 +108,8 @@ run: deps
 
 test: deps
 	@$(MAKE) --no-print-directory all
-	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/run.sh
+	@$(MAKE) --no-print-directory fuzz
+	@BUILD=$(BUILD) SHARED=$(SHARED) FUZZ_BUILD=$(FUZZ_BUILD) sh tests/run.sh
 
 test-asan: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan OPT=-O1 \
@@ -146,19 +148,35 @@ check-deploy:
 print-version:
 	@echo $(UMBRA_VERSION)
 
-# libFuzzer targets (clang): build/fuzz/fuzz_scene tests/fuzz/corpus; fuzz_model_<fmt> and
-# fuzz_import_reply with tests/fuzz/corpus/<target> (see tests/fuzz/fuzz_model.h)
-fuzz:
-	@$(MAKE) --no-print-directory BUILD=build/fuzz CC=clang OPT=-O1 \
-	  SAN="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" build/fuzz/libapi.a build/fuzz/librenderer.a \
-	  build/fuzz/umbra-import
-	clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
-	  -o build/fuzz/fuzz_scene tests/fuzz/fuzz_scene.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS)
-	@# Model import (one target per format, through the sandbox: build/fuzz/umbra-import above) and
-	@# the decoder of the importer's replies.
-	for t in $(basename $(notdir $(wildcard tests/fuzz/fuzz_model_*.c tests/fuzz/fuzz_import_*.c))); do \
-	  clang -O1 -g -fsanitize=fuzzer,address,undefined -Iapi -Irenderer/include $(PKG_CFLAGS) \
-	    -o build/fuzz/$$t tests/fuzz/$$t.c build/fuzz/libapi.a build/fuzz/librenderer.a $(LIBS) || exit 1; done
+# libFuzzer targets (clang, ASan + UBSan; tests/fuzz/run.sh has the conventions): every
+# tests/fuzz/fuzz_*.c becomes build/fuzz/fuzz_*, linked with the api, renderer and server
+# (server/main.c with its main() renamed) libraries built with fuzzer instrumentation. Seeds:
+# tests/fuzz/corpus/<name>/; optional <name>.dict and <name>.options next to the source.
+#   make fuzz                      build them all
+#   make fuzz-long FUZZ_RUNS=N  run each for FUZZ_RUNS executions, one at a time; prints a table
+FUZZ_BUILD := build/fuzz
+FUZZ_SRC := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_SAN := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_RUNS ?= 1000000
+fuzz: deps
+	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang OPT=-O1 SAN="$(FUZZ_SAN)" fuzz-targets
+
+fuzz-long: fuzz
+	@FUZZ_BUILD=$(FUZZ_BUILD) sh tests/fuzz/long.sh $(FUZZ_RUNS)
+
+# Inside the sub-make above (BUILD = build/fuzz).
+# The model-import targets go through the sandbox: umbra-import next to them.
+fuzz-targets: $(FUZZ_SRC:tests/fuzz/%.c=$(BUILD)/%) $(BUILD)/umbra-import
+# server/main.c goes in with its main() renamed: targets get srv_now() and the other helpers it
+# defines, and libFuzzer keeps its own main().
+$(BUILD)/obj/server/main_fuzz.o: server/main.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Dmain=srv_main_unused -c -o $@ $<
+$(BUILD)/libsrv.a: $(filter-out $(BUILD)/obj/server/main.o,$(SRV_OBJ)) $(BUILD)/obj/server/main_fuzz.o
+	@rm -f $@; ar rcs $@ $^
+.PRECIOUS: $(BUILD)/obj/tests/fuzz/%.o
+$(BUILD)/fuzz_%: $(BUILD)/obj/tests/fuzz/fuzz_%.o $(BUILD)/libsrv.a $(BUILD)/libapi.a $(BUILD)/librenderer.a
+	$(CC) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(LIBS)
 
 clean:
 	rm -rf $(BUILD)

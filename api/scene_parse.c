@@ -30,6 +30,7 @@
 #include <jansson.h>
 #include "api.h"
 #include "arena.h"
+#include "base64.h"
 #include "ground.h"
 #include "preset.h"
 #include "model.h"
@@ -453,56 +454,21 @@ static int require_object(struct pctx *c, json_t *v, const char *name)
 
 /* ---- base64 and binary arrays ---- */
 
-static int b64_value(unsigned char ch)
-{
-	if (ch >= 'A' && ch <= 'Z') return ch - 'A';
-	if (ch >= 'a' && ch <= 'z') return ch - 'a' + 26;
-	if (ch >= '0' && ch <= '9') return ch - '0' + 52;
-	if (ch == '+' || ch == '-') return 62;   /* standard or URL-safe alphabet */
-	if (ch == '/' || ch == '_') return 63;
-	return -1;
-}
-
-/* Decodes standard or URL-safe base64, padding optional, ASCII whitespace ignored.
- * Returns the byte count or -1 with *bad set to the offending character's offset. */
-static long long b64_decode(const char *s, size_t n, unsigned char *out, size_t *bad)
-{
-	uint32_t acc = 0;
-	int bits = 0, pad = 0;
-	size_t o = 0;
-	for (size_t i = 0; i < n; i++) {
-		unsigned char ch = (unsigned char)s[i];
-		if (ch == ' ' || ch == '\n' || ch == '\r' || ch == '\t') continue;
-		if (ch == '=') { pad++; continue; }
-		int v = b64_value(ch);
-		if (v < 0 || pad) { *bad = i; return -1; }
-		acc = (acc << 6) | (uint32_t)v;
-		bits += 6;
-		if (bits >= 8) {
-			bits -= 8;
-			out[o++] = (unsigned char)(acc >> bits);
-		}
-	}
-	/* 6 leftover bits cannot come from whole bytes; more than two '=' is not base64. */
-	if (bits >= 6 || pad > 2) { *bad = n; return -1; }
-	return (long long)o;
-}
-
 /* Decodes a base64 member into the arena. Returns 0 or -1 (400 at the current pointer). */
 static int decode_b64_member(struct pctx *c, const char *name, json_t *v, unsigned char **out, size_t *len)
 {
 	const char *s = json_string_value(v);
 	size_t n = json_string_length(v);
-	unsigned char *buf = api_arena_alloc(c->arena, n / 4 * 3 + 3);
+	size_t cap = api_base64_decoded_max(n);
+	unsigned char *buf = api_arena_alloc(c->arena, cap);
 	if (!buf) return fail(c, "%s is too large to decode (out of memory)", name);
-	size_t bad = 0;
-	long long got = b64_decode(s, n, buf, &bad);
-	if (got < 0) {
+	size_t bad = 0, got = 0;
+	if (api_base64_decode(s, n, buf, cap, &got, &bad) != API_OK) {
 		if (bad < n) return fail(c, "%s is not valid base64 (bad character at offset %zu)", name, bad);
 		return fail(c, "%s is not valid base64 (truncated or over-padded)", name);
 	}
 	*out = buf;
-	*len = (size_t)got;
+	*len = got;
 	return 0;
 }
 

@@ -7,14 +7,17 @@
 # puppeteer-core from npm), and nodejs/npm when no node or npm is on the PATH.
 set -eu
 
+# clang + libclang-rt-14-dev: make fuzz (libFuzzer's libclang_rt.fuzzer*.a and the sanitizer
+# runtimes for Debian 12's clang 14 are in libclang-rt-14-dev, which clang does not pull in).
+
 PKGS="build-essential pkg-config ca-certificates curl python3
 libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
 glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
 libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev xxd"
 # Test tools (make test): the load balancer of the cluster test, YAML for the deploy checks,
-# chromium and node for the playground's browser test.
+# chromium and node for the playground's browser test, clang + libFuzzer for the fuzz targets.
 if [ "${1:-}" != "--no-test-tools" ]; then
-  PKGS="$PKGS haproxy python3-yaml chromium"
+  PKGS="$PKGS haproxy python3-yaml chromium clang libclang-rt-14-dev"
   command -v node >/dev/null 2>&1 || PKGS="$PKGS nodejs"
   command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi

@@ -58,5 +58,7 @@ command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
 # The playground in a real browser, when Debian's chromium is installed (install-deps does).
 [ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh
+# libFuzzer targets, a few seconds each (make test builds them into FUZZ_BUILD).
+[ -n "${FUZZ_BUILD:-}" ] && run_suite fuzz sh tests/fuzz/run.sh
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]
