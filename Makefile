@@ -4,6 +4,7 @@
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench
+#   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
 BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
@@ -47,7 +48,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz clean
+.PHONY: all deps run test test-asan bench fuzz soak clean
 all: $(BINS)
 
 deps:
@@ -94,6 +95,11 @@ test-asan: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan OPT=-O1 \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
 	@BUILD=build/asan SHARED=$(SHARED) ASAN=1 sh tests/run.sh
+
+# tests/run.sh runs a 1,000-request soak; this is the full one (SOAK_N=N for another size).
+soak: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) UMBRA_VALIDATION=1 sh tests/http/soak.sh
 
 bench: deps
 	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench

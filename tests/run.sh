@@ -50,6 +50,9 @@ fi
 run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/tests/gpu_tests" ] && run_suite gpu env LD_PRELOAD="$PRELOAD" "$BUILD/tests/gpu_tests"
 [ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
+[ -f tests/http/conn.sh ] && [ -x "$BUILD/umbrad" ] && run_suite conn sh tests/http/conn.sh
+# A short soak (make soak runs 10,000); under ASan soak.sh lowers it to 300.
+[ -f tests/http/soak.sh ] && [ -x "$BUILD/umbrad" ] && run_suite soak sh tests/http/soak.sh "${SOAK_N:-1000}"
 [ -f tests/cli.sh ] && run_suite cli sh tests/cli.sh
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]
