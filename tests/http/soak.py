@@ -3,7 +3,8 @@
 open descriptors sampled as it goes.
 
 The mix (fixed by a seeded generator, so runs are comparable): small renders (64², 128²), a few
-bigger ones (1024² MSAA 4 every 500th request), bad JSON, 404s, 405s, /metrics, /readyz,
+bigger ones (1024² MSAA 4 every 500th request, 4096² with a 4096 shadow map every 2500th from the 500th:
+the warm-up sees every kind of request once), bad JSON, 404s, 405s, /metrics, /readyz,
 /healthz and /v1/info by GET and HEAD, multipart renders with a small OBJ model, a framing error,
 and aborted connections (closed mid-body, or closed before the answer). Requests go over one
 keep-alive connection (http.client) that is reopened whenever the daemon closes it; the raw
@@ -49,6 +50,7 @@ def scene(w, h, msaa=1, res=512, segments=32, extra=""):
 SMALL = [scene(64, 64, segments=16 + 8 * i) for i in range(4)] + [scene(64, 48)]
 MEDIUM = [scene(128, 128, segments=24), scene(128, 128, msaa=4)]
 BIG = scene(1024, 1024, msaa=4, res=2048, segments=128)
+HUGE = scene(4096, 4096, res=4096, segments=64)
 MODEL = scene(64, 64, extra='{"shape": "model", "part": "mesh", "format": "obj"}, ')
 OBJ = b"v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n"
 BOUNDARY = "soak-boundary-7c1f"
@@ -132,6 +134,9 @@ def raw(data, read=True):
 
 def one(cl, i, kind):
     """Sends request i of `kind`; returns None when its answer is right, else why not."""
+    if i % 2500 == 500:
+        r, d = cl.request("POST", "/v1/render", HUGE, JSON)
+        return None if is_png(r, d) else "4096² render %d %r" % (r.status, d[:120])
     if i % 500 == 250:
         r, d = cl.request("POST", "/v1/render", BIG, JSON)
         return None if is_png(r, d) else "big render %d %r" % (r.status, d[:120])
@@ -217,7 +222,7 @@ def main():
             why = "%s: %r" % (kind, e)
         if why:
             bad.append("#%d %s" % (i, why))
-        if i % SAMPLE == 0 or i == WARM:
+        if i in (499, 501) or i % SAMPLE == 0 or i == WARM:
             settle(cl)
             samples.append(sample(i))
     secs = time.monotonic() - t0
