@@ -2,7 +2,8 @@
  * umbrad HTTP: libmicrohttpd callbacks and the routes of contract §5.
  *
  * The access handler runs on libmicrohttpd's polling thread and never blocks on a render:
- *   1st call   (headers only)  route, method, Content-Type, Content-Length, readiness; an error
+ *   1st call   (headers only)  framing (conn.c: Host, Content-Length, Transfer-Encoding), route,
+ *                              method, Content-Type, Content-Length, readiness; an error
  *                              is answered at once (libmicrohttpd then skips the body, sends no
  *                              "100 Continue" and closes the connection).
  *   next calls (body chunks)   appended and hashed (ETag); past --max-body -> 413.
