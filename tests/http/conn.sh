@@ -84,6 +84,21 @@ if UMBRA_HEADER_TIMEOUT=1 start framing --idle-timeout 8; then
 	run_py framing "$PORT" "$T/scene.json" "$PID"
 	stop framing
 fi
+# Too few descriptors for --max-connections: the limit is lowered (with a warning) rather than
+# accept() failing for every client once the descriptors run out.
+UMBRAD_REAL=$UMBRAD
+UMBRAD="$T/umbrad-200fds"
+printf '#!/bin/sh\nulimit -n 200 || exit 1\nexec "%s" "$@"\n' "$UMBRAD_REAL" >"$UMBRAD"
+chmod +x "$UMBRAD"
+if start fdlimit; then
+	if grep -q -- '--max-connections 1024 lowered to 136: the open-file limit is 200' "$T/fdlimit.log"; then
+		ok "open-file limit 200: --max-connections lowered to 136, with a warning"
+	else
+		nok "open-file limit 200: --max-connections lowered to 136, with a warning"; grep -i 'connections\|limit' "$T/fdlimit.log" | sed 's/^/# /'
+	fi
+	stop fdlimit
+fi
+UMBRAD=$UMBRAD_REAL
 # One client's idle sockets against the default limits.
 if start hogs; then
 	run_py hogs "$PORT" "$PID"
