@@ -9,6 +9,7 @@
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
 #   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
+#   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
 BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
@@ -55,7 +56,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz fuzz-long fuzz-targets clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: all deps run test test-asan bench fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -115,6 +116,11 @@ test-asan: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan OPT=-O1 \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
 	@BUILD=build/asan SHARED=$(SHARED) ASAN=1 sh tests/run.sh
+
+# tests/run.sh runs a 1,000-request soak; this is the full one (SOAK_N=N for another size).
+soak: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) UMBRA_VALIDATION=1 sh tests/http/soak.sh
 
 bench: deps
 	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench

@@ -45,9 +45,11 @@ static const struct opt_def opts[] = {
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
 	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (8192)", CFG(atlas_size), 0, 16384 },
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
-	{ "max-connections", OPT_UINT, "N", "concurrent connections (1024)", CFG(max_connections), 1, 1000000 },
+	{ "max-connections", OPT_UINT, "N", "concurrent connections; more are closed unanswered (1024)", CFG(max_connections), 1, 1000000 },
+	{ "max-connections-per-ip", OPT_UINT, "N", "concurrent connections from one client address, 0 = no limit (256)", CFG(max_connections_per_ip), 0, 1000000 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
 	{ "max-memory", OPT_SIZE, "BYTES", "memory renders in flight may need together; a render estimated over it is a 422, others wait (half the machine's or container's memory)", CFG(max_memory), 0, UINT64_MAX },
+	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
 };
 #define OPT_COUNT (sizeof opts / sizeof opts[0])
@@ -208,6 +210,11 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	cfg->log_format = SRV_LOG_TEXT;
 	cfg->max_connections = 1024;
 	cfg->idle_timeout_s = 60;
+	/* Behind a load balancer every connection comes from the balancer's address: a quarter of
+	 * the connections still leaves room for a balancer's pool (haproxy's per-server maxconn
+	 * is far lower) while one direct client can no longer take them all. */
+	cfg->max_connections_per_ip = 256;
+	cfg->header_timeout_s = 10;
 	cfg->drain_timeout_s = 60;
 	const char *v = getenv("UMBRA_VALIDATION");
 	cfg->validation = v && *v && strcmp(v, "0") != 0;

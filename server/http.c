@@ -2,7 +2,8 @@
  * umbrad HTTP: libmicrohttpd callbacks and the routes of contract §5.
  *
  * The access handler runs on libmicrohttpd's polling thread and never blocks on a render:
- *   1st call   (headers only)  route, method, Content-Type, Content-Length, readiness; an error
+ *   1st call   (headers only)  framing (conn.c: Host, Content-Length, Transfer-Encoding), route,
+ *                              method, Content-Type, Content-Length, readiness; an error
  *                              is answered at once (libmicrohttpd then skips the body, sends no
  *                              "100 Continue" and closes the connection).
  *   next calls (body chunks)   appended and hashed (ETag); past --max-body -> 413.
@@ -24,6 +25,7 @@
 #include <unistd.h>
 
 #include "buf.h"
+#include "conn.h"
 #include "log.h"
 #include "metrics.h"
 #include "queue.h"
@@ -126,7 +128,7 @@ static enum MHD_Result respond(struct srv_request *req, int status, const char *
 	}
 	if (req->route != SRV_ROUTE_RENDER || status != 200)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
-	if (atomic_load(&s->draining))
+	if (atomic_load(&s->draining) || req->close_after)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
 	enum MHD_Result r = MHD_queue_response(req->conn, (unsigned)status, resp);
 	MHD_destroy_response(resp);
@@ -155,6 +157,20 @@ static enum MHD_Result respond_problem(struct srv_request *req, int status, cons
 	api_problem_set(&p, status, pointer, "%s", detail);
 	char *json = api_problem_json(&p);
 	return respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, allow);
+}
+
+/* A request whose framing is unusable (see conn.h): problem+json typed as an HTTP error, not
+ * as a scene error, and the connection closed since the body's end is unknown. */
+static enum MHD_Result respond_framing(struct srv_request *req, int status, const char *detail)
+{
+	struct api_problem p;
+	api_problem_set(&p, status, "", "%s", detail);
+	snprintf(p.type, sizeof p.type, "https://umbra.dev/problems/%s",
+	         status == 501 ? "not-implemented" : "malformed-request");
+	snprintf(p.title, sizeof p.title, "%s", status == 501 ? "Not implemented" : "Malformed HTTP request");
+	req->close_after = true;
+	char *json = api_problem_json(&p);
+	return respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, NULL);
 }
 
 static enum MHD_Result respond_text(struct srv_request *req, int status, const char *ctype, const char *text)
@@ -561,9 +577,14 @@ static const char *allow_of(enum srv_route r)
 	return r == SRV_ROUTE_RENDER ? "POST" : "GET, HEAD";
 }
 
-static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection *conn)
+static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection *conn, const char *version)
 {
 	bool get = !strcmp(req->method, "GET") || !strcmp(req->method, "HEAD");
+	int status;
+	const char *framing = srv_conn_framing_error(conn, version, &status);
+	if (framing)
+		return respond_framing(req, status, framing);
+	srv_conn_request_begins(&req->srv->cfg, conn);
 	if (req->route == SRV_ROUTE_OTHER)
 		return respond_problem(req, 404, NULL, "", "no route %s", req->path);
 	if (req->route == SRV_ROUTE_RENDER ? strcmp(req->method, "POST") != 0 : !get)
@@ -632,7 +653,6 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 {
 	struct srv_server *s = cls;
 	struct srv_request *req = *con_cls;
-	(void)version;
 	if (!req) {
 		req = calloc(1, sizeof *req);
 		if (!req)
@@ -646,7 +666,7 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 		snprintf(req->path, sizeof req->path, "%s", url);
 		req->route = route_of(url);
 		request_id(req, conn);
-		return first_call(req, conn);
+		return first_call(req, conn, version);
 	}
 	switch (req->state) {
 	case SRV_REQ_HEADERS:
@@ -709,58 +729,32 @@ static void mhd_log(void *cls, const char *fmt, va_list ap)
 	srv_log(SRV_LOG_WARN, "libmicrohttpd: %s", msg);
 }
 
-/* Parses ADDR:PORT ("[::1]:8080" for IPv6) into a socket address. */
-static int listen_addr(const char *listen, struct sockaddr_storage *ss, socklen_t *len)
-{
-	char host[256];
-	const char *colon = strrchr(listen, ':');
-	if (!colon || colon == listen) {
-		srv_log(SRV_LOG_ERROR, "--listen '%s': expected ADDR:PORT", listen);
-		return -1;
-	}
-	const char *h = listen;
-	size_t hl = (size_t)(colon - listen);
-	if (*h == '[' && hl >= 2 && h[hl - 1] == ']') {
-		h++;
-		hl -= 2;
-	}
-	if (hl >= sizeof host) {
-		srv_log(SRV_LOG_ERROR, "--listen '%s': address too long", listen);
-		return -1;
-	}
-	memcpy(host, h, hl);
-	host[hl] = 0;
-	struct addrinfo hints = { .ai_family = AF_UNSPEC, .ai_socktype = SOCK_STREAM, .ai_flags = AI_PASSIVE };
-	struct addrinfo *ai = NULL;
-	int e = getaddrinfo(host, colon + 1, &hints, &ai);
-	if (e != 0) {
-		srv_log(SRV_LOG_ERROR, "--listen '%s': %s", listen, gai_strerror(e));
-		return -1;
-	}
-	memcpy(ss, ai->ai_addr, ai->ai_addrlen);
-	*len = ai->ai_addrlen;
-	freeaddrinfo(ai);
-	return 0;
-}
-
 int srv_http_start(struct srv_server *s)
 {
 	struct sockaddr_storage ss;
 	socklen_t sl;
-	if (listen_addr(s->cfg.listen, &ss, &sl) != 0)
+	srv_conn_prepare(&s->cfg);
+	if (srv_conn_listen_addr(s->cfg.listen, &ss, &sl) != 0)
 		return -1;
-	unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
-	if (MHD_is_feature_supported(MHD_FEATURE_EPOLL) == MHD_YES)
-		flags |= MHD_USE_EPOLL;
-	else
-		flags |= MHD_USE_POLL;
+	/* poll(), not epoll: libmicrohttpd 0.9.75 registers sockets edge-triggered and takes a
+	 * short recv() as "drained", so the end of a client that closes right after a partial
+	 * body (both in one segment) raises no further edge and the connection would sit in
+	 * CLOSE_WAIT until --idle-timeout. Level-triggered poll() sees it at once; a scan of
+	 * --max-connections descriptors per wake-up costs microseconds. */
+	unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG |
+	                 MHD_USE_POLL;
 	if (ss.ss_family == AF_INET6)
 		flags |= MHD_USE_IPv6;
 	s->daemon = MHD_start_daemon(flags, 0, NULL, NULL, access_handler, s,
 	                             MHD_OPTION_EXTERNAL_LOGGER, mhd_log, s,
 	                             MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&ss,
 	                             MHD_OPTION_CONNECTION_LIMIT, (unsigned)s->cfg.max_connections,
+	                             MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)s->cfg.max_connections_per_ip,
 	                             MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)s->cfg.idle_timeout_s,
+	                             MHD_OPTION_NOTIFY_CONNECTION, srv_conn_notify, &s->cfg,
+	                             /* 0, not 1: at 1 the library answers a missing Host itself
+	                              * (HTML, header block sent twice in 0.9.75); conn.c checks it */
+	                             MHD_OPTION_STRICT_FOR_CLIENT, 0,
 	                             MHD_OPTION_NOTIFY_COMPLETED, completed, s,
 	                             MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024u,
 	                             MHD_OPTION_END);

@@ -5,6 +5,7 @@
  *   flags.c    srv_config: defaults, UMBRA_* environment, command-line flags, --help
  *   main.c     startup (listen, context, warm-up, workers), signals, graceful drain, exit code
  *   http.c     libmicrohttpd callbacks: routes, body reading, negotiation, answers
+ *   conn.c     connection limits and timeouts, HTTP/1.1 framing checks, the listen address
  *   queue.c    the bounded two-level (interactive before bulk) job queue
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
  *   metrics.c  Prometheus counters, gauges and histograms
@@ -63,7 +64,9 @@ struct srv_config {
 	const char *device;            /* substring of the Vulkan device name */
 	unsigned atlas_size;           /* shadow atlas side, 0 = renderer default */
 	unsigned max_connections;      /* concurrent TCP connections, default 1024 */
+	unsigned max_connections_per_ip; /* concurrent connections from one address, 0 = any, default 256 */
 	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
+	unsigned header_timeout_s;     /* a new connection's first request head, 0 = idle, default 10 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
@@ -149,6 +152,7 @@ struct srv_request {
 	char etag[40];
 	char if_none_match[256];       /* checked after parsing for scenes that read asset files */
 	bool want_exr;                 /* Accept prefers image/x-exr */
+	bool close_after;              /* answer with Connection: close (framing error) */
 
 	/* result, written by the worker before srv_request_finish() */
 	int status;

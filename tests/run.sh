@@ -60,5 +60,8 @@ command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env
 [ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh
 # libFuzzer targets, a few seconds each (make test builds them into FUZZ_BUILD).
 [ -n "${FUZZ_BUILD:-}" ] && run_suite fuzz sh tests/fuzz/run.sh
+[ -f tests/http/conn.sh ] && [ -x "$BUILD/umbrad" ] && run_suite conn sh tests/http/conn.sh
+# A short soak (make soak runs 10,000); under ASan soak.sh lowers it to 300.
+[ -f tests/http/soak.sh ] && [ -x "$BUILD/umbrad" ] && run_suite soak sh tests/http/soak.sh "${SOAK_N:-1000}"
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]
