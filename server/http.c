@@ -137,13 +137,20 @@ static enum MHD_Result respond(struct srv_request *req, int status, const char *
 	req->state = SRV_REQ_ANSWERED;
 	double secs = srv_now() - req->t_start;
 	srv_metrics_request(s->metrics, req->route, status, secs, len);
-	srv_log_request(req->method, req->path, srv_route_name(req->route), status, len, secs * 1000.0, req->id);
+	srv_log_request(req->method, req->path, srv_route_name(req->route), status, len, secs * 1000.0, req->id,
+	                status >= 400 ? req->problem_detail : NULL, status >= 400 ? req->problem_pointer : NULL);
 	return r;
 }
 
 static enum MHD_Result respond_problem(struct srv_request *req, int status, const char *allow,
                                        const char *pointer, const char *fmt, ...)
 	__attribute__((format(printf, 5, 6)));
+
+void srv_request_note_problem(struct srv_request *req, const struct api_problem *p)
+{
+	snprintf(req->problem_pointer, sizeof req->problem_pointer, "%s", p->pointer);
+	snprintf(req->problem_detail, sizeof req->problem_detail, "%s", p->detail);
+}
 
 static enum MHD_Result respond_problem(struct srv_request *req, int status, const char *allow,
                                        const char *pointer, const char *fmt, ...)
@@ -155,6 +162,7 @@ static enum MHD_Result respond_problem(struct srv_request *req, int status, cons
 	vsnprintf(detail, sizeof detail, fmt, ap);
 	va_end(ap);
 	api_problem_set(&p, status, pointer, "%s", detail);
+	srv_request_note_problem(req, &p);
 	char *json = api_problem_json(&p);
 	return respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, allow);
 }
@@ -169,6 +177,7 @@ static enum MHD_Result respond_framing(struct srv_request *req, int status, cons
 	         status == 501 ? "not-implemented" : "malformed-request");
 	snprintf(p.title, sizeof p.title, "%s", status == 501 ? "Not implemented" : "Malformed HTTP request");
 	req->close_after = true;
+	srv_request_note_problem(req, &p);
 	char *json = api_problem_json(&p);
 	return respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, NULL);
 }
@@ -759,7 +768,10 @@ int srv_http_start(struct srv_server *s)
 	                             MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024u,
 	                             MHD_OPTION_END);
 	if (!s->daemon) {
-		srv_log(SRV_LOG_ERROR, "cannot listen on %s: %s", s->cfg.listen, strerror(errno));
+		int e = errno;
+		srv_log(SRV_LOG_ERROR, "cannot listen on %s: %s%s", s->cfg.listen, strerror(e),
+		        e == EADDRINUSE ? " (another process has that port: choose another --listen port, or port 0 "
+		                          "with --port-file for any free one)" : "");
 		return -1;
 	}
 	const union MHD_DaemonInfo *di = MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_BIND_PORT);

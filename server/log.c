@@ -4,6 +4,7 @@
 #include "log.h"
 
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -73,23 +74,33 @@ void srv_log(enum srv_log_level level, const char *fmt, ...)
 }
 
 void srv_log_request(const char *method, const char *path, const char *route, int status,
-                     uint64_t bytes, double ms, const char *request_id)
+                     uint64_t bytes, double ms, const char *request_id, const char *detail,
+                     const char *pointer)
 {
-	char ts[40], line[1024], epath[400], eid[200], emethod[40];
+	char ts[40], line[1536], epath[400], eid[200], emethod[40], edetail[520] = "", eptr[260] = "";
 	log_timestamp(ts, sizeof ts);
 	srv_json_escape(epath, sizeof epath, path);
 	srv_json_escape(eid, sizeof eid, request_id);
 	srv_json_escape(emethod, sizeof emethod, method);
+	bool problem = detail && *detail;
+	if (problem) {
+		srv_json_escape(edetail, sizeof edetail, detail);
+		srv_json_escape(eptr, sizeof eptr, pointer ? pointer : "");
+	}
 	int n;
 	if (log_format == SRV_LOG_JSON)
 		n = snprintf(line, sizeof line,
 		             "{\"ts\":\"%s\",\"level\":\"info\",\"msg\":\"request\",\"method\":\"%s\","
 		             "\"path\":\"%s\",\"route\":\"%s\",\"status\":%d,\"bytes\":%llu,\"ms\":%.3f,"
-		             "\"request_id\":\"%s\"}",
-		             ts, emethod, epath, route, status, (unsigned long long)bytes, ms, eid);
+		             "\"request_id\":\"%s\"%s%s%s%s%s}",
+		             ts, emethod, epath, route, status, (unsigned long long)bytes, ms, eid,
+		             problem ? ",\"pointer\":\"" : "", eptr, problem ? "\",\"detail\":\"" : "", edetail,
+		             problem ? "\"" : "");
 	else
-		n = snprintf(line, sizeof line, "%s info  %s %s %d %lluB %.1fms route=%s id=%s", ts,
-		             emethod, epath, status, (unsigned long long)bytes, ms, route, eid);
+		n = snprintf(line, sizeof line, "%s info  %s %s %d %lluB %.1fms route=%s id=%s%s%s%s%s%s", ts,
+		             emethod, epath, status, (unsigned long long)bytes, ms, route, eid,
+		             problem ? " pointer=" : "", problem ? (pointer && *pointer ? eptr : "\"\"") : "",
+		             problem ? " detail=\"" : "", edetail, problem ? "\"" : "");
 	if (n > 0)
 		log_write(line, (size_t)n, sizeof line);
 }

@@ -160,7 +160,13 @@ struct srv_request {
 	size_t out_len;
 	const char *content_type;
 	char server_timing[320];
+	/* the problem answered (4xx/5xx), for the access log */
+	char problem_pointer[256];
+	char problem_detail[512];
 };
+
+/* Keeps what the access log says of a problem answer (its detail and pointer). */
+void srv_request_note_problem(struct srv_request *req, const struct api_problem *p);
 
 /* Worker side: stores nothing more and resumes the connection so http.c sends the answer. */
 void srv_request_finish(struct srv_request *req);

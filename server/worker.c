@@ -238,6 +238,7 @@ static void job_problem(struct srv_request *req, const struct api_problem *p)
 {
 	req->status = p->status;
 	req->content_type = "application/problem+json";
+	srv_request_note_problem(req, p);
 	char *json = api_problem_json(p);
 	req->out = (uint8_t *)json;
 	req->out_len = json ? strlen(json) : 0;

@@ -65,6 +65,8 @@ fi
 gen image 64 64 aovs >"$T/aovpng.json"
 code=$(post aovpng "$T/aovpng.json")
 check "aovs without output.format: 400 at /output/aovs (default PNG)" eval '[ "$code" = 400 ] && problem aovpng 400 /output/aovs'
+check "the access log line of a 4xx names the problem's pointer and detail" \
+	grep -q 'POST /v1/render 400 .* pointer=/output/aovs detail="aovs need an EXR answer' "$T/atlas.log"
 code=$(post aovaccept "$T/aovpng.json" -H 'Accept: image/x-exr')
 check "aovs without output.format, Accept: image/x-exr: 200 EXR" eval '[ "$code" = 200 ] && is_exr "$T/aovaccept.body"'
 

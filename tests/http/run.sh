@@ -279,13 +279,14 @@ echo "# starting the deadline daemon"
 if start deadline --workers 1 --deadline-ms 1 --log-format json; then
 	c=$(post d1 "$T/small.json" -H 'X-Request-Id: deadline-1'); check "render past --deadline-ms: 504" [ "$c" = 504 ]
 	check "504 is problem+json" problem d1 504 -
-	check "--log-format json: every line is a JSON object; the access line has the fields" python3 - "$T/deadline.log" <<'PY'
+	check "--log-format json: every line is a JSON object; the access line has the fields and the problem's detail" python3 - "$T/deadline.log" <<'PY'
 import json, sys
 ok = False
 for line in open(sys.argv[1]):
     d = json.loads(line)
     if d.get("request_id") == "deadline-1":
-        ok = d["status"] == 504 and d["method"] == "POST" and d["route"] == "/v1/render" and "ms" in d and "bytes" in d
+        ok = d["status"] == 504 and d["method"] == "POST" and d["route"] == "/v1/render" and "ms" in d and "bytes" in d \
+             and "deadline" in d.get("detail", "") and d.get("pointer") == ""
 sys.exit(0 if ok else 1)
 PY
 	stop deadline $PID
