@@ -294,8 +294,11 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 	uint32_t ntex, nmat, nmesh, ninst;
 	if (!take_u32(&d.r, &ntex) || !take_u32(&d.r, &nmat) || !take_u32(&d.r, &nmesh) || !take_u32(&d.r, &ninst))
 		return bad(&d.r, "the counts are cut short");
-	/* Each item needs at least 8 bytes, so counts beyond that are lies caught before allocating. */
-	if (ntex > MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, (uint64_t)ntex + nmat + nmesh + ninst, 8))
+	/* Each item has a smallest size on the wire (texture 8, material 52, mesh 16, instance 68
+	 * bytes): counts the reply's bytes cannot hold are lies caught before allocating (the arrays
+	 * are larger in memory than on the wire, and zeroed). */
+	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 52 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
+	if (ntex > MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, min_wire, 1))
 		return bad(&d.r, "%u textures, %u materials, %u meshes, %u instances", ntex, nmat, nmesh, ninst);
 	struct rnd_texture *tex = dec_alloc(&d, ntex, sizeof *tex);
 	struct rnd_material *mats = dec_alloc(&d, nmat, sizeof *mats);

@@ -226,7 +226,10 @@ static int read_status(int fd, int64_t deadline, struct api_sbx_status *st)
 	while (got < sizeof *st) {
 		int64_t left = deadline - now_ms();
 		struct pollfd p = {fd, POLLIN, 0};
-		if (left <= 0 || poll(&p, 1, (int)left) == 0) return -1;
+		if (left <= 0) return -1;
+		int pr = poll(&p, 1, (int)left);
+		if (pr < 0 && errno == EINTR) continue;
+		if (pr <= 0) return -1;
 		ssize_t r = read(fd, (char *)st + got, sizeof *st - got);
 		if (r < 0 && errno == EINTR) continue;
 		if (r <= 0) return -1;
@@ -315,6 +318,9 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 	size_t max_reply = rq->memory ? (size_t)rq->memory : (size_t)4 << 30;
 	size_t rlen = 0;
 	bool got = exchange(ds[0], data, rq->input_len, deadline, max_reply, reply, &rlen) == 0;
+	/* A reply we stopped reading (over max_reply): the child's writes fail at once instead of
+	 * blocking it until the timeout. */
+	if (!got) shutdown(ds[0], SHUT_RDWR);
 	struct api_sbx_status st;
 	if (read_status(ps[0], deadline, &st) < 0) {
 		if (now_ms() >= deadline) fail(status, 422, err, errsize, "took longer than the import time limit of %u ms",
@@ -323,7 +329,7 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 		goto out;
 	}
 	if (classify(&st, got, rq, status, err, errsize) < 0) goto out;
-	enum api_wire_kind kind;
+	enum api_wire_kind kind = rq->kind;
 	enum api_wire_status ws;
 	char msg[API_WIRE_MAX_MESSAGE + 1], werr[200];
 	if (api_wire_header(*reply, rlen, &kind, &ws, msg, sizeof msg, body, body_len, werr, sizeof werr) != API_OK ||

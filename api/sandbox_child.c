@@ -10,6 +10,7 @@
  * and exits; children also get SIGKILL if it dies (PR_SET_PDEATHSIG).
  */
 #include <errno.h>
+#include <fcntl.h>
 #include <poll.h>
 #include <seccomp.h>
 #include <signal.h>
@@ -134,6 +135,9 @@ static void child_main(int data_fd, const struct api_sbx_request *rq)
 {
 	if (prctl(PR_SET_PDEATHSIG, SIGKILL) || getppid() == 1) _exit(API_SBX_EXIT_SETUP);
 	if (data_fd != API_SBX_DATA_FD && dup2(data_fd, API_SBX_DATA_FD) < 0) _exit(API_SBX_EXIT_SETUP);
+	/* stdin/stdout/stderr are the daemon's: a compromised child must not write into its log. */
+	int dn = open("/dev/null", O_RDWR | O_CLOEXEC);
+	if (dn < 0 || dup2(dn, 0) < 0 || dup2(dn, 1) < 0 || dup2(dn, 2) < 0) _exit(API_SBX_EXIT_SETUP);
 	close_range(API_SBX_DATA_FD + 1, ~0u, 0);
 	sigset_t none;
 	sigemptyset(&none);

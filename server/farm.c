@@ -143,6 +143,8 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 		else if (dot && !strcasecmp(dot, ".exr")) fmt = API_FORMAT_EXR;
 		else {
 			snprintf(r->error, sizeof r->error, "output '%s' must end in .png or .exr", j->out);
+			api_scene_free(*s);
+			*s = NULL;
 			return JOB_INVALID;
 		}
 		snprintf(r->out, sizeof r->out, "%s", j->out);
@@ -153,6 +155,8 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 		goto invalid;
 	return JOB_OK;
 invalid:
+	api_scene_free(*s);   /* NULL-safe: a parse that failed left none */
+	*s = NULL;
 	api_problem_format(&prob, r->error, sizeof r->error);
 	return JOB_INVALID;
 }

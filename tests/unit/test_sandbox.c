@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include "api.h"
@@ -118,6 +119,10 @@ TEST(sandbox_hanging_ply_is_422_and_others_go_on)
 	struct hang_arg a = {0};
 	pthread_t t;
 	REQUIRE(pthread_create(&t, NULL, import_hanging, &a) == 0);
+	/* Let the hanging import get under way first: a lock held across imports would then make
+	 * the one below wait (without the pause it could win the race and hide such a lock). */
+	struct timespec pause = {0, 300 * 1000 * 1000};
+	nanosleep(&pause, NULL);
 	struct api_limits l = limits(5000);
 	struct api_model *m = NULL;
 	char err[400];
@@ -321,6 +326,20 @@ TEST(sandbox_reply_decoder_refuses_malformed)
 		memcpy(b.data + counts + 4 * f, &save, 4);
 	}
 	api_wire_buf_release(&b);
+	/* Counts that fit 8 bytes an item but not the items' real wire sizes (an instance is 68
+	 * bytes): refused at the counts, before arrays larger than the reply are allocated. */
+	enum { BODY = 1 << 16 };
+	uint8_t *body = calloc(1, BODY);
+	REQUIRE(body);
+	uint32_t lie_counts[4] = {0, 1, 1, BODY / 8 - 2};
+	memcpy(body, lie_counts, sizeof lie_counts);
+	struct api_arena *a = api_arena_create();
+	size_t bytes;
+	err[0] = 0;
+	CHECK(api_wire_decode_model(body, BODY, a, 1u << 20, &m, &bytes, err, sizeof err) == API_ERR &&
+	      strstr(err, "instances"), "%s", err);
+	api_arena_destroy(a);
+	free(body);
 	/* An index past the vertices, a NaN position. */
 	wire_model(&b, 3, 0);
 	CHECK(decode(b.data, b.len, &m, err, sizeof err) == API_ERR && strstr(err, "index"), "%s", err);
