@@ -687,6 +687,7 @@ lost_check:
 done:
 	if (r == RND_ERR_DEVICE_LOST) {
 		__atomic_store_n(&ctx->failed, 1, __ATOMIC_RELAXED);
+		rnd_cache_wake(ctx);   /* renders waiting for atlas room: they would wait for ever */
 		rnd_log(ctx, 0, "device lost: %s", err->msg);
 	}
 	/* Everything this render submitted has completed (each submit is waited on) — unless a

@@ -301,6 +301,12 @@ enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cach
 	 * each render holds its tiles only while it runs, and a waiting render holds none, so the
 	 * wait ends. */
 	while (!attempt(c, req, n, res, true, out) && !attempt(c, req, n, res, false, out)) {
+		/* A lost device never gives its tiles back (the GPU may still use them): waiting for
+		 * them would last until the context is recreated, which waits for this render. */
+		if (__atomic_load_n(&ctx->failed, __ATOMIC_RELAXED)) {
+			r = rnd_fail(err, RND_ERR_DEVICE_LOST, "the device was lost while waiting for room in the shadow atlas");
+			break;
+		}
 		if (!others_hold_tiles(c)) {
 			r = rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0, "the shadow maps do not fit in the %ux%u atlas",
 			                c->atlas.size, c->atlas.size);
@@ -363,4 +369,13 @@ void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st)
 	pthread_mutex_unlock(&c->mu);
 	st->shadow_cache_hits = __atomic_load_n(&ctx->stats_hits, __ATOMIC_RELAXED);
 	st->shadow_cache_misses = __atomic_load_n(&ctx->stats_misses, __ATOMIC_RELAXED);
+}
+
+void rnd_cache_wake(struct rnd_context *ctx)
+{
+	struct rnd_shadow_cache *c = ctx->cache;
+	if (!c) return;
+	pthread_mutex_lock(&c->mu);
+	pthread_cond_broadcast(&c->released);
+	pthread_mutex_unlock(&c->mu);
 }

@@ -48,6 +48,9 @@ void rnd_cache_release_all(struct rnd_context *ctx);
  * cannot fit even alone at 64² texels a tile. */
 enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cache_request *req, uint32_t n,
                                   double deadline, struct rnd_cache_grant *out, struct rnd_error *err);
+/* Wakes every render waiting for room (after the context failed: they return
+ * RND_ERR_DEVICE_LOST instead of waiting for tiles a lost render never gives back). */
+void rnd_cache_wake(struct rnd_context *ctx);
 /* Ends a render's use: ok = the render completed, so new entries become reusable. */
 void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g, uint32_t n, bool ok);
 
