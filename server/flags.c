@@ -46,6 +46,7 @@ static const struct opt_def opts[] = {
 	{ "max-connections", OPT_UINT, "N", "concurrent connections (1024)", CFG(max_connections), 1, 1000000 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
+	{ "test-fault", OPT_STR, "submit:N:lost|oom", "tests only: the Nth queue submit after warm-up fails", CFG(test_fault), 0, 0 },
 };
 #define OPT_COUNT (sizeof opts / sizeof opts[0])
 

@@ -50,6 +50,7 @@ fi
 run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/tests/gpu_tests" ] && run_suite gpu env LD_PRELOAD="$PRELOAD" "$BUILD/tests/gpu_tests"
 [ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
+[ -f tests/http/faults.sh ] && [ -x "$BUILD/umbrad" ] && run_suite faults sh tests/http/faults.sh
 [ -f tests/cli.sh ] && run_suite cli sh tests/cli.sh
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]
