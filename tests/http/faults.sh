@@ -110,7 +110,7 @@ if start lost --workers 1 --test-fault submit:1:lost; then
 	check "device loss: counted in umbra_device_lost_total" [ "$(metric umbra_device_lost_total)" = 1 ]
 	c=$(post lost2 "$T/scene.json")
 	check "device loss: the next request gets 200" [ "$c" = 200 ]
-	if "$BUILD/umbra-render" "$T/scene.json" -o "$T/ref.png" 2>"$T/cli.log"; then
+	if LD_PRELOAD="$DAEMON_PRELOAD" "$BUILD/umbra-render" "$T/scene.json" -o "$T/ref.png" 2>"$T/cli.log"; then
 		check "device loss: the next request's bytes equal the CLI's" cmp -s "$T/lost2.body" "$T/ref.png"
 	else
 		nok "device loss: reference render with the CLI" "$(tail -n 3 "$T/cli.log")"
