@@ -121,6 +121,8 @@ struct rnd_context {
 
 	volatile int validation_count;       /* atomically incremented by the messenger */
 	volatile int failed;                 /* device lost: every render fails */
+	int fault_kind;                      /* enum rnd_fault armed by rnd_context_inject_fault (atomic) */
+	uint32_t fault_countdown;            /* submits until it fires (atomic) */
 };
 
 void rnd_log(const struct rnd_context *ctx, int level, const char *fmt, ...) __attribute__((format(printf, 3, 4)));

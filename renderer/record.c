@@ -41,13 +41,23 @@ void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags a
 	vkCmdPipelineBarrier2(cmd, &di);
 }
 
+/* The rows of the view this submit draws. */
+static VkRect2D band_area(const struct record_view *rv)
+{
+	uint32_t h = rv->sc->height;
+	uint32_t y = rv->band_y < h ? rv->band_y : h - 1;
+	uint32_t n = rv->band_h && rv->band_h <= h - y ? rv->band_h : h - y;
+	return (VkRect2D){{0, (int32_t)y}, {rv->sc->width, n}};
+}
+
 static float srgb_encode(float c)
 {
 	c = c < 0 ? 0 : c > 1 ? 1 : c;
 	return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
-void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t *casters_drawn)
+void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t first,
+                    uint32_t end)
 {
 	const struct rnd_scene *sc = rv->sc;
 	const struct rnd_shadow_plan *sp = rv->sp;
@@ -68,7 +78,7 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
 	vkCmdPipelineBarrier2(cmd, &di);
 	VkDeviceSize zero = 0;
-	for (uint32_t v = 0; v < sp->view_count; v++) {
+	for (uint32_t v = first; v < end && v < sp->view_count; v++) {
 		if (sp->view_skip[v]) continue;
 		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
 		const float *rect = sp->views[v].rect;
@@ -129,7 +139,6 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 				vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
 				                        &s->texture_sets[d->texture_set], 0, NULL);
 			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
-			(*casters_drawn)++;
 		}
 		vkCmdEndRendering(cmd);
 		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1,
@@ -262,7 +271,17 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	}
 	VkCommandBuffer cmd = s->cmd;
 	uint32_t w = sc->width, h = sc->height;
+	VkRect2D area = band_area(rv);
 	bool ms = sc->output.msaa > 1;
+	/* The atlas tiles may have been written by an earlier submit of this render (or another
+	 * render's): make them visible to this pass's shadow lookups. */
+	VkMemoryBarrier2 mb = {
+		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+		.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, .srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, .dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
+	vkCmdPipelineBarrier2(cmd, &di);
 	VkImage target = ms ? s->color_ms.img : s->resolve.img;
 	record_image_barrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
 	              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
@@ -305,14 +324,13 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 		.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0}, /* reversed Z */
 	};
 	VkRenderingInfo ri = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
+		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,
 		.colorAttachmentCount = 1, .pColorAttachments = &ca, .pDepthAttachment = &da,
 	};
 	vkCmdBeginRendering(cmd, &ri);
 	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
-	VkRect2D scissor = {{0, 0}, {w, h}};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
-	vkCmdSetScissor(cmd, 0, 1, &scissor);
+	vkCmdSetScissor(cmd, 0, 1, &area);
 	VkDeviceSize zero = 0;
 	vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
 	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
@@ -362,6 +380,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	const struct rnd_scene *sc = rv->sc;
 	VkCommandBuffer cmd = s->cmd;
 	uint32_t w = sc->width, h = sc->height;
+	VkRect2D area = band_area(rv);
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
 	main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
@@ -412,14 +431,13 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 			.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0},
 		};
 		VkRenderingInfo ri = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
+			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,
 			.colorAttachmentCount = UMBRA_AOV_ATTACHMENTS, .pColorAttachments = ca, .pDepthAttachment = &da,
 		};
 		vkCmdBeginRendering(cmd, &ri);
 		VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
-		VkRect2D scissor = {{0, 0}, {w, h}};
 		vkCmdSetViewport(cmd, 0, 1, &vp);
-		vkCmdSetScissor(cmd, 0, 1, &scissor);
+		vkCmdSetScissor(cmd, 0, 1, &area);
 		vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
 		vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
 		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
@@ -446,9 +464,11 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 			                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
 			                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
 			VkBufferImageCopy region = {
-				.bufferOffset = rv->aov_offset + (VkDeviceSize)(pass * UMBRA_AOV_ATTACHMENTS + a) * rv->aov_stride,
+				.bufferOffset = rv->aov_offset + (VkDeviceSize)(pass * UMBRA_AOV_ATTACHMENTS + a) * rv->aov_stride +
+				                (VkDeviceSize)area.offset.y * rv->sheet_width * 16,
 				.bufferRowLength = rv->sheet_width,
-				.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, .imageExtent = {w, h, 1},
+				.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+				.imageOffset = {0, area.offset.y, 0}, .imageExtent = {w, area.extent.height, 1},
 			};
 			vkCmdCopyImageToBuffer(cmd, s->aov[a].img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
 		}
@@ -497,9 +517,12 @@ void record_readback(struct rnd_slot *s, const struct record_view *rv)
 	record_image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
 	              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
 	              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+	VkRect2D area = band_area(rv);
 	VkBufferImageCopy region = {
-		.bufferOffset = rv->color_offset, .bufferRowLength = rv->sheet_width,
-		.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, .imageExtent = {sc->width, sc->height, 1},
+		.bufferOffset = rv->color_offset + (VkDeviceSize)area.offset.y * rv->sheet_width * rv->pixel_bytes,
+		.bufferRowLength = rv->sheet_width,
+		.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+		.imageOffset = {0, area.offset.y, 0}, .imageExtent = {sc->width, area.extent.height, 1},
 	};
 	vkCmdCopyImageToBuffer(cmd, s->resolve.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
 	VkBufferMemoryBarrier2 bb = {

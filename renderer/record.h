@@ -1,7 +1,7 @@
 /*
  * renderer/record.h — recording one view's commands into a slot's command buffer: texture
  * uploads, shadow passes, the camera's depth pre-pass + main pass, the AOV passes, and the
- * copies into the readback buffer. Called by render.c only; nothing here submits or waits.
+ * copies into the readback buffer. Called by submit.c only; nothing here submits or waits.
  */
 #ifndef UMBRA_RENDERER_RECORD_H
 #define UMBRA_RENDERER_RECORD_H
@@ -35,6 +35,10 @@ struct record_view {
 	VkDeviceSize aov_offset;       /* where its first AOV attachment goes */
 	VkDeviceSize aov_stride;       /* bytes between AOV attachments' regions */
 	uint32_t sheet_width;          /* pixels per readback row */
+	uint32_t pixel_bytes;          /* of one colour pixel in the readback buffer */
+	/* The rows of this view that one submit draws (render area + scissor; the viewport stays
+	 * the whole view, so a band's pixels are exactly those of the unsplit pass). */
+	uint32_t band_y, band_h;       /* band_h 0 = every row */
 };
 
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
@@ -43,12 +47,15 @@ void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags a
 /* Copies the staged texels (slot->staging, tightly packed in texture order) into the slot's
  * texture images and leaves them ready for sampling. */
 void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, uint32_t n);
-void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v, uint32_t *casters_drawn);
+/* Shadow views first..end-1 of v->sp (skipped ones left out), each drawn into the slot's
+ * scratch map and copied into its atlas tile. */
+void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v, uint32_t first,
+                    uint32_t end);
 enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
                             struct rnd_error *err);
 enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
                            struct rnd_error *err);
-/* Copies the resolved colour (and AOV targets) into the readback buffer, then makes it host-visible. */
+/* Copies the band's resolved colour into the readback buffer, then makes it host-visible. */
 void record_readback(struct rnd_slot *s, const struct record_view *v);
 
 /* The public enums as the shaders spell them (umbra_shared.h); the uniforms (render.c) and

@@ -2,12 +2,13 @@
  * renderer/render.c — rnd_render(): one scene, start to finish, on one render slot.
  *
  *   validate -> tessellate straight into the slot's mapped vertex/index buffers (upload)
- *   -> plan camera and shadow views -> write uniforms -> record: shadow pass per view,
- *   main pass (MSAA + resolve), copy to the readback buffer -> submit, wait on the slot's
- *   fence -> copy pixels out.
+ *   -> plan camera and shadow views -> write uniforms -> per view, submit.c records and
+ *   submits the shadow passes and the main pass (MSAA + resolve) with its copy into the
+ *   readback buffer, in several submits when the scene has a deadline -> copy pixels out.
  *
- * The slot is waited on before rnd_render() returns, so nothing of this render is in flight
- * afterwards and the slot's resources may be reused or grown by the next render.
+ * Every submit is waited on before the next, so nothing of this render is in flight when
+ * rnd_render() returns (unless a fence wait itself failed: the context is then failed) and
+ * the slot's resources may be reused or grown by the next render.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -19,9 +20,7 @@
 #include "moments.h"
 #include "record.h"
 #include "shadow_cache.h"
-
-/* How long a submitted render may take before the device is considered hung. */
-#define RND_FENCE_TIMEOUT_NS (120ull * 1000 * 1000 * 1000)
+#include "submit.h"
 
 static double now_ms(void)
 {
@@ -249,7 +248,8 @@ static size_t pixel_size(enum rnd_pixel_format f)
 
 /* Tessellates every object into the slot's buffers; fills draws and the scene bounds. */
 static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                              struct draw *draws, struct rnd_aabb *bounds, struct rnd_error *err)
+                              const struct rnd_pacer *pacer, struct draw *draws, struct rnd_aabb *bounds,
+                              struct rnd_error *err)
 {
 	uint64_t nv = 0, ni = 0;
 	for (uint32_t i = 0; i < sc->object_count; i++) {
@@ -275,6 +275,8 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		struct draw *d = &draws[i];
 		uint32_t v, x;
 		rnd_mesh_counts(o, &v, &x);
+		/* Tessellating millions of triangles takes seconds: the deadline holds here too. */
+		if (((i & 15) == 0 || x > (1u << 20)) && (r = rnd_pacer_check(pacer, err)) != RND_OK) return r;
 		rnd_aabb_empty(&d->bounds);
 		if ((r = rnd_mesh_write(o, vtx + vbase, idx + ibase, vbase, &d->bounds, err)) != RND_OK) {
 			char m[sizeof err->msg];
@@ -412,41 +414,10 @@ static void unpremultiply(void *pixels, uint64_t n, enum rnd_pixel_format f)
 	}
 }
 
-static enum rnd_result submit_and_wait(struct rnd_context *ctx, struct rnd_slot *s, struct rnd_timings *tm,
-                                       struct rnd_error *err)
-{
-	VkResult vr;
-	VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &s->cmd};
-	double t0 = now_ms();
-	pthread_mutex_lock(&ctx->queue_mu);
-	vr = vkQueueSubmit(ctx->queue, 1, &si, s->fence);
-	pthread_mutex_unlock(&ctx->queue_mu);
-	if (vr != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkQueueSubmit");
-	vr = vkWaitForFences(ctx->device, 1, &s->fence, VK_TRUE, RND_FENCE_TIMEOUT_NS);
-	if (vr != VK_SUCCESS)
-		/* A render that does not finish in minutes means a hung or lost device. */
-		return rnd_fail_vk(err, vr == VK_TIMEOUT ? VK_ERROR_DEVICE_LOST : vr,
-		                   vr == VK_TIMEOUT ? "render did not finish within 120 s (device hung)" : "vkWaitForFences (render)");
-	vkResetFences(ctx->device, 1, &s->fence);
-	double t1 = now_ms();
-	uint64_t ts[RND_TS_COUNT];
-	if (s->queries && vkGetQueryPoolResults(ctx->device, s->queries, 0, RND_TS_COUNT, sizeof ts, ts, sizeof ts[0],
-	                                        VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
-		double k = ctx->timestamp_period / 1e6;
-		tm->shadow_ms += (double)(ts[RND_TS_SHADOW_END] - ts[RND_TS_START]) * k;
-		tm->main_ms += (double)(ts[RND_TS_MAIN_END] - ts[RND_TS_SHADOW_END]) * k;
-		tm->readback_ms += (double)(ts[RND_TS_COPY_END] - ts[RND_TS_MAIN_END]) * k;
-	} else {
-		tm->main_ms += t1 - t0;
-	}
-	return RND_OK;
-}
-
 enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, struct rnd_image *out,
                            struct rnd_timings *timings, struct rnd_error *err)
 {
 	enum rnd_result r;
-	VkResult vr;
 	struct rnd_timings tm = {0};
 	struct rnd_error scratch_err;
 	if (!err) err = &scratch_err;   /* failure paths below always fill it */
@@ -482,11 +453,14 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 
 	struct rnd_slot *s = rnd_slot_acquire(ctx);
 	double t0 = now_ms();
+	struct rnd_pacer pacer;
+	rnd_pacer_init(&pacer, sc);
+	if ((r = rnd_pacer_check(&pacer, err)) != RND_OK) goto done;
 	struct rnd_aabb bounds;
 	struct rnd_camera_plan cam;
 	const struct rnd_texture *tex[UMBRA_MAX_TEXTURES];
 	uint32_t ntex = 0;
-	if ((r = upload(ctx, s, sc, draws, &bounds, err)) != RND_OK) goto done;
+	if ((r = upload(ctx, s, sc, &pacer, draws, &bounds, err)) != RND_OK) goto done;
 	/* Auto-framing `fit: objects` leaves out planes and shadow catchers (the ground). */
 	struct rnd_aabb obj_bounds;
 	rnd_aabb_empty(&obj_bounds);
@@ -496,6 +470,9 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if (rnd_aabb_is_empty(&obj_bounds)) obj_bounds = bounds;
 	if ((r = textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;
 	tm.upload_ms = now_ms() - t0;
+	pacer.tex = tex;
+	pacer.ntex = ntex;
+	pacer.prologue = true;
 
 	VkFormat fmt = ctx->color_formats[sc->output.pixels];
 	if ((r = rnd_slot_targets(ctx, s, fmt, sc->width, sc->height, sc->output.msaa, err)) != RND_OK) goto done;
@@ -589,7 +566,9 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 				if (lp->moments && res > mmax) res = mmax;
 				req[ngrant++] = (struct rnd_cache_request){key, lp->view_count, res};
 			}
-			if ((r = rnd_cache_acquire(ctx, req, ngrant, 0, grants, err)) != RND_OK) { ngrant = 0; goto done; }
+			/* Waiting for atlas room counts against the render's deadline like its submits. */
+			double wait_until = sc->deadline_ns ? (double)sc->deadline_ns * 1e-9 : 0.0;
+			if ((r = rnd_cache_acquire(ctx, req, ngrant, wait_until, grants, err)) != RND_OK) { ngrant = 0; goto done; }
 			granted = true;
 		}
 		uint32_t max_moment_res = 0;
@@ -626,38 +605,9 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		struct record_view rv = {
 			.sc = sc, .cam = &cam, .sp = sp, .draws = draws, .ndraw = sc->object_count, .aov_passes = passes,
 			.color_offset = cell * px, .aov_offset = color_bytes + cell * 16, .aov_stride = att_bytes,
-			.sheet_width = (uint32_t)sheet_w,
+			.sheet_width = (uint32_t)sheet_w, .pixel_bytes = (uint32_t)px,
 		};
-		if ((vr = vkResetCommandBuffer(s->cmd, 0)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkResetCommandBuffer"); goto done; }
-		VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
-		if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkBeginCommandBuffer"); goto done; }
-		if (s->queries) {
-			vkCmdResetQueryPool(s->cmd, s->queries, 0, RND_TS_COUNT);
-			vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, s->queries, RND_TS_START);
-		}
-		if (v == 0) record_textures(s, tex, ntex);
-		/* The blur temporary's contents never carry over: take it from UNDEFINED each time. */
-		if (s->moments_tmp.img)
-			record_image_barrier(s->cmd, s->moments_tmp.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-			                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-			                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-		uint32_t casters = 0;
-		record_shadows(ctx, s, &rv, &casters);
-		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_SHADOW_END);
-		if ((r = record_main(ctx, s, &rv, err)) != RND_OK || (passes && (r = record_aov(ctx, s, &rv, err)) != RND_OK)) {
-			vkEndCommandBuffer(s->cmd);
-			goto done;
-		}
-		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_MAIN_END);
-		record_readback(s, &rv);
-		if (s->queries) vkCmdWriteTimestamp2(s->cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, RND_TS_COPY_END);
-		if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) { r = rnd_fail_vk(err, vr, "vkEndCommandBuffer"); goto done; }
-		if ((r = submit_and_wait(ctx, s, &tm, err)) != RND_OK) {
-			gpu_busy = true;
-			goto lost_check;
-		}
-		s->white_ready = true;   /* its clear (recorded while false) has run */
+		if ((r = rnd_submit_view(ctx, s, &rv, &pacer, &tm, &gpu_busy, err)) != RND_OK) goto done;
 	}
 
 	double t_copy = now_ms();
@@ -683,16 +633,17 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	r = RND_OK;
 	goto done;
 
-lost_check:
 done:
 	if (r == RND_ERR_DEVICE_LOST) {
 		__atomic_store_n(&ctx->failed, 1, __ATOMIC_RELAXED);
 		rnd_cache_wake(ctx);   /* renders waiting for atlas room: they would wait for ever */
 		rnd_log(ctx, 0, "device lost: %s", err->msg);
 	}
-	/* Everything this render submitted has completed (each submit is waited on) — unless a
-	 * wait failed: then the GPU may still use the tiles and textures, and they stay held (the
-	 * context is failed and must be recreated, which waits for the device first). */
+	/* Everything this render submitted has completed (each submit is waited on; a failed
+	 * vkQueueSubmit leaves nothing in flight, a deadline stops between submits) — unless a
+	 * fence wait failed: then the GPU may still use the tiles and textures, and they stay held
+	 * (the context is failed and must be recreated, which waits for the device first). Any
+	 * other failure, out of memory included, gives its tiles back to the atlas here. */
 	if (!gpu_busy) {
 		if (granted) rnd_cache_release(ctx, grants, ngrant, r == RND_OK);
 		rnd_slot_drop_textures(ctx, s);

@@ -120,6 +120,17 @@ unsigned srv_queue_depth_prio(struct srv_queue *q, enum srv_priority p)
 	return n;
 }
 
+double srv_queue_oldest(struct srv_queue *q)
+{
+	double t = 0;
+	pthread_mutex_lock(&q->mu);
+	for (int p = 0; p < SRV_PRIO_COUNT; p++)
+		if (q->fifo[p].head && (t == 0 || q->fifo[p].head->t_queued < t))
+			t = q->fifo[p].head->t_queued;
+	pthread_mutex_unlock(&q->mu);
+	return t;
+}
+
 unsigned srv_queue_capacity(const struct srv_queue *q)
 {
 	return q->capacity;

@@ -28,5 +28,7 @@ void srv_queue_close(struct srv_queue *q);
 unsigned srv_queue_depth(struct srv_queue *q);
 unsigned srv_queue_depth_prio(struct srv_queue *q, enum srv_priority p);
 unsigned srv_queue_capacity(const struct srv_queue *q);
+/* When the longest-waiting request was queued (srv_now() seconds), 0 when none waits. */
+double srv_queue_oldest(struct srv_queue *q);
 
 #endif

@@ -71,6 +71,7 @@ struct srv_config {
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
 	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */
+	const char *test_fault;        /* tests only: "submit:N:lost|oom" armed after warm-up */
 };
 
 enum srv_route {
@@ -112,6 +113,7 @@ struct srv_server {
 	atomic_uint pending;           /* requests begun and not yet completed by libmicrohttpd */
 	atomic_uint in_flight;         /* renders running now */
 	atomic_uint_fast64_t next_id;  /* request id counter */
+	atomic_uint_fast64_t yield_mark; /* queue time (ns) of the waiter a render last yielded to */
 	uint64_t id_seed;
 };
 
@@ -184,6 +186,7 @@ int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged) */
 int srv_workers_start(struct srv_server *s);
 void srv_workers_join(struct srv_server *s);        /* after srv_queue_close() */
 int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */
+int srv_fault_arm(struct srv_server *s);            /* --test-fault; 0 or -1 (logged) */
 
 /* flags.c: 0 ok, 1 --help printed (exit 0), -1 error printed (exit 2). The strings in cfg
  * point into argv or the environment: nothing to free. */

@@ -4,6 +4,15 @@
  *   deadline check -> api_scene_parse -> Accept -> deadline check -> rnd_render -> api_encode
  *   -> deadline check -> srv_request_finish().
  * A worker never touches the request after srv_request_finish().
+ *
+ * Deadlines: --deadline-ms counts from when the request was queued. The renderer gets it as an
+ * absolute time and stops between submits once it has passed (504). A render also yields
+ * (504) when a request has waited in the queue for half the deadline, so that one huge
+ * request cannot make every request behind it miss its deadline; one render yields per waiter.
+ *
+ * Device loss: the render that saw it marks the daemon not ready (/readyz 503) before its own
+ * 503 answer goes out; its worker then recreates the context and runs the warm-up again, and
+ * only then is the daemon ready again.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,33 +66,66 @@ int srv_context_open(struct srv_server *s)
 }
 
 /* After RND_ERR_DEVICE_LOST from the context of generation `gen`: the first worker to get
- * here waits for the other renders to leave, then destroys and recreates the context; the
- * others see a newer generation and do nothing. /readyz answers 503 meanwhile. */
-static void context_recover(struct srv_server *s, unsigned gen)
+ * here waits for the other renders to leave, then destroys and recreates the context and warms
+ * it up again; the others see a newer generation and do nothing. /readyz answers 503 from the
+ * moment the loss was seen until the new context is warm. */
+static bool context_recover_once(struct srv_server *s, unsigned gen, unsigned *new_gen)
 {
 	pthread_rwlock_wrlock(&s->ctx_lock);
-	if (s->ctx_gen == gen) {
-		atomic_store(&s->ready, false);
-		srv_metrics_add(s->metrics, SRV_CTR_DEVICE_LOST, 1);
-		srv_log(SRV_LOG_ERROR, "device lost: recreating the renderer context");
-		if (s->ctx)
-			s->validation_lost += rnd_context_validation_messages(s->ctx);
-		rnd_context_destroy(s->ctx);
-		s->ctx = NULL;
-		s->ctx_gen++;
-		struct rnd_context *ctx;
-		if (context_create(s, &ctx) == 0) {
-			s->ctx = ctx;
-			rnd_context_info(ctx, &s->info);
-			atomic_store(&s->ready, true);
-			srv_log(SRV_LOG_INFO, "renderer context recreated on \"%s\"", s->info.device_name);
-		}
+	if (s->ctx_gen != gen) {
+		pthread_rwlock_unlock(&s->ctx_lock);
+		return true;
+	}
+	atomic_store(&s->ready, false);
+	srv_metrics_add(s->metrics, SRV_CTR_DEVICE_LOST, 1);
+	srv_log(SRV_LOG_ERROR, "device lost: recreating the renderer context");
+	if (s->ctx)
+		s->validation_lost += rnd_context_validation_messages(s->ctx);
+	rnd_context_destroy(s->ctx);
+	s->ctx = NULL;
+	s->ctx_gen++;
+	unsigned my_gen = *new_gen = s->ctx_gen;
+	struct rnd_context *ctx;
+	bool created = context_create(s, &ctx) == 0;
+	if (created) {
+		s->ctx = ctx;
+		rnd_context_info(ctx, &s->info);
 	}
 	pthread_rwlock_unlock(&s->ctx_lock);
+	if (!created)
+		return true;   /* renders answer 503 "could not be recreated"; nothing more to try */
+	srv_log(SRV_LOG_INFO, "renderer context recreated on \"%s\"; warming up again", s->info.device_name);
+	/* The warm-up renders take the lock for reading like any render; requests that reach a
+	 * worker meanwhile render on the new context (compiling what they need). */
+	bool warm = srv_warmup(s) == 0;
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	bool mine = s->ctx_gen == my_gen;   /* else lost again and recovered by another worker */
+	if (warm && mine && s->ctx && !atomic_load(&s->draining))
+		atomic_store(&s->ready, true);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	if (!warm)
+		srv_log(SRV_LOG_ERROR, "warm-up after the device loss failed");
+	return warm || !mine;
 }
 
+/* A loss during the new warm-up would leave the daemon not ready with no request reaching a
+ * worker to notice: try again a few times. */
+static void context_recover(struct srv_server *s, unsigned gen)
+{
+	for (int attempt = 0; attempt < 3; attempt++) {
+		unsigned new_gen = gen;
+		if (context_recover_once(s, gen, &new_gen) || new_gen == gen)
+			return;
+		gen = new_gen;
+	}
+	srv_log(SRV_LOG_ERROR, "the renderer could not be brought back after a device loss: staying not ready");
+}
+
+/* Renders on the shared context. On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the lost
+ * context's generation + 1 for context_recover(), and the daemon is marked not ready before
+ * the lock is let go (so a recovery cannot finish before this mark). */
 static enum rnd_result render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
-                              struct rnd_timings *t, struct rnd_error *err)
+                              struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen)
 {
 	pthread_rwlock_rdlock(&s->ctx_lock);
 	unsigned gen = s->ctx_gen;
@@ -96,11 +138,34 @@ static enum rnd_result render(struct srv_server *s, const struct rnd_scene *scen
 		atomic_fetch_add(&s->in_flight, 1);
 		r = rnd_render(s->ctx, scene, img, t, err);
 		atomic_fetch_sub(&s->in_flight, 1);
+		if (r == RND_ERR_DEVICE_LOST) {
+			atomic_store(&s->ready, false);
+			if (lost_gen)
+				*lost_gen = gen + 1;
+		}
 	}
 	pthread_rwlock_unlock(&s->ctx_lock);
-	if (r == RND_ERR_DEVICE_LOST)
-		context_recover(s, gen);
 	return r;
+}
+
+int srv_fault_arm(struct srv_server *s)
+{
+	const char *f = s->cfg.test_fault;
+	if (!f)
+		return 0;
+	unsigned n = 0;
+	char kind[8] = "";
+	if (sscanf(f, "submit:%u:%7s", &n, kind) != 2 || n == 0 || (strcmp(kind, "lost") && strcmp(kind, "oom"))) {
+		srv_log(SRV_LOG_ERROR, "--test-fault '%s': want submit:N:lost or submit:N:oom (N >= 1)", f);
+		return -1;
+	}
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	if (s->ctx)
+		rnd_context_inject_fault(s->ctx, strcmp(kind, "lost") ? RND_FAULT_OUT_OF_MEMORY : RND_FAULT_DEVICE_LOST, n);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	srv_log(SRV_LOG_WARN, "test fault armed: queue submit %u from now returns %s", n,
+	        strcmp(kind, "lost") ? "out of device memory" : "device lost");
+	return 0;
 }
 
 int srv_context_close(struct srv_server *s)
@@ -180,7 +245,7 @@ static int warm_one(struct srv_server *s, size_t i)
 		char msg[700];
 		api_problem_format(&p, msg, sizeof msg);
 		srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, msg);
-	} else if (render(s, &sc->scene, &img, &t, &err) != RND_OK) {
+	} else if (render(s, &sc->scene, &img, &t, &err, NULL) != RND_OK) {
 		srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, err.msg);
 	} else if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
 		srv_log(SRV_LOG_WARN, "warm-up '%s': encode: %s", warm_scenes[i].name, p.detail);
@@ -292,17 +357,42 @@ static int render_status(enum rnd_result r)
 	case RND_ERR_LIMIT: return 422;
 	case RND_ERR_TIMEOUT: return 504;
 	case RND_ERR_OOM: return 503;
+	case RND_ERR_DEVICE_LOST: return 503;   /* the context is recreated: a retry can succeed */
 	default: return 500;
 	}
 }
 
-static void job_run(struct srv_server *s, struct srv_request *req)
+/* The renderer's cancel callback: yield to a request that has waited half its deadline. */
+struct render_watch {
+	struct srv_server *srv;
+	bool yielded;
+};
+
+static bool render_should_yield(void *user)
 {
+	struct render_watch *w = user;
+	struct srv_server *s = w->srv;
+	double oldest = srv_queue_oldest(s->queue);
+	if (oldest <= 0 || srv_now() < oldest + s->cfg.deadline_ms / 2000.0)
+		return false;
+	uint_fast64_t mark = (uint_fast64_t)(oldest * 1e9), prev = atomic_load(&s->yield_mark);
+	/* One render yields per waiter: the one that moves the mark. */
+	if (prev == mark || !atomic_compare_exchange_strong(&s->yield_mark, &prev, mark))
+		return false;
+	w->yielded = true;
+	return true;
+}
+
+/* Answers the request; returns the lost context's generation + 1 when its render lost the
+ * device (the caller recovers after answering), else 0. */
+static unsigned job_run(struct srv_server *s, struct srv_request *req)
+{
+	unsigned lost_gen = 0;
 	double t_pop = srv_now();
 	srv_metrics_queue_wait(s->metrics, t_pop - req->t_queued);
 	if (past_deadline(s, req, t_pop)) {
 		job_deadline(s, req, "while waiting in the queue", t_pop);
-		return;
+		return 0;
 	}
 
 	struct api_scene *sc = NULL;
@@ -324,7 +414,7 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 	srv_request_drop_body(req);
 	if (pr != API_OK) {
 		job_problem(req, &p);
-		return;
+		return 0;
 	}
 	if (sc->asset_hash) {
 		/* The image depends on files under --asset-root as well as on the body. */
@@ -352,12 +442,30 @@ static void job_run(struct srv_server *s, struct srv_request *req)
 		job_problem(req, &p);
 		goto out;
 	}
-	enum rnd_result r = render(s, &sc->scene, &img, &t, &err);
+	struct render_watch watch = { .srv = s };
+	if (s->cfg.deadline_ms) {
+		sc->scene.deadline_ns = (uint64_t)((req->t_queued + s->cfg.deadline_ms / 1000.0) * 1e9);
+		sc->scene.cancel = render_should_yield;
+		sc->scene.cancel_user = &watch;
+	}
+	enum rnd_result r = render(s, &sc->scene, &img, &t, &err, &lost_gen);
 	if (r != RND_OK) {
+		double tf = srv_now();
 		srv_metrics_add(s->metrics, SRV_CTR_RENDER_FAILED, 1);
 		if (r == RND_ERR_TIMEOUT)
 			srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
-		api_problem_from_render(&p, sc, &err, render_status(r));
+		if (r == RND_ERR_TIMEOUT && watch.yielded)
+			api_problem_set(&p, 504, "", "the render was stopped %.0f ms after it was queued (%s) so that requests "
+			                "waiting behind it can meet their deadline of %u ms", (tf - req->t_queued) * 1000.0,
+			                err.msg, s->cfg.deadline_ms);
+		else if (r == RND_ERR_TIMEOUT)
+			api_problem_set(&p, 504, "", "the render passed its deadline of %u ms and was stopped %.0f ms after it "
+			                "was queued (%s)", s->cfg.deadline_ms, (tf - req->t_queued) * 1000.0, err.msg);
+		else if (r == RND_ERR_DEVICE_LOST)
+			api_problem_set(&p, 503, "", "the GPU device was lost (%s); the renderer is being recreated, retry",
+			                err.msg);
+		else
+			api_problem_from_render(&p, sc, &err, render_status(r));
 		srv_log(SRV_LOG_WARN, "request %s: render failed: %s (%s)", req->id, err.msg, rnd_result_str(r));
 		job_problem(req, &p);
 		goto out;
@@ -397,6 +505,7 @@ out:
 	rnd_image_release(&img);
 	api_scene_free(sc);
 	srv_admit_release(&s->admit, admitted);
+	return lost_gen;
 }
 
 static void *worker_main(void *arg)
@@ -404,8 +513,11 @@ static void *worker_main(void *arg)
 	struct srv_server *s = arg;
 	struct srv_request *req;
 	while ((req = srv_queue_pop(s->queue))) {
-		job_run(s, req);
+		unsigned lost_gen = job_run(s, req);
 		srv_request_finish(req);
+		/* After the answer: the client learns of the failure at once, /readyz is already 503. */
+		if (lost_gen)
+			context_recover(s, lost_gen - 1);
 	}
 	return NULL;
 }

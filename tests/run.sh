@@ -63,5 +63,6 @@ command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env
 [ -f tests/http/conn.sh ] && [ -x "$BUILD/umbrad" ] && run_suite conn sh tests/http/conn.sh
 # A short soak (make soak runs 10,000); under ASan soak.sh lowers it to 300.
 [ -f tests/http/soak.sh ] && [ -x "$BUILD/umbrad" ] && run_suite soak sh tests/http/soak.sh "${SOAK_N:-1000}"
+[ -f tests/http/faults.sh ] && [ -x "$BUILD/umbrad" ] && run_suite faults sh tests/http/faults.sh
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

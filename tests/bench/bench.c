@@ -53,9 +53,13 @@ int main(int argc, char **argv)
 	int n = 15;
 	int first = 1;
 	int cold_models = 0;   /* -c: no model cache, every run imports its models again */
+	int deadline_ms = 0;
 	for (;;) {
 		if (argc > first + 1 && !strcmp(argv[first], "-n")) { n = atoi(argv[first + 1]); first += 2; }
 		else if (argc > first && !strcmp(argv[first], "-c")) { cold_models = 1; first += 1; }
+		/* -d MS: each render gets a deadline MS from its start (as umbrad gives one), so the
+		 * submits are split as they are in the daemon. */
+		else if (argc > first + 1 && !strcmp(argv[first], "-d")) { deadline_ms = atoi(argv[first + 1]); first += 2; }
 		else break;
 	}
 	if (n < 1) n = 1;
@@ -90,6 +94,7 @@ int main(int argc, char **argv)
 			double t1 = now_ms();
 			struct rnd_image img;
 			struct rnd_timings tm;
+			if (deadline_ms > 0) s->scene.deadline_ns = (uint64_t)((t0 + deadline_ms) * 1e6);
 			if (rnd_render(ctx, &s->scene, &img, &tm, &err) != RND_OK) {
 				fprintf(stderr, "bench: %s: %s\n", argv[a], err.msg); api_scene_free(s); rc = 1; break;
 			}

@@ -216,6 +216,19 @@ struct rnd_scene {
 	const struct rnd_object *objects;     uint32_t object_count;
 	const struct rnd_light *lights;       uint32_t light_count;
 	struct rnd_output output;
+
+	/* How long the render may run (not part of the picture; zero = no limit). The renderer
+	 * splits its work into submits that can stop (shadow views in groups, the main pass in
+	 * horizontal bands sized from measured time) and checks between submits; past the
+	 * deadline, or when `cancel` returns true, it stops at the next submit boundary, releases
+	 * everything and returns RND_ERR_TIMEOUT. A submit already running is waited for, so a
+	 * render ends at most about one submit (~1 s on lavapipe, less under short deadlines)
+	 * past its deadline. Without deadline and cancel everything goes in as few submits as
+	 * possible. */
+	uint64_t deadline_ns;     /* absolute CLOCK_MONOTONIC time in nanoseconds, 0 = none */
+	bool (*cancel)(void *user); /* polled between submits (any thread-safe check), NULL = none */
+	void *cancel_user;
+	uint32_t band_rows;       /* main-pass rows per submit, 0 = chosen by the renderer (tests) */
 };
 
 /* Contract defaults: 512x512, perspective camera at (0,0,5) looking at the origin, default
@@ -317,7 +330,16 @@ void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
 /* Writes the pipeline cache to desc.pipeline_cache_path (atomic rename). */
 enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error *err);
 
-/* Renders one scene. Blocks until done. See the threading note at the top. */
+/* Test-only fault injection (issue "tests of the bad day"): the nth queue submit of this
+ * context from now (1 = the next one) is not submitted and returns kind's VkResult instead —
+ * VK_ERROR_DEVICE_LOST (the context turns FAILED, exactly as for a real loss) or
+ * VK_ERROR_OUT_OF_DEVICE_MEMORY (the render fails with RND_ERR_OOM, the context stays usable).
+ * One shot; RND_FAULT_NONE disarms. umbrad sets it from --test-fault after its warm-up. */
+enum rnd_fault { RND_FAULT_NONE, RND_FAULT_DEVICE_LOST, RND_FAULT_OUT_OF_MEMORY };
+void rnd_context_inject_fault(struct rnd_context *ctx, enum rnd_fault kind, uint32_t nth_submit);
+
+/* Renders one scene. Blocks until done (or until scene->deadline_ns / cancel stop it:
+ * RND_ERR_TIMEOUT). See the threading note at the top. */
 enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *scene,
                            struct rnd_image *out, struct rnd_timings *timings, struct rnd_error *err);
 

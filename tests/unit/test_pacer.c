@@ -1,0 +1,71 @@
+/* tests/unit — main-pass band sizing (renderer/submit.c, rnd_pacer_band_rows): pure arithmetic,
+ * no GPU. The numbers are the ones a lavapipe run of 16 soft-shadowed spot lights produced:
+ * cheap sky rows above, rows ~40x dearer below. */
+#include "test.h"
+#include "submit.h"
+
+static struct rnd_pacer pacer(double slice_ms)
+{
+	struct rnd_pacer p = {0};
+	p.slice_ms = slice_ms;
+	return p;
+}
+
+static void measured(struct rnd_pacer *p, uint32_t rows, double ms)
+{
+	p->rows[0] = p->rows[1]; p->ms[0] = p->ms[1];
+	p->rows[1] = rows; p->ms[1] = ms;
+	p->measured++;
+}
+
+TEST(pacer_cheap_scene_is_one_band)
+{
+	struct rnd_pacer p = pacer(1000);
+	/* thumb-512 by the estimate: ~0.7 ms a row, 60 ms of vertices */
+	CHECK(rnd_pacer_band_rows(&p, 512, 1, 0.7, 60) == 512);
+}
+
+TEST(pacer_first_band_from_the_estimate)
+{
+	struct rnd_pacer p = pacer(1000);
+	uint32_t r = rnd_pacer_band_rows(&p, 2048, 1, 150, 10);
+	CHECK(r == 6, "rows %u", r);   /* (1000 - 10) / 150 */
+	CHECK(rnd_pacer_band_rows(&p, 2048, 1, 5000, 10) == 1, "never below min_rows");
+}
+
+TEST(pacer_cheap_rows_do_not_make_huge_bands)
+{
+	/* The first bands are sky (a few ms for dozens of rows); the estimate says 150 ms a row. */
+	struct rnd_pacer p = pacer(1000);
+	measured(&p, 6, 2);
+	uint32_t r = rnd_pacer_band_rows(&p, 2000, 1, 150, 10);
+	CHECK(r <= 12, "rows %u: more than twice the last band", r);
+	measured(&p, 12, 3);
+	r = rnd_pacer_band_rows(&p, 2000, 1, 150, 10);
+	CHECK(r <= 27, "rows %u: more than a slice at a quarter of the estimate", r);
+}
+
+TEST(pacer_follows_measured_cost)
+{
+	struct rnd_pacer p = pacer(1000);
+	measured(&p, 20, 2000);   /* 100 ms a row: twice the estimate */
+	uint32_t r = rnd_pacer_band_rows(&p, 1000, 1, 50, 0);
+	CHECK(r == 10, "rows %u", r);
+}
+
+TEST(pacer_vertex_bound_bands_do_not_shrink_forever)
+{
+	/* 600 ms per band whatever its height, 1 ms a row on top: slicing cannot go under 600 ms,
+	 * so bands take at least three times that in rows instead of one row each. */
+	struct rnd_pacer p = pacer(1000);
+	measured(&p, 100, 700);
+	measured(&p, 200, 800);
+	uint32_t r = rnd_pacer_band_rows(&p, 4000, 1, 0.1, 600);
+	CHECK(r >= 400 && r <= 2000, "rows %u", r);
+}
+
+TEST(pacer_no_sliver_at_the_bottom)
+{
+	struct rnd_pacer p = pacer(1000);
+	CHECK(rnd_pacer_band_rows(&p, 11, 4, 100, 0) == 11, "a last band of 1 row left over");
+}
