@@ -1,5 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "umbra_shared.h"
 #include "shading.glsl"
 // AOV pass (single-sample, after the main pass): writes what EXR outputs carry besides colour.
@@ -23,12 +24,6 @@ float visibility(uint i, vec3 n_geo, bool receive)
 	return shadow_visibility(L, v_pos, n_geo, l, view);
 }
 
-vec4 visibility4(uint first, vec3 n_geo, bool receive)
-{
-	return vec4(visibility(first, n_geo, receive), visibility(first + 1u, n_geo, receive),
-	            visibility(first + 2u, n_geo, receive), visibility(first + 3u, n_geo, receive));
-}
-
 void main()
 {
 	umbra_material m = materials[pc.info.x];
@@ -37,16 +32,23 @@ void main()
 	if (!gl_FrontFacing) n_geo = -n_geo;
 	bool receive = (pc.info.y & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	uint first = pc.info.z;
+	// One call site of visibility() in a loop the compiler keeps: written out once per light
+	// (8 or 16 copies of every shadow filter), lavapipe's JIT took minutes on this shader
+	// with PCSS lights, inside the render's first submit.
+	float vis[16];
+	uint count = first == 0u ? 8u : 16u;
+	[[dont_unroll]] for (uint k = 0u; k < 16u; k++)
+		vis[k] = k < count ? visibility(first + k, n_geo, receive) : 1.0;
 	if (first == 0u) {
 		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
 		o_aov0 = vec4(z, n_geo);
 		o_aov1 = vec4(bc.rgb, 1.0);
-		o_aov2 = visibility4(0u, n_geo, receive);
-		o_aov3 = visibility4(4u, n_geo, receive);
+		o_aov2 = vec4(vis[0], vis[1], vis[2], vis[3]);
+		o_aov3 = vec4(vis[4], vis[5], vis[6], vis[7]);
 	} else {
-		o_aov0 = visibility4(first, n_geo, receive);
-		o_aov1 = visibility4(first + 4u, n_geo, receive);
-		o_aov2 = visibility4(first + 8u, n_geo, receive);
-		o_aov3 = visibility4(first + 12u, n_geo, receive);
+		o_aov0 = vec4(vis[0], vis[1], vis[2], vis[3]);
+		o_aov1 = vec4(vis[4], vis[5], vis[6], vis[7]);
+		o_aov2 = vec4(vis[8], vis[9], vis[10], vis[11]);
+		o_aov3 = vec4(vis[12], vis[13], vis[14], vis[15]);
 	}
 }

@@ -34,12 +34,16 @@ echo
 echo "== model import isolation: the same STL imported cold in-process and in the sandbox (api/sandbox.h)"
 "$BUILD/tests/import_bench" -n "${BENCH_RUNS_SMALL:-7}" 1000 100000
 echo
-echo "== cold CLI (new process each: device + pipelines + first-use JIT), thumb-512"
+echo "== cold CLI (new process each: device + pipelines + first-use JIT), thumb-512: PNG, and EXR with the shadow AOV"
+python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); s["output"]={"format":"exr","aovs":["shadow"]}; print(json.dumps(s))' \
+	"$SHARED/bench/thumb-512.json" >"$tmp/thumb512-aov.json"
 for i in 1 2 3; do
 	s=$(date +%s%N)
 	"$BUILD/umbra-render" "$SHARED/bench/thumb-512.json" -o "$tmp/cold.png"
 	e=$(date +%s%N)
-	echo "run $i: $(( (e - s) / 1000000 )) ms"
+	"$BUILD/umbra-render" "$tmp/thumb512-aov.json" -o "$tmp/cold.exr"
+	f=$(date +%s%N)
+	echo "run $i: png $(( (e - s) / 1000000 )) ms, exr+aov $(( (f - e) / 1000000 )) ms"
 done
 if [ -x "$BUILD/tests/http_bench" ] && [ -f tests/bench/http_bench.sh ]; then
 	echo
