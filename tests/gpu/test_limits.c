@@ -4,6 +4,7 @@
  * (renders that do not fit next to each other wait); moment maps stay within the device's
  * storage-buffer range; a render whose single allocation is over the device's limit is refused
  * up front with the member at fault (rnd_error.at), before anything is allocated. */
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -224,4 +225,43 @@ TEST(limits_allocation_over_device_limit_names_aovs)
 		CHECK(re == RND_OK, "%s", err.msg);
 	}
 	api_scene_free(s);
+}
+
+/* EXR shadow AOVs of PCSS lights: the AOV pass evaluates every light's filter; written out once
+ * per light it made lavapipe's JIT take minutes (a request that held its worker). The AOV is the
+ * debug view's visibility (contract §4): both agree within 1/255 on nearly every pixel. */
+TEST(limits_aov_of_pcss_lights_matches_debug_view)
+{
+	static const char *const scene =
+		"{'width':64,'height':64,'camera':{'position':[5,6,7],'target':[0,0,0]},"
+		"'objects':[{'shape':'plane','size':[12,12]},{'shape':'box','transform':{'translation':[0,0.5,0]}}],"
+		"'lights':[{'type':'spot','position':[1,5,0],'direction':[0,-1,0],'radius':0.3,'shadow':{'filter':'pcss'}},"
+		"{'type':'point','position':[-1,4,1],'radius':0.2,'shadow':{'filter':'pcss'}}],"
+		"'output':{'msaa':1,%s}}";
+	char doc[1024];
+	struct rnd_image aov, dbg;
+	struct rnd_error err;
+	struct rnd_context *ctx = gpu_ctx();
+	if (!ctx) return;
+	snprintf(doc, sizeof doc, scene, "'format':'exr','aovs':['shadow']");
+	REQUIRE(render_doc(ctx, doc, &aov, &err) == RND_OK, "%s", err.msg);
+	snprintf(doc, sizeof doc, scene, "'debug':'shadow','debug_light':1");
+	enum rnd_result r = render_doc(ctx, doc, &dbg, &err);
+	CHECK(r == RND_OK, "%s", err.msg);
+	const float *s1 = NULL;
+	for (uint32_t i = 0; i < aov.aov_count; i++)
+		if (!strcmp(aov.aov_names[i], "shadow.1")) s1 = aov.aov[i];
+	CHECK(s1, "no shadow.1 plane");
+	if (s1 && r == RND_OK) {
+		int agree = 0, n = 64 * 64;
+		for (int j = 0; j < 64; j++)
+			for (int i = 0; i < 64; i++) {
+				int a = (int)lrintf(s1[j * 64 + i] * 255.0f), d = gpu_px8(&dbg, i, j)[0];
+				agree += abs(a - d) <= 1;
+			}
+		CHECK(agree >= 0.99 * n, "shadow.1 agrees with the debug view on %d of %d pixels", agree, n);
+	}
+	rnd_image_release(&aov);
+	rnd_image_release(&dbg);
+	CHECK(rnd_context_validation_messages(ctx) == 0);
 }
