@@ -19,6 +19,7 @@ static const struct {
 	{400, "invalid-scene", "Invalid scene"},
 	{404, "not-found", "Not found"},
 	{405, "method-not-allowed", "Method not allowed"},
+	{406, "not-acceptable", "Not acceptable"},
 	{408, "request-timeout", "Request timeout"},
 	{413, "body-too-large", "Request body too large"},
 	{415, "unsupported-media-type", "Unsupported media type"},

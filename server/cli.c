@@ -78,7 +78,10 @@ static int load_scene(const char *in, const char *out, struct api_scene **scene)
 		enum api_format f = (*scene)->format;
 		if (dot && !strcasecmp(dot, ".png")) f = API_FORMAT_PNG;
 		else if (dot && !strcasecmp(dot, ".exr")) f = API_FORMAT_EXR;
-		r = api_scene_set_format(*scene, f, &prob);
+		else if (dot && !strchr(dot, '/'))
+			r = api_problem_set(&prob, 400, "", "cannot write '%s': umbra-render writes PNG (.png) or EXR (.exr)",
+			                    out);
+		if (r == API_OK) r = api_scene_set_format(*scene, f, &prob);
 	}
 	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
 	if (r == API_OK) return 0;

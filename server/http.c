@@ -334,12 +334,13 @@ static enum MHD_Result part_data(void *cls, enum MHD_ValueKind kind, const char 
 	return MHD_YES;
 }
 
-/* Accept: true when image/x-exr is preferred (higher q) over image/png. Wildcards count with
- * their q for both; a tie keeps PNG, the default. */
-static bool accept_prefers_exr(const char *accept)
+/* Accept: 1 when image/x-exr is preferred (higher q) over image/png, 0 for PNG (also without
+ * the header; a tie keeps PNG, the default), -1 when the header accepts neither (q = 0 or not
+ * named, no wildcard): that request is answered 406. Wildcards count with their q for both. */
+static int accept_choice(const char *accept)
 {
-	if (!accept)
-		return false;
+	if (!accept || !*accept)
+		return 0;
 	double q_png = -1, q_exr = -1, q_wild = -1;
 	bool spec_png = false, spec_exr = false;
 	const char *p = accept;
@@ -380,7 +381,9 @@ static bool accept_prefers_exr(const char *accept)
 		q_png = q_wild;
 	if (!spec_exr)
 		q_exr = q_wild;
-	return q_exr > 0 && q_exr > q_png;
+	if (q_png <= 0 && q_exr <= 0)
+		return -1;
+	return q_exr > 0 && q_exr > q_png ? 1 : 0;
 }
 
 /* Called by queue_push() under the queue lock, once the push is certain (see queue.h). */
@@ -454,7 +457,12 @@ static enum MHD_Result render_begin(struct srv_request *req, struct MHD_Connecti
 		if (!req->post)
 			return respond_problem(req, 400, NULL, "", "multipart/form-data without a usable boundary");
 	}
-	req->want_exr = accept_prefers_exr(MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT));
+	const char *accept = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
+	int choice = accept_choice(accept);
+	if (choice < 0)
+		return respond_problem(req, 406, NULL, "", "this server answers image/png or image/x-exr (or a problem+json "
+		                       "document); Accept: %.200s names neither", accept);
+	req->want_exr = choice == 1;
 	req->body_hash = FNV_OFFSET;
 	req->state = SRV_REQ_BODY;
 	return MHD_YES;

@@ -159,6 +159,10 @@ cli "$T/ground-t.json" -o "$T/ground-t.png" 2>/dev/null
 sa=$($PNG px "$T/ground-t.png" 64 48 2>/dev/null | cut -d' ' -f4)
 ba=$($PNG px "$T/ground-t.png" 16 48 2>/dev/null | cut -d' ' -f4)
 check "ground, transparent: shadow has alpha ($sa), background none ($ba)" sh -c "[ '${sa:-0}' -gt 60 ] && [ '$ba' = 0 ]"
+cli "$T/ground.json" -o "$T/ground.jpg" 2>"$T/jpg.err"
+rc=$?
+check "-o x.jpg: exit 2, nothing written, the reason on stderr" \
+	eval '[ $rc = 2 ] && [ ! -e "$T/ground.jpg" ] && grep -q "writes PNG (.png) or EXR (.exr)" "$T/jpg.err"'
 
 # ---- several scenes and a manifest in one process ----
 mkdir -p "$T/scenes"

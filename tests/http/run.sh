@@ -141,6 +141,8 @@ check "EXR magic" is_exr "$T/rexr.body"
 check "Accept changes the ETag" [ "$(hdr rexr ETag)" != "$etag" ]
 c=$(post rexr2 "$T/exr.json"); check "output.format exr: image/x-exr" sh -c "[ $c = 200 ] && [ '$(hdr rexr2 Content-Type)' = image/x-exr ]"
 c=$(post rpng "$T/small.json" -H 'Accept: image/png, image/x-exr;q=0.5'); check "Accept preferring PNG: image/png" [ "$(hdr rpng Content-Type)" = image/png ]
+c=$(post rjpg "$T/small.json" -H 'Accept: image/jpeg'); check "Accept: image/jpeg (neither format): 406 problem+json" eval '[ "$c" = 406 ] && problem rjpg 406 ""'
+c=$(post rjpg2 "$T/small.json" -H 'Accept: image/jpeg, */*;q=0.1'); check "Accept: image/jpeg, */*;q=0.1: 200 PNG" eval '[ "$c" = 200 ] && [ "$(hdr rjpg2 Content-Type)" = image/png ]'
 c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
 c=$(post mpath "$T/model-path.json"); check "model by path under --asset-root 200" [ "$c" = 200 ]
 # The answer depends on the file under --asset-root: when it changes, so must the ETag, and the
