@@ -40,6 +40,7 @@ static int usage(FILE *f, int code)
 	           "  -o DIR/      batch: one image per input in DIR (name of the input, extension of the format)\n"
 	           "  --timings    print per-stage milliseconds to stderr (one scene)\n"
 	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n"
+	           "  --asset-root DIR  models' \"path\" is relative to DIR and never leaves it (default: none, a 400)\n"
 	           "  thumb        MODEL files (.glb .gltf .obj .stl .ply) as thumbnails: \"preset\": \"thumbnail\"\n"
 	           "               (framed, soft sun and sky light, a ground shadow catcher under the model)\n"
 	           "  --size N     thumbnail width and height (default 512)\n"
@@ -59,7 +60,7 @@ static void log_cb(void *user, int level, const char *msg)
 
 /* Reads and parses one scene and settles its format (the output name's extension wins).
  * 0 with *scene set, or the exit status (problem on stderr). */
-static int load_scene(const char *in, const char *out, struct api_scene **scene)
+static int load_scene(const char *in, const char *out, const char *asset_root, struct api_scene **scene)
 {
 	size_t len = 0;
 	char *json = farm_read_file(in, &len);
@@ -69,6 +70,7 @@ static int load_scene(const char *in, const char *out, struct api_scene **scene)
 	}
 	struct api_limits lim;
 	api_limits_defaults(&lim);
+	lim.asset_root = asset_root;
 	struct api_problem prob;
 	char line[1024];
 	enum api_result r = api_scene_parse(json, len, &lim, scene, &prob);
@@ -93,13 +95,13 @@ static int load_scene(const char *in, const char *out, struct api_scene **scene)
 }
 
 /* One scene, as before the batch runner: stdout or one file, --timings. */
-static int render_one(const char *in, const char *out, const char *device, int timings)
+static int render_one(const char *in, const char *out, const char *device, const char *asset_root, int timings)
 {
 	double t0 = farm_now_ms();
 	struct api_scene *scene = NULL;
 	struct api_problem prob;
 	char line[1024];
-	int rc = load_scene(in, out, &scene);
+	int rc = load_scene(in, out, asset_root, &scene);
 	if (rc) return rc;
 	rc = 1;
 	double t_parse = farm_now_ms() - t0;
@@ -207,6 +209,7 @@ static int parse_args(int argc, char **argv, struct args *a)
 		i++;
 		if (!strcmp(s, "-o")) a->out = v;
 		else if (!strcmp(s, "--device")) a->device = v;
+		else if (!strcmp(s, "--asset-root")) a->farm.asset_root = v;
 		else if (!strcmp(s, "--manifest")) a->manifest = v;
 		else if (!strcmp(s, "--report")) a->report = v;
 		else if (!strcmp(s, "-j") && (a->farm.threads = uint_arg(v, 64))) continue;
@@ -288,7 +291,7 @@ int main(int argc, char **argv)
 	}
 	bool batch = a.thumb || a.manifest || a.ninputs > 1 || (a.out && is_dir(a.out));
 	if (!batch) {
-		rc = render_one(a.inputs[0], a.out, a.device, a.timings);
+		rc = render_one(a.inputs[0], a.out, a.device, a.farm.asset_root, a.timings);
 		free(a.inputs);
 		return rc;
 	}

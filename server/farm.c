@@ -113,6 +113,7 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 	struct job_result *r = &f->res[i];
 	struct api_limits lim;
 	api_limits_defaults(&lim);
+	lim.asset_root = f->o->asset_root;
 	struct api_problem prob;
 	char doc[512];
 	size_t len = 0;

@@ -36,6 +36,7 @@ struct farm_opts {
 	const char *dir;          /* output directory (created if missing) */
 	const char *report;       /* JSON-lines report path, NULL: none */
 	const char *device;       /* Vulkan device name filter, NULL: first */
+	const char *asset_root;   /* directory models' `path` is relative to, NULL: none (a 400) */
 	unsigned threads;         /* 0: one per core */
 	unsigned size;            /* thumbnails: width = height (0: the preset's 512) */
 	bool transparent;         /* thumbnails: transparent background */

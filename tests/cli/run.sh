@@ -159,6 +159,18 @@ cli "$T/ground-t.json" -o "$T/ground-t.png" 2>/dev/null
 sa=$($PNG px "$T/ground-t.png" 64 48 2>/dev/null | cut -d' ' -f4)
 ba=$($PNG px "$T/ground-t.png" 16 48 2>/dev/null | cut -d' ' -f4)
 check "ground, transparent: shadow has alpha ($sa), background none ($ba)" sh -c "[ '${sa:-0}' -gt 60 ] && [ '$ba' = 0 ]"
+# A model by `path`: only under --asset-root, never outside it.
+mkdir -p "$T/assets"
+printf 'v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
+sed 's|{"shape": "box", "transform": {"translation": \[0, 3, 0\]}}|{"shape": "model", "path": "tri.obj"}|' "$T/ground.json" >"$T/path.json"
+cli "$T/path.json" -o "$T/path-none.png" 2>"$T/path-none.err"
+rc=$?
+check "a path model without --asset-root: exit 2 naming the member" eval '[ $rc = 2 ] && grep -q "/objects/1" "$T/path-none.err"'
+cli "$T/path.json" -o "$T/path.png" --asset-root "$T/assets" 2>"$T/path.err"
+check "a path model with --asset-root: exit 0, a PNG" eval '[ $? = 0 ] && [ "$($PNG size "$T/path.png" 2>/dev/null)" = "96 96" ]'
+sed 's|"path": "tri.obj"|"path": "../ground.json"|' "$T/path.json" >"$T/escape.json"
+cli "$T/escape.json" -o "$T/escape.png" --asset-root "$T/assets" 2>/dev/null
+check "--asset-root: a path leaving it is exit 2" [ $? = 2 ]
 cli "$T/ground.json" -o "$T/ground.jpg" 2>"$T/jpg.err"
 rc=$?
 check "-o x.jpg: exit 2, nothing written, the reason on stderr" \
