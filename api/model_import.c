@@ -472,6 +472,10 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
 	unsigned flags = aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
 	                 aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+	/* STL facet normals are often wrong (opposite the winding, or zero): flat normals from the
+	 * winding instead, as STL viewers shade them. */
+	if (format == API_MODEL_STL)
+		flags = (flags & ~(unsigned)aiProcess_GenSmoothNormals) | aiProcess_DropNormals | aiProcess_GenNormals;
 	enum api_wire_status st = API_WIRE_OK;
 	pthread_mutex_lock(&import_mu);
 	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, flags, &io, props);

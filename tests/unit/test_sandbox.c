@@ -348,3 +348,27 @@ TEST(sandbox_reply_decoder_refuses_malformed)
 	CHECK(decode(b.data, b.len, &m, err, sizeof err) == API_ERR && strstr(err, "finite"), "%s", err);
 	api_wire_buf_release(&b);
 }
+
+/* A binary STL whose stored facet normal opposes its winding (common from some exporters):
+ * the normal follows the winding (counter-clockwise seen from the front, as glTF and the
+ * renderer's culling assume), so the model is not shaded from behind. */
+TEST(sandbox_stl_normals_follow_the_winding)
+{
+	uint8_t d[84 + 50] = {0};
+	uint32_t one = 1;
+	memcpy(d + 80, &one, 4);
+	/* Triangle in the z = 0 plane, counter-clockwise seen from +z; stored normal -z. */
+	float t[12] = {0, 0, -1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+	memcpy(d + 84, t, sizeof t);
+	struct api_limits l = limits(5000);
+	struct api_model *m = NULL;
+	char err[400];
+	int st;
+	REQUIRE(api_model_get(d, sizeof d, API_MODEL_STL, &l, &m, &st, err, sizeof err) == API_OK && m, "%s", err);
+	REQUIRE(m->mesh_count == 1 && m->meshes[0].vertex_count >= 3);
+	int up = 0;
+	for (uint32_t v = 0; v < m->meshes[0].vertex_count; v++) up += m->meshes[0].normals[3 * v + 2] > 0.99f;
+	CHECK(up == (int)m->meshes[0].vertex_count, "%d of %u normals along +z (the winding's side)", up,
+	      m->meshes[0].vertex_count);
+	api_model_release(m);
+}
