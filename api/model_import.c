@@ -24,6 +24,7 @@
 #include <assimp/scene.h>
 #include <jansson.h>
 #include "model_import.h"
+#include "ply_strips.h"
 #include "umbra/rnd_math.h"
 
 #define MAX_NODE_DEPTH 256
@@ -463,6 +464,13 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	out->format = format;
 	if ((format == API_MODEL_GLB || format == API_MODEL_GLTF) && gltf_precheck(data, len, format, err, errsize) < 0)
 		return API_WIRE_BAD_INPUT;
+	/* PLY triangle strips: Assimp 5.2 reads a strip as one polygon (a flat sliver). */
+	size_t strips_len = 0;
+	uint8_t *strips = format == API_MODEL_PLY ? api_ply_strips_to_faces(data, len, &strips_len) : NULL;
+	if (strips) {
+		data = strips;
+		len = strips_len;
+	}
 	struct mem_io mi = {.data = data, .len = len};
 	snprintf(mi.name, sizeof mi.name, MEM_NAME ".%s", FORMAT_NAMES[format]);
 	struct aiFileIO io = {.OpenProc = mem_open, .CloseProc = mem_close, .UserData = (aiUserData)&mi};
@@ -487,6 +495,7 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	}
 	pthread_mutex_unlock(&import_mu);
 	aiReleasePropertyStore(props);
+	free(strips);   /* Assimp copied what it needed */
 	if (!sc) return st;
 
 	struct conv c = {.sc = sc, .arena = arena, .out = out, .err = err, .errsize = errsize};

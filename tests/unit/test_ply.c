@@ -1,0 +1,83 @@
+/* tests/unit — PLY triangle strips (api/ply_strips.c): a `tristrips` element becomes triangles
+ * with the strip's alternating winding, -1 restarts, degenerate triangles dropped; the model
+ * imports with every triangle (Assimp 5.2 alone read a strip as one flat sliver). */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "api.h"
+#include "model.h"
+#include "ply_strips.h"
+#include "test.h"
+
+/* A binary little-endian PLY: 7 vertices, one strip 0 1 2 3 -1 4 5 6 6 (a quad, a restart, a
+ * triangle and a repeated index). */
+static uint8_t *strip_ply_binary(size_t *len)
+{
+	static const char hdr[] = "ply\nformat binary_little_endian 1.0\ncomment strips\nelement vertex 7\n"
+	                          "property float x\nproperty float y\nproperty float z\nelement tristrips 1\n"
+	                          "property list int int vertex_indices\nend_header\n";
+	static const float v[21] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 3, 0, 0, 4, 0, 0, 3, 1, 0};
+	static const int32_t s[10] = {9, 0, 1, 2, 3, -1, 4, 5, 6, 6};
+	*len = sizeof hdr - 1 + sizeof v + sizeof s;
+	uint8_t *d = malloc(*len);
+	memcpy(d, hdr, sizeof hdr - 1);
+	memcpy(d + sizeof hdr - 1, v, sizeof v);
+	memcpy(d + sizeof hdr - 1 + sizeof v, s, sizeof s);
+	return d;
+}
+
+TEST(ply_strips_become_triangles)
+{
+	size_t len, n = 0;
+	uint8_t *d = strip_ply_binary(&len);
+	uint8_t *out = api_ply_strips_to_faces(d, len, &n);
+	REQUIRE(out && n > 0);
+	static const char face_hdr[] = "element face 3\nproperty list uchar int vertex_indices\n";
+	CHECK(memmem(out, n, face_hdr, sizeof face_hdr - 1) != NULL, "header");
+	CHECK(!memmem(out, n, "tristrips", 9), "the strips element is gone");
+	/* faces after the 84 vertex bytes: (0 1 2), (2 1 3) flipped on the odd step, (4 5 6) */
+	const uint8_t *f = memmem(out, n, "end_header\n", 11) + 11 + 84;
+	static const int32_t want[9] = {0, 1, 2, 2, 1, 3, 4, 5, 6};
+	int ok = 1;
+	for (int t = 0; t < 3; t++) {
+		int32_t tri[3];
+		ok &= f[13 * t] == 3;
+		memcpy(tri, f + 13 * t + 1, 12);
+		ok &= !memcmp(tri, want + 3 * t, 12);
+	}
+	CHECK(ok && (size_t)(f + 39 - out) == n, "face records");
+	free(out);
+	/* A file with faces, or none of the element, is left alone. */
+	static const char faces[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+	                            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+	                            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+	CHECK(!api_ply_strips_to_faces((const uint8_t *)faces, sizeof faces - 1, &n));
+	/* Cut short or an index past the vertices: left to the importer (which refuses it). */
+	CHECK(!api_ply_strips_to_faces(d, len - 3, &n));
+	int32_t bad = 7;
+	memcpy(d + len - 4, &bad, 4);
+	CHECK(!api_ply_strips_to_faces(d, len, &n));
+	free(d);
+}
+
+TEST(ply_strips_ascii_import_every_triangle)
+{
+	static const char ply[] = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+	                          "property float z\nelement tristrips 1\nproperty list int int vertex_indices\n"
+	                          "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 2 3\n";
+	struct api_limits l;
+	api_limits_defaults(&l);
+	l.model_cache_bytes = 0;
+	struct api_model *m = NULL;
+	char err[300];
+	int st;
+	REQUIRE(api_model_get((const uint8_t *)ply, sizeof ply - 1, API_MODEL_PLY, &l, &m, &st, err, sizeof err) == API_OK &&
+	        m, "%s", err);
+	CHECK(m->triangles == 2, "%llu triangles (a quad strip has 2)", (unsigned long long)m->triangles);
+	/* Both triangles face the same way (+z here): the odd one's winding was flipped back. */
+	int up = 0;
+	for (uint32_t v = 0; v < m->meshes[0].vertex_count; v++) up += m->meshes[0].normals[3 * v + 2] > 0.99f;
+	CHECK(up == (int)m->meshes[0].vertex_count, "%d of %u normals +z", up, m->meshes[0].vertex_count);
+	api_model_release(m);
+}
