@@ -214,6 +214,21 @@ static void mat_from_ai(float out[16], const struct aiMatrix4x4 *a)
 		for (int col = 0; col < 4; col++) out[col * 4 + row] = r[row * 4 + col];
 }
 
+/* True when some triangle of the meshes has an area (a model of only degenerate triangles
+ * imports "fine" and renders nothing: it is refused instead). */
+static bool any_area(const struct api_model_mesh *m, uint32_t n)
+{
+	for (uint32_t i = 0; i < n; i++)
+		for (uint32_t t = 0; t + 2 < m[i].index_count; t += 3) {
+			const float *a = &m[i].positions[3 * m[i].indices[t]], *b = &m[i].positions[3 * m[i].indices[t + 1]],
+			            *c = &m[i].positions[3 * m[i].indices[t + 2]];
+			float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+			float x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+			if (x * x + y * y + z * z > 0.0f) return true;
+		}
+	return false;
+}
+
 static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_model_mesh *out)
 {
 	uint32_t nv = am->mNumVertices, ntri = 0;
@@ -431,6 +446,9 @@ static int convert(struct conv *c)
 		c->mesh_map[i] = (int32_t)nmesh++;
 	}
 	if (!nmesh) return err_set(c->err, c->errsize, "the model has no triangles"), -1;
+	if (!any_area(meshes, nmesh))
+		return err_set(c->err, c->errsize, "the model's triangles have no area (every one's corners lie on a line "
+		               "or a point): nothing would be drawn"), -1;
 
 	float id[16];
 	rnd_mat4_identity(id);

@@ -81,3 +81,19 @@ TEST(ply_strips_ascii_import_every_triangle)
 	CHECK(up == (int)m->meshes[0].vertex_count, "%d of %u normals +z", up, m->meshes[0].vertex_count);
 	api_model_release(m);
 }
+
+/* A model whose every triangle is degenerate imports "fine" in Assimp and draws nothing: a 400
+ * with the reason, never a silently empty image. */
+TEST(model_of_degenerate_triangles_is_refused)
+{
+	static const char obj[] = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n";
+	struct api_limits l;
+	api_limits_defaults(&l);
+	l.model_cache_bytes = 0;
+	struct api_model *m = NULL;
+	char err[300] = "";
+	int st = 0;
+	enum api_result r = api_model_get((const uint8_t *)obj, sizeof obj - 1, API_MODEL_OBJ, &l, &m, &st, err, sizeof err);
+	CHECK(r == API_ERR && st == 400 && strstr(err, "no area"), "%d %d: %s", (int)r, st, err);
+	api_model_release(m);
+}
