@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "errmsg.h"
 #include "arena.h"
 #include "model.h"
 #include "sandbox.h"
@@ -44,17 +45,6 @@ const char *api_model_format_name(enum api_model_format f)
 	return f >= API_MODEL_GLB && f <= API_MODEL_PLY ? FORMAT_NAMES[f] : "unknown";
 }
 
-static enum api_result err_set(char *err, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static enum api_result err_set(char *err, size_t n, const char *fmt, ...)
-{
-	if (err && n) {
-		va_list ap;
-		va_start(ap, fmt);
-		vsnprintf(err, n, fmt, ap);
-		va_end(ap);
-	}
-	return API_ERR;
-}
 
 /* ---- format sniffing ---- */
 
@@ -113,7 +103,7 @@ static struct model_priv *import(const uint8_t *data, size_t len, enum api_model
 	if (!m || !(m->arena = api_arena_create())) {
 		free(m);
 		*status = 500;
-		err_set(err, errsize, "out of memory importing the model");
+		api_err_set(err, errsize, "out of memory importing the model");
 		return NULL;
 	}
 	atomic_init(&m->refs, 1);
@@ -186,10 +176,10 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 		lim = &def;
 	}
 	uint64_t cache_bytes = lim->model_cache_bytes;
-	if (!data || !len) return err_set(err, errsize, "the model file is empty");
+	if (!data || !len) return api_err_set(err, errsize, "the model file is empty");
 	if (format == API_MODEL_SNIFF) format = api_model_sniff(data, len);
 	if (format < API_MODEL_GLB || format > API_MODEL_PLY)
-		return err_set(err, errsize, "the file is not a recognisable glb, gltf, obj, stl or ply model "
+		return api_err_set(err, errsize, "the file is not a recognisable glb, gltf, obj, stl or ply model "
 		               "(give format to say which)");
 	uint64_t h = fnv1a(data, len, 0xcbf29ce484222325ull ^ (uint64_t)format);
 

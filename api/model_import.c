@@ -23,6 +23,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <jansson.h>
+#include "errmsg.h"
 #include "model_import.h"
 #include "ply_strips.h"
 #include "umbra/rnd_math.h"
@@ -36,17 +37,6 @@ static pthread_mutex_t import_mu = PTHREAD_MUTEX_INITIALIZER;
 
 static const char *const FORMAT_NAMES[] = {"glb", "gltf", "obj", "stl", "ply"};
 
-static enum api_result err_set(char *err, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static enum api_result err_set(char *err, size_t n, const char *fmt, ...)
-{
-	if (err && n) {
-		va_list ap;
-		va_start(ap, fmt);
-		vsnprintf(err, n, fmt, ap);
-		va_end(ap);
-	}
-	return API_ERR;
-}
 
 /* ---- glTF checks Assimp 5.2 lacks ---- */
 
@@ -64,9 +54,9 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
 	size_t jlen = len;
 	if (f == API_MODEL_GLB) {
 		if (len < 20 || memcmp(d + 16, "JSON", 4))
-			return err_set(err, errsize, "the glb has no JSON chunk"), -1;
+			return api_err_set(err, errsize, "the glb has no JSON chunk"), -1;
 		uint32_t n = (uint32_t)d[12] | (uint32_t)d[13] << 8 | (uint32_t)d[14] << 16 | (uint32_t)d[15] << 24;
-		if (n > len - 20) return err_set(err, errsize, "the glb's JSON chunk is longer than the file"), -1;
+		if (n > len - 20) return api_err_set(err, errsize, "the glb's JSON chunk is longer than the file"), -1;
 		json = (const char *)d + 20;
 		jlen = n;
 	}
@@ -74,7 +64,7 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
 	json_t *root = json_loadb(json, jlen, 0, &je);
 	if (!json_is_object(root)) {
 		json_decref(root);
-		return err_set(err, errsize, "the glTF JSON is malformed (line %d: %s)", je.line,
+		return api_err_set(err, errsize, "the glTF JSON is malformed (line %d: %s)", je.line,
 		               root ? "not an object" : je.text), -1;
 	}
 	json_t *images = json_object_get(root, "images"), *im;
@@ -93,7 +83,7 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
 		if (rc) break;
 	}
 	json_decref(root);
-	if (rc) return err_set(err, errsize, "glTF image %zu is not a PNG or JPEG image (mimeType)", i), -1;
+	if (rc) return api_err_set(err, errsize, "glTF image %zu is not a PNG or JPEG image (mimeType)", i), -1;
 	return 0;
 }
 
@@ -238,11 +228,11 @@ static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_mode
 	float *uv = am->mTextureCoords[0] ? conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
 	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
 	if (!pos || (am->mNormals && !nrm) || (am->mTextureCoords[0] && !uv) || !idx)
-		return err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	for (uint32_t v = 0; v < nv; v++) {
 		const struct aiVector3D *p = &am->mVertices[v];
 		if (!isfinite(p->x) || !isfinite(p->y) || !isfinite(p->z))
-			return err_set(c->err, c->errsize, "mesh \"%.64s\": vertex %u is not a finite position",
+			return api_err_set(c->err, c->errsize, "mesh \"%.64s\": vertex %u is not a finite position",
 			               am->mName.data, v), -1;
 		pos[3 * v] = p->x; pos[3 * v + 1] = p->y; pos[3 * v + 2] = p->z;
 		if (nrm) {
@@ -264,7 +254,7 @@ static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_mode
 		if (face->mNumIndices != 3) continue;
 		for (int j = 0; j < 3; j++) {
 			if (face->mIndices[j] >= nv)
-				return err_set(c->err, c->errsize, "mesh \"%.64s\": face %u refers to vertex %u of %u",
+				return api_err_set(c->err, c->errsize, "mesh \"%.64s\": face %u refers to vertex %u of %u",
 				               am->mName.data, f, face->mIndices[j], nv), -1;
 			idx[k++] = face->mIndices[j];
 		}
@@ -305,7 +295,7 @@ static const struct rnd_texture *texture(struct conv *c, int ti)
 	if (c->tex[ti]) return c->tex[ti];
 	const struct aiTexture *at = c->sc->mTextures[ti];
 	struct rnd_texture *t = conv_alloc(c, 1, sizeof *t);
-	if (!t) return err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+	if (!t) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
 	if (at->mHeight == 0) {
 		/* Compressed: mWidth bytes of a PNG or JPEG file. */
 		uint8_t *px;
@@ -313,20 +303,20 @@ static const struct rnd_texture *texture(struct conv *c, int ti)
 		char e[200];
 		if (api_image_decode((const uint8_t *)at->pcData, at->mWidth, MAX_TEXTURE_PIXELS, &px, &w, &h, e,
 		                     sizeof e) != API_OK)
-			return err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
+			return api_err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
 		uint8_t *copy = conv_alloc(c, (size_t)w * h, 4);
 		if (copy) memcpy(copy, px, (size_t)w * h * 4);
 		free(px);
-		if (!copy) return err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+		if (!copy) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
 		t->rgba = copy;
 		t->width = w;
 		t->height = h;
 	} else {
 		uint64_t n = (uint64_t)at->mWidth * at->mHeight;
 		if (n > MAX_TEXTURE_PIXELS)
-			return err_set(c->err, c->errsize, "embedded texture %d is over the texture size limit", ti), NULL;
+			return api_err_set(c->err, c->errsize, "embedded texture %d is over the texture size limit", ti), NULL;
 		uint8_t *px = conv_alloc(c, (size_t)n, 4);
-		if (!px) return err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+		if (!px) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
 		for (size_t i = 0; i < n; i++) { /* aiTexel is BGRA */
 			px[4 * i] = at->pcData[i].r;
 			px[4 * i + 1] = at->pcData[i].g;
@@ -389,13 +379,13 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, struct 
 static int walk(struct conv *c, const struct aiNode *node, const float parent[16], int depth)
 {
 	if (depth > MAX_NODE_DEPTH)
-		return err_set(c->err, c->errsize, "the node tree is deeper than %d levels", MAX_NODE_DEPTH), -1;
+		return api_err_set(c->err, c->errsize, "the node tree is deeper than %d levels", MAX_NODE_DEPTH), -1;
 	float local[16], global[16];
 	mat_from_ai(local, &node->mTransformation);
 	rnd_mat4_mul(global, parent, local);
 	for (int i = 0; i < 16; i++)
 		if (!isfinite(global[i]))
-			return err_set(c->err, c->errsize, "node \"%.64s\" has a transform that is not finite",
+			return api_err_set(c->err, c->errsize, "node \"%.64s\" has a transform that is not finite",
 			               node->mName.data), -1;
 	for (unsigned i = 0; i < node->mNumMeshes; i++) {
 		unsigned mi = node->mMeshes[i];
@@ -404,7 +394,7 @@ static int walk(struct conv *c, const struct aiNode *node, const float parent[16
 			uint32_t cap = c->inst_cap ? c->inst_cap * 2 : 16;
 			struct api_model_instance *n = realloc(c->inst, cap * sizeof *n);
 			if (!n || cap < c->inst_cap)
-				return c->oom = true, err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+				return c->oom = true, api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 			c->inst = n;
 			c->inst_cap = cap;
 		}
@@ -424,17 +414,17 @@ static int convert(struct conv *c)
 	c->mesh_map = calloc(sc->mNumMeshes ? sc->mNumMeshes : 1, sizeof *c->mesh_map);
 	c->tex = calloc(sc->mNumTextures ? sc->mNumTextures : 1, sizeof *c->tex);
 	if (!c->mesh_map || !c->tex)
-		return c->oom = true, err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+		return c->oom = true, api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 
 	uint32_t nmat = sc->mNumMaterials ? sc->mNumMaterials : 1;
 	struct rnd_material *mats = conv_alloc(c, nmat, sizeof *mats);
-	if (!mats) return err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	if (!mats) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	rnd_material_defaults(&mats[0]);
 	for (unsigned i = 0; i < sc->mNumMaterials; i++)
 		if (convert_material(c, sc->mMaterials[i], &mats[i]) < 0) return -1;
 
 	struct api_model_mesh *meshes = conv_alloc(c, sc->mNumMeshes, sizeof *meshes);
-	if (!meshes) return err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	if (!meshes) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	uint32_t nmesh = 0;
 	for (unsigned i = 0; i < sc->mNumMeshes; i++) {
 		const struct aiMesh *am = sc->mMeshes[i];
@@ -445,17 +435,17 @@ static int convert(struct conv *c)
 		if (meshes[nmesh].material >= nmat) meshes[nmesh].material = 0;
 		c->mesh_map[i] = (int32_t)nmesh++;
 	}
-	if (!nmesh) return err_set(c->err, c->errsize, "the model has no triangles"), -1;
+	if (!nmesh) return api_err_set(c->err, c->errsize, "the model has no triangles"), -1;
 	if (!any_area(meshes, nmesh))
-		return err_set(c->err, c->errsize, "the model's triangles have no area (every one's corners lie on a line "
+		return api_err_set(c->err, c->errsize, "the model's triangles have no area (every one's corners lie on a line "
 		               "or a point): nothing would be drawn"), -1;
 
 	float id[16];
 	rnd_mat4_identity(id);
 	if (sc->mRootNode && walk(c, sc->mRootNode, id, 0) < 0) return -1;
-	if (!c->ninst) return err_set(c->err, c->errsize, "no node of the model shows a mesh"), -1;
+	if (!c->ninst) return api_err_set(c->err, c->errsize, "no node of the model shows a mesh"), -1;
 	struct api_model_instance *inst = conv_alloc(c, c->ninst, sizeof *inst);
-	if (!inst) return err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	if (!inst) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	memcpy(inst, c->inst, c->ninst * sizeof *inst);
 	uint64_t tris = 0;
 	for (uint32_t i = 0; i < c->ninst; i++) tris += meshes[inst[i].mesh].index_count / 3;
@@ -478,7 +468,7 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	memset(out, 0, sizeof *out);
 	*bytes = 0;
 	if (!data || !len || format < API_MODEL_GLB || format > API_MODEL_PLY)
-		return err_set(err, errsize, "the model file is empty or of no known format"), API_WIRE_BAD_INPUT;
+		return api_err_set(err, errsize, "the model file is empty or of no known format"), API_WIRE_BAD_INPUT;
 	out->format = format;
 	if ((format == API_MODEL_GLB || format == API_MODEL_GLTF) && gltf_precheck(data, len, format, err, errsize) < 0)
 		return API_WIRE_BAD_INPUT;
@@ -507,7 +497,7 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, flags, &io, props);
 	if (!sc) {
 		const char *msg = aiGetErrorString();
-		err_set(err, errsize, "%s", msg && msg[0] ? msg : "Assimp could not read it");
+		api_err_set(err, errsize, "%s", msg && msg[0] ? msg : "Assimp could not read it");
 		/* Assimp turns std::bad_alloc into its error string. */
 		st = msg && strstr(msg, "bad_alloc") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 	}

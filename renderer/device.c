@@ -27,17 +27,23 @@ const char *rnd_vk_str(VkResult r)
 	}
 }
 
+static void vfail(struct rnd_error *err, enum rnd_result code, enum rnd_error_at at, uint32_t index, const char *fmt,
+                  va_list ap)
+{
+	vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+	err->code = code;
+	err->vk_result = 0;
+	err->at = at;
+	err->at_index = index;
+}
+
 enum rnd_result rnd_fail(struct rnd_error *err, enum rnd_result code, const char *fmt, ...)
 {
 	if (err) {
 		va_list ap;
 		va_start(ap, fmt);
-		vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+		vfail(err, code, RND_AT_NONE, 0, fmt, ap);
 		va_end(ap);
-		err->code = code;
-		err->vk_result = 0;
-		err->at = RND_AT_NONE;
-		err->at_index = 0;
 	}
 	return code;
 }
@@ -48,12 +54,8 @@ enum rnd_result rnd_fail_at(struct rnd_error *err, enum rnd_result code, enum rn
 	if (err) {
 		va_list ap;
 		va_start(ap, fmt);
-		vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+		vfail(err, code, at, index, fmt, ap);
 		va_end(ap);
-		err->code = code;
-		err->vk_result = 0;
-		err->at = at;
-		err->at_index = index;
 	}
 	return code;
 }

@@ -24,12 +24,12 @@ uint32_t rnd_aov_passes(const struct rnd_scene *sc)
 	return n <= 8 ? 1 : 1 + (n - 8 + 15) / 16;
 }
 
-static uint64_t pixel_bytes(enum rnd_pixel_format f)
+uint64_t rnd_pixel_bytes(enum rnd_pixel_format f)
 {
 	return f == RND_PIXELS_RGBA8 ? 4 : f == RND_PIXELS_RGBA16 ? 8 : 16;
 }
 
-static uint32_t aov_planes(const struct rnd_scene *sc)
+uint32_t rnd_aov_planes(const struct rnd_scene *sc)
 {
 	uint32_t a = sc->output.aovs;
 	return (a & RND_AOV_DEPTH ? 1 : 0) + (a & RND_AOV_NORMAL ? 3 : 0) + (a & RND_AOV_ALBEDO ? 3 : 0) +
@@ -43,7 +43,7 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 	uint32_t cols, rows;
 	rnd_sheet_layout(sc->view_count, &cols, &rows);
 	uint64_t px = (uint64_t)sc->width * sc->height, sheet = px * cols * rows;
-	uint64_t pb = pixel_bytes(sc->output.pixels), samples = sc->output.msaa > 1 ? sc->output.msaa : 1;
+	uint64_t pb = rnd_pixel_bytes(sc->output.pixels), samples = sc->output.msaa > 1 ? sc->output.msaa : 1;
 	uint32_t passes = rnd_aov_passes(sc);
 	uint64_t colour = sheet * pb, aov_att = sheet * 16;
 	uint64_t readback = colour + (uint64_t)passes * UMBRA_AOV_ATTACHMENTS * aov_att;
@@ -68,7 +68,7 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 	uint64_t aov_targets = passes ? px * (16 * UMBRA_AOV_ATTACHMENTS + 4) : 0;
 	e->device_bytes = targets + aov_targets + readback + geometry + scratch;
 	/* The image handed back (colour + float AOV planes) and, at most as large, its encoding. */
-	uint64_t image = colour + sheet * 4 * aov_planes(sc);
+	uint64_t image = colour + sheet * 4 * rnd_aov_planes(sc);
 	e->host_bytes = 2 * image;
 	e->largest_allocation = max64(max64(readback, geometry), max64(px * pb * samples, px * 16));
 	e->readback_bytes = readback;
@@ -90,7 +90,7 @@ enum rnd_result rnd_check_allocation(const struct rnd_context *ctx, const struct
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_AOVS, 0,
 		                   "%ux%u%s with %u AOV planes needs %.2f GB in one buffer; this device allows %.2f GB: "
 		                   "ask for fewer AOVs (each light's shadow is one plane) or fewer pixels",
-		                   sc->width, sc->height, sc->view_count > 1 ? " per view" : "", aov_planes(sc),
+		                   sc->width, sc->height, sc->view_count > 1 ? " per view" : "", rnd_aov_planes(sc),
 		                   e->largest_allocation / 1e9, max / 1e9);
 	return rnd_fail_at(err, RND_ERR_LIMIT, sc->view_count > 1 ? RND_AT_VIEWS : RND_AT_SIZE, 0,
 	                   "the image needs %.2f GB in one buffer; this device allows %.2f GB: fewer pixels",

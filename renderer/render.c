@@ -49,8 +49,7 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 		return rnd_fail(err, RND_ERR_INVALID, "debug_light %u names no light", sc->output.debug_light);
 	if (sc->output.aovs && sc->output.pixels != RND_PIXELS_RGBA32F)
 		return rnd_fail(err, RND_ERR_INVALID, "AOVs need the linear RGBA32F output (EXR)");
-	uint32_t planes = (sc->output.aovs & RND_AOV_DEPTH ? 1 : 0) + (sc->output.aovs & RND_AOV_NORMAL ? 3 : 0) +
-	                  (sc->output.aovs & RND_AOV_ALBEDO ? 3 : 0) + (sc->output.aovs & RND_AOV_SHADOW ? sc->light_count : 0);
+	uint32_t planes = rnd_aov_planes(sc);
 	if (planes > RND_MAX_AOV_PLANES)
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_AOVS, 0, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)",
 		                   planes, RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
@@ -241,10 +240,6 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	return RND_OK;
 }
 
-static size_t pixel_size(enum rnd_pixel_format f)
-{
-	return f == RND_PIXELS_RGBA8 ? 4 : f == RND_PIXELS_RGBA16 ? 8 : 16;
-}
 
 /* Tessellates every object into the slot's buffers; fills draws and the scene bounds. */
 static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
@@ -478,7 +473,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if ((r = rnd_slot_targets(ctx, s, fmt, sc->width, sc->height, sc->output.msaa, err)) != RND_OK) goto done;
 	uint32_t passes = rnd_aov_passes(sc);
 	if (passes && (r = rnd_slot_aov(ctx, s, sc->width, sc->height, err)) != RND_OK) goto done;
-	size_t px = pixel_size(sc->output.pixels);
+	size_t px = (size_t)rnd_pixel_bytes(sc->output.pixels);
 	VkDeviceSize color_bytes = sheet_w * sheet_h * px;
 	VkDeviceSize att_bytes = sheet_w * sheet_h * 16;
 	VkDeviceSize rb = color_bytes + (VkDeviceSize)passes * UMBRA_AOV_ATTACHMENTS * att_bytes;
