@@ -23,13 +23,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <errno.h>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <jansson.h>
 #include "api.h"
 #include "arena.h"
+#include "asset.h"
 #include "base64.h"
 #include "ground.h"
 #include "preset.h"
@@ -734,65 +731,20 @@ static int parse_mesh(struct pctx *c, json_t *j, struct rnd_object *o)
 	return 0;
 }
 
-#define MAX_ASSET_BYTES (1ull << 30)
-
-/* Reads `path` (already checked: relative, no ".." component) under the asset root into a
- * malloc'd buffer. Symlinks are followed only while they stay inside the root. 0 or -1 (400 at
+/* Reads `path` (checked by api_asset_check_path) under the asset root (api/asset.h) into a
+ * malloc'd buffer, folding it into the scene's asset hash: the answer depends on the file, not
+ * only on the request, so the server's ETag must change when the file does. 0 or -1 (400 at
  * the current pointer, 500 when the root itself is unusable). */
 static int read_asset(struct pctx *c, const char *path, unsigned char **out, size_t *len)
 {
-	const char *root = c->lim->asset_root;
-	if (!root || !root[0]) return fail(c, "path cannot be used: no asset root configured on this server");
-	char rroot[PATH_MAX], full[PATH_MAX], real[PATH_MAX];
-	if (!realpath(root, rroot)) {
-		api_problem_set(c->p, 500, c->ptr, "the asset root cannot be resolved: %s", strerror(errno));
+	char err[300];
+	int status;
+	if (api_asset_read(c->lim->asset_root, path, out, len, &status, err, sizeof err) != API_OK) {
+		api_problem_set(c->p, status, c->ptr, "%s", err);
 		return -1;
 	}
-	if ((size_t)snprintf(full, sizeof full, "%s/%s", rroot, path) >= sizeof full)
-		return fail(c, "path is too long");
-	if (!realpath(full, real)) return fail(c, "path \"%.128s\" cannot be opened: %s", path, strerror(errno));
-	size_t n = strlen(rroot);
-	bool inside = !strcmp(rroot, "/") || (!strncmp(real, rroot, n) && real[n] == '/');
-	if (!inside) return fail(c, "path \"%.128s\" leaves the asset root (through a symbolic link)", path);
-	/* O_NONBLOCK: opening a FIFO (or a device) must not wait for a writer; anything but a
-	 * regular file is refused right after, before a read could block. */
-	int fd = open(real, O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
-	if (fd < 0) return fail(c, "path \"%.128s\" cannot be opened: %s", path, strerror(errno));
-	struct stat st;
-	int rc = 0;
-	unsigned char *buf = NULL;
-	if (fstat(fd, &st) < 0 || !S_ISREG(st.st_mode)) {
-		rc = fail(c, "path \"%.128s\" is not a regular file", path);
-	} else if ((uint64_t)st.st_size > MAX_ASSET_BYTES || !st.st_size) {
-		rc = fail(c, "path \"%.128s\" is empty or larger than %llu bytes", path, MAX_ASSET_BYTES);
-	} else if (!(buf = malloc((size_t)st.st_size))) {
-		rc = fail(c, "path \"%.128s\" is too large to read (out of memory)", path);
-	} else {
-		size_t got = 0;
-		while (got < (size_t)st.st_size) {
-			ssize_t r = read(fd, buf + got, (size_t)st.st_size - got);
-			if (r < 0 && errno == EINTR) continue;
-			if (r <= 0) break;
-			got += (size_t)r;
-		}
-		if (got != (size_t)st.st_size) {
-			free(buf);
-			buf = NULL;
-			rc = fail(c, "path \"%.128s\" could not be read", path);
-		}
-	}
-	close(fd);
-	*out = buf;
-	*len = buf ? (size_t)st.st_size : 0;
-	/* The answer depends on the file, not only on the request: fold its bytes (and name)
-	 * into the scene's asset hash so the server's ETag changes when the file does. */
-	if (buf) {
-		uint64_t h = c->asset_hash ? c->asset_hash : 0xcbf29ce484222325ull;
-		for (const char *q = path; *q; q++) h = (h ^ (unsigned char)*q) * 0x100000001b3ull;
-		for (size_t i = 0; i < *len; i++) h = (h ^ buf[i]) * 0x100000001b3ull;
-		c->asset_hash = h;
-	}
-	return rc;
+	api_asset_hash(&c->asset_hash, path, *out, *len);
+	return 0;
 }
 
 static int parse_model(struct pctx *c, json_t *j)
@@ -823,11 +775,8 @@ static int parse_model(struct pctx *c, json_t *j)
 		else if (!len) rc = fail(c, "data must not be empty");
 	} else if (!strcmp(first, "path")) {
 		const char *s = json_string_value(v);
-		bool bad = !s[0] || s[0] == '/' || s[0] == '\\' || strchr(s, ':') || strchr(s, '\\');
-		/* No ".." segment anywhere: the path never escapes the asset root. */
-		for (const char *q = s; !bad && *q; q = strchr(q, '/') ? strchr(q, '/') + 1 : q + strlen(q))
-			if (q[0] == '.' && q[1] == '.' && (q[2] == '/' || q[2] == 0)) bad = true;
-		if (bad) rc = fail(c, "path must be a relative path inside the asset root (no leading \"/\", no \"..\")");
+		char perr[200];
+		if (api_asset_check_path(s, perr, sizeof perr) != API_OK) rc = fail(c, "%s", perr);
 		else rc = read_asset(c, s, &b, &len);
 		if (!rc && !given) { /* the extension says what the bytes may not (obj, ascii stl) */
 			const char *dot = strrchr(s, '.');

@@ -1,0 +1,153 @@
+/*
+ * tests/unit/test_asset — api/asset.c: paths and references under an asset root. Escapes by
+ * "..", by an absolute path, by a symbolic link (absolute, relative, through a linked
+ * directory) are refused; a FIFO and a directory are refused at once; references resolve
+ * against the referring file's directory.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include "asset.h"
+#include "test.h"
+
+static void put(const char *dir, const char *name, const char *text)
+{
+	char p[1024];
+	snprintf(p, sizeof p, "%s/%s", dir, name);
+	FILE *f = fopen(p, "wb");
+	if (f) {
+		fputs(text, f);
+		fclose(f);
+	}
+}
+
+/* A root with sub/a.txt, outside/secret.txt beside it, and links in and out. */
+static void make_tree(char *base, char *root, size_t n)
+{
+	snprintf(root, n, "%s/root", base);
+	char p[512];
+	mkdir(root, 0700);
+	snprintf(p, sizeof p, "%s/outside", base);
+	mkdir(p, 0700);
+	put(p, "secret.txt", "secret");
+	snprintf(p, sizeof p, "%s/sub", root);
+	mkdir(p, 0700);
+	put(p, "a.txt", "inside");
+	char target[512], link[512];
+	snprintf(target, sizeof target, "%s/outside/secret.txt", base);
+	snprintf(link, sizeof link, "%s/abs_out.txt", root);
+	symlink(target, link);
+	snprintf(link, sizeof link, "%s/rel_out.txt", root);
+	symlink("../outside/secret.txt", link);
+	snprintf(link, sizeof link, "%s/updir", root);
+	symlink("..", link);
+	snprintf(link, sizeof link, "%s/in.txt", root);
+	symlink("sub/a.txt", link);
+	snprintf(p, sizeof p, "%s/pipe.bin", root);
+	mkfifo(p, 0600);
+}
+
+static void remove_tree(const char *base)
+{
+	char cmd[600];
+	snprintf(cmd, sizeof cmd, "rm -rf '%s'", base);
+	CHECK(system(cmd) == 0);
+}
+
+TEST(asset_reads_inside_root)
+{
+	char base[] = "/tmp/umbra-asset-XXXXXX", root[300];
+	REQUIRE(mkdtemp(base));
+	make_tree(base, root, sizeof root);
+	uint8_t *b = NULL;
+	size_t n = 0;
+	int st = 0;
+	char err[300];
+	CHECK(api_asset_read(root, "sub/a.txt", &b, &n, &st, err, sizeof err) == API_OK && n == 6 &&
+	      !memcmp(b, "inside", 6), "%d %s", st, err);
+	free(b);
+	/* A link that stays inside the root is followed. */
+	CHECK(api_asset_read(root, "in.txt", &b, &n, &st, err, sizeof err) == API_OK && n == 6, "%d %s", st, err);
+	free(b);
+	remove_tree(base);
+}
+
+TEST(asset_refuses_escapes)
+{
+	char base[] = "/tmp/umbra-asset-XXXXXX", root[300];
+	REQUIRE(mkdtemp(base));
+	make_tree(base, root, sizeof root);
+	static const char *const out[] = {"abs_out.txt", "rel_out.txt", "updir/outside/secret.txt",
+	                                  "../outside/secret.txt", "sub/../../outside/secret.txt"};
+	for (size_t i = 0; i < sizeof out / sizeof out[0]; i++) {
+		uint8_t *b = (uint8_t *)"x";
+		size_t n = 1;
+		int st = 0;
+		char err[300] = "";
+		CHECK(api_asset_read(root, out[i], &b, &n, &st, err, sizeof err) == API_ERR && st == 400 && !b && !n,
+		      "%s: %d %s", out[i], st, err);
+		CHECK(strstr(err, "leaves the asset root"), "%s: %s", out[i], err);
+	}
+	/* The same paths never get that far as a `path`. */
+	char err[300];
+	CHECK(api_asset_check_path("../outside/secret.txt", err, sizeof err) == API_ERR);
+	CHECK(api_asset_check_path("sub/../a.txt", err, sizeof err) == API_ERR);
+	CHECK(api_asset_check_path("/etc/passwd", err, sizeof err) == API_ERR);
+	CHECK(api_asset_check_path("C:/x.obj", err, sizeof err) == API_ERR);
+	CHECK(api_asset_check_path("sub\\a.txt", err, sizeof err) == API_ERR);
+	CHECK(api_asset_check_path("", err, sizeof err) == API_ERR);
+	CHECK(api_asset_check_path("sub/a.txt", err, sizeof err) == API_OK);
+	CHECK(api_asset_check_path("..a/b..", err, sizeof err) == API_OK);
+	remove_tree(base);
+}
+
+TEST(asset_refuses_fifo_directory_missing)
+{
+	char base[] = "/tmp/umbra-asset-XXXXXX", root[300];
+	REQUIRE(mkdtemp(base));
+	make_tree(base, root, sizeof root);
+	static const char *const bad[] = {"pipe.bin", "sub", "missing.bin"};
+	static const char *const why[] = {"not a regular file", "not a regular file", "No such file"};
+	for (int i = 0; i < 3; i++) {
+		uint8_t *b = NULL;
+		size_t n = 0;
+		int st = 0;
+		char err[300] = "";
+		/* The FIFO has no writer: a blocking open would never return. */
+		CHECK(api_asset_read(root, bad[i], &b, &n, &st, err, sizeof err) == API_ERR && st == 400 &&
+		      strstr(err, why[i]), "%s: %d %s", bad[i], st, err);
+	}
+	uint8_t *b = NULL;
+	size_t n = 0;
+	int st = 0;
+	char err[300] = "";
+	CHECK(api_asset_read(NULL, "sub/a.txt", &b, &n, &st, err, sizeof err) == API_ERR && st == 400 &&
+	      strstr(err, "no asset root"), "%s", err);
+	CHECK(api_asset_read("/nonexistent-umbra-root", "a", &b, &n, &st, err, sizeof err) == API_ERR && st == 500,
+	      "%d %s", st, err);
+	remove_tree(base);
+}
+
+TEST(asset_resolves_references)
+{
+	char out[256], err[300];
+	CHECK(api_asset_resolve("models/x.gltf", "x.bin", out, sizeof out, err, sizeof err) == API_OK &&
+	      !strcmp(out, "models/x.bin"), "%s", out);
+	CHECK(api_asset_resolve("models/x.gltf", "./tex/../img/a.png", out, sizeof out, err, sizeof err) == API_OK &&
+	      !strcmp(out, "models/img/a.png"), "%s", out);
+	CHECK(api_asset_resolve("models/x.obj", "..\\shared\\t.png", out, sizeof out, err, sizeof err) == API_OK &&
+	      !strcmp(out, "shared/t.png"), "%s", out);
+	CHECK(api_asset_resolve("x.gltf", "a.bin", out, sizeof out, err, sizeof err) == API_OK && !strcmp(out, "a.bin"),
+	      "%s", out);
+	/* Above the root, absolute, with a scheme, empty, a directory. */
+	CHECK(api_asset_resolve("models/x.gltf", "../../etc/passwd", out, sizeof out, err, sizeof err) == API_ERR &&
+	      strstr(err, "leaves the asset root"), "%s", err);
+	CHECK(api_asset_resolve("x.gltf", "../x.bin", out, sizeof out, err, sizeof err) == API_ERR);
+	CHECK(api_asset_resolve("x.gltf", "/etc/passwd", out, sizeof out, err, sizeof err) == API_ERR);
+	CHECK(api_asset_resolve("x.gltf", "http://example.com/a.bin", out, sizeof out, err, sizeof err) == API_ERR);
+	CHECK(api_asset_resolve("x.gltf", "C:\\a.png", out, sizeof out, err, sizeof err) == API_ERR);
+	CHECK(api_asset_resolve("x.gltf", "", out, sizeof out, err, sizeof err) == API_ERR);
+	CHECK(api_asset_resolve("m/x.gltf", "..", out, sizeof out, err, sizeof err) == API_ERR);
+}
