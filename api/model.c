@@ -30,6 +30,7 @@ struct model_priv {
 	uint64_t hash;
 	uint8_t *src;
 	size_t src_len;
+	size_t model_len;             /* of src: the model file; the rest are the files it refers to */
 	struct model_priv *prev, *next;
 	bool listed;
 };
@@ -96,8 +97,9 @@ static void model_free(struct model_priv *m)
 }
 
 /* Imports through the sandbox (api/sandbox.h): the bytes never meet Assimp in this process. */
-static struct model_priv *import(const uint8_t *data, size_t len, enum api_model_format format,
-                                 const struct api_limits *lim, int *status, char *err, size_t errsize)
+static struct model_priv *import(const uint8_t *data, size_t len, size_t model_len, size_t nfiles,
+                                 enum api_model_format format, const struct api_limits *lim, int *status, char *err,
+                                 size_t errsize)
 {
 	struct model_priv *m = calloc(1, sizeof *m);
 	if (!m || !(m->arena = api_arena_create())) {
@@ -109,7 +111,8 @@ static struct model_priv *import(const uint8_t *data, size_t len, enum api_model
 	atomic_init(&m->refs, 1);
 	m->pub.priv_ = m;
 	size_t bytes = 0;
-	if (api_sandbox_import_model(data, len, format, lim, m->arena, &m->pub, &bytes, status, err, errsize) != API_OK) {
+	if (api_sandbox_import_bundle(data, len, model_len, nfiles, format, lim, m->arena, &m->pub, &bytes, status, err,
+	                              errsize) != API_OK) {
 		model_free(m);
 		return NULL;
 	}
@@ -150,10 +153,13 @@ static void lru_push_front(struct model_priv *m)
 	cache_total += m->pub.bytes_;
 }
 
-static struct model_priv *lru_find(uint64_t h, const uint8_t *data, size_t len, enum api_model_format f)
+static struct model_priv *lru_find(uint64_t h, const uint8_t *data, size_t len, size_t model_len,
+                                   enum api_model_format f)
 {
 	for (struct model_priv *m = lru_head; m; m = m->next)
-		if (m->hash == h && m->src_len == len && m->pub.format == f && !memcmp(m->src, data, len)) return m;
+		if (m->hash == h && m->src_len == len && m->model_len == model_len && m->pub.format == f &&
+		    !memcmp(m->src, data, len))
+			return m;
 	return NULL;
 }
 
@@ -164,27 +170,17 @@ void api_model_release(struct api_model *pub)
 	if (atomic_fetch_sub(&m->refs, 1) == 1) model_free(m);
 }
 
-enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format,
-                              const struct api_limits *lim, struct api_model **out, int *status, char *err,
-                              size_t errsize)
+/* The cache's entry for `data` (the model's model_len bytes, then nfiles files as the sandbox's
+ * bundle lays them out: the key covers the files too), importing it on a miss. */
+static enum api_result get(const uint8_t *data, size_t len, size_t model_len, size_t nfiles,
+                           enum api_model_format format, const struct api_limits *lim, struct api_model **out,
+                           int *status, char *err, size_t errsize)
 {
-	*out = NULL;
-	*status = 400;
-	struct api_limits def;
-	if (!lim) {
-		api_limits_defaults(&def);
-		lim = &def;
-	}
 	uint64_t cache_bytes = lim->model_cache_bytes;
-	if (!data || !len) return api_err_set(err, errsize, "the model file is empty");
-	if (format == API_MODEL_SNIFF) format = api_model_sniff(data, len);
-	if (format < API_MODEL_GLB || format > API_MODEL_PLY)
-		return api_err_set(err, errsize, "the file is not a recognisable glb, gltf, obj, stl or ply model "
-		               "(give format to say which)");
 	uint64_t h = fnv1a(data, len, 0xcbf29ce484222325ull ^ (uint64_t)format);
 
 	pthread_mutex_lock(&cache_mu);
-	struct model_priv *hit = lru_find(h, data, len, format);
+	struct model_priv *hit = lru_find(h, data, len, model_len, format);
 	if (hit) {
 		cache_hits++;
 		lru_unlink(hit);
@@ -200,7 +196,7 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 		return API_OK;
 	}
 
-	struct model_priv *m = import(data, len, format, lim, status, err, errsize);
+	struct model_priv *m = import(data, len, model_len, nfiles, format, lim, status, err, errsize);
 	if (!m) return API_ERR;
 	*status = 0;
 	uint64_t cost = m->pub.bytes_ + len;
@@ -210,13 +206,14 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 	}
 	memcpy(m->src, data, len);
 	m->src_len = len;
+	m->model_len = model_len;
 	m->hash = h;
 	m->pub.bytes_ = cost;
 
 	struct model_priv *evicted = NULL;
 	pthread_mutex_lock(&cache_mu);
 	/* Another request may have imported the same bytes meanwhile: use the listed one. */
-	struct model_priv *dup = lru_find(h, data, len, format);
+	struct model_priv *dup = lru_find(h, data, len, model_len, format);
 	if (dup) {
 		atomic_fetch_add(&dup->refs, 1);
 	} else {
@@ -242,6 +239,41 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 	}
 	*out = &m->pub;
 	return API_OK;
+}
+
+enum api_result api_model_get_files(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                    size_t nfiles, enum api_model_format format, const struct api_limits *lim,
+                                    struct api_model **out, int *status, char *err, size_t errsize)
+{
+	*out = NULL;
+	*status = 400;
+	struct api_limits def;
+	if (!lim) {
+		api_limits_defaults(&def);
+		lim = &def;
+	}
+	if (!data || !len) return api_err_set(err, errsize, "the model file is empty");
+	if (format == API_MODEL_SNIFF) format = api_model_sniff(data, len);
+	if (format < API_MODEL_GLB || format > API_MODEL_PLY)
+		return api_err_set(err, errsize, "the file is not a recognisable glb, gltf, obj, stl or ply model "
+		               "(give format to say which)");
+	if (!nfiles) return get(data, len, len, 0, format, lim, out, status, err, errsize);
+	size_t blen;
+	uint8_t *bundle = api_sbx_bundle_encode(data, len, files, nfiles, &blen);
+	if (!bundle) {
+		*status = 422;
+		return api_err_set(err, errsize, "the model and its files are too large to import (out of memory)");
+	}
+	enum api_result rc = get(bundle, blen, len, nfiles, format, lim, out, status, err, errsize);
+	free(bundle);
+	return rc;
+}
+
+enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format,
+                              const struct api_limits *lim, struct api_model **out, int *status, char *err,
+                              size_t errsize)
+{
+	return api_model_get_files(data, len, NULL, 0, format, lim, out, status, err, errsize);
 }
 
 void api_model_cache_stats(uint64_t *hits, uint64_t *misses, uint64_t *bytes)

@@ -1,7 +1,8 @@
 /*
- * api/model — imported 3D models (contract shape "model"): glb, self-contained gltf, obj, stl,
- * ply through the Assimp C API, base-colour textures through api/image_decode.c, and a bounded
- * LRU cache of imported models keyed by their bytes.
+ * api/model — imported 3D models (contract shape "model"): glb, gltf (self-contained or with
+ * its buffer and image files), obj (with its .mtl and textures), stl, ply through the Assimp C
+ * API, base-colour textures through api/image_decode.c, and a bounded LRU cache of imported
+ * models keyed by their bytes (and those of the files they refer to).
  *
  * Isolation: model files are untrusted, and Assimp has crashed and looped on small malformed
  * ones. api_model_get() therefore never parses in the calling process: Assimp (and the decoding
@@ -77,6 +78,19 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
                               const struct api_limits *lim, struct api_model **out, int *status, char *err,
                               size_t errsize);
 void api_model_release(struct api_model *m);
+
+/* A file the model refers to (a .gltf's buffer or image, an .obj's .mtl or texture), named as
+ * the referring file writes it; found by api/model_refs.h. */
+struct api_model_file {
+	const char *name;
+	const uint8_t *data;
+	size_t len;
+};
+/* api_model_get() with the files the model refers to: the importer serves them, and only
+ * them, when it asks for those names. The cache key covers every file's name and bytes. */
+enum api_result api_model_get_files(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                    size_t nfiles, enum api_model_format format, const struct api_limits *lim,
+                                    struct api_model **out, int *status, char *err, size_t errsize);
 
 /* Tells the format from the bytes; API_MODEL_SNIFF when it cannot. */
 enum api_model_format api_model_sniff(const uint8_t *data, size_t len);

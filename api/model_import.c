@@ -3,13 +3,14 @@
  * api_model in an arena out. Runs inside the sandboxed importer process (api/sandbox_child.c);
  * the daemon never calls it (the bench does, to measure what isolation costs).
  *
- * Import: Assimp reads the bytes through an aiFileIO that serves only those bytes, so a file
- * that refers to others (an .obj's mtllib, a .gltf's external buffer or image) can never make
- * the importer read from a disk: such references fail or are ignored, as Assimp decides (and
- * the sandbox's system-call filter would refuse an open anyway). The node tree is walked with
+ * Import: Assimp reads the bytes through an aiFileIO that serves only those bytes and the files
+ * the daemon found for the model's references (an .obj's mtllib and textures, a .gltf's
+ * buffers and images; api/model_refs.h), so the importer never reads from a disk (the
+ * sandbox's system-call filter would refuse an open anyway); a name it was not given fails. The node tree is walked with
  * every node's transform (Assimp's aiMatrix4x4 is row-major; ours are column-major), each
  * (node, mesh) pair becoming one instance; meshes keep triangles only.
  */
+#include <ctype.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -95,7 +96,40 @@ struct mem_io {
 	const uint8_t *data;
 	size_t len;
 	char name[32];
+	const struct api_model_file *files;  /* the files the model refers to (api/model_refs.h) */
+	size_t nfiles;
 };
+
+/* Compares a name Assimp asks for with a file's name as the model wrote it: "\\" as "/", no
+ * leading "./", %XX decoded (glTF URIs), so "./a%20b.bin" finds "a b.bin". */
+static void name_norm(const char *in, char *out, size_t n)
+{
+	size_t k = 0;
+	while (in[0] == '.' && (in[1] == '/' || in[1] == '\\')) in += 2;
+	for (const char *p = in; *p && k + 1 < n; p++) {
+		unsigned v;
+		if (p[0] == '%' && isxdigit((unsigned char)p[1]) && isxdigit((unsigned char)p[2]) &&
+		    sscanf(p + 1, "%2x", &v) == 1) {
+			out[k++] = (char)v;
+			p += 2;
+		} else {
+			out[k++] = *p == '\\' ? '/' : *p;
+		}
+	}
+	out[k] = 0;
+}
+
+/* The index of the referred file named `name`, or -1. */
+static long file_index(const struct api_model_file *files, size_t n, const char *name)
+{
+	char a[1024], b[1024];
+	name_norm(name, a, sizeof a);
+	for (size_t i = 0; i < n; i++) {
+		name_norm(files[i].name, b, sizeof b);
+		if (!strcmp(a, b)) return (long)i;
+	}
+	return -1;
+}
 
 struct mem_file {
 	struct aiFile f;
@@ -147,14 +181,17 @@ static enum aiReturn mem_seek(struct aiFile *f, size_t off, enum aiOrigin origin
 static struct aiFile *mem_open(struct aiFileIO *io, const char *name, const char *mode)
 {
 	struct mem_io *mi = (struct mem_io *)io->UserData;
-	/* Only the model itself, read-only; Assimp may prefix a directory ("./"). */
+	/* Only the model itself and the files it refers to, read-only; Assimp may prefix a
+	 * directory ("./"). */
+	if (mode && strchr(mode, 'w')) return NULL;
 	const char *base = strrchr(name, '/');
 	base = base ? base + 1 : name;
-	if (strcmp(base, mi->name) || (mode && strchr(mode, 'w'))) return NULL;
+	long fi = strcmp(base, mi->name) ? file_index(mi->files, mi->nfiles, name) : -2;
+	if (fi == -1) return NULL;
 	struct mem_file *m = calloc(1, sizeof *m);
 	if (!m) return NULL;
-	m->data = mi->data;
-	m->len = mi->len;
+	m->data = fi >= 0 ? mi->files[fi].data : mi->data;
+	m->len = fi >= 0 ? mi->files[fi].len : mi->len;
 	m->f.ReadProc = mem_read;
 	m->f.WriteProc = mem_write;
 	m->f.TellProc = mem_tell;
@@ -180,7 +217,9 @@ struct conv {
 	size_t bytes;
 	bool oom;                     /* an allocation failed: over the memory limit, not a bad file */
 	int32_t *mesh_map;            /* Assimp mesh -> our mesh, -1 = skipped (not triangles) */
-	struct rnd_texture **tex;     /* decoded embedded textures, by scene->mTextures index */
+	struct rnd_texture **tex;     /* decoded textures: scene->mTextures, then the referred files */
+	const struct api_model_file *files;
+	size_t nfiles;
 	struct api_model_instance *inst;
 	uint32_t ninst, inst_cap;
 	char *err;
@@ -274,9 +313,11 @@ static float clampf(float v, float lo, float hi)
 	return !(v >= lo) ? lo : v > hi ? hi : v;  /* NaN -> lo */
 }
 
-/* The embedded texture that `path` names ("*N" or the embedded file's name), or NULL. */
-static int find_texture(const struct aiScene *sc, const char *path)
+/* The texture that `path` names: an embedded one ("*N" or the embedded file's name), then a
+ * file the model refers to (index mNumTextures + k); -1 when none. */
+static int find_texture(const struct conv *c, const char *path)
 {
+	const struct aiScene *sc = c->sc;
 	if (path[0] == '*') {
 		char *end;
 		unsigned long n = strtoul(path + 1, &end, 10);
@@ -287,23 +328,28 @@ static int find_texture(const struct aiScene *sc, const char *path)
 		const char *fn = sc->mTextures[i]->mFilename.data;
 		if (fn[0] && !strcmp(fn, path)) return (int)i;
 	}
-	return -1;
+	long k = file_index(c->files, c->nfiles, path);
+	return k < 0 ? -1 : (int)(sc->mNumTextures + (unsigned)k);
 }
 
 static const struct rnd_texture *texture(struct conv *c, int ti)
 {
 	if (c->tex[ti]) return c->tex[ti];
-	const struct aiTexture *at = c->sc->mTextures[ti];
+	unsigned nemb = c->sc->mNumTextures;
+	const struct aiTexture *at = (unsigned)ti < nemb ? c->sc->mTextures[ti] : NULL;
+	const struct api_model_file *file = at ? NULL : &c->files[(unsigned)ti - nemb];
 	struct rnd_texture *t = conv_alloc(c, 1, sizeof *t);
 	if (!t) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
-	if (at->mHeight == 0) {
-		/* Compressed: mWidth bytes of a PNG or JPEG file. */
+	if (file || at->mHeight == 0) {
+		/* Compressed: mWidth bytes of a PNG or JPEG file, or a whole file beside the model. */
 		uint8_t *px;
 		uint32_t w, h;
 		char e[200];
-		if (api_image_decode((const uint8_t *)at->pcData, at->mWidth, MAX_TEXTURE_PIXELS, &px, &w, &h, e,
-		                     sizeof e) != API_OK)
+		if (api_image_decode(file ? file->data : (const uint8_t *)at->pcData, file ? file->len : at->mWidth,
+		                     MAX_TEXTURE_PIXELS, &px, &w, &h, e, sizeof e) != API_OK) {
+			if (file) return api_err_set(c->err, c->errsize, "texture \"%.128s\": %s", file->name, e), NULL;
 			return api_err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
+		}
 		uint8_t *copy = conv_alloc(c, (size_t)w * h, 4);
 		if (copy) memcpy(copy, px, (size_t)w * h * 4);
 		free(px);
@@ -367,8 +413,9 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, struct 
 	for (int i = 0; i < 2; i++) {
 		if (aiGetMaterialTexture(am, types[i], 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS)
 			continue;
-		int ti = find_texture(c->sc, s.data);
-		/* A texture in another file is not reachable from a self-contained model: ignored. */
+		int ti = find_texture(c, s.data);
+		/* A texture that is neither embedded nor among the referred files: ignored (the daemon
+		 * has already refused a model whose referenced file it could not find). */
 		if (ti < 0) break;
 		if (!(m->base_color_texture = texture(c, ti))) return -1;
 		break;
@@ -412,7 +459,7 @@ static int convert(struct conv *c)
 	const struct aiScene *sc = c->sc;
 	struct api_model *m = c->out;
 	c->mesh_map = calloc(sc->mNumMeshes ? sc->mNumMeshes : 1, sizeof *c->mesh_map);
-	c->tex = calloc(sc->mNumTextures ? sc->mNumTextures : 1, sizeof *c->tex);
+	c->tex = calloc(sc->mNumTextures + c->nfiles + 1, sizeof *c->tex);
 	if (!c->mesh_map || !c->tex)
 		return c->oom = true, api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 
@@ -465,6 +512,13 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
                                             struct api_arena *arena, struct api_model *out, size_t *bytes,
                                             char *err, size_t errsize)
 {
+	return api_model_import_files(data, len, NULL, 0, format, arena, out, bytes, err, errsize);
+}
+
+enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                            size_t nfiles, enum api_model_format format, struct api_arena *arena,
+                                            struct api_model *out, size_t *bytes, char *err, size_t errsize)
+{
 	memset(out, 0, sizeof *out);
 	*bytes = 0;
 	if (!data || !len || format < API_MODEL_GLB || format > API_MODEL_PLY)
@@ -479,7 +533,7 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 		data = strips;
 		len = strips_len;
 	}
-	struct mem_io mi = {.data = data, .len = len};
+	struct mem_io mi = {.data = data, .len = len, .files = files, .nfiles = nfiles};
 	snprintf(mi.name, sizeof mi.name, MEM_NAME ".%s", FORMAT_NAMES[format]);
 	struct aiFileIO io = {.OpenProc = mem_open, .CloseProc = mem_close, .UserData = (aiUserData)&mi};
 	struct aiPropertyStore *props = aiCreatePropertyStore();
@@ -506,7 +560,8 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	free(strips);   /* Assimp copied what it needed */
 	if (!sc) return st;
 
-	struct conv c = {.sc = sc, .arena = arena, .out = out, .err = err, .errsize = errsize};
+	struct conv c = {.sc = sc, .arena = arena, .out = out, .err = err, .errsize = errsize, .files = files,
+	                 .nfiles = nfiles};
 	int rc = convert(&c);
 	free(c.mesh_map);
 	free(c.tex);

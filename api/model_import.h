@@ -23,4 +23,10 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
                                             struct api_arena *arena, struct api_model *out, size_t *bytes,
                                             char *err, size_t errsize);
 
+/* The same with the files the model refers to (names as the model writes them): Assimp's
+ * file system and the texture lookup serve them from memory. */
+enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                            size_t nfiles, enum api_model_format format, struct api_arena *arena,
+                                            struct api_model *out, size_t *bytes, char *err, size_t errsize);
+
 #endif

@@ -352,23 +352,77 @@ out:
 	return rc;
 }
 
-enum api_result api_sandbox_import_model(const uint8_t *data, size_t len, enum api_model_format format,
-                                         const struct api_limits *lim, struct api_arena *arena,
-                                         struct api_model *out, size_t *bytes, int *status, char *err,
-                                         size_t errsize)
+enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_len, size_t len, size_t nfiles,
+                                          enum api_model_format format, const struct api_limits *lim,
+                                          struct api_arena *arena, struct api_model *out, size_t *bytes,
+                                          int *status, char *err, size_t errsize)
 {
 	*status = 0;
 	struct api_sbx_request rq = {.kind = API_WIRE_MODEL, .format = (uint32_t)format,
-	                             .max_pixels = MAX_TEXTURE_PIXELS, .input_len = len};
+	                             .max_pixels = MAX_TEXTURE_PIXELS, .input_len = bundle_len, .model_len = len,
+	                             .file_count = (uint32_t)nfiles};
 	uint8_t *reply;
 	const uint8_t *body;
 	size_t blen;
-	if (run_job(&rq, data, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
+	if (run_job(&rq, bundle, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
 	enum api_result rc = api_wire_decode_model(body, blen, arena, MAX_TEXTURE_PIXELS, out, bytes, err, errsize);
 	if (rc != API_OK) *status = 400;
 	out->format = format;
 	free(reply);
 	return rc;
+}
+
+enum api_result api_sandbox_import_model(const uint8_t *data, size_t len, enum api_model_format format,
+                                         const struct api_limits *lim, struct api_arena *arena,
+                                         struct api_model *out, size_t *bytes, int *status, char *err,
+                                         size_t errsize)
+{
+	return api_sandbox_import_bundle(data, len, len, 0, format, lim, arena, out, bytes, status, err, errsize);
+}
+
+uint8_t *api_sbx_bundle_encode(const uint8_t *model, size_t len, const struct api_model_file *files, size_t n,
+                               size_t *out_len)
+{
+	size_t total = len;
+	for (size_t i = 0; i < n; i++) {
+		size_t add = 12 + strlen(files[i].name) + 1 + files[i].len;
+		if (total + add < total || strlen(files[i].name) >= UINT32_MAX) return NULL;
+		total += add;
+	}
+	uint8_t *b = malloc(total ? total : 1), *p = b;
+	if (!b) return NULL;
+	memcpy(p, model, len);
+	p += len;
+	for (size_t i = 0; i < n; i++) {
+		uint32_t nl = (uint32_t)strlen(files[i].name) + 1;
+		uint64_t dl = files[i].len;
+		memcpy(p, &nl, 4);
+		memcpy(p + 4, &dl, 8);
+		memcpy(p + 12, files[i].name, nl);
+		memcpy(p + 12 + nl, files[i].data, files[i].len);
+		p += 12 + nl + files[i].len;
+	}
+	*out_len = total;
+	return b;
+}
+
+int api_sbx_bundle_decode(const uint8_t *in, size_t len, size_t model_len, uint32_t count,
+                          struct api_model_file *files)
+{
+	if (model_len > len) return -1;
+	size_t off = model_len;
+	for (uint32_t i = 0; i < count; i++) {
+		uint32_t nl;
+		uint64_t dl;
+		if (len - off < 12) return -1;
+		memcpy(&nl, in + off, 4);
+		memcpy(&dl, in + off + 4, 8);
+		off += 12;
+		if (!nl || nl > len - off || dl > len - off - nl || in[off + nl - 1] != 0) return -1;
+		files[i] = (struct api_model_file){(const char *)in + off, in + off + nl, (size_t)dl};
+		off += nl + (size_t)dl;
+	}
+	return off == len ? 0 : -1;
 }
 
 enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64_t max_pixels,

@@ -51,6 +51,12 @@ enum api_result api_sandbox_import_model(const uint8_t *data, size_t len, enum a
                                          const struct api_limits *lim, struct api_arena *arena,
                                          struct api_model *out, size_t *bytes, int *status, char *err,
                                          size_t errsize);
+/* The same for a model with the files it refers to: `bundle` (bundle_len bytes) is the model's
+ * len bytes followed by nfiles files, as api_sbx_bundle_encode() lays them out. */
+enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_len, size_t len, size_t nfiles,
+                                          enum api_model_format format, const struct api_limits *lim,
+                                          struct api_arena *arena, struct api_model *out, size_t *bytes,
+                                          int *status, char *err, size_t errsize);
 /* Decodes a PNG or JPEG (at most max_pixels) into malloc'd RGBA8 (*rgba, you free it). */
 enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64_t max_pixels,
                                          const struct api_limits *lim, uint8_t **rgba, uint32_t *w, uint32_t *h,
@@ -88,7 +94,19 @@ struct api_sbx_request {
 	uint64_t memory;        /* RLIMIT_AS bytes */
 	uint64_t max_pixels;    /* per image / texture */
 	uint64_t input_len;     /* bytes that follow on the data socket */
+	uint64_t model_len;     /* model: the model file's bytes at the start of the input ... */
+	uint32_t file_count;    /* ... followed by this many files (api_sbx_bundle_encode) */
+	uint32_t reserved;
 };
+
+/* A model's input with the files it refers to: the model's bytes, then per file
+ * {uint32 name_len (with its NUL), uint64 data_len, name, NUL, data}, host byte order (both
+ * ends run on one machine). Encode: malloc'd, NULL when out of memory or too large. Decode (the
+ * child): files[] point into `in`; -1 when the layout is inconsistent. */
+uint8_t *api_sbx_bundle_encode(const uint8_t *model, size_t len, const struct api_model_file *files, size_t n,
+                               size_t *out_len);
+int api_sbx_bundle_decode(const uint8_t *in, size_t len, size_t model_len, uint32_t count,
+                          struct api_model_file *files);
 
 enum api_sbx_how { API_SBX_EXITED = 1, API_SBX_SIGNALED, API_SBX_TIMED_OUT, API_SBX_REFUSED };
 /* Child exit codes besides 0. */

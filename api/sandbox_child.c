@@ -122,10 +122,14 @@ static void do_job(const struct api_sbx_request *rq, const uint8_t *in, struct a
 	struct api_arena *arena = api_arena_create();
 	struct api_model m;
 	size_t bytes;
-	enum api_wire_status st = arena ? api_model_import_local(in, rq->input_len, (enum api_model_format)rq->format,
-	                                                         arena, &m, &bytes, err, sizeof err)
-	                                : API_WIRE_OVER_MEMORY;
-	if (!arena) snprintf(err, sizeof err, "out of memory");
+	/* The model's bytes, then the files it refers to (api_sbx_bundle_encode). */
+	struct api_model_file *files = calloc(rq->file_count + 1u, sizeof *files);
+	enum api_wire_status st = API_WIRE_OVER_MEMORY;
+	if (!arena || !files) snprintf(err, sizeof err, "out of memory");
+	else if (api_sbx_bundle_decode(in, rq->input_len, rq->model_len, rq->file_count, files) < 0)
+		st = API_WIRE_BAD_INPUT, snprintf(err, sizeof err, "the importer's input is inconsistent");
+	else st = api_model_import_files(in, rq->model_len, files, rq->file_count, (enum api_model_format)rq->format,
+	                                 arena, &m, &bytes, err, sizeof err);
 	api_wire_put_header(out, API_WIRE_MODEL, st, err);
 	if (st == API_WIRE_OK) api_wire_put_model(out, &m);
 	/* No api_arena_destroy: the process ends right after the reply. */

@@ -31,6 +31,7 @@
 #include "ground.h"
 #include "preset.h"
 #include "model.h"
+#include "model_refs.h"
 #include "sandbox.h"
 #include "umbra/rnd_math.h"
 
@@ -60,6 +61,7 @@ struct pctx {
 	const uint32_t *object_source;  /* document object of each rnd object (NULL: the same index) */
 	const char *views_key;          /* "views" or "turntable" when the document has either */
 	struct api_model *cur_model;
+	char warnings[sizeof(((struct api_scene *)0)->warnings)]; /* what is drawn other than asked ("; " between) */
 	/* Ground placement (api/ground.h): margin per document object, > 0 for placement "ground". */
 	float *ground_margin;
 	size_t cur_object;
@@ -110,6 +112,19 @@ static void ptr_pop(struct pctx *c, size_t old)
 }
 
 /* ---- errors ---- */
+
+/* Something the scene asked for that is left out of the image, said in the answer (the
+ * server's Umbra-Warning header, the CLI's stderr) instead of silently. */
+__attribute__((format(printf, 2, 3)))
+static void warn(struct pctx *c, const char *fmt, ...)
+{
+	size_t n = strlen(c->warnings);
+	if (n && n + 2 < sizeof c->warnings) memcpy(c->warnings + n, "; ", 3), n += 2;
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(c->warnings + n, sizeof c->warnings - n, fmt, ap);
+	va_end(ap);
+}
 
 static int vfail(struct pctx *c, const char *fmt, va_list ap)
 {
@@ -793,6 +808,26 @@ static int parse_model(struct pctx *c, json_t *j)
 		else if (!c->parts[i].len) rc = fail(c, "part \"%.64s\" is empty", name);
 		else b = (unsigned char *)c->parts[i].data, len = c->parts[i].len;
 	}
+	/* The files it refers to (a .gltf's buffers and images, an .obj's .mtl and textures): read
+	 * here, beside the model or among the request's parts (api/model_refs.h). */
+	struct api_model_refs refs = {0};
+	if (rc == 0) {
+		struct api_ref_source src = {.root = c->lim->asset_root, .path = !strcmp(first, "path") ? json_string_value(v)
+		                             : NULL, .parts = c->parts, .nparts = c->nparts};
+		char err[400];
+		int status;
+		if (api_model_refs_collect(b, len, given ? (enum api_model_format)f : api_model_sniff(b, len), &src, &refs,
+		                           &status, err, sizeof err) != API_OK) {
+			json_t *nm = json_object_get(j, "name");
+			const char *what = json_is_string(nm) ? json_string_value(nm) : src.path;
+			if (what) api_problem_set(c->p, status, c->ptr, "model \"%.128s\" cannot be imported: %s", what, err);
+			else api_problem_set(c->p, status, c->ptr, "the model in %s cannot be imported: %s", first, err);
+			rc = -1;
+		} else {
+			if (refs.asset_hash) api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&refs.asset_hash, 8);
+			if (refs.warning[0]) warn(c, "%s: %s", c->ptr, refs.warning);
+		}
+	}
 	if (rc == 0) {
 		struct api_model *m = NULL;
 		char err[400];
@@ -800,8 +835,8 @@ static int parse_model(struct pctx *c, json_t *j)
 		struct model_ref *ref = api_arena_alloc(c->arena, sizeof *ref);
 		if (!ref) {
 			rc = fail(c, "out of memory");
-		} else if (api_model_get(b, len, given ? (enum api_model_format)f : API_MODEL_SNIFF, c->lim, &m, &status,
-		                         err, sizeof err) != API_OK) {
+		} else if (api_model_get_files(b, len, refs.files, refs.count, given ? (enum api_model_format)f : API_MODEL_SNIFF,
+		                               c->lim, &m, &status, err, sizeof err) != API_OK) {
 			/* Named by the object's name, else by its path, else by its source member; 400 for a bad
 			 * file, 422 over the import time/memory limit, 500 when the importer cannot run. */
 			json_t *nm = json_object_get(j, "name");
@@ -819,6 +854,7 @@ static int parse_model(struct pctx *c, json_t *j)
 			c->cur_model = m;
 		}
 	}
+	api_model_refs_release(&refs);
 	if (!strcmp(first, "path")) free(b);
 	ptr_pop(c, old);
 	return rc < 0 ? -1 : 0;
@@ -1704,6 +1740,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
+	memcpy(s->warnings, c.warnings, sizeof s->warnings);
 	*out = s;
 	return API_OK;
 }
