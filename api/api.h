@@ -57,6 +57,9 @@ struct api_limits {
 	 * Over either is a 422 at the member that carried the bytes. */
 	uint32_t import_timeout_ms;      /* default 10000; 0 = the default */
 	uint64_t import_memory;          /* bytes, default 2147483648 (2 GiB); 0 = no memory limit */
+	/* Distinct textures in one scene (the renderer's rnd_info.max_textures: its desc's value
+	 * capped by the device); over it is a 422 at the object that brought one too many. */
+	uint32_t max_textures;           /* default RND_DEFAULT_MAX_TEXTURES (256); 0 = the default */
 };
 void api_limits_defaults(struct api_limits *l);
 
@@ -97,7 +100,8 @@ struct api_scene {
  * renderer's fit frames the whole scene. The sheet (ceil(sqrt(n)) columns, unused cells
  * included) counts against max_pixels: 422 at /views or /turntable.
  * Material `base_color_texture` is decoded here (PNG/JPEG, 400 at the member when it cannot be);
- * more than 16 distinct textures, or one over 16384 texels a side, is a 422. */
+ * more than limits.max_textures distinct textures (422 at the object that brought one too many),
+ * or one over 16384 texels a side, is a 422. */
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
                                 struct api_scene **out, struct api_problem *p);
 void api_scene_free(struct api_scene *s);

@@ -112,6 +112,7 @@ void api_limits_defaults(struct api_limits *l)
 	l->model_cache_bytes = 256u << 20;
 	l->import_timeout_ms = 10000;
 	l->import_memory = 2ull << 30;
+	l->max_textures = RND_DEFAULT_MAX_TEXTURES;
 }
 
 const char *api_format_mime(enum api_format f)

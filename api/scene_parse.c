@@ -566,7 +566,6 @@ out:
 /* The renderer's bounds on base-colour textures (renderer/render.c textures()). */
 #define MAX_TEXTURE_SIDE 16384u
 #define MAX_TEXTURE_PIXELS (64ull << 20)
-#define MAX_TEXTURES 16u
 
 static const char *const MATERIAL_MEMBERS[] = {"base_color", "base_color_texture", "alpha_mode", "alpha_cutoff",
                                                "roughness", "metallic", "emissive", "shadow_catcher", NULL};
@@ -1433,6 +1432,37 @@ static int place_ground(struct pctx *c, struct rnd_scene *sc)
 	return 0;
 }
 
+/* Distinct textures against lim->max_textures (the server's --max-textures, capped by the
+ * device): counted in object order, so the 422 names the object that brought one too many
+ * (a model's object for its textures, else the object whose material has it). */
+static int check_textures(struct pctx *c, const struct rnd_scene *sc)
+{
+	uint32_t max = c->lim->max_textures ? c->lim->max_textures : RND_DEFAULT_MAX_TEXTURES;
+	const struct rnd_texture **seen = api_arena_calloc(c->arena, c->mat_count + 1, sizeof *seen);
+	uint8_t *counted = api_arena_calloc(c->arena, c->mat_count + 1, 1);
+	if (!seen || !counted) return fail(c, "out of memory");
+	uint32_t ntex = 0;
+	for (uint32_t o = 0; o < sc->object_count && c->mat_count; o++) {
+		uint32_t mi = sc->objects[o].material;
+		const struct rnd_texture *t = mi < c->mat_count ? c->mats[mi].base_color_texture : NULL;
+		if (!t || counted[mi]) continue;
+		counted[mi] = 1;
+		uint32_t k = 0;
+		while (k < ntex && seen[k] != t) k++;
+		if (k < ntex) continue;
+		if (ntex == max) {
+			size_t old = ptr_push(c, "objects");
+			ptr_index(c, c->object_source ? c->object_source[o] : o);
+			defer(c, false, NULL, "this object brings the scene over %u distinct textures (this server's limit: "
+			      "--max-textures, capped by the device)", max);
+			ptr_pop(c, old);
+			break;
+		}
+		seen[ntex++] = t;
+	}
+	return 0;
+}
+
 static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 {
 	struct rnd_scene *sc = &s->scene;
@@ -1660,21 +1690,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 
 	sc->materials = c->mats;
 	sc->material_count = c->mat_count;
-	const struct rnd_texture *seen[MAX_TEXTURES];
-	uint32_t ntex = 0;
-	for (uint32_t i = 0; i < c->mat_count && ntex <= MAX_TEXTURES; i++) {
-		const struct rnd_texture *t = c->mats[i].base_color_texture;
-		uint32_t k = 0;
-		while (t && k < ntex && seen[k] != t) k++;
-		if (!t || k < ntex) continue;
-		if (ntex == MAX_TEXTURES) {
-			defer(c, false, "materials", "the scene has more than %u distinct base-colour textures (the "
-			      "renderer's limit)", MAX_TEXTURES);
-			break;
-		}
-		seen[ntex++] = t;
-	}
-	return 0;
+	return check_textures(c, sc);
 }
 
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,

@@ -252,6 +252,14 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 	vkGetPhysicalDeviceProperties2(ctx->phys, &lim2);
 	ctx->max_allocation = m3.maxMemoryAllocationSize;
 	if (m4.maxBufferSize && m4.maxBufferSize < ctx->max_allocation) ctx->max_allocation = m4.maxBufferSize;
+	/* Textures per scene. Today each texture is its own descriptor set (set 1, one sampler) and
+	 * a draw binds one; the bound taken from the device is the stricter one of a layout that
+	 * would hold all of a scene's textures at once beside set 0's two samplers (sampled images
+	 * per set and per stage), so the number stays valid if textures move into one array. */
+	const VkPhysicalDeviceLimits *dl = &ctx->props.limits;
+	uint32_t dev = dl->maxDescriptorSetSampledImages < dl->maxPerStageDescriptorSampledImages
+	               ? dl->maxDescriptorSetSampledImages : dl->maxPerStageDescriptorSampledImages;
+	ctx->device_max_textures = dev > 2 ? dev - 2 : 1;
 
 	VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
 	VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &drv};
@@ -401,6 +409,8 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if ((r = create_instance(ctx, err)) != RND_OK) goto fail_instance;
 	if ((r = pick_device(ctx, err)) != RND_OK) goto fail_device;
 	ctx->desc.device_name = NULL;
+	ctx->max_textures = d.max_textures ? d.max_textures : RND_DEFAULT_MAX_TEXTURES;
+	if (ctx->max_textures > ctx->device_max_textures) ctx->max_textures = ctx->device_max_textures;
 	if ((r = create_device(ctx, err)) != RND_OK) goto fail_device;
 	create_pipeline_cache(ctx);
 	if ((r = rnd_pipelines_init(ctx, err)) != RND_OK) goto fail_pipelines;
@@ -456,6 +466,8 @@ void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info)
 	info->api_version = ctx->props.apiVersion;
 	info->is_cpu = ctx->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
 	info->max_allocation = ctx->max_allocation;
+	info->max_textures = ctx->max_textures;
+	info->device_max_textures = ctx->device_max_textures;
 	info->max_image_dimension = ctx->props.limits.maxImageDimension2D;
 	info->max_shadow_resolution = ctx->props.limits.maxImageDimension2D < 8192 ? ctx->props.limits.maxImageDimension2D : 8192;
 	info->moments_fp32_filterable = ctx->moments.fp32;

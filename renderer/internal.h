@@ -95,6 +95,7 @@ struct rnd_context {
 	VkPhysicalDeviceProperties props;
 	VkPhysicalDeviceMemoryProperties mem_props;
 	VkDeviceSize max_allocation;         /* maxMemoryAllocationSize (Vulkan 1.1), min maxBufferSize (1.3) */
+	uint32_t max_textures, device_max_textures; /* distinct textures per scene (device.c) */
 	char driver_name[256], driver_info[256];
 	VkDevice device;
 	VkQueue queue;

@@ -179,17 +179,16 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		{s->params.buf, off_view, nview * sizeof(struct umbra_shadow_view)},
 	};
 	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
-	VkDescriptorImageInfo ti[UMBRA_MAX_TEXTURES];
-	VkWriteDescriptorSet tw[UMBRA_MAX_TEXTURES];
+	/* One write per texture: their number is the device's (ctx->max_textures), not a constant. */
 	for (uint32_t t = 0; t < ntex; t++) {
-		ti[t] = (VkDescriptorImageInfo){ctx->pipes.texture_sampler, s->textures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-		tw[t] = (VkWriteDescriptorSet){
+		VkDescriptorImageInfo ti = {ctx->pipes.texture_sampler, s->textures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+		VkWriteDescriptorSet tw = {
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[1 + t],
 			.dstBinding = UMBRA_BINDING_BASE_TEXTURE, .descriptorCount = 1,
-			.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ti[t],
+			.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ti,
 		};
+		vkUpdateDescriptorSets(ctx->device, 1, &tw, 0, NULL);
 	}
-	if (ntex) vkUpdateDescriptorSets(ctx->device, ntex, tw, 0, NULL);
 	/* Without a moment atlas (no storage images) no light uses moments; the binding still
 	 * needs an image. */
 	VkDescriptorImageInfo mi = ctx->atlas_moments.view
@@ -306,15 +305,17 @@ static enum rnd_result textures(struct rnd_context *ctx, struct rnd_slot *s, con
 	uint32_t n = 0;
 	VkDeviceSize bytes = 0;
 	rnd_slot_drop_textures(ctx, s);
-	for (uint32_t i = 0; i < sc->material_count; i++) {
+	/* In object order, so that the limit's error names the object that brought one too many. */
+	for (uint32_t o = 0; o < sc->object_count && sc->material_count; o++) {
+		uint32_t i = sc->objects[o].material;
 		const struct rnd_texture *t = sc->materials[i].base_color_texture;
 		if (!t) continue;
 		uint32_t k = 0;
 		while (k < n && tex[k] != t) k++;
 		if (k < n) continue;
-		if (n == UMBRA_MAX_TEXTURES)
-			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_MATERIALS, 0, "more than %d distinct textures in one scene",
-			                   UMBRA_MAX_TEXTURES);
+		if (n == ctx->max_textures)
+			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u distinct textures in one scene "
+			                   "(this renderer's limit)", ctx->max_textures);
 		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", i, t->width, t->height);
 		tex[n++] = t;
@@ -439,9 +440,10 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	bool gpu_busy = false;        /* a submit did not finish: keep its resources alive */
 	uint8_t cascades[UMBRA_MAX_LIGHTS] = {0};
 
-	/* Per-request memory: one block for the draw list and the shadow plan. */
+	/* Per-request memory: one block for the draw list, the shadow plan and the texture list. */
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
-	void *arena = malloc(draws_bytes + sizeof(struct rnd_shadow_plan));
+	size_t tex_off = (draws_bytes + sizeof(struct rnd_shadow_plan) + 15) & ~(size_t)15;
+	void *arena = malloc(tex_off + ctx->max_textures * sizeof(void *));
 	if (!arena) return rnd_fail(err, RND_ERR_OOM, "out of memory for %u objects", sc->object_count);
 	struct draw *draws = arena;
 	struct rnd_shadow_plan *sp = (struct rnd_shadow_plan *)((char *)arena + draws_bytes);
@@ -453,7 +455,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if ((r = rnd_pacer_check(&pacer, err)) != RND_OK) goto done;
 	struct rnd_aabb bounds;
 	struct rnd_camera_plan cam;
-	const struct rnd_texture *tex[UMBRA_MAX_TEXTURES];
+	const struct rnd_texture **tex = (const struct rnd_texture **)((char *)arena + tex_off);
 	uint32_t ntex = 0;
 	if ((r = upload(ctx, s, sc, &pacer, draws, &bounds, err)) != RND_OK) goto done;
 	/* Auto-framing `fit: objects` leaves out planes and shadow catchers (the ground). */

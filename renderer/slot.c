@@ -12,6 +12,14 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	struct rnd_slot *s = calloc(1, sizeof *s);
 	if (!s) return rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
 	s->index = index;
+	uint32_t ntex = ctx->max_textures;
+	s->textures = calloc(ntex, sizeof *s->textures);
+	s->texture_sets = calloc(1 + ntex, sizeof *s->texture_sets);
+	VkDescriptorSetLayout *layouts = calloc(1 + ntex, sizeof *layouts);
+	if (!s->textures || !s->texture_sets || !layouts) {
+		r = rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
+		goto fail_pool;
+	}
 	VkCommandPoolCreateInfo pci = {
 		.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
 		.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, .queueFamilyIndex = ctx->queue_family,
@@ -68,9 +76,9 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		goto fail_set;
 	}
 	/* Descriptor sets stay unnamed: lavapipe never frees a set's debug name with its pool. */
-	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + UMBRA_MAX_TEXTURES};
+	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + ntex};
 	VkDescriptorPoolCreateInfo tpi = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1 + UMBRA_MAX_TEXTURES, .poolSizeCount = 1,
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1 + ntex, .poolSizeCount = 1,
 		.pPoolSizes = &tsize,
 	};
 	if ((vr = vkCreateDescriptorPool(ctx->device, &tpi, NULL, &s->texture_pool)) != VK_SUCCESS) {
@@ -78,11 +86,10 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		goto fail_set;
 	}
 	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->texture_pool, "slot %u texture descriptor pool", index);
-	VkDescriptorSetLayout layouts[1 + UMBRA_MAX_TEXTURES];
-	for (int i = 0; i < 1 + UMBRA_MAX_TEXTURES; i++) layouts[i] = ctx->pipes.texture_layout;
+	for (uint32_t i = 0; i < 1 + ntex; i++) layouts[i] = ctx->pipes.texture_layout;
 	VkDescriptorSetAllocateInfo tai = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->texture_pool,
-		.descriptorSetCount = 1 + UMBRA_MAX_TEXTURES, .pSetLayouts = layouts,
+		.descriptorSetCount = 1 + ntex, .pSetLayouts = layouts,
 	};
 	if ((vr = vkAllocateDescriptorSets(ctx->device, &tai, s->texture_sets)) != VK_SUCCESS) {
 		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets (textures)");
@@ -116,6 +123,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets (moments)");
 		goto fail_moments_pool;
 	}
+	free(layouts);
 	*out = s;
 	return RND_OK;
 
@@ -135,6 +143,9 @@ fail_queries:
 fail_cmd:
 	vkDestroyCommandPool(ctx->device, s->pool, NULL); /* frees the command buffer */
 fail_pool:
+	free(layouts);
+	free(s->texture_sets);
+	free(s->textures);
 	free(s);
 	return r;
 }
@@ -163,6 +174,8 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
 	vkDestroyFence(ctx->device, s->fence, NULL);
 	vkDestroyCommandPool(ctx->device, s->pool, NULL);
+	free(s->texture_sets);
+	free(s->textures);
 	free(s);
 }
 

@@ -25,11 +25,11 @@ struct rnd_slot {
 
 	struct rnd_buffer vertices, indices, params, readback, staging;
 	/* this render's material textures (destroyed when the next render starts) */
-	struct rnd_image_res textures[UMBRA_MAX_TEXTURES];
+	struct rnd_image_res *textures;   /* ctx->max_textures */
 	uint32_t texture_count;
 	/* set 1 per texture: [0] the white 1x1 (untextured draws), [1 + i] textures[i] */
 	VkDescriptorPool texture_pool;
-	VkDescriptorSet texture_sets[1 + UMBRA_MAX_TEXTURES];
+	VkDescriptorSet *texture_sets;    /* 1 + ctx->max_textures */
 	struct rnd_image_res white;
 	bool white_ready;             /* cleared to white and in SHADER_READ_ONLY layout */
 	/* AOV pass targets: UMBRA_AOV_ATTACHMENTS x RGBA32F + a single-sample depth */

@@ -125,6 +125,8 @@ static enum MHD_Result respond(struct srv_request *req, int status, const char *
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Accept");
 		if (req->server_timing[0])
 			MHD_add_response_header(resp, MHD_HTTP_HEADER_SERVER_TIMING, req->server_timing);
+		if (status == 200 && req->warnings[0])
+			MHD_add_response_header(resp, "Umbra-Warning", req->warnings);
 	}
 	if (req->route != SRV_ROUTE_RENDER || status != 200)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
@@ -213,13 +215,14 @@ static enum MHD_Result answer_info(struct srv_request *req)
 	srv_buf_printf(&b, ",\"limits\":{\"max_body\":%llu,\"max_pixels\":%llu,\"max_triangles\":%llu,"
 	                   "\"max_lights\":%u,\"max_shadow_resolution\":%u,\"max_dimension\":%u,"
 	                   "\"device_max_shadow_resolution\":%u,\"deadline_ms\":%u,\"queue\":%u,\"workers\":%u,"
-	                   "\"max_memory\":%llu,\"device_max_allocation\":%llu,\"import_timeout_ms\":%u,\"import_memory\":%llu}",
+	                   "\"max_memory\":%llu,\"device_max_allocation\":%llu,\"import_timeout_ms\":%u,\"import_memory\":%llu,"
+	                   "\"max_textures\":%u,\"device_max_textures\":%u}",
 	               (unsigned long long)c->max_body, (unsigned long long)c->limits.max_pixels,
 	               (unsigned long long)c->limits.max_triangles, c->limits.max_lights,
 	               c->limits.max_shadow_resolution, info.max_image_dimension < 8192 ? info.max_image_dimension : 8192,
 	               info.max_shadow_resolution, c->deadline_ms, c->queue, c->workers,
 	               (unsigned long long)c->max_memory, (unsigned long long)info.max_allocation, c->limits.import_timeout_ms,
-	               (unsigned long long)c->limits.import_memory);
+	               (unsigned long long)c->limits.import_memory, info.max_textures, info.device_max_textures);
 	srv_buf_puts(&b, ",\"filters\":[\"hard\",\"pcf\",\"pcss\",\"vsm\",\"evsm\"]"
 	                 ",\"formats\":[\"png\",\"exr\"],\"media_types\":[\"image/png\",\"image/x-exr\"]"
 	                 ",\"priorities\":[\"interactive\",\"bulk\"]}\n");

@@ -40,6 +40,7 @@ static int context_create(struct srv_server *s, struct rnd_context **out)
 	cd.pipeline_cache_path = s->cfg.pipeline_cache;
 	cd.slots = s->cfg.workers;
 	cd.atlas_size = s->cfg.atlas_size;
+	cd.max_textures = s->cfg.limits.max_textures;
 	cd.log = rnd_log_cb;
 	enum rnd_result r = rnd_context_create(&cd, out, &err);
 	if (r != RND_OK) {
@@ -58,6 +59,8 @@ int srv_context_open(struct srv_server *s)
 	pthread_rwlock_wrlock(&s->ctx_lock);
 	s->ctx = ctx;
 	rnd_context_info(ctx, &s->info);
+	/* --max-textures as the device grants it: the parser's 422 then comes before the renderer's. */
+	if (s->cfg.limits.max_textures != s->info.max_textures) s->cfg.limits.max_textures = s->info.max_textures;
 	pthread_rwlock_unlock(&s->ctx_lock);
 	srv_log(SRV_LOG_INFO, "device \"%s\", driver \"%s\" %s%s, %u render slots%s", s->info.device_name,
 	        s->info.driver_name, s->info.driver_info, s->info.is_cpu ? " (CPU)" : "", s->cfg.workers,
@@ -416,6 +419,9 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 		job_problem(req, &p);
 		return 0;
 	}
+	/* A header value is one line of printable ASCII: file names from a model may hold anything. */
+	for (size_t i = 0; i + 1 < sizeof req->warnings && (req->warnings[i] = sc->warnings[i]); i++)
+		if ((unsigned char)req->warnings[i] < 0x20 || (unsigned char)req->warnings[i] > 0x7e) req->warnings[i] = '?';
 	if (sc->asset_hash) {
 		/* The image depends on files under --asset-root as well as on the body. */
 		unsigned long long h = strtoull(req->etag + 1, NULL, 16) ^ sc->asset_hash;

@@ -28,7 +28,6 @@
 #define UMBRA_MAX_LIGHTS        64
 #define UMBRA_MAX_SHADOW_VIEWS  256   /* directional 1..4 (cascades), spot 1, point 6 */
 #define UMBRA_MAX_MATERIALS     4096
-#define UMBRA_MAX_TEXTURES      16    /* distinct base-colour textures in one scene */
 #define UMBRA_AOV_ATTACHMENTS   4     /* RGBA32F targets of one AOV pass */
 
 /* umbra_light.color.w: light type */

@@ -273,6 +273,8 @@ struct rnd_context; /* opaque */
 
 typedef void (*rnd_log_fn)(void *user, int level /* 0 error 1 warn 2 info */, const char *msg);
 
+#define RND_DEFAULT_MAX_TEXTURES 256u
+
 struct rnd_context_desc {
 	const char *device_name;   /* substring of the device name to pick; NULL = $UMBRA_DEVICE, else a GPU, else lavapipe */
 	bool validation;           /* enable VK_LAYER_KHRONOS_validation; messages are counted and logged */
@@ -280,6 +282,9 @@ struct rnd_context_desc {
 	uint32_t slots;            /* concurrent renders (render slots); 0 = 1 */
 	uint32_t max_width, max_height; /* 0 = 8192 */
 	uint32_t atlas_size;       /* texels per side of the shadow atlases (power of two), 0 = 4096 */
+	/* Distinct textures one scene may use; 0 = RND_DEFAULT_MAX_TEXTURES. Capped by the device
+	 * (rnd_info.max_textures says what was granted); each slot holds a descriptor set per texture. */
+	uint32_t max_textures;
 	rnd_log_fn log; void *log_user;
 };
 
@@ -292,6 +297,8 @@ struct rnd_info {
 	uint32_t max_image_dimension;
 	uint32_t max_shadow_resolution;
 	uint64_t max_allocation;   /* largest single buffer/allocation (an image with its AOVs must fit) */
+	uint32_t max_textures;     /* distinct textures per scene: the desc's, capped by the device */
+	uint32_t device_max_textures; /* the device's own bound on that (see device.c) */
 	bool moments_fp32_filterable;
 };
 
