@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "asset.h"
+#include "model.h"
 #include "test.h"
 
 static void put(const char *dir, const char *name, const char *text)
@@ -150,4 +151,38 @@ TEST(asset_resolves_references)
 	CHECK(api_asset_resolve("x.gltf", "C:\\a.png", out, sizeof out, err, sizeof err) == API_ERR);
 	CHECK(api_asset_resolve("x.gltf", "", out, sizeof out, err, sizeof err) == API_ERR);
 	CHECK(api_asset_resolve("m/x.gltf", "..", out, sizeof out, err, sizeof err) == API_ERR);
+}
+
+/* A .gltf whose buffer is a separate file: imported with it, and the cache tells two
+ * different .bin files apart although the .gltf's bytes are the same. */
+static const char TRI_GLTF[] =
+	"{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+	"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+	"\"buffers\":[{\"uri\":\"tri%20angle.bin\",\"byteLength\":36}],"
+	"\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+	"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+	"\"min\":[0,0,0],\"max\":[9,9,0]}]}";
+
+TEST(model_files_served_and_keyed)
+{
+	float a[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, b[9] = {0, 0, 0, 9, 0, 0, 0, 9, 0};
+	struct api_model_file fa = {"tri angle.bin", (const uint8_t *)a, sizeof a};
+	struct api_model_file fb = {"tri angle.bin", (const uint8_t *)b, sizeof b};
+	struct api_model *ma = NULL, *mb = NULL, *mn = NULL;
+	int st;
+	char err[400] = "";
+	const uint8_t *g = (const uint8_t *)TRI_GLTF;
+	size_t n = strlen(TRI_GLTF);
+	CHECK(api_model_get_files(g, n, &fa, 1, API_MODEL_GLTF, NULL, &ma, &st, err, sizeof err) == API_OK && ma,
+	      "%d %s", st, err);
+	CHECK(api_model_get_files(g, n, &fb, 1, API_MODEL_GLTF, NULL, &mb, &st, err, sizeof err) == API_OK && mb,
+	      "%d %s", st, err);
+	REQUIRE(ma && mb);
+	CHECK(ma != mb && ma->meshes[0].positions[3] == 1 && mb->meshes[0].positions[3] == 9, "%g %g",
+	      ma->meshes[0].positions[3], mb->meshes[0].positions[3]);
+	/* Without the file the importer cannot open it (it reads no disk). */
+	CHECK(api_model_get(g, n, API_MODEL_GLTF, NULL, &mn, &st, err, sizeof err) == API_ERR && !mn && st == 400,
+	      "%d %s", st, err);
+	api_model_release(ma);
+	api_model_release(mb);
 }
