@@ -265,3 +265,43 @@ TEST(limits_aov_of_pcss_lights_matches_debug_view)
 	rnd_image_release(&dbg);
 	CHECK(rnd_context_validation_messages(ctx) == 0);
 }
+
+/* Textures per scene come from the context (desc.max_textures, capped by the device), not a
+ * constant: three textured objects render under a limit of 3 and are refused under 2, the
+ * error naming the object that brought the third (rnd_error.at / at_index). */
+TEST(limits_textures_from_the_context_name_the_object)
+{
+	static const uint8_t px[3][4] = {{255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}};
+	struct rnd_texture tex[3];
+	for (int i = 0; i < 3; i++) tex[i] = (struct rnd_texture){.rgba = px[i], .width = 1, .height = 1};
+	const char *doc = "{\"width\":32,\"height\":32,\"camera\":{\"position\":[0,0,8]},"
+	                  "\"materials\":{\"a\":{},\"b\":{},\"c\":{}},\"objects\":["
+	                  "{\"shape\":\"sphere\",\"material\":\"a\",\"transform\":{\"translation\":[-2,0,0]}},"
+	                  "{\"shape\":\"sphere\",\"material\":\"b\"},"
+	                  "{\"shape\":\"sphere\",\"material\":\"c\",\"transform\":{\"translation\":[2,0,0]}}],"
+	                  "\"lights\":[{\"type\":\"directional\",\"direction\":[0,-1,-1]}]}";
+	for (uint32_t max = 2; max <= 3; max++) {
+		const char *v = getenv("UMBRA_VALIDATION");
+		struct rnd_context_desc cd = {.validation = v && !strcmp(v, "1"), .max_textures = max};
+		struct rnd_context *ctx = NULL;
+		struct rnd_error err = {0};
+		REQUIRE(rnd_context_create(&cd, &ctx, &err) == RND_OK, "%s", err.msg);
+		struct rnd_info info;
+		rnd_context_info(ctx, &info);
+		CHECK(info.max_textures == max && info.device_max_textures >= max, "%u of %u", info.max_textures,
+		      info.device_max_textures);
+		struct api_scene *s = NULL;
+		struct api_problem p;
+		REQUIRE(api_scene_parse(doc, strlen(doc), NULL, &s, &p) == API_OK, "%s", p.detail);
+		struct rnd_material *m = (struct rnd_material *)s->scene.materials;
+		for (uint32_t o = 0; o < 3; o++) m[s->scene.objects[o].material].base_color_texture = &tex[o];
+		struct rnd_image img = {0};
+		enum rnd_result r = rnd_render(ctx, &s->scene, &img, NULL, &err);
+		if (max == 3) CHECK(r == RND_OK, "%s", err.msg);
+		else CHECK(r == RND_ERR_LIMIT && err.at == RND_AT_OBJECT && err.at_index == 2, "%d %d %u %s", r, err.at,
+		           err.at_index, err.msg);
+		rnd_image_release(&img);
+		api_scene_free(s);
+		rnd_context_destroy(ctx);
+	}
+}

@@ -1019,19 +1019,27 @@ TEST(parse_base_color_texture)
 	      strstr(p.detail, "could not be decoded"), "%d %s %s", p.status, p.pointer, p.detail);
 	api_scene_free(sb);
 
-	/* 17 distinct textures are over the renderer's limit (422); 16 are fine. */
+	/* With max_textures 16, 17 distinct textures used by objects are a 422 at the object that
+	 * brought the 17th; 16 are fine, and a material no object uses does not count. */
+	struct api_limits lim;
+	api_limits_defaults(&lim);
+	lim.max_textures = 16;
 	for (int n = 16; n <= 17; n++) {
 		b64(png, len, enc);
-		size_t cap = 64 + (size_t)n * (strlen(enc) + 64);
+		size_t cap = 256 + (size_t)(n + 1) * (strlen(enc) + 128);
 		char *d = malloc(cap);
 		REQUIRE(d);
-		size_t o = (size_t)snprintf(d, cap, "{\"camera\":{},\"objects\":[],\"materials\":{");
+		size_t o = (size_t)snprintf(d, cap, "{\"camera\":{\"position\":[0,0,5]},\"objects\":[");
 		for (int i = 0; i < n; i++)
-			o += (size_t)snprintf(d + o, cap - o, "%s\"m%d\":{\"base_color_texture\":\"%s\"}", i ? "," : "", i, enc);
+			o += (size_t)snprintf(d + o, cap - o, "%s{\"shape\":\"sphere\",\"material\":\"m%d\"}", i ? "," : "", i);
+		o += (size_t)snprintf(d + o, cap - o, "],\"materials\":{\"unused\":{\"base_color_texture\":\"%s\"}", enc);
+		for (int i = 0; i < n; i++)
+			o += (size_t)snprintf(d + o, cap - o, ",\"m%d\":{\"base_color_texture\":\"%s\"}", i, enc);
 		snprintf(d + o, cap - o, "}}");
-		struct api_scene *st = parse(d, &p);
+		struct api_scene *st = NULL;
+		api_scene_parse(d, strlen(d), &lim, &st, &p);
 		if (n == 16) CHECK(st != NULL, "%s", p.detail);
-		else CHECK(!st && p.status == 422 && !strcmp(p.pointer, "/materials"), "%d %s %s", p.status, p.pointer, p.detail);
+		else CHECK(!st && p.status == 422 && !strcmp(p.pointer, "/objects/16"), "%d %s %s", p.status, p.pointer, p.detail);
 		api_scene_free(st);
 		free(d);
 	}
