@@ -5,6 +5,7 @@
  * and goes through api/asset.c's rules before anything is opened.
  */
 #include <limits.h>
+#include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,6 +46,18 @@ static void percent_decode(const char *in, char *out, size_t n)
 		}
 	}
 	out[k] = 0;
+}
+
+__attribute__((format(printf, 2, 3)))
+static void warn(struct ctx *c, const char *fmt, ...)
+{
+	char *w = c->out->warning;
+	size_t n = strlen(w);
+	if (n && n + 2 < sizeof c->out->warning) memcpy(w + n, "; ", 3), n += 2;
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(w + n, sizeof c->out->warning - n, fmt, ap);
+	va_end(ap);
 }
 
 static int push(struct ctx *c, const char *name, const uint8_t *data, size_t len, bool owned)
@@ -106,7 +119,9 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 		size_t i = 0;
 		while (i < s->nparts && (!s->parts[i].name || (strcmp(s->parts[i].name, full) && strcmp(s->parts[i].name, ref))))
 			i++;
-		if (i == s->nparts && !s->nparts) return -2;
+		/* An .obj's .mtl and textures are optional to Assimp: sent without them (inline, or as
+		 * the only part, as the farm does) the model renders with what it has, and says so. */
+		if (i == s->nparts && (!s->nparts || kind == REF_MTL || kind == REF_TEXTURE)) return -2;
 		if (i == s->nparts) {
 			*c->status = 400;
 			return api_err_set(c->err, c->errsize, "its %s \"%.128s\" is not a part of this request (send it as a "
@@ -216,6 +231,7 @@ static int mtl_refs(struct ctx *c, const char *mtl_path, const uint8_t *d, size_
 			texture_name(after, eol, name, sizeof name);
 			long r = name[0] ? fetch(c, REF_TEXTURE, mtl_path, name) : 0;
 			if (r == -1) return -1;
+			if (r == -2) warn(c, "the obj's texture \"%.64s\" is not in the request: drawn without it", name);
 			break;
 		}
 		p = eol + 1;
@@ -237,8 +253,8 @@ static int obj_refs(struct ctx *c, const uint8_t *d, size_t len)
 			long r = name[0] ? fetch(c, REF_MTL, c->src->path, name) : 0;
 			if (r == -1) return -1;
 			if (r == -2) {
-				snprintf(c->out->warning, sizeof c->out->warning, "the obj's material library \"%.64s\" is not "
-				         "in the request (inline data): drawn with the default material", name);
+				warn(c, "the obj's material library \"%.64s\" is not in the request: drawn with the default "
+				     "material", name);
 			} else if (name[0]) {
 				/* The .mtl's textures resolve against the .mtl's own directory. */
 				char mpath[PATH_MAX] = "", why[8];

@@ -9,8 +9,9 @@
  *     the rules of api/asset.h (a ".." above the root, an absolute reference, a link out: 400);
  *   - a model in a multipart request (`part`, or `data` when the request has parts): the parts
  *     named by the reference ("Avocado.bin", "textures/wood.png"); a "../" reference is a 400;
- *   - inline `data` without parts: nothing can be found; a glTF that needs a file is a 400, an
- *     .obj whose .mtl is missing is imported without it and says so in `warning`.
+ *   - inline `data` without parts: nothing can be found; a glTF that needs a file is a 400.
+ * An .obj's .mtl or texture missing from the request (inline data, or parts without it: the
+ * farm sends the model alone) is left out and said in `warning`; by `path` it is a 400.
  * A reference that cannot be found or read is a 400 whose sentence names it; more than
  * API_MODEL_REFS_MAX files or API_ASSET_MAX_FILE bytes with the model is a 422.
  *
@@ -47,7 +48,7 @@ struct api_model_refs {
 	size_t count;
 	uint64_t bytes;                   /* of every file */
 	uint64_t asset_hash;              /* files read under the root (api_asset_hash), 0 = none */
-	char warning[256];                /* "" or what was left out (an .obj's missing .mtl) */
+	char warning[256];                /* "" or what was left out (an .obj's missing .mtl, "; " between) */
 	/* private */
 	size_t cap_;
 	unsigned char *owned_;            /* per file: 1 when its bytes are ours to free */
