@@ -87,6 +87,19 @@ code=$(post escape "$T/escape.json")
 check "a ../ URI above the root: 400 at /objects/0/path" answered "$code" 400 escape /objects/0/path
 check "a ../ URI: the detail says it leaves the root" detail_has escape "leaves the asset root"
 
+mkfifo "$A/pipe.bin"
+ln -s /etc/passwd "$A/link.bin"
+sed 's/quad\.bin/pipe.bin/' "$A/quad.gltf" >"$A/fifo.gltf"
+sed 's/quad\.bin/link.bin/' "$A/quad.gltf" >"$A/link.gltf"
+scene "$T/fifo.json" '"path": "fifo.gltf"'
+code=$(post fifo "$T/fifo.json")
+check "a .bin that is a FIFO: 400 at once at /objects/0/path" answered "$code" 400 fifo /objects/0/path
+check "a FIFO .bin: the detail says it is not a regular file" detail_has fifo "not a regular file"
+scene "$T/link.json" '"path": "link.gltf"'
+code=$(post link "$T/link.json")
+check "a .bin that is a symbolic link out of the root: 400 at /objects/0/path" answered "$code" 400 link /objects/0/path
+check "a linked-out .bin: the detail says it leaves the root" detail_has link "leaves the asset root"
+
 scene "$T/many.json" '"path": "many.gltf"' '{"shape": "plane", "size": [4, 4], "transform": {"translation": [0, 0, -1]}}, '
 check "20 textures under the default limit: 200" [ "$(post many "$T/many.json")" = 200 ]
 get info /v1/info >/dev/null
