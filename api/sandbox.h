@@ -28,6 +28,10 @@
  *   - The fork server kills a child at its wall-clock timeout (it is the child's parent, so
  *     the pid cannot have been reused) and writes how the child ended into the status pipe.
  *   - The daemon validates everything it reads back (api/model_wire.h) as untrusted.
+ *   - A model that refers to other files (a .gltf's .bin and images, an .obj's .mtl and
+ *     textures) gets them in its input, read by the daemon (api/model_refs.h): the model's
+ *     bytes, then name + bytes per file (api_sbx_bundle_encode); the child's Assimp file
+ *     system serves exactly those names from memory.
  *
  * Outcomes: API_OK; else *status says 400 (the bytes are bad: the parser refused them, crashed,
  * or was stopped by the filter), 422 (over the time or memory limit) or 500 (the helper could
