@@ -71,6 +71,9 @@ struct api_scene {
 	uint64_t triangles;         /* total after tessellation */
 	uint64_t asset_hash;        /* hash of files read under the asset root (`path` models), 0 = none:
 	                               the answer depends on them, so caches and ETags must too */
+	const char *warnings;       /* what of the models' materials is not drawn as their files say:
+	                               "/objects/N: sentence; ..." (printable ASCII, <= 1000 bytes), or
+	                               NULL. umbrad answers it as the Umbra-Warnings header. */
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;

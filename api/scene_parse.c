@@ -66,6 +66,7 @@ struct pctx {
 	/* Ground placement (api/ground.h): margin per document object, > 0 for placement "ground". */
 	float *ground_margin;
 	size_t cur_object;
+	char *warnings;                 /* the models' warnings, "/objects/N: ..." joined by "; " */
 };
 
 /* A reference to an imported model, released in api_scene_free() (the node is in the arena). */
@@ -1300,6 +1301,26 @@ static void set_pixels(struct api_scene *s)
 	else s->scene.output.pixels = s->bit_depth == 16 ? RND_PIXELS_RGBA16 : RND_PIXELS_RGBA8;
 }
 
+/* Joins the models' warnings (what of their materials is not drawn as the file says) into
+ * c->warnings, each prefixed with its object's pointer; at most API_MODEL_MAX_WARNINGS bytes. */
+static int collect_warnings(struct pctx *c, struct api_model *const *models, const uint32_t *source, uint32_t nobj)
+{
+	char buf[API_MODEL_MAX_WARNINGS + 1];
+	size_t n = 0;
+	buf[0] = 0;
+	for (uint32_t k = 0; k < nobj; k++) {
+		uint32_t i = source[k];
+		if ((k && source[k - 1] == i) || !models[i] || !models[i]->warnings || !models[i]->warnings[0]) continue;
+		int w = snprintf(buf + n, sizeof buf - n, "%s/objects/%u: %s", n ? "; " : "", i, models[i]->warnings);
+		if (w < 0 || (size_t)w >= sizeof buf - n) break;
+		n += (size_t)w;
+	}
+	if (!n) return 0;
+	if (!(c->warnings = api_arena_calloc(c->arena, n + 1, 1))) return fail(c, "out of memory");
+	memcpy(c->warnings, buf, n + 1);
+	return 0;
+}
+
 /* Replaces every model object by one mesh object per instance of its model, under the
  * object's transform, with the model's materials (appended to the scene's) unless the object
  * names its own. Returns 0 or -1 (out of memory / too many objects). */
@@ -1344,6 +1365,10 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->index_count = me->index_count;
 			o->normals = me->normals;
 			o->uvs = me->uvs;
+			o->colors = me->colors;
+			o->tangents = me->tangents;
+			/* glTF doubleSided: false culls back faces (the object can only add sidedness). */
+			o->double_sided = o->double_sided && !me->single_sided;
 			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);
 			if (!own) o->material = base + me->material;
 		}
@@ -1352,7 +1377,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 	c->mat_count = c->mat_cap = nm;
 	sc->objects = objects;
 	sc->object_count = no;
-	return 0;
+	return collect_warnings(c, models, source, no);
 }
 
 /* ---- several views ---- */
@@ -1677,13 +1702,13 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 	sc->material_count = c->mat_count;
 	const struct rnd_texture *seen[MAX_TEXTURES];
 	uint32_t ntex = 0;
-	for (uint32_t i = 0; i < c->mat_count && ntex <= MAX_TEXTURES; i++) {
-		const struct rnd_texture *t = c->mats[i].base_color_texture;
+	for (uint32_t j = 0; j < c->mat_count * RND_TEX_SLOTS && ntex <= MAX_TEXTURES; j++) {
+		const struct rnd_texture *t = c->mats[j / RND_TEX_SLOTS].textures[j % RND_TEX_SLOTS];
 		uint32_t k = 0;
 		while (t && k < ntex && seen[k] != t) k++;
 		if (!t || k < ntex) continue;
 		if (ntex == MAX_TEXTURES) {
-			defer(c, false, "materials", "the scene has more than %u distinct base-colour textures (the "
+			defer(c, false, "materials", "the scene has more than %u distinct textures (the "
 			      "renderer's limit)", MAX_TEXTURES);
 			break;
 		}
@@ -1755,6 +1780,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
+	s->warnings = c.warnings;
 	*out = s;
 	return API_OK;
 }

@@ -21,10 +21,14 @@
 #include "umbra/rnd.h"
 #include "umbra/rnd_math.h"
 
+/* 40 bytes: lavapipe pays per vertex fetched, so colour and tangent are 8-bit (the colour
+ * linear RGBA unorm, the tangent xyzw snorm: a direction to ~0.5 degrees, w the sign). */
 struct rnd_vertex {
 	float pos[3];
 	float nrm[3];
 	float uv[2];
+	uint8_t color[4];
+	int8_t tangent[4];
 };
 
 /* Vertex and index counts rnd_mesh_write() will produce for o. */

@@ -27,9 +27,10 @@ struct rnd_slot {
 	/* this render's material textures (destroyed when the next render starts) */
 	struct rnd_image_res textures[UMBRA_MAX_TEXTURES];
 	uint32_t texture_count;
-	/* set 1 per texture: [0] the white 1x1 (untextured draws), [1 + i] textures[i] */
+	/* set 1: [0] the white 1x1 in every slot (untextured draws), [1 + i] the i-th textured
+	 * material's textures (render.c textures()) */
 	VkDescriptorPool texture_pool;
-	VkDescriptorSet texture_sets[1 + UMBRA_MAX_TEXTURES];
+	VkDescriptorSet texture_sets[1 + UMBRA_MAX_TEXTURE_SETS];
 	struct rnd_image_res white;
 	bool white_ready;             /* cleared to white and in SHADER_READ_ONLY layout */
 	/* AOV pass targets: UMBRA_AOV_ATTACHMENTS x RGBA32F + a single-sample depth */

@@ -86,7 +86,11 @@ static int load_scene(const char *in, const char *out, const char *asset_root, s
 		if (r == API_OK) r = api_scene_set_format(*scene, f, &prob);
 	}
 	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
-	if (r == API_OK) return 0;
+	if (r == API_OK) {
+		/* What of the models' materials is not drawn as the files say (umbrad: Umbra-Warnings). */
+		if ((*scene)->warnings) fprintf(stderr, "umbra-render: %s: warning: %s\n", in, (*scene)->warnings);
+		return 0;
+	}
 	api_problem_format(&prob, line, sizeof line);
 	fprintf(stderr, "umbra-render: %s\n", line);
 	api_scene_free(*scene);

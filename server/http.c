@@ -125,6 +125,8 @@ static enum MHD_Result respond(struct srv_request *req, int status, const char *
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Accept");
 		if (req->server_timing[0])
 			MHD_add_response_header(resp, MHD_HTTP_HEADER_SERVER_TIMING, req->server_timing);
+		/* What of the scene's model materials is not drawn as the files say (never silent). */
+		if (status == 200 && req->warnings[0]) MHD_add_response_header(resp, "Umbra-Warnings", req->warnings);
 	}
 	if (req->route != SRV_ROUTE_RENDER || status != 200)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");

@@ -162,6 +162,7 @@ struct srv_request {
 	size_t out_len;
 	const char *content_type;
 	char server_timing[320];
+	char warnings[1024];           /* Umbra-Warnings of a 200 (api_scene.warnings), "" = none */
 	/* the problem answered (4xx/5xx), for the access log */
 	char problem_pointer[256];
 	char problem_detail[512];

@@ -496,6 +496,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	req->out = bytes;
 	req->out_len = len;
 	req->content_type = api_format_mime(sc->format);
+	if (sc->warnings) snprintf(req->warnings, sizeof req->warnings, "%s", sc->warnings);
 	snprintf(req->server_timing, sizeof req->server_timing,
 	         "queue;dur=%.3f, parse;dur=%.3f, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
 	         "readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",

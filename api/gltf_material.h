@@ -1,0 +1,46 @@
+/*
+ * api/gltf_material — what of a glTF 2.0 material Assimp 5.2 does not hand over reliably,
+ * read from the document's JSON itself: per texture slot the sampler (wrap and filter modes),
+ * KHR_texture_transform, texCoord, normalTexture.scale and occlusionTexture.strength;
+ * KHR_materials_emissive_strength; doubleSided. Also the list of what the renderer does not
+ * do of the file (unknown extensions, a second uv set, skins, animations, morph targets,
+ * points and lines), as warnings that travel with the model (api_model.warnings).
+ *
+ * Assimp's glTF importer keeps the document's material order (scene material i = glTF
+ * material i, its default material appended after them), which is how the two are joined.
+ *
+ * Usage (api/model_import.c, inside the sandboxed importer):
+ *   struct api_gltf_info gi; api_gltf_info_read(root, &gi);   // root: the parsed JSON
+ *   ... gi.materials[i] while converting Assimp material i (i < gi.material_count) ...
+ *   api_gltf_info_free(&gi);
+ * Ownership: gi owns its materials array (malloc). Threading: no shared state.
+ */
+#ifndef UMBRA_API_GLTF_MATERIAL_H
+#define UMBRA_API_GLTF_MATERIAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <jansson.h>
+#include "model.h"
+
+struct api_gltf_material {
+	float emissive_strength;           /* 1 */
+	bool double_sided;                 /* false (glTF's default) */
+	float normal_scale, occlusion_strength;    /* 1, 1 */
+	struct rnd_texture_sampling sampling[RND_TEX_SLOTS];
+};
+
+struct api_gltf_info {
+	struct api_gltf_material *materials;
+	uint32_t material_count;
+	char warnings[API_MODEL_MAX_WARNINGS + 1];   /* "" when none */
+};
+
+/* Reads root (a JSON object). Never fails: what cannot be read stays at glTF's defaults (a
+ * materials array it cannot allocate leaves material_count 0). */
+void api_gltf_info_read(json_t *root, struct api_gltf_info *out);
+void api_gltf_info_free(struct api_gltf_info *gi);
+/* Adds a warning (once; dropped past the size limit, with "..."). */
+void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+#endif
