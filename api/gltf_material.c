@@ -170,3 +170,54 @@ void api_gltf_info_free(struct api_gltf_info *gi)
 	gi->materials = NULL;
 	gi->material_count = 0;
 }
+
+#define TAG "umbra-gltf-material-"
+
+uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len)
+{
+	json_t *mats = json_object_get(root, "materials"), *m;
+	size_t i;
+	if (!json_array_size(mats)) return NULL;
+	json_array_foreach(mats, i, m) {
+		char tag[48];
+		snprintf(tag, sizeof tag, TAG "%zu", i);
+		if (json_is_object(m) && json_object_set_new(m, "name", json_string(tag)) < 0) return NULL;
+	}
+	char *js = json_dumps(root, JSON_COMPACT);
+	if (!js) return NULL;
+	size_t jn = strlen(js), jpad = (jn + 3) & ~(size_t)3;
+	uint8_t *out = NULL;
+	if (!glb) {
+		out = malloc(jn ? jn : 1);
+		if (out) memcpy(out, js, jn);
+		*out_len = jn;
+	} else {
+		/* header, the new JSON chunk, then the original chunks after the JSON one */
+		uint32_t old = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 | (uint32_t)data[15] << 24;
+		size_t rest_at = 20 + (size_t)old, rest = rest_at <= len ? len - rest_at : 0;
+		size_t total = 20 + jpad + rest;
+		if (total <= UINT32_MAX && (out = malloc(total))) {
+			memcpy(out, data, 12);
+			uint32_t t32 = (uint32_t)total, j32 = (uint32_t)jpad;
+			for (int k = 0; k < 4; k++) {
+				out[8 + k] = (uint8_t)(t32 >> (8 * k));
+				out[12 + k] = (uint8_t)(j32 >> (8 * k));
+			}
+			memcpy(out + 16, "JSON", 4);
+			memcpy(out + 20, js, jn);
+			memset(out + 20 + jn, ' ', jpad - jn);
+			memcpy(out + 20 + jpad, data + rest_at, rest);
+			*out_len = total;
+		}
+	}
+	free(js);
+	return out;
+}
+
+int api_gltf_material_of(const char *name)
+{
+	if (!name || strncmp(name, TAG, strlen(TAG))) return -1;
+	char *end;
+	long v = strtol(name + strlen(TAG), &end, 10);
+	return *end || end == name + strlen(TAG) || v < 0 || v > 65535 ? -1 : (int)v;
+}

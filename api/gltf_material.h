@@ -6,13 +6,17 @@
  * do of the file (unknown extensions, a second uv set, skins, animations, morph targets,
  * points and lines), as warnings that travel with the model (api_model.warnings).
  *
- * Assimp's glTF importer keeps the document's material order (scene material i = glTF
- * material i, its default material appended after them), which is how the two are joined.
+ * Assimp 5.2's glTF importer numbers materials in the order it first meets them walking the
+ * node tree (children before a node's own mesh), not the document's order. So the document is
+ * handed to Assimp with each material renamed to a tag naming its index
+ * (api_gltf_tag_materials), and each Assimp material is joined to its glTF material by that
+ * name (api_gltf_material_of); the original names stay here, for the warnings.
  *
  * Usage (api/model_import.c, inside the sandboxed importer):
  *   struct api_gltf_info gi; api_gltf_info_read(root, &gi);   // root: the parsed JSON
- *   ... gi.materials[i] while converting Assimp material i (i < gi.material_count) ...
- *   api_gltf_info_free(&gi);
+ *   uint8_t *t = api_gltf_tag_materials(root, data, len, glb, &tlen);  // import t (or data if NULL)
+ *   ... i = api_gltf_material_of(assimp material name): gi.materials[i] when i >= 0 ...
+ *   free(t); api_gltf_info_free(&gi);
  * Ownership: gi owns its materials array (malloc). Threading: no shared state.
  */
 #ifndef UMBRA_API_GLTF_MATERIAL_H
@@ -40,6 +44,11 @@ struct api_gltf_info {
  * materials array it cannot allocate leaves material_count 0). */
 void api_gltf_info_read(json_t *root, struct api_gltf_info *out);
 void api_gltf_info_free(struct api_gltf_info *gi);
+/* The file's bytes with every material's name replaced by its index tag (malloc'd, you free
+ * it), or NULL (no materials, or out of memory: import the original then). root is changed. */
+uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len);
+/* The glTF material index an Assimp material name tags, or -1. */
+int api_gltf_material_of(const char *name);
 /* Adds a warning (once; dropped past the size limit, with "..."). */
 void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

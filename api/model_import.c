@@ -416,8 +416,9 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, uint32_
 	struct aiString s;
 	/* Formats without materials (stl, ply, obj without mtl) get Assimp's default material:
 	 * the contract's default grey stands in for it, as for every other shape. */
-	if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) == aiReturn_SUCCESS && !strcmp(s.data, AI_DEFAULT_MATERIAL_NAME))
-		return 0;
+	if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) != aiReturn_SUCCESS) s.data[0] = 0, s.length = 0;
+	else if (!strcmp(s.data, AI_DEFAULT_MATERIAL_NAME)) return 0;
+	int gi = c->gltf ? api_gltf_material_of(s.data) : -1;
 	struct aiColor4D col;
 	if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
 	    aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS) {
@@ -431,7 +432,7 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, uint32_
 		m->metallic = clampf(f, 0, 1);
 	if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, NULL) == aiReturn_SUCCESS)
 		m->roughness = clampf(f, 0, 1);
-	const struct api_gltf_material *gm = index < c->gi.material_count ? &c->gi.materials[index] : NULL;
+	const struct api_gltf_material *gm = gi >= 0 && (uint32_t)gi < c->gi.material_count ? &c->gi.materials[gi] : NULL;
 	float strength = gm ? gm->emissive_strength : 1.0f;
 	if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &col) == aiReturn_SUCCESS) {
 		m->emissive[0] = clampf(col.r * strength, 0, 1e6f);
@@ -561,7 +562,16 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	json_t *root = NULL;
 	if (gltf && gltf_precheck(data, len, format, &root, err, errsize) < 0) return API_WIRE_BAD_INPUT;
 	struct conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf};
-	if (gltf) api_gltf_info_read(root, &c.gi);
+	uint8_t *tagged = NULL;
+	if (gltf) {
+		api_gltf_info_read(root, &c.gi);
+		size_t tagged_len = 0;
+		/* Materials renamed to their glTF index, to find them again (see gltf_material.h). */
+		if ((tagged = api_gltf_tag_materials(root, data, len, format == API_MODEL_GLB, &tagged_len))) {
+			data = tagged;
+			len = tagged_len;
+		}
+	}
 	json_decref(root);
 	/* PLY triangle strips: Assimp 5.2 reads a strip as one polygon (a flat sliver). */
 	size_t strips_len = 0;
@@ -597,6 +607,7 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
 	pthread_mutex_unlock(&import_mu);
 	aiReleasePropertyStore(props);
 	free(strips);   /* Assimp copied what it needed */
+	free(tagged);
 	if (!sc) {
 		api_gltf_info_free(&c.gi);
 		return st;
