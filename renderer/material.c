@@ -40,7 +40,6 @@ void rnd_material_write(const struct rnd_material *in, struct umbra_material *ou
 			r0[0] = 1.0f;
 			r1[1] = 1.0f;
 		}
-		if (getenv("MATDBG")) fprintf(stderr, "slot %u: %g %g %g / %g %g %g\n", k, r0[0], r0[1], r0[2], r1[0], r1[1], r1[2]);
 	}
 }
 
