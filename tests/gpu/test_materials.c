@@ -324,6 +324,56 @@ TEST(materials_normal_map_tilts_n_dot_l)
 	}
 }
 
+/* ---- occlusion ---- */
+
+/* occlusionTexture R = 64 (0.2510 linear), base 0.5. Under a white hemisphere ambient of
+ * intensity 1 alone: 0.5 x (1 + strength x (0.2510 - 1)) = 0.1255 (strength 1), 0.3127
+ * (strength 0.5). Under the direct light alone it changes nothing: 0.51. */
+static bool render_ambient(int line, struct rnd_image *img, const struct mglb *g, bool ambient)
+{
+	size_t n;
+	uint8_t *glb = glb_of(g, &n);
+	char *enc = b64(glb, n);
+	free(glb);
+	bool ok = gpu_render_at(__FILE__, line, img,
+	                        "{'width':%d,'height':%d,"
+	                        "'camera':{'type':'orthographic','position':[0,5,0],'target':[0,0,0],'up':[0,0,-1],"
+	                        "'height':%.9g},"
+	                        "'environment':{'background':[0,0,0],'ambient':{'sky':[1,1,1],'ground':[1,1,1],"
+	                        "'intensity':%d}},"
+	                        "'objects':[{'shape':'model','format':'glb','data':'%s'}],"
+	                        "'lights':[%s],'output':{'tonemap':'none','msaa':1}}",
+	                        MW, MH, MORTHO, ambient ? 1 : 0, enc,
+	                        ambient ? "" : "{'type':'directional','direction':[0,-1,0],'intensity':3.14159265}");
+	free(enc);
+	return ok;
+}
+
+TEST(materials_occlusion_darkens_ambient_only)
+{
+	static const uint8_t tex[4] = {64, 255, 255, 255};
+	struct { const char *strength; bool ambient; double want; } cases[3] = {
+		{"", true, 0.1255}, {",\"strength\":0.5", true, 0.3127}, {"", false, 0.51},
+	};
+	for (int k = 0; k < 3; k++) {
+		char mat[300];
+		snprintf(mat, sizeof mat,
+		         "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":0,"
+		         "\"roughnessFactor\":1},\"occlusionTexture\":{\"index\":0%s}}", cases[k].strength);
+		struct mglb g = {.material = mat, .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP};
+		add_png(&g, tex, 1, 1);
+		struct rnd_image img;
+		bool ok = render_ambient(__LINE__, &img, &g, cases[k].ambient);
+		free_pngs(&g);
+		if (!ok) return;
+		double got = lin_at(&img, false, 0.2, -0.3, 0);
+		printf("    %s%s: %.4f (want %.4f)\n", cases[k].ambient ? "ambient" : "direct light", cases[k].strength, got,
+		       cases[k].want);
+		CHECK(fabs(got - cases[k].want) < 0.015, "case %d: %.4f, want %.4f", k, got, cases[k].want);
+		rnd_image_release(&img);
+	}
+}
+
 /* ---- sampler wrap modes ---- */
 
 /* u runs 0..2 over the quad; the texture is red | blue (2x1, nearest). At u = 1.25 repeat
