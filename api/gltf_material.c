@@ -163,6 +163,39 @@ void api_gltf_info_read(json_t *root, struct api_gltf_info *out)
 	for (size_t i = 0; i < n; i++) read_material(out, root, (uint32_t)i, json_array_get(mats, i), &out->materials[i]);
 }
 
+void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m,
+                             bool *single_sided)
+{
+	if (index >= gi->material_count) return;
+	const struct api_gltf_material *gm = &gi->materials[index];
+	for (int k = 0; k < 3; k++) m->emissive[k] = fminf(m->emissive[k] * gm->emissive_strength, 1e6f);
+	memcpy(m->sampling, gm->sampling, sizeof m->sampling);
+	m->normal_scale = fminf(fmaxf(gm->normal_scale, -1e3f), 1e3f);
+	m->occlusion_strength = gm->occlusion_strength;   /* clamped to 0..1 when read */
+	*single_sided = !gm->double_sided;
+}
+
+void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out)
+{
+	for (size_t i = 0; i < (size_t)n * 4; i++) {
+		float f = rgba[i];
+		out[i] = (uint8_t)lrintf(!(f >= 0.0f) ? 0.0f : f > 1.0f ? 255.0f : f * 255.0f);   /* NaN -> 0 */
+	}
+}
+
+void api_vertex_tangents(const float *t, const float *b, const float *nrm, uint32_t n, float *out)
+{
+	for (size_t v = 0; v < n; v++) {
+		const float *tv = t + 3 * v, *bv = b + 3 * v, *nv = nrm + 3 * v;
+		float cx = nv[1] * tv[2] - nv[2] * tv[1], cy = nv[2] * tv[0] - nv[0] * tv[2], cz = nv[0] * tv[1] - nv[1] * tv[0];
+		bool ok = isfinite(tv[0]) && isfinite(tv[1]) && isfinite(tv[2]);
+		out[4 * v] = ok ? tv[0] : 1;
+		out[4 * v + 1] = ok ? tv[1] : 0;
+		out[4 * v + 2] = ok ? tv[2] : 0;
+		out[4 * v + 3] = cx * bv[0] + cy * bv[1] + cz * bv[2] < 0 ? -1.0f : 1.0f;
+	}
+}
+
 void api_gltf_info_free(struct api_gltf_info *gi)
 {
 	if (!gi) return;

@@ -49,6 +49,15 @@ void api_gltf_info_free(struct api_gltf_info *gi);
 uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len);
 /* The glTF material index an Assimp material name tags, or -1. */
 int api_gltf_material_of(const char *name);
+/* What material `index` of the document adds to m as Assimp read it: emissive x strength,
+ * the samplings, normal scale, occlusion strength; *single_sided from doubleSided. Nothing
+ * when index is past the document's materials. */
+void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m,
+                             bool *single_sided);
+/* Vertex data: n RGBA float colours -> linear RGBA8 (clamped); n tangents, bitangents and
+ * normals (xyz floats) -> xyzw tangents, w = the side of the bitangent (+1 / -1). */
+void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out);
+void api_vertex_tangents(const float *t, const float *b, const float *nrm, uint32_t n, float *out);
 /* Adds a warning (once; dropped past the size limit, with "..."). */
 void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

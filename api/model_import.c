@@ -9,6 +9,11 @@
  * the sandbox's system-call filter would refuse an open anyway). The node tree is walked with
  * every node's transform (Assimp's aiMatrix4x4 is row-major; ours are column-major), each
  * (node, mesh) pair becoming one instance; meshes keep triangles only.
+ *
+ * Materials: glTF's core material model (every texture slot, samplers, texture transforms,
+ * emissive strength, doubleSided: what Assimp 5.2 does not hand over reliably is read from the
+ * document's JSON, api/gltf_material.c), vertex colours, and tangents for normal maps. What a
+ * file asks for and is not drawn becomes the model's warnings.
  */
 #include <math.h>
 #include <pthread.h>
@@ -230,37 +235,22 @@ static bool any_area(const struct api_model_mesh *m, uint32_t n)
 	return false;
 }
 
-static uint8_t unorm8(float f)
-{
-	return (uint8_t)lrintf(!(f >= 0.0f) ? 0.0f : f > 1.0f ? 255.0f : f * 255.0f);
-}
-
 /* Vertex colours (COLOR_0) and, for a mesh whose material has a normal map, tangents (from
- * the file or made by aiProcess_CalcTangentSpace; w from the bitangent's side). */
+ * the file or made by aiProcess_CalcTangentSpace). aiColor4D and aiVector3D are plain floats. */
+_Static_assert(sizeof(struct aiVector3D) == 12 && sizeof(struct aiColor4D) == 16, "Assimp built with doubles");
 static int convert_extras(struct conv *c, const struct aiMesh *am, struct api_model_mesh *out)
 {
 	uint32_t nv = am->mNumVertices;
 	unsigned mi = am->mMaterialIndex < c->sc->mNumMaterials ? am->mMaterialIndex : 0;
-	if (am->mColors[0]) {
-		uint8_t *col = conv_alloc(c, nv, 4);
-		if (!col) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
-		for (uint32_t v = 0; v < nv; v++) {
-			const struct aiColor4D *k = &am->mColors[0][v];
-			col[4 * v] = unorm8(k->r); col[4 * v + 1] = unorm8(k->g); col[4 * v + 2] = unorm8(k->b); col[4 * v + 3] = unorm8(k->a);
-		}
-		out->colors = col;
-	}
-	if (!am->mTangents || !am->mBitangents || !am->mNormals || !c->mats[mi].normal_texture) return 0;
-	float *tan = conv_alloc(c, nv, 4 * sizeof(float));
-	if (!tan) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
-	for (uint32_t v = 0; v < nv; v++) {
-		const struct aiVector3D *t = &am->mTangents[v], *b = &am->mBitangents[v], *n = &am->mNormals[v];
-		float cx = n->y * t->z - n->z * t->y, cy = n->z * t->x - n->x * t->z, cz = n->x * t->y - n->y * t->x;
-		bool ok = isfinite(t->x) && isfinite(t->y) && isfinite(t->z);
-		tan[4 * v] = ok ? t->x : 1; tan[4 * v + 1] = ok ? t->y : 0; tan[4 * v + 2] = ok ? t->z : 0;
-		tan[4 * v + 3] = cx * b->x + cy * b->y + cz * b->z < 0 ? -1.0f : 1.0f;
-	}
-	out->tangents = tan;
+	bool tan = am->mTangents && am->mBitangents && am->mNormals && c->mats[mi].normal_texture;
+	uint8_t *col = am->mColors[0] ? conv_alloc(c, nv, 4) : NULL;
+	float *t = tan ? conv_alloc(c, nv, 4 * sizeof(float)) : NULL;
+	if ((am->mColors[0] && !col) || (tan && !t))
+		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	if (col) api_vertex_colors((const float *)am->mColors[0], nv, col);
+	if (t) api_vertex_tangents((const float *)am->mTangents, (const float *)am->mBitangents, (const float *)am->mNormals, nv, t);
+	out->colors = col;
+	out->tangents = t;
 	return 0;
 }
 
@@ -422,22 +412,17 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, uint32_
 	struct aiColor4D col;
 	if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
 	    aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS) {
-		m->base_color[0] = clampf(col.r, 0, 1e6f);
-		m->base_color[1] = clampf(col.g, 0, 1e6f);
-		m->base_color[2] = clampf(col.b, 0, 1e6f);
-		m->base_color[3] = clampf(col.a, 0, 1);
+		const float v[4] = {col.r, col.g, col.b, col.a};
+		for (int k = 0; k < 4; k++) m->base_color[k] = clampf(v[k], 0, k < 3 ? 1e6f : 1);
 	}
 	ai_real f;
 	if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, NULL) == aiReturn_SUCCESS)
 		m->metallic = clampf(f, 0, 1);
 	if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, NULL) == aiReturn_SUCCESS)
 		m->roughness = clampf(f, 0, 1);
-	const struct api_gltf_material *gm = gi >= 0 && (uint32_t)gi < c->gi.material_count ? &c->gi.materials[gi] : NULL;
-	float strength = gm ? gm->emissive_strength : 1.0f;
 	if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &col) == aiReturn_SUCCESS) {
-		m->emissive[0] = clampf(col.r * strength, 0, 1e6f);
-		m->emissive[1] = clampf(col.g * strength, 0, 1e6f);
-		m->emissive[2] = clampf(col.b * strength, 0, 1e6f);
+		const float v[3] = {col.r, col.g, col.b};
+		for (int k = 0; k < 3; k++) m->emissive[k] = clampf(v[k], 0, 1e6f);
 	}
 	if (aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &s) == aiReturn_SUCCESS) {
 		if (!strcmp(s.data, "MASK")) m->alpha_mode = RND_ALPHA_MASK;
@@ -445,13 +430,8 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, uint32_
 		if (aiGetMaterialFloatArray(am, "$mat.gltf.alphaCutoff", 0, 0, &f, NULL) == aiReturn_SUCCESS)
 			m->alpha_cutoff = clampf(f, 0, 1);
 	}
-	if (gm) {
-		memcpy(m->sampling, gm->sampling, sizeof m->sampling);
-		m->normal_scale = clampf(gm->normal_scale, -1e3f, 1e3f);
-		m->occlusion_strength = clampf(gm->occlusion_strength, 0, 1);
-		*single_sided = !gm->double_sided;
-	}
-	return material_textures(c, am, index, m);
+	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
+	return material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m);
 }
 
 static int walk(struct conv *c, const struct aiNode *node, const float parent[16], int depth)
