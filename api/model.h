@@ -1,7 +1,8 @@
 /*
  * api/model — imported 3D models (contract shape "model"): glb, self-contained gltf, obj, stl,
- * ply through the Assimp C API, base-colour textures through api/image_decode.c, and a bounded
- * LRU cache of imported models keyed by their bytes.
+ * ply through the Assimp C API, glTF 2.0 materials (every texture slot, decoded through
+ * api/image_decode.c; see api/gltf_material.h), and a bounded LRU cache of imported models
+ * keyed by their bytes.
  *
  * Isolation: model files are untrusted, and Assimp has crashed and looped on small malformed
  * ones. api_model_get() therefore never parses in the calling process: Assimp (and the decoding

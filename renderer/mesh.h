@@ -11,7 +11,9 @@
  * triangles with flat normals; sphere = UV sphere of `segments` longitudes x segments/2
  * latitudes (smooth normals, poles as triangle fans); cylinder = `segments` side quads with
  * smooth normals + two capped fans with flat normals; mesh = as given (flat normals computed
- * when none given; with no indices, the vertices are a triangle list).
+ * when none given; with no indices, the vertices are a triangle list). Meshes carry their
+ * vertex colours and tangents (model matrix applied, w flipped by a mirroring one); other
+ * shapes get white and +x.
  * Pure C, no Vulkan, thread-safe.
  */
 #ifndef UMBRA_RENDERER_MESH_H
