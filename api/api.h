@@ -75,9 +75,10 @@ struct api_scene {
 	uint64_t asset_hash;        /* hash of files read under the asset root (`path` models), 0 = none:
 	                               the answer depends on them, so caches and ETags must too */
 	/* What the image leaves out of what the scene asked for ("" = nothing), as sentences joined
-	 * by "; " that start with the member's JSON Pointer, e.g. an .obj sent inline whose .mtl is
-	 * not in the request. The server sends it as the Umbra-Warning header, the CLI on stderr. */
-	char warnings[512];
+	 * by "; " that start with the member's JSON Pointer: an .obj sent inline whose .mtl is not in
+	 * the request, material data of a model that is not drawn as its file says. The server sends
+	 * it as the Umbra-Warnings header, the CLI on stderr. */
+	char warnings[1024];
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;

@@ -1,8 +1,9 @@
 /*
  * api/model — imported 3D models (contract shape "model"): glb, gltf (self-contained or with
  * its buffer and image files), obj (with its .mtl and textures), stl, ply through the Assimp C
- * API, base-colour textures through api/image_decode.c, and a bounded LRU cache of imported
- * models keyed by their bytes (and those of the files they refer to).
+ * API, glTF 2.0 materials (every texture slot, decoded through api/image_decode.c; see
+ * api/gltf_material.h), and a bounded LRU cache of imported models keyed by their bytes (and
+ * those of the files they refer to).
  *
  * Isolation: model files are untrusted, and Assimp has crashed and looped on small malformed
  * ones. api_model_get() therefore never parses in the calling process: Assimp (and the decoding
@@ -31,6 +32,7 @@
 #ifndef UMBRA_API_MODEL_H
 #define UMBRA_API_MODEL_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "api.h"
@@ -40,14 +42,20 @@ enum api_model_format {
 	API_MODEL_GLB = 0, API_MODEL_GLTF, API_MODEL_OBJ, API_MODEL_STL, API_MODEL_PLY,
 };
 
+#define API_MODEL_MAX_WARNINGS 1000u
+
 /* One geometry array set (an Assimp mesh, triangles only). */
 struct api_model_mesh {
 	const float *positions;   /* xyz per vertex */
 	const float *normals;     /* xyz per vertex, always present (generated when the file has none) */
 	const float *uvs;         /* uv per vertex (glTF convention: v = 0 at the image's top row), or NULL */
+	const uint8_t *colors;    /* linear RGBA8 per vertex (glTF COLOR_0), or NULL */
+	const float *tangents;    /* xyzw per vertex (w = bitangent sign), or NULL (kept only when the
+	                             mesh's material has a normal map) */
 	const uint32_t *indices;  /* index_count, a multiple of 3, every index < vertex_count */
 	uint32_t vertex_count, index_count;
 	uint32_t material;        /* index into api_model.materials */
+	bool single_sided;        /* its material says doubleSided: false (back faces culled) */
 };
 
 /* A node's use of a mesh: one rnd_object. */
@@ -61,6 +69,9 @@ struct api_model {
 	const struct api_model_instance *instances; uint32_t instance_count;
 	const struct rnd_material *materials;      uint32_t material_count; /* textures point into the model */
 	uint64_t triangles;       /* over all instances */
+	/* What of the file's materials (and scene) is not drawn as the file says, as sentences
+	 * joined by "; " (printable ASCII, at most API_MODEL_MAX_WARNINGS bytes), or NULL. */
+	const char *warnings;
 	enum api_model_format format;
 	/* private */
 	size_t bytes_;            /* what the cache charges for it */

@@ -9,6 +9,11 @@
  * sandbox's system-call filter would refuse an open anyway); a name it was not given fails. The node tree is walked with
  * every node's transform (Assimp's aiMatrix4x4 is row-major; ours are column-major), each
  * (node, mesh) pair becoming one instance; meshes keep triangles only.
+ *
+ * Materials: glTF's core material model (every texture slot, samplers, texture transforms,
+ * emissive strength, doubleSided: what Assimp 5.2 does not hand over reliably is read from the
+ * document's JSON, api/gltf_material.c), vertex colours, and tangents for normal maps. What a
+ * file asks for and is not drawn becomes the model's warnings.
  */
 #include <ctype.h>
 #include <math.h>
@@ -25,6 +30,7 @@
 #include <assimp/scene.h>
 #include <jansson.h>
 #include "errmsg.h"
+#include "gltf_material.h"
 #include "model_import.h"
 #include "ply_strips.h"
 #include "umbra/rnd_math.h"
@@ -49,8 +55,11 @@ static bool image_type_ok(const char *t, size_t n)
 	return (n == 9 && !memcmp(t, "image/png", 9)) || (n == 10 && !memcmp(t, "image/jpeg", 10));
 }
 
-static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, char *err, size_t errsize)
+/* On success *root_out is the parsed document (the caller's reference). */
+static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, json_t **root_out, char *err,
+                         size_t errsize)
 {
+	*root_out = NULL;
 	const char *json = (const char *)d;
 	size_t jlen = len;
 	if (f == API_MODEL_GLB) {
@@ -83,8 +92,11 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
 		}
 		if (rc) break;
 	}
-	json_decref(root);
-	if (rc) return api_err_set(err, errsize, "glTF image %zu is not a PNG or JPEG image (mimeType)", i), -1;
+	if (rc) {
+		json_decref(root);
+		return api_err_set(err, errsize, "glTF image %zu is not a PNG or JPEG image (mimeType)", i), -1;
+	}
+	*root_out = root;
 	return 0;
 }
 
@@ -222,6 +234,10 @@ struct conv {
 	size_t nfiles;
 	struct api_model_instance *inst;
 	uint32_t ninst, inst_cap;
+	bool gltf;                    /* glb / gltf: every texture slot, glTF material details */
+	struct api_gltf_info gi;      /* those details, and the warnings (filled for glTF only) */
+	const struct rnd_material *mats;
+	const bool *single_sided;     /* by material */
 	char *err;
 	size_t errsize;
 };
@@ -258,6 +274,25 @@ static bool any_area(const struct api_model_mesh *m, uint32_t n)
 	return false;
 }
 
+/* Vertex colours (COLOR_0) and, for a mesh whose material has a normal map, tangents (from
+ * the file or made by aiProcess_CalcTangentSpace). aiColor4D and aiVector3D are plain floats. */
+_Static_assert(sizeof(struct aiVector3D) == 12 && sizeof(struct aiColor4D) == 16, "Assimp built with doubles");
+static int convert_extras(struct conv *c, const struct aiMesh *am, struct api_model_mesh *out)
+{
+	uint32_t nv = am->mNumVertices;
+	unsigned mi = am->mMaterialIndex < c->sc->mNumMaterials ? am->mMaterialIndex : 0;
+	bool tan = am->mTangents && am->mBitangents && am->mNormals && c->mats[mi].normal_texture;
+	uint8_t *col = am->mColors[0] ? conv_alloc(c, nv, 4) : NULL;
+	float *t = tan ? conv_alloc(c, nv, 4 * sizeof(float)) : NULL;
+	if ((am->mColors[0] && !col) || (tan && !t))
+		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	if (col) api_vertex_colors((const float *)am->mColors[0], nv, col);
+	if (t) api_vertex_tangents((const float *)am->mTangents, (const float *)am->mBitangents, (const float *)am->mNormals, nv, t);
+	out->colors = col;
+	out->tangents = t;
+	return 0;
+}
+
 static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_model_mesh *out)
 {
 	uint32_t nv = am->mNumVertices, ntri = 0;
@@ -268,6 +303,7 @@ static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_mode
 	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
 	if (!pos || (am->mNormals && !nrm) || (am->mTextureCoords[0] && !uv) || !idx)
 		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	if (convert_extras(c, am, out) < 0) return -1;
 	for (uint32_t v = 0; v < nv; v++) {
 		const struct aiVector3D *p = &am->mVertices[v];
 		if (!isfinite(p->x) || !isfinite(p->y) || !isfinite(p->z))
@@ -301,6 +337,7 @@ static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_mode
 	out->positions = pos;
 	out->normals = nrm;
 	out->uvs = uv;
+	out->single_sided = c->single_sided[am->mMaterialIndex < c->sc->mNumMaterials ? am->mMaterialIndex : 0];
 	out->indices = idx;
 	out->vertex_count = nv;
 	out->index_count = k;
@@ -377,21 +414,52 @@ static const struct rnd_texture *texture(struct conv *c, int ti)
 	return t;
 }
 
-static int convert_material(struct conv *c, const struct aiMaterial *am, struct rnd_material *m)
+/* Assimp's texture types per slot, in the order tried (glTF: base colour also as DIFFUSE;
+ * metallic-roughness as UNKNOWN, 5.2's name for it; occlusion as LIGHTMAP). */
+static const enum aiTextureType SLOT_TYPES[RND_TEX_SLOTS][3] = {
+	{aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, aiTextureType_NONE},
+	{aiTextureType_UNKNOWN, aiTextureType_METALNESS, aiTextureType_DIFFUSE_ROUGHNESS},
+	{aiTextureType_NORMALS, aiTextureType_NONE, aiTextureType_NONE},
+	{aiTextureType_LIGHTMAP, aiTextureType_AMBIENT_OCCLUSION, aiTextureType_NONE},
+	{aiTextureType_EMISSIVE, aiTextureType_NONE, aiTextureType_NONE},
+};
+
+static int material_textures(struct conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m)
+{
+	struct aiString s;
+	for (uint32_t k = 0; k < (c->gltf ? RND_TEX_SLOTS : 1u); k++) {
+		for (int j = 0; j < 3 && SLOT_TYPES[k][j] != aiTextureType_NONE; j++) {
+			if (aiGetMaterialTexture(am, SLOT_TYPES[k][j], 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS)
+				continue;
+			int ti = find_texture(c, s.data);
+			if (ti < 0) {
+				/* Neither embedded nor among the files the daemon sent with the model. */
+				if (c->gltf) api_gltf_warn(&c->gi, "material %u: texture \"%.60s\" is not in the file (not drawn)", index, s.data);
+				break;
+			}
+			if (!(m->textures[k] = texture(c, ti))) return -1;
+			break;
+		}
+	}
+	return 0;
+}
+
+static int convert_material(struct conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m,
+                            bool *single_sided)
 {
 	rnd_material_defaults(m);
+	*single_sided = false;
 	struct aiString s;
 	/* Formats without materials (stl, ply, obj without mtl) get Assimp's default material:
 	 * the contract's default grey stands in for it, as for every other shape. */
-	if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) == aiReturn_SUCCESS && !strcmp(s.data, AI_DEFAULT_MATERIAL_NAME))
-		return 0;
+	if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) != aiReturn_SUCCESS) s.data[0] = 0, s.length = 0;
+	else if (!strcmp(s.data, AI_DEFAULT_MATERIAL_NAME)) return 0;
+	int gi = c->gltf ? api_gltf_material_of(s.data) : -1;
 	struct aiColor4D col;
 	if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
 	    aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS) {
-		m->base_color[0] = clampf(col.r, 0, 1e6f);
-		m->base_color[1] = clampf(col.g, 0, 1e6f);
-		m->base_color[2] = clampf(col.b, 0, 1e6f);
-		m->base_color[3] = clampf(col.a, 0, 1);
+		const float v[4] = {col.r, col.g, col.b, col.a};
+		for (int k = 0; k < 4; k++) m->base_color[k] = clampf(v[k], 0, k < 3 ? 1e6f : 1);
 	}
 	ai_real f;
 	if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, NULL) == aiReturn_SUCCESS)
@@ -399,28 +467,17 @@ static int convert_material(struct conv *c, const struct aiMaterial *am, struct 
 	if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, NULL) == aiReturn_SUCCESS)
 		m->roughness = clampf(f, 0, 1);
 	if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &col) == aiReturn_SUCCESS) {
-		m->emissive[0] = clampf(col.r, 0, 1e6f);
-		m->emissive[1] = clampf(col.g, 0, 1e6f);
-		m->emissive[2] = clampf(col.b, 0, 1e6f);
+		const float v[3] = {col.r, col.g, col.b};
+		for (int k = 0; k < 3; k++) m->emissive[k] = clampf(v[k], 0, 1e6f);
 	}
-	if (aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &s) == aiReturn_SUCCESS && !strcmp(s.data, "MASK")) {
-		m->alpha_mode = RND_ALPHA_MASK;
+	if (aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &s) == aiReturn_SUCCESS) {
+		if (!strcmp(s.data, "MASK")) m->alpha_mode = RND_ALPHA_MASK;
+		if (!strcmp(s.data, "BLEND")) m->alpha_mode = RND_ALPHA_BLEND;   /* drawn dithered */
 		if (aiGetMaterialFloatArray(am, "$mat.gltf.alphaCutoff", 0, 0, &f, NULL) == aiReturn_SUCCESS)
 			m->alpha_cutoff = clampf(f, 0, 1);
 	}
-	/* BLEND has no counterpart in the renderer: drawn opaque. */
-	static const enum aiTextureType types[] = {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE};
-	for (int i = 0; i < 2; i++) {
-		if (aiGetMaterialTexture(am, types[i], 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS)
-			continue;
-		int ti = find_texture(c, s.data);
-		/* A texture that is neither embedded nor among the referred files: ignored (the daemon
-		 * has already refused a model whose referenced file it could not find). */
-		if (ti < 0) break;
-		if (!(m->base_color_texture = texture(c, ti))) return -1;
-		break;
-	}
-	return 0;
+	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
+	return material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m);
 }
 
 static int walk(struct conv *c, const struct aiNode *node, const float parent[16], int depth)
@@ -465,10 +522,13 @@ static int convert(struct conv *c)
 
 	uint32_t nmat = sc->mNumMaterials ? sc->mNumMaterials : 1;
 	struct rnd_material *mats = conv_alloc(c, nmat, sizeof *mats);
-	if (!mats) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+	bool *single = conv_alloc(c, nmat, sizeof *single);
+	if (!mats || !single) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	rnd_material_defaults(&mats[0]);
 	for (unsigned i = 0; i < sc->mNumMaterials; i++)
-		if (convert_material(c, sc->mMaterials[i], &mats[i]) < 0) return -1;
+		if (convert_material(c, sc->mMaterials[i], i, &mats[i], &single[i]) < 0) return -1;
+	c->mats = mats;
+	c->single_sided = single;
 
 	struct api_model_mesh *meshes = conv_alloc(c, sc->mNumMeshes, sizeof *meshes);
 	if (!meshes) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
@@ -504,6 +564,13 @@ static int convert(struct conv *c)
 	m->materials = mats;
 	m->material_count = nmat;
 	m->triangles = tris;
+	if (c->gi.warnings[0]) {
+		size_t n = strlen(c->gi.warnings) + 1;
+		char *w = conv_alloc(c, n, 1);
+		if (!w) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
+		memcpy(w, c->gi.warnings, n);
+		m->warnings = w;
+	}
 	return 0;
 }
 
@@ -524,8 +591,21 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	if (!data || !len || format < API_MODEL_GLB || format > API_MODEL_PLY)
 		return api_err_set(err, errsize, "the model file is empty or of no known format"), API_WIRE_BAD_INPUT;
 	out->format = format;
-	if ((format == API_MODEL_GLB || format == API_MODEL_GLTF) && gltf_precheck(data, len, format, err, errsize) < 0)
-		return API_WIRE_BAD_INPUT;
+	bool gltf = format == API_MODEL_GLB || format == API_MODEL_GLTF;
+	json_t *root = NULL;
+	if (gltf && gltf_precheck(data, len, format, &root, err, errsize) < 0) return API_WIRE_BAD_INPUT;
+	struct conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf};
+	uint8_t *tagged = NULL;
+	if (gltf) {
+		api_gltf_info_read(root, &c.gi);
+		size_t tagged_len = 0;
+		/* Materials renamed to their glTF index, to find them again (see gltf_material.h). */
+		if ((tagged = api_gltf_tag_materials(root, data, len, format == API_MODEL_GLB, &tagged_len))) {
+			data = tagged;
+			len = tagged_len;
+		}
+	}
+	json_decref(root);
 	/* PLY triangle strips: Assimp 5.2 reads a strip as one polygon (a flat sliver). */
 	size_t strips_len = 0;
 	uint8_t *strips = format == API_MODEL_PLY ? api_ply_strips_to_faces(data, len, &strips_len) : NULL;
@@ -546,6 +626,8 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	 * winding instead, as STL viewers shade them. */
 	if (format == API_MODEL_STL)
 		flags = (flags & ~(unsigned)aiProcess_GenSmoothNormals) | aiProcess_DropNormals | aiProcess_GenNormals;
+	/* Normal maps need tangents: the file's, or made from the uvs where it has none. */
+	if (gltf) flags |= aiProcess_CalcTangentSpace;
 	enum api_wire_status st = API_WIRE_OK;
 	pthread_mutex_lock(&import_mu);
 	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, flags, &io, props);
@@ -558,11 +640,17 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	pthread_mutex_unlock(&import_mu);
 	aiReleasePropertyStore(props);
 	free(strips);   /* Assimp copied what it needed */
-	if (!sc) return st;
+	free(tagged);
+	if (!sc) {
+		api_gltf_info_free(&c.gi);
+		return st;
+	}
 
-	struct conv c = {.sc = sc, .arena = arena, .out = out, .err = err, .errsize = errsize, .files = files,
-	                 .nfiles = nfiles};
+c.sc = sc;
+	c.files = files;
+	c.nfiles = nfiles;
 	int rc = convert(&c);
+	api_gltf_info_free(&c.gi);
 	free(c.mesh_map);
 	free(c.tex);
 	free(c.inst);

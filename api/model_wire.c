@@ -63,45 +63,66 @@ void api_wire_put_image(struct api_wire_buf *b, const uint8_t *rgba, uint32_t w,
 	put(b, rgba, (size_t)w * h * 4);
 }
 
+static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, const struct rnd_texture *const *tex,
+                         uint32_t ntex)
+{
+	float f[13] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
+	               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff,
+	               mt->normal_scale, mt->occlusion_strength, 0};
+	put(b, f, sizeof f); /* the last one reserved, zero */
+	put_u32(b, (uint32_t)mt->alpha_mode);
+	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
+		int32_t ti = -1;
+		for (uint32_t k = 0; mt->textures[s] && k < ntex; k++)
+			if (tex[k] == mt->textures[s]) ti = (int32_t)k;
+		put(b, &ti, 4);
+	}
+	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
+		const struct rnd_texture_sampling *ts = &mt->sampling[s];
+		put_u32(b, (uint32_t)ts->wrap_s | (uint32_t)ts->wrap_t << 2 | (uint32_t)ts->mag_nearest << 4 |
+		           (uint32_t)ts->min_nearest << 5 | (uint32_t)ts->transformed << 6);
+		put(b, ts->transform, sizeof ts->transform);
+	}
+}
+
 void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 {
 	/* Textures are shared between materials by pointer: each goes once, by its first index. */
 	const struct rnd_texture *tex[MAX_TEXTURES];
 	uint32_t ntex = 0;
 	for (uint32_t i = 0; i < m->material_count; i++) {
-		const struct rnd_texture *t = m->materials[i].base_color_texture;
-		uint32_t k = 0;
-		while (t && k < ntex && tex[k] != t) k++;
-		if (t && k == ntex) {
-			if (ntex == MAX_TEXTURES) { b->failed = 1; return; }
-			tex[ntex++] = t;
+		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
+			const struct rnd_texture *t = m->materials[i].textures[s];
+			uint32_t k = 0;
+			while (t && k < ntex && tex[k] != t) k++;
+			if (t && k == ntex) {
+				if (ntex == MAX_TEXTURES) { b->failed = 1; return; }
+				tex[ntex++] = t;
+			}
 		}
 	}
+	size_t wlen = m->warnings ? strlen(m->warnings) : 0;
+	if (wlen > API_MODEL_MAX_WARNINGS) wlen = API_MODEL_MAX_WARNINGS;
 	put_u32(b, ntex);
 	put_u32(b, m->material_count);
 	put_u32(b, m->mesh_count);
 	put_u32(b, m->instance_count);
+	put_u32(b, (uint32_t)wlen);
+	put(b, m->warnings, wlen);
 	for (uint32_t i = 0; i < ntex; i++) api_wire_put_image(b, tex[i]->rgba, tex[i]->width, tex[i]->height);
-	for (uint32_t i = 0; i < m->material_count; i++) {
-		const struct rnd_material *mt = &m->materials[i];
-		float f[11] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
-		               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff, 0};
-		put(b, f, sizeof f); /* the last one reserved, zero */
-		put_u32(b, (uint32_t)mt->alpha_mode);
-		int32_t ti = -1;
-		for (uint32_t k = 0; mt->base_color_texture && k < ntex; k++)
-			if (tex[k] == mt->base_color_texture) ti = (int32_t)k;
-		put(b, &ti, 4);
-	}
+	for (uint32_t i = 0; i < m->material_count; i++) put_material(b, &m->materials[i], tex, ntex);
 	for (uint32_t i = 0; i < m->mesh_count; i++) {
 		const struct api_model_mesh *me = &m->meshes[i];
 		put_u32(b, me->vertex_count);
 		put_u32(b, me->index_count);
 		put_u32(b, me->material);
-		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u));
+		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u) | (me->colors ? 4u : 0u) | (me->tangents ? 8u : 0u) |
+		           (me->single_sided ? 16u : 0u));
 		put(b, me->positions, (size_t)me->vertex_count * 12);
 		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
 		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
+		if (me->colors) put(b, me->colors, (size_t)me->vertex_count * 4);
+		if (me->tangents) put(b, me->tangents, (size_t)me->vertex_count * 16);
 		put(b, me->indices, (size_t)me->index_count * 4);
 	}
 	for (uint32_t i = 0; i < m->instance_count; i++) {
@@ -231,31 +252,55 @@ static void *dec_alloc(struct dec *d, size_t n, size_t size)
 	return p;
 }
 
+static bool sampling_ok(uint32_t packed, const float *t)
+{
+	if (packed > 0x7f || (packed & 3) > RND_WRAP_MIRROR || (packed >> 2 & 3) > RND_WRAP_MIRROR) return false;
+	for (int k = 0; k < 6; k++)
+		if (!isfinite(t[k]) || fabsf(t[k]) > 1e6f) return false;
+	return true;
+}
+
 static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd_texture *tex, uint32_t ntex,
                                         struct rnd_material *mats)
 {
 	for (uint32_t i = 0; i < nmat; i++) {
-		float f[11];
-		uint32_t mode;
-		int32_t ti;
-		if (!take(&d->r, f, sizeof f) || !take_u32(&d->r, &mode) || !take(&d->r, &ti, 4))
+		float f[13], tf[RND_TEX_SLOTS][6];
+		uint32_t mode, packed[RND_TEX_SLOTS];
+		int32_t ti[RND_TEX_SLOTS];
+		if (!take(&d->r, f, sizeof f) || !take_u32(&d->r, &mode) || !take(&d->r, ti, sizeof ti))
 			return bad(&d->r, "material %u is cut short", i);
-		bool ok = finite_all(f, 11) && f[10] == 0;
+		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++)
+			if (!take_u32(&d->r, &packed[s]) || !take(&d->r, tf[s], sizeof tf[s]))
+				return bad(&d->r, "material %u is cut short", i);
+		bool ok = finite_all(f, 13) && f[12] == 0;
 		for (int k = 0; k < 3; k++) ok = ok && f[k] >= 0 && f[k] <= 1e6f && f[6 + k] >= 0 && f[6 + k] <= 1e6f;
 		ok = ok && f[3] >= 0 && f[3] <= 1 && f[4] >= 0 && f[4] <= 1 && f[5] >= 0 && f[5] <= 1 && f[9] >= 0 &&
-		     f[9] <= 1;
+		     f[9] <= 1 && fabsf(f[10]) <= 1e3f && f[11] >= 0 && f[11] <= 1;
+		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) ok = ok && sampling_ok(packed[s], tf[s]);
 		if (!ok) return bad(&d->r, "material %u has a value out of range", i);
-		if (mode != RND_ALPHA_OPAQUE && mode != RND_ALPHA_MASK) return bad(&d->r, "material %u alpha mode", i);
-		if (ti < -1 || (ti >= 0 && (uint32_t)ti >= ntex)) return bad(&d->r, "material %u texture %d", i, ti);
+		if (mode > RND_ALPHA_BLEND) return bad(&d->r, "material %u alpha mode", i);
 		struct rnd_material *m = &mats[i];
 		rnd_material_defaults(m);
+		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
+			if (ti[s] < -1 || (ti[s] >= 0 && (uint32_t)ti[s] >= ntex))
+				return bad(&d->r, "material %u texture %d", i, ti[s]);
+			m->textures[s] = ti[s] >= 0 ? &tex[ti[s]] : NULL;
+			struct rnd_texture_sampling *ts = &m->sampling[s];
+			ts->wrap_s = (uint8_t)(packed[s] & 3);
+			ts->wrap_t = (uint8_t)(packed[s] >> 2 & 3);
+			ts->mag_nearest = packed[s] >> 4 & 1;
+			ts->min_nearest = packed[s] >> 5 & 1;
+			ts->transformed = packed[s] >> 6 & 1;
+			memcpy(ts->transform, tf[s], sizeof tf[s]);
+		}
 		memcpy(m->base_color, f, 4 * sizeof(float));
 		m->roughness = f[4];
 		m->metallic = f[5];
 		memcpy(m->emissive, f + 6, 3 * sizeof(float));
 		m->alpha_cutoff = f[9];
+		m->normal_scale = f[10];
+		m->occlusion_strength = f[11];
 		m->alpha_mode = (enum rnd_alpha_mode)mode;
-		m->base_color_texture = ti >= 0 ? &tex[ti] : NULL;
 	}
 	return API_OK;
 }
@@ -265,24 +310,31 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 	uint32_t nv, ni, mat, flags;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &mat) || !take_u32(&d->r, &flags))
 		return bad(&d->r, "mesh %u is cut short", i);
-	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 3)
+	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 31)
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
-	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0);
+	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
 	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u is cut short", i);
 	float *pos = dec_alloc(d, nv, 12), *nrm = flags & 1 ? dec_alloc(d, nv, 12) : NULL;
 	float *uv = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
+	uint8_t *col = flags & 4 ? dec_alloc(d, nv, 4) : NULL;
+	float *tan = flags & 8 ? dec_alloc(d, nv, 16) : NULL;
 	uint32_t *idx = dec_alloc(d, ni, 4);
-	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || !idx) return bad(&d->r, "out of memory");
+	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || ((flags & 4) && !col) || ((flags & 8) && !tan) || !idx)
+		return bad(&d->r, "out of memory");
 	take(&d->r, pos, (size_t)nv * 12);
 	if (nrm) take(&d->r, nrm, (size_t)nv * 12);
 	if (uv) take(&d->r, uv, (size_t)nv * 8);
+	if (col) take(&d->r, col, (size_t)nv * 4);
+	if (tan) take(&d->r, tan, (size_t)nv * 16);
 	if (!take(&d->r, idx, (size_t)ni * 4)) return bad(&d->r, "mesh %u is cut short", i);
 	if (!finite_all(pos, (size_t)nv * 3) || (nrm && !finite_all(nrm, (size_t)nv * 3)) ||
-	    (uv && !finite_all(uv, (size_t)nv * 2)))
+	    (uv && !finite_all(uv, (size_t)nv * 2)) || (tan && !finite_all(tan, (size_t)nv * 4)))
 		return bad(&d->r, "mesh %u has a value that is not finite", i);
 	for (uint32_t k = 0; k < ni; k++)
 		if (idx[k] >= nv) return bad(&d->r, "mesh %u: index %u refers to vertex %u of %u", i, k, idx[k], nv);
-	*me = (struct api_model_mesh){pos, nrm, uv, idx, nv, ni, mat};
+	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .uvs = uv, .colors = col, .tangents = tan,
+	                              .indices = idx, .vertex_count = nv, .index_count = ni, .material = mat,
+	                              .single_sided = (flags & 16) != 0};
 	return API_OK;
 }
 
@@ -291,13 +343,23 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
                                       char *err, size_t errsize)
 {
 	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
-	uint32_t ntex, nmat, nmesh, ninst;
-	if (!take_u32(&d.r, &ntex) || !take_u32(&d.r, &nmat) || !take_u32(&d.r, &nmesh) || !take_u32(&d.r, &ninst))
+	uint32_t ntex, nmat, nmesh, ninst, nwarn;
+	if (!take_u32(&d.r, &ntex) || !take_u32(&d.r, &nmat) || !take_u32(&d.r, &nmesh) || !take_u32(&d.r, &ninst) ||
+	    !take_u32(&d.r, &nwarn))
 		return bad(&d.r, "the counts are cut short");
-	/* Each item has a smallest size on the wire (texture 8, material 52, mesh 16, instance 68
+	if (nwarn > API_MODEL_MAX_WARNINGS || nwarn > d.r.left) return bad(&d.r, "warnings of %u bytes", nwarn);
+	char *warn = NULL;
+	if (nwarn) {
+		if (!(warn = dec_alloc(&d, nwarn + 1, 1))) return bad(&d.r, "out of memory");
+		take(&d.r, warn, nwarn);
+		/* Printable ASCII only: it becomes a response header. */
+		for (uint32_t k = 0; k < nwarn; k++)
+			if (warn[k] < 0x20 || warn[k] > 0x7e) warn[k] = '?';
+	}
+	/* Each item has a smallest size on the wire (texture 8, material 216, mesh 16, instance 68
 	 * bytes): counts the reply's bytes cannot hold are lies caught before allocating (the arrays
 	 * are larger in memory than on the wire, and zeroed). */
-	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 52 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
+	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 216 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
 	if (ntex > MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, min_wire, 1))
 		return bad(&d.r, "%u textures, %u materials, %u meshes, %u instances", ntex, nmat, nmesh, ninst);
 	struct rnd_texture *tex = dec_alloc(&d, ntex, sizeof *tex);
@@ -332,6 +394,7 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 	out->materials = mats;
 	out->material_count = nmat;
 	out->triangles = tris;
+	out->warnings = warn;
 	*bytes = d.bytes;
 	return API_OK;
 }

@@ -15,12 +15,17 @@
  *   header   "UMBRAIMP" version kind status msg_len, then msg_len bytes of message
  *            (status != OK: the reply ends there)
  *   image    width height, width*height*4 bytes RGBA8
- *   model    texture_count material_count mesh_count instance_count
+ *   model    texture_count material_count mesh_count instance_count warnings_len,
+ *            warnings_len bytes of warnings (printable ASCII, at most API_MODEL_MAX_WARNINGS)
  *            textures:  width height, width*height*4 bytes RGBA8
- *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff reserved
- *                       (f32, reserved = 0), alpha_mode (u32), texture (i32, -1 = none)
- *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs),
- *                       positions f32[3v], normals f32[3v], uvs f32[2v], indices u32[i]
+ *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff normal_scale
+ *                       occlusion_strength reserved (f32, reserved = 0), alpha_mode (u32),
+ *                       texture[5] (i32 per rnd_texture_slot, -1 = none), then per slot the
+ *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
+ *                       transformed << 6 (u32), transform f32[6]
+ *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
+ *                       8 tangents, 16 single-sided), positions f32[3v], normals f32[3v],
+ *                       uvs f32[2v], colours u8[4v], tangents f32[4v], indices u32[i]
  *            instances: mesh (u32), model matrix f32[16] (column-major)
  *   Nothing may follow the last instance.
  *
@@ -37,7 +42,7 @@
 #include "model.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 1u
+#define API_WIRE_VERSION 2u
 #define API_WIRE_MAX_MESSAGE 1024u
 
 enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2 };

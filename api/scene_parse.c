@@ -114,7 +114,7 @@ static void ptr_pop(struct pctx *c, size_t old)
 /* ---- errors ---- */
 
 /* Something the scene asked for that is left out of the image, said in the answer (the
- * server's Umbra-Warning header, the CLI's stderr) instead of silently. */
+ * server's Umbra-Warnings header, the CLI's stderr) instead of silently. */
 __attribute__((format(printf, 2, 3)))
 static void warn(struct pctx *c, const char *fmt, ...)
 {
@@ -1284,6 +1284,18 @@ static void set_pixels(struct api_scene *s)
 	else s->scene.output.pixels = s->bit_depth == 16 ? RND_PIXELS_RGBA16 : RND_PIXELS_RGBA8;
 }
 
+/* Adds the models' warnings (what of their materials is not drawn as the file says) to
+ * c->warnings, each prefixed with its object's pointer. */
+static int collect_warnings(struct pctx *c, struct api_model *const *models, const uint32_t *source, uint32_t nobj)
+{
+	for (uint32_t k = 0; k < nobj; k++) {
+		uint32_t i = source[k];
+		if ((k && source[k - 1] == i) || !models[i] || !models[i]->warnings || !models[i]->warnings[0]) continue;
+		warn(c, "/objects/%u: %s", i, models[i]->warnings);
+	}
+	return 0;
+}
+
 /* Replaces every model object by one mesh object per instance of its model, under the
  * object's transform, with the model's materials (appended to the scene's) unless the object
  * names its own. Returns 0 or -1 (out of memory / too many objects). */
@@ -1328,6 +1340,10 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->index_count = me->index_count;
 			o->normals = me->normals;
 			o->uvs = me->uvs;
+			o->colors = me->colors;
+			o->tangents = me->tangents;
+			/* glTF doubleSided: false culls back faces (the object can only add sidedness). */
+			o->double_sided = o->double_sided && !me->single_sided;
 			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);
 			if (!own) o->material = base + me->material;
 		}
@@ -1336,7 +1352,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 	c->mat_count = c->mat_cap = nm;
 	sc->objects = objects;
 	sc->object_count = no;
-	return 0;
+	return collect_warnings(c, models, source, no);
 }
 
 /* ---- several views ---- */
@@ -1438,27 +1454,29 @@ static int place_ground(struct pctx *c, struct rnd_scene *sc)
 static int check_textures(struct pctx *c, const struct rnd_scene *sc)
 {
 	uint32_t max = c->lim->max_textures ? c->lim->max_textures : RND_DEFAULT_MAX_TEXTURES;
-	const struct rnd_texture **seen = api_arena_calloc(c->arena, c->mat_count + 1, sizeof *seen);
+	const struct rnd_texture **seen = api_arena_calloc(c->arena, c->mat_count * RND_TEX_SLOTS + 1, sizeof *seen);
 	uint8_t *counted = api_arena_calloc(c->arena, c->mat_count + 1, 1);
 	if (!seen || !counted) return fail(c, "out of memory");
 	uint32_t ntex = 0;
 	for (uint32_t o = 0; o < sc->object_count && c->mat_count; o++) {
 		uint32_t mi = sc->objects[o].material;
-		const struct rnd_texture *t = mi < c->mat_count ? c->mats[mi].base_color_texture : NULL;
-		if (!t || counted[mi]) continue;
+		if (mi >= c->mat_count || counted[mi]) continue;
 		counted[mi] = 1;
-		uint32_t k = 0;
-		while (k < ntex && seen[k] != t) k++;
-		if (k < ntex) continue;
-		if (ntex == max) {
-			size_t old = ptr_push(c, "objects");
-			ptr_index(c, c->object_source ? c->object_source[o] : o);
-			defer(c, false, NULL, "this object brings the scene over %u distinct textures (this server's limit: "
-			      "--max-textures, capped by the device)", max);
-			ptr_pop(c, old);
-			break;
+		for (uint32_t slot = 0; slot < RND_TEX_SLOTS; slot++) {
+			const struct rnd_texture *t = c->mats[mi].textures[slot];
+			uint32_t k = 0;
+			while (t && k < ntex && seen[k] != t) k++;
+			if (!t || k < ntex) continue;
+			if (ntex == max) {
+				size_t old = ptr_push(c, "objects");
+				ptr_index(c, c->object_source ? c->object_source[o] : o);
+				defer(c, false, NULL, "this object brings the scene over %u distinct textures (this server's "
+				      "limit: --max-textures, capped by the device)", max);
+				ptr_pop(c, old);
+				return 0;
+			}
+			seen[ntex++] = t;
 		}
-		seen[ntex++] = t;
 	}
 	return 0;
 }

@@ -43,12 +43,22 @@ struct rnd_image_res {
 	uint32_t width, height, layers, samples;
 };
 
+/* Samplers of material textures: wrap s (3) x wrap t (3) x mag nearest (2) x min nearest (2);
+ * index 0 is repeat / linear (glTF's default, and the white texture's). */
+#define RND_TEXTURE_SAMPLERS 36
+static inline uint32_t rnd_texture_sampler_index(const struct rnd_texture_sampling *t)
+{
+	return (uint32_t)(t->wrap_s % 3u) * 12u + (uint32_t)(t->wrap_t % 3u) * 4u + (t->mag_nearest ? 2u : 0u) +
+	       (t->min_nearest ? 1u : 0u);
+}
+
 struct rnd_pipelines {
 	VkDescriptorSetLayout set_layout;     /* set 0: frame, materials, lights, views, shadow maps */
-	VkDescriptorSetLayout texture_layout; /* set 1: the draw's base-colour texture */
+	VkDescriptorSetLayout texture_layout; /* set 1: the draw's material textures (UMBRA_TEX_SLOTS bindings) */
 	VkPipelineLayout layout;
 	VkSampler shadow_sampler;            /* nearest, clamp to border white (depth 1 = lit) */
-	VkSampler texture_sampler;           /* material textures: linear, repeat */
+	/* material textures, one per sampling state: see rnd_texture_sampler_index() */
+	VkSampler texture_samplers[RND_TEXTURE_SAMPLERS];
 	/* [cull: 0 none, 1 back] */
 	VkPipeline shadow[2];
 	/* [msaa: 0 = 1x, 1 = 4x][cull] depth-only pre-pass of the camera view */

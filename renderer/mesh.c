@@ -90,6 +90,22 @@ static void set_vertex(struct rnd_vertex *v, float px, float py, float pz, float
 	v->pos[0] = px; v->pos[1] = py; v->pos[2] = pz;
 	v->nrm[0] = nx; v->nrm[1] = ny; v->nrm[2] = nz;
 	v->uv[0] = u; v->uv[1] = tv;
+	v->color[0] = v->color[1] = v->color[2] = v->color[3] = 255;
+	v->tangent[0] = 127; v->tangent[1] = 0; v->tangent[2] = 0; v->tangent[3] = 127;
+}
+
+static int8_t snorm8(float f)
+{
+	f = !(f >= -1.0f) ? -1.0f : f > 1.0f ? 1.0f : f;   /* NaN -> -1 */
+	return (int8_t)lrintf(f * 127.0f);
+}
+
+/* Vertex colour and tangent of source vertex i of a mesh, when it has them. */
+static void mesh_extras(const struct rnd_object *o, uint32_t i, struct rnd_vertex *v)
+{
+	if (o->colors) memcpy(v->color, o->colors + 4 * (size_t)i, 4);
+	if (o->tangents)
+		for (int k = 0; k < 4; k++) v->tangent[k] = snorm8(o->tangents[4 * (size_t)i + (size_t)k]);
 }
 
 /* One quad face: centre direction n, in-face axes u, v with u x v = n (so the quad
@@ -230,6 +246,7 @@ static void gen_mesh(const struct rnd_object *o, struct rnd_vertex *vt, uint32_t
 			const float *p = o->positions + 3 * i, *n = o->normals + 3 * i;
 			const float *t = o->uvs ? o->uvs + 2 * i : NULL;
 			set_vertex(&vt[i], p[0], p[1], p[2], n[0], n[1], n[2], t ? t[0] : 0.0f, t ? t[1] : 0.0f);
+			mesh_extras(o, i, &vt[i]);
 		}
 		memcpy(ix, o->indices, (size_t)o->index_count * sizeof *ix);
 		return;
@@ -252,6 +269,7 @@ static void gen_mesh(const struct rnd_object *o, struct rnd_vertex *vt, uint32_t
 			const float *uv = o->uvs ? o->uvs + 2 * src[k] : NULL;
 			set_vertex(&vt[3 * t + (uint32_t)k], p[0], p[1], p[2], n[0], n[1], n[2], uv ? uv[0] : 0.0f,
 			           uv ? uv[1] : 0.0f);
+			mesh_extras(o, src[k], &vt[3 * t + (uint32_t)k]);
 			ix[3 * t + (uint32_t)k] = 3 * t + (uint32_t)k;
 		}
 	}
@@ -287,14 +305,24 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
 		return mesh_error(err, RND_ERR_INVALID, "unknown shape %d", (int)o->shape);
 	}
 
+	bool flip = rnd_mat4_det3(o->model) < 0.0f;
+	bool tangents = o->shape == RND_SHAPE_MESH && o->tangents;
 	for (uint32_t i = 0; i < (uint32_t)vc; i++) {
 		struct rnd_vertex *v = &vertices[i];
 		rnd_mat4_mul_point(v->pos, o->model, v->pos);
 		rnd_mat4_mul_dir(v->nrm, nm, v->nrm);
 		if (!rnd_v3_normalize(v->nrm, v->nrm)) { v->nrm[0] = 0.0f; v->nrm[1] = 1.0f; v->nrm[2] = 0.0f; }
+		if (tangents) {
+			/* Tangents follow the surface (the model matrix itself); a mirror turns the
+			 * bitangent around, so its sign flips with the winding. */
+			float t[3] = {v->tangent[0] / 127.0f, v->tangent[1] / 127.0f, v->tangent[2] / 127.0f};
+			rnd_mat4_mul_dir(t, o->model, t);
+			if (!rnd_v3_normalize(t, t)) { t[0] = 1.0f; t[1] = 0.0f; t[2] = 0.0f; }
+			for (int k = 0; k < 3; k++) v->tangent[k] = snorm8(t[k]);
+			v->tangent[3] = (v->tangent[3] < 0) != flip ? -127 : 127;
+		}
 		if (bounds) rnd_aabb_add_point(bounds, v->pos);
 	}
-	bool flip = rnd_mat4_det3(o->model) < 0.0f;
 	for (uint32_t i = 0; i < (uint32_t)ic; i += 3) {
 		if (flip) { uint32_t t = indices[i + 1]; indices[i + 1] = indices[i + 2]; indices[i + 2] = t; }
 		indices[i] += base_vertex; indices[i + 1] += base_vertex; indices[i + 2] += base_vertex;

@@ -11,7 +11,9 @@
  * triangles with flat normals; sphere = UV sphere of `segments` longitudes x segments/2
  * latitudes (smooth normals, poles as triangle fans); cylinder = `segments` side quads with
  * smooth normals + two capped fans with flat normals; mesh = as given (flat normals computed
- * when none given; with no indices, the vertices are a triangle list).
+ * when none given; with no indices, the vertices are a triangle list). Meshes carry their
+ * vertex colours and tangents (model matrix applied, w flipped by a mirroring one); other
+ * shapes get white and +x.
  * Pure C, no Vulkan, thread-safe.
  */
 #ifndef UMBRA_RENDERER_MESH_H
@@ -21,10 +23,14 @@
 #include "umbra/rnd.h"
 #include "umbra/rnd_math.h"
 
+/* 40 bytes: lavapipe pays per vertex fetched, so colour and tangent are 8-bit (the colour
+ * linear RGBA unorm, the tangent xyzw snorm: a direction to ~0.5 degrees, w the sign). */
 struct rnd_vertex {
 	float pos[3];
 	float nrm[3];
 	float uv[2];
+	uint8_t color[4];
+	int8_t tangent[4];
 };
 
 /* Vertex and index counts rnd_mesh_write() will produce for o. */

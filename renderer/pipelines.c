@@ -47,11 +47,13 @@ static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *e
 	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &p->set_layout)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout");
 	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, p->set_layout, "umbra frame set layout");
-	/* Set 1: one texture per draw (lavapipe has no dynamic indexing of sampler arrays). */
-	VkDescriptorSetLayoutBinding tb = {UMBRA_BINDING_BASE_TEXTURE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
-	                                   VK_SHADER_STAGE_FRAGMENT_BIT, NULL};
+	/* Set 1: the draw's material textures, one binding per slot (lavapipe has no dynamic
+	 * indexing of sampler arrays, so a set per textured material). */
+	VkDescriptorSetLayoutBinding tb[UMBRA_TEX_SLOTS];
+	for (uint32_t i = 0; i < UMBRA_TEX_SLOTS; i++)
+		tb[i] = (VkDescriptorSetLayoutBinding){i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, NULL};
 	VkDescriptorSetLayoutCreateInfo tci0 = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 1, .pBindings = &tb,
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = UMBRA_TEX_SLOTS, .pBindings = tb,
 	};
 	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &tci0, NULL, &p->texture_layout)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (texture)");
@@ -77,15 +79,22 @@ static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *e
 	if ((vr = vkCreateSampler(ctx->device, &sci, NULL, &p->shadow_sampler)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateSampler");
 	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->shadow_sampler, "umbra shadow sampler");
-	/* Material textures: bilinear, repeat (glTF's default wrap); no mipmaps are built. */
-	VkSamplerCreateInfo tci = {
-		.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
-		.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST, .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-		.addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT, .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = 0.0f,
-	};
-	if ((vr = vkCreateSampler(ctx->device, &tci, NULL, &p->texture_sampler)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreateSampler (textures)");
-	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->texture_sampler, "umbra texture sampler");
+	/* Material textures: glTF sampler wrap and filter modes; no mipmaps are built, so a
+	 * mipmapped minFilter reads as its base filter. */
+	static const VkSamplerAddressMode wrap[3] = {VK_SAMPLER_ADDRESS_MODE_REPEAT, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+	                                             VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT};
+	for (uint32_t i = 0; i < RND_TEXTURE_SAMPLERS; i++) {
+		VkSamplerCreateInfo tci = {
+			.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+			.magFilter = (i & 2) ? VK_FILTER_NEAREST : VK_FILTER_LINEAR,
+			.minFilter = (i & 1) ? VK_FILTER_NEAREST : VK_FILTER_LINEAR,
+			.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST, .addressModeU = wrap[i / 12], .addressModeV = wrap[(i / 4) % 3],
+			.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = 0.0f,
+		};
+		if ((vr = vkCreateSampler(ctx->device, &tci, NULL, &p->texture_samplers[i])) != VK_SUCCESS)
+			return rnd_fail_vk(err, vr, "vkCreateSampler (textures)");
+		RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->texture_samplers[i], "umbra texture sampler %u", i);
+	}
 	return RND_OK;
 }
 
@@ -97,7 +106,7 @@ struct pipe_desc {
 	bool cull_back;
 	bool shadow;                /* depth bias + clamp, LESS compare; else reversed-Z */
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
-	bool uv_only;               /* vertex input: position (0) and uv (2) */
+	bool uv_only;               /* vertex input: position (0), uv (2), colour (3) */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	const VkSpecializationInfo *spec;  /* fragment stage */
@@ -113,12 +122,15 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		 .pSpecializationInfo = d->spec},
 	};
 	VkVertexInputBindingDescription vb = {0, sizeof(struct rnd_vertex), VK_VERTEX_INPUT_RATE_VERTEX};
-	VkVertexInputAttributeDescription va[3] = {
+	VkVertexInputAttributeDescription va[5] = {
 		{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, pos)},
 		{1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, nrm)},
 		{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
+		{3, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(struct rnd_vertex, color)},
+		{4, 0, VK_FORMAT_R8G8B8A8_SNORM, offsetof(struct rnd_vertex, tangent)},
 	};
-	VkVertexInputAttributeDescription va_uv[2] = {va[0], va[2]};
+	/* alpha-tested depth passes: position, uv and colour (its alpha scales coverage) */
+	VkVertexInputAttributeDescription va_uv[3] = {va[0], va[2], va[3]};
 	uint32_t ncolor = d->color == VK_FORMAT_UNDEFINED ? 0 : d->color_count ? d->color_count : 1;
 	VkFormat formats[UMBRA_AOV_ATTACHMENTS];
 	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
@@ -130,7 +142,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
 		.pVertexBindingDescriptions = &vb,
 		.vertexBindingDescriptionCount = d->no_vertices ? 0 : 1,
-		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 2 : d->shadow ? 1 : 3,
+		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 3 : d->shadow ? 1 : 5,
 		.pVertexAttributeDescriptions = d->uv_only ? va_uv : va,
 	};
 	VkPipelineInputAssemblyStateCreateInfo ia = {
@@ -356,7 +368,8 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 		}
 	}
 	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
-	if (p->texture_sampler) vkDestroySampler(ctx->device, p->texture_sampler, NULL);
+	for (uint32_t i = 0; i < RND_TEXTURE_SAMPLERS; i++)
+		if (p->texture_samplers[i]) vkDestroySampler(ctx->device, p->texture_samplers[i], NULL);
 	if (p->mesh_fs) vkDestroyShaderModule(ctx->device, p->mesh_fs, NULL);
 	if (p->mesh_vs) vkDestroyShaderModule(ctx->device, p->mesh_vs, NULL);
 	if (p->shadow_sampler) vkDestroySampler(ctx->device, p->shadow_sampler, NULL);

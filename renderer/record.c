@@ -231,8 +231,8 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	uint64_t dense = 0;
 	for (uint32_t i = 0; i < ndraw; i++) {
 		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
-		if (draws[i].texture_set) k->sc[UMBRA_SC_TEXTURES] = 1;
-		if (draws[i].masked) k->sc[UMBRA_SC_MASKED] = 1;
+		k->sc[UMBRA_SC_TEXTURES] |= draws[i].tex_bits;
+		if (draws[i].masked) k->sc[UMBRA_SC_MASKED] |= 1u << (uint32_t)sc->materials[draws[i].material].alpha_mode;
 		if (!draws[i].cull_back) dense += draws[i].index_count / 3;
 	}
 	/* A depth pre-pass pays off where many small two-sided triangles would each shade whole

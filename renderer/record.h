@@ -19,8 +19,9 @@ struct draw {
 	bool cast, cull_back;
 	bool closed;         /* sphere / box / cylinder: back faces never show from outside */
 	bool single_sided;   /* double_sided: false */
-	bool masked;         /* alpha_mode MASK: alpha-tested depth passes */
-	uint32_t texture_set; /* slot->texture_sets index: 0 = white, 1 + i = texture i */
+	bool masked;         /* alpha_mode MASK or BLEND (dithered): alpha-tested depth passes */
+	uint32_t texture_set; /* slot->texture_sets index: 0 = white, 1 + i = textured material i */
+	uint32_t tex_bits;    /* (1 << UMBRA_TEX_*) its material samples | UMBRA_TEXBIT_VERTEX_COLOR */
 };
 
 /* Everything the recorders need to know about this view. */

@@ -15,6 +15,7 @@
 #include <string.h>
 #include <time.h>
 #include "estimate.h"
+#include "material.h"
 #include "mesh.h"
 #include "plan.h"
 #include "moments.h"
@@ -75,8 +76,7 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 /* Fills the uniform/storage regions and points the slot's descriptor set at them. */
 static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                     const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                    uint32_t ntex, float exposure,
-                                    struct rnd_error *err)
+                                    float exposure, struct rnd_error *err)
 {
 	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
 	if (ctx->props.limits.minUniformBufferOffsetAlignment > al) al = ctx->props.limits.minUniformBufferOffsetAlignment;
@@ -125,16 +125,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		memcpy(m[0].base_color, d.base_color, sizeof d.base_color);
 		m[0].emissive[3] = d.roughness;
 	}
-	for (uint32_t i = 0; i < sc->material_count; i++) {
-		const struct rnd_material *in = &sc->materials[i];
-		memcpy(m[i].base_color, in->base_color, sizeof in->base_color);
-		memcpy(m[i].emissive, in->emissive, sizeof in->emissive);
-		m[i].emissive[3] = in->roughness;
-		m[i].params[0] = in->metallic;
-		m[i].params[1] = in->alpha_mode == RND_ALPHA_MASK ? in->alpha_cutoff : -1.0f;
-		m[i].tex[1] = in->alpha_mode == RND_ALPHA_MASK;
-		m[i].tex[0] = in->base_color_texture != NULL;
-	}
+	for (uint32_t i = 0; i < sc->material_count; i++) rnd_material_write(&sc->materials[i], &m[i]);
 
 	struct umbra_light *l = (struct umbra_light *)(base + off_light);
 	for (uint32_t i = 0; i < sc->light_count; i++) {
@@ -179,16 +170,6 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		{s->params.buf, off_view, nview * sizeof(struct umbra_shadow_view)},
 	};
 	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
-	/* One write per texture: their number is the device's (ctx->max_textures), not a constant. */
-	for (uint32_t t = 0; t < ntex; t++) {
-		VkDescriptorImageInfo ti = {ctx->pipes.texture_sampler, s->textures[t].view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-		VkWriteDescriptorSet tw = {
-			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[1 + t],
-			.dstBinding = UMBRA_BINDING_BASE_TEXTURE, .descriptorCount = 1,
-			.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ti,
-		};
-		vkUpdateDescriptorSets(ctx->device, 1, &tw, 0, NULL);
-	}
 	/* Without a moment atlas (no storage images) no light uses moments; the binding still
 	 * needs an image. */
 	VkDescriptorImageInfo mi = ctx->atlas_moments.view
@@ -286,62 +267,14 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		d->flags = (o->receive_shadows ? UMBRA_DRAW_RECEIVE_SHADOWS : 0) | (catcher ? UMBRA_DRAW_SHADOW_CATCHER : 0);
 		/* A shadow catcher receives shadows and casts none (contract §7). */
 		d->cast = o->cast_shadows && !catcher;
-		d->masked = sc->material_count && sc->materials[o->material].alpha_mode == RND_ALPHA_MASK;
-		d->texture_set = 0; /* set by textures() */
+		/* MASK and dithered BLEND both take the alpha-tested depth passes. */
+		d->masked = sc->material_count && sc->materials[o->material].alpha_mode != RND_ALPHA_OPAQUE;
+		d->texture_set = 0; /* set by rnd_material_textures() */
 		d->single_sided = !o->double_sided;
 		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER;
 		d->cull_back = d->single_sided;
 		rnd_aabb_union(bounds, &d->bounds);
 		vbase += v; ibase += x;
-	}
-	return RND_OK;
-}
-
-/* Creates the scene's distinct base-colour textures in the slot and stages their texels. */
-static enum rnd_result textures(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                                struct draw *draws, const struct rnd_texture **tex, uint32_t *ntex, struct rnd_error *err)
-{
-	enum rnd_result r;
-	uint32_t n = 0;
-	VkDeviceSize bytes = 0;
-	rnd_slot_drop_textures(ctx, s);
-	/* In object order, so that the limit's error names the object that brought one too many. */
-	for (uint32_t o = 0; o < sc->object_count && sc->material_count; o++) {
-		uint32_t i = sc->objects[o].material;
-		const struct rnd_texture *t = sc->materials[i].base_color_texture;
-		if (!t) continue;
-		uint32_t k = 0;
-		while (k < n && tex[k] != t) k++;
-		if (k < n) continue;
-		if (n == ctx->max_textures)
-			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u distinct textures in one scene "
-			                   "(this renderer's limit)", ctx->max_textures);
-		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
-			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", i, t->width, t->height);
-		tex[n++] = t;
-		bytes += (VkDeviceSize)t->width * t->height * 4;
-	}
-	for (uint32_t i = 0; i < sc->object_count; i++) {
-		const struct rnd_texture *t = sc->material_count ? sc->materials[sc->objects[i].material].base_color_texture : NULL;
-		for (uint32_t k = 0; t && k < n; k++)
-			if (tex[k] == t) draws[i].texture_set = 1 + k;
-	}
-	*ntex = n;
-	if (!n) return RND_OK;
-	if ((r = rnd_buffer_reserve(ctx, &s->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "slot staging", err)) != RND_OK)
-		return r;
-	VkDeviceSize off = 0;
-	for (uint32_t i = 0; i < n; i++) {
-		char name[48];
-		snprintf(name, sizeof name, "slot %u texture %u", s->index, i);
-		if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, tex[i]->width, tex[i]->height, 1, 1,
-		                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
-		                          name, &s->textures[i], err)) != RND_OK)
-			return r;
-		s->texture_count = i + 1;
-		size_t sz = (size_t)tex[i]->width * tex[i]->height * 4;
-		memcpy((uint8_t *)s->staging.map + off, tex[i]->rgba, sz);
-		off += sz;
 	}
 	return RND_OK;
 }
@@ -465,7 +398,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		if (sc->objects[i].shape != RND_SHAPE_PLANE && !(draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER))
 			rnd_aabb_union(&obj_bounds, &draws[i].bounds);
 	if (rnd_aabb_is_empty(&obj_bounds)) obj_bounds = bounds;
-	if ((r = textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;
+	if ((r = rnd_material_textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;
 	tm.upload_ms = now_ms() - t0;
 	pacer.tex = tex;
 	pacer.ntex = ntex;
@@ -497,6 +430,8 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		if (d->masked) {
 			const struct rnd_material *m = &sc->materials[sc->objects[i].material];
 			geo = rnd_hash(geo, &m->alpha_cutoff, sizeof m->alpha_cutoff);
+			geo = rnd_hash(geo, &m->alpha_mode, sizeof m->alpha_mode);
+			geo = rnd_hash(geo, &m->sampling[RND_TEX_BASE], sizeof m->sampling[RND_TEX_BASE]);
 			geo = rnd_hash(geo, m->base_color, sizeof m->base_color);
 			if (m->base_color_texture)
 				geo = rnd_hash(geo, m->base_color_texture->rgba,
@@ -595,7 +530,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		for (uint32_t k = 0; k < ngrant; k++)
 			if (grants[k].res > max_res) max_res = grants[k].res;
 		if ((r = rnd_slot_shadow_scratch(ctx, s, max_res, err)) != RND_OK) goto done;
-		if ((r = write_params(ctx, s, sc, &cam, sp, ntex, camera->exposure, err)) != RND_OK) goto done;
+		if ((r = write_params(ctx, s, sc, &cam, sp, camera->exposure, err)) != RND_OK) goto done;
 
 		uint32_t col = v % cols, row = v / cols;
 		VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sheet_w + (VkDeviceSize)col * sc->width);

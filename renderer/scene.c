@@ -60,6 +60,8 @@ void rnd_material_defaults(struct rnd_material *m)
 	m->alpha_mode = RND_ALPHA_OPAQUE;
 	m->alpha_cutoff = 0.5f;
 	m->shadow_catcher = false;
+	m->normal_scale = 1.0f;
+	m->occlusion_strength = 1.0f;
 }
 
 void rnd_object_defaults(struct rnd_object *o)

@@ -76,7 +76,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		goto fail_set;
 	}
 	/* Descriptor sets stay unnamed: lavapipe never frees a set's debug name with its pool. */
-	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + ntex};
+	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (1 + ntex) * UMBRA_TEX_SLOTS};
 	VkDescriptorPoolCreateInfo tpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1 + ntex, .poolSizeCount = 1,
 		.pPoolSizes = &tsize,
@@ -100,12 +100,14 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, 1, 1, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
 	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->white, err)) != RND_OK)
 		goto fail_texture_pool;
-	VkDescriptorImageInfo wi = {ctx->pipes.texture_sampler, s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-	VkWriteDescriptorSet ww = {
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[0], .dstBinding = UMBRA_BINDING_BASE_TEXTURE,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
-	};
-	vkUpdateDescriptorSets(ctx->device, 1, &ww, 0, NULL);
+	VkDescriptorImageInfo wi = {ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	VkWriteDescriptorSet ww[UMBRA_TEX_SLOTS];
+	for (uint32_t b = 0; b < UMBRA_TEX_SLOTS; b++)
+		ww[b] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[0], .dstBinding = b,
+			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
+		};
+	vkUpdateDescriptorSets(ctx->device, UMBRA_TEX_SLOTS, ww, 0, NULL);
 	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
 	VkDescriptorPoolCreateInfo mpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = msizes,

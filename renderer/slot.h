@@ -27,7 +27,8 @@ struct rnd_slot {
 	/* this render's material textures (destroyed when the next render starts) */
 	struct rnd_image_res *textures;   /* ctx->max_textures */
 	uint32_t texture_count;
-	/* set 1 per texture: [0] the white 1x1 (untextured draws), [1 + i] textures[i] */
+	/* set 1: [0] the white 1x1 in every slot (untextured draws), [1 + i] the i-th textured
+	 * material's textures (render.c textures()) */
 	VkDescriptorPool texture_pool;
 	VkDescriptorSet *texture_sets;    /* 1 + ctx->max_textures */
 	struct rnd_image_res white;

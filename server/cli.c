@@ -86,8 +86,11 @@ static int load_scene(const char *in, const char *out, const char *asset_root, s
 		if (r == API_OK) r = api_scene_set_format(*scene, f, &prob);
 	}
 	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
-	if (r == API_OK && (*scene)->warnings[0]) fprintf(stderr, "umbra-render: warning: %s\n", (*scene)->warnings);
-	if (r == API_OK) return 0;
+	if (r == API_OK) {
+		/* What the image leaves out of what was asked (umbrad: the Umbra-Warnings header). */
+		if ((*scene)->warnings[0]) fprintf(stderr, "umbra-render: %s: warning: %s\n", in, (*scene)->warnings);
+		return 0;
+	}
 	api_problem_format(&prob, line, sizeof line);
 	fprintf(stderr, "umbra-render: %s\n", line);
 	api_scene_free(*scene);

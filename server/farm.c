@@ -27,6 +27,7 @@ struct job_result {
 	char stem[PATH_MAX - 8];  /* output path without extension (default names) */
 	char out[PATH_MAX];
 	char error[640];
+	char warnings[1024];      /* api_scene.warnings of a rendered model, "" = none */
 };
 
 struct farm {
@@ -203,6 +204,7 @@ static enum job_status run_job(struct farm *f, size_t i)
 		api_scene_free(s);
 		return fault ? JOB_INVALID : JOB_FAILED;
 	}
+	snprintf(r->warnings, sizeof r->warnings, "%s", s->warnings);
 	uint8_t *bytes = NULL;
 	size_t n = 0;
 	struct api_problem prob;
@@ -288,6 +290,9 @@ static int write_report(const struct farm *f, const char *path)
 		else fputs("null", fp);
 		fprintf(fp, ",\"status\":\"%s\",\"ms\":%.1f,\"error\":", STATUS[r->status], r->ms);
 		if (r->error[0]) json_str(fp, r->error);
+		else fputs("null", fp);
+		fputs(",\"warnings\":", fp);   /* what of a model's material is not drawn (Umbra-Warnings) */
+		if (r->warnings[0]) json_str(fp, r->warnings);
 		else fputs("null", fp);
 		fputs("}\n", fp);
 	}

@@ -125,8 +125,8 @@ static enum MHD_Result respond(struct srv_request *req, int status, const char *
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Accept");
 		if (req->server_timing[0])
 			MHD_add_response_header(resp, MHD_HTTP_HEADER_SERVER_TIMING, req->server_timing);
-		if (status == 200 && req->warnings[0])
-			MHD_add_response_header(resp, "Umbra-Warning", req->warnings);
+		/* What the image leaves out of what the scene asked for (never silent). */
+		if (status == 200 && req->warnings[0]) MHD_add_response_header(resp, "Umbra-Warnings", req->warnings);
 	}
 	if (req->route != SRV_ROUTE_RENDER || status != 200)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");

@@ -162,7 +162,7 @@ struct srv_request {
 	size_t out_len;
 	const char *content_type;
 	char server_timing[320];
-	char warnings[512];            /* api_scene.warnings, sent as Umbra-Warning on a 200 */
+	char warnings[1024];           /* api_scene.warnings, sent as Umbra-Warnings on a 200; "" = none */
 	/* the problem answered (4xx/5xx), for the access log */
 	char problem_pointer[256];
 	char problem_detail[512];

@@ -2,15 +2,19 @@
 #extension GL_GOOGLE_include_directive : require
 #include "umbra_shared.h"
 // Alpha test of the depth-only passes: masked texels write no depth, so they cast no shadow
-// and hide nothing. Opaque casters keep the fragment-shader-free pipeline.
+// and hide nothing; BLEND surfaces keep the dithered share of their texels, so they cast a
+// shadow in proportion to their coverage once the shadow filter averages it. Opaque casters
+// keep the fragment-shader-free pipeline.
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonly buffer Materials { umbra_material materials[]; };
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
 layout(push_constant) uniform PushBlock { umbra_push pc; };
+#include "material.glsl"
 layout(location = 2) in vec2 v_uv;
+layout(location = 3) in float v_alpha;
 void main()
 {
 	umbra_material m = materials[pc.info.x];
-	float a = m.base_color.a;
-	if (m.tex.x != 0u) a *= texture(base_texture, v_uv).a;
-	if (a < m.params.y) discard;
+	float a = m.base_color.a * v_alpha;
+	if ((m.tex.x & (1u << UMBRA_TEX_BASE)) != 0u) a *= texture(base_texture, material_uv(m, UMBRA_TEX_BASE, v_uv)).a;
+	if (!alpha_keep(m, a, gl_FragCoord.xy)) discard;
 }

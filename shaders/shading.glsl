@@ -17,6 +17,10 @@ layout(std140, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) unif
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2D shadow_atlas;
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2D moment_atlas;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
+layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_METAL_ROUGH_TEXTURE) uniform sampler2D metal_rough_texture;
+layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
+layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_OCCLUSION_TEXTURE) uniform sampler2D occlusion_texture;
+layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_EMISSIVE_TEXTURE) uniform sampler2D emissive_texture;
 layout(push_constant) uniform PushBlock { umbra_push pc; };
 
 // Specialization constants: each pipeline variant carries only the code its scene needs.
@@ -29,12 +33,21 @@ layout(constant_id = UMBRA_SC_TONEMAP) const uint SC_TONEMAP = 0u;     // UMBRA_
 layout(constant_id = UMBRA_SC_CATCHER) const uint SC_CATCHER = 0u;     // scene has shadow catchers
 layout(constant_id = UMBRA_SC_LIGHT_TYPES) const uint SC_LIGHT_TYPES = 7u; // bit (1 << UMBRA_LIGHT_*)
 layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any directional light has cascades
-layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 1u;   // any material has a texture
-layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 1u;       // any material is alpha-masked
+layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 63u;  // bit (1 << UMBRA_TEX_*) | vertex colour
+layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1 << UMBRA_ALPHA_*)
 
 layout(location = 0) in vec3 v_pos;
 layout(location = 1) in vec3 v_nrm;
 layout(location = 2) in vec2 v_uv;
+layout(location = 3) in vec4 v_color;
+layout(location = 4) in vec4 v_tangent;
+#include "material.glsl"
+
+// Whether the material samples texture slot `slot` (and any material of the scene does).
+bool has_tex(umbra_material m, uint slot)
+{
+	return (SC_TEXTURES & (1u << slot)) != 0u && (m.tex.x & (1u << slot)) != 0u;
+}
 
 const float PI = 3.14159265358979;
 
@@ -335,13 +348,14 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 	return l;
 }
 
-// Base colour times its texture (sRGB texels decode to linear in the sampler); masked
-// texels below the cutoff are discarded, as glTF alpha_mode MASK.
+// Base colour times its texture (sRGB texels decode to linear in the sampler) times the
+// vertex colour; alpha MASK discards below the cutoff, BLEND by the dither (material.glsl).
 vec4 base_color(umbra_material m)
 {
 	vec4 c = m.base_color;
-	if (SC_TEXTURES != 0u && m.tex.x != 0u) c *= texture(base_texture, v_uv);
-	if (SC_MASKED != 0u && m.tex.y != 0u && c.a < m.params.y) discard;
+	if (has_tex(m, UMBRA_TEX_BASE)) c *= texture(base_texture, material_uv(m, UMBRA_TEX_BASE, v_uv));
+	if ((SC_TEXTURES & UMBRA_TEXBIT_VERTEX_COLOR) != 0u) c *= v_color;
+	if (SC_MASKED != 0u && m.tex.y != UMBRA_ALPHA_OPAQUE && !alpha_keep(m, c.a, gl_FragCoord.xy)) discard;
 	return c;
 }
 

@@ -21,9 +21,27 @@
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
 #define UMBRA_MOMENTS_BINDING_TMP    1
 #define UMBRA_MOMENTS_BINDING_OUT    2
-/* Set 1: the material's base-colour texture (sRGB), bound per draw; a white 1x1 when none. */
+/* Set 1: the material's textures, bound per draw (one set per textured material); a white 1x1
+ * in every binding the material does not use. Binding = texture slot (UMBRA_TEX_*). */
 #define UMBRA_SET_MATERIAL           1
-#define UMBRA_BINDING_BASE_TEXTURE   0
+#define UMBRA_TEX_BASE               0  /* base colour, sRGB (rgb x factor, a x alpha) */
+#define UMBRA_TEX_METAL_ROUGH        1  /* linear: G roughness, B metallic */
+#define UMBRA_TEX_NORMAL             2  /* linear tangent-space normal */
+#define UMBRA_TEX_OCCLUSION          3  /* linear: R ambient occlusion */
+#define UMBRA_TEX_EMISSIVE           4  /* sRGB */
+#define UMBRA_TEX_SLOTS              5
+#define UMBRA_BINDING_BASE_TEXTURE       UMBRA_TEX_BASE
+#define UMBRA_BINDING_METAL_ROUGH_TEXTURE UMBRA_TEX_METAL_ROUGH
+#define UMBRA_BINDING_NORMAL_TEXTURE     UMBRA_TEX_NORMAL
+#define UMBRA_BINDING_OCCLUSION_TEXTURE  UMBRA_TEX_OCCLUSION
+#define UMBRA_BINDING_EMISSIVE_TEXTURE   UMBRA_TEX_EMISSIVE
+/* umbra_material.tex.x: bit (1 << UMBRA_TEX_*) per texture the material samples; the same
+ * bits, ORed over a scene, make UMBRA_SC_TEXTURES, plus this one for vertex colours. */
+#define UMBRA_TEXBIT_VERTEX_COLOR    (1u << UMBRA_TEX_SLOTS)
+/* umbra_material.tex.y: alpha mode */
+#define UMBRA_ALPHA_OPAQUE 0u
+#define UMBRA_ALPHA_MASK   1u
+#define UMBRA_ALPHA_BLEND  2u      /* dithered: ordered 4x4 threshold in screen / shadow-map space */
 
 #define UMBRA_MAX_LIGHTS        64
 #define UMBRA_MAX_SHADOW_VIEWS  256   /* directional 1..4 (cascades), spot 1, point 6 */
@@ -65,8 +83,8 @@
 #define UMBRA_SC_CATCHER     4
 #define UMBRA_SC_LIGHT_TYPES 5
 #define UMBRA_SC_CASCADES    6
-#define UMBRA_SC_TEXTURES    7
-#define UMBRA_SC_MASKED      8
+#define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR */
+#define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_COUNT       9
 
 /* umbra_material.params.z flags */
@@ -99,9 +117,12 @@ struct umbra_frame {
 
 struct umbra_material {
 	U_VEC4 base_color;       /* linear rgba */
-	U_VEC4 emissive;         /* rgb, a roughness */
-	U_VEC4 params;           /* x metallic, y alpha cutoff */
-	U_UVEC4 tex;             /* x 1 = has a base-colour texture (set 1), y 1 = alpha mask */
+	U_VEC4 emissive;         /* rgb (x KHR_materials_emissive_strength), a roughness */
+	U_VEC4 params;           /* x metallic, y alpha cutoff, z normal scale, w occlusion strength */
+	U_UVEC4 tex;             /* x texture bits (1 << UMBRA_TEX_*), y UMBRA_ALPHA_* */
+	/* per texture slot, the uv transform (KHR_texture_transform) as two rows:
+	 * uv' = (dot(uvx[2s].xy, uv) + uvx[2s].z, dot(uvx[2s+1].xy, uv) + uvx[2s+1].z) */
+	U_VEC4 uvx[2 * UMBRA_TEX_SLOTS];
 };
 
 struct umbra_light {

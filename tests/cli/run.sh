@@ -115,6 +115,24 @@ check "thumb: report names the broken model, its status and error" \
 	grep -q '"file":"[^"]*broken.stl","output":null,"status":"invalid","ms":[0-9.]*,"error":"400 ' "$T/thumbs/report.jsonl"
 check "thumb: report is in input order" sh -c "head -n 1 '$T/thumbs/report.jsonl' | grep -q cube.obj"
 check "thumb: plain progress lines when stderr is not a terminal" grep -q '^umbra-render: \[4/4\]' "$T/thumb.err"
+
+# ---- thumb: a glTF whose material uses an extension umbra does not do: named in the report ----
+python3 - "$T/models/coat.gltf" <<'PY'
+import base64, json, struct, sys
+pos = struct.pack('<9f', -1, 0, 0, 1, 0, 0, 0, 1, 0)
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+     "extensionsUsed": ["KHR_materials_clearcoat"],
+     "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+     "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + base64.b64encode(pos).decode()}],
+     "bufferViews": [{"buffer": 0, "byteLength": 36}],
+     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, 0, 0], "max": [1, 1, 0]}]}
+json.dump(g, open(sys.argv[1], "w"))
+PY
+cli thumb "$T/models/coat.gltf" "$T/models/cube.obj" -o "$T/thumbw/" --size 64 --no-progress 2>/dev/null
+check "thumb: report carries a model's material warnings" \
+	grep -q '"file":"[^"]*coat.gltf".*"warnings":"/objects/0: extension KHR_materials_clearcoat' "$T/thumbw/report.jsonl"
+check "thumb: no warnings for a model without such data" grep -q '"file":"[^"]*cube.obj".*"warnings":null' "$T/thumbw/report.jsonl"
 check "thumb: summary line" grep -q '3 ok, 1 invalid, 0 failed, 0 skipped of 4' "$T/thumb.err"
 
 # --progress forces the bar (as on a terminal): done/total, images/s, ETA, on one line.

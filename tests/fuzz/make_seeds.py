@@ -59,12 +59,17 @@ glb = b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(buf)) + struct.p
 put("fuzz_model_glb", "tri.glb", glb)
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
-    return b"UMBRAIMP" + struct.pack("<IIII", 1, kind, status, len(msg)) + msg
+    return b"UMBRAIMP" + struct.pack("<IIII", 2, kind, status, len(msg)) + msg
 tex = struct.pack("<II", 2, 1) + bytes([255, 0, 0, 255, 0, 255, 0, 255])
-mat = struct.pack("<11f", 1, 1, 1, 1, 0.5, 0, 0, 0, 0, 0.5, 0) + struct.pack("<Ii", 0, 0)
-mesh = struct.pack("<4I", 3, 3, 0, 3) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0, 0, 1, 0, 0, 1) + \
-       struct.pack("<3I", 0, 1, 2)
+# material: 13 floats, alpha mode, a texture per slot (base, metal-rough, normal, occlusion,
+# emissive), per slot the sampling (packed modes + a 2x3 uv transform)
+mat = struct.pack("<13f", 1, 1, 1, 1, 0.5, 0, 1, 1, 1, 0.5, 1, 1, 0) + struct.pack("<I5i", 2, 0, -1, 0, -1, 0) + \
+      b"".join(struct.pack("<I6f", 0x45, 1, 0, 0.5, 0, 1, 0) for _ in range(5))
+# mesh: normals, uvs, colours, tangents, single-sided
+mesh = struct.pack("<4I", 3, 3, 0, 31) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0, 0, 1, 0, 0, 1) + \
+       bytes([255, 0, 0, 255] * 3) + struct.pack("<12f", 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, -1) + struct.pack("<3I", 0, 1, 2)
 inst = struct.pack("<I", 0) + struct.pack("<16f", 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1)
-put("fuzz_import_reply", "model.bin", header(1, 0) + struct.pack("<4I", 1, 1, 1, 1) + tex + mat + mesh + inst)
+warn = b"skins are not applied (drawn in the bind pose)"
+put("fuzz_import_reply", "model.bin", header(1, 0) + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn + tex + mat + mesh + inst)
 put("fuzz_import_reply", "image.bin", header(2, 0) + tex)
 put("fuzz_import_reply", "error.bin", header(1, 1, b"PLY: bad header"))

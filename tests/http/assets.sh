@@ -2,7 +2,7 @@
 # tests/http/assets.sh — models made of several files, and the texture limit, against a live
 # umbrad: a .gltf with its .bin and PNG by `path` under --asset-root and as multipart parts
 # named by their URI, an .obj with its .mtl and map_Kd texture, an inline .obj whose .mtl is
-# missing (Umbra-Warning, also as a lone part), an inline .gltf needing its .bin (400), a missing .bin and a "../" URI (400 at the model's member), 20
+# missing (Umbra-Warnings, also as a lone part), an inline .gltf needing its .bin (400), a missing .bin and a "../" URI (400 at the model's member), 20
 # textures under the default limit (200) and over --max-textures 4 (422 at /objects/N).
 # The quad's texture is red on its left half, blue on its right: the image must be too.
 . tests/http/lib.sh
@@ -65,14 +65,14 @@ check "obj by multipart: the texture's halves" halves objmp
 b64=$(base64 -w0 "$A/box.obj")
 scene "$T/inline.json" "\"data\": \"$b64\", \"format\": \"obj\""
 check "inline obj whose .mtl is not in the request: 200" [ "$(post inline "$T/inline.json")" = 200 ]
-warned() { hdr "$1" Umbra-Warning | grep -q "$2"; }
-check "inline obj without its .mtl: Umbra-Warning names box.mtl" warned inline box.mtl
+warned() { hdr "$1" Umbra-Warnings | grep -q "$2"; }
+check "inline obj without its .mtl: Umbra-Warnings names box.mtl" warned inline box.mtl
 code=$(multipart objalone "$T/mp.json" -F "model=@$A/box.obj")
 check "obj as the only part (no .mtl part): 200" [ "$code" = 200 ]
-check "obj without its .mtl part: Umbra-Warning names box.mtl" warned objalone box.mtl
+check "obj without its .mtl part: Umbra-Warnings names box.mtl" warned objalone box.mtl
 code=$(multipart objnotex "$T/mp.json" -F "model=@$A/box.obj" -F "box.mtl=@$A/box.mtl")
 check "obj + mtl parts without the texture part: 200" [ "$code" = 200 ]
-check "obj without its texture part: Umbra-Warning names halves.png" warned objnotex halves.png
+check "obj without its texture part: Umbra-Warnings names halves.png" warned objnotex halves.png
 scene "$T/gltfinline.json" "\"data\": \"$(base64 -w0 "$A/quad.gltf")\", \"format\": \"gltf\""
 code=$(post gltfinline "$T/gltfinline.json")
 check "inline gltf whose .bin is a separate file: 400 at /objects/0/data" answered "$code" 400 gltfinline /objects/0/data

@@ -162,6 +162,28 @@ check "multipart/form-data scene + model part 200" sh -c "[ $c = 200 ] && [ '$(p
 c=$(curl -s --max-time 60 -o "$T/mp2.body" -D "$T/mp2.hdr" -w '%{http_code}' -F "mesh=@$T/assets/tri.obj" "$URL/v1/render")
 check "multipart without a scene part 400" [ "$c" = 400 ]
 
+# -- a model material feature the renderer does not do is named in Umbra-Warnings (never silent)
+python3 - "$T/small.json" "$T/model-warn.json" <<'PY'
+import base64, json, struct, sys
+pos = struct.pack('<9f', -1, 0, 0, 1, 0, 0, 0, 1, 0)
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+     "extensionsUsed": ["KHR_materials_clearcoat"],
+     "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+     "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + base64.b64encode(pos).decode()}],
+     "bufferViews": [{"buffer": 0, "byteLength": 36}],
+     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, 0, 0], "max": [1, 1, 0]}]}
+doc = json.load(open(sys.argv[1]))
+doc["objects"].append({"shape": "model", "format": "gltf", "data": base64.b64encode(json.dumps(g).encode()).decode()})
+json.dump(doc, open(sys.argv[2], "w"))
+PY
+c=$(post mwarn "$T/model-warn.json")
+w=$(hdr mwarn Umbra-Warnings)
+case "$w" in /objects/*KHR_materials_clearcoat*) wok=1 ;; *) wok=0 ;; esac
+check "model with an unsupported material extension: 200" [ "$c" = 200 ]
+check "Umbra-Warnings names the extension under its object's pointer ($w)" [ "$wok" = 1 ]
+check "a model without such data: no Umbra-Warnings" [ -z "$(hdr mp Umbra-Warnings)" ]
+
 # -- 20 concurrent requests
 cpids=""
 i=0

@@ -141,8 +141,9 @@ static void put32(uint8_t *p, uint32_t v)
 }
 
 /* A quad (2 triangles) in a node translated by (0,2,0), material: baseColorFactor, metallic,
- * roughness, alphaMode MASK with cutoff 0.4, and the 2x2 PNG as base-colour texture. */
-static uint8_t *quad_glb(size_t *len)
+ * roughness, alphaMode MASK with cutoff 0.4, and the 2x2 PNG as base-colour texture;
+ * tex_extra is added to the baseColorTexture object, root_extra to the document. */
+static uint8_t *quad_glb_ex(const char *tex_extra, const char *root_extra, size_t *len)
 {
 	static const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
 	static const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
@@ -159,8 +160,8 @@ static uint8_t *quad_glb(size_t *len)
 		"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},"
 		"\"indices\":3,\"material\":0}]}],"
 		"\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.25,1,1],\"metallicFactor\":0.3,"
-		"\"roughnessFactor\":0.7,\"baseColorTexture\":{\"index\":0}},\"alphaMode\":\"MASK\",\"alphaCutoff\":0.4}],"
-		"\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":4,\"mimeType\":\"image/png\"}],"
+		"\"roughnessFactor\":0.7,\"baseColorTexture\":{\"index\":0%s}},\"alphaMode\":\"MASK\",\"alphaCutoff\":0.4}],"
+		"\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":4,\"mimeType\":\"image/png\"}]%s,"
 		"\"buffers\":[{\"byteLength\":%zu}],"
 		"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
 		"{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":32},"
@@ -170,7 +171,7 @@ static uint8_t *quad_glb(size_t *len)
 		"{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
 		"{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
 		"{\"bufferView\":3,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}]}",
-		binpad, pnglen);
+		tex_extra, root_extra, binpad, pnglen);
 	size_t jpad = ((size_t)jn + 3) & ~(size_t)3;
 	size_t total = 12 + 8 + jpad + 8 + binpad;
 	uint8_t *g = calloc(1, total);
@@ -193,6 +194,11 @@ static uint8_t *quad_glb(size_t *len)
 	free(png);
 	*len = total;
 	return g;
+}
+
+static uint8_t *quad_glb(size_t *len)
+{
+	return quad_glb_ex("", "", len);
 }
 
 /* ---- tests ---- */
@@ -617,4 +623,30 @@ TEST(model_cache_threads)
 	uint64_t bytes;
 	api_model_cache_stats(NULL, NULL, &bytes);
 	CHECK(bytes == 0);
+}
+
+/* What of a file's material the renderer does not do is listed, never dropped silently: an
+ * unknown extension and a texture on a second uv set come back as the scene's warnings (the
+ * Umbra-Warnings header), each under the pointer of the object that brought them; a file
+ * without such things has none. */
+TEST(model_glb_unsupported_material_data_warned)
+{
+	size_t n;
+	uint8_t *glb = quad_glb_ex(",\"texCoord\":1", ",\"extensionsUsed\":[\"KHR_materials_clearcoat\"]", &n);
+	REQUIRE(glb);
+	struct api_problem p;
+	struct api_scene *s = parse_model(glb, n, "", &p);
+	free(glb);
+	REQUIRE(s, "parse failed: %d %s: %s", p.status, p.pointer, p.detail);
+	const char *w = s->warnings;
+	CHECK(!strncmp(w, "/objects/0: ", 12) && strstr(w, "KHR_materials_clearcoat") && strstr(w, "TEXCOORD_1"),
+	      "warnings: %s", w[0] ? w : "(none)");
+	api_scene_free(s);
+	glb = quad_glb(&n);
+	REQUIRE(glb);
+	s = parse_model(glb, n, "", &p);
+	free(glb);
+	REQUIRE(s, "parse failed: %d %s: %s", p.status, p.pointer, p.detail);
+	CHECK(!s->warnings[0], "warnings: %s", s->warnings);
+	api_scene_free(s);
 }

@@ -277,7 +277,8 @@ static void wire_model(struct api_wire_buf *b, uint32_t index2, float x0)
 	struct rnd_material mat;
 	rnd_material_defaults(&mat);
 	mat.base_color_texture = &tex;
-	struct api_model_mesh mesh = {pos, nrm, uv, idx, 3, 3, 0};
+	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .uvs = uv, .indices = idx, .vertex_count = 3,
+	                              .index_count = 3, .material = 0};
 	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
 	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
 	                      .materials = &mat, .material_count = 1};

@@ -70,10 +70,18 @@ struct rnd_error {
 
 enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYLINDER, RND_SHAPE_MESH };
 
-enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK };
+/* BLEND is drawn dithered: an ordered 4x4 threshold pattern keeps a pixel when alpha is over
+ * its threshold (deterministic: the same request gives the same bytes), and shadow maps use the
+ * same test, so a surface of coverage a casts a shadow of about a once filtered. */
+enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK, RND_ALPHA_BLEND };
 
-/* A decoded texture: RGBA8, rows top to bottom, colour channels sRGB-encoded (as in PNG/JPEG
- * files and glTF base-colour textures), alpha linear. */
+/* Texture slots of a material (the order of rnd_material.textures). */
+enum rnd_texture_slot { RND_TEX_BASE, RND_TEX_METAL_ROUGH, RND_TEX_NORMAL, RND_TEX_OCCLUSION, RND_TEX_EMISSIVE,
+                        RND_TEX_SLOTS };
+enum rnd_wrap { RND_WRAP_REPEAT, RND_WRAP_CLAMP, RND_WRAP_MIRROR };
+
+/* A decoded texture: RGBA8, rows top to bottom, as stored in the file. The slot that uses it
+ * says how it is read: base colour and emissive as sRGB (alpha linear), the others linear. */
 struct rnd_texture {
 	const uint8_t *rgba;
 	uint32_t width, height;
@@ -87,7 +95,25 @@ struct rnd_material {
 	enum rnd_alpha_mode alpha_mode;
 	float alpha_cutoff;   /* 0.5 */
 	bool shadow_catcher;  /* not drawn; only received shadows show */
-	const struct rnd_texture *base_color_texture; /* NULL = none; multiplies base_color, sampled with the uvs */
+	/* Textures, NULL = none, sampled with the uvs (glTF 2.0 meanings): base colour x base_color;
+	 * metallic-roughness (B x metallic, G x roughness); normal (tangent space, xy x normal_scale);
+	 * occlusion (R, mixed in by occlusion_strength, ambient light only); emissive x emissive. */
+	union {
+		struct {
+			const struct rnd_texture *base_color_texture, *metal_rough_texture, *normal_texture,
+			                         *occlusion_texture, *emissive_texture;
+		};
+		const struct rnd_texture *textures[RND_TEX_SLOTS];
+	};
+	float normal_scale;        /* 1 */
+	float occlusion_strength;  /* 1 */
+	/* How each slot's texture is sampled (zero = repeat, linear, untransformed). */
+	struct rnd_texture_sampling {
+		uint8_t wrap_s, wrap_t;             /* enum rnd_wrap */
+		bool mag_nearest, min_nearest;
+		bool transformed;                   /* KHR_texture_transform: uv' = M (u, v, 1) */
+		float transform[6];                 /* rows of M: (m00 m01 m02), (m10 m11 m12) */
+	} sampling[RND_TEX_SLOTS];
 };
 
 struct rnd_object {
@@ -104,6 +130,8 @@ struct rnd_object {
 	uint32_t index_count;
 	const float *normals;
 	const float *uvs;
+	const uint8_t *colors;  /* optional linear RGBA8 per vertex (glTF COLOR_0): multiplies base colour */
+	const float *tangents;  /* optional xyzw per vertex (w = bitangent sign), for normal maps */
 	float model[16];      /* object -> world, column-major (T*R*S resolved by the caller) */
 	uint32_t material;    /* index into scene.materials */
 	bool cast_shadows, receive_shadows, double_sided;

@@ -1,0 +1,256 @@
+/*
+ * api/gltf_material — glTF 2.0 material details from the document's JSON (see the header).
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "gltf_material.h"
+
+/* glTF sampler enums (OpenGL's) */
+#define GL_NEAREST 9728
+#define GL_NEAREST_MIPMAP_NEAREST 9984
+#define GL_NEAREST_MIPMAP_LINEAR 9986
+#define GL_CLAMP_TO_EDGE 33071
+#define GL_MIRRORED_REPEAT 33648
+
+static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
+                                                       "occlusionTexture", "emissiveTexture"};
+static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform", NULL};
+
+void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...)
+{
+	size_t n = strlen(gi->warnings), cap = sizeof gi->warnings;
+	if (n + 8 >= cap) return;
+	char line[300];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(line, sizeof line, fmt, ap);
+	va_end(ap);
+	if (strstr(gi->warnings, line)) return;   /* once each */
+	if (n + (n ? 2 : 0) + strlen(line) >= cap) {
+		if (n + 5 < cap) snprintf(gi->warnings + n, cap - n, "%s...", n ? "; " : "");
+		return;
+	}
+	snprintf(gi->warnings + n, cap - n, "%s%s", n ? "; " : "", line);
+	/* A header value: printable ASCII only (names come from the file). */
+	for (char *p = gi->warnings + n; *p; p++)
+		if (*p < 0x20 || *p > 0x7e) *p = '?';
+}
+
+static float num(json_t *o, const char *key, float dflt)
+{
+	json_t *v = json_object_get(o, key);
+	double d = json_is_number(v) ? json_number_value(v) : dflt;
+	return isfinite(d) && fabs(d) < 1e6 ? (float)d : dflt;
+}
+
+static uint8_t wrap_of(json_t *sampler, const char *key)
+{
+	json_int_t w = json_integer_value(json_object_get(sampler, key));
+	return w == GL_CLAMP_TO_EDGE ? RND_WRAP_CLAMP : w == GL_MIRRORED_REPEAT ? RND_WRAP_MIRROR : RND_WRAP_REPEAT;
+}
+
+/* KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv, in glTF's uv space. */
+static void transform_of(json_t *tt, struct rnd_texture_sampling *ts)
+{
+	json_t *off = json_object_get(tt, "offset"), *sc = json_object_get(tt, "scale");
+	float ox = 0, oy = 0, sx = 1, sy = 1, r = num(tt, "rotation", 0);
+	if (json_array_size(off) == 2) {
+		ox = json_is_number(json_array_get(off, 0)) ? (float)json_number_value(json_array_get(off, 0)) : 0;
+		oy = json_is_number(json_array_get(off, 1)) ? (float)json_number_value(json_array_get(off, 1)) : 0;
+	}
+	if (json_array_size(sc) == 2) {
+		sx = json_is_number(json_array_get(sc, 0)) ? (float)json_number_value(json_array_get(sc, 0)) : 1;
+		sy = json_is_number(json_array_get(sc, 1)) ? (float)json_number_value(json_array_get(sc, 1)) : 1;
+	}
+	float c = cosf(r), s = sinf(r);
+	float m[6] = {c * sx, s * sy, ox, -s * sx, c * sy, oy};
+	for (int i = 0; i < 6; i++)
+		if (!isfinite(m[i]) || fabsf(m[i]) > 1e6f) return;
+	memcpy(ts->transform, m, sizeof m);
+	ts->transformed = true;
+}
+
+static void read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, uint32_t slot,
+                         json_t *info, struct api_gltf_material *gm)
+{
+	if (!json_is_object(info)) return;
+	struct rnd_texture_sampling *ts = &gm->sampling[slot];
+	json_t *tex = json_array_get(json_object_get(root, "textures"), (size_t)json_integer_value(json_object_get(info, "index")));
+	json_t *sampler = json_array_get(json_object_get(root, "samplers"),
+	                                 (size_t)json_integer_value(json_object_get(tex, "sampler")));
+	if (json_is_object(sampler) && json_is_integer(json_object_get(tex, "sampler"))) {
+		ts->wrap_s = wrap_of(sampler, "wrapS");
+		ts->wrap_t = wrap_of(sampler, "wrapT");
+		ts->mag_nearest = json_integer_value(json_object_get(sampler, "magFilter")) == GL_NEAREST;
+		json_int_t mf = json_integer_value(json_object_get(sampler, "minFilter"));
+		ts->min_nearest = mf == GL_NEAREST || mf == GL_NEAREST_MIPMAP_NEAREST || mf == GL_NEAREST_MIPMAP_LINEAR;
+	}
+	json_int_t tc = json_integer_value(json_object_get(info, "texCoord"));
+	json_t *tt = json_object_get(json_object_get(info, "extensions"), "KHR_texture_transform");
+	if (json_is_object(tt)) {
+		transform_of(tt, ts);
+		if (json_is_integer(json_object_get(tt, "texCoord"))) tc = json_integer_value(json_object_get(tt, "texCoord"));
+	}
+	if (tc != 0)
+		api_gltf_warn(gi, "material %u (\"%.40s\"): %s reads TEXCOORD_%lld, drawn with TEXCOORD_0", mi, mname, SLOT_NAMES[slot],
+		     (long long)tc);
+	if (slot == RND_TEX_NORMAL) gm->normal_scale = num(info, "scale", 1);
+	if (slot == RND_TEX_OCCLUSION) gm->occlusion_strength = fminf(fmaxf(num(info, "strength", 1), 0), 1);
+}
+
+static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, json_t *mat, struct api_gltf_material *gm)
+{
+	memset(gm, 0, sizeof *gm);
+	gm->emissive_strength = 1;
+	gm->normal_scale = 1;
+	gm->occlusion_strength = 1;
+	if (!json_is_object(mat)) return;
+	const char *name = json_string_value(json_object_get(mat, "name"));
+	name = name ? name : "";
+	gm->double_sided = json_is_true(json_object_get(mat, "doubleSided"));
+	json_t *pbr = json_object_get(mat, "pbrMetallicRoughness");
+	json_t *infos[RND_TEX_SLOTS] = {json_object_get(pbr, SLOT_NAMES[0]), json_object_get(pbr, SLOT_NAMES[1]),
+	                                json_object_get(mat, SLOT_NAMES[2]), json_object_get(mat, SLOT_NAMES[3]),
+	                                json_object_get(mat, SLOT_NAMES[4])};
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) read_texinfo(gi, root, mi, name, k, infos[k], gm);
+	json_t *ext = json_object_get(mat, "extensions"), *v;
+	const char *key;
+	json_object_foreach(ext, key, v) {
+		if (!strcmp(key, "KHR_materials_emissive_strength")) {
+			float s = num(v, "emissiveStrength", 1);
+			gm->emissive_strength = s >= 0 ? s : 1;
+		}
+	}
+}
+
+/* Extensions the renderer does not know, and parts of a scene it does not draw. */
+static void scene_warnings(struct api_gltf_info *gi, json_t *root)
+{
+	json_t *used = json_object_get(root, "extensionsUsed"), *e;
+	size_t i;
+	json_array_foreach(used, i, e) {
+		const char *s = json_string_value(e);
+		bool known = false;
+		for (int k = 0; s && SUPPORTED_EXT[k]; k++) known = known || !strcmp(s, SUPPORTED_EXT[k]);
+		if (s && !known) api_gltf_warn(gi, "extension %.60s is not supported (ignored)", s);
+	}
+	if (json_array_size(json_object_get(root, "skins"))) api_gltf_warn(gi, "skins are not applied (drawn in the bind pose)");
+	if (json_array_size(json_object_get(root, "animations"))) api_gltf_warn(gi, "animations are not played");
+	json_t *meshes = json_object_get(root, "meshes"), *m, *p;
+	size_t j;
+	json_array_foreach(meshes, i, m) {
+		json_array_foreach(json_object_get(m, "primitives"), j, p) {
+			if (json_array_size(json_object_get(p, "targets")))
+				api_gltf_warn(gi, "morph targets are not applied (drawn in the base shape)");
+			json_t *mode = json_object_get(p, "mode");
+			if (json_is_integer(mode) && json_integer_value(mode) < 4) api_gltf_warn(gi, "points and lines are not drawn");
+		}
+	}
+}
+
+void api_gltf_info_read(json_t *root, struct api_gltf_info *out)
+{
+	memset(out, 0, sizeof *out);
+	if (!json_is_object(root)) return;
+	scene_warnings(out, root);
+	json_t *mats = json_object_get(root, "materials");
+	size_t n = json_array_size(mats);
+	if (!n || n > 65536 || !(out->materials = calloc(n, sizeof *out->materials))) return;
+	out->material_count = (uint32_t)n;
+	for (size_t i = 0; i < n; i++) read_material(out, root, (uint32_t)i, json_array_get(mats, i), &out->materials[i]);
+}
+
+void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m,
+                             bool *single_sided)
+{
+	if (index >= gi->material_count) return;
+	const struct api_gltf_material *gm = &gi->materials[index];
+	for (int k = 0; k < 3; k++) m->emissive[k] = fminf(m->emissive[k] * gm->emissive_strength, 1e6f);
+	memcpy(m->sampling, gm->sampling, sizeof m->sampling);
+	m->normal_scale = fminf(fmaxf(gm->normal_scale, -1e3f), 1e3f);
+	m->occlusion_strength = gm->occlusion_strength;   /* clamped to 0..1 when read */
+	*single_sided = !gm->double_sided;
+}
+
+void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out)
+{
+	for (size_t i = 0; i < (size_t)n * 4; i++) {
+		float f = rgba[i];
+		out[i] = (uint8_t)lrintf(!(f >= 0.0f) ? 0.0f : f > 1.0f ? 255.0f : f * 255.0f);   /* NaN -> 0 */
+	}
+}
+
+void api_vertex_tangents(const float *t, const float *b, const float *nrm, uint32_t n, float *out)
+{
+	for (size_t v = 0; v < n; v++) {
+		const float *tv = t + 3 * v, *bv = b + 3 * v, *nv = nrm + 3 * v;
+		float cx = nv[1] * tv[2] - nv[2] * tv[1], cy = nv[2] * tv[0] - nv[0] * tv[2], cz = nv[0] * tv[1] - nv[1] * tv[0];
+		bool ok = isfinite(tv[0]) && isfinite(tv[1]) && isfinite(tv[2]);
+		out[4 * v] = ok ? tv[0] : 1;
+		out[4 * v + 1] = ok ? tv[1] : 0;
+		out[4 * v + 2] = ok ? tv[2] : 0;
+		out[4 * v + 3] = cx * bv[0] + cy * bv[1] + cz * bv[2] < 0 ? -1.0f : 1.0f;
+	}
+}
+
+void api_gltf_info_free(struct api_gltf_info *gi)
+{
+	if (!gi) return;
+	free(gi->materials);
+	gi->materials = NULL;
+	gi->material_count = 0;
+}
+
+#define TAG "umbra-gltf-material-"
+
+uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len)
+{
+	json_t *mats = json_object_get(root, "materials"), *m;
+	size_t i;
+	if (!json_array_size(mats)) return NULL;
+	json_array_foreach(mats, i, m) {
+		char tag[48];
+		snprintf(tag, sizeof tag, TAG "%zu", i);
+		if (json_is_object(m) && json_object_set_new(m, "name", json_string(tag)) < 0) return NULL;
+	}
+	char *js = json_dumps(root, JSON_COMPACT);
+	if (!js) return NULL;
+	size_t jn = strlen(js), jpad = (jn + 3) & ~(size_t)3;
+	uint8_t *out = NULL;
+	if (!glb) {
+		out = malloc(jn ? jn : 1);
+		if (out) memcpy(out, js, jn);
+		*out_len = jn;
+	} else {
+		/* header, the new JSON chunk, then the original chunks after the JSON one */
+		uint32_t old = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 | (uint32_t)data[15] << 24;
+		size_t rest_at = 20 + (size_t)old, rest = rest_at <= len ? len - rest_at : 0;
+		size_t total = 20 + jpad + rest;
+		if (total <= UINT32_MAX && (out = malloc(total))) {
+			memcpy(out, data, 12);
+			uint32_t t32 = (uint32_t)total, j32 = (uint32_t)jpad;
+			for (int k = 0; k < 4; k++) {
+				out[8 + k] = (uint8_t)(t32 >> (8 * k));
+				out[12 + k] = (uint8_t)(j32 >> (8 * k));
+			}
+			memcpy(out + 16, "JSON", 4);
+			memcpy(out + 20, js, jn);
+			memset(out + 20 + jn, ' ', jpad - jn);
+			memcpy(out + 20 + jpad, data + rest_at, rest);
+			*out_len = total;
+		}
+	}
+	free(js);
+	return out;
+}
+
+int api_gltf_material_of(const char *name)
+{
+	if (!name || strncmp(name, TAG, strlen(TAG))) return -1;
+	char *end;
+	long v = strtol(name + strlen(TAG), &end, 10);
+	return *end || end == name + strlen(TAG) || v < 0 || v > 65535 ? -1 : (int)v;
+}

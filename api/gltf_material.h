@@ -1,0 +1,64 @@
+/*
+ * api/gltf_material — what of a glTF 2.0 material Assimp 5.2 does not hand over reliably,
+ * read from the document's JSON itself: per texture slot the sampler (wrap and filter modes),
+ * KHR_texture_transform, texCoord, normalTexture.scale and occlusionTexture.strength;
+ * KHR_materials_emissive_strength; doubleSided. Also the list of what the renderer does not
+ * do of the file (unknown extensions, a second uv set, skins, animations, morph targets,
+ * points and lines), as warnings that travel with the model (api_model.warnings).
+ *
+ * Assimp 5.2's glTF importer numbers materials in the order it first meets them walking the
+ * node tree (children before a node's own mesh), not the document's order. So the document is
+ * handed to Assimp with each material renamed to a tag naming its index
+ * (api_gltf_tag_materials), and each Assimp material is joined to its glTF material by that
+ * name (api_gltf_material_of); the original names stay here, for the warnings.
+ *
+ * Usage (api/model_import.c, inside the sandboxed importer):
+ *   struct api_gltf_info gi; api_gltf_info_read(root, &gi);   // root: the parsed JSON
+ *   uint8_t *t = api_gltf_tag_materials(root, data, len, glb, &tlen);  // import t (or data if NULL)
+ *   ... i = api_gltf_material_of(assimp material name): gi.materials[i] when i >= 0 ...
+ *   free(t); api_gltf_info_free(&gi);
+ * Ownership: gi owns its materials array (malloc). Threading: no shared state.
+ */
+#ifndef UMBRA_API_GLTF_MATERIAL_H
+#define UMBRA_API_GLTF_MATERIAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <jansson.h>
+#include "model.h"
+
+struct api_gltf_material {
+	float emissive_strength;           /* 1 */
+	bool double_sided;                 /* false (glTF's default) */
+	float normal_scale, occlusion_strength;    /* 1, 1 */
+	struct rnd_texture_sampling sampling[RND_TEX_SLOTS];
+};
+
+struct api_gltf_info {
+	struct api_gltf_material *materials;
+	uint32_t material_count;
+	char warnings[API_MODEL_MAX_WARNINGS + 1];   /* "" when none */
+};
+
+/* Reads root (a JSON object). Never fails: what cannot be read stays at glTF's defaults (a
+ * materials array it cannot allocate leaves material_count 0). */
+void api_gltf_info_read(json_t *root, struct api_gltf_info *out);
+void api_gltf_info_free(struct api_gltf_info *gi);
+/* The file's bytes with every material's name replaced by its index tag (malloc'd, you free
+ * it), or NULL (no materials, or out of memory: import the original then). root is changed. */
+uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len);
+/* The glTF material index an Assimp material name tags, or -1. */
+int api_gltf_material_of(const char *name);
+/* What material `index` of the document adds to m as Assimp read it: emissive x strength,
+ * the samplings, normal scale, occlusion strength; *single_sided from doubleSided. Nothing
+ * when index is past the document's materials. */
+void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m,
+                             bool *single_sided);
+/* Vertex data: n RGBA float colours -> linear RGBA8 (clamped); n tangents, bitangents and
+ * normals (xyz floats) -> xyzw tangents, w = the side of the bitangent (+1 / -1). */
+void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out);
+void api_vertex_tangents(const float *t, const float *b, const float *nrm, uint32_t n, float *out);
+/* Adds a warning (once; dropped past the size limit, with "..."). */
+void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+#endif

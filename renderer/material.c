@@ -1,0 +1,183 @@
+/*
+ * renderer/material — glTF 2.0 materials on the GPU (see material.h).
+ *
+ * A material samples only the textures it has: umbra_material.tex.x carries one bit per slot
+ * and the scene's union of those bits specialises mesh.frag (UMBRA_SC_TEXTURES), so an
+ * untextured scene runs no texture code at all. Slots a textured material lacks are bound to
+ * the slot's white 1x1, which is the neutral value of every multiply (base, metal-rough,
+ * occlusion, emissive); the normal map's bit gates its use.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "material.h"
+
+static bool slot_srgb(uint32_t slot)
+{
+	return slot == RND_TEX_BASE || slot == RND_TEX_EMISSIVE;
+}
+
+void rnd_material_write(const struct rnd_material *in, struct umbra_material *out)
+{
+	memset(out, 0, sizeof *out);
+	memcpy(out->base_color, in->base_color, sizeof in->base_color);
+	memcpy(out->emissive, in->emissive, sizeof in->emissive);
+	out->emissive[3] = in->roughness;
+	out->params[0] = in->metallic;
+	out->params[1] = in->alpha_mode == RND_ALPHA_MASK ? in->alpha_cutoff : -1.0f;
+	out->params[2] = in->normal_scale;
+	out->params[3] = in->occlusion_strength;
+	out->tex[1] = in->alpha_mode == RND_ALPHA_MASK ? UMBRA_ALPHA_MASK
+	            : in->alpha_mode == RND_ALPHA_BLEND ? UMBRA_ALPHA_BLEND : UMBRA_ALPHA_OPAQUE;
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
+		if (in->textures[k]) out->tex[0] |= 1u << k;
+		const struct rnd_texture_sampling *ts = &in->sampling[k];
+		float *r0 = out->uvx[2 * k], *r1 = out->uvx[2 * k + 1];
+		if (ts->transformed) {
+			memcpy(r0, ts->transform, 3 * sizeof(float));
+			memcpy(r1, ts->transform + 3, 3 * sizeof(float));
+		} else {
+			r0[0] = 1.0f;
+			r1[1] = 1.0f;
+		}
+	}
+}
+
+/* Arrays sized by ctx->max_textures (the device's, capped by the caller): that many distinct
+ * images and that many textured materials (each has at least one image). */
+struct tex_plan {
+	uint32_t max;
+	uint32_t n;                                /* distinct images */
+	const struct rnd_texture **tex;
+	bool *srgb;
+	uint32_t nsets;
+	int16_t (*img)[UMBRA_TEX_SLOTS];          /* -1: white */
+	uint8_t (*smp)[UMBRA_TEX_SLOTS];
+};
+
+/* The image index of texture t read in colour space srgb, added when new; -1 past the limit. */
+static int image_of(struct tex_plan *p, const struct rnd_texture *t, bool srgb)
+{
+	for (uint32_t k = 0; k < p->n; k++)
+		if (p->tex[k] == t && p->srgb[k] == srgb) return (int)k;
+	if (p->n == p->max) return -1;
+	p->tex[p->n] = t;
+	p->srgb[p->n] = srgb;
+	return (int)p->n++;
+}
+
+/* Gives material mi, first met on object o, its set (its images and samplers); 0 when it has
+ * no texture. The limit's error names o: the object that brought one too many. */
+static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene *sc, uint32_t mi, uint32_t o,
+                                     uint32_t *set, struct rnd_error *err)
+{
+	const struct rnd_material *m = &sc->materials[mi];
+	bool any = false;
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) any = any || m->textures[k];
+	*set = 0;
+	if (!any) return RND_OK;
+	if (p->nsets == p->max)
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u textured materials in one scene "
+		                   "(this renderer's limit)", p->max);
+	uint32_t si = p->nsets++;
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
+		const struct rnd_texture *t = m->textures[k];
+		p->img[si][k] = -1;
+		p->smp[si][k] = (uint8_t)rnd_texture_sampler_index(&m->sampling[k]);
+		if (!t) continue;
+		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
+			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", mi, t->width, t->height);
+		int ii = image_of(p, t, slot_srgb(k));
+		if (ii < 0)
+			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u distinct textures in one scene "
+			                   "(this renderer's limit)", p->max);
+		p->img[si][k] = (int16_t)ii;
+	}
+	*set = 1 + si;
+	return RND_OK;
+}
+
+static void write_sets(struct rnd_context *ctx, struct rnd_slot *s, const struct tex_plan *p)
+{
+	VkDescriptorImageInfo ii[UMBRA_TEX_SLOTS];
+	VkWriteDescriptorSet w[UMBRA_TEX_SLOTS];
+	for (uint32_t si = 0; si < p->nsets; si++) {
+		for (uint32_t k = 0; k < UMBRA_TEX_SLOTS; k++) {
+			int img = p->img[si][k];
+			ii[k] = (VkDescriptorImageInfo){ctx->pipes.texture_samplers[img < 0 ? 0 : p->smp[si][k]],
+			                                img < 0 ? s->white.view : s->textures[img].view,
+			                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+			w[k] = (VkWriteDescriptorSet){
+				.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->texture_sets[1 + si], .dstBinding = k,
+				.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ii[k],
+			};
+		}
+		vkUpdateDescriptorSets(ctx->device, UMBRA_TEX_SLOTS, w, 0, NULL);
+	}
+}
+
+enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
+                                      struct draw *draws, const struct rnd_texture **tex, uint32_t *ntex,
+                                      struct rnd_error *err)
+{
+	enum rnd_result r = RND_OK;
+	rnd_slot_drop_textures(ctx, s);
+	*ntex = 0;
+	uint32_t max = ctx->max_textures;
+	struct tex_plan *p = calloc(1, sizeof *p);
+	if (p) {
+		p->max = max;
+		p->srgb = calloc(max, sizeof *p->srgb);
+		p->img = calloc(max, sizeof *p->img);
+		p->smp = calloc(max, sizeof *p->smp);
+	}
+	/* material -> its set + 1 (0 = not planned yet) */
+	uint32_t *set_of = calloc(sc->material_count ? sc->material_count : 1, sizeof *set_of);
+	if (!p || !p->srgb || !p->img || !p->smp || !set_of) {
+		r = rnd_fail(err, RND_ERR_OOM, "out of memory planning textures");
+		goto done;
+	}
+	p->tex = tex;
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		draws[i].texture_set = 0;
+		draws[i].tex_bits = 0;
+		if (!sc->material_count) continue;
+		uint32_t mi = sc->objects[i].material, set;
+		if (!set_of[mi]) {
+			if ((r = plan_material(p, sc, mi, i, &set, err)) != RND_OK) goto done;
+			set_of[mi] = set + 1;
+		}
+		draws[i].texture_set = set_of[mi] - 1;
+		for (uint32_t k = 0; k < RND_TEX_SLOTS; k++)
+			if (sc->materials[mi].textures[k]) draws[i].tex_bits |= 1u << k;
+		if (sc->objects[i].shape == RND_SHAPE_MESH && sc->objects[i].colors)
+			draws[i].tex_bits |= UMBRA_TEXBIT_VERTEX_COLOR;
+	}
+	VkDeviceSize bytes = 0, off = 0;
+	for (uint32_t i = 0; i < p->n; i++) bytes += (VkDeviceSize)tex[i]->width * tex[i]->height * 4;
+	if (p->n && (r = rnd_buffer_reserve(ctx, &s->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "slot staging", err)) != RND_OK)
+		goto done;
+	for (uint32_t i = 0; i < p->n; i++) {
+		char name[48];
+		snprintf(name, sizeof name, "slot %u texture %u", s->index, i);
+		if ((r = rnd_image_create(ctx, p->srgb[i] ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM, tex[i]->width,
+		                          tex[i]->height, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+		                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->textures[i], err)) != RND_OK)
+			goto done;
+		s->texture_count = i + 1;
+		size_t sz = (size_t)tex[i]->width * tex[i]->height * 4;
+		memcpy((uint8_t *)s->staging.map + off, tex[i]->rgba, sz);
+		off += sz;
+	}
+	write_sets(ctx, s, p);
+	*ntex = p->n;
+done:
+	free(set_of);
+	if (p) {
+		free(p->srgb);
+		free(p->img);
+		free(p->smp);
+	}
+	free(p);
+	return r;
+}
