@@ -1070,11 +1070,6 @@ static int parse_shadow(struct pctx *c, json_t *j, struct rnd_shadow *s, const c
 		     get_float(c, sub, "distance", &R_POS, &s->contact_distance) < 0 ||
 		     get_u32(c, sub, "steps", 1, 256, &s->contact_steps) < 0 ||
 		     get_float(c, sub, "thickness", &R_POS, &s->contact_thickness) < 0;
-		/* Parsed and validated, but the renderer does not march contact shadows yet: asking
-		 * for them is a 422, never a silently different image. */
-		if (!rc && s->contact_enabled)
-			defer(c, true, "enabled", "contact shadows are not supported by this renderer yet; leave "
-			      "contact.enabled false (soft shadows near contact come from the shadow filter)");
 		ptr_pop(c, old);
 		if (rc) return -1;
 	}
