@@ -1184,6 +1184,11 @@ static int parse_camera(struct pctx *c, json_t *j, struct rnd_camera *cam)
 	if ((rc = get_float(c, j, "margin", &margin, &mg)) < 0) return -1;
 	if (rc && fit < 0) return fail_at(c, "margin", "margin is only used with fit");
 	if (rc) cam->fit_margin = mg;
+	/* Auto-framing places a perspective camera (contract §2): an orthographic one asked to fit
+	 * would silently come out perspective. */
+	if (fit >= 0 && type == 1)
+		defer(c, true, "type", "fit frames a perspective camera; an orthographic fit is not supported "
+		      "(give position, target and height instead)");
 	if (fit >= 0) {
 		cam->fit = fit ? RND_FIT_OBJECTS : RND_FIT_SCENE;
 		if (cam->fit_direction[0] == 0 && cam->fit_direction[1] == 0 && cam->fit_direction[2] == 0) {

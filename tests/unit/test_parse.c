@@ -208,6 +208,9 @@ static const struct bad bad_docs[] = {
 	 "/lights/0/shadow/filter", "\"pcss\""},
 	{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'contact':{'steps':0}}}]}", 400,
 	 "/lights/0/shadow/contact/steps", "between 1 and 256"},
+	/* an orthographic camera with fit came out perspective: now a 422 at the member */
+	{"{'camera':{'fit':'scene','type':'orthographic','height':2},'objects':[]}", 422, "/camera/type",
+	 "orthographic fit is not supported"},
 	{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'contact':{'distance':0}}}]}", 400,
 	 "/lights/0/shadow/contact/distance", "greater than 0"},
 	{BASE ",'shadows':{'contact':{'enabled':true,'thickness':-1}}}", 400, "/shadows/contact/thickness",
