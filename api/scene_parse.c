@@ -1054,11 +1054,6 @@ static int parse_shadow(struct pctx *c, json_t *j, struct rnd_shadow *s, const c
 		     get_float(c, sub, "distance", &R_POS, &s->contact_distance) < 0 ||
 		     get_u32(c, sub, "steps", 1, 256, &s->contact_steps) < 0 ||
 		     get_float(c, sub, "thickness", &R_POS, &s->contact_thickness) < 0;
-		/* Parsed and validated, but the renderer does not march contact shadows yet: asking
-		 * for them is a 422, never a silently different image. */
-		if (!rc && s->contact_enabled)
-			defer(c, true, "enabled", "contact shadows are not supported by this renderer yet; leave "
-			      "contact.enabled false (soft shadows near contact come from the shadow filter)");
 		ptr_pop(c, old);
 		if (rc) return -1;
 	}
@@ -1173,6 +1168,11 @@ static int parse_camera(struct pctx *c, json_t *j, struct rnd_camera *cam)
 	if ((rc = get_float(c, j, "margin", &margin, &mg)) < 0) return -1;
 	if (rc && fit < 0) return fail_at(c, "margin", "margin is only used with fit");
 	if (rc) cam->fit_margin = mg;
+	/* Auto-framing places a perspective camera (contract §2): an orthographic one asked to fit
+	 * would silently come out perspective. */
+	if (fit >= 0 && type == 1)
+		defer(c, true, "type", "fit frames a perspective camera; an orthographic fit is not supported "
+		      "(give position, target and height instead)");
 	if (fit >= 0) {
 		cam->fit = fit ? RND_FIT_OBJECTS : RND_FIT_SCENE;
 		if (cam->fit_direction[0] == 0 && cam->fit_direction[1] == 0 && cam->fit_direction[2] == 0) {

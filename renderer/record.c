@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 #include "moments.h"
+#include "contact.h"
 #include "record.h"
 
 /* Culling back faces of a closed primitive changes nothing in the picture as long as the
@@ -224,6 +225,7 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 		k->sc[UMBRA_SC_LIGHT_TYPES] |= 1u << type;
 		if (lp->view_count) k->sc[UMBRA_SC_FILTERS] |= 1u << lp->filter;
 		if (type == UMBRA_LIGHT_DIRECTIONAL && lp->view_count > 1) k->sc[UMBRA_SC_CASCADES] = 1;
+		if (rnd_contact_on(sc, sp, i)) k->sc[UMBRA_SC_CONTACT] = 1;
 	}
 	k->sc[UMBRA_SC_DEBUG] = record_debug(sc->output.debug);
 	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;

@@ -40,6 +40,7 @@ struct record_view {
 	/* The rows of this view that one submit draws (render area + scissor; the viewport stays
 	 * the whole view, so a band's pixels are exactly those of the unsplit pass). */
 	uint32_t band_y, band_h;       /* band_h 0 = every row */
+	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
 };
 
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,

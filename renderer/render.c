@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "contact.h"
 #include "estimate.h"
 #include "material.h"
 #include "mesh.h"
@@ -76,7 +77,7 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 /* Fills the uniform/storage regions and points the slot's descriptor set at them. */
 static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                     const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                    float exposure, struct rnd_error *err)
+                                    float exposure, bool contact, struct rnd_error *err)
 {
 	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
 	if (ctx->props.limits.minUniformBufferOffsetAlignment > al) al = ctx->props.limits.minUniformBufferOffsetAlignment;
@@ -117,6 +118,15 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	f->mode2[0] = sc->output.pixels == RND_PIXELS_RGBA32F ? 1u : 0u;
 	f->mode2[1] = sc->output.transparent ? 1u : 0u;
 	memcpy(f->poisson, POISSON, sizeof f->poisson);
+	f->depth_lin[0] = cam->proj[10];
+	f->depth_lin[1] = cam->proj[14];
+	f->depth_lin[2] = cam->proj[11];
+	f->depth_lin[3] = cam->proj[15];
+	f->target[0] = (float)sc->width;
+	f->target[1] = (float)sc->height;
+	/* proj[5] = -1/tan(fov/2) (perspective) or -2/height (orthographic): a pixel's world size. */
+	f->target[2] = 2.0f / ((float)sc->height * fabsf(cam->proj[5]));
+	f->target[3] = cam->ortho ? 1.0f : 0.0f;
 
 	struct umbra_material *m = (struct umbra_material *)(base + off_mat);
 	if (!sc->material_count) {
@@ -160,6 +170,9 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 			 * depth range (VSM), so flat receivers do not self-shadow. */
 			l[i].moment_params[2] = lp->evsm ? 1e-4f : 2e-6f;
 		}
+		/* The mapped block keeps the previous render's values: off is written, not assumed. */
+		memset(l[i].contact, 0, sizeof l[i].contact);
+		if (rnd_contact_on(sc, sp, i)) rnd_contact_params(&in->shadow, l[i].contact);
 	}
 	memcpy(base + off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));
 
@@ -175,10 +188,19 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	VkDescriptorImageInfo mi = ctx->atlas_moments.view
 		? (VkDescriptorImageInfo){ctx->moments.sampler, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL}
 		: (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
-	VkWriteDescriptorSet w[6];
+	/* Contact shadows read the view's depth (drawn before the main pass); other renders bind
+	 * the white texture, which their pipelines never read. */
+	VkDescriptorImageInfo di = contact
+		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, s->scene_depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL}
+		: (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	VkWriteDescriptorSet w[7];
 	w[5] = (VkWriteDescriptorSet){
 		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
+	};
+	w[6] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SCENE_DEPTH,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &di,
 	};
 	for (int i = 0; i < 5; i++) {
 		w[i] = (VkWriteDescriptorSet){
@@ -189,7 +211,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, 6, w, 0, NULL);
+	vkUpdateDescriptorSets(ctx->device, 7, w, 0, NULL);
 	/* moments.comp: the scratch map in, the blur temporary, the moment atlas out. */
 	/* Moment maps read at most maxStorageBufferRange bytes of it (their resolution is capped to
 	 * fit: rnd_moments_max_res); a larger depth-only scratch is never read through this. */
@@ -530,14 +552,16 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 		for (uint32_t k = 0; k < ngrant; k++)
 			if (grants[k].res > max_res) max_res = grants[k].res;
 		if ((r = rnd_slot_shadow_scratch(ctx, s, max_res, err)) != RND_OK) goto done;
-		if ((r = write_params(ctx, s, sc, &cam, sp, camera->exposure, err)) != RND_OK) goto done;
+		bool contact = rnd_contact_any(sc, sp);
+		if (contact && (r = rnd_slot_scene_depth(ctx, s, sc->width, sc->height, err)) != RND_OK) goto done;
+		if ((r = write_params(ctx, s, sc, &cam, sp, camera->exposure, contact, err)) != RND_OK) goto done;
 
 		uint32_t col = v % cols, row = v / cols;
 		VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sheet_w + (VkDeviceSize)col * sc->width);
 		struct record_view rv = {
 			.sc = sc, .cam = &cam, .sp = sp, .draws = draws, .ndraw = sc->object_count, .aov_passes = passes,
 			.color_offset = cell * px, .aov_offset = color_bytes + cell * 16, .aov_stride = att_bytes,
-			.sheet_width = (uint32_t)sheet_w, .pixel_bytes = (uint32_t)px,
+			.sheet_width = (uint32_t)sheet_w, .pixel_bytes = (uint32_t)px, .contact = contact,
 		};
 		if ((r = rnd_submit_view(ctx, s, &rv, &pacer, &tm, &gpu_busy, err)) != RND_OK) goto done;
 	}

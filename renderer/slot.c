@@ -57,7 +57,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	VkDescriptorPoolSize sizes[3] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
 	};
 	VkDescriptorPoolCreateInfo dpi = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 3, .pPoolSizes = sizes,
@@ -164,6 +164,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
 	rnd_image_destroy(ctx, &s->aov_depth);
+	rnd_image_destroy(ctx, &s->scene_depth);
 	rnd_buffer_destroy(ctx, &s->staging);
 	rnd_image_destroy(ctx, &s->resolve);
 	rnd_image_destroy(ctx, &s->depth);
@@ -349,6 +350,7 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 		rnd_image_destroy(ctx, &s->depth);
 		rnd_image_destroy(ctx, &s->resolve);
 	}
+	if (image_bytes(ctx, &s->scene_depth) > keep) rnd_image_destroy(ctx, &s->scene_depth);
 	if (image_bytes(ctx, &s->shadow_scratch) + s->scratch_buf.size > keep) {
 		rnd_image_destroy(ctx, &s->shadow_scratch);
 		rnd_buffer_destroy(ctx, &s->scratch_buf);
@@ -360,4 +362,16 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 	struct rnd_buffer *bufs[] = {&s->readback, &s->vertices, &s->indices, &s->staging};
 	for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
 		if (bufs[i]->size > keep) rnd_buffer_destroy(ctx, bufs[i]);
+}
+
+enum rnd_result rnd_slot_scene_depth(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
+                                     struct rnd_error *err)
+{
+	if (s->scene_depth.img && s->scene_depth.width == w && s->scene_depth.height == h) return RND_OK;
+	rnd_image_destroy(ctx, &s->scene_depth);
+	char name[48];
+	snprintf(name, sizeof name, "slot %u scene depth", s->index);
+	return rnd_image_create(ctx, RND_SHADOW_FORMAT, w, h, 1, 1,
+	                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                        VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->scene_depth, err);
 }

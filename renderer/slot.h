@@ -44,6 +44,8 @@ struct rnd_slot {
 	VkDescriptorPool moments_pool;
 	VkDescriptorSet moments_set;
 	struct rnd_image_res color_ms, depth, resolve;
+	/* the camera view's depth, single-sample, drawn before the main pass for contact shadows */
+	struct rnd_image_res scene_depth;
 };
 
 /* Makes the colour/depth targets match (format, w, h, samples). */
@@ -55,6 +57,9 @@ enum rnd_result rnd_slot_aov(struct rnd_context *ctx, struct rnd_slot *s, uint32
 enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err);
 /* Makes the moment blur temporary at least res x res. */
 enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err);
+/* Makes the contact-shadow scene depth image match w x h. */
+enum rnd_result rnd_slot_scene_depth(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
+                                     struct rnd_error *err);
 /* Destroys the previous render's textures. */
 void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 #include "submit.h"
+#include "contact.h"
 
 /* Cost model for the first band and for grouping shadow views, in lavapipe milliseconds (a
  * GPU is faster: the model then only makes the first band smaller than needed, and measured
@@ -283,6 +284,11 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 	struct cmd_state st = {0};
 	const struct rnd_scene *sc = rv->sc;
 	if ((r = submit_shadows(ctx, s, rv, p, &st, tm, gpu_busy, err)) != RND_OK) goto fail;
+	/* Contact shadows march against the whole view's depth: drawn once, before any band. */
+	if (rv->contact) {
+		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
+		record_scene_depth(ctx, s, rv);
+	}
 
 	bool split = p->slice_ms > 0 || sc->band_rows;
 	uint64_t tris = 0;

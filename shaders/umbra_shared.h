@@ -16,7 +16,8 @@
 #define UMBRA_BINDING_SHADOW_VIEWS   3  /* uniform  umbra_shadow_view[UMBRA_MAX_SHADOW_VIEWS] */
 #define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2D, the depth atlas (R32F): one tile per shadow view */
 #define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
-#define UMBRA_BINDING_COUNT          6
+#define UMBRA_BINDING_SCENE_DEPTH    6  /* sampler2D, the camera view's depth (D32, 1 - reversed Z), contact shadows */
+#define UMBRA_BINDING_COUNT          7
 /* moments.comp's own set 0 */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
 #define UMBRA_MOMENTS_BINDING_TMP    1
@@ -85,7 +86,8 @@
 #define UMBRA_SC_CASCADES    6
 #define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR */
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
-#define UMBRA_SC_COUNT       9
+#define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
+#define UMBRA_SC_COUNT       10
 
 /* umbra_material.params.z flags */
 #define UMBRA_MATERIAL_SHADOW_CATCHER 1u
@@ -112,6 +114,10 @@ struct umbra_frame {
 	U_VEC4 params;           /* x exposure multiplier, y near, z far, w unused */
 	U_UVEC4 mode;            /* x tonemap, y debug, z debug light, w light count */
 	U_UVEC4 mode2;           /* x 1 = linear output (no tone map / sRGB), y transparent */
+	U_VEC4 depth_lin;        /* proj[10], proj[14], proj[11], proj[15]: contact shadows turn the scene
+	                            depth back into view depth (perspective and orthographic alike) */
+	U_VEC4 target;           /* x, y view size in pixels; z world size of a pixel at view depth 1
+	                            (perspective) or everywhere (orthographic); w 1 = orthographic */
 	U_VEC4 poisson[16];      /* 32 Poisson-disk taps in the unit disk, two per vec4 */
 };
 
@@ -136,6 +142,8 @@ struct umbra_light {
 	                            z blend band (fraction), w fade start (view depth) */
 	U_VEC4 splits;           /* directional cascades: far view depth of cascade 0..3 */
 	U_VEC4 moment_params;    /* x EVSM exponent (0 = VSM), y light-bleed reduction, z min variance */
+	U_VEC4 contact;          /* contact shadows: x ray length (world, 0 = from the map's texel), y steps,
+	                            z thickness (view depth, world units; 0 = default), w 1 = on */
 };
 
 struct umbra_shadow_view {

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Writes the benchmark's scene variants into DIR: thumb-512 with each shadow filter,
-outdoor-csm with each directional mode, studio-spots with 1/4/16 shadowed lights, models of
-10k/100k/1M triangles (binary STL, base64 inline), and a 16-frame turntable.
+"""Writes the benchmark's scene variants into DIR: thumb-512 with each shadow filter and with
+pcf plus contact shadows, outdoor-csm with each directional mode, studio-spots with 1/4/16
+shadowed lights, models of 10k/100k/1M triangles (binary STL, base64 inline), and a 16-frame
+turntable.
 Usage: variants.py SHARED_BENCH_DIR OUT_DIR"""
 import base64, copy, json, math, os, struct, sys
 
@@ -19,6 +20,11 @@ for f in ("hard", "pcf", "pcss", "vsm", "evsm"):
     if f == "pcss":
         d["lights"][0]["angular_diameter"] = 2.0
     save("thumb512-%s.json" % f, d)
+# Contact shadows: the pcf variant with them on (one light: the difference is their cost per
+# light, the view depth prepass included).
+d = copy.deepcopy(thumb)
+d["shadows"] = {"filter": "pcf", "contact": {"enabled": True}}
+save("thumb512-pcf-contact.json", d)
 
 # Outputs: encode cost per format and size.
 for size in (256, 512, 1024):

@@ -208,10 +208,13 @@ static const struct bad bad_docs[] = {
 	 "/lights/0/shadow/filter", "\"pcss\""},
 	{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'contact':{'steps':0}}}]}", 400,
 	 "/lights/0/shadow/contact/steps", "between 1 and 256"},
-	/* contact shadows are parsed but not rendered yet: asking for them is a 422, not ignored */
-	{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'contact':{'enabled':true}}}]}", 422,
-	 "/lights/0/shadow/contact/enabled", "not supported"},
-	{BASE ",'shadows':{'contact':{'enabled':true,'steps':8}}}", 422, "/shadows/contact/enabled", "not supported"},
+	/* an orthographic camera with fit came out perspective: now a 422 at the member */
+	{"{'camera':{'fit':'scene','type':'orthographic','height':2},'objects':[]}", 422, "/camera/type",
+	 "orthographic fit is not supported"},
+	{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'contact':{'distance':0}}}]}", 400,
+	 "/lights/0/shadow/contact/distance", "greater than 0"},
+	{BASE ",'shadows':{'contact':{'enabled':true,'thickness':-1}}}", 400, "/shadows/contact/thickness",
+	 "greater than 0"},
 	/* shadows */
 	{BASE ",'shadows':{'resolution':32}}", 400, "/shadows/resolution", "between 64 and 8192"},
 	{BASE ",'shadows':{'resolution':16384}}", 400, "/shadows/resolution", "between 64 and 8192"},
@@ -450,6 +453,19 @@ TEST(parse_shadow_merge)
 	CHECK(c->enabled && c->resolution == 1024 && c->pcf_radius == 2 && c->cascades == 3 && near_f(c->split_lambda, 0.75f));
 	CHECK(d->filter == RND_FILTER_EVSM && d->vsm_precision == RND_VSM_FP16 && d->vsm_exponent == 5);
 	CHECK(!d->contact_enabled && d->contact_steps == 16 && d->resolution == 1024);
+	api_scene_free(s);
+
+	/* Contact shadows are rendered (shading.glsl contact_visibility): a request that asks for
+	 * them parses, settings inherited from the root and overridden per light. */
+	s = PARSE_OK(BASE ",'shadows':{'contact':{'enabled':true,'distance':0.3,'steps':24,'thickness':0.02}},"
+	             "'lights':[{'type':'point','position':[0,1,0]},"
+	             "{'type':'directional','direction':[0,-1,0],'shadow':{'contact':{'steps':8}}}]}");
+	REQUIRE(s);
+	a = &s->scene.lights[0].shadow;
+	b = &s->scene.lights[1].shadow;
+	CHECK(a->contact_enabled && near_f(a->contact_distance, 0.3f) && a->contact_steps == 24 &&
+	      near_f(a->contact_thickness, 0.02f));
+	CHECK(b->contact_enabled && b->contact_steps == 8 && near_f(b->contact_distance, 0.3f));
 	api_scene_free(s);
 
 	s = PARSE_OK(BASE ",'shadows':{'enabled':false},'lights':[{'type':'point','position':[0,1,0]},"
