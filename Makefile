@@ -87,7 +87,7 @@ $(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
-$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 # The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
 # them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).
@@ -95,8 +95,9 @@ $(BUILD)/umbra-import: $(BUILD)/obj/api/helper/umbra_import.o $(BUILD)/libapi.a 
 	$(CC) $(LDFLAGS) -Wl,--as-needed -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-# flags.o (+ admit.o, which it calls): the unit tests cover srv_default_workers() (cgroup CPU quota).
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+# flags.o (+ admit.o, which it calls): the unit tests cover srv_default_workers() (cgroup CPU quota);
+# negotiate.o and buf.o: Accept, Content-Type, ETag and the JSON escaper (test_negotiate.c).
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a

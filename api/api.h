@@ -18,6 +18,7 @@
 #ifndef UMBRA_API_H
 #define UMBRA_API_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "umbra/rnd.h"
@@ -146,6 +147,19 @@ enum api_result api_png_encode(const struct rnd_image *img, int level, uint8_t *
 enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p);
 
 const char *api_format_mime(enum api_format f);
+
+/* What umbrad says of itself in GET /v1/info (the strings are only read). */
+struct api_info {
+	const char *version, *device, *driver, *driver_info;
+	uint32_t vulkan_api;              /* VK_MAKE_API_VERSION packing */
+	bool cpu;                         /* a CPU (software) device */
+	struct api_limits limits;         /* the 422 limits in force */
+	uint64_t max_body, max_memory, device_max_allocation;
+	uint32_t max_dimension, device_max_shadow_resolution, deadline_ms, queue, workers;
+};
+/* The /v1/info document (compact JSON and a newline), malloc'd (the caller frees it); *len its
+ * length. NULL when out of memory. api/info.c. */
+char *api_info_json(const struct api_info *in, size_t *len);
 
 /* One line of a JSON-lines render manifest (umbra-render --manifest), api/manifest.c:
  * {"scene": "path.json" | {document}, "output": "name.png"}; output optional, a bare file name.

@@ -20,6 +20,7 @@
 #include "errmsg.h"
 #include "arena.h"
 #include "model.h"
+#include "umbra/rnd_math.h"
 #include "sandbox.h"
 
 struct model_priv {
@@ -121,15 +122,6 @@ static struct model_priv *import(const uint8_t *data, size_t len, enum api_model
 
 /* ---- cache ---- */
 
-static uint64_t fnv1a(const uint8_t *d, size_t n, uint64_t h)
-{
-	for (size_t i = 0; i < n; i++) {
-		h ^= d[i];
-		h *= 0x100000001b3ull;
-	}
-	return h;
-}
-
 /* With cache_mu held. */
 static void lru_unlink(struct model_priv *m)
 {
@@ -181,7 +173,7 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 	if (format < API_MODEL_GLB || format > API_MODEL_PLY)
 		return api_err_set(err, errsize, "the file is not a recognisable glb, gltf, obj, stl or ply model "
 		               "(give format to say which)");
-	uint64_t h = fnv1a(data, len, 0xcbf29ce484222325ull ^ (uint64_t)format);
+	uint64_t h = rnd_fnv1a(RND_FNV_SEED ^ (uint64_t)format, data, len);
 
 	pthread_mutex_lock(&cache_mu);
 	struct model_priv *hit = lru_find(h, data, len, format);

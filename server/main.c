@@ -27,30 +27,6 @@ double srv_now(void)
 	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-void srv_json_escape(char *dst, size_t size, const char *src)
-{
-	static const char hex[] = "0123456789abcdef";
-	size_t o = 0;
-	for (; src && *src && o + 7 < size; src++) {
-		unsigned char c = (unsigned char)*src;
-		if (c == '"' || c == '\\') {
-			dst[o++] = '\\';
-			dst[o++] = (char)c;
-		} else if (c < 0x20 || c == 0x7f) {
-			dst[o++] = '\\';
-			dst[o++] = 'u';
-			dst[o++] = '0';
-			dst[o++] = '0';
-			dst[o++] = hex[c >> 4];
-			dst[o++] = hex[c & 15];
-		} else {
-			dst[o++] = (char)c;
-		}
-	}
-	if (size)
-		dst[o < size ? o : size - 1] = 0;
-}
-
 /* Waits until every begun request has been answered and completed, or the timeout. */
 static void wait_pending(struct srv_server *s, double timeout_s)
 {
