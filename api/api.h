@@ -12,7 +12,8 @@
  *
  * Ownership: a parsed api_scene owns every array its rnd_scene points to (one arena) and
  * must be freed with api_scene_free() (NULL-safe). Encoders return malloc'd bytes the caller
- * frees. Threading: no shared state; every function is safe to call from several threads.
+ * frees. Threading: every function is safe to call from several threads. The one process-wide
+ * state is the cache of imported models (api/model.h), behind its own mutex.
  * jansson is used only inside api/; this header does not expose it.
  */
 #ifndef UMBRA_API_H
@@ -89,12 +90,13 @@ struct api_scene {
  * only those exist) from azimuth 360°·k/N (frame 0 on +Z, frame N/4 on +X) at the elevation:
  * view direction -(cos el·sin az, sin el, cos el·cos az), up +Y, fov_y of a perspective root
  * camera (else 45°), the root camera's exposure, near/far derived; from `distance`, or else
- * where the bounding sphere fills the frame with a 0.1 margin (the camera-fit rule). Cameras
- * with `fit: "objects"` are placed the same way here (fit becomes RND_FIT_NONE) because the
- * renderer's fit frames the whole scene. The sheet (ceil(sqrt(n)) columns, unused cells
- * included) counts against max_pixels: 422 at /views or /turntable.
- * Material `base_color_texture` is decoded here (PNG/JPEG, 400 at the member when it cannot be);
- * more than 16 distinct textures, or one over 16384 texels a side, is a 422. */
+ * where the bounding sphere fills the frame with a 0.1 margin (a sphere, so that every frame is
+ * at the same distance). A camera's `fit` ("scene" or "objects") is left to the renderer, which
+ * frames the bounds tightly (rnd_object_frames() says what counts for "objects"). The sheet
+ * (rnd_sheet_layout(), unused cells included) counts against max_pixels: 422 at /views or
+ * /turntable. Material `base_color_texture` is decoded here (PNG/JPEG, 400 at the member when it
+ * cannot be); more than RND_MAX_TEXTURES distinct textures, or one over RND_MAX_TEXTURE_SIDE
+ * texels a side, is a 422. */
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
                                 struct api_scene **out, struct api_problem *p);
 void api_scene_free(struct api_scene *s);

@@ -63,8 +63,8 @@ int api_parse_camera(struct pctx *c, json_t *j, struct rnd_camera *cam)
 }
 
 
-/* Centre and radius of the scene's "objects" bounds: every object except planes and shadow
- * catchers (all objects when that leaves none; the unit sphere at the origin when empty). */
+/* Centre and radius of the scene's "objects" bounds: every object rnd_object_frames() counts
+ * (all objects when that leaves none; the unit sphere at the origin when empty). */
 void api_objects_sphere(const struct rnd_scene *sc, const struct rnd_material *mats, double centre[3],
                            double *radius)
 {
@@ -72,7 +72,7 @@ void api_objects_sphere(const struct rnd_scene *sc, const struct rnd_material *m
 	for (int pass = 0; pass < 2 && lo[0] > hi[0]; pass++)
 		for (uint32_t i = 0; i < sc->object_count; i++) {
 			const struct rnd_object *o = &sc->objects[i];
-			if (!pass && (o->shape == RND_SHAPE_PLANE || mats[o->material].shadow_catcher)) continue;
+			if (!pass && !rnd_object_frames(o, mats)) continue;
 			api_object_bounds(o, lo, hi);
 		}
 	if (lo[0] > hi[0]) {

@@ -9,10 +9,9 @@
 #include "sandbox.h"
 #include "scene_internal.h"
 
-/* The renderer's bounds on base-colour textures (renderer/render.c textures()). */
-#define MAX_TEXTURE_SIDE 16384u
+/* Texels a texture may decode to (a bound on the decoder's memory, under the renderer's
+ * RND_MAX_TEXTURE_SIDE squared). */
 #define MAX_TEXTURE_PIXELS (64ull << 20)
-#define MAX_TEXTURES 16u
 
 static const char *const MATERIAL_MEMBERS[] = {"base_color", "base_color_texture", "alpha_mode", "alpha_cutoff",
                                                "roughness", "metallic", "emissive", "shadow_catcher", NULL};
@@ -82,9 +81,9 @@ int api_parse_material(struct pctx *c, json_t *j, struct rnd_material *m, const 
 		t->width = w;
 		t->height = h;
 		m->base_color_texture = t;
-		if (w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE)
+		if (w > RND_MAX_TEXTURE_SIDE || h > RND_MAX_TEXTURE_SIDE)
 			api_defer(c, false, NULL, "base_color_texture is %ux%u texels, over the limit of %u per side", w, h,
-			      MAX_TEXTURE_SIDE);
+			      RND_MAX_TEXTURE_SIDE);
 		api_ptr_pop(c, old);
 	}
 	return 0;
@@ -137,16 +136,16 @@ int api_parse_materials(struct pctx *c, json_t *root, size_t nobj)
 
 void api_check_textures(struct pctx *c)
 {
-	const struct rnd_texture *seen[MAX_TEXTURES];
+	const struct rnd_texture *seen[RND_MAX_TEXTURES];
 	uint32_t ntex = 0;
-	for (uint32_t i = 0; i < c->mat_count && ntex <= MAX_TEXTURES; i++) {
+	for (uint32_t i = 0; i < c->mat_count && ntex <= RND_MAX_TEXTURES; i++) {
 		const struct rnd_texture *t = c->mats[i].base_color_texture;
 		uint32_t k = 0;
 		while (t && k < ntex && seen[k] != t) k++;
 		if (!t || k < ntex) continue;
-		if (ntex == MAX_TEXTURES) {
+		if (ntex == RND_MAX_TEXTURES) {
 			api_defer(c, false, "materials", "the scene has more than %u distinct base-colour textures (the "
-			      "renderer's limit)", MAX_TEXTURES);
+			      "renderer's limit)", RND_MAX_TEXTURES);
 			break;
 		}
 		seen[ntex++] = t;

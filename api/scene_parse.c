@@ -192,7 +192,8 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 	struct rnd_scene *sc = &s->scene;
 	if (!json_is_object(root)) return api_fail(c, "the scene document must be a JSON object, not %s", api_type_name(root));
 	if (api_check_members(c, root, ROOT_MEMBERS, NULL, "the scene") < 0) return -1;
-	if (api_get_u32(c, root, "width", 1, 8192, &sc->width) < 0 || api_get_u32(c, root, "height", 1, 8192, &sc->height) < 0)
+	if (api_get_u32(c, root, "width", 1, RND_MAX_DIMENSION, &sc->width) < 0 ||
+	    api_get_u32(c, root, "height", 1, RND_MAX_DIMENSION, &sc->height) < 0)
 		return -1;
 	json_t *objs = json_object_get(root, "objects");
 	if (!objs) return api_fail_at(c, "objects", "objects is required (it may be an empty array)");

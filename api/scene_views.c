@@ -12,11 +12,6 @@ static const char *const OUTPUT_MEMBERS[] = {"format", "bit_depth", "transparent
                                              "debug", "debug_light", "png_level", NULL};
 static const char *const TURNTABLE_MEMBERS[] = {"frames", "elevation", "distance", NULL};
 
-#define MAX_VIEWS 1024u
-/* The renderer's bounds on a sheet (renderer/render.c rnd_render()). */
-#define MAX_SHEET_SIDE 65536u
-#define MAX_SHEET_PIXELS (1ull << 28)
-
 static int parse_views(struct pctx *c, json_t *views, struct rnd_scene *sc)
 {
 	size_t old = api_ptr_push(c, "views");
@@ -24,7 +19,7 @@ static int parse_views(struct pctx *c, json_t *views, struct rnd_scene *sc)
 	size_t n = json_is_array(views) ? json_array_size(views) : 0;
 	struct rnd_camera *vs = NULL;
 	if (!n) rc = api_fail(c, "views must be a non-empty array of cameras");
-	else if (n > MAX_VIEWS) rc = api_fail(c, "views has %zu cameras, at most %u are allowed", n, MAX_VIEWS);
+	else if (n > RND_MAX_VIEWS) rc = api_fail(c, "views has %zu cameras, at most %u are allowed", n, RND_MAX_VIEWS);
 	else if (!(vs = api_arena_calloc(c->arena, n, sizeof *vs))) rc = api_fail(c, "out of memory");
 	for (size_t i = 0; !rc && i < n; i++) {
 		vs[i] = sc->camera;
@@ -48,7 +43,7 @@ static int parse_turntable(struct pctx *c, json_t *root, struct turntable *tt)
 	static const struct range elev = {-90, 90, false, false};
 	long long frames = 0;
 	double el = 20, dist = 0;
-	rc = api_get_int(c, sub, "frames", 1, MAX_VIEWS, &frames);
+	rc = api_get_int(c, sub, "frames", 1, RND_MAX_VIEWS, &frames);
 	if (rc == 0) rc = api_fail_at(c, "frames", "frames is required for a turntable");
 	if (rc > 0 && (api_get_num(c, sub, "elevation", &elev, &el) < 0 || api_get_num(c, sub, "distance", &R_POS, &dist) < 0))
 		rc = -1;
@@ -218,10 +213,9 @@ void api_check_size(struct pctx *c, json_t *root, const struct rnd_scene *sc)
 		      "width x height = %llu pixels is over this server's limit of %llu", (unsigned long long)px,
 		      (unsigned long long)c->lim->max_pixels);
 	if (!sc->view_count) return;
-	/* Several views: the whole sheet counts (ceil(sqrt(n)) columns, unused cells included). */
-	uint32_t n = sc->view_count, cols = 1;
-	while (cols * cols < n) cols++;
-	uint32_t rows = (n + cols - 1) / cols;
+	/* Several views: the whole sheet counts (the renderer's layout, unused cells included). */
+	uint32_t n = sc->view_count, cols, rows;
+	rnd_sheet_layout(n, &cols, &rows);
 	uint64_t sw = (uint64_t)cols * sc->width, sh = (uint64_t)rows * sc->height, sheet = sw * sh;
 	const char *key = json_object_get(root, "views") ? "views" : "turntable";
 	c->views_key = key;
@@ -229,8 +223,8 @@ void api_check_size(struct pctx *c, json_t *root, const struct rnd_scene *sc)
 		api_defer(c, false, key, "%u views of %ux%u make a %llux%llu sheet (%llu pixels), over this server's "
 		      "limit of %llu", n, sc->width, sc->height, (unsigned long long)sw, (unsigned long long)sh,
 		      (unsigned long long)sheet, (unsigned long long)c->lim->max_pixels);
-	else if (sw > MAX_SHEET_SIDE || sh > MAX_SHEET_SIDE || sheet > MAX_SHEET_PIXELS)
+	else if (sw > RND_MAX_SHEET_SIDE || sh > RND_MAX_SHEET_SIDE || sheet > RND_MAX_SHEET_PIXELS)
 		api_defer(c, false, key, "%u views of %ux%u make a %llux%llu sheet, over the renderer's limit (%u per "
 		      "side, %llu pixels)", n, sc->width, sc->height, (unsigned long long)sw, (unsigned long long)sh,
-		      MAX_SHEET_SIDE, (unsigned long long)MAX_SHEET_PIXELS);
+		      RND_MAX_SHEET_SIDE, (unsigned long long)RND_MAX_SHEET_PIXELS);
 }

@@ -149,8 +149,6 @@ void rnd_pipelines_release(struct rnd_context *ctx);
 /* The main-pass pipeline for key, compiled on first use (thread-safe). */
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
                                    struct rnd_error *err);
-/* Number of main-pass variants compiled so far (warm-up checks). */
-uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx);
 
 /* slot.c */
 struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx);

@@ -1,7 +1,9 @@
 /*
  * renderer/pipelines.c — shader modules (SPIR-V embedded at build time), the one descriptor
- * set layout and pipeline layout, the shadow sampler, and every graphics pipeline, all
- * created once per context so that no render compiles anything.
+ * set layout and pipeline layout, the shadow sampler, and the graphics pipelines. The fixed
+ * ones are created with the context; a main-pass variant (specialization constants of a
+ * scene's lights and filters) is compiled on its first use, outside the lock, and kept (at most
+ * RND_MAX_VARIANTS); the daemon's warm-up and the pipeline cache make that first use cheap.
  *
  * Pipelines use dynamic rendering (Vulkan 1.3): no render pass or framebuffer objects.
  * Variants: shadow depth-only [cull none/back]; main [output format][MSAA 1/4][cull none/back].
@@ -332,14 +334,6 @@ out_modules:
 	*out = pipe;
 	pthread_mutex_unlock(&p->mu);
 	return RND_OK;
-}
-
-uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx)
-{
-	pthread_mutex_lock(&ctx->pipes.mu);
-	uint32_t n = ctx->pipes.variant_count;
-	pthread_mutex_unlock(&ctx->pipes.mu);
-	return n;
 }
 
 void rnd_pipelines_release(struct rnd_context *ctx)

@@ -54,7 +54,7 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_AOVS, 0, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)",
 		                   planes, RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
 	if (sc->view_count && !sc->views) return rnd_fail(err, RND_ERR_INVALID, "view_count %u with no views", sc->view_count);
-	if (sc->view_count > 1024) return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "%u views: at most 1024", sc->view_count);
+	if (sc->view_count > RND_MAX_VIEWS) return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "%u views: at most %u", sc->view_count, RND_MAX_VIEWS);
 	return RND_OK;
 }
 
@@ -315,7 +315,7 @@ static enum rnd_result textures(struct rnd_context *ctx, struct rnd_slot *s, con
 		if (n == UMBRA_MAX_TEXTURES)
 			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_MATERIALS, 0, "more than %d distinct textures in one scene",
 			                   UMBRA_MAX_TEXTURES);
-		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
+		if (!t->rgba || !t->width || !t->height || t->width > RND_MAX_TEXTURE_SIDE || t->height > RND_MAX_TEXTURE_SIDE)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", i, t->width, t->height);
 		tex[n++] = t;
 		bytes += (VkDeviceSize)t->width * t->height * 4;
@@ -426,7 +426,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	uint32_t cols, rows;
 	rnd_sheet_layout(nviews, &cols, &rows);
 	uint64_t sheet_w = (uint64_t)cols * sc->width, sheet_h = (uint64_t)rows * sc->height;
-	if (sheet_w > 65536 || sheet_h > 65536 || sheet_w * sheet_h > (1ull << 28))
+	if (sheet_w > RND_MAX_SHEET_SIDE || sheet_h > RND_MAX_SHEET_SIDE || sheet_w * sheet_h > RND_MAX_SHEET_PIXELS)
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "a sheet of %u views is %llux%llu pixels: too large", nviews,
 		                (unsigned long long)sheet_w, (unsigned long long)sheet_h);
 	struct rnd_estimate est;
@@ -460,7 +460,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	struct rnd_aabb obj_bounds;
 	rnd_aabb_empty(&obj_bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++)
-		if (sc->objects[i].shape != RND_SHAPE_PLANE && !(draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER))
+		if (rnd_object_frames(&sc->objects[i], sc->material_count ? sc->materials : NULL))
 			rnd_aabb_union(&obj_bounds, &draws[i].bounds);
 	if (rnd_aabb_is_empty(&obj_bounds)) obj_bounds = bounds;
 	if ((r = textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;

@@ -187,7 +187,7 @@ static enum MHD_Result answer_info(struct srv_request *req)
 		.driver_info = info.driver_info, .vulkan_api = info.api_version, .cpu = info.is_cpu,
 		.limits = c->limits, .max_body = c->max_body, .max_memory = c->max_memory,
 		.device_max_allocation = info.max_allocation,
-		.max_dimension = info.max_image_dimension < 8192 ? info.max_image_dimension : 8192,
+		.max_dimension = info.max_image_dimension < RND_MAX_DIMENSION ? info.max_image_dimension : RND_MAX_DIMENSION,
 		.device_max_shadow_resolution = info.max_shadow_resolution, .deadline_ms = c->deadline_ms,
 		.queue = c->queue, .workers = c->workers,
 	};
