@@ -52,8 +52,6 @@ struct api_limits {
 	/* Directory that model `path`s are relative to (NULL = none: a `path` is a 400). A path never
 	 * leaves it: no absolute paths, no ".." components, no symlinks that resolve outside. */
 	const char *asset_root;          /* default NULL */
-	/* Bound of the process-wide cache of imported models (bytes; 0 = do not cache). */
-	uint64_t model_cache_bytes;      /* default 268435456 (256 MiB) */
 	/* Bounds of one sandboxed model import or texture decode (api/sandbox.h): wall clock (the CPU
 	 * time limit is the same, rounded up to seconds) and address space of the importer process.
 	 * Over either is a 422 at the member that carried the bytes. */
@@ -114,8 +112,12 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
                                       const struct api_part *parts, size_t nparts,
                                       struct api_scene **out, struct api_problem *p);
 
-/* Imported models are cached process-wide (LRU, bounded by limits.model_cache_bytes, keyed by
- * the file's bytes). Counters since start; any pointer may be NULL. Thread-safe. */
+/* Imported models are cached process-wide (LRU, keyed by the file's bytes), so its bound is
+ * process-wide too: set it once at start-up (umbrad --model-cache); bytes 0 = do not cache;
+ * default 268435456 (256 MiB). Lowering it evicts at once (models still used by a scene live
+ * until that scene is freed). Thread-safe. */
+void api_model_cache_set_limit(uint64_t bytes);
+/* Counters since start; any pointer may be NULL. Thread-safe. */
 void api_model_cache_stats(uint64_t *hits, uint64_t *misses, uint64_t *bytes);
 /* Drops every cached model (models still used by a scene live until that scene is freed).
  * For tests and shutdown: after it and after every scene is freed, nothing is left allocated. */

@@ -38,6 +38,7 @@ struct model_priv {
 static pthread_mutex_t cache_mu = PTHREAD_MUTEX_INITIALIZER;
 static struct model_priv *lru_head, *lru_tail; /* head = most recently used */
 static uint64_t cache_total, cache_hits, cache_misses;
+static uint64_t cache_limit = 256u << 20;   /* api_model_cache_set_limit() */
 
 static const char *const FORMAT_NAMES[] = {"glb", "gltf", "obj", "stl", "ply"};
 
@@ -156,6 +157,31 @@ void api_model_release(struct api_model *pub)
 	if (atomic_fetch_sub(&m->refs, 1) == 1) model_free(m);
 }
 
+/* With cache_mu held: unlists least recently used models (never `keep`) until the cache is
+ * within its limit; returns them as a list for release_list() outside the lock. */
+static struct model_priv *evict_over_limit(const struct model_priv *keep)
+{
+	struct model_priv *evicted = NULL;
+	while (lru_tail && lru_tail != keep && cache_total > cache_limit) {
+		struct model_priv *t = lru_tail;
+		lru_unlink(t);
+		t->next = evicted;
+		evicted = t;
+	}
+	return evicted;
+}
+
+/* Drops the cache's reference to each model of the list (without cache_mu). */
+static void release_list(struct model_priv *list)
+{
+	while (list) {
+		struct model_priv *n = list->next;
+		list->next = NULL;
+		api_model_release(&list->pub);
+		list = n;
+	}
+}
+
 enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format,
                               const struct api_limits *lim, struct api_model **out, int *status, char *err,
                               size_t errsize)
@@ -167,7 +193,6 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 		api_limits_defaults(&def);
 		lim = &def;
 	}
-	uint64_t cache_bytes = lim->model_cache_bytes;
 	if (!data || !len) return api_err_set(err, errsize, "the model file is empty");
 	if (format == API_MODEL_SNIFF) format = api_model_sniff(data, len);
 	if (format < API_MODEL_GLB || format > API_MODEL_PLY)
@@ -196,6 +221,9 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 	if (!m) return API_ERR;
 	*status = 0;
 	uint64_t cost = m->pub.bytes_ + len;
+	pthread_mutex_lock(&cache_mu);
+	uint64_t cache_bytes = cache_limit;
+	pthread_mutex_unlock(&cache_mu);
 	if (!cache_bytes || cost > cache_bytes || !(m->src = malloc(len))) {
 		*out = &m->pub;    /* not cached: the caller's reference is the only one */
 		return API_OK;
@@ -214,26 +242,25 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 	} else {
 		lru_push_front(m);
 		atomic_fetch_add(&m->refs, 1); /* the cache's reference */
-		while (cache_total > cache_bytes && lru_tail != m) {
-			struct model_priv *t = lru_tail;
-			lru_unlink(t);
-			t->next = evicted; /* released outside the lock */
-			evicted = t;
-		}
+		evicted = evict_over_limit(m);
 	}
 	pthread_mutex_unlock(&cache_mu);
-	while (evicted) {
-		struct model_priv *n = evicted->next;
-		evicted->next = NULL;
-		api_model_release(&evicted->pub);
-		evicted = n;
-	}
+	release_list(evicted);
 	if (dup) {
 		api_model_release(&m->pub);
 		m = dup;
 	}
 	*out = &m->pub;
 	return API_OK;
+}
+
+void api_model_cache_set_limit(uint64_t bytes)
+{
+	pthread_mutex_lock(&cache_mu);
+	cache_limit = bytes;
+	struct model_priv *evicted = evict_over_limit(NULL);
+	pthread_mutex_unlock(&cache_mu);
+	release_list(evicted);
 }
 
 void api_model_cache_stats(uint64_t *hits, uint64_t *misses, uint64_t *bytes)
@@ -256,10 +283,5 @@ void api_model_cache_clear(void)
 		list = t;
 	}
 	pthread_mutex_unlock(&cache_mu);
-	while (list) {
-		struct model_priv *n = list->next;
-		list->next = NULL;
-		api_model_release(&list->pub);
-		list = n;
-	}
+	release_list(list);
 }

@@ -38,7 +38,7 @@ static const struct opt_def opts[] = {
 	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
 	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
 	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to (none: `path` is a 400)", CFG(asset_root), 0, 0 },
-	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", LIM(model_cache_bytes), 0, UINT64_MAX },
+	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", CFG(model_cache_bytes), 0, UINT64_MAX },
 	{ "import-timeout-ms", OPT_UINT, "MS", "wall-clock and CPU limit of one sandboxed model import (10000)", LIM(import_timeout_ms), 1, 3600000 },
 	{ "import-memory", OPT_SIZE, "BYTES", "memory limit of one sandboxed model import, 0 = none (2G)", LIM(import_memory), 0, UINT64_MAX },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
@@ -136,7 +136,7 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 		}
 		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
 		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles) ||
-		    o->offset == LIM(model_cache_bytes) || o->offset == CFG(max_memory) ||
+		    o->offset == CFG(model_cache_bytes) || o->offset == CFG(max_memory) ||
 		    o->offset == LIM(import_memory))
 			*(uint64_t *)(base + o->offset) = v;
 		else
@@ -207,6 +207,7 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	cfg->atlas_size = 8192;
 	cfg->max_body = 64ull << 20;
 	api_limits_defaults(&cfg->limits);
+	cfg->model_cache_bytes = 256u << 20;
 	cfg->deadline_ms = 30000;
 	cfg->log_format = SRV_LOG_TEXT;
 	cfg->max_connections = 1024;

@@ -52,6 +52,7 @@ int main(int argc, char **argv)
 	if (rc < 0)
 		return 2;
 	srv_log_init(s->cfg.log_format);
+	api_model_cache_set_limit(s->cfg.model_cache_bytes);
 
 	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
 	 * main thread takes the signals with sigwait(). */

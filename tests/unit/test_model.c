@@ -197,6 +197,8 @@ static uint8_t *quad_glb(size_t *len)
 
 /* ---- tests ---- */
 
+#define DEFAULT_CACHE (256ull << 20)
+
 TEST(model_obj_cube)
 {
 	struct api_problem p;
@@ -446,6 +448,7 @@ TEST(model_cache)
 	char obj[sizeof CUBE_OBJ + 32];
 	snprintf(obj, sizeof obj, "# cache test\n%s", CUBE_OBJ);
 	uint64_t h0, m0, h1, m1, bytes;
+	api_model_cache_set_limit(DEFAULT_CACHE);   /* the bound is process-wide: other tests change it */
 	api_model_cache_stats(&h0, &m0, NULL);
 	struct api_problem p;
 	struct api_scene *a = parse_model((const uint8_t *)obj, strlen(obj), "", &p);
@@ -470,7 +473,7 @@ TEST(model_cache)
 	/* A cache too small for the model: imported every time, nothing kept. */
 	struct api_limits lim;
 	api_limits_defaults(&lim);
-	lim.model_cache_bytes = 16;
+	api_model_cache_set_limit(16);
 	char *doc = model_doc((const uint8_t *)obj, strlen(obj), "");
 	api_model_cache_stats(&h0, &m0, NULL);
 	for (int i = 0; i < 2; i++) {
@@ -488,11 +491,11 @@ TEST(model_cache)
 	struct api_model *m_a, *m_b, *m_c;
 	char err[256];
 	int st;
-	lim.model_cache_bytes = 1u << 20;
+	api_model_cache_set_limit(1u << 20);
 	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, &lim, &m_a, &st, err, sizeof err) == API_OK);
 	uint64_t one;
 	api_model_cache_stats(NULL, NULL, &one);
-	lim.model_cache_bytes = one + one / 2;
+	api_model_cache_set_limit(one + one / 2);
 	REQUIRE(api_model_get((const uint8_t *)obj2, strlen(obj2), API_MODEL_OBJ, &lim, &m_b, &st, err, sizeof err) ==
 	        API_OK);
 	api_model_cache_stats(&h0, &m0, &bytes);
@@ -506,6 +509,33 @@ TEST(model_cache)
 	api_model_release(m_b);
 	api_model_release(m_c);
 	api_model_cache_clear();
+	api_model_cache_set_limit(DEFAULT_CACHE);
+}
+
+/* Lowering the process-wide bound evicts at once; models in use stay valid. */
+TEST(model_cache_limit_is_global)
+{
+	char obj[sizeof CUBE_OBJ + 32];
+	snprintf(obj, sizeof obj, "# global limit\n%s", CUBE_OBJ);
+	api_model_cache_clear();
+	api_model_cache_set_limit(DEFAULT_CACHE);
+	struct api_model *m = NULL, *m2 = NULL;
+	char err[256];
+	int st;
+	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, NULL, &m, &st, err, sizeof err) == API_OK);
+	uint64_t bytes, h0, h1;
+	api_model_cache_stats(&h0, NULL, &bytes);
+	CHECK(bytes > 0, "cached under the default bound");
+	api_model_cache_set_limit(0);
+	api_model_cache_stats(NULL, NULL, &bytes);
+	CHECK(bytes == 0, "%llu bytes left after the bound went to 0", (unsigned long long)bytes);
+	CHECK(m->triangles == 12, "still ours after eviction");
+	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, NULL, &m2, &st, err, sizeof err) == API_OK);
+	api_model_cache_stats(&h1, NULL, &bytes);
+	CHECK(h1 == h0 && bytes == 0 && m2 != m, "bound 0: imported again, not kept");
+	api_model_release(m);
+	api_model_release(m2);
+	api_model_cache_set_limit(DEFAULT_CACHE);
 }
 
 TEST(model_image_decode)
@@ -579,7 +609,6 @@ static void *stress(void *p)
 	api_limits_defaults(&lim);
 	uint64_t one;
 	api_model_cache_stats(NULL, NULL, &one);
-	lim.model_cache_bytes = 9000; /* about one model: constant eviction */
 	for (int i = 0; i < 60; i++) {
 		int k = i % 3;
 		char *doc = model_doc(a->data[k], a->len[k], "");
@@ -604,6 +633,7 @@ TEST(model_cache_threads)
 	REQUIRE(glb);
 	struct stress_arg args[6];
 	pthread_t th[6];
+	api_model_cache_set_limit(9000);   /* about one model: constant eviction */
 	for (int t = 0; t < 6; t++) {
 		args[t] = (struct stress_arg){{(const uint8_t *)CUBE_OBJ, stl, glb}, {strlen(CUBE_OBJ), ns, ng}, 0};
 		CHECK(pthread_create(&th[t], NULL, stress, &args[t]) == 0);
@@ -614,6 +644,7 @@ TEST(model_cache_threads)
 	}
 	free(glb);
 	api_model_cache_clear();
+	api_model_cache_set_limit(DEFAULT_CACHE);
 	uint64_t bytes;
 	api_model_cache_stats(NULL, NULL, &bytes);
 	CHECK(bytes == 0);

@@ -68,7 +68,7 @@ static struct api_limits limits(uint32_t timeout_ms)
 {
 	struct api_limits l;
 	api_limits_defaults(&l);
-	l.model_cache_bytes = 0;
+	api_model_cache_set_limit(0);   /* every import runs in the sandbox (model_cache sets it back) */
 	l.import_timeout_ms = timeout_ms;
 	return l;
 }
