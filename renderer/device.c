@@ -282,6 +282,9 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 	VkPhysicalDeviceVulkan13Features f13 = {
 		.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
 		.dynamicRendering = VK_TRUE, .synchronization2 = VK_TRUE,
+		/* SPIR-V for Vulkan 1.3 gives a compute shader's spec-constant workgroup size as
+		 * LocalSizeId, which needs maintenance4 (a feature every 1.3 device has). */
+		.maintenance4 = VK_TRUE,
 	};
 	VkPhysicalDeviceFeatures2 f2 = {
 		.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &f13,

@@ -9,28 +9,11 @@
 #include <string.h>
 #include <png.h>
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
+#include "util.h"
 
 /* ---- building files ---- */
 
-static char *b64(const uint8_t *d, size_t n)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	size_t i = 0;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
 
 static void put32(uint8_t *p, uint32_t v)
 {
@@ -389,7 +372,7 @@ TEST(models_fit_glb_box)
 	struct glb_in in = {.pos = pos, .nrm = nrm, .nv = 24, .idx = idx, .ni = 36, .node_t = {1.5f, 1, -2}};
 	size_t n;
 	uint8_t *glb = glb_build(&in, &n);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	size_t cap = strlen(enc) + 256;
 	char *obj = malloc(cap);
@@ -407,7 +390,7 @@ TEST(models_fit_obj_box)
 	/* 2 x 1 x 0.5 box at [-3, -1, 0.5] .. [-1, 0, 1] in the file, object translation (0, 0.25, 0) */
 	float lo[3] = {-3, -1, 0.5f}, hi[3] = {-1, 0, 1};
 	char *text = box_obj(lo, hi);
-	char *enc = b64((const uint8_t *)text, strlen(text));
+	char *enc = test_b64((const uint8_t *)text, strlen(text));
 	free(text);
 	size_t cap = strlen(enc) + 256;
 	char *obj = malloc(cap);
@@ -427,7 +410,7 @@ TEST(models_fit_stl_tetrahedron)
 	static const float p[4][3] = {{-2, 0.3f, 1}, {-0.5f, 0.3f, 1}, {-2, 1.8f, 1}, {-2, 0.3f, 2.5f}};
 	uint8_t stl[284];
 	size_t n = tetra_stl(stl, p);
-	char *enc = b64(stl, n);
+	char *enc = test_b64(stl, n);
 	size_t cap = strlen(enc) + 256;
 	char *obj = malloc(cap);
 	snprintf(obj, cap, "{'shape':'model','data':'%s'," RED_MAT "}", enc);
@@ -606,7 +589,7 @@ static char *mesh_quad_json(bool masked)
 	size_t pl;
 	uint8_t *png = checker_png(&pl);
 	if (!png) return NULL;
-	char *enc = b64(png, pl);
+	char *enc = test_b64(png, pl);
 	free(png);
 	char nums[4][512];
 	const float *arr[3] = {QPOS, QNRM, QUV};
@@ -639,7 +622,7 @@ static char *glb_quad_json(bool masked)
 	size_t n;
 	uint8_t *glb = glb_build(&in, &n);
 	free(png);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	size_t cap = strlen(enc) + 256;
 	char *s = malloc(cap);

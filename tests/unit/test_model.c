@@ -13,6 +13,7 @@
 #include "api.h"
 #include "model.h"
 #include "test.h"
+#include "util.h"
 #include "umbra/rnd_math.h"
 
 static bool near_f(float a, float b)
@@ -22,29 +23,11 @@ static bool near_f(float a, float b)
 
 /* ---- building documents ---- */
 
-static char *b64(const uint8_t *d, size_t n)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	size_t i = 0;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
 
 /* A scene with one model object: `extra` goes inside the object ("" or ",'k':v" with ' for "). */
 static char *model_doc(const uint8_t *d, size_t n, const char *extra)
 {
-	char *enc = b64(d, n);
+	char *enc = test_b64(d, n);
 	size_t cap = strlen(enc) + strlen(extra) + 512;
 	char *doc = malloc(cap);
 	snprintf(doc, cap, "{\"camera\":{\"position\":[0,0,5]},\"materials\":{\"grey\":{\"base_color\":[0.5,0.5,0.5]}},"
