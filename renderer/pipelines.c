@@ -30,19 +30,23 @@ static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code
 	return RND_OK;
 }
 
+const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
+	[UMBRA_BINDING_FRAME] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_MATERIALS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+	[UMBRA_BINDING_LIGHTS] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_SHADOW_VIEWS] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_SHADOW_MAP] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_MOMENTS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+};
+
 static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_pipelines *p = &ctx->pipes;
 	VkResult vr;
 	VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-	VkDescriptorSetLayoutBinding b[UMBRA_BINDING_COUNT] = {
-		{UMBRA_BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_SHADOW_VIEWS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_SHADOW_MAP, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, NULL},
-		{UMBRA_BINDING_MOMENTS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, NULL},
-	};
+	VkDescriptorSetLayoutBinding b[UMBRA_BINDING_COUNT];
+	for (uint32_t i = 0; i < UMBRA_BINDING_COUNT; i++)
+		b[i] = (VkDescriptorSetLayoutBinding){i, rnd_binding_type[i], 1, stages, NULL};
 	VkDescriptorSetLayoutCreateInfo dci = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = UMBRA_BINDING_COUNT, .pBindings = b,
 	};

@@ -204,8 +204,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		w[i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
 			.descriptorCount = 1,
-			.descriptorType = i == 0 || i == 2 || i == 3 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-			                : i == 4 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+			.descriptorType = rnd_binding_type[i],
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
