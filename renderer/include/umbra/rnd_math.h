@@ -1,5 +1,6 @@
 /*
- * umbra renderer — small vector/matrix math shared by the renderer and api/.
+ * umbra renderer — small vector/matrix math shared by the renderer and api/, and the byte-stream
+ * hash of the project (rnd_fnv1a: ETags, the model cache).
  *
  * Conventions: float arrays; matrices are 4x4 column-major (m[col*4 + row]) as in glTF and
  * GLSL; right-handed world, +Y up. Projections produce Vulkan clip space: depth 0..1 and the
