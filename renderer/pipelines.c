@@ -110,6 +110,8 @@ struct pipe_desc {
 	const char *name;
 };
 
+/* One graphics pipeline from d. Longer than most functions here on purpose: one create-info
+ * per fixed-function state, read top to bottom in the order Vulkan's struct takes them. */
 static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_desc *d, VkPipeline *out,
                                      struct rnd_error *err)
 {

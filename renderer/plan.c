@@ -21,6 +21,39 @@ static void reverse_z(float m[16])
 	for (int c = 0; c < 4; c++) m[c * 4 + 2] = m[c * 4 + 3] - m[c * 4 + 2];
 }
 
+/* Auto-framing (`fit`): aim at the bounds' centre along the fit direction, then back off until
+ * every corner of the box projects inside the frame less the margin (margin = fraction of the
+ * frame on each side), so the widest corner touches the margin. bounds NULL: the unit box. */
+static enum rnd_result fit_eye(const struct rnd_camera *cam, struct rnd_camera_plan *out,
+                               const struct rnd_aabb *bounds, float pos[3], float target[3], struct rnd_error *err)
+{
+	float dir[3];
+	if (!rnd_v3_normalize(dir, cam->fit_direction))
+		return rnd_fail(err, RND_ERR_INVALID, "camera fit direction must not be zero");
+	float c[3] = {0, 0, 0};
+	struct rnd_aabb b = {{-1, -1, -1}, {1, 1, 1}};
+	if (bounds) b = *bounds;
+	for (int i = 0; i < 3; i++) c[i] = 0.5f * (b.min[i] + b.max[i]);
+	float eye0[3], basis[16];
+	for (int i = 0; i < 3; i++) eye0[i] = c[i] - dir[i];
+	rnd_mat4_look_at(basis, eye0, c, cam->up);
+	float shrink = fmaxf(1.0f - 2.0f * cam->fit_margin, 0.05f);
+	float ty = tanf(0.5f * out->fov_y) * shrink, tx = tanf(0.5f * out->fov_y) * out->aspect * shrink;
+	float dist = 1e-3f;
+	for (int i = 0; i < 8; i++) {
+		float p[3] = {i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]};
+		float q[3], rel[3];
+		rnd_v3_sub(rel, p, c);
+		rnd_mat4_mul_dir(q, basis, rel);     /* view axes: x right, y up, -z forward */
+		float z = -q[2];                     /* along the view direction */
+		dist = fmaxf(dist, fabsf(q[0]) / tx - z);
+		dist = fmaxf(dist, fabsf(q[1]) / ty - z);
+	}
+	for (int i = 0; i < 3; i++) { target[i] = c[i]; pos[i] = c[i] - dir[i] * dist; }
+	out->ortho = false;
+	return RND_OK;
+}
+
 enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, uint32_t height,
                                 const struct rnd_aabb *bounds, struct rnd_camera_plan *out, struct rnd_error *err)
 {
@@ -35,34 +68,8 @@ enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, ui
 	bool empty = !bounds || rnd_aabb_is_empty(bounds);
 
 	if (cam->fit != RND_FIT_NONE) {
-		/* Auto-framing: the bounding sphere fills the frame up to the margin. */
-		float dir[3];
-		if (!rnd_v3_normalize(dir, cam->fit_direction))
-			return rnd_fail(err, RND_ERR_INVALID, "camera fit direction must not be zero");
-		/* Tight fit: aim at the bounds' centre along `dir`, then back off until every corner
-		 * of the box projects inside the frame less the margin (margin = fraction of the frame
-		 * on each side), so the widest corner touches the margin. */
-		float c[3] = {0, 0, 0};
-		struct rnd_aabb b = {{-1, -1, -1}, {1, 1, 1}};
-		if (!empty) b = *bounds;
-		for (int i = 0; i < 3; i++) c[i] = 0.5f * (b.min[i] + b.max[i]);
-		float eye0[3], basis[16];
-		for (int i = 0; i < 3; i++) eye0[i] = c[i] - dir[i];
-		rnd_mat4_look_at(basis, eye0, c, cam->up);
-		float shrink = fmaxf(1.0f - 2.0f * cam->fit_margin, 0.05f);
-		float ty = tanf(0.5f * out->fov_y) * shrink, tx = tanf(0.5f * out->fov_y) * out->aspect * shrink;
-		float dist = 1e-3f;
-		for (int i = 0; i < 8; i++) {
-			float p[3] = {i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]};
-			float q[3], rel[3];
-			rnd_v3_sub(rel, p, c);
-			rnd_mat4_mul_dir(q, basis, rel);     /* view axes: x right, y up, -z forward */
-			float z = -q[2];                     /* along the view direction */
-			dist = fmaxf(dist, fabsf(q[0]) / tx - z);
-			dist = fmaxf(dist, fabsf(q[1]) / ty - z);
-		}
-		for (int i = 0; i < 3; i++) { target[i] = c[i]; pos[i] = c[i] - dir[i] * dist; }
-		out->ortho = false;
+		enum rnd_result r = fit_eye(cam, out, empty ? NULL : bounds, pos, target, err);
+		if (r != RND_OK) return r;
 	}
 	memcpy(out->pos, pos, sizeof pos);
 	float fwd[3];

@@ -35,6 +35,8 @@ static enum rnd_result pool_with_sets(struct rnd_context *ctx, const VkDescripto
 	return RND_OK;
 }
 
+/* One render slot: every object in creation order, unwound in reverse by the goto chain at the
+ * end (kept in one function so that the chain stays next to what it undoes). */
 static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, struct rnd_slot **out, struct rnd_error *err)
 {
 	VkResult vr;

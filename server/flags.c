@@ -193,9 +193,9 @@ unsigned srv_default_workers(const char *root, const char *self_cgroup, unsigned
 	return n < (long long)cpus ? (unsigned)n : cpus;
 }
 
-int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+/* The contract's defaults, then UMBRA_VALIDATION and UMBRA_NO_PLAYGROUND. */
+static void set_defaults(struct srv_config *cfg)
 {
-	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
 	memset(cfg, 0, sizeof *cfg);
 	cfg->listen = "127.0.0.1:8080";
 	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
@@ -222,6 +222,12 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	cfg->validation = v && *v && strcmp(v, "0") != 0;
 	v = getenv("UMBRA_NO_PLAYGROUND");
 	cfg->no_playground = v && *v && strcmp(v, "0") != 0;
+}
+
+int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+{
+	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
+	set_defaults(cfg);
 
 	/* Environment first. */
 	for (size_t i = 0; i < OPT_COUNT; i++) {

@@ -40,6 +40,26 @@ static void wait_pending(struct srv_server *s, double timeout_s)
 		srv_log(SRV_LOG_WARN, "drain: %u requests still open after %.0f s; closing them", left, timeout_s);
 }
 
+/* Signals, the context lock and the request-id seed, before any thread starts. */
+static void process_init(struct srv_server *s, sigset_t *sigs)
+{
+	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
+	 * main thread takes the signals with sigwait(). */
+	sigemptyset(sigs);
+	sigaddset(sigs, SIGTERM);
+	sigaddset(sigs, SIGINT);
+	pthread_sigmask(SIG_BLOCK, sigs, NULL);
+	signal(SIGPIPE, SIG_IGN);
+
+	pthread_rwlockattr_t rwa;
+	pthread_rwlockattr_init(&rwa);
+	pthread_rwlockattr_setkind_np(&rwa, PTHREAD_RWLOCK_PREFER_WRITER_NONRECURSIVE_NP);
+	pthread_rwlock_init(&s->ctx_lock, &rwa);
+	pthread_rwlockattr_destroy(&rwa);
+	if (getrandom(&s->id_seed, sizeof s->id_seed, 0) != sizeof s->id_seed)
+		s->id_seed = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32);
+}
+
 int main(int argc, char **argv)
 {
 	static struct srv_server srv;
@@ -54,22 +74,8 @@ int main(int argc, char **argv)
 	srv_log_init(s->cfg.log_format);
 	api_model_cache_set_limit(s->cfg.model_cache_bytes);
 
-	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
-	 * main thread takes the signals with sigwait(). */
 	sigset_t sigs;
-	sigemptyset(&sigs);
-	sigaddset(&sigs, SIGTERM);
-	sigaddset(&sigs, SIGINT);
-	pthread_sigmask(SIG_BLOCK, &sigs, NULL);
-	signal(SIGPIPE, SIG_IGN);
-
-	pthread_rwlockattr_t rwa;
-	pthread_rwlockattr_init(&rwa);
-	pthread_rwlockattr_setkind_np(&rwa, PTHREAD_RWLOCK_PREFER_WRITER_NONRECURSIVE_NP);
-	pthread_rwlock_init(&s->ctx_lock, &rwa);
-	pthread_rwlockattr_destroy(&rwa);
-	if (getrandom(&s->id_seed, sizeof s->id_seed, 0) != sizeof s->id_seed)
-		s->id_seed = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32);
+	process_init(s, &sigs);
 
 	s->metrics = srv_metrics_create();
 	s->queue = srv_queue_create(s->cfg.queue);

@@ -12,6 +12,7 @@
 #include <jpeglib.h>
 #include "api.h"
 #include "model.h"
+#include "models.h"
 #include "test.h"
 #include "util.h"
 #include "umbra/rnd_math.h"
@@ -87,40 +88,14 @@ static const char CUBE_OBJ[] =
 static size_t tetra_stl(uint8_t *out /* 284 bytes */)
 {
 	static const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-	static const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
-	memset(out, 0, 84);
-	memcpy(out, "binary tetrahedron", 18);
-	out[80] = 4;
-	uint8_t *q = out + 84;
-	for (int i = 0; i < 4; i++, q += 50) {
-		float rec[12] = {0};
-		for (int k = 0; k < 3; k++) memcpy(rec + 3 + 3 * k, p[f[i][k]], sizeof p[0]);
-		memcpy(q, rec, sizeof rec); /* normal 0: recomputed by the importer */
-		q[48] = q[49] = 0;
-	}
-	return 84 + 4 * 50;
+	return test_tetra_stl(out, p);
 }
 
 static const uint8_t TEX[16] = {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 255, 255, 255, 255};
 
 static uint8_t *png_2x2(size_t *len)
 {
-	png_image img;
-	memset(&img, 0, sizeof img);
-	img.version = PNG_IMAGE_VERSION;
-	img.width = img.height = 2;
-	img.format = PNG_FORMAT_RGBA;
-	png_alloc_size_t n = 0;
-	if (!png_image_write_to_memory(&img, NULL, &n, 0, TEX, 0, NULL)) return NULL;
-	uint8_t *buf = malloc(n);
-	if (!png_image_write_to_memory(&img, buf, &n, 0, TEX, 0, NULL)) { free(buf); return NULL; }
-	*len = n;
-	return buf;
-}
-
-static void put32(uint8_t *p, uint32_t v)
-{
-	p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
+	return test_png_rgba(TEX, 2, 2, len);
 }
 
 /* A quad (2 triangles) in a node translated by (0,2,0), material: baseColorFactor, metallic,
@@ -154,27 +129,16 @@ static uint8_t *quad_glb(size_t *len)
 		"{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
 		"{\"bufferView\":3,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}]}",
 		binpad, pnglen);
-	size_t jpad = ((size_t)jn + 3) & ~(size_t)3;
-	size_t total = 12 + 8 + jpad + 8 + binpad;
-	uint8_t *g = calloc(1, total);
-	memcpy(g, "glTF", 4);
-	put32(g + 4, 2);
-	put32(g + 8, (uint32_t)total);
-	put32(g + 12, (uint32_t)jpad);
-	memcpy(g + 16, "JSON", 4);
-	memset(g + 20, ' ', jpad);
-	memcpy(g + 20, json, (size_t)jn);
-	uint8_t *bin = g + 20 + jpad;
-	put32(bin, (uint32_t)binpad);
-	memcpy(bin + 4, "BIN\0", 4);
-	uint8_t *b = bin + 8;
+	uint8_t *b = calloc(1, binpad);
+	if (!b) { free(png); return NULL; }
 	memcpy(b, pos, 48);
 	memcpy(b + 48, nrm, 48);
 	memcpy(b + 96, uv, 32);
 	memcpy(b + 128, idx, 24);
 	memcpy(b + 152, png, pnglen);
 	free(png);
-	*len = total;
+	uint8_t *g = test_glb_pack(json, (size_t)jn, b, binpad, binpad, len);
+	free(b);
 	return g;
 }
 
@@ -292,12 +256,12 @@ TEST(model_corrupt_bytes)
 	struct api_scene *s = parse_model(glb, n / 2, "", &p);
 	CHECK(!s && p.status == 400 && strstr(p.detail, "could not be imported"), "%d %s", p.status, p.detail);
 	api_scene_free(s);
-	put32(glb + 12, (uint32_t)n * 2);   /* JSON chunk longer than the file */
+	test_put32(glb + 12, (uint32_t)n * 2);   /* JSON chunk longer than the file */
 	s = parse_model(glb, n, "", &p);
 	CHECK(!s && p.status == 400, "%d %s", p.status, p.detail);
 	api_scene_free(s);
 	uint8_t save = glb[20];
-	put32(glb + 12, (uint32_t)(n - 40));
+	test_put32(glb + 12, (uint32_t)(n - 40));
 	glb[20] = '[';                        /* JSON that is not an object */
 	s = parse_model(glb, n, "", &p);
 	CHECK(!s && p.status == 400, "%d %s", p.status, p.detail);
