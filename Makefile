@@ -20,11 +20,19 @@ OPT ?= -O2
 SAN ?=
 CFLAGS ?= $(OPT) -g
 CFLAGS += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror -Wno-missing-field-initializers \
-          -fno-strict-aliasing -pthread -MMD -MP $(SAN) \
-          -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders -I$(BUILD)/www
+          -fno-strict-aliasing -pthread -MMD -MP $(SAN)
 LDFLAGS += -pthread $(SAN)
-PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+# Each module sees only the headers it may use (server -> api -> renderer -> shaders): an
+# include across the layering is a compile error, not a review comment. Tests see everything.
+INC_RENDERER := -Irenderer/include -Irenderer -Ishaders -I$(BUILD)/shaders
+INC_API := -Irenderer/include -Iapi
+INC_SERVER := -Irenderer/include -Iapi -Iserver -I$(BUILD)/www
+INC_TESTS := -Itests/util -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders -I$(BUILD)/www
+# pkg-config's answer is checked (pkg-check below), not silenced: a missing package fails the
+# build with pkg-config's own message instead of a confusing compile or link error later.
+PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
+PKG_STATUS := $(.SHELLSTATUS)
+PKG_LIBS := $(shell pkg-config --libs $(PKGS))
 CFLAGS += $(PKG_CFLAGS)
 # The build's version (in /v1/info and the ETag): the commit, "-dirty" with local changes.
 # Without .git (a container build, a tarball): `make UMBRA_VERSION=...` or a VERSION file.
@@ -39,14 +47,17 @@ API_SRC := $(wildcard api/*.c)
 SRV_SRC := $(filter-out server/cli.c server/farm.c,$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)
+# tests/util/: the harness (test.h, test_main.c) and helpers both test binaries share.
+UTIL_SRC := $(wildcard tests/util/*.c)
 SHADERS := $(wildcard shaders/*.vert shaders/*.frag shaders/*.comp)
 SHADER_HDRS := $(patsubst shaders/%,$(BUILD)/shaders/%.spv.h,$(SHADERS))
 
 RND_OBJ := $(RND_SRC:%.c=$(BUILD)/obj/%.o)
 API_OBJ := $(API_SRC:%.c=$(BUILD)/obj/%.o)
 SRV_OBJ := $(SRV_SRC:%.c=$(BUILD)/obj/%.o)
-UNIT_OBJ := $(UNIT_SRC:%.c=$(BUILD)/obj/%.o)
-GPU_OBJ := $(GPU_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/tests/unit/test_main.o
+UTIL_OBJ := $(UTIL_SRC:%.c=$(BUILD)/obj/%.o)
+UNIT_OBJ := $(UNIT_SRC:%.c=$(BUILD)/obj/%.o) $(UTIL_OBJ)
+GPU_OBJ := $(GPU_SRC:%.c=$(BUILD)/obj/%.o) $(UTIL_OBJ)
 
 BINS := $(BUILD)/librenderer.a $(BUILD)/libapi.a $(BUILD)/umbra-render $(BUILD)/umbra-import $(BUILD)/tests/unit_tests
 ifneq ($(SRV_SRC),)
@@ -56,24 +67,33 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: pkg-check all deps run test test-asan bench fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
 	@sh deploy/install-deps.sh
 
-# Shaders: SPIR-V embedded as C arrays (spv_<file>_<stage>).
+pkg-check:
+	@[ "$(PKG_STATUS)" = 0 ] || { echo "pkg-config cannot find every one of: $(PKGS) (make deps installs them)"; \
+	  pkg-config --cflags $(PKGS) >/dev/null; exit 1; }
+
+# Shaders: SPIR-V embedded as C arrays (spv_<file>_<stage>), for Vulkan 1.3 (the device's version).
 $(BUILD)/shaders/%.spv.h: shaders/% $(wildcard shaders/*.h shaders/*.glsl) | $(BUILD)/shaders
-	$(GLSLANG) -V --target-env vulkan1.2 -Ishaders --vn spv_$(subst .,_,$*) -o $@ $< >/dev/null || \
-	  { $(GLSLANG) -V --target-env vulkan1.2 -Ishaders -o /dev/null $<; exit 1; }
+	$(GLSLANG) -V --target-env vulkan1.3 -Ishaders --vn spv_$(subst .,_,$*) -o $@ $< >/dev/null || \
+	  { $(GLSLANG) -V --target-env vulkan1.3 -Ishaders -o /dev/null $<; exit 1; }
 $(BUILD)/shaders:
 	@mkdir -p $@
 
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c | pkg-check
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -c -o $@ $<
-# The renderer embeds the SPIR-V headers.
-$(RND_OBJ): $(SHADER_HDRS)
+	$(CC) $(CFLAGS) $(INC) -c -o $@ $<
+$(BUILD)/obj/renderer/%.o: INC := $(INC_RENDERER)
+$(BUILD)/obj/api/%.o: INC := $(INC_API)
+$(BUILD)/obj/server/%.o: INC := $(INC_SERVER)
+$(BUILD)/obj/tests/%.o: INC := $(INC_TESTS)
+# The renderer embeds the SPIR-V headers: they must exist before its first compile; after
+# that the dependency files (-MMD) rebuild only the objects that include a changed one.
+$(RND_OBJ): | $(SHADER_HDRS)
 
 $(BUILD)/librenderer.a: $(RND_OBJ)
 	@rm -f $@; ar rcs $@ $^
@@ -87,7 +107,7 @@ $(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
-$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 # The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
 # them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).
@@ -95,8 +115,9 @@ $(BUILD)/umbra-import: $(BUILD)/obj/api/helper/umbra_import.o $(BUILD)/libapi.a 
 	$(CC) $(LDFLAGS) -Wl,--as-needed -o $@ $^ $(LIBS)
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-# flags.o (+ admit.o, which it calls): the unit tests cover srv_default_workers() (cgroup CPU quota).
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+# flags.o (+ admit.o, which it calls): the unit tests cover srv_default_workers() (cgroup CPU quota);
+# negotiate.o and buf.o: Accept, Content-Type, ETag and the JSON escaper (test_negotiate.c).
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
@@ -177,7 +198,7 @@ fuzz-targets: $(FUZZ_SRC:tests/fuzz/%.c=$(BUILD)/%) $(BUILD)/umbra-import
 # defines, and libFuzzer keeps its own main().
 $(BUILD)/obj/server/main_fuzz.o: server/main.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Dmain=srv_main_unused -c -o $@ $<
+	$(CC) $(CFLAGS) $(INC_SERVER) -Dmain=srv_main_unused -c -o $@ $<
 $(BUILD)/libsrv.a: $(filter-out $(BUILD)/obj/server/main.o,$(SRV_OBJ)) $(BUILD)/obj/server/main_fuzz.o
 	@rm -f $@; ar rcs $@ $^
 .PRECIOUS: $(BUILD)/obj/tests/fuzz/%.o

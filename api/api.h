@@ -12,12 +12,14 @@
  *
  * Ownership: a parsed api_scene owns every array its rnd_scene points to (one arena) and
  * must be freed with api_scene_free() (NULL-safe). Encoders return malloc'd bytes the caller
- * frees. Threading: no shared state; every function is safe to call from several threads.
+ * frees. Threading: every function is safe to call from several threads. The one process-wide
+ * state is the cache of imported models (api/model.h), behind its own mutex.
  * jansson is used only inside api/; this header does not expose it.
  */
 #ifndef UMBRA_API_H
 #define UMBRA_API_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "umbra/rnd.h"
@@ -50,8 +52,6 @@ struct api_limits {
 	/* Directory that model `path`s are relative to (NULL = none: a `path` is a 400). A path never
 	 * leaves it: no absolute paths, no ".." components, no symlinks that resolve outside. */
 	const char *asset_root;          /* default NULL */
-	/* Bound of the process-wide cache of imported models (bytes; 0 = do not cache). */
-	uint64_t model_cache_bytes;      /* default 268435456 (256 MiB) */
 	/* Bounds of one sandboxed model import or texture decode (api/sandbox.h): wall clock (the CPU
 	 * time limit is the same, rounded up to seconds) and address space of the importer process.
 	 * Over either is a 422 at the member that carried the bytes. */
@@ -96,13 +96,13 @@ struct api_scene {
  * only those exist) from azimuth 360°·k/N (frame 0 on +Z, frame N/4 on +X) at the elevation:
  * view direction -(cos el·sin az, sin el, cos el·cos az), up +Y, fov_y of a perspective root
  * camera (else 45°), the root camera's exposure, near/far derived; from `distance`, or else
- * where the bounding sphere fills the frame with a 0.1 margin (the camera-fit rule). Cameras
- * with `fit: "objects"` are placed the same way here (fit becomes RND_FIT_NONE) because the
- * renderer's fit frames the whole scene. The sheet (ceil(sqrt(n)) columns, unused cells
- * included) counts against max_pixels: 422 at /views or /turntable.
- * Material `base_color_texture` is decoded here (PNG/JPEG, 400 at the member when it cannot be);
- * more than limits.max_textures distinct textures (422 at the object that brought one too many),
- * or one over 16384 texels a side, is a 422. */
+ * where the bounding sphere fills the frame with a 0.1 margin (a sphere, so that every frame is
+ * at the same distance). A camera's `fit` ("scene" or "objects") is left to the renderer, which
+ * frames the bounds tightly (rnd_object_frames() says what counts for "objects"). The sheet
+ * (rnd_sheet_layout(), unused cells included) counts against max_pixels: 422 at /views or
+ * /turntable. Material `base_color_texture` is decoded here (PNG/JPEG, 400 at the member when it
+ * cannot be); more than limits.max_textures distinct textures (422 at the object that brought
+ * one too many), or one over RND_MAX_TEXTURE_SIDE texels a side, is a 422. */
 enum api_result api_scene_parse(const char *json, size_t len, const struct api_limits *limits,
                                 struct api_scene **out, struct api_problem *p);
 void api_scene_free(struct api_scene *s);
@@ -120,8 +120,12 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
                                       const struct api_part *parts, size_t nparts,
                                       struct api_scene **out, struct api_problem *p);
 
-/* Imported models are cached process-wide (LRU, bounded by limits.model_cache_bytes, keyed by
- * the file's bytes). Counters since start; any pointer may be NULL. Thread-safe. */
+/* Imported models are cached process-wide (LRU, keyed by the file's bytes), so its bound is
+ * process-wide too: set it once at start-up (umbrad --model-cache); bytes 0 = do not cache;
+ * default 268435456 (256 MiB). Lowering it evicts at once (models still used by a scene live
+ * until that scene is freed). Thread-safe. */
+void api_model_cache_set_limit(uint64_t bytes);
+/* Counters since start; any pointer may be NULL. Thread-safe. */
 void api_model_cache_stats(uint64_t *hits, uint64_t *misses, uint64_t *bytes);
 /* Drops every cached model (models still used by a scene live until that scene is freed).
  * For tests and shutdown: after it and after every scene is freed, nothing is left allocated. */
@@ -155,6 +159,20 @@ enum api_result api_png_encode(const struct rnd_image *img, int level, uint8_t *
 enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p);
 
 const char *api_format_mime(enum api_format f);
+
+/* What umbrad says of itself in GET /v1/info (the strings are only read). */
+struct api_info {
+	const char *version, *device, *driver, *driver_info;
+	uint32_t vulkan_api;              /* VK_MAKE_API_VERSION packing */
+	bool cpu;                         /* a CPU (software) device */
+	struct api_limits limits;         /* the 422 limits in force */
+	uint64_t max_body, max_memory, device_max_allocation;
+	uint32_t max_dimension, device_max_shadow_resolution, deadline_ms, queue, workers;
+	uint32_t max_textures, device_max_textures;   /* in force (--max-textures, capped) / the device's */
+};
+/* The /v1/info document (compact JSON and a newline), malloc'd (the caller frees it); *len its
+ * length. NULL when out of memory. api/info.c. */
+char *api_info_json(const struct api_info *in, size_t *len);
 
 /* One line of a JSON-lines render manifest (umbra-render --manifest), api/manifest.c:
  * {"scene": "path.json" | {document}, "output": "name.png"}; output optional, a bare file name.

@@ -92,20 +92,15 @@ static uint16_t float_to_half(float f)
 
 static const char *const RGBA_NAMES[4] = {"R", "G", "B", "A"};
 
-enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p)
+/* 500 unless img is an RGBA32F image (one view or a sheet) whose AOV planes the EXR can hold. */
+static enum api_result check_image(const struct rnd_image *img, uint32_t naov, struct api_problem *p)
 {
-	struct api_problem scratch;
-	if (!p) p = &scratch;
-	if (!out || !len) return api_problem_set(p, 500, "", "EXR encoder: no output pointer");
-	*out = NULL;
-	*len = 0;
 	if (!img || !img->pixels || !img->width || !img->height)
 		return api_problem_set(p, 500, "", "EXR encoder: empty image");
 	if (img->format != RND_PIXELS_RGBA32F)
 		return api_problem_set(p, 500, "", "EXR encoder: the image is not RGBA32F");
 	if (img->width > INT32_MAX / 4 || img->height > INT32_MAX / 4 || img->stride < (size_t)img->width * 16)
 		return api_problem_set(p, 500, "", "EXR encoder: bad image size or stride");
-	uint32_t naov = img->aov_count > RND_MAX_AOV_PLANES ? RND_MAX_AOV_PLANES : img->aov_count;
 	for (uint32_t i = 0; i < naov; i++) {
 		if (!img->aov[i] || !img->aov_names[i][0] || !memchr(img->aov_names[i], 0, sizeof img->aov_names[i]))
 			return api_problem_set(p, 500, "", "EXR encoder: AOV plane %u has no data or no name", i);
@@ -117,20 +112,124 @@ enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_
 				return api_problem_set(p, 500, "", "EXR encoder: AOV name \"%s\" appears twice",
 				                       img->aov_names[i]);
 	}
+	return API_OK;
+}
 
-	const size_t W = img->width, H = img->height;
-	/* Views: one part per view ("view0", "view1", ...), each the view's cell of the sheet. */
-	uint32_t nview = img->view_count ? img->view_count : 1, cols = img->view_columns ? img->view_columns : 1;
-	uint32_t vw = img->view_width ? img->view_width : img->width, vh = img->view_height ? img->view_height : img->height;
-	if (nview > 1) {
-		uint32_t rows = (nview + cols - 1) / cols;
-		if (nview > 1024 || !cols || (uint64_t)cols * vw > W || (uint64_t)rows * vh > H)
-			return api_problem_set(p, 500, "", "EXR encoder: %u views of %ux%u in %u columns do not fit a %ux%u sheet",
-			                       nview, vw, vh, cols, img->width, img->height);
-	} else {
-		vw = img->width;
-		vh = img->height;
+/* The image's views: one part per view ("view0", "view1", ...), each the view's cell of the sheet. */
+struct exr_views { uint32_t n, cols, w, h; };
+
+static enum api_result views_of(const struct rnd_image *img, struct exr_views *v, struct api_problem *p)
+{
+	v->n = img->view_count ? img->view_count : 1;
+	v->cols = img->view_columns ? img->view_columns : 1;
+	v->w = img->view_width ? img->view_width : img->width;
+	v->h = img->view_height ? img->view_height : img->height;
+	if (v->n <= 1) {
+		v->w = img->width;
+		v->h = img->height;
+		return API_OK;
 	}
+	uint32_t rows = (v->n + v->cols - 1) / v->cols;
+	if (v->n > RND_MAX_VIEWS || !v->cols || (uint64_t)v->cols * v->w > img->width ||
+	    (uint64_t)rows * v->h > img->height)
+		return api_problem_set(p, 500, "", "EXR encoder: %u views of %ux%u in %u columns do not fit a %ux%u sheet",
+		                       v->n, v->w, v->h, v->cols, img->width, img->height);
+	return API_OK;
+}
+
+/* One part per view, each with R, G, B, A (half) and the AOV planes (float), then the header. */
+static exr_result_t add_parts(exr_context_t ctx, const struct rnd_image *img, uint32_t naov,
+                              const struct exr_views *v)
+{
+	exr_result_t rv = EXR_ERR_SUCCESS;
+	for (uint32_t k = 0; rv == EXR_ERR_SUCCESS && k < v->n; k++) {
+		char name[16] = "";
+		if (v->n > 1) snprintf(name, sizeof name, "view%u", k);
+		int part = 0;
+		rv = exr_add_part(ctx, name, EXR_STORAGE_SCANLINE, &part);
+		if (rv == EXR_ERR_SUCCESS)
+			rv = exr_initialize_required_attr_simple(ctx, part, (int32_t)v->w, (int32_t)v->h, EXR_COMPRESSION_ZIP);
+		for (int c = 0; rv == EXR_ERR_SUCCESS && c < 4; c++)
+			rv = exr_add_channel(ctx, part, RGBA_NAMES[c], EXR_PIXEL_HALF, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+		for (uint32_t i = 0; rv == EXR_ERR_SUCCESS && i < naov; i++)
+			rv = exr_add_channel(ctx, part, img->aov_names[i], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+	}
+	if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
+	return rv;
+}
+
+/* Points each channel of the chunk whose first pixel is sheet index `first` at its plane: the
+ * planar half copies of R, G, B, A, or an AOV plane. The library lists channels sorted by name:
+ * each is matched by name. */
+static void bind_channels(exr_encode_pipeline_t *enc, const struct rnd_image *img, uint32_t naov,
+                          const uint16_t *half, size_t first)
+{
+	const size_t W = img->width, H = img->height;
+	for (int16_t c = 0; c < enc->channel_count; c++) {
+		exr_coding_channel_info_t *ch = &enc->channels[c];
+		const uint8_t *src = NULL;
+		for (int k = 0; k < 4 && !src; k++)
+			if (!strcmp(ch->channel_name, RGBA_NAMES[k]))
+				src = (const uint8_t *)(half + (size_t)k * W * H + first);
+		if (src) {
+			ch->user_bytes_per_element = 2;
+			ch->user_data_type = EXR_PIXEL_HALF;
+			ch->user_pixel_stride = 2;
+			ch->user_line_stride = (int32_t)(W * 2);
+		} else {
+			for (uint32_t i = 0; i < naov && !src; i++)
+				if (!strcmp(ch->channel_name, img->aov_names[i]))
+					src = (const uint8_t *)(img->aov[i] + first);
+			ch->user_bytes_per_element = 4;
+			ch->user_data_type = EXR_PIXEL_FLOAT;
+			ch->user_pixel_stride = 4;
+			ch->user_line_stride = (int32_t)(W * 4);
+		}
+		ch->encode_from_ptr = src;
+	}
+}
+
+/* Writes part `part` (view `part` of the sheet) chunk by chunk; its pipeline is destroyed. */
+static exr_result_t write_part(exr_context_t ctx, uint32_t part, const struct rnd_image *img, uint32_t naov,
+                               const uint16_t *half, const struct exr_views *v)
+{
+	/* The cell's top-left pixel in the sheet. */
+	const size_t x0 = (size_t)(part % v->cols) * v->w, y0 = (size_t)(part / v->cols) * v->h;
+	exr_encode_pipeline_t enc = {0};
+	bool enc_live = false;
+	int32_t lines = 0;
+	exr_result_t rv = exr_get_scanlines_per_chunk(ctx, (int)part, &lines);
+	for (int32_t y = 0; rv == EXR_ERR_SUCCESS && y < (int32_t)v->h; y += lines) {
+		exr_chunk_info_t ci;
+		rv = exr_write_scanline_chunk_info(ctx, (int)part, y, &ci);
+		if (rv != EXR_ERR_SUCCESS) break;
+		rv = enc_live ? exr_encoding_update(ctx, (int)part, &ci, &enc)
+		              : exr_encoding_initialize(ctx, (int)part, &ci, &enc);
+		if (rv != EXR_ERR_SUCCESS) break;
+		bind_channels(&enc, img, naov, half, (y0 + (size_t)ci.start_y) * img->width + x0);
+		if (!enc_live) {
+			enc_live = true;
+			rv = exr_encoding_choose_default_routines(ctx, (int)part, &enc);
+			if (rv != EXR_ERR_SUCCESS) break;
+		}
+		rv = exr_encoding_run(ctx, (int)part, &enc);
+	}
+	/* A pipeline belongs to one part. */
+	if (enc_live) exr_encoding_destroy(ctx, &enc);
+	return rv;
+}
+
+enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p)
+{
+	struct api_problem scratch;
+	if (!p) p = &scratch;
+	if (!out || !len) return api_problem_set(p, 500, "", "EXR encoder: no output pointer");
+	*out = NULL;
+	*len = 0;
+	uint32_t naov = img && img->aov_count > RND_MAX_AOV_PLANES ? RND_MAX_AOV_PLANES : img ? img->aov_count : 0;
+	struct exr_views v;
+	if (check_image(img, naov, p) != API_OK || views_of(img, &v, p) != API_OK) return API_ERR;
+	const size_t W = img->width, H = img->height;
 	/* Planar half copies of R, G, B, A: the core's packer then only copies rows. */
 	uint16_t *half = malloc(W * H * 4 * sizeof(uint16_t));
 	if (!half) return api_problem_set(p, 500, "", "EXR encoder: out of memory");
@@ -147,74 +246,9 @@ enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_
 	init.error_handler_fn = on_error;
 	init.zip_level = 3; /* 512x512: level 3 ~19 ms, 1 ~14 ms (+30% bytes), 6 ~34 ms (-25% bytes) */
 	exr_context_t ctx = NULL;
-	exr_encode_pipeline_t enc = {0};
-	bool enc_live = false;
 	exr_result_t rv = exr_start_write(&ctx, "umbra.exr", EXR_WRITE_FILE_DIRECTLY, &init);
-	for (uint32_t v = 0; rv == EXR_ERR_SUCCESS && v < nview; v++) {
-		char name[16] = "";
-		if (nview > 1) snprintf(name, sizeof name, "view%u", v);
-		int part = 0;
-		rv = exr_add_part(ctx, name, EXR_STORAGE_SCANLINE, &part);
-		if (rv == EXR_ERR_SUCCESS)
-			rv = exr_initialize_required_attr_simple(ctx, part, (int32_t)vw, (int32_t)vh, EXR_COMPRESSION_ZIP);
-		for (int c = 0; rv == EXR_ERR_SUCCESS && c < 4; c++)
-			rv = exr_add_channel(ctx, part, RGBA_NAMES[c], EXR_PIXEL_HALF, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
-		for (uint32_t i = 0; rv == EXR_ERR_SUCCESS && i < naov; i++)
-			rv = exr_add_channel(ctx, part, img->aov_names[i], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
-	}
-	if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
-
-	for (uint32_t part = 0; rv == EXR_ERR_SUCCESS && part < nview; part++) {
-		/* The cell's top-left pixel in the sheet. */
-		const size_t x0 = (size_t)(part % cols) * vw, y0 = (size_t)(part / cols) * vh;
-		int32_t lines = 0;
-		rv = exr_get_scanlines_per_chunk(ctx, (int)part, &lines);
-		for (int32_t y = 0; rv == EXR_ERR_SUCCESS && y < (int32_t)vh; y += lines) {
-			exr_chunk_info_t ci;
-			rv = exr_write_scanline_chunk_info(ctx, (int)part, y, &ci);
-			if (rv != EXR_ERR_SUCCESS) break;
-			rv = enc_live ? exr_encoding_update(ctx, (int)part, &ci, &enc)
-			              : exr_encoding_initialize(ctx, (int)part, &ci, &enc);
-			if (rv != EXR_ERR_SUCCESS) break;
-			const size_t first = (y0 + (size_t)ci.start_y) * W + x0; /* sheet index of the chunk's first pixel */
-			/* The library lists channels sorted by name: match each by name. */
-			for (int16_t c = 0; c < enc.channel_count; c++) {
-				exr_coding_channel_info_t *ch = &enc.channels[c];
-				const uint8_t *src = NULL;
-				for (int k = 0; k < 4 && !src; k++)
-					if (!strcmp(ch->channel_name, RGBA_NAMES[k]))
-						src = (const uint8_t *)(half + (size_t)k * W * H + first);
-				if (src) {
-					ch->user_bytes_per_element = 2;
-					ch->user_data_type = EXR_PIXEL_HALF;
-					ch->user_pixel_stride = 2;
-					ch->user_line_stride = (int32_t)(W * 2);
-				} else {
-					for (uint32_t i = 0; i < naov && !src; i++)
-						if (!strcmp(ch->channel_name, img->aov_names[i]))
-							src = (const uint8_t *)(img->aov[i] + first);
-					ch->user_bytes_per_element = 4;
-					ch->user_data_type = EXR_PIXEL_FLOAT;
-					ch->user_pixel_stride = 4;
-					ch->user_line_stride = (int32_t)(W * 4);
-				}
-				ch->encode_from_ptr = src;
-			}
-			if (!enc_live) {
-				enc_live = true;
-				rv = exr_encoding_choose_default_routines(ctx, (int)part, &enc);
-				if (rv != EXR_ERR_SUCCESS) break;
-			}
-			rv = exr_encoding_run(ctx, (int)part, &enc);
-		}
-		/* A pipeline belongs to one part. */
-		if (enc_live) {
-			exr_encoding_destroy(ctx, &enc);
-			enc_live = false;
-			memset(&enc, 0, sizeof enc);
-		}
-	}
-	if (enc_live) exr_encoding_destroy(ctx, &enc);
+	if (rv == EXR_ERR_SUCCESS) rv = add_parts(ctx, img, naov, &v);
+	for (uint32_t part = 0; rv == EXR_ERR_SUCCESS && part < v.n; part++) rv = write_part(ctx, part, img, naov, half, &v);
 	exr_result_t fin = ctx ? exr_finish(&ctx) : EXR_ERR_SUCCESS;
 	if (rv == EXR_ERR_SUCCESS) rv = fin;
 	free(half);

@@ -57,7 +57,7 @@ void api_ground_place(struct rnd_object *objs, uint32_t n, const struct rnd_mate
 	for (uint32_t i = 0; i < n; i++) {
 		const struct rnd_object *o = &objs[i];
 		if (margin[i] > 0) any_ground = true;
-		if (o->shape == RND_SHAPE_PLANE || (mats && mats[o->material].shadow_catcher)) continue;
+		if (!rnd_object_frames(o, mats)) continue;
 		api_object_bounds(o, lo, hi);
 	}
 	if (!any_ground) return;

@@ -1,7 +1,7 @@
 /*
  * api/ground — world bounds of scene objects, and the ground plane that places itself.
  *
- * Usage (api/scene_parse.c, after models are expanded into mesh objects):
+ * Usage (api/scene_objects.c, after models are expanded into mesh objects):
  *   float margin[n];   // > 0 for each plane object with "placement": "ground", else 0
  *   api_ground_place(objects, n, materials, margin);
  *

@@ -20,6 +20,7 @@
 #include "errmsg.h"
 #include "arena.h"
 #include "model.h"
+#include "umbra/rnd_math.h"
 #include "sandbox.h"
 
 struct model_priv {
@@ -38,6 +39,7 @@ struct model_priv {
 static pthread_mutex_t cache_mu = PTHREAD_MUTEX_INITIALIZER;
 static struct model_priv *lru_head, *lru_tail; /* head = most recently used */
 static uint64_t cache_total, cache_hits, cache_misses;
+static uint64_t cache_limit = 256u << 20;   /* api_model_cache_set_limit() */
 
 static const char *const FORMAT_NAMES[] = {"glb", "gltf", "obj", "stl", "ply"};
 
@@ -124,15 +126,6 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 
 /* ---- cache ---- */
 
-static uint64_t fnv1a(const uint8_t *d, size_t n, uint64_t h)
-{
-	for (size_t i = 0; i < n; i++) {
-		h ^= d[i];
-		h *= 0x100000001b3ull;
-	}
-	return h;
-}
-
 /* With cache_mu held. */
 static void lru_unlink(struct model_priv *m)
 {
@@ -170,14 +163,38 @@ void api_model_release(struct api_model *pub)
 	if (atomic_fetch_sub(&m->refs, 1) == 1) model_free(m);
 }
 
+/* With cache_mu held: unlists least recently used models (never `keep`) until the cache is
+ * within its limit; returns them as a list for release_list() outside the lock. */
+static struct model_priv *evict_over_limit(const struct model_priv *keep)
+{
+	struct model_priv *evicted = NULL;
+	while (lru_tail && lru_tail != keep && cache_total > cache_limit) {
+		struct model_priv *t = lru_tail;
+		lru_unlink(t);
+		t->next = evicted;
+		evicted = t;
+	}
+	return evicted;
+}
+
+/* Drops the cache's reference to each model of the list (without cache_mu). */
+static void release_list(struct model_priv *list)
+{
+	while (list) {
+		struct model_priv *n = list->next;
+		list->next = NULL;
+		api_model_release(&list->pub);
+		list = n;
+	}
+}
+
 /* The cache's entry for `data` (the model's model_len bytes, then nfiles files as the sandbox's
  * bundle lays them out: the key covers the files too), importing it on a miss. */
 static enum api_result get(const uint8_t *data, size_t len, size_t model_len, size_t nfiles,
                            enum api_model_format format, const struct api_limits *lim, struct api_model **out,
                            int *status, char *err, size_t errsize)
 {
-	uint64_t cache_bytes = lim->model_cache_bytes;
-	uint64_t h = fnv1a(data, len, 0xcbf29ce484222325ull ^ (uint64_t)format);
+	uint64_t h = rnd_fnv1a(RND_FNV_SEED ^ (uint64_t)format, data, len);
 
 	pthread_mutex_lock(&cache_mu);
 	struct model_priv *hit = lru_find(h, data, len, model_len, format);
@@ -200,6 +217,9 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	if (!m) return API_ERR;
 	*status = 0;
 	uint64_t cost = m->pub.bytes_ + len;
+	pthread_mutex_lock(&cache_mu);
+	uint64_t cache_bytes = cache_limit;
+	pthread_mutex_unlock(&cache_mu);
 	if (!cache_bytes || cost > cache_bytes || !(m->src = malloc(len))) {
 		*out = &m->pub;    /* not cached: the caller's reference is the only one */
 		return API_OK;
@@ -219,20 +239,10 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	} else {
 		lru_push_front(m);
 		atomic_fetch_add(&m->refs, 1); /* the cache's reference */
-		while (cache_total > cache_bytes && lru_tail != m) {
-			struct model_priv *t = lru_tail;
-			lru_unlink(t);
-			t->next = evicted; /* released outside the lock */
-			evicted = t;
-		}
+		evicted = evict_over_limit(m);
 	}
 	pthread_mutex_unlock(&cache_mu);
-	while (evicted) {
-		struct model_priv *n = evicted->next;
-		evicted->next = NULL;
-		api_model_release(&evicted->pub);
-		evicted = n;
-	}
+	release_list(evicted);
 	if (dup) {
 		api_model_release(&m->pub);
 		m = dup;
@@ -276,6 +286,15 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
 	return api_model_get_files(data, len, NULL, 0, format, lim, out, status, err, errsize);
 }
 
+void api_model_cache_set_limit(uint64_t bytes)
+{
+	pthread_mutex_lock(&cache_mu);
+	cache_limit = bytes;
+	struct model_priv *evicted = evict_over_limit(NULL);
+	pthread_mutex_unlock(&cache_mu);
+	release_list(evicted);
+}
+
 void api_model_cache_stats(uint64_t *hits, uint64_t *misses, uint64_t *bytes)
 {
 	pthread_mutex_lock(&cache_mu);
@@ -296,10 +315,5 @@ void api_model_cache_clear(void)
 		list = t;
 	}
 	pthread_mutex_unlock(&cache_mu);
-	while (list) {
-		struct model_priv *n = list->next;
-		list->next = NULL;
-		api_model_release(&list->pub);
-		list = n;
-	}
+	release_list(list);
 }

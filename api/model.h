@@ -79,9 +79,8 @@ struct api_model {
 };
 
 /* Imports (or finds in the cache) the model in data[0..len). format API_MODEL_SNIFF tells it
- * from the bytes. From lim (NULL = api_limits_defaults): model_cache_bytes bounds the cache
- * after this insertion (0 = do not cache this one); import_timeout_ms and import_memory bound
- * the importer. Returns API_OK with *out (one reference), or API_ERR with *status 400 (bad
+ * from the bytes. The cache is bounded by api_model_cache_set_limit() (api.h). From lim (NULL =
+ * api_limits_defaults): import_timeout_ms and import_memory bound the importer. Returns API_OK with *out (one reference), or API_ERR with *status 400 (bad
  * file: refused, crashed the importer), 422 (over the import time or memory limit) or 500 (the
  * importer could not run) and a sentence in err (Assimp's message or what was wrong with the
  * bytes; never mentions the caller's member names). */

@@ -109,7 +109,6 @@ void api_limits_defaults(struct api_limits *l)
 	l->max_lights = 64;
 	l->max_shadow_resolution = 8192;
 	l->asset_root = NULL;
-	l->model_cache_bytes = 256u << 20;
 	l->import_timeout_ms = 10000;
 	l->import_memory = 2ull << 30;
 	l->max_textures = RND_DEFAULT_MAX_TEXTURES;

@@ -290,6 +290,9 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 	VkPhysicalDeviceVulkan13Features f13 = {
 		.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
 		.dynamicRendering = VK_TRUE, .synchronization2 = VK_TRUE,
+		/* SPIR-V for Vulkan 1.3 gives a compute shader's spec-constant workgroup size as
+		 * LocalSizeId, which needs maintenance4 (a feature every 1.3 device has). */
+		.maintenance4 = VK_TRUE,
 	};
 	VkPhysicalDeviceFeatures2 f2 = {
 		.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &f13,
@@ -394,8 +397,8 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if (!ctx) return rnd_fail(err, RND_ERR_OOM, "out of memory for the context");
 	if (desc) ctx->desc = *desc;
 	if (!ctx->desc.slots) ctx->desc.slots = 1;
-	if (!ctx->desc.max_width) ctx->desc.max_width = 8192;
-	if (!ctx->desc.max_height) ctx->desc.max_height = 8192;
+	if (!ctx->desc.max_width) ctx->desc.max_width = RND_MAX_DIMENSION;
+	if (!ctx->desc.max_height) ctx->desc.max_height = RND_MAX_DIMENSION;
 	if (!ctx->desc.atlas_size) ctx->desc.atlas_size = 4096;
 	if (ctx->desc.pipeline_cache_path) snprintf(ctx->cache_path, sizeof ctx->cache_path, "%s", ctx->desc.pipeline_cache_path);
 	ctx->desc.pipeline_cache_path = ctx->cache_path;

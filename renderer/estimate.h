@@ -7,8 +7,6 @@
 
 #include "internal.h"
 
-/* Sheet of several views: ceil(sqrt(n)) columns, as many rows as needed (n = 0 means 1). */
-void rnd_sheet_layout(uint32_t view_count, uint32_t *cols, uint32_t *rows);
 /* AOV passes (each UMBRA_AOV_ATTACHMENTS RGBA32F targets) the scene's output.aovs need. */
 uint32_t rnd_aov_passes(const struct rnd_scene *sc);
 /* Bytes per pixel of an output pixel format (RGBA8 4, RGBA16 8, RGBA32F 16). */

@@ -157,11 +157,12 @@ void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
 /* pipelines.c */
 enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err);
 void rnd_pipelines_release(struct rnd_context *ctx);
+/* The descriptor type of each binding of the main set (UMBRA_BINDING_* of umbra_shared.h): one
+ * table for the set layout and for the descriptor writes (render.c). */
+extern const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT];
 /* The main-pass pipeline for key, compiled on first use (thread-safe). */
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
                                    struct rnd_error *err);
-/* Number of main-pass variants compiled so far (warm-up checks). */
-uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx);
 
 /* slot.c */
 struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx);

@@ -85,7 +85,7 @@ static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene 
 		p->img[si][k] = -1;
 		p->smp[si][k] = (uint8_t)rnd_texture_sampler_index(&m->sampling[k]);
 		if (!t) continue;
-		if (!t->rgba || !t->width || !t->height || t->width > 16384 || t->height > 16384)
+		if (!t->rgba || !t->width || !t->height || t->width > RND_MAX_TEXTURE_SIDE || t->height > RND_MAX_TEXTURE_SIDE)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", mi, t->width, t->height);
 		int ii = image_of(p, t, slot_srgb(k));
 		if (ii < 0)

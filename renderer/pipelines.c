@@ -1,7 +1,9 @@
 /*
  * renderer/pipelines.c — shader modules (SPIR-V embedded at build time), the one descriptor
- * set layout and pipeline layout, the shadow sampler, and every graphics pipeline, all
- * created once per context so that no render compiles anything.
+ * set layout and pipeline layout, the shadow sampler, and the graphics pipelines. The fixed
+ * ones are created with the context; a main-pass variant (specialization constants of a
+ * scene's lights and filters) is compiled on its first use, outside the lock, and kept (at most
+ * RND_MAX_VARIANTS); the daemon's warm-up and the pipeline cache make that first use cheap.
  *
  * Pipelines use dynamic rendering (Vulkan 1.3): no render pass or framebuffer objects.
  * Variants: shadow depth-only [cull none/back]; main [output format][MSAA 1/4][cull none/back].
@@ -28,20 +30,24 @@ static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code
 	return RND_OK;
 }
 
+const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
+	[UMBRA_BINDING_FRAME] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_MATERIALS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+	[UMBRA_BINDING_LIGHTS] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_SHADOW_VIEWS] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_SHADOW_MAP] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_MOMENTS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_SCENE_DEPTH] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+};
+
 static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_pipelines *p = &ctx->pipes;
 	VkResult vr;
 	VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-	VkDescriptorSetLayoutBinding b[UMBRA_BINDING_COUNT] = {
-		{UMBRA_BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_LIGHTS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_SHADOW_VIEWS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, NULL},
-		{UMBRA_BINDING_SHADOW_MAP, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, NULL},
-		{UMBRA_BINDING_MOMENTS, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, NULL},
-		{UMBRA_BINDING_SCENE_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, NULL},
-	};
+	VkDescriptorSetLayoutBinding b[UMBRA_BINDING_COUNT];
+	for (uint32_t i = 0; i < UMBRA_BINDING_COUNT; i++)
+		b[i] = (VkDescriptorSetLayoutBinding){i, rnd_binding_type[i], 1, stages, NULL};
 	VkDescriptorSetLayoutCreateInfo dci = {
 		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = UMBRA_BINDING_COUNT, .pBindings = b,
 	};
@@ -114,6 +120,8 @@ struct pipe_desc {
 	const char *name;
 };
 
+/* One graphics pipeline from d. Longer than most functions here on purpose: one create-info
+ * per fixed-function state, read top to bottom in the order Vulkan's struct takes them. */
 static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_desc *d, VkPipeline *out,
                                      struct rnd_error *err)
 {
@@ -345,14 +353,6 @@ out_modules:
 	*out = pipe;
 	pthread_mutex_unlock(&p->mu);
 	return RND_OK;
-}
-
-uint32_t rnd_pipelines_variant_count(struct rnd_context *ctx)
-{
-	pthread_mutex_lock(&ctx->pipes.mu);
-	uint32_t n = ctx->pipes.variant_count;
-	pthread_mutex_unlock(&ctx->pipes.mu);
-	return n;
 }
 
 void rnd_pipelines_release(struct rnd_context *ctx)

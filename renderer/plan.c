@@ -21,6 +21,39 @@ static void reverse_z(float m[16])
 	for (int c = 0; c < 4; c++) m[c * 4 + 2] = m[c * 4 + 3] - m[c * 4 + 2];
 }
 
+/* Auto-framing (`fit`): aim at the bounds' centre along the fit direction, then back off until
+ * every corner of the box projects inside the frame less the margin (margin = fraction of the
+ * frame on each side), so the widest corner touches the margin. bounds NULL: the unit box. */
+static enum rnd_result fit_eye(const struct rnd_camera *cam, struct rnd_camera_plan *out,
+                               const struct rnd_aabb *bounds, float pos[3], float target[3], struct rnd_error *err)
+{
+	float dir[3];
+	if (!rnd_v3_normalize(dir, cam->fit_direction))
+		return rnd_fail(err, RND_ERR_INVALID, "camera fit direction must not be zero");
+	float c[3] = {0, 0, 0};
+	struct rnd_aabb b = {{-1, -1, -1}, {1, 1, 1}};
+	if (bounds) b = *bounds;
+	for (int i = 0; i < 3; i++) c[i] = 0.5f * (b.min[i] + b.max[i]);
+	float eye0[3], basis[16];
+	for (int i = 0; i < 3; i++) eye0[i] = c[i] - dir[i];
+	rnd_mat4_look_at(basis, eye0, c, cam->up);
+	float shrink = fmaxf(1.0f - 2.0f * cam->fit_margin, 0.05f);
+	float ty = tanf(0.5f * out->fov_y) * shrink, tx = tanf(0.5f * out->fov_y) * out->aspect * shrink;
+	float dist = 1e-3f;
+	for (int i = 0; i < 8; i++) {
+		float p[3] = {i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]};
+		float q[3], rel[3];
+		rnd_v3_sub(rel, p, c);
+		rnd_mat4_mul_dir(q, basis, rel);     /* view axes: x right, y up, -z forward */
+		float z = -q[2];                     /* along the view direction */
+		dist = fmaxf(dist, fabsf(q[0]) / tx - z);
+		dist = fmaxf(dist, fabsf(q[1]) / ty - z);
+	}
+	for (int i = 0; i < 3; i++) { target[i] = c[i]; pos[i] = c[i] - dir[i] * dist; }
+	out->ortho = false;
+	return RND_OK;
+}
+
 enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, uint32_t height,
                                 const struct rnd_aabb *bounds, struct rnd_camera_plan *out, struct rnd_error *err)
 {
@@ -35,34 +68,8 @@ enum rnd_result rnd_camera_plan(const struct rnd_camera *cam, uint32_t width, ui
 	bool empty = !bounds || rnd_aabb_is_empty(bounds);
 
 	if (cam->fit != RND_FIT_NONE) {
-		/* Auto-framing: the bounding sphere fills the frame up to the margin. */
-		float dir[3];
-		if (!rnd_v3_normalize(dir, cam->fit_direction))
-			return rnd_fail(err, RND_ERR_INVALID, "camera fit direction must not be zero");
-		/* Tight fit: aim at the bounds' centre along `dir`, then back off until every corner
-		 * of the box projects inside the frame less the margin (margin = fraction of the frame
-		 * on each side), so the widest corner touches the margin. */
-		float c[3] = {0, 0, 0};
-		struct rnd_aabb b = {{-1, -1, -1}, {1, 1, 1}};
-		if (!empty) b = *bounds;
-		for (int i = 0; i < 3; i++) c[i] = 0.5f * (b.min[i] + b.max[i]);
-		float eye0[3], basis[16];
-		for (int i = 0; i < 3; i++) eye0[i] = c[i] - dir[i];
-		rnd_mat4_look_at(basis, eye0, c, cam->up);
-		float shrink = fmaxf(1.0f - 2.0f * cam->fit_margin, 0.05f);
-		float ty = tanf(0.5f * out->fov_y) * shrink, tx = tanf(0.5f * out->fov_y) * out->aspect * shrink;
-		float dist = 1e-3f;
-		for (int i = 0; i < 8; i++) {
-			float p[3] = {i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]};
-			float q[3], rel[3];
-			rnd_v3_sub(rel, p, c);
-			rnd_mat4_mul_dir(q, basis, rel);     /* view axes: x right, y up, -z forward */
-			float z = -q[2];                     /* along the view direction */
-			dist = fmaxf(dist, fabsf(q[0]) / tx - z);
-			dist = fmaxf(dist, fabsf(q[1]) / ty - z);
-		}
-		for (int i = 0; i < 3; i++) { target[i] = c[i]; pos[i] = c[i] - dir[i] * dist; }
-		out->ortho = false;
+		enum rnd_result r = fit_eye(cam, out, empty ? NULL : bounds, pos, target, err);
+		if (r != RND_OK) return r;
 	}
 	memcpy(out->pos, pos, sizeof pos);
 	float fwd[3];
@@ -195,7 +202,6 @@ static void persp_view(struct umbra_shadow_view *v, const float eye[3], const fl
 	v->params[1] = 1.0f;
 	v->params[2] = znear;
 	v->params[3] = zfar;
-	(void)dir;
 	v->rect[2] = res;   /* x, y and the atlas size are filled in when the tile is granted */
 }
 
@@ -252,6 +258,174 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 	return rnd_shadow_plan_with(scene, bounds, cam, NULL, out, err);
 }
 
+/* The next shadow view, of light i (ortho: depth clamp instead of near-plane culling). */
+static struct umbra_shadow_view *next_view(struct rnd_shadow_plan *out, uint32_t i, bool ortho)
+{
+	out->view_light[out->view_count] = i;
+	out->view_ortho[out->view_count] = ortho;
+	return &out->views[out->view_count++];
+}
+
+/* The light's filter (AUTO: PCSS for an area light, else PCF), PCF radius, search and bias. */
+static enum rnd_result plan_filter(const struct rnd_light *L, uint32_t i, struct rnd_light_plan *lp,
+                                   struct rnd_error *err)
+{
+	const struct rnd_shadow *s = &L->shadow;
+	float size = L->type == RND_LIGHT_DIRECTIONAL ? L->angular_diameter : L->radius;
+	enum rnd_filter f = s->filter;
+	if (f == RND_FILTER_AUTO) f = size > 0 ? RND_FILTER_PCSS : RND_FILTER_PCF;
+	switch (f) {
+	case RND_FILTER_HARD: lp->filter = UMBRA_FILTER_HARD; break;
+	case RND_FILTER_PCF: lp->filter = UMBRA_FILTER_PCF; break;
+	case RND_FILTER_PCSS: lp->filter = UMBRA_FILTER_PCSS; break;
+	case RND_FILTER_VSM:
+	case RND_FILTER_EVSM:
+		lp->filter = UMBRA_FILTER_MOMENTS;
+		lp->moments = true;
+		lp->evsm = f == RND_FILTER_EVSM;
+		lp->evsm_exponent = s->vsm_exponent;
+		lp->fp16 = s->vsm_precision == RND_VSM_FP16;
+		break;
+	default:
+		return rnd_fail(err, RND_ERR_INVALID, "light %u: unknown shadow filter %d", i, (int)f);
+	}
+	lp->pcf_radius = s->pcf_radius > 5 ? 5 : s->pcf_radius;
+	lp->search_texels = 24.0f;
+	/* Defaults come from rnd_shadow_defaults(); see there. */
+	lp->bias_constant = s->bias_constant; lp->bias_slope = s->bias_slope; lp->bias_normal = s->bias_normal;
+	return RND_OK;
+}
+
+/* Clipmap: concentric camera-centred levels, each twice as wide as the one before; every level
+ * snapped to its own texel grid. */
+static void plan_clipmap(const struct rnd_shadow *s, uint32_t i, const float view[16], const float d[3], float zmin,
+                         float zmax, const struct rnd_aabb *bounds, const struct rnd_camera_plan *cam, uint32_t ncasc,
+                         struct rnd_light_plan *lp, struct rnd_shadow_plan *out)
+{
+	float fres = (float)lp->resolution;
+	float maxd = s->max_distance > 0 ? s->max_distance : fminf(cam->zfar, max_dist(cam->pos, bounds));
+	float extent = s->clipmap_extent > 0 ? s->clipmap_extent : 2.0f * maxd / (float)(1u << (ncasc - 1));
+	float eye_ls[3];
+	rnd_mat4_mul_point(eye_ls, view, cam->pos);
+	for (uint32_t c = 0; c < ncasc; c++) {
+		float half = 0.5f * extent * (float)(1u << c);
+		float texel = 2.0f * half / fres;
+		float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
+		float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
+		ortho_view(next_view(out, i, true), view, cx, cy, half, zmin, zmax, fres, d);
+	}
+	lp->clipmap = true;
+	lp->max_distance = s->max_distance > 0 ? s->max_distance : 0.5f * extent * (float)(1u << (ncasc - 1));
+}
+
+/* Cascades: camera-centred spheres of the split slices, snapped to whole texels. */
+static void plan_cascades(const struct rnd_shadow *s, uint32_t i, const float view[16], const float d[3], float zmin,
+                          float zmax, const struct rnd_aabb *bounds, const struct rnd_camera_plan *cam,
+                          uint32_t ncasc, struct rnd_light_plan *lp, struct rnd_shadow_plan *out)
+{
+	float fres = (float)lp->resolution;
+	/* Splits must not depend on where the camera is (a derived near/far does), or the
+	 * cascades' texel size would change as it moves: use the light's max_distance, else the
+	 * caller's far, capped by the scene's size. */
+	float diag[3];
+	rnd_v3_sub(diag, bounds->max, bounds->min);
+	float maxd = rnd_v3_length(diag);
+	if (cam->user_far > 0 && cam->user_far < maxd) maxd = cam->user_far;
+	if (s->max_distance > 0) maxd = s->max_distance;
+	float split_near = cam->user_near > 0 ? cam->user_near : fmaxf(0.05f, maxd / 2000.0f);
+	split_near = fmaxf(split_near, 0.05f);
+	if (maxd <= split_near) maxd = split_near * 2.0f;
+	rnd_cascade_splits(split_near, maxd, ncasc, s->split_lambda, lp->splits);
+	lp->max_distance = maxd;
+	/* Distance from the eye to a far corner of the slice at depth z. */
+	float k = cam->ortho ? 0.0f : tanf(cam->fov_y * 0.5f);
+	float corner = sqrtf(1.0f + k * k * (1.0f + cam->aspect * cam->aspect));
+	float eye_ls[3];
+	rnd_mat4_mul_point(eye_ls, view, cam->pos);
+	for (uint32_t c = 0; c < ncasc; c++) {
+		float r = lp->splits[c] * corner;
+		if (cam->ortho) {
+			float h = cam->ortho_height * 0.5f, w = h * cam->aspect;
+			r = sqrtf(lp->splits[c] * lp->splits[c] + h * h + w * w);
+		}
+		/* Round the radius up to a coarse step so small changes of near/far do not change
+		 * the texel size; then snap the centre to whole texels. */
+		r = ceilf(r * 16.0f) / 16.0f;
+		/* Room for the half texel that snapping moves the centre by and for the filter
+		 * footprint, so taps near a cascade's edge stay inside it. */
+		float margin = 0.5f + (float)lp->pcf_radius + 2.0f +
+		               (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
+		r *= fres / (fres - 2.0f * margin);
+		float texel = 2.0f * r / fres;
+		float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
+		float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
+		ortho_view(next_view(out, i, true), view, cx, cy, r, zmin, zmax, fres, d);
+	}
+}
+
+/* A directional light's views: clipmap levels, one fitted map, or cascades. */
+static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, const struct rnd_aabb *bounds,
+                                        const struct rnd_camera_plan *cam, bool clipmap, bool cascades,
+                                        uint32_t ncasc, struct rnd_light_plan *lp, struct rnd_shadow_plan *out,
+                                        struct rnd_error *err)
+{
+	const struct rnd_shadow *s = &L->shadow;
+	float fres = (float)lp->resolution;
+	float d[3], view[16];
+	if (!rnd_v3_normalize(d, L->direction))
+		return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
+	light_basis(view, d);
+	float zmin, zmax;
+	depth_range(view, bounds, &zmin, &zmax);
+	if (clipmap) {
+		plan_clipmap(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
+	} else if (!cascades) {
+		/* fit: the light-space box around the scene bounds, square texels */
+		struct rnd_aabb lb;
+		rnd_aabb_transform(&lb, bounds, view);
+		float cx = 0.5f * (lb.min[0] + lb.max[0]), cy = 0.5f * (lb.min[1] + lb.max[1]);
+		float half = 0.5f * fmaxf(lb.max[0] - lb.min[0], lb.max[1] - lb.min[1]);
+		half *= 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
+		ortho_view(next_view(out, i, true), view, cx, cy, half, zmin, zmax, fres, d);
+		lp->max_distance = s->max_distance;
+	} else {
+		plan_cascades(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
+	}
+	lp->fade_start = lp->max_distance * (1.0f - fminf(fmaxf(s->fade, 0.0f), 1.0f));
+	return RND_OK;
+}
+
+/* A spot light's cone, or a point light's six cube faces. */
+static enum rnd_result plan_local(const struct rnd_light *L, uint32_t i, const struct rnd_aabb *bounds,
+                                  struct rnd_light_plan *lp, struct rnd_shadow_plan *out, struct rnd_error *err)
+{
+	float fres = (float)lp->resolution;
+	float reach = L->range > 0 ? L->range : max_dist(L->position, bounds);
+	float zfar = fmaxf(reach, 0.1f) * 1.01f;
+	float znear = fmaxf(zfar * 1e-3f, 0.01f);
+	/* Widen the frustum by the filter footprint so taps near an edge stay inside this view:
+	 * no seams between cube faces, no clipped cones. */
+	float margin = (float)(lp->pcf_radius + 2) + (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
+	float grow = 1.0f + 2.0f * margin / fres;
+	if (L->type == RND_LIGHT_SPOT) {
+		float d[3];
+		if (!rnd_v3_normalize(d, L->direction))
+			return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
+		float up[3] = {0, 1, 0};
+		if (fabsf(d[1]) > 0.99f) { up[1] = 0; up[2] = 1; }
+		float half = fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f);
+		float fov = 2.0f * atanf(tanf(half) * grow);
+		persp_view(next_view(out, i, false), L->position, d, up, fov, znear, zfar, fres);
+		return RND_OK;
+	}
+	static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+	static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+	float fov = 2.0f * atanf(grow);
+	for (int f6 = 0; f6 < 6; f6++)
+		persp_view(next_view(out, i, false), L->position, dirs[f6], ups[f6], fov, znear, zfar, fres);
+	return RND_OK;
+}
+
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                      const struct rnd_camera_plan *cam, const uint8_t *forced,
                                      struct rnd_shadow_plan *out, struct rnd_error *err)
@@ -267,6 +441,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		const struct rnd_light *L = &scene->lights[i];
 		const struct rnd_shadow *s = &L->shadow;
 		struct rnd_light_plan *lp = &out->lights[i];
+		enum rnd_result r;
 		if (!s->enabled) continue;
 		/* Tile size: the light's resolution rounded up to a power of two (atlas tiles), else
 		 * by type: a sun map covers the whole view, a spot cone less, a cube face a sixth. */
@@ -276,29 +451,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		while (res < want && res < 8192) res *= 2;
 		lp->resolution = res;
 		if (res > out->resolution) out->resolution = res;
-		float fres = (float)res;
-		float size = L->type == RND_LIGHT_DIRECTIONAL ? L->angular_diameter : L->radius;
-		enum rnd_filter f = s->filter;
-		if (f == RND_FILTER_AUTO) f = size > 0 ? RND_FILTER_PCSS : RND_FILTER_PCF;
-		switch (f) {
-		case RND_FILTER_HARD: lp->filter = UMBRA_FILTER_HARD; break;
-		case RND_FILTER_PCF: lp->filter = UMBRA_FILTER_PCF; break;
-		case RND_FILTER_PCSS: lp->filter = UMBRA_FILTER_PCSS; break;
-		case RND_FILTER_VSM:
-		case RND_FILTER_EVSM:
-			lp->filter = UMBRA_FILTER_MOMENTS;
-			lp->moments = true;
-			lp->evsm = f == RND_FILTER_EVSM;
-			lp->evsm_exponent = s->vsm_exponent;
-			lp->fp16 = s->vsm_precision == RND_VSM_FP16;
-			break;
-		default:
-			return rnd_fail(err, RND_ERR_INVALID, "light %u: unknown shadow filter %d", i, (int)f);
-		}
-		lp->pcf_radius = s->pcf_radius > 5 ? 5 : s->pcf_radius;
-		lp->search_texels = 24.0f;
-		/* Defaults come from rnd_shadow_defaults(); see there. */
-		lp->bias_constant = s->bias_constant; lp->bias_slope = s->bias_slope; lp->bias_normal = s->bias_normal;
+		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false, clipmap = false;
 		uint32_t ncasc = 1;
@@ -318,115 +471,9 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 			                   UMBRA_MAX_SHADOW_VIEWS);
 		lp->first_view = out->view_count;
 		lp->view_count = need;
-
-		if (L->type == RND_LIGHT_DIRECTIONAL) {
-			float d[3], view[16];
-			if (!rnd_v3_normalize(d, L->direction))
-				return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
-			light_basis(view, d);
-			float zmin, zmax;
-			depth_range(view, bounds, &zmin, &zmax);
-			if (clipmap) {
-				/* Concentric camera-centred levels, each twice as wide as the one before;
-				 * every level snapped to its own texel grid. */
-				float maxd = s->max_distance > 0 ? s->max_distance : fminf(cam->zfar, max_dist(cam->pos, bounds));
-				float extent = s->clipmap_extent > 0 ? s->clipmap_extent : 2.0f * maxd / (float)(1u << (ncasc - 1));
-				float eye_ls[3];
-				rnd_mat4_mul_point(eye_ls, view, cam->pos);
-				for (uint32_t c = 0; c < ncasc; c++) {
-					float half = 0.5f * extent * (float)(1u << c);
-					float texel = 2.0f * half / fres;
-					float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
-					float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
-					ortho_view(&out->views[out->view_count], view, cx, cy, half, zmin, zmax, fres, d);
-					out->view_light[out->view_count] = i;
-					out->view_ortho[out->view_count++] = true;
-				}
-				lp->clipmap = true;
-				lp->max_distance = s->max_distance > 0 ? s->max_distance : 0.5f * extent * (float)(1u << (ncasc - 1));
-			} else if (!cascades) {
-				/* fit: the light-space box around the scene bounds, square texels */
-				struct rnd_aabb lb;
-				rnd_aabb_transform(&lb, bounds, view);
-				float cx = 0.5f * (lb.min[0] + lb.max[0]), cy = 0.5f * (lb.min[1] + lb.max[1]);
-				float half = 0.5f * fmaxf(lb.max[0] - lb.min[0], lb.max[1] - lb.min[1]);
-				half *= 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
-				ortho_view(&out->views[out->view_count], view, cx, cy, half, zmin, zmax, fres, d);
-				out->view_light[out->view_count] = i;
-				out->view_ortho[out->view_count++] = true;
-				lp->max_distance = s->max_distance;
-			} else {
-				/* Splits must not depend on where the camera is (a derived near/far does), or
-				 * the cascades' texel size would change as it moves: use the light's
-				 * max_distance, else the caller's far, capped by the scene's size. */
-				float diag[3];
-				rnd_v3_sub(diag, bounds->max, bounds->min);
-				float maxd = rnd_v3_length(diag);
-				if (cam->user_far > 0 && cam->user_far < maxd) maxd = cam->user_far;
-				if (s->max_distance > 0) maxd = s->max_distance;
-				float split_near = cam->user_near > 0 ? cam->user_near : fmaxf(0.05f, maxd / 2000.0f);
-				split_near = fmaxf(split_near, 0.05f);
-				if (maxd <= split_near) maxd = split_near * 2.0f;
-				rnd_cascade_splits(split_near, maxd, ncasc, s->split_lambda, lp->splits);
-				lp->max_distance = maxd;
-				/* Distance from the eye to a far corner of the slice at depth z. */
-				float k = cam->ortho ? 0.0f : tanf(cam->fov_y * 0.5f);
-				float corner = sqrtf(1.0f + k * k * (1.0f + cam->aspect * cam->aspect));
-				float eye_ls[3];
-				rnd_mat4_mul_point(eye_ls, view, cam->pos);
-				for (uint32_t c = 0; c < ncasc; c++) {
-					float r = lp->splits[c] * corner;
-					if (cam->ortho) {
-						float h = cam->ortho_height * 0.5f, w = h * cam->aspect;
-						r = sqrtf(lp->splits[c] * lp->splits[c] + h * h + w * w);
-					}
-					/* Round the radius up to a coarse step so small changes of near/far do not
-					 * change the texel size; then snap the centre to whole texels. */
-					r = ceilf(r * 16.0f) / 16.0f;
-					/* Room for the half texel that snapping moves the centre by and for the
-					 * filter footprint, so taps near a cascade's edge stay inside it. */
-					float margin = 0.5f + (float)lp->pcf_radius + 2.0f +
-					               (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
-					r *= fres / (fres - 2.0f * margin);
-					float texel = 2.0f * r / fres;
-					float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
-					float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
-					ortho_view(&out->views[out->view_count], view, cx, cy, r, zmin, zmax, fres, d);
-					out->view_light[out->view_count] = i;
-					out->view_ortho[out->view_count++] = true;
-				}
-			}
-			lp->fade_start = lp->max_distance * (1.0f - fminf(fmaxf(s->fade, 0.0f), 1.0f));
-		} else {
-			float reach = L->range > 0 ? L->range : max_dist(L->position, bounds);
-			float zfar = fmaxf(reach, 0.1f) * 1.01f;
-			float znear = fmaxf(zfar * 1e-3f, 0.01f);
-			/* Widen the frustum by the filter footprint so taps near an edge stay inside
-			 * this view: no seams between cube faces, no clipped cones. */
-			float margin = (float)(lp->pcf_radius + 2) + (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
-			float grow = 1.0f + 2.0f * margin / fres;
-			if (L->type == RND_LIGHT_SPOT) {
-				float d[3];
-				if (!rnd_v3_normalize(d, L->direction))
-					return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
-				float up[3] = {0, 1, 0};
-				if (fabsf(d[1]) > 0.99f) { up[1] = 0; up[2] = 1; }
-				float half = fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f);
-				float fov = 2.0f * atanf(tanf(half) * grow);
-				persp_view(&out->views[out->view_count], L->position, d, up, fov, znear, zfar, fres);
-				out->view_light[out->view_count] = i;
-				out->view_ortho[out->view_count++] = false;
-			} else {
-				static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-				static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-				float fov = 2.0f * atanf(grow);
-				for (int f6 = 0; f6 < 6; f6++) {
-					persp_view(&out->views[out->view_count], L->position, dirs[f6], ups[f6], fov, znear, zfar, fres);
-					out->view_light[out->view_count] = i;
-					out->view_ortho[out->view_count++] = false;
-				}
-			}
-		}
+		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, cam, clipmap, cascades, ncasc, lp, out, err)
+		                                     : plan_local(L, i, bounds, lp, out, err);
+		if (r != RND_OK) return r;
 	}
 	return RND_OK;
 }

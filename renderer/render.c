@@ -56,7 +56,7 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_AOVS, 0, "%u AOV planes: at most %d (shadow AOVs of at most %d lights)",
 		                   planes, RND_MAX_AOV_PLANES, RND_MAX_AOV_PLANES - 7);
 	if (sc->view_count && !sc->views) return rnd_fail(err, RND_ERR_INVALID, "view_count %u with no views", sc->view_count);
-	if (sc->view_count > 1024) return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "%u views: at most 1024", sc->view_count);
+	if (sc->view_count > RND_MAX_VIEWS) return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "%u views: at most %u", sc->view_count, RND_MAX_VIEWS);
 	return RND_OK;
 }
 
@@ -206,8 +206,7 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 		w[i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
 			.descriptorCount = 1,
-			.descriptorType = i == 0 || i == 2 || i == 3 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-			                : i == 4 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+			.descriptorType = rnd_binding_type[i],
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
@@ -382,7 +381,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	uint32_t cols, rows;
 	rnd_sheet_layout(nviews, &cols, &rows);
 	uint64_t sheet_w = (uint64_t)cols * sc->width, sheet_h = (uint64_t)rows * sc->height;
-	if (sheet_w > 65536 || sheet_h > 65536 || sheet_w * sheet_h > (1ull << 28))
+	if (sheet_w > RND_MAX_SHEET_SIDE || sheet_h > RND_MAX_SHEET_SIDE || sheet_w * sheet_h > RND_MAX_SHEET_PIXELS)
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_VIEWS, 0, "a sheet of %u views is %llux%llu pixels: too large", nviews,
 		                (unsigned long long)sheet_w, (unsigned long long)sheet_h);
 	struct rnd_estimate est;
@@ -417,7 +416,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	struct rnd_aabb obj_bounds;
 	rnd_aabb_empty(&obj_bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++)
-		if (sc->objects[i].shape != RND_SHAPE_PLANE && !(draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER))
+		if (rnd_object_frames(&sc->objects[i], sc->material_count ? sc->materials : NULL))
 			rnd_aabb_union(&obj_bounds, &draws[i].bounds);
 	if (rnd_aabb_is_empty(&obj_bounds)) obj_bounds = bounds;
 	if ((r = rnd_material_textures(ctx, s, sc, draws, tex, &ntex, err)) != RND_OK) goto done;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mesh.h"
+#include "umbra_shared.h"
 #include "umbra/rnd.h"
 #include "umbra/rnd_math.h"
 
@@ -119,6 +120,13 @@ void rnd_light_defaults(struct rnd_light *l, enum rnd_light_type type)
 	l->radius = 0.0f;
 	rnd_shadow_defaults(&l->shadow);
 }
+
+bool rnd_object_frames(const struct rnd_object *o, const struct rnd_material *mats)
+{
+	return o->shape != RND_SHAPE_PLANE && !(mats && mats[o->material].shadow_catcher);
+}
+
+/* The public limits restate the shaders' where both exist (rnd.h needs no shader header). */
 
 void rnd_image_release(struct rnd_image *img)
 {

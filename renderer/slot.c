@@ -5,6 +5,38 @@
 #include <string.h>
 #include "slot.h"
 
+/* A descriptor pool (named "slot N <what> descriptor pool") holding exactly `count` sets, one
+ * per layouts[i], all allocated into sets[]. On failure nothing is left. Descriptor sets stay
+ * unnamed: lavapipe never frees a set's debug name with its pool. */
+static enum rnd_result pool_with_sets(struct rnd_context *ctx, const VkDescriptorPoolSize *sizes, uint32_t nsizes,
+                                      uint32_t count, const VkDescriptorSetLayout *layouts, const char *what,
+                                      uint32_t index, VkDescriptorPool *pool, VkDescriptorSet *sets,
+                                      struct rnd_error *err)
+{
+	VkResult vr;
+	VkDescriptorPoolCreateInfo dpi = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = count, .poolSizeCount = nsizes,
+		.pPoolSizes = sizes,
+	};
+	char call[64];
+	snprintf(call, sizeof call, "vkCreateDescriptorPool%s%s%s", what[0] ? " (" : "", what, what[0] ? ")" : "");
+	if ((vr = vkCreateDescriptorPool(ctx->device, &dpi, NULL, pool)) != VK_SUCCESS) return rnd_fail_vk(err, vr, call);
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, *pool, "slot %u %s%sdescriptor pool", index, what, what[0] ? " " : "");
+	VkDescriptorSetAllocateInfo dai = {
+		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = *pool,
+		.descriptorSetCount = count, .pSetLayouts = layouts,
+	};
+	if ((vr = vkAllocateDescriptorSets(ctx->device, &dai, sets)) != VK_SUCCESS) {
+		vkDestroyDescriptorPool(ctx->device, *pool, NULL);
+		*pool = VK_NULL_HANDLE;
+		snprintf(call, sizeof call, "vkAllocateDescriptorSets%s%s%s", what[0] ? " (" : "", what, what[0] ? ")" : "");
+		return rnd_fail_vk(err, vr, call);
+	}
+	return RND_OK;
+}
+
+/* One render slot: every object in creation order, unwound in reverse by the goto chain at the
+ * end (kept in one function so that the chain stays next to what it undoes). */
 static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, struct rnd_slot **out, struct rnd_error *err)
 {
 	VkResult vr;
@@ -59,42 +91,13 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
 		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
 	};
-	VkDescriptorPoolCreateInfo dpi = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 3, .pPoolSizes = sizes,
-	};
-	if ((vr = vkCreateDescriptorPool(ctx->device, &dpi, NULL, &s->desc_pool)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkCreateDescriptorPool");
+	if ((r = pool_with_sets(ctx, sizes, 3, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
 		goto fail_desc_pool;
-	}
-	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->desc_pool, "slot %u descriptor pool", index);
-	VkDescriptorSetAllocateInfo dai = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->desc_pool,
-		.descriptorSetCount = 1, .pSetLayouts = &ctx->pipes.set_layout,
-	};
-	if ((vr = vkAllocateDescriptorSets(ctx->device, &dai, &s->set)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets");
-		goto fail_set;
-	}
-	/* Descriptor sets stay unnamed: lavapipe never frees a set's debug name with its pool. */
 	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (1 + ntex) * UMBRA_TEX_SLOTS};
-	VkDescriptorPoolCreateInfo tpi = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1 + ntex, .poolSizeCount = 1,
-		.pPoolSizes = &tsize,
-	};
-	if ((vr = vkCreateDescriptorPool(ctx->device, &tpi, NULL, &s->texture_pool)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkCreateDescriptorPool (textures)");
-		goto fail_set;
-	}
-	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->texture_pool, "slot %u texture descriptor pool", index);
 	for (uint32_t i = 0; i < 1 + ntex; i++) layouts[i] = ctx->pipes.texture_layout;
-	VkDescriptorSetAllocateInfo tai = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->texture_pool,
-		.descriptorSetCount = 1 + ntex, .pSetLayouts = layouts,
-	};
-	if ((vr = vkAllocateDescriptorSets(ctx->device, &tai, s->texture_sets)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets (textures)");
-		goto fail_texture_pool;
-	}
+	if ((r = pool_with_sets(ctx, &tsize, 1, 1 + ntex, layouts, "texture", index, &s->texture_pool, s->texture_sets,
+	                        err)) != RND_OK)
+		goto fail_set;
 	char name[48];
 	snprintf(name, sizeof name, "slot %u white texture", index);
 	if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, 1, 1, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
@@ -109,28 +112,13 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		};
 	vkUpdateDescriptorSets(ctx->device, UMBRA_TEX_SLOTS, ww, 0, NULL);
 	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
-	VkDescriptorPoolCreateInfo mpi = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = msizes,
-	};
-	if ((vr = vkCreateDescriptorPool(ctx->device, &mpi, NULL, &s->moments_pool)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkCreateDescriptorPool (moments)");
+	if ((r = pool_with_sets(ctx, msizes, 2, 1, &ctx->moments.set_layout, "moments", index, &s->moments_pool,
+	                        &s->moments_set, err)) != RND_OK)
 		goto fail_white;
-	}
-	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_POOL, s->moments_pool, "slot %u moments descriptor pool", index);
-	VkDescriptorSetAllocateInfo mai = {
-		.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, .descriptorPool = s->moments_pool,
-		.descriptorSetCount = 1, .pSetLayouts = &ctx->moments.set_layout,
-	};
-	if ((vr = vkAllocateDescriptorSets(ctx->device, &mai, &s->moments_set)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkAllocateDescriptorSets (moments)");
-		goto fail_moments_pool;
-	}
 	free(layouts);
 	*out = s;
 	return RND_OK;
 
-fail_moments_pool:
-	vkDestroyDescriptorPool(ctx->device, s->moments_pool, NULL);
 fail_white:
 	rnd_image_destroy(ctx, &s->white);
 

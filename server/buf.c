@@ -59,21 +59,30 @@ void srv_buf_puts(struct srv_buf *b, const char *s)
 	b->len += n;
 }
 
-void srv_buf_json_str(struct srv_buf *b, const char *s)
+/* The one JSON string escaper of the server (logs, the CLI's report); JSON answers are
+ * jansson's (api/). */
+void srv_json_escape(char *dst, size_t size, const char *src)
 {
-	srv_buf_puts(b, "\"");
-	for (; s && *s; s++) {
-		unsigned char c = (unsigned char)*s;
-		if (c == '"' || c == '\\')
-			srv_buf_printf(b, "\\%c", c);
-		else if (c < 0x20)
-			srv_buf_printf(b, "\\u%04x", c);
-		else if (buf_reserve(b, 1)) {
-			b->data[b->len++] = (char)c;
-			b->data[b->len] = 0;
+	static const char hex[] = "0123456789abcdef";
+	size_t o = 0;
+	for (; src && *src && o + 7 < size; src++) {
+		unsigned char c = (unsigned char)*src;
+		if (c == '"' || c == '\\') {
+			dst[o++] = '\\';
+			dst[o++] = (char)c;
+		} else if (c < 0x20 || c == 0x7f) {
+			dst[o++] = '\\';
+			dst[o++] = 'u';
+			dst[o++] = '0';
+			dst[o++] = '0';
+			dst[o++] = hex[c >> 4];
+			dst[o++] = hex[c & 15];
+		} else {
+			dst[o++] = (char)c;
 		}
 	}
-	srv_buf_puts(b, "\"");
+	if (size)
+		dst[o < size ? o : size - 1] = 0;
 }
 
 char *srv_buf_detach(struct srv_buf *b, size_t *len)

@@ -17,6 +17,7 @@
  * UMBRA_VALIDATION=1 turns the Vulkan validation layer on; any message then fails the run.
  */
 #include <errno.h>
+#include <getopt.h>
 #include <limits.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -195,34 +196,44 @@ static unsigned uint_arg(const char *s, unsigned max)
 	return *s && !*end && v > 0 && v <= max ? (unsigned)v : 0;
 }
 
+/* getopt_long, as umbrad's flags.c: options and inputs in any order ("-" is an input: stdin). */
 static int parse_args(int argc, char **argv, struct args *a)
 {
+	enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
+	       O_REPORT, O_SIZE };
+	static const struct option lopts[] = {
+		{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
+		{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
+		{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
+		{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
+		{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
+		{0},
+	};
 	a->farm.progress = -1;
 	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
 	if (!a->inputs) return 1;
-	int i = 1;
-	if (argc > 1 && !strcmp(argv[1], "thumb")) a->thumb = true, i = 2;
-	for (; i < argc; i++) {
-		const char *s = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-		if (!strcmp(s, "-h") || !strcmp(s, "--help")) return usage(stdout, 0) - 1;
-		if (!strcmp(s, "--timings")) { a->timings = 1; continue; }
-		if (!strcmp(s, "--transparent")) { a->farm.transparent = true; continue; }
-		if (!strcmp(s, "--progress") || !strcmp(s, "--no-progress")) { a->farm.progress = s[2] == 'p'; continue; }
-		if (s[0] != '-' || !s[1]) { a->inputs[a->ninputs++] = s; continue; }
-		if (!v) return usage(stderr, 1);
-		i++;
-		if (!strcmp(s, "-o")) a->out = v;
-		else if (!strcmp(s, "--device")) a->device = v;
-		else if (!strcmp(s, "--asset-root")) a->farm.asset_root = v;
-		else if (!strcmp(s, "--manifest")) a->manifest = v;
-		else if (!strcmp(s, "--report")) a->report = v;
-		else if (!strcmp(s, "-j") && (a->farm.threads = uint_arg(v, 64))) continue;
-		else if (!strcmp(s, "--size") && (a->farm.size = uint_arg(v, 8192))) continue;
-		else {
-			fprintf(stderr, "umbra-render: bad option %s %s\n", s, v);
+	optind = 1;
+	if (argc > 1 && !strcmp(argv[1], "thumb")) a->thumb = true, optind = 2;
+	for (int c; (c = getopt_long(argc, argv, "ho:j:", lopts, NULL)) != -1;) {
+		switch (c) {
+		case 'h': return usage(stdout, 0) - 1;
+		case 'o': a->out = optarg; break;
+		case O_TIMINGS: a->timings = 1; break;
+		case O_TRANSPARENT: a->farm.transparent = true; break;
+		case O_PROGRESS: case O_NO_PROGRESS: a->farm.progress = c == O_PROGRESS; break;
+		case O_DEVICE: a->device = optarg; break;
+		case O_ASSET_ROOT: a->farm.asset_root = optarg; break;
+		case O_MANIFEST: a->manifest = optarg; break;
+		case O_REPORT: a->report = optarg; break;
+		case 'j': case O_SIZE:
+			if ((c == 'j' ? (a->farm.threads = uint_arg(optarg, 64)) : (a->farm.size = uint_arg(optarg, 8192))))
+				break;
+			fprintf(stderr, "umbra-render: bad option %s %s\n", c == 'j' ? "-j" : "--size", optarg);
 			return usage(stderr, 1);
+		default: return usage(stderr, 1);   /* getopt_long said what was wrong */
 		}
 	}
+	for (int i = optind; i < argc; i++) a->inputs[a->ninputs++] = argv[i];
 	if (!a->ninputs && !a->manifest) return usage(stderr, 1);
 	return 0;
 }

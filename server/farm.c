@@ -15,6 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "api.h"
+#include "buf.h"
 #include "farm.h"
 #include "umbra/rnd.h"
 
@@ -264,14 +265,11 @@ static void *worker(void *arg)
 
 static void json_str(FILE *fp, const char *s)
 {
-	fputc('"', fp);
-	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-		if (*p == '"' || *p == '\\') fprintf(fp, "\\%c", *p);
-		else if (*p == '\n') fputs("\\n", fp);
-		else if (*p < 0x20) fprintf(fp, "\\u%04x", *p);
-		else fputc(*p, fp);
-	}
-	fputc('"', fp);
+	size_t n = strlen(s) * 6 + 1;   /* every byte may become \u00XX */
+	char *e = malloc(n);
+	if (e) srv_json_escape(e, n, s);
+	fprintf(fp, "\"%s\"", e ? e : "");
+	free(e);
 }
 
 static int write_report(const struct farm *f, const char *path)

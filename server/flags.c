@@ -38,7 +38,7 @@ static const struct opt_def opts[] = {
 	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
 	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
 	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to (none: `path` is a 400)", CFG(asset_root), 0, 0 },
-	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", LIM(model_cache_bytes), 0, UINT64_MAX },
+	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", CFG(model_cache_bytes), 0, UINT64_MAX },
 	{ "import-timeout-ms", OPT_UINT, "MS", "wall-clock and CPU limit of one sandboxed model import (10000)", LIM(import_timeout_ms), 1, 3600000 },
 	{ "import-memory", OPT_SIZE, "BYTES", "memory limit of one sandboxed model import, 0 = none (2G)", LIM(import_memory), 0, UINT64_MAX },
 	{ "max-textures", OPT_UINT, "N", "distinct textures in one scene, capped by the device's limit (256)", LIM(max_textures), 1, 1000000 },
@@ -137,7 +137,7 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 		}
 		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
 		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles) ||
-		    o->offset == LIM(model_cache_bytes) || o->offset == CFG(max_memory) ||
+		    o->offset == CFG(model_cache_bytes) || o->offset == CFG(max_memory) ||
 		    o->offset == LIM(import_memory))
 			*(uint64_t *)(base + o->offset) = v;
 		else
@@ -194,9 +194,9 @@ unsigned srv_default_workers(const char *root, const char *self_cgroup, unsigned
 	return n < (long long)cpus ? (unsigned)n : cpus;
 }
 
-int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+/* The contract's defaults, then UMBRA_VALIDATION and UMBRA_NO_PLAYGROUND. */
+static void set_defaults(struct srv_config *cfg)
 {
-	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
 	memset(cfg, 0, sizeof *cfg);
 	cfg->listen = "127.0.0.1:8080";
 	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
@@ -208,6 +208,7 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	cfg->atlas_size = 8192;
 	cfg->max_body = 64ull << 20;
 	api_limits_defaults(&cfg->limits);
+	cfg->model_cache_bytes = 256u << 20;
 	cfg->deadline_ms = 30000;
 	cfg->log_format = SRV_LOG_TEXT;
 	cfg->max_connections = 1024;
@@ -222,6 +223,12 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	cfg->validation = v && *v && strcmp(v, "0") != 0;
 	v = getenv("UMBRA_NO_PLAYGROUND");
 	cfg->no_playground = v && *v && strcmp(v, "0") != 0;
+}
+
+int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+{
+	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
+	set_defaults(cfg);
 
 	/* Environment first. */
 	for (size_t i = 0; i < OPT_COUNT; i++) {

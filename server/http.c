@@ -9,6 +9,8 @@
  *   next calls (body chunks)   appended and hashed (ETag); past --max-body -> 413.
  *   last call  (body complete) If-None-Match -> 304, else suspend + queue (full -> 503).
  *   after resume               the worker's answer is sent.
+ * This file dispatches (routes, methods, the GET routes) and answers; POST /v1/render's headers
+ * and body are render_route.c's, the negotiation rules negotiate.c's.
  * The request struct is freed in the completion callback, which also ends the pending count
  * that the drain at exit waits for.
  */
@@ -24,25 +26,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "buf.h"
 #include "conn.h"
 #include "log.h"
 #include "metrics.h"
+#include "http.h"
 #include "queue.h"
-#include "srv.h"
-
-#define FNV_OFFSET 0xcbf29ce484222325ull
-#define FNV_PRIME 0x100000001b3ull
-
-static uint64_t fnv1a(uint64_t h, const void *data, size_t len)
-{
-	const unsigned char *p = data;
-	for (size_t i = 0; i < len; i++) {
-		h ^= p[i];
-		h *= FNV_PRIME;
-	}
-	return h;
-}
 
 const char *srv_route_name(enum srv_route r)
 {
@@ -102,8 +90,8 @@ static void request_free(struct srv_request *req)
 
 /* Queues an answer. body is malloc'd and becomes libmicrohttpd's (freed with free()), or NULL.
  * Logs the request and counts it. Returns what the access handler returns. */
-static enum MHD_Result respond(struct srv_request *req, int status, const char *content_type,
-                               void *body, size_t len, const char *allow)
+enum MHD_Result srv_respond(struct srv_request *req, int status, const char *content_type,
+                            void *body, size_t len, const char *allow)
 {
 	struct srv_server *s = req->srv;
 	struct MHD_Response *resp =
@@ -144,18 +132,14 @@ static enum MHD_Result respond(struct srv_request *req, int status, const char *
 	return r;
 }
 
-static enum MHD_Result respond_problem(struct srv_request *req, int status, const char *allow,
-                                       const char *pointer, const char *fmt, ...)
-	__attribute__((format(printf, 5, 6)));
-
 void srv_request_note_problem(struct srv_request *req, const struct api_problem *p)
 {
 	snprintf(req->problem_pointer, sizeof req->problem_pointer, "%s", p->pointer);
 	snprintf(req->problem_detail, sizeof req->problem_detail, "%s", p->detail);
 }
 
-static enum MHD_Result respond_problem(struct srv_request *req, int status, const char *allow,
-                                       const char *pointer, const char *fmt, ...)
+enum MHD_Result srv_respond_problem(struct srv_request *req, int status, const char *allow,
+                                    const char *pointer, const char *fmt, ...)
 {
 	struct api_problem p;
 	char detail[512];
@@ -166,7 +150,7 @@ static enum MHD_Result respond_problem(struct srv_request *req, int status, cons
 	api_problem_set(&p, status, pointer, "%s", detail);
 	srv_request_note_problem(req, &p);
 	char *json = api_problem_json(&p);
-	return respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, allow);
+	return srv_respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, allow);
 }
 
 /* A request whose framing is unusable (see conn.h): problem+json typed as an HTTP error, not
@@ -181,13 +165,13 @@ static enum MHD_Result respond_framing(struct srv_request *req, int status, cons
 	req->close_after = true;
 	srv_request_note_problem(req, &p);
 	char *json = api_problem_json(&p);
-	return respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, NULL);
+	return srv_respond(req, status, "application/problem+json", json, json ? strlen(json) : 0, NULL);
 }
 
 static enum MHD_Result respond_text(struct srv_request *req, int status, const char *ctype, const char *text)
 {
 	char *body = strdup(text);
-	return respond(req, status, ctype, body, body ? strlen(body) : 0, NULL);
+	return srv_respond(req, status, ctype, body, body ? strlen(body) : 0, NULL);
 }
 
 /* ---- GET routes ---- */
@@ -195,42 +179,26 @@ static enum MHD_Result respond_text(struct srv_request *req, int status, const c
 static enum MHD_Result answer_info(struct srv_request *req)
 {
 	struct srv_server *s = req->srv;
-	struct srv_buf b = { 0 };
 	const struct srv_config *c = &s->cfg;
 	struct rnd_info info;
 	pthread_rwlock_rdlock(&s->ctx_lock);
 	info = s->info;
 	pthread_rwlock_unlock(&s->ctx_lock);
-
-	srv_buf_puts(&b, "{\"name\":\"umbrad\",\"version\":");
-	srv_buf_json_str(&b, UMBRA_VERSION);
-	srv_buf_puts(&b, ",\"contract\":\"scene-v1\",\"device\":");
-	srv_buf_json_str(&b, info.device_name);
-	srv_buf_puts(&b, ",\"driver\":");
-	srv_buf_json_str(&b, info.driver_name);
-	srv_buf_puts(&b, ",\"driver_info\":");
-	srv_buf_json_str(&b, info.driver_info);
-	srv_buf_printf(&b, ",\"vulkan_api\":\"%u.%u.%u\",\"cpu\":%s", (info.api_version >> 22) & 0x7fu,
-	               (info.api_version >> 12) & 0x3ffu, info.api_version & 0xfffu, info.is_cpu ? "true" : "false");
-	srv_buf_printf(&b, ",\"limits\":{\"max_body\":%llu,\"max_pixels\":%llu,\"max_triangles\":%llu,"
-	                   "\"max_lights\":%u,\"max_shadow_resolution\":%u,\"max_dimension\":%u,"
-	                   "\"device_max_shadow_resolution\":%u,\"deadline_ms\":%u,\"queue\":%u,\"workers\":%u,"
-	                   "\"max_memory\":%llu,\"device_max_allocation\":%llu,\"import_timeout_ms\":%u,\"import_memory\":%llu,"
-	                   "\"max_textures\":%u,\"device_max_textures\":%u}",
-	               (unsigned long long)c->max_body, (unsigned long long)c->limits.max_pixels,
-	               (unsigned long long)c->limits.max_triangles, c->limits.max_lights,
-	               c->limits.max_shadow_resolution, info.max_image_dimension < 8192 ? info.max_image_dimension : 8192,
-	               info.max_shadow_resolution, c->deadline_ms, c->queue, c->workers,
-	               (unsigned long long)c->max_memory, (unsigned long long)info.max_allocation, c->limits.import_timeout_ms,
-	               (unsigned long long)c->limits.import_memory, info.max_textures, info.device_max_textures);
-	srv_buf_puts(&b, ",\"filters\":[\"hard\",\"pcf\",\"pcss\",\"vsm\",\"evsm\"]"
-	                 ",\"formats\":[\"png\",\"exr\"],\"media_types\":[\"image/png\",\"image/x-exr\"]"
-	                 ",\"priorities\":[\"interactive\",\"bulk\"]}\n");
-	size_t len;
-	char *json = srv_buf_detach(&b, &len);
+	struct api_info in = {
+		.version = UMBRA_VERSION, .device = info.device_name, .driver = info.driver_name,
+		.driver_info = info.driver_info, .vulkan_api = info.api_version, .cpu = info.is_cpu,
+		.limits = c->limits, .max_body = c->max_body, .max_memory = c->max_memory,
+		.device_max_allocation = info.max_allocation,
+		.max_dimension = info.max_image_dimension < RND_MAX_DIMENSION ? info.max_image_dimension : RND_MAX_DIMENSION,
+		.device_max_shadow_resolution = info.max_shadow_resolution, .deadline_ms = c->deadline_ms,
+		.queue = c->queue, .workers = c->workers, .max_textures = info.max_textures,
+		.device_max_textures = info.device_max_textures,
+	};
+	size_t len = 0;
+	char *json = api_info_json(&in, &len);
 	if (!json)
 		return MHD_NO;
-	return respond(req, 200, "application/json", json, len, NULL);
+	return srv_respond(req, 200, "application/json", json, len, NULL);
 }
 
 static enum MHD_Result answer_metrics(struct srv_request *req)
@@ -239,355 +207,20 @@ static enum MHD_Result answer_metrics(struct srv_request *req)
 	char *text = srv_metrics_text(req->srv, &len);
 	if (!text)
 		return MHD_NO;
-	return respond(req, 200, "text/plain; version=0.0.4; charset=utf-8", text, len, NULL);
+	return srv_respond(req, 200, "text/plain; version=0.0.4; charset=utf-8", text, len, NULL);
 }
 
-static bool is_ready(const struct srv_server *s)
+bool srv_is_ready(const struct srv_server *s)
 {
 	return atomic_load(&s->ready) && !atomic_load(&s->draining);
 }
 
-static enum MHD_Result answer_not_ready(struct srv_request *req)
+enum MHD_Result srv_answer_not_ready(struct srv_request *req)
 {
 	struct srv_server *s = req->srv;
 	if (atomic_load(&s->draining))
-		return respond_problem(req, 503, NULL, "", "the server is shutting down");
-	return respond_problem(req, 503, NULL, "", "the renderer is not ready yet (device start-up and pipeline warm-up)");
-}
-
-/* ---- POST /v1/render ---- */
-
-/* Content-Type must be application/json (parameters such as charset allowed) or a +json type. */
-static bool json_content_type(const char *ct)
-{
-	if (!ct)
-		return false;
-	while (*ct == ' ' || *ct == '\t')
-		ct++;
-	size_t n = strcspn(ct, "; \t");
-	if (n == 16 && !strncasecmp(ct, "application/json", 16))
-		return true;
-	return n > 17 && !strncasecmp(ct, "application/", 12) && !strncasecmp(ct + n - 5, "+json", 5);
-}
-
-static bool multipart_content_type(const char *ct)
-{
-	if (!ct)
-		return false;
-	while (*ct == ' ' || *ct == '\t')
-		ct++;
-	return !strncasecmp(ct, "multipart/form-data", 19) && strchr("; \t", ct[19]);
-}
-
-/* Grows a byte buffer to hold `need` bytes plus a NUL. */
-static bool grow(uint8_t **data, size_t *cap, size_t need)
-{
-	if (need + 1 <= *cap)
-		return true;
-	size_t c = *cap ? *cap : 4096;
-	while (c < need + 1)
-		c *= 2;
-	uint8_t *p = realloc(*data, c);
-	if (!p)
-		return false;
-	*data = p;
-	*cap = c;
-	return true;
-}
-
-#define MAX_PARTS 64
-
-/* libmicrohttpd's multipart parser hands over each part's bytes in order. */
-static enum MHD_Result part_data(void *cls, enum MHD_ValueKind kind, const char *key, const char *filename,
-                                 const char *content_type, const char *transfer_encoding, const char *data,
-                                 uint64_t off, size_t size)
-{
-	struct srv_request *req = cls;
-	(void)kind; (void)filename; (void)content_type; (void)transfer_encoding;
-	if (!key)
-		return MHD_YES;
-	struct srv_part *part = NULL;
-	for (size_t i = 0; i < req->part_count; i++)
-		if (!strcmp(req->parts[i].name, key))
-			part = &req->parts[i];
-	if (part && off == 0 && part->len) {
-		req->part_error = "two parts have the same name";
-		return MHD_NO;
-	}
-	if (!part) {
-		if (req->part_count == MAX_PARTS) {
-			req->part_error = "more than 64 parts";
-			return MHD_NO;
-		}
-		struct srv_part *parts = realloc(req->parts, (req->part_count + 1) * sizeof *parts);
-		if (!parts)
-			return MHD_NO;
-		req->parts = parts;
-		part = &parts[req->part_count];
-		*part = (struct srv_part){ .name = strdup(key) };
-		if (!part->name)
-			return MHD_NO;
-		req->part_count++;
-	}
-	if (!grow(&part->data, &part->cap, part->len + size))
-		return MHD_NO;
-	memcpy(part->data + part->len, data, size);
-	part->len += size;
-	part->data[part->len] = 0;
-	return MHD_YES;
-}
-
-/* Accept: 1 when image/x-exr is preferred (higher q) over image/png, 0 for PNG (also without
- * the header; a tie keeps PNG, the default), -1 when the header accepts neither (q = 0 or not
- * named, no wildcard): that request is answered 406. Wildcards count with their q for both. */
-static int accept_choice(const char *accept)
-{
-	if (!accept || !*accept)
-		return 0;
-	double q_png = -1, q_exr = -1, q_wild = -1;
-	bool spec_png = false, spec_exr = false;
-	const char *p = accept;
-	while (*p) {
-		while (*p == ' ' || *p == ',')
-			p++;
-		if (!*p)
-			break;
-		size_t item = strcspn(p, ",");
-		char buf[128];
-		size_t n = item < sizeof buf - 1 ? item : sizeof buf - 1;
-		memcpy(buf, p, n);
-		buf[n] = 0;
-		p += item;
-		double q = 1;
-		char *semi = strchr(buf, ';');
-		if (semi) {
-			*semi = 0;
-			char *qs = strstr(semi + 1, "q=");
-			if (qs)
-				q = strtod(qs + 2, NULL);
-		}
-		char *end = buf + strlen(buf);
-		while (end > buf && (end[-1] == ' ' || end[-1] == '\t'))
-			*--end = 0;
-		if (!strcasecmp(buf, "image/png")) {
-			q_png = q;
-			spec_png = true;
-		} else if (!strcasecmp(buf, "image/x-exr")) {
-			q_exr = q;
-			spec_exr = true;
-		} else if (!strcasecmp(buf, "image/*") || !strcasecmp(buf, "*/*")) {
-			if (q > q_wild)
-				q_wild = q;
-		}
-	}
-	if (!spec_png)
-		q_png = q_wild;
-	if (!spec_exr)
-		q_exr = q_wild;
-	if (q_png <= 0 && q_exr <= 0)
-		return -1;
-	return q_exr > 0 && q_exr > q_png ? 1 : 0;
-}
-
-/* Called by queue_push() under the queue lock, once the push is certain (see queue.h). */
-static void suspend_before_push(struct srv_request *req)
-{
-	req->state = SRV_REQ_QUEUED;
-	req->t_queued = srv_now();
-	MHD_suspend_connection(req->conn);
-}
-
-bool srv_etag_matches(const char *inm, const char *etag)
-{
-	if (!inm)
-		return false;
-	size_t el = strlen(etag);
-	const char *p = inm;
-	while (*p) {
-		while (*p == ' ' || *p == ',' || *p == '\t')
-			p++;
-		if (!*p)
-			break;
-		/* "*" is not a match: a render always has a representation to make, and an
-		 * unconditional 304 would hide it. */
-		if (!strncmp(p, "W/", 2))
-			p += 2;
-		size_t n = strcspn(p, ", \t");
-		if (n == el && !strncmp(p, etag, el))
-			return true;
-		p += n;
-	}
-	return false;
-}
-
-static enum MHD_Result render_begin(struct srv_request *req, struct MHD_Connection *conn)
-{
-	struct srv_server *s = req->srv;
-	if (!is_ready(s))
-		return answer_not_ready(req);
-	const char *ct = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-	bool multipart = multipart_content_type(ct);
-	if (!multipart && !json_content_type(ct))
-		return respond_problem(req, 415, NULL, "", "Content-Type must be application/json or multipart/form-data, not '%s'",
-		                       ct ? ct : "(none)");
-	const char *ce = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_ENCODING);
-	if (ce && strcasecmp(ce, "identity") != 0)
-		return respond_problem(req, 415, NULL, "", "Content-Encoding '%s' is not supported", ce);
-	const char *prio = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "X-Priority");
-	if (!prio || !strcasecmp(prio, "interactive"))
-		req->priority = SRV_PRIO_INTERACTIVE;
-	else if (!strcasecmp(prio, "bulk"))
-		req->priority = SRV_PRIO_BULK;
-	else
-		return respond_problem(req, 400, NULL, "", "X-Priority must be interactive or bulk, not '%s'", prio);
-	const char *cl = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-	if (cl) {
-		char *end;
-		errno = 0;
-		unsigned long long n = strtoull(cl, &end, 10);
-		if (!errno && end != cl && n > s->cfg.max_body)
-			return respond_problem(req, 413, NULL, "", "the body of %llu bytes is over the limit of %llu bytes",
-			                       n, (unsigned long long)s->cfg.max_body);
-		if (!errno && end != cl && n > 0 && !multipart) {
-			req->body = malloc((size_t)n + 1);
-			if (!req->body)
-				return respond_problem(req, 503, NULL, "", "out of memory for a body of %llu bytes", n);
-			req->body_cap = (size_t)n + 1;
-		}
-	}
-	if (multipart) {
-		req->post = MHD_create_post_processor(conn, 64 * 1024, part_data, req);
-		if (!req->post)
-			return respond_problem(req, 400, NULL, "", "multipart/form-data without a usable boundary");
-	}
-	const char *accept = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
-	int choice = accept_choice(accept);
-	if (choice < 0)
-		return respond_problem(req, 406, NULL, "", "this server answers image/png or image/x-exr (or a problem+json "
-		                       "document); Accept: %.200s names neither", accept);
-	req->want_exr = choice == 1;
-	req->body_hash = FNV_OFFSET;
-	req->state = SRV_REQ_BODY;
-	return MHD_YES;
-}
-
-/* A chunk of body. Returns false when over the limit. */
-static bool render_body(struct srv_request *req, const char *data, size_t size)
-{
-	struct srv_server *s = req->srv;
-	if (req->body_discarded || req->body_received + size > s->cfg.max_body) {
-		if (!req->body_discarded)
-			srv_request_drop_body(req);
-		req->body_discarded += req->body_received + size;
-		req->body_received = 0;
-		return false;
-	}
-	req->body_received += size;
-	req->body_hash = fnv1a(req->body_hash, data, size);
-	if (req->body_oom)
-		return true; /* the rest is read and dropped; answered 503 at the end */
-	if (req->post) {
-		if (!req->part_error && MHD_post_process(req->post, data, size) != MHD_YES && !req->part_error)
-			req->part_error = "malformed multipart/form-data body";
-		return true;
-	}
-	if (req->body_len + size + 1 > req->body_cap) {
-		size_t cap = req->body_cap ? req->body_cap : 4096;
-		while (cap < req->body_len + size + 1)
-			cap *= 2;
-		if (cap > s->cfg.max_body + 1)
-			cap = s->cfg.max_body + 1;
-		char *p = realloc(req->body, cap);
-		if (!p) {
-			srv_request_drop_body(req);
-			req->body_oom = true;
-			return true;
-		}
-		req->body = p;
-		req->body_cap = cap;
-	}
-	memcpy(req->body + req->body_len, data, size);
-	req->body_len += size;
-	return true;
-}
-
-static enum MHD_Result render_body_done(struct srv_request *req, struct MHD_Connection *conn)
-{
-	struct srv_server *s = req->srv;
-	if (req->body_discarded)
-		return respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
-		                       (unsigned long long)s->cfg.max_body);
-	if (req->body_oom)
-		return respond_problem(req, 503, NULL, "", "out of memory while reading the body");
-	if (req->post) {
-		if (MHD_destroy_post_processor(req->post) != MHD_YES && !req->part_error)
-			req->part_error = "truncated multipart/form-data body";
-		req->post = NULL;
-		if (req->part_error)
-			return respond_problem(req, 400, NULL, "", "%s", req->part_error);
-		/* The `scene` part is the document; the others stay as named parts. */
-		for (size_t i = 0; i < req->part_count; i++) {
-			if (strcmp(req->parts[i].name, "scene") != 0)
-				continue;
-			req->body = (char *)req->parts[i].data;
-			req->body_len = req->parts[i].len;
-			req->body_cap = req->parts[i].cap;
-			free(req->parts[i].name);
-			req->parts[i] = req->parts[--req->part_count];
-			break;
-		}
-		if (!req->body)
-			return respond_problem(req, 400, NULL, "", "the multipart/form-data request has no `scene` part");
-	}
-	if (!req->body_len)
-		return respond_problem(req, 400, NULL, "", "the request has no body: a scene document is required");
-	req->body[req->body_len] = 0;
-
-	/* ETag: the body, the format negotiation, the build and the device. */
-	uint64_t h = req->body_hash;
-	h = fnv1a(h, req->want_exr ? "\0exr" : "\0png", 4);
-	h = fnv1a(h, UMBRA_VERSION, strlen(UMBRA_VERSION));
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	h = fnv1a(h, s->info.device_name, strlen(s->info.device_name));
-	h = fnv1a(h, s->info.driver_info, strlen(s->info.driver_info));
-	pthread_rwlock_unlock(&s->ctx_lock);
-	snprintf(req->etag, sizeof req->etag, "\"%016llx\"", (unsigned long long)h);
-	/* A scene that reads models from --asset-root may change without its body changing: its
-	 * ETag is only known after parsing, so it never gets an early 304. */
-	bool reads_assets = memmem(req->body, req->body_len, "\"path\"", 6) != NULL;
-	const char *inm = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-	if (reads_assets && inm) snprintf(req->if_none_match, sizeof req->if_none_match, "%s", inm);
-	if (!reads_assets && srv_etag_matches(inm, req->etag)) {
-		srv_metrics_add(s->metrics, SRV_CTR_NOT_MODIFIED, 1);
-		return respond(req, 304, NULL, NULL, 0, NULL);
-	}
-
-	switch (srv_queue_push(s->queue, req, suspend_before_push)) {
-	case SRV_PUSH_OK:
-		return MHD_YES;
-	case SRV_PUSH_FULL:
-		srv_metrics_add(s->metrics, SRV_CTR_QUEUE_REJECTED, 1);
-		return respond_problem(req, 503, NULL, "", "the render queue is full (%u waiting)", srv_queue_capacity(s->queue));
-	case SRV_PUSH_CLOSED:
-		break;
-	}
-	return respond_problem(req, 503, NULL, "", "the server is shutting down");
-}
-
-void srv_request_finish(struct srv_request *req)
-{
-	req->state = SRV_REQ_FINISHED;
-	MHD_resume_connection(req->conn);
-}
-
-static enum MHD_Result render_answer(struct srv_request *req)
-{
-	uint8_t *out = req->out;
-	req->out = NULL;
-	if (!out && req->status == 200)
-		req->status = 500;
-	return respond(req, req->status ? req->status : 500, out ? req->content_type : NULL, out,
-	               out ? req->out_len : 0, NULL);
+		return srv_respond_problem(req, 503, NULL, "", "the server is shutting down");
+	return srv_respond_problem(req, 503, NULL, "", "the renderer is not ready yet (device start-up and pipeline warm-up)");
 }
 
 /* ---- dispatch ---- */
@@ -606,12 +239,12 @@ static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection
 		return respond_framing(req, status, framing);
 	srv_conn_request_begins(&req->srv->cfg, conn);
 	if (req->route == SRV_ROUTE_OTHER)
-		return respond_problem(req, 404, NULL, "", "no route %s", req->path);
+		return srv_respond_problem(req, 404, NULL, "", "no route %s", req->path);
 	if (req->route == SRV_ROUTE_RENDER ? strcmp(req->method, "POST") != 0 : !get)
-		return respond_problem(req, 405, allow_of(req->route), "", "%s is not allowed on %s; allowed: %s",
+		return srv_respond_problem(req, 405, allow_of(req->route), "", "%s is not allowed on %s; allowed: %s",
 		                       req->method, srv_route_name(req->route), allow_of(req->route));
 	if (req->route == SRV_ROUTE_RENDER)
-		return render_begin(req, conn);
+		return srv_render_begin(req, conn);
 	/* GET routes answer on the next call, once libmicrohttpd has the whole request (an
 	 * answer queued on the first call makes it close the connection). */
 	req->state = SRV_REQ_HEADERS;
@@ -625,23 +258,23 @@ static enum MHD_Result answer_get(struct srv_request *req)
 	case SRV_ROUTE_HEALTHZ:
 		return respond_text(req, 200, "text/plain; charset=utf-8", "ok\n");
 	case SRV_ROUTE_READYZ:
-		if (!is_ready(s))
-			return answer_not_ready(req);
+		if (!srv_is_ready(s))
+			return srv_answer_not_ready(req);
 		return respond_text(req, 200, "text/plain; charset=utf-8", "ready\n");
 	case SRV_ROUTE_METRICS:
 		return answer_metrics(req);
 	case SRV_ROUTE_INFO:
 		if (!atomic_load(&s->ready))
-			return answer_not_ready(req);
+			return srv_answer_not_ready(req);
 		return answer_info(req);
 	case SRV_ROUTE_PLAYGROUND: {
 		size_t len = 0;
 		if (s->cfg.no_playground)
-			return respond_problem(req, 404, NULL, "", "no route %s (--no-playground)", req->path);
+			return srv_respond_problem(req, 404, NULL, "", "no route %s (--no-playground)", req->path);
 		char *page = srv_playground_page(&len);
 		if (!page)
-			return respond_problem(req, 503, NULL, "", "out of memory for the playground page");
-		return respond(req, 200, "text/html; charset=utf-8", page, len, NULL);
+			return srv_respond_problem(req, 503, NULL, "", "out of memory for the playground page");
+		return srv_respond(req, 200, "text/html; charset=utf-8", page, len, NULL);
 	}
 	default:
 		return MHD_NO;
@@ -699,10 +332,10 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 		if (*upload_data_size) {
 			size_t n = *upload_data_size;
 			*upload_data_size = 0;
-			if (!render_body(req, upload_data, n)) {
+			if (!srv_render_body(req, upload_data, n)) {
 				/* Over the limit: answer now if libmicrohttpd lets us, else after the body;
 				 * a client that keeps sending far past the limit is cut off. */
-				if (respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
+				if (srv_respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
 				                    (unsigned long long)s->cfg.max_body) == MHD_YES)
 					return MHD_YES;
 				if (req->body_discarded > 2 * s->cfg.max_body + (16u << 20))
@@ -710,9 +343,9 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 			}
 			return MHD_YES;
 		}
-		return render_body_done(req, conn);
+		return srv_render_body_done(req, conn);
 	case SRV_REQ_FINISHED:
-		return render_answer(req);
+		return srv_render_answer(req);
 	case SRV_REQ_QUEUED:
 	case SRV_REQ_ANSWERED:
 		*upload_data_size = 0;

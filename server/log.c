@@ -2,6 +2,7 @@
  * umbrad logging (see log.h).
  */
 #include "log.h"
+#include "buf.h"
 
 #include <stdarg.h>
 #include <stdbool.h>

@@ -27,30 +27,6 @@ double srv_now(void)
 	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-void srv_json_escape(char *dst, size_t size, const char *src)
-{
-	static const char hex[] = "0123456789abcdef";
-	size_t o = 0;
-	for (; src && *src && o + 7 < size; src++) {
-		unsigned char c = (unsigned char)*src;
-		if (c == '"' || c == '\\') {
-			dst[o++] = '\\';
-			dst[o++] = (char)c;
-		} else if (c < 0x20 || c == 0x7f) {
-			dst[o++] = '\\';
-			dst[o++] = 'u';
-			dst[o++] = '0';
-			dst[o++] = '0';
-			dst[o++] = hex[c >> 4];
-			dst[o++] = hex[c & 15];
-		} else {
-			dst[o++] = (char)c;
-		}
-	}
-	if (size)
-		dst[o < size ? o : size - 1] = 0;
-}
-
 /* Waits until every begun request has been answered and completed, or the timeout. */
 static void wait_pending(struct srv_server *s, double timeout_s)
 {
@@ -62,6 +38,26 @@ static void wait_pending(struct srv_server *s, double timeout_s)
 	unsigned left = atomic_load(&s->pending);
 	if (left)
 		srv_log(SRV_LOG_WARN, "drain: %u requests still open after %.0f s; closing them", left, timeout_s);
+}
+
+/* Signals, the context lock and the request-id seed, before any thread starts. */
+static void process_init(struct srv_server *s, sigset_t *sigs)
+{
+	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
+	 * main thread takes the signals with sigwait(). */
+	sigemptyset(sigs);
+	sigaddset(sigs, SIGTERM);
+	sigaddset(sigs, SIGINT);
+	pthread_sigmask(SIG_BLOCK, sigs, NULL);
+	signal(SIGPIPE, SIG_IGN);
+
+	pthread_rwlockattr_t rwa;
+	pthread_rwlockattr_init(&rwa);
+	pthread_rwlockattr_setkind_np(&rwa, PTHREAD_RWLOCK_PREFER_WRITER_NONRECURSIVE_NP);
+	pthread_rwlock_init(&s->ctx_lock, &rwa);
+	pthread_rwlockattr_destroy(&rwa);
+	if (getrandom(&s->id_seed, sizeof s->id_seed, 0) != sizeof s->id_seed)
+		s->id_seed = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32);
 }
 
 int main(int argc, char **argv)
@@ -76,23 +72,10 @@ int main(int argc, char **argv)
 	if (rc < 0)
 		return 2;
 	srv_log_init(s->cfg.log_format);
+	api_model_cache_set_limit(s->cfg.model_cache_bytes);
 
-	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
-	 * main thread takes the signals with sigwait(). */
 	sigset_t sigs;
-	sigemptyset(&sigs);
-	sigaddset(&sigs, SIGTERM);
-	sigaddset(&sigs, SIGINT);
-	pthread_sigmask(SIG_BLOCK, &sigs, NULL);
-	signal(SIGPIPE, SIG_IGN);
-
-	pthread_rwlockattr_t rwa;
-	pthread_rwlockattr_init(&rwa);
-	pthread_rwlockattr_setkind_np(&rwa, PTHREAD_RWLOCK_PREFER_WRITER_NONRECURSIVE_NP);
-	pthread_rwlock_init(&s->ctx_lock, &rwa);
-	pthread_rwlockattr_destroy(&rwa);
-	if (getrandom(&s->id_seed, sizeof s->id_seed, 0) != sizeof s->id_seed)
-		s->id_seed = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32);
+	process_init(s, &sigs);
 
 	s->metrics = srv_metrics_create();
 	s->queue = srv_queue_create(s->cfg.queue);

@@ -187,88 +187,95 @@ static void label_escape(char *dst, size_t size, const char *src)
 	dst[o] = 0;
 }
 
-char *srv_metrics_text(struct srv_server *s, size_t *len)
+/* Requests, their durations, the render stages and the queue wait (histograms). */
+static void write_requests(struct srv_buf *b, const struct srv_metrics *snap)
 {
-	struct srv_metrics *m = s->metrics;
-	struct srv_metrics snap;
-	struct srv_buf b = { 0 };
 	char labels[128];
-
-	pthread_mutex_lock(&m->mu);
-	memcpy(&snap, m, sizeof snap);
-	pthread_mutex_unlock(&m->mu);
-
-	srv_buf_puts(&b, "# HELP umbra_requests_total HTTP requests answered, by route and status.\n"
+	srv_buf_puts(b, "# HELP umbra_requests_total HTTP requests answered, by route and status.\n"
 	                 "# TYPE umbra_requests_total counter\n");
-	for (unsigned i = 0; i < snap.series_count; i++)
-		srv_buf_printf(&b, "umbra_requests_total{route=\"%s\",status=\"%d\"} %llu\n",
-		               srv_route_name(snap.series[i].route), snap.series[i].status,
-		               (unsigned long long)snap.series[i].count);
+	for (unsigned i = 0; i < snap->series_count; i++)
+		srv_buf_printf(b, "umbra_requests_total{route=\"%s\",status=\"%d\"} %llu\n",
+		               srv_route_name(snap->series[i].route), snap->series[i].status,
+		               (unsigned long long)snap->series[i].count);
 
-	srv_buf_puts(&b, "# HELP umbra_request_duration_seconds Time from request arrival to answer.\n"
+	srv_buf_puts(b, "# HELP umbra_request_duration_seconds Time from request arrival to answer.\n"
 	                 "# TYPE umbra_request_duration_seconds histogram\n");
 	for (int r = 0; r < SRV_ROUTE_COUNT; r++) {
-		if (!snap.duration[r].count)
+		if (!snap->duration[r].count)
 			continue;
 		snprintf(labels, sizeof labels, "route=\"%s\"", srv_route_name((enum srv_route)r));
-		write_histogram(&b, "umbra_request_duration_seconds", labels, &snap.duration[r]);
+		write_histogram(b, "umbra_request_duration_seconds", labels, &snap->duration[r]);
 	}
 
-	srv_buf_puts(&b, "# HELP umbra_stage_seconds Time per render stage.\n"
+	srv_buf_puts(b, "# HELP umbra_stage_seconds Time per render stage.\n"
 	                 "# TYPE umbra_stage_seconds histogram\n");
 	for (int st = 0; st < SRV_STAGE_COUNT; st++) {
 		snprintf(labels, sizeof labels, "stage=\"%s\"", srv_stage_name((enum srv_stage)st));
-		write_histogram(&b, "umbra_stage_seconds", labels, &snap.stage[st]);
+		write_histogram(b, "umbra_stage_seconds", labels, &snap->stage[st]);
 	}
 
-	srv_buf_puts(&b, "# HELP umbra_queue_wait_seconds Time a render waited in the queue.\n"
+	srv_buf_puts(b, "# HELP umbra_queue_wait_seconds Time a render waited in the queue.\n"
 	                 "# TYPE umbra_queue_wait_seconds histogram\n");
-	write_histogram(&b, "umbra_queue_wait_seconds", "", &snap.queue_wait);
+	write_histogram(b, "umbra_queue_wait_seconds", "", &snap->queue_wait);
 
+}
+
+/* The queue and the workers, read live (gauges). */
+static void write_queue(struct srv_buf *b, struct srv_server *s)
+{
 	unsigned qi = s->queue ? srv_queue_depth_prio(s->queue, SRV_PRIO_INTERACTIVE) : 0;
 	unsigned qb = s->queue ? srv_queue_depth_prio(s->queue, SRV_PRIO_BULK) : 0;
-	srv_buf_printf(&b, "# HELP umbra_queue_depth Renders waiting for a worker.\n"
+	srv_buf_printf(b, "# HELP umbra_queue_depth Renders waiting for a worker.\n"
 	                   "# TYPE umbra_queue_depth gauge\n"
 	                   "umbra_queue_depth %u\n"
 	                   "# HELP umbra_queue_depth_by_priority Renders waiting, by X-Priority.\n"
 	                   "# TYPE umbra_queue_depth_by_priority gauge\n"
 	                   "umbra_queue_depth_by_priority{priority=\"interactive\"} %u\n"
 	                   "umbra_queue_depth_by_priority{priority=\"bulk\"} %u\n", qi + qb, qi, qb);
-	write_gauge(&b, "umbra_queue_capacity", "Most renders that may wait in the queue.",
+	write_gauge(b, "umbra_queue_capacity", "Most renders that may wait in the queue.",
 	            s->queue ? srv_queue_capacity(s->queue) : 0);
-	write_gauge(&b, "umbra_renders_in_flight", "Renders running now.", atomic_load(&s->in_flight));
-	write_gauge(&b, "umbra_workers", "Render worker threads (context render slots).",
+	write_gauge(b, "umbra_renders_in_flight", "Renders running now.", atomic_load(&s->in_flight));
+	write_gauge(b, "umbra_workers", "Render worker threads (context render slots).",
 	            s->cfg.workers);
-	write_gauge(&b, "umbra_ready", "1 when /readyz answers 200.",
+	write_gauge(b, "umbra_ready", "1 when /readyz answers 200.",
 	            atomic_load(&s->ready) && !atomic_load(&s->draining));
-	write_gauge(&b, "umbra_draining", "1 after SIGTERM/SIGINT.", atomic_load(&s->draining));
+	write_gauge(b, "umbra_draining", "1 after SIGTERM/SIGINT.", atomic_load(&s->draining));
 
-	srv_buf_puts(&b, "# HELP umbra_renders_total Renders attempted by workers, by result.\n"
+}
+
+static void write_renders(struct srv_buf *b, const struct srv_metrics *snap)
+{
+	srv_buf_puts(b, "# HELP umbra_renders_total Renders attempted by workers, by result.\n"
 	                 "# TYPE umbra_renders_total counter\n");
-	srv_buf_printf(&b, "umbra_renders_total{result=\"ok\"} %llu\n",
-	               (unsigned long long)snap.counter[SRV_CTR_RENDER_OK]);
-	srv_buf_printf(&b, "umbra_renders_total{result=\"error\"} %llu\n",
-	               (unsigned long long)snap.counter[SRV_CTR_RENDER_FAILED]);
-	write_counter(&b, "umbra_shadow_maps_rendered_total", "Shadow maps rendered.",
-	              snap.counter[SRV_CTR_SHADOW_RENDERED]);
-	write_counter(&b, "umbra_shadow_maps_reused_total", "Shadow maps reused from the renderer's cache.",
-	              snap.counter[SRV_CTR_SHADOW_REUSED]);
-	write_counter(&b, "umbra_not_modified_total", "Renders answered 304 from If-None-Match (ETag hits).",
-	              snap.counter[SRV_CTR_NOT_MODIFIED]);
-	write_counter(&b, "umbra_queue_rejected_total", "Renders refused with 503 because the queue was full.",
-	              snap.counter[SRV_CTR_QUEUE_REJECTED]);
-	write_counter(&b, "umbra_deadline_exceeded_total", "Renders answered 504.",
-	              snap.counter[SRV_CTR_DEADLINE]);
-	write_counter(&b, "umbra_device_lost_total", "Lost devices (context recreated).",
-	              snap.counter[SRV_CTR_DEVICE_LOST]);
-	write_counter(&b, "umbra_response_bytes_total", "Bytes of answer bodies.",
-	              snap.counter[SRV_CTR_BYTES_OUT]);
+	srv_buf_printf(b, "umbra_renders_total{result=\"ok\"} %llu\n",
+	               (unsigned long long)snap->counter[SRV_CTR_RENDER_OK]);
+	srv_buf_printf(b, "umbra_renders_total{result=\"error\"} %llu\n",
+	               (unsigned long long)snap->counter[SRV_CTR_RENDER_FAILED]);
+	write_counter(b, "umbra_shadow_maps_rendered_total", "Shadow maps rendered.",
+	              snap->counter[SRV_CTR_SHADOW_RENDERED]);
+	write_counter(b, "umbra_shadow_maps_reused_total", "Shadow maps reused from the renderer's cache.",
+	              snap->counter[SRV_CTR_SHADOW_REUSED]);
+	write_counter(b, "umbra_not_modified_total", "Renders answered 304 from If-None-Match (ETag hits).",
+	              snap->counter[SRV_CTR_NOT_MODIFIED]);
+	write_counter(b, "umbra_queue_rejected_total", "Renders refused with 503 because the queue was full.",
+	              snap->counter[SRV_CTR_QUEUE_REJECTED]);
+	write_counter(b, "umbra_deadline_exceeded_total", "Renders answered 504.",
+	              snap->counter[SRV_CTR_DEADLINE]);
+	write_counter(b, "umbra_device_lost_total", "Lost devices (context recreated).",
+	              snap->counter[SRV_CTR_DEVICE_LOST]);
+	write_counter(b, "umbra_response_bytes_total", "Bytes of answer bodies.",
+	              snap->counter[SRV_CTR_BYTES_OUT]);
 
+}
+
+/* The model cache, the renderer's atlas and shadow cache, validation messages, the build. */
+static void write_device(struct srv_buf *b, struct srv_server *s)
+{
 	uint64_t mhits = 0, mmiss = 0, mbytes = 0;
 	api_model_cache_stats(&mhits, &mmiss, &mbytes);
-	write_counter(&b, "umbra_model_cache_hits_total", "Imported models found in the model cache.", mhits);
-	write_counter(&b, "umbra_model_cache_misses_total", "Imported models decoded.", mmiss);
-	write_gauge(&b, "umbra_model_cache_bytes", "Bytes held by the model cache.", (double)mbytes);
+	write_counter(b, "umbra_model_cache_hits_total", "Imported models found in the model cache.", mhits);
+	write_counter(b, "umbra_model_cache_misses_total", "Imported models decoded.", mmiss);
+	write_gauge(b, "umbra_model_cache_bytes", "Bytes held by the model cache.", (double)mbytes);
 
 	uint32_t vmsg = s->validation_lost;
 	char dev[300] = "", drv[300] = "";
@@ -283,27 +290,48 @@ char *srv_metrics_text(struct srv_server *s, size_t *len)
 		label_escape(drv, sizeof drv, s->info.driver_name);
 		pthread_rwlock_unlock(&s->ctx_lock);
 	}
-	write_gauge(&b, "umbra_atlas_size_texels", "Texels per side of the shadow atlas.", st.atlas_size);
-	write_gauge(&b, "umbra_atlas_occupancy_ratio", "Share of shadow-atlas texels held by tiles.", st.atlas_occupancy);
-	write_gauge(&b, "umbra_atlas_tiles", "Tiles in the shadow atlas.", st.atlas_tiles);
-	write_gauge(&b, "umbra_shadow_cache_maps", "Spot/point shadow maps kept for reuse.", st.cached_maps);
-	write_counter(&b, "umbra_shadow_cache_hits_total", "Lights whose shadow passes were skipped (cache hits).",
+	write_gauge(b, "umbra_atlas_size_texels", "Texels per side of the shadow atlas.", st.atlas_size);
+	write_gauge(b, "umbra_atlas_occupancy_ratio", "Share of shadow-atlas texels held by tiles.", st.atlas_occupancy);
+	write_gauge(b, "umbra_atlas_tiles", "Tiles in the shadow atlas.", st.atlas_tiles);
+	write_gauge(b, "umbra_shadow_cache_maps", "Spot/point shadow maps kept for reuse.", st.cached_maps);
+	write_counter(b, "umbra_shadow_cache_hits_total", "Lights whose shadow passes were skipped (cache hits).",
 	              st.shadow_cache_hits);
-	write_counter(&b, "umbra_shadow_cache_misses_total", "Lights whose shadow passes were rendered (cache misses).",
+	write_counter(b, "umbra_shadow_cache_misses_total", "Lights whose shadow passes were rendered (cache misses).",
 	              st.shadow_cache_misses);
-	write_gauge(&b, "umbra_validation_messages", "Vulkan validation-layer messages since start.", vmsg);
-	srv_buf_printf(&b, "# HELP umbra_build_info Build and device.\n# TYPE umbra_build_info gauge\n"
+	write_gauge(b, "umbra_validation_messages", "Vulkan validation-layer messages since start.", vmsg);
+	srv_buf_printf(b, "# HELP umbra_build_info Build and device.\n# TYPE umbra_build_info gauge\n"
 	                   "umbra_build_info{version=\"%s\",device=\"%s\",driver=\"%s\"} 1\n",
 	               UMBRA_VERSION, dev, drv);
+}
+
+/* Admission by estimated memory, and the process. */
+static void write_process(struct srv_buf *b, struct srv_server *s)
+{
 	uint64_t adm_in_use, adm_budget, adm_peak;
 	srv_admit_stats(&s->admit, &adm_in_use, &adm_budget, &adm_peak);
-	write_gauge(&b, "umbra_memory_admitted_bytes", "Estimated memory of the renders admitted now (--max-memory).",
+	write_gauge(b, "umbra_memory_admitted_bytes", "Estimated memory of the renders admitted now (--max-memory).",
 	            (double)adm_in_use);
-	write_gauge(&b, "umbra_memory_admitted_peak_bytes", "Largest estimated memory of renders in flight at once.",
+	write_gauge(b, "umbra_memory_admitted_peak_bytes", "Largest estimated memory of renders in flight at once.",
 	            (double)adm_peak);
-	write_gauge(&b, "umbra_memory_budget_bytes", "--max-memory: what renders in flight may need together.",
+	write_gauge(b, "umbra_memory_budget_bytes", "--max-memory: what renders in flight may need together.",
 	            (double)adm_budget);
-	write_gauge(&b, "process_resident_memory_bytes", "Resident set size.", (double)process_rss_bytes());
-	write_gauge(&b, "process_open_fds", "Open file descriptors.", (double)process_open_fds());
+	write_gauge(b, "process_resident_memory_bytes", "Resident set size.", (double)process_rss_bytes());
+	write_gauge(b, "process_open_fds", "Open file descriptors.", (double)process_open_fds());
+}
+
+char *srv_metrics_text(struct srv_server *s, size_t *len)
+{
+	struct srv_metrics *m = s->metrics;
+	struct srv_metrics snap;
+	struct srv_buf b = { 0 };
+
+	pthread_mutex_lock(&m->mu);
+	memcpy(&snap, m, sizeof snap);
+	pthread_mutex_unlock(&m->mu);
+	write_requests(&b, &snap);
+	write_queue(&b, s);
+	write_renders(&b, &snap);
+	write_device(&b, s);
+	write_process(&b, s);
 	return srv_buf_detach(&b, len);
 }

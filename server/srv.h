@@ -4,15 +4,17 @@
  * Modules (prefix srv_):
  *   flags.c    srv_config: defaults, UMBRA_* environment, command-line flags, --help
  *   main.c     startup (listen, context, warm-up, workers), signals, graceful drain, exit code
- *   http.c     libmicrohttpd callbacks: routes, body reading, negotiation, answers
+ *   http.c     libmicrohttpd callbacks: dispatch, GET routes, answers (http.h)
+ *   render_route.c  POST /v1/render: headers, body (JSON or multipart), ETag, queueing
+ *   negotiate.c  pure rules: Content-Type, Accept, the ETag (negotiate.h)
  *   conn.c     connection limits and timeouts, HTTP/1.1 framing checks, the listen address
  *   queue.c    the bounded two-level (interactive before bulk) job queue
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
  *   metrics.c  Prometheus counters, gauges and histograms
  *   log.c      one line per event or request on stderr, text or JSON
- *   buf.c      growable text buffer for the metrics and JSON answers
+ *   buf.c      growable text buffer for the metrics; the JSON string escaper (logs, CLI report)
  *
- * Threading: libmicrohttpd runs one internal polling thread (epoll where available) that does
+ * Threading: libmicrohttpd runs one internal polling thread (poll(): see srv_http_start) that does
  * all socket I/O and calls http.c. A POST /v1/render is read completely, then its connection is
  * suspended and the request is handed to the queue; a worker thread renders it, stores the
  * answer in the request and resumes the connection, and the polling thread sends it. Nothing
@@ -68,6 +70,7 @@ struct srv_config {
 	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
 	unsigned header_timeout_s;     /* a new connection's first request head, 0 = idle, default 10 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
+	uint64_t model_cache_bytes;    /* api_model_cache_set_limit() at start, default 256 MiB */
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
 	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */
@@ -150,7 +153,8 @@ struct srv_request {
 	uint64_t body_received;        /* raw body bytes so far (multipart included) */
 	bool body_oom;                 /* a body buffer could not grow: answer 503 */
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
-	uint64_t body_hash;            /* FNV-1a 64, running */
+	uint64_t body_hash;            /* srv_etag_body() of the raw body so far */
+	uint64_t etag_hash;            /* the ETag's value (srv_etag_finish(), then srv_etag_assets()) */
 	char etag[40];
 	char if_none_match[256];       /* checked after parsing for scenes that read asset files */
 	bool want_exr;                 /* Accept prefers image/x-exr */
@@ -202,9 +206,5 @@ char *srv_playground_page(size_t *len);
 
 /* Small shared helpers (main.c). */
 double srv_now(void);                               /* monotonic seconds */
-void srv_json_escape(char *dst, size_t size, const char *src); /* without the quotes */
-
-/* True when an If-None-Match value lists etag (strong comparison; "*" never matches). */
-bool srv_etag_matches(const char *if_none_match, const char *etag);
 
 #endif

@@ -20,6 +20,7 @@
 
 #include "log.h"
 #include "metrics.h"
+#include "negotiate.h"
 #include "queue.h"
 #include "srv.h"
 
@@ -424,8 +425,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 		if ((unsigned char)req->warnings[i] < 0x20 || (unsigned char)req->warnings[i] > 0x7e) req->warnings[i] = '?';
 	if (sc->asset_hash) {
 		/* The image depends on files under --asset-root as well as on the body. */
-		unsigned long long h = strtoull(req->etag + 1, NULL, 16) ^ sc->asset_hash;
-		snprintf(req->etag, sizeof req->etag, "\"%016llx\"", h * 0x100000001b3ull);
+		srv_etag_format(req->etag, sizeof req->etag, srv_etag_assets(req->etag_hash, sc->asset_hash));
 		if (req->if_none_match[0] && srv_etag_matches(req->if_none_match, req->etag)) {
 			req->status = 304;
 			goto out;

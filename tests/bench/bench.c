@@ -83,7 +83,7 @@ int main(int argc, char **argv)
 		struct api_limits lim;
 		api_limits_defaults(&lim);
 		lim.max_triangles = 0;
-		if (cold_models) lim.model_cache_bytes = 0;
+		api_model_cache_set_limit(cold_models ? 0 : 256u << 20);
 		for (int i = -1; i < n && rc == 0; i++) {
 			double t0 = now_ms();
 			struct api_scene *s;

@@ -15,7 +15,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
 	struct api_limits lim;
 	api_limits_defaults(&lim);
-	lim.model_cache_bytes = 0;   /* every input stands alone */
+	api_model_cache_set_limit(0);   /* every input stands alone */
 	struct api_scene *s = NULL;
 	struct api_problem p;
 	if (api_scene_parse((const char *)data, size, &lim, &s, &p) == API_OK) {

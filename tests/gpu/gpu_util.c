@@ -6,7 +6,8 @@
 #include <string.h>
 #include "api.h"
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
+#include "util.h"
 
 static struct rnd_context *g_ctx;
 static bool g_ctx_failed;
@@ -45,11 +46,9 @@ bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char
 
 	va_list ap;
 	va_start(ap, fmt);
-	char *doc = NULL;
-	int n = vasprintf(&doc, fmt, ap);
+	char *doc = test_vdoc(fmt, ap);
 	va_end(ap);
-	if (n < 0) { test_fail_at(file, line, "gpu_render", " vasprintf"); return false; }
-	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
+	if (!doc) { test_fail_at(file, line, "gpu_render", " vasprintf"); return false; }
 
 	struct api_limits lim;
 	api_limits_defaults(&lim);

@@ -8,7 +8,7 @@
 #include <time.h>
 #include "api.h"
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 /* Spot, point and sun lights over a sphere and a box, every AOV: all passes are exercised. */
 #define FAULT_SCENE(res)                                                                                 \

@@ -13,7 +13,8 @@
 #include <string.h>
 #include "api.h"
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
+#include "util.h"
 
 /* ---- rendering with timings, on any context ---- */
 
@@ -36,11 +37,9 @@ static int lrender_at(const char *file, int line, struct rnd_context *ctx, struc
 	if (!ctx) { test_fail_at(file, line, "lrender", " no context"); return R_FAIL; }
 	va_list ap;
 	va_start(ap, fmt);
-	char *doc = NULL;
-	int n = vasprintf(&doc, fmt, ap);
+	char *doc = test_vdoc(fmt, ap);
 	va_end(ap);
-	if (n < 0) { test_fail_at(file, line, "lrender", " vasprintf"); return R_FAIL; }
-	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
+	if (!doc) { test_fail_at(file, line, "lrender", " vasprintf"); return R_FAIL; }
 
 	struct api_limits lim;
 	api_limits_defaults(&lim);

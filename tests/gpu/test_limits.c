@@ -11,7 +11,7 @@
 #include <string.h>
 #include "api.h"
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 /* A context of our own (validation as the binary's). */
 static struct rnd_context *limits_ctx(uint32_t atlas_size, uint32_t slots)

@@ -11,7 +11,7 @@
 #include <string.h>
 #include <png.h>
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 static char *b64(const uint8_t *d, size_t n)
 {

@@ -9,50 +9,12 @@
 #include <string.h>
 #include <png.h>
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "models.h"
+#include "test.h"
+#include "util.h"
 
 /* ---- building files ---- */
 
-static char *b64(const uint8_t *d, size_t n)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	size_t i = 0;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
-
-static void put32(uint8_t *p, uint32_t v)
-{
-	p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
-}
-
-/* A straight-alpha RGBA8 PNG in memory (malloc'd). */
-static uint8_t *png_rgba(const uint8_t *px, int w, int h, size_t *len)
-{
-	png_image img;
-	memset(&img, 0, sizeof img);
-	img.version = PNG_IMAGE_VERSION;
-	img.width = (png_uint_32)w;
-	img.height = (png_uint_32)h;
-	img.format = PNG_FORMAT_RGBA;
-	png_alloc_size_t n = 0;
-	if (!png_image_write_to_memory(&img, NULL, &n, 0, px, 0, NULL)) return NULL;
-	uint8_t *buf = malloc(n);
-	if (!png_image_write_to_memory(&img, buf, &n, 0, px, 0, NULL)) { free(buf); return NULL; }
-	*len = n;
-	return buf;
-}
 
 /* The 8x8 checkerboard: texel (col, row) (row 0 = the image's first row) is opaque red when
  * col + row is even, transparent green (alpha 0) when odd. */
@@ -68,7 +30,7 @@ static uint8_t *checker_png(size_t *len)
 			bool o = chk_opaque(c, r);
 			p[0] = o ? 255 : 0; p[1] = o ? 0 : 255; p[2] = 0; p[3] = o ? 255 : 0;
 		}
-	return png_rgba(px, CHK, CHK, len);
+	return test_png_rgba(px, CHK, CHK, len);
 }
 
 /* A .glb with one mesh (positions, optional normals and uvs, uint32 indices) in one node
@@ -143,26 +105,15 @@ static uint8_t *glb_build(const struct glb_in *in, size_t *len)
 		"\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[%s],\"accessors\":[%s]}",
 		in->node_t[0], in->node_t[1], in->node_t[2], attrs, idx_acc, in->png ? ",\"material\":0" : "", mat, imgs,
 		binpad, views, accs);
-	size_t jpad = ((size_t)jn + 3) & ~(size_t)3;
-	size_t total = 12 + 8 + jpad + 8 + binpad;
-	uint8_t *g = calloc(1, total);
-	memcpy(g, "glTF", 4);
-	put32(g + 4, 2);
-	put32(g + 8, (uint32_t)total);
-	put32(g + 12, (uint32_t)jpad);
-	memcpy(g + 16, "JSON", 4);
-	memset(g + 20, ' ', jpad);
-	memcpy(g + 20, json, (size_t)jn);
-	uint8_t *bin = g + 20 + jpad;
-	put32(bin, (uint32_t)binpad);
-	memcpy(bin + 4, "BIN\0", 4);
-	uint8_t *b = bin + 8;
+	uint8_t *b = calloc(1, binpad ? binpad : 1);
+	if (!b) return NULL;
 	memcpy(b + off_pos, in->pos, n_pos);
 	if (in->nrm) memcpy(b + off_nrm, in->nrm, n_nrm);
 	if (in->uv) memcpy(b + off_uv, in->uv, n_uv);
 	memcpy(b + off_idx, in->idx, n_idx);
 	if (in->png) memcpy(b + off_png, in->png, n_png);
-	*len = total;
+	uint8_t *g = test_glb_pack(json, (size_t)jn, b, binpad, binpad, len);
+	free(b);
 	return g;
 }
 
@@ -205,23 +156,6 @@ static char *box_obj(const float lo[3], const float hi[3])
 	snprintf(s + n, 1024 - n,
 	         "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
 	return s;
-}
-
-/* Binary .stl of the tetrahedron with the given 4 vertices (84 + 4*50 bytes). */
-static size_t tetra_stl(uint8_t *out, const float p[4][3])
-{
-	static const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
-	memset(out, 0, 84);
-	memcpy(out, "binary tetrahedron", 18);
-	put32(out + 80, 4);
-	uint8_t *q = out + 84;
-	for (int i = 0; i < 4; i++, q += 50) {
-		float rec[12] = {0};
-		for (int k = 0; k < 3; k++) memcpy(rec + 3 + 3 * k, p[f[i][k]], sizeof p[0]);
-		memcpy(q, rec, sizeof rec); /* normal 0: recomputed by the importer */
-		q[48] = q[49] = 0;
-	}
-	return 84 + 4 * 50;
 }
 
 /* ---- 1. framing ---- */
@@ -389,7 +323,7 @@ TEST(models_fit_glb_box)
 	struct glb_in in = {.pos = pos, .nrm = nrm, .nv = 24, .idx = idx, .ni = 36, .node_t = {1.5f, 1, -2}};
 	size_t n;
 	uint8_t *glb = glb_build(&in, &n);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	size_t cap = strlen(enc) + 256;
 	char *obj = malloc(cap);
@@ -407,7 +341,7 @@ TEST(models_fit_obj_box)
 	/* 2 x 1 x 0.5 box at [-3, -1, 0.5] .. [-1, 0, 1] in the file, object translation (0, 0.25, 0) */
 	float lo[3] = {-3, -1, 0.5f}, hi[3] = {-1, 0, 1};
 	char *text = box_obj(lo, hi);
-	char *enc = b64((const uint8_t *)text, strlen(text));
+	char *enc = test_b64((const uint8_t *)text, strlen(text));
 	free(text);
 	size_t cap = strlen(enc) + 256;
 	char *obj = malloc(cap);
@@ -426,8 +360,8 @@ TEST(models_fit_stl_tetrahedron)
 	/* a right-angled tetrahedron of legs 1.5 at (-2, 0.3, 1), sniffed (no format) */
 	static const float p[4][3] = {{-2, 0.3f, 1}, {-0.5f, 0.3f, 1}, {-2, 1.8f, 1}, {-2, 0.3f, 2.5f}};
 	uint8_t stl[284];
-	size_t n = tetra_stl(stl, p);
-	char *enc = b64(stl, n);
+	size_t n = test_tetra_stl(stl, p);
+	char *enc = test_b64(stl, n);
 	size_t cap = strlen(enc) + 256;
 	char *obj = malloc(cap);
 	snprintf(obj, cap, "{'shape':'model','data':'%s'," RED_MAT "}", enc);
@@ -606,7 +540,7 @@ static char *mesh_quad_json(bool masked)
 	size_t pl;
 	uint8_t *png = checker_png(&pl);
 	if (!png) return NULL;
-	char *enc = b64(png, pl);
+	char *enc = test_b64(png, pl);
 	free(png);
 	char nums[4][512];
 	const float *arr[3] = {QPOS, QNRM, QUV};
@@ -639,7 +573,7 @@ static char *glb_quad_json(bool masked)
 	size_t n;
 	uint8_t *glb = glb_build(&in, &n);
 	free(png);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	size_t cap = strlen(enc) + 256;
 	char *s = malloc(cap);

@@ -11,7 +11,7 @@
 #include <png.h>
 #include "api.h"
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 /* ---- helpers ---- */
 

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 static double luma(const struct rnd_image *img, int i, int j)
 {

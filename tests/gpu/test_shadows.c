@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 enum { L_DIR, L_POINT, L_SPOT };
 

@@ -14,7 +14,7 @@
 #include "api.h"
 #include "model.h"
 #include "gpu_util.h"
-#include "../unit/test.h"
+#include "test.h"
 
 #define TRUTH_DIR "tests/gpu/truth/"
 

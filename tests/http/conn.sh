@@ -3,23 +3,8 @@
 # (tests/http/conn.py does the talking). Loopback only: the daemon listens on 127.0.0.1 with an
 # ephemeral port. Prints "ok - x" / "FAIL - x" per test and, last, "N passed, N failed".
 # Env: BUILD (build dir), UMBRA_VALIDATION (tests/run.sh sets 1).
-BUILD=${BUILD:-build}
-UMBRAD=${UMBRAD:-$BUILD/umbrad}
-START_TIMEOUT=${START_TIMEOUT:-240}
-DAEMON_PRELOAD=""
-asan_rt=$(ldd "$UMBRAD" 2>/dev/null | awk '/libasan/ { print $3; exit }')
-if [ -n "$asan_rt" ]; then
-	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
-		[ -f "$lvp" ] && DAEMON_PRELOAD="$asan_rt $lvp" && break
-	done
-fi
-T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-conn.XXXXXX")
-pass=0; fail=0; PID=""
-ok() { echo "ok - $1"; pass=$((pass + 1)); }
-nok() { echo "FAIL - $1${2:+: $2}"; fail=$((fail + 1)); }
-cleanup() { [ -n "$PID" ] && kill -9 "$PID" 2>/dev/null; rm -rf "$T"; }
-trap cleanup EXIT
-trap 'exit 1' INT TERM
+SUITE=conn . tests/util/suite.sh
+# This suite's finish also exits (it is called on fatal set-up failures too).
 finish() { echo "$pass passed, $fail failed"; [ "$fail" -eq 0 ]; exit $?; }
 
 # ---- flags ----
@@ -43,6 +28,7 @@ start() {
 	name=$1; shift
 	LD_PRELOAD="$DAEMON_PRELOAD" "$UMBRAD" --listen 127.0.0.1:0 --port-file "$T/$name.port" --workers 1 "$@" 2>"$T/$name.log" &
 	PID=$!
+	PIDS="$PIDS $PID"
 	i=0
 	while :; do
 		if [ -s "$T/$name.port" ]; then

@@ -6,36 +6,7 @@
 # a render far longer than --deadline-ms is stopped (504) and a small request queued behind it
 # is served (200). Prints "ok - x" / "FAIL - x" and, last, "N passed, N failed".
 # Env: BUILD, UMBRA_VALIDATION (tests/run.sh sets 1), START_TIMEOUT (s).
-BUILD=${BUILD:-build}
-UMBRAD=${UMBRAD:-$BUILD/umbrad}
-START_TIMEOUT=${START_TIMEOUT:-240}
-DAEMON_PRELOAD=""
-asan_rt=$(ldd "$UMBRAD" 2>/dev/null | awk '/libasan/ { print $3; exit }')
-if [ -n "$asan_rt" ]; then
-	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
-		[ -f "$lvp" ] && DAEMON_PRELOAD="$asan_rt $lvp" && break
-	done
-fi
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-faults.XXXXXX")
-pass=0
-fail=0
-PIDS=""
-ok() { echo "ok - $1"; pass=$((pass + 1)); }
-nok() { echo "FAIL - $1${2:+: $2}"; fail=$((fail + 1)); }
-check() { n=$1; shift; if "$@"; then ok "$n"; else nok "$n"; fi; }
-cleanup() {
-	for p in $PIDS; do kill -9 "$p" 2>/dev/null; done
-	rm -rf "$T"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
-
-if [ ! -x "$UMBRAD" ]; then
-	nok "daemon binary" "$UMBRAD not built"
-	echo "$pass passed, $fail failed"
-	exit 1
-fi
+SUITE=faults . tests/util/suite.sh
 
 # start NAME FLAGS...: sets PID and URL, waits for /readyz 200.
 start() {

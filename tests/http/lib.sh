@@ -1,53 +1,17 @@
 #!/bin/sh
-# tests/http/lib.sh — what every black-box daemon suite shares: the set-up (BUILD, SHARED, the
-# daemon binary, ASan preloads, a temporary folder $T removed at exit), ok/nok counting and
-# helpers to start, stop and query daemons on loopback (ephemeral ports, --port-file).
+# tests/http/lib.sh — what the black-box daemon suites share: the set-up of tests/util/suite.sh
+# (BUILD, SHARED, the daemon binary, ASan preloads, $T, ok/nok counting, finish) and helpers to
+# start, stop and query daemons on loopback (ephemeral ports, --port-file).
 # Sourced by tests/http/*.sh: `. tests/http/lib.sh`; the suite ends with `finish`.
-BUILD=${BUILD:-build}
-SHARED=${SHARED:-../shared}
-UMBRAD=${UMBRAD:-$BUILD/umbrad}
+SUITE=${SUITE:-http} . tests/util/suite.sh
 REPS=500
 [ -n "${ASAN:-}" ] && REPS=100
 case "$BUILD" in *asan*) REPS=100 ;; esac
-START_TIMEOUT=${START_TIMEOUT:-240}
-# ASan daemons: the Vulkan loader of Debian 12 (1.3.239) unloads the driver at vkDestroyInstance
-# whatever VK_LOADER_DISABLE_DYNAMIC_LIBRARY_UNLOADING says, so LeakSanitizer sees the driver's
-# own leaks as "<unknown module>" and tests/lsan.supp cannot name them. Preloading the driver
-# (after the ASan runtime, which must come first) keeps it mapped. Daemons only: curl and
-# python3 run without it.
-DAEMON_PRELOAD=""
-asan_rt=$(ldd "$UMBRAD" 2>/dev/null | awk '/libasan/ { print $3; exit }')
 RSS_BOUND_KB=32768
 if [ -n "$asan_rt" ]; then
 	REPS=100
 	# ASan holds freed memory in its quarantine (256 MiB by default): LeakSanitizer checks leaks.
 	RSS_BOUND_KB=307200
-	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
-		[ -f "$lvp" ] && DAEMON_PRELOAD="$asan_rt $lvp" && break
-	done
-fi
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-http.XXXXXX")
-pass=0
-fail=0
-PIDS=""
-
-ok() { echo "ok - $1"; pass=$((pass + 1)); }
-nok() { echo "FAIL - $1${2:+: $2}"; fail=$((fail + 1)); }
-# check NAME CMD...: ok when CMD succeeds.
-check() { n=$1; shift; if "$@"; then ok "$n"; else nok "$n"; fi; }
-
-cleanup() {
-	for p in $PIDS; do kill -9 "$p" 2>/dev/null; done
-	rm -rf "$T"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
-
-if [ ! -x "$UMBRAD" ]; then
-	nok "daemon binary" "$UMBRAD not built"
-	echo "$pass passed, $fail failed"
-	exit 1
 fi
 
 # ---- helpers ----
@@ -140,9 +104,3 @@ metric() {
 }
 rss_kb() { awk '/^VmRSS:/ { print $2 }' "/proc/$1/status"; }
 fd_count() { ls "/proc/$1/fd" | wc -l | tr -d ' '; }
-
-# finish: the closing line every suite prints, and its exit status.
-finish() {
-	echo "$pass passed, $fail failed"
-	[ "$fail" -eq 0 ]
-}

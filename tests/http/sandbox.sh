@@ -4,28 +4,11 @@
 # member's pointer while other requests sent at the same time render, /readyz stays 200 and
 # SIGTERM drains; a FIFO under --asset-root is a 400 at once. Every input is generated here.
 # Prints "ok - x" / "FAIL - x" and, last, "N passed, N failed". Env: BUILD, UMBRAD, ASAN.
-BUILD=${BUILD:-build}
-UMBRAD=${UMBRAD:-$BUILD/umbrad}
-START_TIMEOUT=${START_TIMEOUT:-240}
 # IMPORT_FLAGS="" runs the same checks against a daemon from before the sandbox (no such flag).
 IMPORT_FLAGS=${IMPORT_FLAGS---import-timeout-ms 2000}
-DAEMON_PRELOAD=""
-asan_rt=$(ldd "$UMBRAD" 2>/dev/null | awk '/libasan/ { print $3; exit }')
-if [ -n "$asan_rt" ]; then
-	for lvp in /usr/lib/*/libvulkan_lvp.so /usr/lib64/libvulkan_lvp.so; do
-		[ -f "$lvp" ] && DAEMON_PRELOAD="$asan_rt $lvp" && break
-	done
-fi
-T=$(mktemp -d "${TMPDIR:-/tmp}/umbra-sandbox.XXXXXX")
-pass=0; fail=0; PIDS=""
-ok() { echo "ok - $1"; pass=$((pass + 1)); }
-nok() { echo "FAIL - $1${2:+: $2}"; fail=$((fail + 1)); }
-check() { n=$1; shift; if "$@"; then ok "$n"; else nok "$n"; fi; }
-cleanup() { for p in $PIDS; do kill -9 "$p" 2>/dev/null; done; rm -rf "$T"; }
-trap cleanup EXIT
-trap 'exit 1' INT TERM
+SUITE=sandbox . tests/util/suite.sh
+# This suite's finish also exits (it is called on fatal set-up failures too).
 finish() { echo "$pass passed, $fail failed"; [ $fail -eq 0 ]; exit $?; }
-[ -x "$UMBRAD" ] || { nok "daemon binary" "$UMBRAD not built"; finish; }
 
 # ---- inputs: scenes with an inline model (base64) ----
 python3 - "$T" <<'PY'

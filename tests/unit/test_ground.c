@@ -9,6 +9,7 @@
 #include "api.h"
 #include "ground.h"
 #include "test.h"
+#include "util.h"
 #include "umbra/rnd_math.h"
 
 static bool near_d(double a, double b)
@@ -205,32 +206,14 @@ TEST(preset_problems_keep_the_scene_pointers)
 	               "/camera/fov_y");
 }
 
-static char *b64(const char *s)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	size_t n = strlen(s), i = 0;
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	const unsigned char *d = (const unsigned char *)s;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
 
 TEST(ground_under_an_imported_model_with_two_meshes)
 {
 	/* An OBJ of two separate triangles (two objects: the model expands into two mesh objects,
 	 * so the ground, after it in the document, moves in the scene's object list). Scaled by 2
 	 * and lifted by 1: its lowest vertex y = -0.5 becomes 2 x -0.5 + 1 = 0. */
-	char *data = b64("o a\nv 0 -0.5 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 2 0 0\nv 3 0 0\nv 2 2 1\nf 4 5 6\n");
+	static const char two[] = "o a\nv 0 -0.5 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 2 0 0\nv 3 0 0\nv 2 2 1\nf 4 5 6\n";
+	char *data = test_b64(two, sizeof two - 1);
 	char doc[1024];
 	snprintf(doc, sizeof doc,
 	         "{\"camera\":{\"position\":[0,2,8],\"target\":[0,0,0]},\"objects\":["

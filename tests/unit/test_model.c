@@ -12,7 +12,9 @@
 #include <jpeglib.h>
 #include "api.h"
 #include "model.h"
+#include "models.h"
 #include "test.h"
+#include "util.h"
 #include "umbra/rnd_math.h"
 
 static bool near_f(float a, float b)
@@ -22,29 +24,11 @@ static bool near_f(float a, float b)
 
 /* ---- building documents ---- */
 
-static char *b64(const uint8_t *d, size_t n)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	size_t i = 0;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
 
 /* A scene with one model object: `extra` goes inside the object ("" or ",'k':v" with ' for "). */
 static char *model_doc(const uint8_t *d, size_t n, const char *extra)
 {
-	char *enc = b64(d, n);
+	char *enc = test_b64(d, n);
 	size_t cap = strlen(enc) + strlen(extra) + 512;
 	char *doc = malloc(cap);
 	snprintf(doc, cap, "{\"camera\":{\"position\":[0,0,5]},\"materials\":{\"grey\":{\"base_color\":[0.5,0.5,0.5]}},"
@@ -104,40 +88,14 @@ static const char CUBE_OBJ[] =
 static size_t tetra_stl(uint8_t *out /* 284 bytes */)
 {
 	static const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-	static const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
-	memset(out, 0, 84);
-	memcpy(out, "binary tetrahedron", 18);
-	out[80] = 4;
-	uint8_t *q = out + 84;
-	for (int i = 0; i < 4; i++, q += 50) {
-		float rec[12] = {0};
-		for (int k = 0; k < 3; k++) memcpy(rec + 3 + 3 * k, p[f[i][k]], sizeof p[0]);
-		memcpy(q, rec, sizeof rec); /* normal 0: recomputed by the importer */
-		q[48] = q[49] = 0;
-	}
-	return 84 + 4 * 50;
+	return test_tetra_stl(out, p);
 }
 
 static const uint8_t TEX[16] = {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 255, 255, 255, 255};
 
 static uint8_t *png_2x2(size_t *len)
 {
-	png_image img;
-	memset(&img, 0, sizeof img);
-	img.version = PNG_IMAGE_VERSION;
-	img.width = img.height = 2;
-	img.format = PNG_FORMAT_RGBA;
-	png_alloc_size_t n = 0;
-	if (!png_image_write_to_memory(&img, NULL, &n, 0, TEX, 0, NULL)) return NULL;
-	uint8_t *buf = malloc(n);
-	if (!png_image_write_to_memory(&img, buf, &n, 0, TEX, 0, NULL)) { free(buf); return NULL; }
-	*len = n;
-	return buf;
-}
-
-static void put32(uint8_t *p, uint32_t v)
-{
-	p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
+	return test_png_rgba(TEX, 2, 2, len);
 }
 
 /* A quad (2 triangles) in a node translated by (0,2,0), material: baseColorFactor, metallic,
@@ -172,27 +130,16 @@ static uint8_t *quad_glb_ex(const char *tex_extra, const char *root_extra, size_
 		"{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
 		"{\"bufferView\":3,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}]}",
 		tex_extra, root_extra, binpad, pnglen);
-	size_t jpad = ((size_t)jn + 3) & ~(size_t)3;
-	size_t total = 12 + 8 + jpad + 8 + binpad;
-	uint8_t *g = calloc(1, total);
-	memcpy(g, "glTF", 4);
-	put32(g + 4, 2);
-	put32(g + 8, (uint32_t)total);
-	put32(g + 12, (uint32_t)jpad);
-	memcpy(g + 16, "JSON", 4);
-	memset(g + 20, ' ', jpad);
-	memcpy(g + 20, json, (size_t)jn);
-	uint8_t *bin = g + 20 + jpad;
-	put32(bin, (uint32_t)binpad);
-	memcpy(bin + 4, "BIN\0", 4);
-	uint8_t *b = bin + 8;
+	uint8_t *b = calloc(1, binpad);
+	if (!b) { free(png); return NULL; }
 	memcpy(b, pos, 48);
 	memcpy(b + 48, nrm, 48);
 	memcpy(b + 96, uv, 32);
 	memcpy(b + 128, idx, 24);
 	memcpy(b + 152, png, pnglen);
 	free(png);
-	*len = total;
+	uint8_t *g = test_glb_pack(json, (size_t)jn, b, binpad, binpad, len);
+	free(b);
 	return g;
 }
 
@@ -202,6 +149,8 @@ static uint8_t *quad_glb(size_t *len)
 }
 
 /* ---- tests ---- */
+
+#define DEFAULT_CACHE (256ull << 20)
 
 TEST(model_obj_cube)
 {
@@ -313,12 +262,12 @@ TEST(model_corrupt_bytes)
 	struct api_scene *s = parse_model(glb, n / 2, "", &p);
 	CHECK(!s && p.status == 400 && strstr(p.detail, "could not be imported"), "%d %s", p.status, p.detail);
 	api_scene_free(s);
-	put32(glb + 12, (uint32_t)n * 2);   /* JSON chunk longer than the file */
+	test_put32(glb + 12, (uint32_t)n * 2);   /* JSON chunk longer than the file */
 	s = parse_model(glb, n, "", &p);
 	CHECK(!s && p.status == 400, "%d %s", p.status, p.detail);
 	api_scene_free(s);
 	uint8_t save = glb[20];
-	put32(glb + 12, (uint32_t)(n - 40));
+	test_put32(glb + 12, (uint32_t)(n - 40));
 	glb[20] = '[';                        /* JSON that is not an object */
 	s = parse_model(glb, n, "", &p);
 	CHECK(!s && p.status == 400, "%d %s", p.status, p.detail);
@@ -452,6 +401,7 @@ TEST(model_cache)
 	char obj[sizeof CUBE_OBJ + 32];
 	snprintf(obj, sizeof obj, "# cache test\n%s", CUBE_OBJ);
 	uint64_t h0, m0, h1, m1, bytes;
+	api_model_cache_set_limit(DEFAULT_CACHE);   /* the bound is process-wide: other tests change it */
 	api_model_cache_stats(&h0, &m0, NULL);
 	struct api_problem p;
 	struct api_scene *a = parse_model((const uint8_t *)obj, strlen(obj), "", &p);
@@ -476,7 +426,7 @@ TEST(model_cache)
 	/* A cache too small for the model: imported every time, nothing kept. */
 	struct api_limits lim;
 	api_limits_defaults(&lim);
-	lim.model_cache_bytes = 16;
+	api_model_cache_set_limit(16);
 	char *doc = model_doc((const uint8_t *)obj, strlen(obj), "");
 	api_model_cache_stats(&h0, &m0, NULL);
 	for (int i = 0; i < 2; i++) {
@@ -494,11 +444,11 @@ TEST(model_cache)
 	struct api_model *m_a, *m_b, *m_c;
 	char err[256];
 	int st;
-	lim.model_cache_bytes = 1u << 20;
+	api_model_cache_set_limit(1u << 20);
 	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, &lim, &m_a, &st, err, sizeof err) == API_OK);
 	uint64_t one;
 	api_model_cache_stats(NULL, NULL, &one);
-	lim.model_cache_bytes = one + one / 2;
+	api_model_cache_set_limit(one + one / 2);
 	REQUIRE(api_model_get((const uint8_t *)obj2, strlen(obj2), API_MODEL_OBJ, &lim, &m_b, &st, err, sizeof err) ==
 	        API_OK);
 	api_model_cache_stats(&h0, &m0, &bytes);
@@ -512,6 +462,33 @@ TEST(model_cache)
 	api_model_release(m_b);
 	api_model_release(m_c);
 	api_model_cache_clear();
+	api_model_cache_set_limit(DEFAULT_CACHE);
+}
+
+/* Lowering the process-wide bound evicts at once; models in use stay valid. */
+TEST(model_cache_limit_is_global)
+{
+	char obj[sizeof CUBE_OBJ + 32];
+	snprintf(obj, sizeof obj, "# global limit\n%s", CUBE_OBJ);
+	api_model_cache_clear();
+	api_model_cache_set_limit(DEFAULT_CACHE);
+	struct api_model *m = NULL, *m2 = NULL;
+	char err[256];
+	int st;
+	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, NULL, &m, &st, err, sizeof err) == API_OK);
+	uint64_t bytes, h0, h1;
+	api_model_cache_stats(&h0, NULL, &bytes);
+	CHECK(bytes > 0, "cached under the default bound");
+	api_model_cache_set_limit(0);
+	api_model_cache_stats(NULL, NULL, &bytes);
+	CHECK(bytes == 0, "%llu bytes left after the bound went to 0", (unsigned long long)bytes);
+	CHECK(m->triangles == 12, "still ours after eviction");
+	REQUIRE(api_model_get((const uint8_t *)obj, strlen(obj), API_MODEL_OBJ, NULL, &m2, &st, err, sizeof err) == API_OK);
+	api_model_cache_stats(&h1, NULL, &bytes);
+	CHECK(h1 == h0 && bytes == 0 && m2 != m, "bound 0: imported again, not kept");
+	api_model_release(m);
+	api_model_release(m2);
+	api_model_cache_set_limit(DEFAULT_CACHE);
 }
 
 TEST(model_image_decode)
@@ -585,7 +562,6 @@ static void *stress(void *p)
 	api_limits_defaults(&lim);
 	uint64_t one;
 	api_model_cache_stats(NULL, NULL, &one);
-	lim.model_cache_bytes = 9000; /* about one model: constant eviction */
 	for (int i = 0; i < 60; i++) {
 		int k = i % 3;
 		char *doc = model_doc(a->data[k], a->len[k], "");
@@ -610,6 +586,7 @@ TEST(model_cache_threads)
 	REQUIRE(glb);
 	struct stress_arg args[6];
 	pthread_t th[6];
+	api_model_cache_set_limit(9000);   /* about one model: constant eviction */
 	for (int t = 0; t < 6; t++) {
 		args[t] = (struct stress_arg){{(const uint8_t *)CUBE_OBJ, stl, glb}, {strlen(CUBE_OBJ), ns, ng}, 0};
 		CHECK(pthread_create(&th[t], NULL, stress, &args[t]) == 0);
@@ -620,6 +597,7 @@ TEST(model_cache_threads)
 	}
 	free(glb);
 	api_model_cache_clear();
+	api_model_cache_set_limit(DEFAULT_CACHE);
 	uint64_t bytes;
 	api_model_cache_stats(NULL, NULL, &bytes);
 	CHECK(bytes == 0);

@@ -68,7 +68,6 @@ TEST(ply_strips_ascii_import_every_triangle)
 	                          "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 2 3\n";
 	struct api_limits l;
 	api_limits_defaults(&l);
-	l.model_cache_bytes = 0;
 	struct api_model *m = NULL;
 	char err[300];
 	int st;
@@ -89,7 +88,6 @@ TEST(model_of_degenerate_triangles_is_refused)
 	static const char obj[] = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n";
 	struct api_limits l;
 	api_limits_defaults(&l);
-	l.model_cache_bytes = 0;
 	struct api_model *m = NULL;
 	char err[300] = "";
 	int st = 0;

@@ -5,24 +5,8 @@
 #include <string.h>
 #include "api.h"
 #include "test.h"
+#include "util.h"
 
-static char *b64(const char *s)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	size_t n = strlen(s), k = 0;
-	char *out = malloc(4 * ((n + 2) / 3) + 1);
-	if (!out) return NULL;
-	for (size_t i = 0; i < n; i += 3) {
-		uint32_t v = (uint32_t)(uint8_t)s[i] << 16 | (i + 1 < n ? (uint32_t)(uint8_t)s[i + 1] << 8 : 0) |
-		             (i + 2 < n ? (uint8_t)s[i + 2] : 0);
-		out[k++] = tab[v >> 18 & 63];
-		out[k++] = tab[v >> 12 & 63];
-		out[k++] = i + 1 < n ? tab[v >> 6 & 63] : '=';
-		out[k++] = i + 2 < n ? tab[v & 63] : '=';
-	}
-	out[k] = 0;
-	return out;
-}
 
 static struct api_scene *parse(const char *doc)
 {
@@ -49,8 +33,9 @@ TEST(problem_from_render_names_the_member)
 {
 	/* Two objects in one OBJ file: the model object becomes two renderer objects, so the box
 	 * after it is renderer object 2 but document object 1. */
-	char *obj = b64("o first\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
-	                "o second\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n");
+	static const char two[] = "o first\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+	                          "o second\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+	char *obj = test_b64(two, sizeof two - 1);
 	REQUIRE(obj);
 	char doc[2048];
 	snprintf(doc, sizeof doc, "{\"width\":64,\"height\":32,\"camera\":{\"position\":[0,0,5]},\"objects\":["

@@ -18,6 +18,7 @@
 #include "model_wire.h"
 #include "sandbox.h"
 #include "test.h"
+#include "util.h"
 
 /* ---- inputs ---- */
 
@@ -68,7 +69,7 @@ static struct api_limits limits(uint32_t timeout_ms)
 {
 	struct api_limits l;
 	api_limits_defaults(&l);
-	l.model_cache_bytes = 0;
+	api_model_cache_set_limit(0);   /* every import runs in the sandbox (model_cache sets it back) */
 	l.import_timeout_ms = timeout_ms;
 	return l;
 }
@@ -190,24 +191,6 @@ TEST(sandbox_image_decode)
 
 /* ---- scene documents: the pointer names the member ---- */
 
-static char *b64(const uint8_t *d, size_t n)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	size_t i = 0;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
 
 static char *scene_with(const char *model_member)
 {
@@ -226,7 +209,7 @@ TEST(sandbox_scene_crash_and_hang_pointers)
 	struct api_limits l = limits(1000);
 	uint8_t buf[1024];
 	size_t n = ply_crashing(buf, sizeof buf);
-	char *enc = b64(buf, n), member[2048];
+	char *enc = test_b64(buf, n), member[2048];
 	snprintf(member, sizeof member, "\"data\": \"%s\", \"format\": \"ply\"", enc);
 	free(enc);
 	char *doc = scene_with(member);
@@ -237,7 +220,7 @@ TEST(sandbox_scene_crash_and_hang_pointers)
 	free(doc);
 
 	n = ply_hanging((char *)buf, sizeof buf);
-	enc = b64(buf, n);
+	enc = test_b64(buf, n);
 	snprintf(member, sizeof member, "\"data\": \"%s\"", enc);
 	free(enc);
 	doc = scene_with(member);

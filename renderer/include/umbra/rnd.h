@@ -270,6 +270,25 @@ void rnd_shadow_defaults(struct rnd_shadow *s);
 /* Triangles the renderer will draw for an object (tessellation of the contract's shapes). */
 uint64_t rnd_object_triangle_count(const struct rnd_object *o);
 
+/* Whether the object counts for `fit: "objects"` framing (and for what api/ places a ground
+ * under or circles with a turntable): every object but planes and shadow catchers. mats: the
+ * scene's materials, NULL when there are none (no object is then a catcher). When no object
+ * counts, the whole scene is framed instead. */
+bool rnd_object_frames(const struct rnd_object *o, const struct rnd_material *mats);
+
+/* ---- limits ----
+ * What rnd_render() accepts at most (RND_ERR_LIMIT / RND_ERR_INVALID past them); api/ checks
+ * documents against the same numbers so that the member at fault gets its 422. */
+#define RND_MAX_DIMENSION 8192u          /* default desc.max_width / max_height of a view */
+#define RND_MAX_VIEWS 1024u              /* scene.view_count */
+#define RND_MAX_SHEET_SIDE 65536u        /* pixels per side of the sheet of several views */
+#define RND_MAX_SHEET_PIXELS (1ull << 28)
+#define RND_MAX_TEXTURE_SIDE 16384u      /* texels per side of one texture */
+
+/* The sheet of several views: ceil(sqrt(n)) columns, as many rows as needed (n = 0 means 1);
+ * unused cells count in its size. */
+void rnd_sheet_layout(uint32_t view_count, uint32_t *cols, uint32_t *rows);
+
 /* ---- result ---- */
 
 #define RND_MAX_AOV_PLANES 40

@@ -1,5 +1,6 @@
 /*
- * umbra renderer — small vector/matrix math shared by the renderer and api/.
+ * umbra renderer — small vector/matrix math shared by the renderer and api/, and the byte-stream
+ * hash of the project (rnd_fnv1a: ETags, the model cache).
  *
  * Conventions: float arrays; matrices are 4x4 column-major (m[col*4 + row]) as in glTF and
  * GLSL; right-handed world, +Y up. Projections produce Vulkan clip space: depth 0..1 and the
@@ -11,12 +12,23 @@
 #define UMBRA_RND_MATH_H
 
 #include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 struct rnd_aabb { float min[3], max[3]; };
+
+/* The byte-stream hash (64-bit FNV-1a) of the project: start from RND_FNV_SEED (or a previous
+ * result); streaming, so hashing a then b equals hashing a‖b, and a body that arrives in chunks
+ * hashes the same however it is cut. Used for ETags (server/negotiate.c), the model cache key
+ * (api/model.c) and asset files. Not for security. The shadow cache keys use rnd_hash()
+ * (renderer/shadow_cache.h) instead: a word-at-a-time hash of fixed records, several times
+ * faster on large inputs but not streaming. */
+#define RND_FNV_SEED 0xcbf29ce484222325ull
+uint64_t rnd_fnv1a(uint64_t h, const void *data, size_t len);
 
 float rnd_v3_dot(const float a[3], const float b[3]);
 void rnd_v3_cross(float out[3], const float a[3], const float b[3]);

@@ -3,7 +3,7 @@
  *
  *   TEST(parses_sphere) { CHECK(x == 1, "x is %d", x); }
  *
- * TEST registers the function at load time (constructor). The runner (tests/unit/test_main.c)
+ * TEST registers the function at load time (constructor). The runner (tests/util/test_main.c)
  * runs every test, or those whose name contains argv[1], prints "ok - name" or
  * "FAIL - name" with each failed CHECK's file:line and message, and ends with the line
  * "N passed, N failed". A test fails when any CHECK in it fails; CHECK does not return.

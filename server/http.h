@@ -1,0 +1,36 @@
+/*
+ * server/http.h — what the HTTP modules share (http.c: dispatch and answers; render_route.c:
+ * POST /v1/render). Everything here runs on libmicrohttpd's polling thread, except
+ * srv_request_finish() (srv.h), which a worker calls.
+ *
+ * Answers: srv_respond() queues one (body: malloc'd, becomes libmicrohttpd's, or NULL), sets
+ * the common headers (X-Request-Id, Allow, Retry-After, ETag/Vary/Server-Timing for a render,
+ * Cache-Control, Connection), logs and counts the request. It returns what the access handler
+ * returns.
+ */
+#ifndef UMBRA_SRV_HTTP_H
+#define UMBRA_SRV_HTTP_H
+
+#include <microhttpd.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "srv.h"
+
+enum MHD_Result srv_respond(struct srv_request *req, int status, const char *content_type, void *body, size_t len,
+                            const char *allow);
+/* A problem+json answer with a printf-style detail at `pointer`. */
+enum MHD_Result srv_respond_problem(struct srv_request *req, int status, const char *allow, const char *pointer,
+                                    const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+/* Ready: the renderer is warmed up and the server is not draining. */
+bool srv_is_ready(const struct srv_server *s);
+/* 503 saying why the server is not ready (starting up, or shutting down). */
+enum MHD_Result srv_answer_not_ready(struct srv_request *req);
+
+/* render_route.c, in the order the access handler calls them. */
+enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection *conn);
+bool srv_render_body(struct srv_request *req, const char *data, size_t size);   /* false: over --max-body */
+enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connection *conn);
+enum MHD_Result srv_render_answer(struct srv_request *req);
+
+#endif

@@ -1,0 +1,139 @@
+/*
+ * server/negotiate — Content-Type, Accept and ETag rules of POST /v1/render (see negotiate.h).
+ * Pure string work; the hash is the project's byte-stream hash, rnd_fnv1a() (umbra/rnd_math.h).
+ */
+#include <stdlib.h>
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+
+#include "negotiate.h"
+#include "umbra/rnd_math.h"
+
+#ifndef UMBRA_VERSION
+#define UMBRA_VERSION "0.1.0"
+#endif
+
+bool srv_json_content_type(const char *ct)
+{
+	if (!ct)
+		return false;
+	while (*ct == ' ' || *ct == '\t')
+		ct++;
+	size_t n = strcspn(ct, "; \t");
+	if (n == 16 && !strncasecmp(ct, "application/json", 16))
+		return true;
+	return n > 17 && !strncasecmp(ct, "application/", 12) && !strncasecmp(ct + n - 5, "+json", 5);
+}
+
+bool srv_multipart_content_type(const char *ct)
+{
+	if (!ct)
+		return false;
+	while (*ct == ' ' || *ct == '\t')
+		ct++;
+	return !strncasecmp(ct, "multipart/form-data", 19) && strchr("; \t", ct[19]);
+}
+
+enum srv_accept srv_accept_choice(const char *accept)
+{
+	if (!accept || !*accept)
+		return SRV_ACCEPT_PNG;
+	double q_png = -1, q_exr = -1, q_wild = -1;
+	bool spec_png = false, spec_exr = false;
+	const char *p = accept;
+	while (*p) {
+		while (*p == ' ' || *p == ',')
+			p++;
+		if (!*p)
+			break;
+		size_t item = strcspn(p, ",");
+		char buf[128];
+		size_t n = item < sizeof buf - 1 ? item : sizeof buf - 1;
+		memcpy(buf, p, n);
+		buf[n] = 0;
+		p += item;
+		double q = 1;
+		char *semi = strchr(buf, ';');
+		if (semi) {
+			*semi = 0;
+			char *qs = strstr(semi + 1, "q=");
+			if (qs)
+				q = strtod(qs + 2, NULL);
+		}
+		char *end = buf + strlen(buf);
+		while (end > buf && (end[-1] == ' ' || end[-1] == '\t'))
+			*--end = 0;
+		if (!strcasecmp(buf, "image/png")) {
+			q_png = q;
+			spec_png = true;
+		} else if (!strcasecmp(buf, "image/x-exr")) {
+			q_exr = q;
+			spec_exr = true;
+		} else if (!strcasecmp(buf, "image/*") || !strcasecmp(buf, "*/*")) {
+			if (q > q_wild)
+				q_wild = q;
+		}
+	}
+	if (!spec_png)
+		q_png = q_wild;
+	if (!spec_exr)
+		q_exr = q_wild;
+	if (q_png <= 0 && q_exr <= 0)
+		return SRV_ACCEPT_NONE;
+	return q_exr > 0 && q_exr > q_png ? SRV_ACCEPT_EXR : SRV_ACCEPT_PNG;
+}
+
+/* ---- ETag ---- */
+
+uint64_t srv_etag_start(void)
+{
+	return RND_FNV_SEED;
+}
+
+uint64_t srv_etag_body(uint64_t h, const void *data, size_t len)
+{
+	return rnd_fnv1a(h, data, len);
+}
+
+uint64_t srv_etag_finish(uint64_t h, bool exr, const char *device_name, const char *driver_info)
+{
+	h = rnd_fnv1a(h, exr ? "\0exr" : "\0png", 4);
+	h = rnd_fnv1a(h, UMBRA_VERSION, strlen(UMBRA_VERSION));
+	h = rnd_fnv1a(h, device_name, strlen(device_name));
+	return rnd_fnv1a(h, driver_info, strlen(driver_info));
+}
+
+uint64_t srv_etag_assets(uint64_t h, uint64_t asset_hash)
+{
+	/* One FNV step with the asset hash as the "byte": the ETag changes when a file does. */
+	return (h ^ asset_hash) * 0x100000001b3ull;
+}
+
+void srv_etag_format(char *out, size_t n, uint64_t h)
+{
+	snprintf(out, n, "\"%016llx\"", (unsigned long long)h);
+}
+
+bool srv_etag_matches(const char *inm, const char *etag)
+{
+	if (!inm)
+		return false;
+	size_t el = strlen(etag);
+	const char *p = inm;
+	while (*p) {
+		while (*p == ' ' || *p == ',' || *p == '\t')
+			p++;
+		if (!*p)
+			break;
+		/* "*" is not a match: a render always has a representation to make, and an
+		 * unconditional 304 would hide it. */
+		if (!strncmp(p, "W/", 2))
+			p += 2;
+		size_t n = strcspn(p, ", \t");
+		if (n == el && !strncmp(p, etag, el))
+			return true;
+		p += n;
+	}
+	return false;
+}

@@ -1,0 +1,65 @@
+/* tests/util/models.c — see models.h. */
+#include <png.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models.h"
+
+void test_put32(uint8_t *p, uint32_t v)
+{
+	p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
+}
+
+uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len)
+{
+	png_image img;
+	memset(&img, 0, sizeof img);
+	img.version = PNG_IMAGE_VERSION;
+	img.width = (png_uint_32)w;
+	img.height = (png_uint_32)h;
+	img.format = PNG_FORMAT_RGBA;
+	png_alloc_size_t n = 0;
+	if (!png_image_write_to_memory(&img, NULL, &n, 0, px, 0, NULL)) return NULL;
+	uint8_t *buf = malloc(n);
+	if (!buf) return NULL;
+	if (!png_image_write_to_memory(&img, buf, &n, 0, px, 0, NULL)) { free(buf); return NULL; }
+	*len = n;
+	return buf;
+}
+
+size_t test_tetra_stl(uint8_t *out, const float p[4][3])
+{
+	static const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+	memset(out, 0, 84);
+	memcpy(out, "binary tetrahedron", 18);
+	test_put32(out + 80, 4);
+	uint8_t *q = out + 84;
+	for (int i = 0; i < 4; i++, q += 50) {
+		float rec[12] = {0};
+		for (int k = 0; k < 3; k++) memcpy(rec + 3 + 3 * k, p[f[i][k]], sizeof p[0]);
+		memcpy(q, rec, sizeof rec); /* normal 0: recomputed by the importer */
+		q[48] = q[49] = 0;
+	}
+	return 84 + 4 * 50;
+}
+
+uint8_t *test_glb_pack(const char *json, size_t jn, const uint8_t *bin, size_t binlen, size_t binpad, size_t *len)
+{
+	size_t jpad = (jn + 3) & ~(size_t)3;
+	size_t total = 12 + 8 + jpad + 8 + binpad;
+	uint8_t *g = calloc(1, total);
+	if (!g) return NULL;
+	memcpy(g, "glTF", 4);
+	test_put32(g + 4, 2);
+	test_put32(g + 8, (uint32_t)total);
+	test_put32(g + 12, (uint32_t)jpad);
+	memcpy(g + 16, "JSON", 4);
+	memset(g + 20, ' ', jpad);
+	memcpy(g + 20, json, jn);
+	uint8_t *b = g + 20 + jpad;
+	test_put32(b, (uint32_t)binpad);
+	memcpy(b + 4, "BIN\0", 4);
+	memcpy(b + 8, bin, binlen);
+	*len = total;
+	return g;
+}

@@ -1,0 +1,25 @@
+/*
+ * tests/util/models.h — model and image files built in memory for the tests (unit and GPU),
+ * one copy of each builder: a PNG from RGBA8 texels (libpng), a binary STL tetrahedron, the
+ * GLB container around a glTF JSON chunk and a binary chunk. Every result is malloc'd (the
+ * caller frees it) except where the caller passes the buffer.
+ */
+#ifndef UMBRA_TEST_MODELS_H
+#define UMBRA_TEST_MODELS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Little-endian uint32 at p. */
+void test_put32(uint8_t *p, uint32_t v);
+/* A straight-alpha RGBA8 PNG of w x h texels; NULL on failure. */
+uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len);
+/* Binary .stl of the tetrahedron with the given 4 vertices into out (84 + 4*50 = 284 bytes);
+ * facet normals 0 (the importer recomputes them). Returns the size. */
+size_t test_tetra_stl(uint8_t *out, const float p[4][3]);
+/* A .glb: the JSON chunk (padded with spaces) and the binary chunk (bin[0..binlen), padded with
+ * zeros to binpad, which the JSON's buffer byteLength must state). NULL when out of memory. */
+uint8_t *test_glb_pack(const char *json, size_t json_len, const uint8_t *bin, size_t binlen, size_t binpad,
+                       size_t *len);
+
+#endif

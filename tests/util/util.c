@@ -1,0 +1,34 @@
+/* tests/util/util.c — see util.h. */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "util.h"
+
+char *test_b64(const void *data, size_t n)
+{
+	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+	const uint8_t *d = data;
+	char *o = malloc(n / 3 * 4 + 8), *p = o;
+	if (!o) return NULL;
+	size_t i = 0;
+	for (; i + 2 < n; i += 3) {
+		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
+		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
+	}
+	if (i < n) {
+		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
+		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
+		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
+		*p++ = '=';
+	}
+	*p = 0;
+	return o;
+}
+
+char *test_vdoc(const char *fmt, va_list ap)
+{
+	char *doc = NULL;
+	if (vasprintf(&doc, fmt, ap) < 0) return NULL;
+	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
+	return doc;
+}

@@ -1,0 +1,19 @@
+/*
+ * tests/util/util.h — helpers shared by the unit and GPU test binaries (tests/util/util.c),
+ * instead of a copy in each test file. Plain C, no GPU; every result is malloc'd and the
+ * caller frees it.
+ */
+#ifndef UMBRA_TEST_UTIL_H
+#define UMBRA_TEST_UTIL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* Standard base64 (with padding) of d[0..n), NUL-terminated. */
+char *test_b64(const void *d, size_t n);
+/* A scene document from a printf format in which ' stands for " (so that tests can write
+ * "{'width': %d}"). NULL when out of memory. */
+char *test_vdoc(const char *fmt, va_list ap);
+
+#endif
