@@ -4,7 +4,8 @@
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
 #   make fuzz       libFuzzer targets in build/fuzz (clang); make test runs each briefly
-#   make bench      warm-process and HTTP benchmarks of ../shared/bench
+#   make bench      warm-process and HTTP benchmarks of ../shared/bench, the floor, the ratio table
+#   make bench-quick  only the ratio table's rows (BENCH_ONLY=ratios)
 #   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
@@ -56,7 +57,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: all deps run test test-asan bench fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -122,9 +123,18 @@ soak: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) UMBRA_VALIDATION=1 sh tests/http/soak.sh
 
-bench: deps
-	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench
+bench: deps bench-tools
 	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/bench.sh
+
+# Only what the ratio table needs, fewer runs (a few minutes instead of a quarter of an hour).
+bench-quick: deps bench-tools
+	@BUILD=$(BUILD) SHARED=$(SHARED) BENCH_ONLY=ratios sh tests/bench.sh
+
+# The floor (../shared/floor, read-only) builds out of tree into $(BUILD)/floor.
+bench-tools:
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench \
+		$(BUILD)/tests/edge_error
+	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor
 
 $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
@@ -132,6 +142,9 @@ $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD
 $(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/tests/edge_error: $(BUILD)/obj/tests/bench/edge_error.o
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ -lpng16 -lm
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^

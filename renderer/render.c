@@ -15,6 +15,7 @@
 #include <string.h>
 #include <time.h>
 #include "estimate.h"
+#include "lod.h"
 #include "mesh.h"
 #include "plan.h"
 #include "moments.h"
@@ -243,13 +244,15 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 
 /* Tessellates every object into the slot's buffers; fills draws and the scene bounds. */
 static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                              const struct rnd_pacer *pacer, struct draw *draws, struct rnd_aabb *bounds,
-                              struct rnd_error *err)
+                              const struct rnd_pacer *pacer, const uint32_t *lod, struct draw *draws,
+                              struct rnd_aabb *bounds, struct rnd_error *err)
 {
 	uint64_t nv = 0, ni = 0;
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		uint32_t v, x;
-		rnd_mesh_counts(&sc->objects[i], &v, &x);
+		struct rnd_object o = sc->objects[i];
+		o.segments = lod[i]; /* renderer/lod.h: no finer than the output can show */
+		rnd_mesh_counts(&o, &v, &x);
 		nv += v; ni += x;
 	}
 	if (nv > UINT32_MAX || ni > UINT32_MAX)
@@ -266,7 +269,10 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 	uint32_t vbase = 0, ibase = 0;
 	rnd_aabb_empty(bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++) {
-		const struct rnd_object *o = &sc->objects[i];
+		struct rnd_object lo = sc->objects[i];
+		lo.segments = lod[i];
+		lo.radius = rnd_lod_radius(lo.radius, lod[i], sc->objects[i].segments);
+		const struct rnd_object *o = &lo;
 		struct draw *d = &draws[i];
 		uint32_t v, x;
 		rnd_mesh_counts(o, &v, &x);
@@ -441,10 +447,13 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 
 	/* Per-request memory: one block for the draw list and the shadow plan. */
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
-	void *arena = malloc(draws_bytes + sizeof(struct rnd_shadow_plan));
+	size_t lod_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(uint32_t);
+	void *arena = malloc(draws_bytes + sizeof(struct rnd_shadow_plan) + lod_bytes);
 	if (!arena) return rnd_fail(err, RND_ERR_OOM, "out of memory for %u objects", sc->object_count);
 	struct draw *draws = arena;
 	struct rnd_shadow_plan *sp = (struct rnd_shadow_plan *)((char *)arena + draws_bytes);
+	uint32_t *lod = (uint32_t *)((char *)sp + sizeof *sp);
+	rnd_lod_choose(sc, nviews, sp, lod);
 
 	struct rnd_slot *s = rnd_slot_acquire(ctx);
 	double t0 = now_ms();
@@ -455,7 +464,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	struct rnd_camera_plan cam;
 	const struct rnd_texture *tex[UMBRA_MAX_TEXTURES];
 	uint32_t ntex = 0;
-	if ((r = upload(ctx, s, sc, &pacer, draws, &bounds, err)) != RND_OK) goto done;
+	if ((r = upload(ctx, s, sc, &pacer, lod, draws, &bounds, err)) != RND_OK) goto done;
 	/* Auto-framing `fit: objects` leaves out planes and shadow catchers (the ground). */
 	struct rnd_aabb obj_bounds;
 	rnd_aabb_empty(&obj_bounds);
@@ -480,6 +489,15 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if ((r = rnd_buffer_reserve(ctx, &s->readback, rb, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "slot readback", err)) != RND_OK)
 		goto done;
 	if (nviews > 1) memset(s->readback.map, 0, rb); /* unused cells of the sheet (colour and AOVs) */
+
+	/* A plane with every other object on its lit side shadows nothing: out of the shadow pass. */
+	for (uint32_t i = 0; i < sc->object_count && sc->object_count <= 256; i++) {
+		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
+		bool casts = false;
+		for (uint32_t j = 0; j < sc->object_count && !casts; j++)
+			casts = j != i && rnd_plane_may_shadow(sc, &sc->objects[i], &draws[j].bounds);
+		draws[i].cast = casts;
+	}
 
 	/* What every spot/point key starts from: the casters' world-space geometry, their
 	 * culling and alpha masks (with texture content), and the scene bounds (far planes). */

@@ -229,6 +229,9 @@ struct rnd_scene {
 	bool (*cancel)(void *user); /* polled between submits (any thread-safe check), NULL = none */
 	void *cancel_user;
 	uint32_t band_rows;       /* main-pass rows per submit, 0 = chosen by the renderer (tests) */
+	/* false: spheres and cylinders get no more segments than the output can show (renderer/lod.h,
+	 * within 1/32 pixel and 1/8 shadow texel); true: exactly `segments` (tests, comparisons). */
+	bool exact_segments;
 };
 
 /* Contract defaults: 512x512, perspective camera at (0,0,5) looking at the origin, default
