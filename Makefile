@@ -33,7 +33,8 @@ ifeq ($(UMBRA_VERSION),)
 UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || cat VERSION 2>/dev/null || echo unknown)
 endif
 CFLAGS += -DUMBRA_VERSION=\"$(UMBRA_VERSION)\"
-LIBS := $(PKG_LIBS) -lm
+# meshoptimizer (api/model_lod.c) ships no pkg-config file in Debian 12.
+LIBS := $(PKG_LIBS) -lmeshoptimizer -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)

@@ -47,6 +47,9 @@ struct api_model_mesh {
 	const uint32_t *indices;  /* index_count, a multiple of 3, every index < vertex_count */
 	uint32_t vertex_count, index_count;
 	uint32_t material;        /* index into api_model.materials */
+	/* Simplified levels (api/model_lod.h), finest first; set once after import, then immutable. */
+	const struct rnd_mesh_lod *lods;
+	uint32_t lod_count;
 };
 
 /* A node's use of a mesh: one rnd_object. */

@@ -1344,6 +1344,8 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->index_count = me->index_count;
 			o->normals = me->normals;
 			o->uvs = me->uvs;
+			o->lods = me->lods;
+			o->lod_count = me->lod_count;
 			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);
 			if (!own) o->material = base + me->material;
 		}

@@ -65,19 +65,56 @@ float rnd_lod_pixel_world(const float view_proj[16], float width, float height, 
 	return g > 0.0f ? 2.0f * w / g : INFINITY;
 }
 
-/* Centre, bounding radius and largest axis scale of a sphere / cylinder in world space. */
+/* Centre, bounding radius and largest axis scale of a sphere / cylinder / mesh with levels in
+ * world space (a mesh's from its coarsest level: few vertices, the same extent within its error). */
 static void object_sphere(const struct rnd_object *o, float centre[3], float *bound, float *scale)
 {
 	const float *m = o->model;
-	float s = 0.0f;
+	float s = 0.0f, lc[3] = {0, 0, 0}, r = fabsf(o->radius);
 	for (int c = 0; c < 3; c++) {
 		float l = sqrtf(m[4 * c] * m[4 * c] + m[4 * c + 1] * m[4 * c + 1] + m[4 * c + 2] * m[4 * c + 2]);
 		if (l > s) s = l;
 	}
-	centre[0] = m[12]; centre[1] = m[13]; centre[2] = m[14];
-	float r = fabsf(o->radius), h = o->shape == RND_SHAPE_CYLINDER ? 0.5f * fabsf(o->height) : 0.0f;
+	if (o->shape == RND_SHAPE_MESH && o->lod_count) {
+		const struct rnd_mesh_lod *l = &o->lods[o->lod_count - 1];
+		struct rnd_aabb b;
+		rnd_aabb_empty(&b);
+		for (uint32_t i = 0; i < l->vertex_count; i++) rnd_aabb_add_point(&b, l->positions + 3 * i);
+		float d[3];
+		for (int k = 0; k < 3; k++) { lc[k] = 0.5f * (b.min[k] + b.max[k]); d[k] = b.max[k] - lc[k]; }
+		r = l->vertex_count ? rnd_v3_length(d) : 0.0f;
+	}
+	rnd_mat4_mul_point(centre, m, lc);
+	float h = o->shape == RND_SHAPE_CYLINDER ? 0.5f * fabsf(o->height) : 0.0f;
 	*bound = sqrtf(r * r + h * h) * s;
 	*scale = s;
+}
+
+uint32_t rnd_lod_mesh_level(const struct rnd_object *o, float pixel_world, float error_pixels)
+{
+	if (o->shape != RND_SHAPE_MESH || !o->lod_count) return 0;
+	float c[3], bound, scale;
+	object_sphere(o, c, &bound, &scale);
+	float allowed = scale > 0.0f ? error_pixels * pixel_world / scale : 0.0f;
+	uint32_t level = 0;
+	while (level < o->lod_count && o->lods[level].error <= allowed) level++;
+	return level;
+}
+
+void rnd_lod_apply(struct rnd_object *o, uint32_t lod)
+{
+	if (o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_CYLINDER) {
+		o->radius = rnd_lod_radius(o->radius, lod, o->segments);
+		o->segments = lod;
+	} else if (o->shape == RND_SHAPE_MESH && lod > 0 && lod <= o->lod_count) {
+		const struct rnd_mesh_lod *l = &o->lods[lod - 1];
+		o->positions = l->positions;
+		o->normals = l->normals;
+		o->uvs = l->uvs;
+		o->indices = l->indices;
+		o->vertex_count = l->vertex_count;
+		o->index_count = l->index_count;
+	}
 }
 
 uint32_t rnd_lod_object_segments(const struct rnd_object *o, float pixel_world, float error_pixels)
@@ -95,25 +132,38 @@ static bool is_round(const struct rnd_object *o)
 	return o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_CYLINDER;
 }
 
-/* Raises need[i] to what view_proj (w x h pixels, error bound err pixels) asks of each round
- * object (only the casters when casters_only). */
+static bool has_levels(const struct rnd_object *o)
+{
+	return o->shape == RND_SHAPE_MESH && o->lod_count > 0;
+}
+
+/* Raises need[i] to what view_proj (w x h pixels, error bounds err for round shapes and
+ * mesh_err for meshes with levels, in pixels) asks of each object (only the casters when
+ * casters_only); for a mesh lowers the level instead. */
 static void need_in_view(const struct rnd_scene *sc, const float vp[16], float w, float h, float near_w, float err,
-                         bool casters_only, uint32_t *need)
+                         float mesh_err, bool casters_only, uint32_t *need)
 {
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		const struct rnd_object *o = &sc->objects[i];
-		if (!is_round(o) || (casters_only && !o->cast_shadows)) continue;
+		if ((!is_round(o) && !has_levels(o)) || (casters_only && !o->cast_shadows)) continue;
 		float c[3], bound, scale;
 		object_sphere(o, c, &bound, &scale);
-		uint32_t s = rnd_lod_object_segments(o, rnd_lod_pixel_world(vp, w, h, c, bound, near_w), err);
+		float pw = rnd_lod_pixel_world(vp, w, h, c, bound, near_w);
+		if (has_levels(o)) {
+			uint32_t level = rnd_lod_mesh_level(o, pw, mesh_err); /* coarser is larger: keep the finest */
+			if (level < need[i]) need[i] = level;
+			continue;
+		}
+		uint32_t s = rnd_lod_object_segments(o, pw, err);
 		if (s > need[i]) need[i] = s;
 	}
 }
 
-/* Every object at the segments it asked for (the fallback when a plan fails). */
+/* Every object as asked (the fallback when a plan fails): its segments, a mesh in full. */
 static void as_asked(const struct rnd_scene *sc, uint32_t *segments)
 {
-	for (uint32_t i = 0; i < sc->object_count; i++) segments[i] = sc->objects[i].segments;
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		segments[i] = has_levels(&sc->objects[i]) ? 0 : sc->objects[i].segments;
 }
 
 /* Scene bounds as render.c will find them, from the shapes (tessellated vertices lie on them);
@@ -139,9 +189,10 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 {
 	bool any = false;
 	for (uint32_t i = 0; i < sc->object_count; i++) {
-		bool round = is_round(&sc->objects[i]);
-		segments[i] = round ? 0 : sc->objects[i].segments; /* round: raised to the largest need */
-		any |= round;
+		const struct rnd_object *o = &sc->objects[i];
+		/* round: raised to the largest need; levels: lowered to the finest any view needs */
+		segments[i] = is_round(o) ? 0 : has_levels(o) ? o->lod_count : o->segments;
+		any |= is_round(o) || has_levels(o);
 	}
 	if (!any || sc->exact_segments) {
 		as_asked(sc, segments);
@@ -160,13 +211,13 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 			return;
 		}
 		need_in_view(sc, cam.view_proj, (float)sc->width, (float)sc->height, cam.ortho ? 0.0f : cam.znear,
-		             RND_LOD_PIXEL_ERROR, false, segments);
+		             RND_LOD_PIXEL_ERROR, RND_LOD_MESH_PIXEL_ERROR, false, segments);
 		for (uint32_t k = 0; k < scratch->view_count; k++) {
 			const struct umbra_shadow_view *sv = &scratch->views[k];
 			float res = (float)scratch->lights[scratch->view_light[k]].resolution;
 			bool persp = sv->params[1] > 0.5f;
 			need_in_view(sc, (const float *)&sv->view_proj, res, res, persp ? sv->params[2] : 0.0f, RND_LOD_TEXEL_ERROR,
-			             true, segments);
+			             RND_LOD_MESH_TEXEL_ERROR, true, segments);
 		}
 	}
 	for (uint32_t i = 0; i < sc->object_count; i++)

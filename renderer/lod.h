@@ -9,7 +9,10 @@
  * middle; when N < S the radius is raised so that the chords straddle the arc, half that
  * inside and half outside, see rnd_lod_radius).
  * Asking for more segments than the output can show costs time and changes nothing visible;
- * asking for fewer is honoured exactly. Boxes, planes and meshes are not touched here.
+ * asking for fewer is honoured exactly. A mesh with simplified levels (rnd_object.lods, built
+ * for imported models by api/model_lod.c) is drawn with the coarsest level whose measured error
+ * stays within RND_LOD_MESH_PIXEL_ERROR / RND_LOD_MESH_TEXEL_ERROR. Boxes, planes and other
+ * meshes are not touched.
  *
  * Usage: render.c calls rnd_lod_choose() before tessellating; the rest are the pure pieces it
  * is made of (unit-tested in tests/unit/test_lod.c). No Vulkan, no allocation, thread-safe.
@@ -27,6 +30,13 @@
  * below the 3x3 PCF footprint and the map's own nearest-texel quantisation. */
 #define RND_LOD_PIXEL_ERROR 0.03125f
 #define RND_LOD_TEXEL_ERROR 0.125f
+/* Meshes: a level's error is its measured largest distance from the full mesh
+ * (api/model_lod.c), reached at a few of meshoptimizer's long triangles, and its normals are
+ * recomputed, so the image changes more than the bound alone says. Measured on a 100k-triangle
+ * STL sphere in a 512-pixel thumbnail (edge error against a 4x4-supersampled full render): full
+ * 0.0066, 1/4 pixel 0.0066 (no level fits), 1/2 pixel 0.0087, 1 pixel 0.0107. */
+#define RND_LOD_MESH_PIXEL_ERROR 0.5f
+#define RND_LOD_MESH_TEXEL_ERROR 0.5f
 
 /* Fewest segments (even, >= 4) for a circle of radius `radius` whose centred chords deviate at
  * most `max_error` (same units) from it; UINT32_MAX when max_error <= 0 or radius is not finite. */
@@ -52,8 +62,18 @@ uint32_t rnd_lod_object_segments(const struct rnd_object *o, float pixel_world, 
  * silhouette by the whole error. As asked (no LOD): radius unchanged. */
 float rnd_lod_radius(float radius, uint32_t segments, uint32_t asked);
 
+/* Level of a mesh with levels (o->lods) that a pixel of pixel_world and a bound of
+ * error_pixels allow: the coarsest whose error (scaled to world) stays within the bound;
+ * 0 = the full mesh, k = o->lods[k - 1]. Other objects: 0. */
+uint32_t rnd_lod_mesh_level(const struct rnd_object *o, float pixel_world, float error_pixels);
+
+/* Makes o the object rnd_lod_choose()'s entry `lod` for it says: a sphere / cylinder with lod
+ * segments (and rnd_lod_radius), a mesh with level lod (0: unchanged). */
+void rnd_lod_apply(struct rnd_object *o, uint32_t lod);
+
 /* Fills segments[i] for every object of the scene (nviews views of width x height, scratch for
- * the shadow plans). Estimates the scene bounds from the shapes without tessellating. On a plan
+ * the shadow plans): segments for spheres and cylinders, the level for meshes with levels
+ * (rnd_lod_apply() takes either). Estimates the scene bounds from the shapes without tessellating. On a plan
  * failure every object keeps its requested segments (the render reports the failure later). */
 void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shadow_plan *scratch,
                     uint32_t *segments);

@@ -251,7 +251,7 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		uint32_t v, x;
 		struct rnd_object o = sc->objects[i];
-		o.segments = lod[i]; /* renderer/lod.h: no finer than the output can show */
+		rnd_lod_apply(&o, lod[i]); /* renderer/lod.h: no finer than the output can show */
 		rnd_mesh_counts(&o, &v, &x);
 		nv += v; ni += x;
 	}
@@ -270,8 +270,7 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 	rnd_aabb_empty(bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		struct rnd_object lo = sc->objects[i];
-		lo.segments = lod[i];
-		lo.radius = rnd_lod_radius(lo.radius, lod[i], sc->objects[i].segments);
+		rnd_lod_apply(&lo, lod[i]);
 		const struct rnd_object *o = &lo;
 		struct draw *d = &draws[i];
 		uint32_t v, x;

@@ -90,6 +90,16 @@ struct rnd_material {
 	const struct rnd_texture *base_color_texture; /* NULL = none; multiplies base_color, sampled with the uvs */
 };
 
+/* A coarser version of a mesh object's geometry (api/model_lod.c builds them for imported
+ * models with meshoptimizer); renderer/lod.h picks the coarsest whose error the output cannot
+ * show. Arrays as in rnd_object (normals and indices always present, uvs optional). */
+struct rnd_mesh_lod {
+	const float *positions, *normals, *uvs;
+	const uint32_t *indices;
+	uint32_t vertex_count, index_count;
+	float error;          /* largest deviation from the full mesh, object-space units */
+};
+
 struct rnd_object {
 	enum rnd_shape shape;
 	float size[3];        /* plane: [sx, 0, sz]; box: [sx, sy, sz] */
@@ -104,6 +114,7 @@ struct rnd_object {
 	uint32_t index_count;
 	const float *normals;
 	const float *uvs;
+	const struct rnd_mesh_lod *lods; uint32_t lod_count; /* mesh: coarser levels, finest first, or none */
 	float model[16];      /* object -> world, column-major (T*R*S resolved by the caller) */
 	uint32_t material;    /* index into scene.materials */
 	bool cast_shadows, receive_shadows, double_sided;
@@ -229,8 +240,9 @@ struct rnd_scene {
 	bool (*cancel)(void *user); /* polled between submits (any thread-safe check), NULL = none */
 	void *cancel_user;
 	uint32_t band_rows;       /* main-pass rows per submit, 0 = chosen by the renderer (tests) */
-	/* false: spheres and cylinders get no more segments than the output can show (renderer/lod.h,
-	 * within 1/32 pixel and 1/8 shadow texel); true: exactly `segments` (tests, comparisons). */
+	/* false: spheres and cylinders get no more segments, meshes with levels no more triangles,
+	 * than the output can show (renderer/lod.h: within 1/32 pixel and 1/8 shadow texel); true:
+	 * exactly `segments` and every mesh in full (tests, comparisons). */
 	bool exact_segments;
 };
 
