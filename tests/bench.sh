@@ -3,7 +3,9 @@
 # warm-process medians per stage for the bench scenes, the generated 100k / 1M triangle meshes,
 # the cold CLI and the HTTP benchmark, then the ratio table of issue 12 (tests/bench/ratios.py).
 # Env: BUILD, SHARED; BENCH_ONLY=ratios runs only what the ratio table needs, with fewer runs
-# (`make bench-quick`). Numbers go to stdout; nothing here asserts a time.
+# (`make bench-quick`). BENCH_BEFORE=DIR (the build folder of an older checkout) also runs that
+# build's bench and CLI in the same run and prints its ratio table first ("before").
+# Numbers go to stdout; nothing here asserts a time.
 set -eu
 BUILD=${BUILD:-build}
 SHARED=${SHARED:-../shared}
@@ -24,11 +26,21 @@ floor() {
 		grep '^| c' | tee -a "$log/floor.txt"
 }
 echo "== side by side: the floor (step c, MSAA 1 and 4), umbra warm (build/tests/bench), the floor again"
+warm() { # BUILD_DIR LOG: the ratio table's warm rows
+	"$1/tests/bench" -n "$RUNS" "$SHARED/bench/thumb-256.json" "$SHARED/bench/thumb-512.json" \
+		"$SHARED/bench/studio-spots.json" | tee -a "$2"
+	# the 1M model: by path (a cached import: no 70 MB JSON to parse), and inline
+	"$1/tests/bench" -n 5 -a "$tmp/v" "$tmp/v/studio-16lights.json" "$tmp/v/model-1m-path.json" \
+		"$tmp/v/model-1m.json" | tee -a "$2"
+}
 floor
-"$BUILD/tests/bench" -n "$RUNS" "$SHARED/bench/thumb-256.json" "$SHARED/bench/thumb-512.json" \
-	"$SHARED/bench/studio-spots.json" | tee -a "$log/warm.txt"
+warm "$BUILD" "$log/warm.txt"
 floor
-"$BUILD/tests/bench" -n 5 "$tmp/v/studio-16lights.json" "$tmp/v/model-1m.json" | tee -a "$log/warm.txt"
+if [ -n "${BENCH_BEFORE:-}" ]; then
+	echo "-- before: $BENCH_BEFORE"
+	warm "$BENCH_BEFORE" "$log/warm-before.txt"
+	floor
+fi
 
 if [ $QUICK = 0 ]; then
 	python3 "$SHARED/bench/gen-mesh-scene.py" 100000 >"$tmp/mesh-100k.json"
@@ -68,6 +80,14 @@ for i in $( [ $QUICK = 1 ] && echo 1 || echo 1 2 3); do
 	"$BUILD/umbra-render" "$tmp/thumb512-aov.json" -o "$tmp/cold.exr"
 	f=$(date +%s%N)
 	echo "run $i: png $(( (e - s) / 1000000 )) ms, exr+aov $(( (f - e) / 1000000 )) ms"
+	if [ -n "${BENCH_BEFORE:-}" ]; then
+		s=$(date +%s%N)
+		"$BENCH_BEFORE/umbra-render" "$SHARED/bench/thumb-512.json" -o "$tmp/cold.png"
+		e=$(date +%s%N)
+		"$BENCH_BEFORE/umbra-render" "$tmp/thumb512-aov.json" -o "$tmp/cold.exr"
+		f=$(date +%s%N)
+		echo "before $i: png $(( (e - s) / 1000000 )) ms, exr+aov $(( (f - e) / 1000000 )) ms" >>"$log/cold-before.txt"
+	fi
 done | tee "$log/cold.txt"
 if [ -x "$BUILD/tests/http_bench" ] && [ -f tests/bench/http_bench.sh ]; then
 	echo
@@ -80,4 +100,5 @@ if [ -x "$BUILD/tests/http_bench" ] && [ -f tests/bench/http_bench.sh ]; then
 	fi
 fi
 echo
+[ -n "${BENCH_BEFORE:-}" ] && python3 tests/bench/ratios.py "$log" before && echo
 python3 tests/bench/ratios.py "$log"

@@ -9,10 +9,12 @@ Logs (any may be missing; its rows then say "not run"):
   warm.txt    build/tests/bench: thumb-256, thumb-512, studio-spots, studio-16lights, model-1m
   cold.txt    lines "run i: png X ms, exr+aov Y ms"
   http.txt    tests/bench/http_bench.sh (thumb-256 at concurrency 4) and "umbrad RSS ..." lines
-Usage: ratios.py DIR"""
+  warm-before.txt, cold-before.txt   the same from an older build (BENCH_BEFORE), for "before"
+Usage: ratios.py DIR [before]"""
 import os, re, statistics, sys
 
 d = sys.argv[1]
+before = len(sys.argv) > 2 and sys.argv[2] == "before"
 
 
 def read(name):
@@ -30,7 +32,7 @@ def floor_ms(msaa):
 def warm_total(scene):
     """build/tests/bench's median total (ms) of SCENE; the last row of that name wins."""
     v = None
-    for line in read("warm.txt").splitlines():
+    for line in read("warm-before.txt" if before else "warm.txt").splitlines():
         f = line.split()
         if len(f) >= 8 and f[0] == scene:
             v = float(f[7])
@@ -38,12 +40,12 @@ def warm_total(scene):
 
 
 def cold(kind):
-    v = [float(x) for x in re.findall(r"%s ([0-9]+) ms" % re.escape(kind), read("cold.txt"))]
+    v = [float(x) for x in re.findall(r"%s ([0-9]+) ms" % re.escape(kind), read("cold-before.txt" if before else "cold.txt"))]
     return statistics.median(v) if v else None
 
 
 def http_rate(scene, conc):
-    for line in read("http.txt").splitlines():
+    for line in ("" if before else read("http.txt")).splitlines():
         f = line.split()
         if len(f) >= 5 and f[0] == scene and f[1] == str(conc):
             return float(f[4])
@@ -51,7 +53,7 @@ def http_rate(scene, conc):
 
 
 def rss_mb(which):
-    m = re.search(r"^umbrad RSS %s: ([0-9]+) kB" % which, read("http.txt"), re.M)
+    m = re.search(r"^umbrad RSS %s: ([0-9]+) kB" % which, "" if before else read("http.txt"), re.M)
     return int(m.group(1)) / 1024.0 if m else None
 
 
@@ -70,7 +72,8 @@ def row(target, a, a_txt, b, b_txt, goal, better):
 ms = lambda v: "%.1f ms" % v
 fl4, fl1 = floor_ms(4), floor_ms(1)
 t512, t256 = warm_total("thumb-512.json"), warm_total("thumb-256.json")
-print("== ratio table (issue 12): figures taken side by side in this run, warm medians")
+print("== ratio table (issue 12)%s: figures taken side by side in this run, warm medians"
+      % (" BEFORE (the older build; HTTP and RSS not run for it)" if before else ""))
 print("floor step c: MSAA 4 %s, MSAA 1 %s" % (ms(fl4) if fl4 else "not run", ms(fl1) if fl1 else "not run"))
 print("%-38s %14s %20s %7s %7s %s" % ("target", "umbra", "compared with", "ratio", "goal", "met"))
 row("thumb-512 / floor c MSAA 4", t512, ms, fl4, lambda v: "floor " + ms(v), 1.0, "le")
@@ -78,7 +81,9 @@ row("thumb-256 / floor c MSAA 4", t256, ms, fl4, lambda v: "floor " + ms(v), 0.5
 row("studio-spots / thumb-512", warm_total("studio-spots.json"), ms, t512, lambda v: "thumb-512 " + ms(v), 2.5, "le")
 row("16 shadowed lights / thumb-512", warm_total("studio-16lights.json"), ms, t512, lambda v: "thumb-512 " + ms(v),
     4.0, "le")
-row("1M-triangle model (cached) / thumb-512", warm_total("model-1m.json"), ms, t512,
+row("1M-tri model, cached, by path / thumb-512", warm_total("model-1m-path.json"), ms, t512,
+    lambda v: "thumb-512 " + ms(v), 4.0, "le")
+row("1M-tri model, inline base64 / thumb-512", warm_total("model-1m.json"), ms, t512,
     lambda v: "thumb-512 " + ms(v), 4.0, "le")
 row("cold CLI EXR+AOV / cold PNG", cold("exr+aov"), ms, cold("png"), lambda v: "png " + ms(v), 2.0, "le")
 t256_rate = 1000.0 / t256 if t256 else None
