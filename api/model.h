@@ -30,6 +30,7 @@
 #ifndef UMBRA_API_MODEL_H
 #define UMBRA_API_MODEL_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "api.h"
@@ -50,6 +51,7 @@ struct api_model_mesh {
 	/* Simplified levels (api/model_lod.h), finest first; set once after import, then immutable. */
 	const struct rnd_mesh_lod *lods;
 	uint32_t lod_count;
+	bool closed;              /* watertight and wound outward (api/model_lod.h) */
 };
 
 /* A node's use of a mesh: one rnd_object. */

@@ -325,10 +325,57 @@ done:
 	free(next);
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+	uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+	return x < y ? -1 : x > y;
+}
+
+bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos)
+{
+	uint64_t *e = malloc((ni ? ni : 1) * sizeof *e);
+	if (!e) return false;
+	size_t ne = 0;
+	double vol = 0.0;
+	for (size_t t = 0; t + 2 < ni; t += 3) {
+		uint32_t v[3] = {idx[t], idx[t + 1], idx[t + 2]};
+		if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue;
+		for (int k = 0; k < 3; k++) e[ne++] = (uint64_t)v[k] << 32 | v[(k + 1) % 3];
+		const float *a = pos + 3 * (size_t)v[0], *b = pos + 3 * (size_t)v[1], *c = pos + 3 * (size_t)v[2];
+		vol += (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
+		       (double)a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
+		       (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0]);
+	}
+	qsort(e, ne, sizeof *e, cmp_u64);
+	bool closed = ne > 0 && vol > 0.0;
+	for (size_t i = 0; closed && i < ne; i++) {
+		uint64_t rev = e[i] << 32 | e[i] >> 32;
+		/* each directed edge once, and its reverse present: two triangles per edge, opposite ways */
+		closed = !(i && e[i] == e[i - 1]) && bsearch(&rev, e, ne, sizeof *e, cmp_u64);
+	}
+	free(e);
+	return closed;
+}
+
+/* Welds me by position and tells api_mesh_closed(); meshes that get levels are welded there. */
+static bool mesh_closed(const struct api_model_mesh *me)
+{
+	uint32_t *idx = malloc((size_t)me->index_count * sizeof *idx);
+	struct welded w = {0};
+	bool closed = idx && weld(me, idx, &w) && api_mesh_closed(idx, me->index_count, w.pos);
+	free(w.pos);
+	free(w.nrm);
+	free(w.rep);
+	free(idx);
+	return closed;
+}
+
 void api_model_build_lods(struct api_model *m, struct api_arena *arena, size_t *bytes)
 {
 	for (uint32_t i = 0; i < m->mesh_count; i++) {
 		struct api_model_mesh *me = (struct api_model_mesh *)&m->meshes[i]; /* ours until shared */
-		if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES && me->normals && me->indices) mesh_lods(me, arena, bytes);
+		if (!me->normals || !me->indices || !me->index_count) continue;
+		me->closed = mesh_closed(me);
+		if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES) mesh_lods(me, arena, bytes);
 	}
 }

@@ -19,8 +19,15 @@
 
 /* Builds the levels of every mesh of m with at least API_LOD_MIN_TRIANGLES triangles into
  * arena; adds their size to *bytes. A level that cannot be built (out of memory) ends that
- * mesh's list: fewer levels are always correct, only slower. */
+ * mesh's list: fewer levels are always correct, only slower. Also sets each mesh's `closed`:
+ * welded by position, every edge is shared by exactly two triangles that run it in opposite
+ * directions, and the enclosed volume is positive (wound outward), so the renderer may cull
+ * back faces when the camera is outside it. Out of memory: not closed. */
 void api_model_build_lods(struct api_model *m, struct api_arena *arena, size_t *bytes);
+
+/* Whether triangles idx (ni indices into pos) close a volume wound outward; pure. Triangles
+ * with a repeated index are left out. */
+bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos);
 
 /* The relative error (fraction of the mesh's extent) each level is simplified to; pure. */
 float api_lod_level_error(unsigned level);

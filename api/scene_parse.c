@@ -1346,6 +1346,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->uvs = me->uvs;
 			o->lods = me->lods;
 			o->lod_count = me->lod_count;
+			o->closed = me->closed;
 			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);
 			if (!own) o->material = base + me->material;
 		}

@@ -295,7 +295,8 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		d->masked = sc->material_count && sc->materials[o->material].alpha_mode == RND_ALPHA_MASK;
 		d->texture_set = 0; /* set by textures() */
 		d->single_sided = !o->double_sided;
-		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER;
+		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
+		            (o->shape == RND_SHAPE_MESH && o->closed);
 		d->cull_back = d->single_sided;
 		rnd_aabb_union(bounds, &d->bounds);
 		vbase += v; ibase += x;

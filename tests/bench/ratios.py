@@ -5,7 +5,8 @@ whether it is met. Only ratios of figures taken side by side in one run mean any
 shared machine, so every row divides two numbers from the same run.
 
 Logs (any may be missing; its rows then say "not run"):
-  floor.txt   build/floor/limits --steps c (one or more runs; the median of their medians)
+  floor.txt   build/floor/limits --steps c, run before umbra's rows, after them and after the
+              older build's (BENCH_BEFORE): each table takes the mean of the two runs around it
   warm.txt    build/tests/bench: thumb-256, thumb-512, studio-spots, studio-16lights, model-1m
   cold.txt    lines "run i: png X ms, exr+aov Y ms"
   http.txt    tests/bench/http_bench.sh (thumb-256 at concurrency 4) and "umbrad RSS ..." lines
@@ -23,10 +24,12 @@ def read(name):
 
 
 def floor_ms(msaa):
-    """Median of the floor's step-c medians (one per floor run) at MSAA 1 or 4."""
+    """The floor's step c at MSAA 1 or 4: the mean of the two runs around the rows compared
+    with it (bench.sh runs it before umbra's rows, after them, and after the older build's)."""
     v = [float(m.group(1)) for m in
          re.finditer(r"^\| c +\| one submit: .*MSAA%d .*?\| +([0-9.]+) \|" % msaa, read("floor.txt"), re.M)]
-    return statistics.median(v) if v else None
+    v = v[1:3] if before else v[0:2]
+    return statistics.mean(v) if v else None
 
 
 def warm_total(scene):
@@ -60,12 +63,12 @@ def rss_mb(which):
 def row(target, a, a_txt, b, b_txt, goal, better):
     """better: 'le' (ratio must be <= goal) or 'ge'."""
     if a is None or b is None or b == 0:
-        print("%-38s %14s %20s %7s %7s %s" % (target, a_txt(a) if a is not None else "not run",
+        print("%-42s %14s %20s %7s %7s %s" % (target, a_txt(a) if a is not None else "not run",
                                              b_txt(b) if b is not None else "not run", "-", goal, "not measured"))
         return
     r = a / b
     met = r <= goal if better == "le" else r >= goal
-    print("%-38s %14s %20s %7.2f %7s %s" % (target, a_txt(a), b_txt(b), r,
+    print("%-42s %14s %20s %7.2f %7s %s" % (target, a_txt(a), b_txt(b), r,
                                            ("<= " if better == "le" else ">= ") + str(goal), "yes" if met else "NO"))
 
 
@@ -75,7 +78,7 @@ t512, t256 = warm_total("thumb-512.json"), warm_total("thumb-256.json")
 print("== ratio table (issue 12)%s: figures taken side by side in this run, warm medians"
       % (" BEFORE (the older build; HTTP and RSS not run for it)" if before else ""))
 print("floor step c: MSAA 4 %s, MSAA 1 %s" % (ms(fl4) if fl4 else "not run", ms(fl1) if fl1 else "not run"))
-print("%-38s %14s %20s %7s %7s %s" % ("target", "umbra", "compared with", "ratio", "goal", "met"))
+print("%-42s %14s %20s %7s %7s %s" % ("target", "umbra", "compared with", "ratio", "goal", "met"))
 row("thumb-512 / floor c MSAA 4", t512, ms, fl4, lambda v: "floor " + ms(v), 1.0, "le")
 row("thumb-256 / floor c MSAA 4", t256, ms, fl4, lambda v: "floor " + ms(v), 0.5, "le")
 row("studio-spots / thumb-512", warm_total("studio-spots.json"), ms, t512, lambda v: "thumb-512 " + ms(v), 2.5, "le")

@@ -49,7 +49,7 @@ TEST(model_lod_levels_of_flat_sphere_keep_their_error)
 	float *pos, *nrm;
 	uint32_t *idx, nv, ni;
 	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni); /* 51,200 triangles */
-	struct api_model_mesh me = {pos, nrm, NULL, idx, nv, ni, 0, NULL, 0};
+	struct api_model_mesh me = {pos, nrm, NULL, idx, nv, ni, 0, NULL, 0, false};
 	struct api_model m = {0};
 	m.meshes = &me;
 	m.mesh_count = 1;
@@ -107,7 +107,7 @@ TEST(model_lod_small_meshes_get_no_levels)
 	float *pos, *nrm;
 	uint32_t *idx, nv, ni;
 	flat_sphere(40, &pos, &nrm, &idx, &nv, &ni); /* 3,200 triangles */
-	struct api_model_mesh me = {pos, nrm, NULL, idx, nv, ni, 0, NULL, 0};
+	struct api_model_mesh me = {pos, nrm, NULL, idx, nv, ni, 0, NULL, 0, false};
 	struct api_model m = {0};
 	m.meshes = &me;
 	m.mesh_count = 1;
@@ -139,4 +139,39 @@ TEST(lod_mesh_level_is_coarsest_within_bound)
 	CHECK(full.index_count == o.index_count && full.positions == o.positions, "level 0 is the mesh as given");
 	rnd_lod_apply(&full, 2);
 	CHECK(full.positions == lv[1].positions && full.vertex_count == 1, "level 2 swaps in lods[1]");
+}
+
+TEST(model_mesh_closed_needs_watertight_outward_winding)
+{
+	/* a tetrahedron wound outward (counter-clockwise seen from outside) */
+	static const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+	static const uint32_t out[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+	uint32_t in[12], open[9], twisted[12];
+	for (int i = 0; i < 12; i += 3) { in[i] = out[i]; in[i + 1] = out[i + 2]; in[i + 2] = out[i + 1]; }
+	memcpy(open, out, sizeof open);
+	memcpy(twisted, out, sizeof twisted);
+	twisted[1] = out[2]; twisted[2] = out[1]; /* one face turned around */
+	CHECK(api_mesh_closed(out, 12, pos), "outward tetrahedron");
+	CHECK(!api_mesh_closed(in, 12, pos), "inward: back faces are what shows from outside");
+	CHECK(!api_mesh_closed(open, 9, pos), "a face missing");
+	CHECK(!api_mesh_closed(twisted, 12, pos), "one face wound the other way");
+	uint32_t doubled[24];
+	memcpy(doubled, out, sizeof out);
+	memcpy(doubled + 12, out, sizeof out);
+	CHECK(!api_mesh_closed(doubled, 24, pos), "every edge used four times");
+	/* a flat-shaded sphere (no vertex shared) is closed once welded by position */
+	float *p, *n;
+	uint32_t *idx, nv, ni;
+	flat_sphere(40, &p, &n, &idx, &nv, &ni);
+	CHECK(!api_mesh_closed(idx, ni, p), "unwelded facets share no edge");
+	struct api_model_mesh me = {p, n, NULL, idx, nv, ni, 0, NULL, 0, false};
+	struct api_model m = {0};
+	m.meshes = &me;
+	m.mesh_count = 1;
+	struct api_arena *a = api_arena_create();
+	size_t bytes = 0;
+	api_model_build_lods(&m, a, &bytes);
+	CHECK(me.closed, "welded flat sphere is closed");
+	api_arena_destroy(a);
+	free(p); free(n); free(idx);
 }

@@ -115,6 +115,7 @@ struct rnd_object {
 	const float *normals;
 	const float *uvs;
 	const struct rnd_mesh_lod *lods; uint32_t lod_count; /* mesh: coarser levels, finest first, or none */
+	bool closed;          /* mesh: watertight, wound outward: back faces never show from outside */
 	float model[16];      /* object -> world, column-major (T*R*S resolved by the caller) */
 	uint32_t material;    /* index into scene.materials */
 	bool cast_shadows, receive_shadows, double_sided;
