@@ -19,28 +19,32 @@ mkdir -p "$log"
 trap 'rm -rf "$tmp"' EXIT
 python3 tests/bench/variants.py "$SHARED/bench" "$tmp/v"
 
-# The floor runs before and after umbra's rows so that both see the same load (ratios.py takes
-# the median of its runs); --retries 0: no waiting for quiet, the ratio is what counts.
+# Side by side: rounds of the floor, then umbra's thumbnails (and the older build's), so that
+# each sees the same load; ratios.py takes medians over the rounds. --retries 0: no waiting for
+# quiet, the ratio is what counts.
 floor() {
 	"$BUILD/floor/limits" --steps c --runs "${FLOOR_RUNS:-11}" --quiet-wait 0 --retries 0 --out "$BUILD/floor/out" |
 		grep '^| c' | tee -a "$log/floor.txt"
 }
-echo "== side by side: the floor (step c, MSAA 1 and 4), umbra warm (build/tests/bench), the floor again"
-warm() { # BUILD_DIR LOG: the ratio table's warm rows
-	"$1/tests/bench" -n "$RUNS" "$SHARED/bench/thumb-256.json" "$SHARED/bench/thumb-512.json" \
-		"$SHARED/bench/studio-spots.json" | tee -a "$2"
+thumbs() { # BUILD_DIR LOG
+	"$1/tests/bench" -n "$RUNS" "$SHARED/bench/thumb-256.json" "$SHARED/bench/thumb-512.json" | tee -a "$2"
+}
+rest() { # BUILD_DIR LOG: the rows compared with thumb-512
+	"$1/tests/bench" -n 5 "$SHARED/bench/thumb-512.json" "$SHARED/bench/studio-spots.json" | tee -a "$2"
 	# the 1M model: by path (a cached import: no 70 MB JSON to parse), and inline
 	"$1/tests/bench" -n 5 -a "$tmp/v" "$tmp/v/studio-16lights.json" "$tmp/v/model-1m-path.json" \
 		"$tmp/v/model-1m.json" | tee -a "$2"
 }
-floor
-warm "$BUILD" "$log/warm.txt"
-floor
-if [ -n "${BENCH_BEFORE:-}" ]; then
-	echo "-- before: $BENCH_BEFORE"
-	warm "$BENCH_BEFORE" "$log/warm-before.txt"
+echo "== side by side: the floor (step c, MSAA 1 and 4) and umbra warm (build/tests/bench), in rounds"
+[ -n "${BENCH_BEFORE:-}" ] && echo "   (each round also runs the older build $BENCH_BEFORE)"
+for r in $(seq "${BENCH_ROUNDS:-3}"); do
 	floor
-fi
+	thumbs "$BUILD" "$log/warm.txt"
+	[ -n "${BENCH_BEFORE:-}" ] && thumbs "$BENCH_BEFORE" "$log/warm-before.txt"
+done
+floor
+rest "$BUILD" "$log/warm.txt"
+[ -n "${BENCH_BEFORE:-}" ] && rest "$BENCH_BEFORE" "$log/warm-before.txt"
 
 if [ $QUICK = 0 ]; then
 	python3 "$SHARED/bench/gen-mesh-scene.py" 100000 >"$tmp/mesh-100k.json"

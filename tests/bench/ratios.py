@@ -5,9 +5,9 @@ whether it is met. Only ratios of figures taken side by side in one run mean any
 shared machine, so every row divides two numbers from the same run.
 
 Logs (any may be missing; its rows then say "not run"):
-  floor.txt   build/floor/limits --steps c, run before umbra's rows, after them and after the
-              older build's (BENCH_BEFORE): each table takes the mean of the two runs around it
-  warm.txt    build/tests/bench: thumb-256, thumb-512, studio-spots, studio-16lights, model-1m
+  floor.txt   build/floor/limits --steps c, in rounds between umbra's (and the older build's) rows
+  warm.txt    build/tests/bench: thumb-256, thumb-512 (rounds), studio-spots, studio-16lights,
+              model-1m-path, model-1m
   cold.txt    lines "run i: png X ms, exr+aov Y ms"
   http.txt    tests/bench/http_bench.sh (thumb-256 at concurrency 4) and "umbrad RSS ..." lines
   warm-before.txt, cold-before.txt   the same from an older build (BENCH_BEFORE), for "before"
@@ -24,22 +24,22 @@ def read(name):
 
 
 def floor_ms(msaa):
-    """The floor's step c at MSAA 1 or 4: the mean of the two runs around the rows compared
-    with it (bench.sh runs it before umbra's rows, after them, and after the older build's)."""
+    """The floor's step c at MSAA 1 or 4: the median over its runs (bench.sh runs it in rounds
+    between umbra's rows, and the older build's)."""
     v = [float(m.group(1)) for m in
          re.finditer(r"^\| c +\| one submit: .*MSAA%d .*?\| +([0-9.]+) \|" % msaa, read("floor.txt"), re.M)]
-    v = v[1:3] if before else v[0:2]
-    return statistics.mean(v) if v else None
+    return statistics.median(v) if v else None
 
 
 def warm_total(scene):
-    """build/tests/bench's median total (ms) of SCENE; the last row of that name wins."""
-    v = None
+    """build/tests/bench's median total (ms) of SCENE: the median over every row of that name
+    (one per round)."""
+    v = []
     for line in read("warm-before.txt" if before else "warm.txt").splitlines():
         f = line.split()
         if len(f) >= 8 and f[0] == scene:
-            v = float(f[7])
-    return v
+            v.append(float(f[7]))
+    return statistics.median(v) if v else None
 
 
 def cold(kind):
