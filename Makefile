@@ -4,7 +4,8 @@
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
 #   make fuzz       libFuzzer targets in build/fuzz (clang); make test runs each briefly
-#   make bench      warm-process and HTTP benchmarks of ../shared/bench
+#   make bench      warm-process and HTTP benchmarks of ../shared/bench, the floor, the ratio table
+#   make bench-quick  only the ratio table's rows (BENCH_ONLY=ratios)
 #   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
@@ -40,7 +41,8 @@ ifeq ($(UMBRA_VERSION),)
 UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || cat VERSION 2>/dev/null || echo unknown)
 endif
 CFLAGS += -DUMBRA_VERSION=\"$(UMBRA_VERSION)\"
-LIBS := $(PKG_LIBS) -lm
+# meshoptimizer (api/model_lod.c) ships no pkg-config file in Debian 12.
+LIBS := $(PKG_LIBS) -lmeshoptimizer -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
@@ -67,7 +69,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: pkg-check all deps run test test-asan bench fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -143,9 +145,18 @@ soak: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) UMBRA_VALIDATION=1 sh tests/http/soak.sh
 
-bench: deps
-	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench
+bench: deps bench-tools
 	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/bench.sh
+
+# Only what the ratio table needs, fewer runs (a few minutes instead of a quarter of an hour).
+bench-quick: deps bench-tools
+	@BUILD=$(BUILD) SHARED=$(SHARED) BENCH_ONLY=ratios sh tests/bench.sh
+
+# The floor (../shared/floor, read-only) builds out of tree into $(BUILD)/floor.
+bench-tools:
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench \
+		$(BUILD)/tests/edge_error
+	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor
 
 $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
@@ -153,6 +164,9 @@ $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD
 $(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/tests/edge_error: $(BUILD)/obj/tests/bench/edge_error.o
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ -lpng16 -lm
 $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^

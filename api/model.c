@@ -20,6 +20,7 @@
 #include "errmsg.h"
 #include "arena.h"
 #include "model.h"
+#include "model_lod.h"
 #include "umbra/rnd_math.h"
 #include "sandbox.h"
 
@@ -118,6 +119,7 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 		model_free(m);
 		return NULL;
 	}
+	api_model_build_lods(&m->pub, m->arena, &bytes);
 	m->pub.format = format;
 	m->pub.priv_ = m;
 	m->pub.bytes_ = bytes + sizeof *m;
@@ -194,7 +196,9 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
                            enum api_model_format format, const struct api_limits *lim, struct api_model **out,
                            int *status, char *err, size_t errsize)
 {
-	uint64_t h = rnd_fnv1a(RND_FNV_SEED ^ (uint64_t)format, data, len);
+	/* Word at a time: a cached 50 MB model is hashed on every request that names it (byte at a
+	 * time that alone took ~50 ms); the whole buffer is at hand, so no need to stream. */
+	uint64_t h = rnd_hash(RND_FNV_SEED ^ (uint64_t)format, data, len);
 
 	pthread_mutex_lock(&cache_mu);
 	struct model_priv *hit = lru_find(h, data, len, model_len, format);

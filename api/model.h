@@ -56,6 +56,10 @@ struct api_model_mesh {
 	uint32_t vertex_count, index_count;
 	uint32_t material;        /* index into api_model.materials */
 	bool single_sided;        /* its material says doubleSided: false (back faces culled) */
+	/* Simplified levels (api/model_lod.h), finest first; set once after import, then immutable. */
+	const struct rnd_mesh_lod *lods;
+	uint32_t lod_count;
+	bool closed;              /* watertight and wound outward (api/model_lod.h) */
 };
 
 /* A node's use of a mesh: one rnd_object. */

@@ -276,6 +276,13 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->uvs = me->uvs;
 			o->colors = me->colors;
 			o->tangents = me->tangents;
+			/* Simplified levels carry positions, normals and uvs only: a mesh with vertex
+			 * colours or tangents is always drawn whole. */
+			if (!me->colors && !me->tangents) {
+				o->lods = me->lods;
+				o->lod_count = me->lod_count;
+			}
+			o->closed = me->closed;
 			/* glTF doubleSided: false culls back faces (the object can only add sidedness). */
 			o->double_sided = o->double_sided && !me->single_sided;
 			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);

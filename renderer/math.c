@@ -20,6 +20,24 @@ uint64_t rnd_fnv1a(uint64_t h, const void *data, size_t len)
 	return h;
 }
 
+uint64_t rnd_hash(uint64_t h, const void *data, size_t len)
+{
+	const uint8_t *p = data;
+	const uint64_t m = 0x9e3779b97f4a7c15ull;
+	while (len >= 8) {
+		uint64_t w;
+		memcpy(&w, p, 8);
+		h = (h ^ w) * m;
+		h ^= h >> 29;
+		p += 8; len -= 8;
+	}
+	uint64_t w = 0;
+	memcpy(&w, p, len);
+	h = (h ^ w ^ ((uint64_t)len << 56)) * m;
+	h ^= h >> 32;
+	return h;
+}
+
 float rnd_v3_dot(const float a[3], const float b[3])
 {
 	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];

@@ -16,6 +16,7 @@
 #include <time.h>
 #include "contact.h"
 #include "estimate.h"
+#include "lod.h"
 #include "material.h"
 #include "mesh.h"
 #include "plan.h"
@@ -244,13 +245,15 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 
 /* Tessellates every object into the slot's buffers; fills draws and the scene bounds. */
 static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                              const struct rnd_pacer *pacer, struct draw *draws, struct rnd_aabb *bounds,
-                              struct rnd_error *err)
+                              const struct rnd_pacer *pacer, const uint32_t *lod, struct draw *draws,
+                              struct rnd_aabb *bounds, struct rnd_error *err)
 {
 	uint64_t nv = 0, ni = 0;
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		uint32_t v, x;
-		rnd_mesh_counts(&sc->objects[i], &v, &x);
+		struct rnd_object o = sc->objects[i];
+		rnd_lod_apply(&o, lod[i]); /* renderer/lod.h: no finer than the output can show */
+		rnd_mesh_counts(&o, &v, &x);
 		nv += v; ni += x;
 	}
 	if (nv > UINT32_MAX || ni > UINT32_MAX)
@@ -267,7 +270,9 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 	uint32_t vbase = 0, ibase = 0;
 	rnd_aabb_empty(bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++) {
-		const struct rnd_object *o = &sc->objects[i];
+		struct rnd_object lo = sc->objects[i];
+		rnd_lod_apply(&lo, lod[i]);
+		const struct rnd_object *o = &lo;
 		struct draw *d = &draws[i];
 		uint32_t v, x;
 		rnd_mesh_counts(o, &v, &x);
@@ -292,7 +297,8 @@ static enum rnd_result upload(struct rnd_context *ctx, struct rnd_slot *s, const
 		d->masked = sc->material_count && sc->materials[o->material].alpha_mode != RND_ALPHA_OPAQUE;
 		d->texture_set = 0; /* set by rnd_material_textures() */
 		d->single_sided = !o->double_sided;
-		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER;
+		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
+		            (o->shape == RND_SHAPE_MESH && o->closed);
 		d->cull_back = d->single_sided;
 		rnd_aabb_union(bounds, &d->bounds);
 		vbase += v; ibase += x;
@@ -394,13 +400,17 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	bool gpu_busy = false;        /* a submit did not finish: keep its resources alive */
 	uint8_t cascades[UMBRA_MAX_LIGHTS] = {0};
 
-	/* Per-request memory: one block for the draw list, the shadow plan and the texture list. */
+	/* Per-request memory: one block for the draw list, the shadow plan, the level of detail of
+	 * each object and the texture list. */
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
-	size_t tex_off = (draws_bytes + sizeof(struct rnd_shadow_plan) + 15) & ~(size_t)15;
+	size_t lod_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(uint32_t);
+	size_t tex_off = (draws_bytes + sizeof(struct rnd_shadow_plan) + lod_bytes + 15) & ~(size_t)15;
 	void *arena = malloc(tex_off + ctx->max_textures * sizeof(void *));
 	if (!arena) return rnd_fail(err, RND_ERR_OOM, "out of memory for %u objects", sc->object_count);
 	struct draw *draws = arena;
 	struct rnd_shadow_plan *sp = (struct rnd_shadow_plan *)((char *)arena + draws_bytes);
+	uint32_t *lod = (uint32_t *)((char *)sp + sizeof *sp);
+	rnd_lod_choose(sc, nviews, sp, lod);
 
 	struct rnd_slot *s = rnd_slot_acquire(ctx);
 	double t0 = now_ms();
@@ -411,7 +421,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	struct rnd_camera_plan cam;
 	const struct rnd_texture **tex = (const struct rnd_texture **)((char *)arena + tex_off);
 	uint32_t ntex = 0;
-	if ((r = upload(ctx, s, sc, &pacer, draws, &bounds, err)) != RND_OK) goto done;
+	if ((r = upload(ctx, s, sc, &pacer, lod, draws, &bounds, err)) != RND_OK) goto done;
 	/* Auto-framing `fit: objects` leaves out planes and shadow catchers (the ground). */
 	struct rnd_aabb obj_bounds;
 	rnd_aabb_empty(&obj_bounds);
@@ -436,6 +446,15 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if ((r = rnd_buffer_reserve(ctx, &s->readback, rb, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "slot readback", err)) != RND_OK)
 		goto done;
 	if (nviews > 1) memset(s->readback.map, 0, rb); /* unused cells of the sheet (colour and AOVs) */
+
+	/* A plane with every other object on its lit side shadows nothing: out of the shadow pass. */
+	for (uint32_t i = 0; i < sc->object_count && sc->object_count <= 256; i++) {
+		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
+		bool casts = false;
+		for (uint32_t j = 0; j < sc->object_count && !casts; j++)
+			casts = j != i && rnd_plane_may_shadow(sc, &sc->objects[i], &draws[j].bounds);
+		draws[i].cast = casts;
+	}
 
 	/* What every spot/point key starts from: the casters' world-space geometry, their
 	 * culling and alpha masks (with texture content), and the scene bounds (far planes). */

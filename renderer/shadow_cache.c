@@ -30,24 +30,6 @@ struct rnd_shadow_cache {
 	uint64_t clock;
 };
 
-uint64_t rnd_hash(uint64_t h, const void *data, size_t len)
-{
-	const uint8_t *p = data;
-	const uint64_t m = 0x9e3779b97f4a7c15ull;
-	while (len >= 8) {
-		uint64_t w;
-		memcpy(&w, p, 8);
-		h = (h ^ w) * m;
-		h ^= h >> 29;
-		p += 8; len -= 8;
-	}
-	uint64_t w = 0;
-	memcpy(&w, p, len);
-	h = (h ^ w ^ ((uint64_t)len << 56)) * m;
-	h ^= h >> 32;
-	return h;
-}
-
 /* One-time set-up of both atlases on slot 0's command buffer: the depth atlas cleared to 1
  * (empty texels read "nothing here"), then both in GENERAL layout for good. */
 static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *err)

@@ -54,7 +54,5 @@ void rnd_cache_wake(struct rnd_context *ctx);
 /* Ends a render's use: ok = the render completed, so new entries become reusable. */
 void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g, uint32_t n, bool ok);
 
-/* 64-bit hash of bytes, word at a time (content keys, not security). */
-uint64_t rnd_hash(uint64_t h, const void *data, size_t len);
 
 #endif

@@ -3,7 +3,8 @@
  * line N times in one process (after one warm-up render) and prints median milliseconds per
  * stage (parse, upload, shadow, main, readback, encode), the median total and images/s.
  *
- *   build/tests/bench [-n N] [-c] SCENE.json...     (-c: import models cold every run)
+ *   build/tests/bench [-n N] [-c] [-a DIR] SCENE.json...   (-c: import models cold every run;
+ *                                                          -a: models' "path" is inside DIR)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,9 +55,11 @@ int main(int argc, char **argv)
 	int first = 1;
 	int cold_models = 0;   /* -c: no model cache, every run imports its models again */
 	int deadline_ms = 0;
+	const char *asset_root = NULL;
 	for (;;) {
 		if (argc > first + 1 && !strcmp(argv[first], "-n")) { n = atoi(argv[first + 1]); first += 2; }
 		else if (argc > first && !strcmp(argv[first], "-c")) { cold_models = 1; first += 1; }
+		else if (argc > first + 1 && !strcmp(argv[first], "-a")) { asset_root = argv[first + 1]; first += 2; }
 		/* -d MS: each render gets a deadline MS from its start (as umbrad gives one), so the
 		 * submits are split as they are in the daemon. */
 		else if (argc > first + 1 && !strcmp(argv[first], "-d")) { deadline_ms = atoi(argv[first + 1]); first += 2; }
@@ -84,6 +87,7 @@ int main(int argc, char **argv)
 		api_limits_defaults(&lim);
 		lim.max_triangles = 0;
 		api_model_cache_set_limit(cold_models ? 0 : 256u << 20);
+		lim.asset_root = asset_root;
 		for (int i = -1; i < n && rc == 0; i++) {
 			double t0 = now_ms();
 			struct api_scene *s;

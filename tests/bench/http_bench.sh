@@ -2,7 +2,8 @@
 # tests/bench/http_bench.sh — HTTP benchmark of umbrad over loopback: starts $BUILD/umbrad on an
 # ephemeral port, waits for /readyz, runs $BUILD/tests/http_bench (built here from
 # tests/bench/http_bench.c when missing) on the $SHARED/bench scenes at concurrency 1, 2, 4, 8,
-# then stops the daemon with SIGTERM. Numbers only; nothing is asserted.
+# prints the daemon's RSS when ready and after the rows, then stops it with SIGTERM. Numbers only;
+# nothing is asserted.
 # Env: BUILD, SHARED, HTTP_BENCH_CONC (1,2,4,8), HTTP_BENCH_REQUESTS (16),
 #      HTTP_BENCH_SECONDS (15 per row), HTTP_BENCH_SCENES (default: every $SHARED/bench/*.json).
 set -eu
@@ -27,10 +28,14 @@ until [ -s "$tmp/port" ] && curl -sf -o /dev/null "http://127.0.0.1:$(cat "$tmp/
 	sleep 0.1
 done
 url="http://127.0.0.1:$(cat "$tmp/port")"
+# Resident memory of the daemon, warm (ready) and after the rows: tests/bench/ratios.py reads these.
+rss() { echo "umbrad RSS $1: $(awk '/^VmRSS/ {print $2}' "/proc/$pid/status") kB, peak $(awk '/^VmHWM/ {print $2}' "/proc/$pid/status") kB"; }
+rss ready
 echo "umbrad $(curl -s "$url/v1/info" | sed -n 's/.*"device": *"\([^"]*\)".*/device: \1/p'), $(nproc) CPUs"
 # shellcheck disable=SC2086
 "$BENCH" -c "${HTTP_BENCH_CONC:-1,2,4,8}" -n "${HTTP_BENCH_REQUESTS:-16}" -t "${HTTP_BENCH_SECONDS:-15}" "$url" \
 	${HTTP_BENCH_SCENES:-"$SHARED"/bench/*.json} || status=$?
+rss after
 curl -s "$url/metrics" | grep -E '^umbra_(stage_seconds_(sum|count)|queue_wait_seconds_(sum|count)|shadow_maps_re)' || true
 kill -TERM "$pid"
 wait "$pid" || { rc=$?; echo "umbrad exited $rc" >&2; exit 1; }

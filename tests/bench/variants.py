@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Writes the benchmark's scene variants into DIR: thumb-512 with each shadow filter and with
 pcf plus contact shadows, outdoor-csm with each directional mode, studio-spots with 1/4/16
-shadowed lights, models of 10k/100k/1M triangles (binary STL, base64 inline), and a 16-frame
-turntable.
+shadowed lights, models of 10k/100k/1M triangles (binary STL, base64 inline, and by path:
+model-*-path.json with the .stl files next to them, for build/tests/bench -a OUT_DIR), and a
+16-frame turntable.
 Usage: variants.py SHARED_BENCH_DIR OUT_DIR"""
 import base64, copy, json, math, os, struct, sys
 
@@ -70,12 +71,18 @@ def sphere_stl(tris):
     return b"\0" * 80 + struct.pack("<I", count) + bytes(body)
 
 for n, label in ((10000, "10k"), (100000, "100k"), (1000000, "1m")):
+    stl = sphere_stl(n)
     d = {"width": 512, "height": 512,
          "camera": {"fit": "objects", "direction": [-1, -0.6, -1], "margin": 0.1},
          "objects": [{"shape": "plane", "size": [20, 20], "transform": {"translation": [0, -1, 0]}},
-                     {"shape": "model", "format": "stl", "data": base64.b64encode(sphere_stl(n)).decode()}],
+                     {"shape": "model", "format": "stl", "data": base64.b64encode(stl).decode()}],
          "lights": [{"type": "directional", "direction": [-0.5, -1, -0.3]}]}
     save("model-%s.json" % label, d)
+    # The same model by path (bench -a OUT_DIR): a cached import without a 70 MB JSON to parse.
+    with open(os.path.join(out, "model-%s.stl" % label), "wb") as f:
+        f.write(stl)
+    d["objects"][1] = {"shape": "model", "path": "model-%s.stl" % label}
+    save("model-%s-path.json" % label, d)
 
 d = copy.deepcopy(studio)
 d["turntable"] = {"frames": 16, "elevation": 25}

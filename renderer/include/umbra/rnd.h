@@ -116,6 +116,16 @@ struct rnd_material {
 	} sampling[RND_TEX_SLOTS];
 };
 
+/* A coarser version of a mesh object's geometry (api/model_lod.c builds them for imported
+ * models with meshoptimizer); renderer/lod.h picks the coarsest whose error the output cannot
+ * show. Arrays as in rnd_object (normals and indices always present, uvs optional). */
+struct rnd_mesh_lod {
+	const float *positions, *normals, *uvs;
+	const uint32_t *indices;
+	uint32_t vertex_count, index_count;
+	float error;          /* largest deviation from the full mesh, object-space units */
+};
+
 struct rnd_object {
 	enum rnd_shape shape;
 	float size[3];        /* plane: [sx, 0, sz]; box: [sx, sy, sz] */
@@ -132,6 +142,8 @@ struct rnd_object {
 	const float *uvs;
 	const uint8_t *colors;  /* optional linear RGBA8 per vertex (glTF COLOR_0): multiplies base colour */
 	const float *tangents;  /* optional xyzw per vertex (w = bitangent sign), for normal maps */
+	const struct rnd_mesh_lod *lods; uint32_t lod_count; /* mesh: coarser levels, finest first, or none */
+	bool closed;          /* mesh: watertight, wound outward: back faces never show from outside */
 	float model[16];      /* object -> world, column-major (T*R*S resolved by the caller) */
 	uint32_t material;    /* index into scene.materials */
 	bool cast_shadows, receive_shadows, double_sided;
@@ -257,6 +269,10 @@ struct rnd_scene {
 	bool (*cancel)(void *user); /* polled between submits (any thread-safe check), NULL = none */
 	void *cancel_user;
 	uint32_t band_rows;       /* main-pass rows per submit, 0 = chosen by the renderer (tests) */
+	/* false: spheres and cylinders get no more segments, meshes with levels no more triangles,
+	 * than the output can show (renderer/lod.h: within 1/32 pixel and 1/8 shadow texel); true:
+	 * exactly `segments` and every mesh in full (tests, comparisons). */
+	bool exact_segments;
 };
 
 /* Contract defaults: 512x512, perspective camera at (0,0,5) looking at the origin, default

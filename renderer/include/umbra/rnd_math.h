@@ -24,11 +24,14 @@ struct rnd_aabb { float min[3], max[3]; };
 /* The byte-stream hash (64-bit FNV-1a) of the project: start from RND_FNV_SEED (or a previous
  * result); streaming, so hashing a then b equals hashing a‖b, and a body that arrives in chunks
  * hashes the same however it is cut. Used for ETags (server/negotiate.c), the model cache key
- * (api/model.c) and asset files. Not for security. The shadow cache keys use rnd_hash()
- * (renderer/shadow_cache.h) instead: a word-at-a-time hash of fixed records, several times
- * faster on large inputs but not streaming. */
+ * and asset files. Not for security. Whole buffers (shadow-cache keys, the model cache key)
+ * use rnd_hash() instead: word at a time, several times faster on large inputs but not
+ * streaming. */
 #define RND_FNV_SEED 0xcbf29ce484222325ull
 uint64_t rnd_fnv1a(uint64_t h, const void *data, size_t len);
+/* 64-bit hash of a whole buffer, word at a time (content keys: shadow-cache entries, the model
+ * cache; not streaming, not security). */
+uint64_t rnd_hash(uint64_t h, const void *data, size_t len);
 
 float rnd_v3_dot(const float a[3], const float b[3]);
 void rnd_v3_cross(float out[3], const float a[3], const float b[3]);

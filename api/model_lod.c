@@ -1,0 +1,381 @@
+/*
+ * api/model_lod.c — meshoptimizer levels of detail of imported meshes (see model_lod.h).
+ *
+ * Each level simplifies the previous one (a million triangles are read once, not once per
+ * level) to a target twice the previous, starting at 1/16384 of the mesh's extent. A level's
+ * error is measured here against the full mesh (level_error), in object units: meshoptimizer's
+ * own figure leaves out how far the new triangles' insides are from the surface. Every level gets its own vertex
+ * arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
+ * position (weld), so a level's normals are computed from its own triangles with a crease angle
+ * (write_level) and its uvs are those of each position's first vertex: a texture seam of a
+ * coarse level can show the wrong side's uvs (a thumbnail rarely can tell).
+ */
+#include <math.h>
+#include <meshoptimizer.h>
+#include <stdlib.h>
+#include <string.h>
+#include "model_lod.h"
+#include "umbra/rnd_math.h"
+
+float api_lod_level_error(unsigned level)
+{
+	float e = 1.0f / 16384.0f;
+	for (unsigned i = 0; i < level; i++) e *= 2.0f;
+	return e;
+}
+
+/* A mesh welded by position: what the simplifier works on. meshoptimizer treats vertices at
+ * the same position as attribute seams it must keep, so a flat-shaded file (an STL shares no
+ * vertex between facets) would not simplify at all without this. */
+struct welded {
+	float *pos;           /* count unique positions */
+	float *nrm;           /* their area-weighted normals over the full mesh's faces */
+	uint32_t *rep;        /* the first original vertex of each (for uvs, and which side is out) */
+	size_t count;
+};
+
+static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *w)
+{
+	unsigned int *remap = malloc((size_t)me->vertex_count * sizeof *remap);
+	int32_t *q = malloc((size_t)me->vertex_count * 12);
+	if (!remap || !q) { free(remap); free(q); return false; }
+	/* Positions equal to 2^-20 of the extent are one: a seam written with sin(2 pi) != 0 is
+	 * closed (otherwise it is a border the simplifier must keep, with long slivers along it). */
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, ext = 0.0f;
+	for (uint32_t v = 0; v < me->vertex_count; v++)
+		for (int k = 0; k < 3; k++) lo[k] = fminf(lo[k], me->positions[3 * (size_t)v + (size_t)k]);
+	for (uint32_t v = 0; v < me->vertex_count; v++)
+		for (int k = 0; k < 3; k++) ext = fmaxf(ext, me->positions[3 * (size_t)v + (size_t)k] - lo[k]);
+	float unit = ext > 0.0f ? ext / 1048576.0f : 1.0f;
+	for (uint32_t v = 0; v < me->vertex_count; v++)
+		for (int k = 0; k < 3; k++)
+			q[3 * (size_t)v + (size_t)k] = (int32_t)lrintf((me->positions[3 * (size_t)v + (size_t)k] - lo[k]) / unit);
+	w->count = meshopt_generateVertexRemap(remap, me->indices, me->index_count, q, me->vertex_count, 12);
+	free(q);
+	w->pos = malloc(w->count * 12);
+	w->rep = malloc(w->count * sizeof *w->rep);
+	if (!w->pos || !w->rep) { free(remap); return false; }
+	meshopt_remapVertexBuffer(w->pos, me->positions, me->vertex_count, 12, remap);
+	meshopt_remapIndexBuffer(idx, me->indices, me->index_count, remap);
+	for (uint32_t v = me->vertex_count; v-- > 0;)
+		if (remap[v] != ~0u) w->rep[remap[v]] = v;
+	free(remap);
+	/* Vertex normals of the welded full mesh (degenerate facets, whose file normals are noise,
+	 * weigh nothing); oriented like the file's. */
+	w->nrm = calloc(w->count * 3, sizeof *w->nrm);
+	if (!w->nrm) return false;
+	for (uint32_t t = 0; t + 2 < me->index_count; t += 3) {
+		float e1[3], e2[3], c[3];
+		rnd_v3_sub(e1, w->pos + 3 * (size_t)idx[t + 1], w->pos + 3 * (size_t)idx[t]);
+		rnd_v3_sub(e2, w->pos + 3 * (size_t)idx[t + 2], w->pos + 3 * (size_t)idx[t]);
+		rnd_v3_cross(c, e1, e2);
+		if (rnd_v3_dot(c, me->normals + 3 * (size_t)me->indices[t]) < 0.0f) rnd_v3_scale(c, c, -1.0f);
+		for (int k = 0; k < 3; k++) rnd_v3_add(w->nrm + 3 * (size_t)idx[t + k], w->nrm + 3 * (size_t)idx[t + k], c);
+	}
+	for (size_t v = 0; v < w->count; v++)
+		if (!rnd_v3_normalize(w->nrm + 3 * v, w->nrm + 3 * v)) memcpy(w->nrm + 3 * v, me->normals + 3 * (size_t)w->rep[v], 12);
+	return true;
+}
+
+/* A uniform grid over the welded vertices: the nearest one to a point, for measuring how far a
+ * level's surface is from the full mesh. */
+struct grid {
+	float lo[3], cell;
+	uint32_t dim[3];
+	uint32_t *start, *items;  /* counting-sorted vertex ids per cell */
+};
+
+static uint32_t cell_of(const struct grid *g, const float p[3], int k)
+{
+	float c = (p[k] - g->lo[k]) / g->cell;
+	if (c < 0) c = 0;
+	uint32_t i = (uint32_t)c;
+	return i >= g->dim[k] ? g->dim[k] - 1 : i;
+}
+
+static bool grid_build(struct grid *g, const struct welded *w)
+{
+	float hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (int k = 0; k < 3; k++) g->lo[k] = INFINITY;
+	for (size_t v = 0; v < w->count; v++)
+		for (int k = 0; k < 3; k++) {
+			g->lo[k] = fminf(g->lo[k], w->pos[3 * v + k]);
+			hi[k] = fmaxf(hi[k], w->pos[3 * v + k]);
+		}
+	float ext = fmaxf(fmaxf(hi[0] - g->lo[0], hi[1] - g->lo[1]), hi[2] - g->lo[2]);
+	/* about two vertices per cell of a surface: cells of extent / sqrt(count / 2) */
+	g->cell = fmaxf(ext / sqrtf((float)w->count * 0.5f), 1e-12f);
+	size_t cells = 1;
+	for (int k = 0; k < 3; k++) {
+		g->dim[k] = (uint32_t)fminf((hi[k] - g->lo[k]) / g->cell + 1.0f, 1024.0f);
+		cells *= g->dim[k];
+	}
+	g->start = calloc(cells + 1, sizeof *g->start);
+	g->items = malloc(w->count * sizeof *g->items);
+	if (!g->start || !g->items) return false;
+	size_t *id = malloc(w->count * sizeof *id);
+	if (!id) return false;
+	for (size_t v = 0; v < w->count; v++) {
+		const float *p = w->pos + 3 * v;
+		id[v] = ((size_t)cell_of(g, p, 2) * g->dim[1] + cell_of(g, p, 1)) * g->dim[0] + cell_of(g, p, 0);
+		g->start[id[v] + 1]++;
+	}
+	for (size_t c = 0; c < cells; c++) g->start[c + 1] += g->start[c];
+	for (size_t v = 0; v < w->count; v++) g->items[g->start[id[v]]++] = (uint32_t)v;
+	for (size_t c = cells; c > 0; c--) g->start[c] = g->start[c - 1];
+	g->start[0] = 0;
+	free(id);
+	return true;
+}
+
+/* Distance of p from the full mesh, estimated as its distance from the tangent plane (the
+ * full mesh's vertex normal) of the nearest full-mesh vertex in the cells around it (searched up to 4
+ * cells out; none that near counts as 4 cells, which marks the level as coarse). */
+static float surface_distance(const struct grid *g, const struct welded *w, const float p[3])
+{
+	uint32_t c[3] = {cell_of(g, p, 0), cell_of(g, p, 1), cell_of(g, p, 2)};
+	float best = INFINITY;
+	uint32_t bv = 0;
+	for (int r = 1; r <= 4 && best == INFINITY; r++)
+	for (int dz = -r; dz <= r; dz++)
+		for (int dy = -r; dy <= r; dy++)
+			for (int dx = -r; dx <= r; dx++) {
+				int64_t x = (int64_t)c[0] + dx, y = (int64_t)c[1] + dy, z = (int64_t)c[2] + dz;
+				if (x < 0 || y < 0 || z < 0 || x >= g->dim[0] || y >= g->dim[1] || z >= g->dim[2]) continue;
+				size_t cell = ((size_t)z * g->dim[1] + (size_t)y) * g->dim[0] + (size_t)x;
+				for (uint32_t i = g->start[cell]; i < g->start[cell + 1]; i++) {
+					float d[3];
+					rnd_v3_sub(d, p, w->pos + 3 * (size_t)g->items[i]);
+					float dd = rnd_v3_dot(d, d);
+					if (dd < best) { best = dd; bv = g->items[i]; }
+				}
+			}
+	if (best == INFINITY) return 4.0f * g->cell; /* far from every vertex: at least this coarse */
+	float d[3];
+	rnd_v3_sub(d, p, w->pos + 3 * (size_t)bv);
+	return fabsf(rnd_v3_dot(d, w->nrm + 3 * (size_t)bv));
+}
+
+/* How far a level (idx: ni indices into w) is from the full mesh: the largest distance of its
+ * triangles' centroids and edge midpoints (its vertices are the full mesh's own). meshoptimizer's
+ * own error measures the kept vertices against the removed faces' planes and says nothing of
+ * the new triangles' insides: on a sphere it claims 6x less than this. */
+static float level_error(const struct grid *g, const struct welded *w, const uint32_t *idx, size_t ni)
+{
+	float worst = 0.0f;
+	for (size_t t = 0; t + 2 < ni; t += 3) {
+		const float *a = w->pos + 3 * (size_t)idx[t], *b = w->pos + 3 * (size_t)idx[t + 1],
+		            *c = w->pos + 3 * (size_t)idx[t + 2];
+		float s[4][3];
+		for (int k = 0; k < 3; k++) {
+			s[0][k] = (a[k] + b[k] + c[k]) / 3.0f;
+			s[1][k] = 0.5f * (a[k] + b[k]);
+			s[2][k] = 0.5f * (b[k] + c[k]);
+			s[3][k] = 0.5f * (c[k] + a[k]);
+		}
+		for (int k = 0; k < 4; k++) worst = fmaxf(worst, surface_distance(g, w, s[k]));
+	}
+	return worst;
+}
+
+/* Crease-angle normals of a level (idx: ni indices into w), one per corner: the area-weighted
+ * mean of all face normals around the corner's vertex when that is within 30 degrees of its own
+ * face's (or its face is a sliver, whose own normal is noise), else the mean of those within 30
+ * degrees of its face's (smooth across the fine facets of a curved surface, a crease at a real
+ * edge). Face normals follow the file's normals where the winding disagrees. */
+static bool corner_normals(const struct api_model_mesh *me, const struct welded *w, const uint32_t *idx, size_t ni,
+                           float *nrm)
+{
+	size_t nt = ni / 3;
+	uint32_t *start = calloc(w->count + 1, sizeof *start), *faces = malloc(ni * sizeof *faces);
+	float *fn = malloc(nt * 12);
+	bool ok = start && faces && fn;
+	for (size_t t = 0; ok && t < nt; t++) {
+		const float *a = w->pos + 3 * idx[3 * t], *b = w->pos + 3 * idx[3 * t + 1], *c = w->pos + 3 * idx[3 * t + 2];
+		float e1[3], e2[3];
+		rnd_v3_sub(e1, b, a);
+		rnd_v3_sub(e2, c, a);
+		rnd_v3_cross(fn + 3 * t, e1, e2);
+		/* Winding can disagree with the file's normals: the file's normals say outside. */
+		float ref[3] = {0, 0, 0};
+		for (int k = 0; k < 3; k++) rnd_v3_add(ref, ref, me->normals + 3 * (size_t)w->rep[idx[3 * t + k]]);
+		if (rnd_v3_dot(ref, fn + 3 * t) < 0.0f) rnd_v3_scale(fn + 3 * t, fn + 3 * t, -1.0f);
+		for (int k = 0; k < 3; k++) start[idx[3 * t + k] + 1]++;
+	}
+	if (ok) {
+		/* faces around each vertex, grouped (counting sort) */
+		for (size_t v = 0; v < w->count; v++) start[v + 1] += start[v];
+		for (size_t t = 0; t < nt; t++)
+			for (int k = 0; k < 3; k++) faces[start[idx[3 * t + k]]++] = (uint32_t)t;
+		for (size_t v = w->count; v > 0; v--) start[v] = start[v - 1];
+		start[0] = 0;
+	}
+	const float crease = 0.866f; /* cos 30 degrees */
+	for (size_t t = 0; ok && t < nt; t++) {
+		float own[3], u[3], edge = 0.0f;
+		if (!rnd_v3_normalize(own, fn + 3 * t)) { own[0] = 0; own[1] = 1; own[2] = 0; }
+		for (int k = 0; k < 3; k++) {
+			float e[3];
+			rnd_v3_sub(e, w->pos + 3 * (size_t)idx[3 * t + (size_t)k], w->pos + 3 * (size_t)idx[3 * t + (size_t)(k + 1) % 3]);
+			edge = fmaxf(edge, rnd_v3_dot(e, e));
+		}
+		/* A sliver's own normal is noise: it takes its vertices' normals whatever the angle. */
+		bool sliver = rnd_v3_length(fn + 3 * t) < 0.02f * edge;
+		for (int k = 0; k < 3; k++) {
+			uint32_t v = idx[3 * t + (size_t)k];
+			float all[3] = {0, 0, 0}, near[3] = {0, 0, 0}, *n = nrm + 3 * (3 * t + (size_t)k);
+			for (uint32_t f = start[v]; f < start[v + 1]; f++) {
+				rnd_v3_add(all, all, fn + 3 * faces[f]); /* area-weighted: slivers hardly count */
+				if (rnd_v3_normalize(u, fn + 3 * faces[f]) && rnd_v3_dot(u, own) >= crease)
+					rnd_v3_add(near, near, fn + 3 * faces[f]);
+			}
+			bool smooth = rnd_v3_normalize(all, all) && (sliver || rnd_v3_dot(all, own) >= crease);
+			if (smooth) memcpy(n, all, sizeof all);
+			else if (!rnd_v3_normalize(n, near)) memcpy(n, own, sizeof own);
+		}
+	}
+	free(start);
+	free(faces);
+	free(fn);
+	return ok;
+}
+
+/* Writes one level into the arena: corners with equal position, normal and uv (the uv of the
+ * position's first vertex) become one vertex again. */
+static bool write_level(struct api_arena *arena, const struct api_model_mesh *me, const struct welded *w,
+                        const uint32_t *idx, size_t ni, struct rnd_mesh_lod *out, size_t *bytes)
+{
+	float *cp = malloc(ni * 12), *cn = malloc(ni * 12), *cu = me->uvs ? malloc(ni * 8) : NULL;
+	unsigned int *remap = malloc(ni * sizeof *remap);
+	bool ok = false;
+	if (!cp || !cn || (me->uvs && !cu) || !remap || !corner_normals(me, w, idx, ni, cn)) goto done;
+	for (size_t i = 0; i < ni; i++) {
+		memcpy(cp + 3 * i, w->pos + 3 * (size_t)idx[i], 12);
+		if (cu) memcpy(cu + 2 * i, me->uvs + 2 * (size_t)w->rep[idx[i]], 8);
+	}
+	struct meshopt_Stream st[3] = {{cp, 12, 12}, {cn, 12, 12}, {cu, 8, 8}};
+	size_t nv = meshopt_generateVertexRemapMulti(remap, NULL, ni, ni, st, cu ? 3 : 2);
+	float *pos = api_arena_alloc(arena, nv * 12), *nrm = api_arena_alloc(arena, nv * 12);
+	float *uv = cu ? api_arena_alloc(arena, nv * 8) : NULL;
+	uint32_t *ix = api_arena_alloc(arena, ni * 4);
+	if (!pos || !nrm || (cu && !uv) || !ix) goto done;
+	meshopt_remapVertexBuffer(pos, cp, ni, 12, remap);
+	meshopt_remapVertexBuffer(nrm, cn, ni, 12, remap);
+	if (cu) meshopt_remapVertexBuffer(uv, cu, ni, 8, remap);
+	meshopt_remapIndexBuffer(ix, NULL, ni, remap);
+	*out = (struct rnd_mesh_lod){pos, nrm, uv, ix, (uint32_t)nv, (uint32_t)ni, 0.0f};
+	*bytes += nv * (cu ? 32 : 24) + ni * 4;
+	ok = true;
+done:
+	free(cp);
+	free(cn);
+	free(cu);
+	free(remap);
+	return ok;
+}
+
+/* Removes the triangles of no area (a pole's fan collapsed onto itself): invisible, and with no
+ * normal of their own. Returns the indices kept. */
+static size_t drop_degenerate(const struct welded *w, uint32_t *idx, size_t ni)
+{
+	size_t out = 0;
+	for (size_t t = 0; t + 2 < ni; t += 3) {
+		float e1[3], e2[3], c[3];
+		rnd_v3_sub(e1, w->pos + 3 * (size_t)idx[t + 1], w->pos + 3 * (size_t)idx[t]);
+		rnd_v3_sub(e2, w->pos + 3 * (size_t)idx[t + 2], w->pos + 3 * (size_t)idx[t]);
+		rnd_v3_cross(c, e1, e2);
+		if (rnd_v3_dot(c, c) == 0.0f) continue;
+		memmove(idx + out, idx + t, 3 * sizeof *idx);
+		out += 3;
+	}
+	return out;
+}
+
+static void mesh_lods(struct api_model_mesh *me, struct api_arena *arena, size_t *bytes)
+{
+	struct rnd_mesh_lod *lods = api_arena_calloc(arena, API_LOD_LEVELS, sizeof *lods);
+	uint32_t *cur = malloc((size_t)me->index_count * sizeof *cur), *next = malloc((size_t)me->index_count * sizeof *next);
+	struct welded w = {0};
+	struct grid g = {0};
+	if (!lods || !cur || !next || !weld(me, cur, &w) || !grid_build(&g, &w)) goto done;
+	size_t ni = me->index_count;
+	float prev = 0.0f;
+	uint32_t n = 0;
+	for (unsigned level = 0; level < API_LOD_LEVELS; level++) {
+		size_t got = meshopt_simplify(next, cur, ni, w.pos, w.count, 12, 3, api_lod_level_error(level), 0, NULL);
+		if (got < 3) break;
+		/* Not worth a level under a quarter fewer triangles: try the next error on the same input. */
+		if (got * 4 > ni * 3) continue;
+		got = drop_degenerate(&w, next, got);
+		/* measured against the full mesh; never less than a finer level's */
+		float e = fmaxf(level_error(&g, &w, next, got), prev);
+		if (!write_level(arena, me, &w, next, got, &lods[n], bytes)) break;
+		lods[n++].error = prev = e;
+		uint32_t *t = cur; cur = next; next = t;
+		ni = got;
+	}
+	if (n) { me->lods = lods; me->lod_count = n; }
+done:
+	free(g.start);
+	free(g.items);
+	free(w.pos);
+	free(w.nrm);
+	free(w.rep);
+	free(cur);
+	free(next);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+	uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+	return x < y ? -1 : x > y;
+}
+
+bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos)
+{
+	uint64_t *e = malloc((ni ? ni : 1) * sizeof *e);
+	if (!e) return false;
+	size_t ne = 0;
+	double vol = 0.0;
+	for (size_t t = 0; t + 2 < ni; t += 3) {
+		uint32_t v[3] = {idx[t], idx[t + 1], idx[t + 2]};
+		if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue;
+		for (int k = 0; k < 3; k++) e[ne++] = (uint64_t)v[k] << 32 | v[(k + 1) % 3];
+		const float *a = pos + 3 * (size_t)v[0], *b = pos + 3 * (size_t)v[1], *c = pos + 3 * (size_t)v[2];
+		vol += (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
+		       (double)a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
+		       (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0]);
+	}
+	qsort(e, ne, sizeof *e, cmp_u64);
+	bool closed = ne > 0 && vol > 0.0;
+	for (size_t i = 0; closed && i < ne; i++) {
+		uint64_t rev = e[i] << 32 | e[i] >> 32;
+		/* each directed edge once, and its reverse present: two triangles per edge, opposite ways */
+		closed = !(i && e[i] == e[i - 1]) && bsearch(&rev, e, ne, sizeof *e, cmp_u64);
+	}
+	free(e);
+	return closed;
+}
+
+/* Welds me by position and tells api_mesh_closed(); meshes that get levels are welded there. */
+static bool mesh_closed(const struct api_model_mesh *me)
+{
+	uint32_t *idx = malloc((size_t)me->index_count * sizeof *idx);
+	struct welded w = {0};
+	bool closed = idx && weld(me, idx, &w) && api_mesh_closed(idx, me->index_count, w.pos);
+	free(w.pos);
+	free(w.nrm);
+	free(w.rep);
+	free(idx);
+	return closed;
+}
+
+void api_model_build_lods(struct api_model *m, struct api_arena *arena, size_t *bytes)
+{
+	for (uint32_t i = 0; i < m->mesh_count; i++) {
+		struct api_model_mesh *me = (struct api_model_mesh *)&m->meshes[i]; /* ours until shared */
+		if (!me->normals || !me->indices || !me->index_count) continue;
+		me->closed = mesh_closed(me);
+		if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES) mesh_lods(me, arena, bytes);
+	}
+}

@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""The ratio table of `make bench` (issue 12): reads the logs tests/bench.sh left in DIR and
+prints, per target, umbra's figure, the figure it is compared with, their ratio, the goal and
+whether it is met. Only ratios of figures taken side by side in one run mean anything on a
+shared machine, so every row divides two numbers from the same run.
+
+Logs (any may be missing; its rows then say "not run"):
+  floor.txt   build/floor/limits --steps c, in rounds between umbra's (and the older build's) rows
+  warm.txt    build/tests/bench: thumb-256, thumb-512 (rounds), studio-spots, studio-16lights,
+              model-1m-path, model-1m
+  cold.txt    lines "run i: png X ms, exr+aov Y ms"
+  http.txt    tests/bench/http_bench.sh (thumb-256 at concurrency 4) and "umbrad RSS ..." lines
+  warm-before.txt, cold-before.txt   the same from an older build (BENCH_BEFORE), for "before"
+Usage: ratios.py DIR [before]"""
+import os, re, statistics, sys
+
+d = sys.argv[1]
+before = len(sys.argv) > 2 and sys.argv[2] == "before"
+
+
+def read(name):
+    p = os.path.join(d, name)
+    return open(p).read() if os.path.exists(p) else ""
+
+
+def floor_ms(msaa):
+    """The floor's step c at MSAA 1 or 4: the median over its runs (bench.sh runs it in rounds
+    between umbra's rows, and the older build's)."""
+    v = [float(m.group(1)) for m in
+         re.finditer(r"^\| c +\| one submit: .*MSAA%d .*?\| +([0-9.]+) \|" % msaa, read("floor.txt"), re.M)]
+    return statistics.median(v) if v else None
+
+
+def warm_total(scene):
+    """build/tests/bench's median total (ms) of SCENE: the median over every row of that name
+    (one per round)."""
+    v = []
+    for line in read("warm-before.txt" if before else "warm.txt").splitlines():
+        f = line.split()
+        if len(f) >= 8 and f[0] == scene:
+            v.append(float(f[7]))
+    return statistics.median(v) if v else None
+
+
+def cold(kind):
+    v = [float(x) for x in re.findall(r"%s ([0-9]+) ms" % re.escape(kind), read("cold-before.txt" if before else "cold.txt"))]
+    return statistics.median(v) if v else None
+
+
+def http_rate(scene, conc):
+    for line in ("" if before else read("http.txt")).splitlines():
+        f = line.split()
+        if len(f) >= 5 and f[0] == scene and f[1] == str(conc):
+            return float(f[4])
+    return None
+
+
+def rss_mb(which):
+    m = re.search(r"^umbrad RSS %s: ([0-9]+) kB" % which, "" if before else read("http.txt"), re.M)
+    return int(m.group(1)) / 1024.0 if m else None
+
+
+def row(target, a, a_txt, b, b_txt, goal, better):
+    """better: 'le' (ratio must be <= goal) or 'ge'."""
+    if a is None or b is None or b == 0:
+        print("%-42s %14s %20s %7s %7s %s" % (target, a_txt(a) if a is not None else "not run",
+                                             b_txt(b) if b is not None else "not run", "-", goal, "not measured"))
+        return
+    r = a / b
+    met = r <= goal if better == "le" else r >= goal
+    print("%-42s %14s %20s %7.2f %7s %s" % (target, a_txt(a), b_txt(b), r,
+                                           ("<= " if better == "le" else ">= ") + str(goal), "yes" if met else "NO"))
+
+
+ms = lambda v: "%.1f ms" % v
+fl4, fl1 = floor_ms(4), floor_ms(1)
+t512, t256 = warm_total("thumb-512.json"), warm_total("thumb-256.json")
+print("== ratio table (issue 12)%s: figures taken side by side in this run, warm medians"
+      % (" BEFORE (the older build; HTTP and RSS not run for it)" if before else ""))
+print("floor step c: MSAA 4 %s, MSAA 1 %s" % (ms(fl4) if fl4 else "not run", ms(fl1) if fl1 else "not run"))
+print("%-42s %14s %20s %7s %7s %s" % ("target", "umbra", "compared with", "ratio", "goal", "met"))
+row("thumb-512 / floor c MSAA 4", t512, ms, fl4, lambda v: "floor " + ms(v), 1.0, "le")
+row("thumb-256 / floor c MSAA 4", t256, ms, fl4, lambda v: "floor " + ms(v), 0.5, "le")
+row("studio-spots / thumb-512", warm_total("studio-spots.json"), ms, t512, lambda v: "thumb-512 " + ms(v), 2.5, "le")
+row("16 shadowed lights / thumb-512", warm_total("studio-16lights.json"), ms, t512, lambda v: "thumb-512 " + ms(v),
+    4.0, "le")
+row("1M-tri model, cached, by path / thumb-512", warm_total("model-1m-path.json"), ms, t512,
+    lambda v: "thumb-512 " + ms(v), 4.0, "le")
+row("1M-tri model, inline base64 / thumb-512", warm_total("model-1m.json"), ms, t512,
+    lambda v: "thumb-512 " + ms(v), 4.0, "le")
+row("cold CLI EXR+AOV / cold PNG", cold("exr+aov"), ms, cold("png"), lambda v: "png " + ms(v), 2.0, "le")
+t256_rate = 1000.0 / t256 if t256 else None
+row("HTTP thumb-256 4 clients / in-process", http_rate("thumb-256.json", 4), lambda v: "%.1f img/s" % v, t256_rate,
+    lambda v: "in-proc %.1f img/s" % v, 1.0, "ge")
+rss = rss_mb("after")
+row("warm umbrad RSS (after the HTTP rows)", rss, lambda v: "%.0f MB" % v, 200.0 if rss is not None else None,
+    lambda v: "%.0f MB" % v, 1.0, "le")

@@ -1,0 +1,177 @@
+/* tests — api/model_lod.c (meshoptimizer levels of imported meshes) and the renderer's choice
+ * of a level (renderer/lod.c): a flat-shaded UV sphere (every facet its own vertices, as an STL
+ * arrives) gets levels of fewer and fewer triangles whose claimed error bounds how far their
+ * surface is from the sphere, with outward unit normals; the level chosen for a pixel size is
+ * the coarsest whose error fits. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "test.h"
+#include "arena.h"
+#include "lod.h"
+#include "model_lod.h"
+
+#define PI_D 3.14159265358979323846
+
+/* A unit UV sphere of seg x seg quads, flat-shaded: 6 vertices per quad, face normals. */
+static void flat_sphere(int seg, float **pos, float **nrm, uint32_t **idx, uint32_t *nv, uint32_t *ni)
+{
+	*nv = *ni = (uint32_t)(6 * seg * seg);
+	*pos = malloc(*nv * 12);
+	*nrm = malloc(*nv * 12);
+	*idx = malloc(*ni * 4);
+	uint32_t k = 0;
+	for (int i = 0; i < seg; i++)
+		for (int j = 0; j < seg; j++) {
+			double q[4][3];
+			for (int c = 0; c < 4; c++) {
+				int ii = i + (c >> 1), jj = (j + (c & 1)) % seg;
+				double th = PI_D * ii / seg, ph = 2 * PI_D * jj / seg;
+				q[c][0] = -sin(th) * cos(ph); q[c][1] = cos(th); q[c][2] = sin(th) * sin(ph); /* as mesh.c */
+				if (ii == 0 || ii == seg) q[c][0] = q[c][2] = 0; /* poles: one position */
+			}
+			static const int tri[2][3] = {{0, 2, 1}, {1, 2, 3}};
+			for (int t = 0; t < 2; t++)
+				for (int c = 0; c < 3; c++, k++) {
+					for (int a = 0; a < 3; a++) (*pos)[3 * k + a] = (float)q[tri[t][c]][a];
+					double m[3] = {0, 0, 0};
+					for (int cc = 0; cc < 3; cc++)
+						for (int a = 0; a < 3; a++) m[a] += q[tri[t][cc]][a] / 3;
+					double l = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+					for (int a = 0; a < 3; a++) (*nrm)[3 * k + a] = (float)(m[a] / l);
+					(*idx)[k] = k;
+				}
+		}
+}
+
+TEST(model_lod_levels_of_flat_sphere_keep_their_error)
+{
+	float *pos, *nrm;
+	uint32_t *idx, nv, ni;
+	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni); /* 51,200 triangles */
+	struct api_model_mesh me = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
+	struct api_model m = {0};
+	m.meshes = &me;
+	m.mesh_count = 1;
+	struct api_arena *a = api_arena_create();
+	size_t bytes = 0;
+	api_model_build_lods(&m, a, &bytes);
+	REQUIRE(me.lod_count >= 3, "levels: %u", me.lod_count);
+	CHECK(bytes > 0, "the cache is charged for the levels");
+	uint32_t prev_tris = ni / 3;
+	float prev_err = 0;
+	for (uint32_t l = 0; l < me.lod_count; l++) {
+		const struct rnd_mesh_lod *lv = &me.lods[l];
+		uint32_t tris = lv->index_count / 3;
+		CHECK(tris * 4 <= prev_tris * 3, "level %u: %u triangles after %u", l + 1, tris, prev_tris);
+		CHECK(lv->error >= prev_err && lv->error > 0, "level %u: error %g after %g", l + 1, lv->error, prev_err);
+		CHECK(lv->vertex_count < lv->index_count, "level %u is indexed (%u vertices)", l + 1, lv->vertex_count);
+		/* The claimed error bounds the distance of the level's surface from the sphere (beyond the
+		 * input's own chord error): every vertex and every triangle's centroid. */
+		double input = 1 - cos(PI_D / 160), worst = 0;
+		for (uint32_t t = 0; t < tris; t++) {
+			double c[3] = {0, 0, 0};
+			for (int k = 0; k < 3; k++) {
+				const float *p = lv->positions + 3 * lv->indices[3 * t + (uint32_t)k];
+				for (int x = 0; x < 3; x++) c[x] += p[x] / 3;
+				double r = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+				worst = fmax(worst, fabs(r - 1));
+			}
+			worst = fmax(worst, fabs(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - 1));
+		}
+		CHECK(worst <= lv->error + input + 1e-5, "level %u: surface %g from the sphere, claimed %g", l + 1, worst,
+		      lv->error);
+		/* Normals: unit, never inward, and smooth across the facets: nearly all within 26 degrees
+		 * of the sphere's (a coarse level's few steep fan triangles at the poles get creases). */
+		int inward = 0, off = 0;
+		for (uint32_t v = 0; v < lv->vertex_count; v++) {
+			const float *p = lv->positions + 3 * v, *n = lv->normals + 3 * v;
+			double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+			double r = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+			double cosang = (n[0] * p[0] + n[1] * p[1] + n[2] * p[2]) / r;
+			if (fabs(len - 1) > 1e-3 || cosang <= 0) inward++;
+			if (cosang < 0.9) off++;
+		}
+		CHECK(inward == 0, "level %u: %d normals not unit or inward", l + 1, inward);
+		CHECK(off * 50 <= (int)lv->vertex_count, "level %u: %d of %u normals more than 26 degrees off", l + 1, off,
+		      lv->vertex_count);
+		prev_tris = tris;
+		prev_err = lv->error;
+	}
+	api_arena_destroy(a);
+	free(pos); free(nrm); free(idx);
+}
+
+TEST(model_lod_small_meshes_get_no_levels)
+{
+	float *pos, *nrm;
+	uint32_t *idx, nv, ni;
+	flat_sphere(40, &pos, &nrm, &idx, &nv, &ni); /* 3,200 triangles */
+	struct api_model_mesh me = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
+	struct api_model m = {0};
+	m.meshes = &me;
+	m.mesh_count = 1;
+	struct api_arena *a = api_arena_create();
+	size_t bytes = 0;
+	api_model_build_lods(&m, a, &bytes);
+	CHECK(me.lod_count == 0 && bytes == 0, "%u levels", me.lod_count);
+	api_arena_destroy(a);
+	free(pos); free(nrm); free(idx);
+}
+
+TEST(lod_mesh_level_is_coarsest_within_bound)
+{
+	static const float p[3] = {0, 0, 0};
+	struct rnd_mesh_lod lv[3] = {{p, p, NULL, NULL, 1, 0, 0.001f}, {p, p, NULL, NULL, 1, 0, 0.01f},
+	                             {p, p, NULL, NULL, 1, 0, 0.1f}};
+	struct rnd_object o;
+	rnd_object_defaults(&o);
+	o.shape = RND_SHAPE_MESH;
+	o.lods = lv;
+	o.lod_count = 3;
+	CHECK(rnd_lod_mesh_level(&o, 0.01f, 0.25f) == 1, "allowed 0.0025: level 1 (0.001)");
+	CHECK(rnd_lod_mesh_level(&o, 0.001f, 0.25f) == 0, "allowed 0.00025: the full mesh");
+	CHECK(rnd_lod_mesh_level(&o, 1.0f, 0.25f) == 3, "allowed 0.25: the coarsest");
+	o.model[0] = o.model[5] = o.model[10] = 4.0f; /* four times larger: errors too */
+	CHECK(rnd_lod_mesh_level(&o, 0.01f, 0.25f) == 0, "scaled 4: allowed 0.000625 in object units");
+	struct rnd_object full = o;
+	rnd_lod_apply(&full, 0);
+	CHECK(full.index_count == o.index_count && full.positions == o.positions, "level 0 is the mesh as given");
+	rnd_lod_apply(&full, 2);
+	CHECK(full.positions == lv[1].positions && full.vertex_count == 1, "level 2 swaps in lods[1]");
+}
+
+TEST(model_mesh_closed_needs_watertight_outward_winding)
+{
+	/* a tetrahedron wound outward (counter-clockwise seen from outside) */
+	static const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+	static const uint32_t out[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+	uint32_t in[12], open[9], twisted[12];
+	for (int i = 0; i < 12; i += 3) { in[i] = out[i]; in[i + 1] = out[i + 2]; in[i + 2] = out[i + 1]; }
+	memcpy(open, out, sizeof open);
+	memcpy(twisted, out, sizeof twisted);
+	twisted[1] = out[2]; twisted[2] = out[1]; /* one face turned around */
+	CHECK(api_mesh_closed(out, 12, pos), "outward tetrahedron");
+	CHECK(!api_mesh_closed(in, 12, pos), "inward: back faces are what shows from outside");
+	CHECK(!api_mesh_closed(open, 9, pos), "a face missing");
+	CHECK(!api_mesh_closed(twisted, 12, pos), "one face wound the other way");
+	uint32_t doubled[24];
+	memcpy(doubled, out, sizeof out);
+	memcpy(doubled + 12, out, sizeof out);
+	CHECK(!api_mesh_closed(doubled, 24, pos), "every edge used four times");
+	/* a flat-shaded sphere (no vertex shared) is closed once welded by position */
+	float *p, *n;
+	uint32_t *idx, nv, ni;
+	flat_sphere(40, &p, &n, &idx, &nv, &ni);
+	CHECK(!api_mesh_closed(idx, ni, p), "unwelded facets share no edge");
+	struct api_model_mesh me = {.positions = p, .normals = n, .indices = idx, .vertex_count = nv, .index_count = ni};
+	struct api_model m = {0};
+	m.meshes = &me;
+	m.mesh_count = 1;
+	struct api_arena *a = api_arena_create();
+	size_t bytes = 0;
+	api_model_build_lods(&m, a, &bytes);
+	CHECK(me.closed, "welded flat sphere is closed");
+	api_arena_destroy(a);
+	free(p); free(n); free(idx);
+}
