@@ -160,16 +160,21 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 		blockers += dot(b, vec4(1.0));
 		sum_d += dot(b, d);
 	}
-	if (blockers < 0.5) return 1.0;
-	float zb = view_distance(v, sum_d / blockers);
+	// No blocker: fully lit. The filter's trip count says so rather than an early return:
+	// lavapipe executes an `if` for the whole block of pixels under a mask but leaves a loop
+	// once no pixel of the block has iterations left, so a block that this light reaches
+	// unoccluded skips all 32 taps (with the per-pixel light loop of light_all: 16 spot and
+	// point lights half the main pass).
+	int taps = blockers < 0.5 ? 0 : 32;
+	float zb = view_distance(v, sum_d / max(blockers, 1.0));
 	// Capped like the search: views are widened by that many texels, so taps stay in the view.
 	float radius = clamp(penumbra_texels(v, size, vec4(zb), zr, texel).x, 1.0, L.shadow_params.y);
 	float sum = 0.0;
-	for (int i = 0; i < 32; i++) {
+	for (int i = 0; i < taps; i++) {
 		vec2 off = poisson(i) * radius;
 		sum += bilinear_compare(p + off, rect, ref + dot(grad, off), res);
 	}
-	return sum / 32.0;
+	return taps == 0 ? 1.0 : sum / 32.0;
 }
 
 // Receiver plane: how the receiver's light-space depth changes per shadow-map texel, so that
@@ -357,10 +362,26 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 	debug_vis = 1.0;
 	debug_view = 0u;
 	uint light_count = frame.mode.w;
+	// Light culling per pixel. A light whose range or cone does not reach this point (atten 0)
+	// or that lies behind its surface (n.l <= 0) adds exactly nothing, so only the lights in
+	// `reach` are shaded, in the same order as before. lavapipe runs a block of pixels in lock
+	// step and executes both sides of every `if` under a mask, but it leaves a loop as soon as
+	// no pixel of the block has work left: walking the set bits of `reach` costs a block only
+	// the lights that reach one of its pixels, with their shadow lookups. frame.mode2.z != 0
+	// turns culling off (UMBRA_LIGHT_CULL=0), for the test that the image does not change.
+	uvec2 reach = uvec2(0u);
 	for (uint i = 0u; i < light_count; i++) {
 		umbra_light L = lights[i];
-		uint type = uint(L.color.w);
-		if ((SC_LIGHT_TYPES & (1u << type)) == 0u) continue;
+		if ((SC_LIGHT_TYPES & (1u << uint(L.color.w))) == 0u) continue;
+		float atten;
+		vec3 l = light_dir(L, v_pos, atten);
+		bool reaches = dot(N, l) > 0.0 && atten > 0.0;
+		if (reaches || i == frame.mode.z || frame.mode2.z != 0u) reach[i >> 5] |= 1u << (i & 31u);
+	}
+	while (reach != uvec2(0u)) {
+		uint i = reach.x != 0u ? uint(findLSB(reach.x)) : 32u + uint(findLSB(reach.y));
+		reach[i >> 5] &= ~(1u << (i & 31u));
+		umbra_light L = lights[i];
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
 		float ndl = dot(N, l);

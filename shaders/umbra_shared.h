@@ -94,7 +94,8 @@ struct umbra_frame {
 	U_VEC4 ambient_ground;
 	U_VEC4 params;           /* x exposure multiplier, y near, z far, w unused */
 	U_UVEC4 mode;            /* x tonemap, y debug, z debug light, w light count */
-	U_UVEC4 mode2;           /* x 1 = linear output (no tone map / sRGB), y transparent */
+	U_UVEC4 mode2;           /* x 1 = linear output (no tone map / sRGB), y transparent,
+	                            z 1 = light culling off (UMBRA_LIGHT_CULL=0, tests) */
 	U_VEC4 poisson[16];      /* 32 Poisson-disk taps in the unit disk, two per vec4 */
 };
 
