@@ -96,7 +96,7 @@ $(BUILD)/umbra-import: $(BUILD)/obj/api/helper/umbra_import.o $(BUILD)/libapi.a 
 $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 # flags.o (+ admit.o, which it calls): the unit tests cover srv_default_workers() (cgroup CPU quota).
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/queue.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
