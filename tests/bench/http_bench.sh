@@ -27,10 +27,13 @@ until [ -s "$tmp/port" ] && curl -sf -o /dev/null "http://127.0.0.1:$(cat "$tmp/
 	sleep 0.1
 done
 url="http://127.0.0.1:$(cat "$tmp/port")"
+rss() { sed -n 's/^VmRSS:[[:space:]]*\([0-9]*\) kB/\1/p' "/proc/$pid/status" 2>/dev/null | awk '{printf "%.0f MB", $1 / 1024}'; }
+echo "umbrad RSS warm: $(rss)"
 echo "umbrad $(curl -s "$url/v1/info" | sed -n 's/.*"device": *"\([^"]*\)".*/device: \1/p'), $(nproc) CPUs"
 # shellcheck disable=SC2086
 "$BENCH" -c "${HTTP_BENCH_CONC:-1,2,4,8}" -n "${HTTP_BENCH_REQUESTS:-16}" -t "${HTTP_BENCH_SECONDS:-15}" "$url" \
 	${HTTP_BENCH_SCENES:-"$SHARED"/bench/*.json} || status=$?
+echo "umbrad RSS after the runs: $(rss)"
 curl -s "$url/metrics" | grep -E '^umbra_(stage_seconds_(sum|count)|queue_wait_seconds_(sum|count)|shadow_maps_re)' || true
 kill -TERM "$pid"
 wait "$pid" || { rc=$?; echo "umbrad exited $rc" >&2; exit 1; }
