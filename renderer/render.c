@@ -118,6 +118,10 @@ static enum rnd_result write_params(struct rnd_context *ctx, struct rnd_slot *s,
 	f->mode[3] = sc->light_count;
 	f->mode2[0] = sc->output.pixels == RND_PIXELS_RGBA32F ? 1u : 0u;
 	f->mode2[1] = sc->output.transparent ? 1u : 0u;
+	/* UMBRA_LIGHT_CULL=0: every pixel shades every light, for the test that culling
+	 * (shading.glsl light_all) leaves the image unchanged. */
+	const char *cull = getenv("UMBRA_LIGHT_CULL");
+	f->mode2[2] = cull && strcmp(cull, "0") == 0 ? 1u : 0u;
 	memcpy(f->poisson, POISSON, sizeof f->poisson);
 	f->depth_lin[0] = cam->proj[10];
 	f->depth_lin[1] = cam->proj[14];

@@ -5,8 +5,10 @@
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
+#include <sys/mman.h>
 #include <time.h>
 #include <string.h>
+#include <unistd.h>
 #include "moments.h"
 #include "shadow_cache.h"
 #include "slot.h"
@@ -19,6 +21,7 @@ struct rnd_cache_entry {
 	uint32_t ntiles, res;
 	uint32_t refs;
 	uint64_t last_use;
+	double used_at;           /* CLOCK_MONOTONIC seconds of the last grant (idle eviction) */
 	bool live, valid;
 };
 
@@ -28,49 +31,43 @@ struct rnd_shadow_cache {
 	struct rnd_atlas atlas;
 	struct rnd_cache_entry entries[MAX_ENTRIES];
 	uint64_t clock;
+	bool touched;             /* a tile was drawn since the atlases' pages were last released */
 };
 
-/* One-time set-up of both atlases on slot 0's command buffer: the depth atlas cleared to 1
- * (empty texels read "nothing here"), then both in GENERAL layout for good. */
+static double mono_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* One-time set-up of both atlases on slot 0's command buffer: both in GENERAL layout for good.
+ * Not cleared: every map is copied whole into its tile before anything samples it, and the
+ * filters never read outside a tile. Where device memory is host memory (lavapipe), pages
+ * no tile ever used are never touched, so the atlases take resident memory only as tiles use
+ * it (an 8192² depth atlas cleared at start-up was 256 MB of the daemon's warm RSS). */
 static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_slot *s = ctx->slots[0];
 	VkResult vr;
 	VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
 	if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkBeginCommandBuffer (atlas init)");
-	VkImageSubresourceRange range = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-	VkImageMemoryBarrier2 b = {
-		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_NONE,
-		.dstStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT, .dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT,
-		.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, .newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-		.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-		.image = ctx->atlas_depth.img, .subresourceRange = range,
-	};
-	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
-	vkCmdPipelineBarrier2(s->cmd, &di);
-	VkClearDepthStencilValue one = {1.0f, 0};
-	vkCmdClearDepthStencilImage(s->cmd, ctx->atlas_depth.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &one, 1, &range);
 	VkImageMemoryBarrier2 g[2];
 	uint32_t n = 0;
-	g[n++] = (VkImageMemoryBarrier2){
-		.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT,
-		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-		.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
-		.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, .newLayout = VK_IMAGE_LAYOUT_GENERAL,
-		.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-		.image = ctx->atlas_depth.img, .subresourceRange = range,
-	};
-	if (ctx->atlas_moments.img)
+	const struct rnd_image_res *im[2] = {&ctx->atlas_depth, &ctx->atlas_moments};
+	for (int i = 0; i < 2; i++) {
+		if (!im[i]->img) continue;
 		g[n++] = (VkImageMemoryBarrier2){
 			.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_NONE,
 			.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
 			.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
 			.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, .newLayout = VK_IMAGE_LAYOUT_GENERAL,
 			.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-			.image = ctx->atlas_moments.img, .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1},
+			.image = im[i]->img,
+			.subresourceRange = {i == 0 ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1},
 		};
-	di.imageMemoryBarrierCount = n;
-	di.pImageMemoryBarriers = g;
+	}
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = n, .pImageMemoryBarriers = g};
 	vkCmdPipelineBarrier2(s->cmd, &di);
 	if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkEndCommandBuffer (atlas init)");
 	VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &s->cmd};
@@ -219,6 +216,7 @@ static bool attempt(struct rnd_shadow_cache *c, const struct rnd_cache_request *
 			if (e->live && e->valid && e->key == req[k].key && e->ntiles == req[k].tiles && e->res == res[k]) {
 				e->refs++;
 				e->last_use = c->clock;
+				e->used_at = mono_now();
 				g->entry = i; g->res = e->res; g->hit = true;
 				memcpy(g->tile, e->tile, sizeof e->tile);
 				granted[k] = true;
@@ -243,6 +241,8 @@ static bool attempt(struct rnd_shadow_cache *c, const struct rnd_cache_request *
 			return false;
 		}
 		e->live = true; e->valid = false; e->key = req[k].key; e->refs = 1; e->last_use = c->clock;
+		e->used_at = mono_now();
+		c->touched = true;
 		out[k].entry = slot; out[k].res = e->res; out[k].hit = false;
 		memcpy(out[k].tile, e->tile, sizeof e->tile);
 		granted[k] = true;
@@ -360,4 +360,54 @@ void rnd_cache_wake(struct rnd_context *ctx)
 	pthread_mutex_lock(&c->mu);
 	pthread_cond_broadcast(&c->released);
 	pthread_mutex_unlock(&c->mu);
+}
+
+/* Gives the pages of one atlas image back to the system (madvise MADV_DONTNEED over the
+ * whole pages inside its memory; they read as zero when next touched). Only where every
+ * memory type the image may use is host-visible: there device memory is host memory (a CPU
+ * device such as lavapipe) and holds resident pages; elsewhere it is not this process's RSS. */
+static uint64_t release_pages(struct rnd_context *ctx, const struct rnd_image_res *im)
+{
+	if (!im->img || ctx->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return 0;
+	VkMemoryRequirements req;
+	vkGetImageMemoryRequirements(ctx->device, im->img, &req);
+	for (uint32_t i = 0; i < ctx->mem_props.memoryTypeCount; i++)
+		if ((req.memoryTypeBits & (1u << i)) &&
+		    !(ctx->mem_props.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT))
+			return 0;
+	void *map = NULL;
+	if (vkMapMemory(ctx->device, im->mem, 0, VK_WHOLE_SIZE, 0, &map) != VK_SUCCESS || !map) return 0;
+	uintptr_t page = (uintptr_t)sysconf(_SC_PAGESIZE);
+	uintptr_t lo = ((uintptr_t)map + page - 1) & ~(page - 1), hi = ((uintptr_t)map + req.size) & ~(page - 1);
+	uint64_t released = 0;
+	if (hi > lo && madvise((void *)lo, hi - lo, MADV_DONTNEED) == 0) released = hi - lo;
+	vkUnmapMemory(ctx->device, im->mem);
+	return released;
+}
+
+uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s)
+{
+	struct rnd_shadow_cache *c = ctx->cache;
+	if (!c || __atomic_load_n(&ctx->failed, __ATOMIC_RELAXED)) return 0;
+	uint64_t released = 0;
+	pthread_mutex_lock(&c->mu);
+	/* A render that holds tiles may be drawing into the atlas: then nothing is released. One
+	 * that holds none never reads a texel (maps are sampled only inside granted tiles). */
+	if (!others_hold_tiles(c)) {
+		double now = mono_now();
+		for (uint32_t i = 0; i < MAX_ENTRIES; i++) {
+			struct rnd_cache_entry *e = &c->entries[i];
+			if (e->live && now - e->used_at >= idle_s) entry_free(c, e);
+		}
+		bool empty = true;
+		for (uint32_t i = 0; i < MAX_ENTRIES && empty; i++) empty = !c->entries[i].live;
+		/* All or nothing, like the grants: with every map gone the whole atlas is free, so its
+		 * pages go back without knowing how the driver lays texels out in memory. */
+		if (empty && c->touched) {
+			released = release_pages(ctx, &ctx->atlas_depth) + release_pages(ctx, &ctx->atlas_moments);
+			c->touched = false;
+		}
+	}
+	pthread_mutex_unlock(&c->mu);
+	return released;
 }

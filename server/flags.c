@@ -52,6 +52,7 @@ static const struct opt_def opts[] = {
 	{ "max-memory", OPT_SIZE, "BYTES", "memory renders in flight may need together; a render estimated over it is a 422, others wait (half the machine's or container's memory)", CFG(max_memory), 0, UINT64_MAX },
 	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
+	{ "idle-trim", OPT_UINT, "S", "after S s without a request, drop shadow maps unused for S s and give the atlas pages and freed heap back to the system, 0 = never (30)", CFG(idle_trim_s), 0, 86400 },
 	{ "test-fault", OPT_STR, "submit:N:lost|oom", "tests only: the Nth queue submit after warm-up fails", CFG(test_fault), 0, 0 },
 };
 #define OPT_COUNT (sizeof opts / sizeof opts[0])
@@ -219,6 +220,7 @@ static void set_defaults(struct srv_config *cfg)
 	cfg->max_connections_per_ip = 256;
 	cfg->header_timeout_s = 10;
 	cfg->drain_timeout_s = 60;
+	cfg->idle_trim_s = 30;
 	const char *v = getenv("UMBRA_VALIDATION");
 	cfg->validation = v && *v && strcmp(v, "0") != 0;
 	v = getenv("UMBRA_NO_PLAYGROUND");

@@ -3,7 +3,10 @@
  */
 #include "queue.h"
 
+#include <errno.h>
+#include <math.h>
 #include <stdlib.h>
+#include <time.h>
 
 struct srv_fifo {
 	struct srv_request *head, *tail;
@@ -16,6 +19,8 @@ struct srv_queue {
 	struct srv_fifo fifo[SRV_PRIO_COUNT];
 	unsigned count, capacity;
 	bool closed;
+	unsigned busy;      /* requests handed out and not yet srv_queue_done */
+	bool idle_due;      /* a request was handed out since on_idle last ran (srv_queue_pop_idle) */
 };
 
 struct srv_queue *srv_queue_create(unsigned capacity)
@@ -25,9 +30,15 @@ struct srv_queue *srv_queue_create(unsigned capacity)
 		return NULL;
 	if (pthread_mutex_init(&q->mu, NULL) != 0)
 		goto err_free;
-	if (pthread_cond_init(&q->nonempty, NULL) != 0)
+	pthread_condattr_t ca;
+	pthread_condattr_init(&ca);
+	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+	int e = pthread_cond_init(&q->nonempty, &ca);
+	pthread_condattr_destroy(&ca);
+	if (e != 0)
 		goto err_mutex;
 	q->capacity = capacity;
+	q->idle_due = true;
 	return q;
 
 err_mutex:
@@ -74,26 +85,70 @@ enum srv_push_result srv_queue_push(struct srv_queue *q, struct srv_request *req
 	return SRV_PUSH_OK;
 }
 
-struct srv_request *srv_queue_pop(struct srv_queue *q)
+/* The first request in priority order; the lock is held. */
+static struct srv_request *take(struct srv_queue *q)
 {
-	struct srv_request *req = NULL;
-	pthread_mutex_lock(&q->mu);
-	while (q->count == 0 && !q->closed)
-		pthread_cond_wait(&q->nonempty, &q->mu);
-	for (int p = 0; p < SRV_PRIO_COUNT && !req; p++) {
+	for (int p = 0; p < SRV_PRIO_COUNT; p++) {
 		struct srv_fifo *f = &q->fifo[p];
-		if (!f->head)
+		struct srv_request *req = f->head;
+		if (!req)
 			continue;
-		req = f->head;
 		f->head = req->next;
 		if (!f->head)
 			f->tail = NULL;
 		f->count--;
 		q->count--;
 		req->next = NULL;
+		q->busy++;
+		q->idle_due = true;
+		return req;
 	}
+	return NULL;
+}
+
+struct srv_request *srv_queue_pop(struct srv_queue *q)
+{
+	return srv_queue_pop_idle(q, 0, NULL, NULL);
+}
+
+struct srv_request *srv_queue_pop_idle(struct srv_queue *q, double idle_s, void (*on_idle)(void *arg), void *arg)
+{
+	pthread_mutex_lock(&q->mu);
+	while (q->count == 0 && !q->closed) {
+		if (idle_s <= 0 || !on_idle || !q->idle_due) {
+			pthread_cond_wait(&q->nonempty, &q->mu);
+			continue;
+		}
+		struct timespec ts;
+		clock_gettime(CLOCK_MONOTONIC, &ts);
+		double whole, frac = modf(idle_s, &whole);
+		ts.tv_sec += (time_t)whole;
+		ts.tv_nsec += (long)(frac * 1e9);
+		if (ts.tv_nsec >= 1000000000L) {
+			ts.tv_sec++;
+			ts.tv_nsec -= 1000000000L;
+		}
+		/* Several threads may wait out the same idle time: the first to time out runs it, once
+		 * no request is being worked on either (the last to finish waits out its own). */
+		if (pthread_cond_timedwait(&q->nonempty, &q->mu, &ts) == ETIMEDOUT && q->count == 0 && !q->closed &&
+		    q->idle_due && q->busy == 0) {
+			q->idle_due = false;
+			pthread_mutex_unlock(&q->mu);
+			on_idle(arg);
+			pthread_mutex_lock(&q->mu);
+		}
+	}
+	struct srv_request *req = take(q);
 	pthread_mutex_unlock(&q->mu);
 	return req;
+}
+
+void srv_queue_done(struct srv_queue *q)
+{
+	pthread_mutex_lock(&q->mu);
+	if (q->busy)
+		q->busy--;
+	pthread_mutex_unlock(&q->mu);
 }
 
 void srv_queue_close(struct srv_queue *q)

@@ -71,6 +71,7 @@ struct srv_config {
 	unsigned header_timeout_s;     /* a new connection's first request head, 0 = idle, default 10 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
 	uint64_t model_cache_bytes;    /* api_model_cache_set_limit() at start, default 256 MiB */
+	unsigned idle_trim_s;          /* idle this long: drop unused cached maps, give memory back; 0 = never, default 30 */
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
 	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */

@@ -14,6 +14,7 @@
  * 503 answer goes out; its worker then recreates the context and runs the warm-up again, and
  * only then is the daemon ready again.
  */
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -297,6 +298,8 @@ int srv_warmup(struct srv_server *s)
 	warm_thread(&w);
 	for (unsigned i = 0; i < started; i++)
 		pthread_join(th[i], NULL);
+	/* Pipeline compilation leaves tens of MB free in malloc's arenas: give them back. */
+	malloc_trim(0);
 	srv_log(SRV_LOG_INFO, "warm-up done in %.0f ms", (srv_now() - t0) * 1000);
 	return 0;
 }
@@ -514,13 +517,30 @@ out:
 	return lost_gen;
 }
 
+/* Idle for --idle-trim seconds: cached shadow maps nobody used for as long go, and with them
+ * the atlases' pages (rnd_context_trim); then the heap's free pages go back to the system
+ * (LLVM's compile-time memory and freed image memory stay in malloc's arenas otherwise). */
+static void idle_trim(void *arg)
+{
+	struct srv_server *s = arg;
+	uint64_t released = 0;
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	if (s->ctx)
+		released = rnd_context_trim(s->ctx, s->cfg.idle_trim_s);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	malloc_trim(0);
+	if (released)
+		srv_log(SRV_LOG_INFO, "idle: gave %.0f MB of shadow atlas pages back", released / 1048576.0);
+}
+
 static void *worker_main(void *arg)
 {
 	struct srv_server *s = arg;
 	struct srv_request *req;
-	while ((req = srv_queue_pop(s->queue))) {
+	while ((req = srv_queue_pop_idle(s->queue, s->cfg.idle_trim_s, idle_trim, s))) {
 		unsigned lost_gen = job_run(s, req);
 		srv_request_finish(req);
+		srv_queue_done(s->queue);
 		/* After the answer: the client learns of the failure at once, /readyz is already 503. */
 		if (lost_gen)
 			context_recover(s, lost_gen - 1);

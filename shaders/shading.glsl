@@ -8,6 +8,9 @@
 // filter depth formats linearly, so filtering happens here: textureGather fetches 2x2 texels,
 // each is compared with the receiver depth and the results are weighted bilinearly.
 
+// subgroupOr in light_all: the lights that reach any pixel of a block.
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock { umbra_frame frame; };
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonly buffer Materials { umbra_material materials[]; };
 // Lights and shadow views are uniform blocks: every lane reads the same entry, which lavapipe
@@ -175,16 +178,21 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 		blockers += dot(b, vec4(1.0));
 		sum_d += dot(b, d);
 	}
-	if (blockers < 0.5) return 1.0;
-	float zb = view_distance(v, sum_d / blockers);
+	// No blocker: fully lit. The filter's trip count says so rather than an early return:
+	// lavapipe executes an `if` for the whole block of pixels under a mask but leaves a loop
+	// once no pixel of the block has iterations left, so a block that this light reaches
+	// unoccluded skips all 32 taps (with the per-pixel light loop of light_all: 16 spot and
+	// point lights half the main pass).
+	int taps = blockers < 0.5 ? 0 : 32;
+	float zb = view_distance(v, sum_d / max(blockers, 1.0));
 	// Capped like the search: views are widened by that many texels, so taps stay in the view.
 	float radius = clamp(penumbra_texels(v, size, vec4(zb), zr, texel).x, 1.0, L.shadow_params.y);
 	float sum = 0.0;
-	for (int i = 0; i < 32; i++) {
+	for (int i = 0; i < taps; i++) {
 		vec2 off = poisson(i) * radius;
 		sum += bilinear_compare(p + off, rect, ref + dot(grad, off), res);
 	}
-	return sum / 32.0;
+	return taps == 0 ? 1.0 : sum / 32.0;
 }
 
 // Receiver plane: how the receiver's light-space depth changes per shadow-map texel, so that
@@ -454,10 +462,30 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 	debug_vis = 1.0;
 	debug_view = 0u;
 	uint light_count = frame.mode.w;
+	// Light culling per pixel. A light whose range or cone does not reach this point (atten 0)
+	// or that lies behind its surface (n.l <= 0) adds exactly nothing, so only the lights in
+	// `reach` are shaded, in the same order as before. lavapipe runs a block of pixels (a
+	// subgroup) in lock step and executes both sides of every `if` under a mask, but it leaves
+	// a loop as soon as no pixel has work left: walking the lights that reach some pixel of the
+	// block (subgroupOr) costs the block only those lights, with their shadow lookups; and the
+	// light index is the same for the whole block, so its light and views are read as one
+	// broadcast each rather than lane by lane. frame.mode2.z != 0 turns culling off
+	// (UMBRA_LIGHT_CULL=0), for the test that the image does not change.
+	uvec2 reach = uvec2(0u);
 	for (uint i = 0u; i < light_count; i++) {
 		umbra_light L = lights[i];
-		uint type = uint(L.color.w);
-		if ((SC_LIGHT_TYPES & (1u << type)) == 0u) continue;
+		if ((SC_LIGHT_TYPES & (1u << uint(L.color.w))) == 0u) continue;
+		float atten;
+		vec3 l = light_dir(L, v_pos, atten);
+		bool reaches = dot(N, l) > 0.0 && atten > 0.0;
+		if (reaches || i == frame.mode.z || frame.mode2.z != 0u) reach[i >> 5] |= 1u << (i & 31u);
+	}
+	uvec2 todo = subgroupOr(reach);
+	while (todo != uvec2(0u)) {
+		uint i = todo.x != 0u ? uint(findLSB(todo.x)) : 32u + uint(findLSB(todo.y));
+		todo[i >> 5] &= ~(1u << (i & 31u));
+		if ((reach[i >> 5] & (1u << (i & 31u))) == 0u) continue;
+		umbra_light L = lights[i];
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
 		float ndl = dot(N, l);

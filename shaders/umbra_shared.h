@@ -113,7 +113,8 @@ struct umbra_frame {
 	U_VEC4 ambient_ground;
 	U_VEC4 params;           /* x exposure multiplier, y near, z far, w unused */
 	U_UVEC4 mode;            /* x tonemap, y debug, z debug light, w light count */
-	U_UVEC4 mode2;           /* x 1 = linear output (no tone map / sRGB), y transparent */
+	U_UVEC4 mode2;           /* x 1 = linear output (no tone map / sRGB), y transparent,
+	                            z 1 = light culling off (UMBRA_LIGHT_CULL=0, tests) */
 	U_VEC4 depth_lin;        /* proj[10], proj[14], proj[11], proj[15]: contact shadows turn the scene
 	                            depth back into view depth (perspective and orthographic alike) */
 	U_VEC4 target;           /* x, y view size in pixels; z world size of a pixel at view depth 1

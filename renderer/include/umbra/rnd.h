@@ -397,6 +397,11 @@ struct rnd_stats {
 	uint64_t shadow_cache_misses;
 };
 void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
+/* Idle trim: drops cached shadow maps not used for idle_s seconds (0: all), and once no map
+ * is left, gives the shadow atlases' pages back to the system where device memory is host
+ * memory (lavapipe), so the atlases are resident only while tiles use them. Does nothing while
+ * a render holds tiles. Returns the bytes released (0 when nothing was). Any thread. */
+uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s);
 /* Writes the pipeline cache to desc.pipeline_cache_path (atomic rename). */
 enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error *err);
 
