@@ -8,6 +8,9 @@
 // filter depth formats linearly, so filtering happens here: textureGather fetches 2x2 texels,
 // each is compared with the receiver depth and the results are weighted bilinearly.
 
+// subgroupOr in light_all: the lights that reach any pixel of a block.
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock { umbra_frame frame; };
 layout(std430, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MATERIALS) readonly buffer Materials { umbra_material materials[]; };
 // Lights and shadow views are uniform blocks: every lane reads the same entry, which lavapipe
@@ -364,11 +367,13 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 	uint light_count = frame.mode.w;
 	// Light culling per pixel. A light whose range or cone does not reach this point (atten 0)
 	// or that lies behind its surface (n.l <= 0) adds exactly nothing, so only the lights in
-	// `reach` are shaded, in the same order as before. lavapipe runs a block of pixels in lock
-	// step and executes both sides of every `if` under a mask, but it leaves a loop as soon as
-	// no pixel of the block has work left: walking the set bits of `reach` costs a block only
-	// the lights that reach one of its pixels, with their shadow lookups. frame.mode2.z != 0
-	// turns culling off (UMBRA_LIGHT_CULL=0), for the test that the image does not change.
+	// `reach` are shaded, in the same order as before. lavapipe runs a block of pixels (a
+	// subgroup) in lock step and executes both sides of every `if` under a mask, but it leaves
+	// a loop as soon as no pixel has work left: walking the lights that reach some pixel of the
+	// block (subgroupOr) costs the block only those lights, with their shadow lookups; and the
+	// light index is the same for the whole block, so its light and views are read as one
+	// broadcast each rather than lane by lane. frame.mode2.z != 0 turns culling off
+	// (UMBRA_LIGHT_CULL=0), for the test that the image does not change.
 	uvec2 reach = uvec2(0u);
 	for (uint i = 0u; i < light_count; i++) {
 		umbra_light L = lights[i];
@@ -378,9 +383,11 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 		bool reaches = dot(N, l) > 0.0 && atten > 0.0;
 		if (reaches || i == frame.mode.z || frame.mode2.z != 0u) reach[i >> 5] |= 1u << (i & 31u);
 	}
-	while (reach != uvec2(0u)) {
-		uint i = reach.x != 0u ? uint(findLSB(reach.x)) : 32u + uint(findLSB(reach.y));
-		reach[i >> 5] &= ~(1u << (i & 31u));
+	uvec2 todo = subgroupOr(reach);
+	while (todo != uvec2(0u)) {
+		uint i = todo.x != 0u ? uint(findLSB(todo.x)) : 32u + uint(findLSB(todo.y));
+		todo[i >> 5] &= ~(1u << (i & 31u));
+		if ((reach[i >> 5] & (1u << (i & 31u))) == 0u) continue;
 		umbra_light L = lights[i];
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
