@@ -49,25 +49,9 @@ void record_scene_depth(struct rnd_context *ctx, struct rnd_slot *s, const struc
 	                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
 	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-	VkRenderingAttachmentInfo da = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->scene_depth.view,
-		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-		.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
-	};
-	VkRenderingInfo ri = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
-		.pDepthAttachment = &da,
-	};
-	vkCmdBeginRendering(cmd, &ri);
-	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
-	VkRect2D scissor = {{0, 0}, {w, h}};
-	vkCmdSetViewport(cmd, 0, 1, &vp);
-	vkCmdSetScissor(cmd, 0, 1, &scissor);
+	record_begin_depth(cmd, s->scene_depth.view, w, h);
 	vkCmdSetDepthBias(cmd, 0.0f, 0.0f, 0.0f);
-	VkDeviceSize zero = 0;
-	vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
-	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
-	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+	record_bind_geometry(ctx, s);
 	/* z' = w - z: the reversed-Z camera as the shadow pipelines' near-0 depth. */
 	struct umbra_push push = {0};
 	const float *m = rv->cam->view_proj;
@@ -81,19 +65,7 @@ void record_scene_depth(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		/* What the camera sees: shadow catchers and non-casters occlude contact rays too only
 		 * when they are drawn, which every drawn object is. */
 		if (!d->index_count) continue;
-		VkPipeline p = d->masked ? ctx->pipes.shadow_masked[d->cull_back] : ctx->pipes.shadow[d->cull_back];
-		if (bound != p) {
-			vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p);
-			bound = p;
-		}
-		if (d->masked) {
-			push.info[0] = d->material;
-			vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-			                   sizeof push, &push);
-			vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
-			                        &s->texture_sets[d->texture_set], 0, NULL);
-		}
-		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+		record_depth_draw(ctx, s, d, d->cull_back, &push, &bound);
 	}
 	vkCmdEndRendering(cmd);
 	record_image_barrier(cmd, s->scene_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,

@@ -1,5 +1,8 @@
 /*
- * renderer/record.c — command recording for one view (see record.h).
+ * renderer/record.c — command recording for one view (see record.h): the shadow passes, the
+ * main pass (with its depth pre-pass) and the AOV passes, and the helpers the depth-only passes
+ * share with contact.c. The texture and readback copies live with their jobs (upload.c,
+ * readback.c).
  */
 #include <math.h>
 #include <string.h>
@@ -43,7 +46,7 @@ void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags a
 }
 
 /* The rows of the view this submit draws. */
-static VkRect2D band_area(const struct record_view *rv)
+VkRect2D record_band_area(const struct record_view *rv)
 {
 	uint32_t h = rv->sc->height;
 	uint32_t y = rv->band_y < h ? rv->band_y : h - 1;
@@ -57,13 +60,131 @@ static float srgb_encode(float c)
 	return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
+/* Begins a depth-only pass over (0, 0, w, h) of view, cleared to 1 (the shadow pipelines' far),
+ * with that viewport and scissor. */
+void record_begin_depth(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h)
+{
+	VkRenderingAttachmentInfo da = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = view,
+		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+		.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
+	};
+	VkRenderingInfo ri = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
+		.pDepthAttachment = &da,
+	};
+	vkCmdBeginRendering(cmd, &ri);
+	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
+	VkRect2D scissor = {{0, 0}, {w, h}};
+	vkCmdSetViewport(cmd, 0, 1, &vp);
+	vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	VkDeviceSize zero = 0;
+	vkCmdBindVertexBuffers(s->cmd, 0, 1, &s->vertices.buf, &zero);
+	vkCmdBindIndexBuffer(s->cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
+	vkCmdBindDescriptorSets(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+}
+
+void record_depth_draw(struct rnd_context *ctx, struct rnd_slot *s, const struct draw *d, int cull,
+                       struct umbra_push *push, VkPipeline *bound)
+{
+	VkCommandBuffer cmd = s->cmd;
+	VkPipeline p = d->masked ? ctx->pipes.shadow_masked[cull] : ctx->pipes.shadow[cull];
+	if (*bound != p) {
+		vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p);
+		*bound = p;
+	}
+	if (d->masked) {
+		push->info[0] = d->material;
+		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+		                   0, sizeof *push, push);
+		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
+		                        &s->texture_sets[d->texture_set], 0, NULL);
+	}
+	vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+}
+
+/* Shadow view v drawn into the slot's scratch depth image, left ready to be copied. */
+static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t v)
+{
+	const struct rnd_scene *sc = rv->sc;
+	const struct rnd_shadow_plan *sp = rv->sp;
+	VkCommandBuffer cmd = s->cmd;
+	const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
+	uint32_t res = (uint32_t)sp->views[v].rect[2];
+	/* Each map is drawn at the origin of the slot's scratch depth image and then copied
+	 * into its tile: rasterisation snaps to a grid relative to the framebuffer, so drawing
+	 * at the tile's own offset would make a map (and the image) depend on where the atlas
+	 * happened to place it. The same request then gives the same bytes whatever the cache
+	 * held before. */
+	record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+	                     VK_ACCESS_2_TRANSFER_READ_BIT,
+	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+	record_begin_depth(cmd, s->shadow_scratch.view, res, res);
+	vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
+	/* Masked casters read materials and textures; the set's shadow-map binding is not
+	 * used by the alpha-test shader while the map is a render target. */
+	record_bind_geometry(ctx, s);
+	struct umbra_push push = {0};
+	memcpy(push.view_proj, sp->views[v].view_proj, sizeof push.view_proj);
+	vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+	                   sizeof push, &push);
+	VkPipeline bound = VK_NULL_HANDLE;
+	const struct rnd_light *L = &sc->lights[sp->view_light[v]];
+	for (uint32_t i = 0; i < rv->ndraw; i++) {
+		const struct draw *d = &rv->draws[i];
+		if (!d->cast || !d->index_count) continue;
+		if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) continue;
+		int cull = d->single_sided ||
+		           (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
+		record_depth_draw(ctx, s, d, cull, &push, &bound);
+	}
+	vkCmdEndRendering(cmd);
+	record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1,
+	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+	                     VK_ACCESS_2_TRANSFER_READ_BIT);
+}
+
+/* VSM / EVSM: the map as floats for the moment blur (compute shaders cannot read a
+ * depth image on lavapipe without it copying the image on every dispatch). The
+ * previous view's compute passes must be done reading the buffer. */
+static void copy_for_moments(struct rnd_slot *s, uint32_t res)
+{
+	VkCommandBuffer cmd = s->cmd;
+	VkBufferMemoryBarrier2 bb = {
+		.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2,
+		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+		.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
+		.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->scratch_buf.buf, .size = VK_WHOLE_SIZE,
+	};
+	VkDependencyInfo bdi = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
+	vkCmdPipelineBarrier2(cmd, &bdi);
+	VkBufferImageCopy region = {
+		.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1}, .imageExtent = {res, res, 1},
+	};
+	vkCmdCopyImageToBuffer(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->scratch_buf.buf, 1,
+	                       &region);
+	bb.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+	bb.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+	bb.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+	bb.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+	vkCmdPipelineBarrier2(cmd, &bdi);
+}
+
 void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t first,
                     uint32_t end)
 {
 	const struct rnd_scene *sc = rv->sc;
 	const struct rnd_shadow_plan *sp = rv->sp;
-	const struct draw *draws = rv->draws;
-	uint32_t ndraw = rv->ndraw;
 	VkCommandBuffer cmd = s->cmd;
 	/* The atlas stays in GENERAL layout. Earlier submissions (other renders) may still sample
 	 * or write other tiles; this render writes only its own tiles, so an execution and memory
@@ -78,75 +199,11 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
 	vkCmdPipelineBarrier2(cmd, &di);
-	VkDeviceSize zero = 0;
 	for (uint32_t v = first; v < end && v < sp->view_count; v++) {
 		if (sp->view_skip[v]) continue;
 		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
-		const float *rect = sp->views[v].rect;
-		uint32_t res = (uint32_t)rect[2];
-		/* Each map is drawn at the origin of the slot's scratch depth image and then copied
-		 * into its tile: rasterisation snaps to a grid relative to the framebuffer, so drawing
-		 * at the tile's own offset would make a map (and the image) depend on where the atlas
-		 * happened to place it. The same request then gives the same bytes whatever the cache
-		 * held before. */
-		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-		                     VK_ACCESS_2_TRANSFER_READ_BIT,
-		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-		VkRenderingAttachmentInfo da = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->shadow_scratch.view,
-			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
-		};
-		VkRenderingInfo ri = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {res, res}}, .layerCount = 1,
-			.pDepthAttachment = &da,
-		};
-		vkCmdBeginRendering(cmd, &ri);
-		VkViewport vp = {0, 0, (float)res, (float)res, 0, 1};
-		VkRect2D scissor = {{0, 0}, {res, res}};
-		vkCmdSetViewport(cmd, 0, 1, &vp);
-		vkCmdSetScissor(cmd, 0, 1, &scissor);
-		vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
-		vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
-		vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
-		/* Masked casters read materials and textures; the set's shadow-map binding is not
-		 * used by the alpha-test shader while the map is a render target. */
-		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
-		struct umbra_push push = {0};
-		memcpy(push.view_proj, sp->views[v].view_proj, sizeof push.view_proj);
-		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-		                   sizeof push, &push);
-		VkPipeline bound = VK_NULL_HANDLE;
-		const struct rnd_light *L = &sc->lights[sp->view_light[v]];
-		for (uint32_t i = 0; i < ndraw; i++) {
-			const struct draw *d = &draws[i];
-			if (!d->cast || !d->index_count) continue;
-			if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) continue;
-			int cull = d->single_sided ||
-			           (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
-			VkPipeline p = d->masked ? ctx->pipes.shadow_masked[cull] : ctx->pipes.shadow[cull];
-			if (bound != p) {
-				vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p);
-				bound = p;
-			}
-			if (d->masked) {
-				push.info[0] = d->material;
-				vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-				                   0, sizeof push, &push);
-			}
-			if (d->masked)
-				vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
-				                        &s->texture_sets[d->texture_set], 0, NULL);
-			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
-		}
-		vkCmdEndRendering(cmd);
-		record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1,
-		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-		                     VK_ACCESS_2_TRANSFER_READ_BIT);
+		uint32_t res = (uint32_t)sp->views[v].rect[2];
+		draw_shadow_map(ctx, s, rv, v);
 		/* Into the depth atlas: a same-format image copy, which lavapipe does as a memcpy. */
 		VkImageCopy copy = {
 			.srcSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
@@ -156,29 +213,7 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		vkCmdCopyImage(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, ctx->atlas_depth.img,
 		               VK_IMAGE_LAYOUT_GENERAL, 1, &copy);
 		if (!lp->moments) continue;
-		/* VSM / EVSM: the map as floats for the moment blur (compute shaders cannot read a
-		 * depth image on lavapipe without it copying the image on every dispatch). The
-		 * previous view's compute passes must be done reading the buffer. */
-		VkBufferMemoryBarrier2 bb = {
-			.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2,
-			.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-			.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-			.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
-			.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-			.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->scratch_buf.buf, .size = VK_WHOLE_SIZE,
-		};
-		VkDependencyInfo bdi = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
-		vkCmdPipelineBarrier2(cmd, &bdi);
-		VkBufferImageCopy region = {
-			.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1}, .imageExtent = {res, res, 1},
-		};
-		vkCmdCopyImageToBuffer(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->scratch_buf.buf, 1,
-		                       &region);
-		bb.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-		bb.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-		bb.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-		bb.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
-		vkCmdPipelineBarrier2(cmd, &bdi);
+		copy_for_moments(s, res);
 		rnd_moments_record_view(ctx, s, sp, v, sc);
 	}
 	/* The atlas tiles (depth copied in, moments from compute) are read by the main and AOV
@@ -248,33 +283,23 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	}
 }
 
-enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
-                            struct rnd_error *err)
+/* The main-pass pipelines key k needs: one per culling mode the draws use. */
+static enum rnd_result cull_pipelines(struct rnd_context *ctx, struct rnd_main_key *key, const struct draw *draws,
+                                      uint32_t ndraw, VkPipeline pipes[2], struct rnd_error *err)
 {
-	const struct rnd_scene *sc = rv->sc;
-	const struct rnd_shadow_plan *sp = rv->sp;
-	const struct draw *draws = rv->draws;
-	uint32_t ndraw = rv->ndraw;
-	struct rnd_main_key key;
-	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
-	main_key(sc, sp, draws, ndraw, &key);
-	VkPipeline atlas_pipe = VK_NULL_HANDLE;
-	if (key.atlas_view) {
-		enum rnd_result r = rnd_pipelines_main(ctx, &key, &atlas_pipe, err);
-		if (r != RND_OK) return r;
-		ndraw = 0;   /* the picture is the atlas, not the scene */
-	}
 	for (uint32_t i = 0; i < ndraw; i++) {
 		uint32_t c = draws[i].cull_back;
 		if (!draws[i].index_count || pipes[c]) continue;
-		key.cull_back = c;
-		enum rnd_result r = rnd_pipelines_main(ctx, &key, &pipes[c], err);
+		key->cull_back = c;
+		enum rnd_result r = rnd_pipelines_main(ctx, key, &pipes[c], err);
 		if (r != RND_OK) return r;
 	}
-	VkCommandBuffer cmd = s->cmd;
-	uint32_t w = sc->width, h = sc->height;
-	VkRect2D area = band_area(rv);
-	bool ms = sc->output.msaa > 1;
+	return RND_OK;
+}
+
+/* The colour (and resolve) and depth targets of the main pass, ready to be drawn. */
+static void main_barriers(VkCommandBuffer cmd, struct rnd_slot *s, bool ms)
+{
 	/* The atlas tiles may have been written by an earlier submit of this render (or another
 	 * render's): make them visible to this pass's shadow lookups. */
 	VkMemoryBarrier2 mb = {
@@ -297,19 +322,26 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
 	              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+}
 
-	/* The background is the requested colour itself (sRGB-encoded for display outputs), not
-	 * tone mapped: a caller asking for white gets 255. */
+/* The background is the requested colour itself (sRGB-encoded for display outputs), not
+ * tone mapped: a caller asking for white gets 255. */
+static VkClearColorValue main_clear(const struct rnd_scene *sc)
+{
 	VkClearColorValue clear;
 	const float *bg = sc->environment.background;
 	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
 	for (int k = 0; k < 3; k++) clear.float32[k] = linear ? bg[k] : srgb_encode(bg[k]);
 	clear.float32[3] = sc->output.transparent ? 0.0f : bg[3];
 	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
-	 * colour at edges (render.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
+	 * colour at edges (readback.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
 	if (sc->output.transparent) clear.float32[0] = clear.float32[1] = clear.float32[2] = 0.0f;
 	if (sc->output.debug == RND_DEBUG_SHADOW) clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
+	return clear;
+}
 
+static void begin_main(VkCommandBuffer cmd, struct rnd_slot *s, const struct rnd_scene *sc, VkRect2D area, bool ms)
+{
 	VkRenderingAttachmentInfo ca = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = ms ? s->color_ms.view : s->resolve.view,
 		.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -318,7 +350,7 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 		.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
 		.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
 		.storeOp = ms ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE,
-		.clearValue.color = clear,
+		.clearValue.color = main_clear(sc),
 	};
 	VkRenderingAttachmentInfo da = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->depth.view,
@@ -330,19 +362,19 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 		.colorAttachmentCount = 1, .pColorAttachments = &ca, .pDepthAttachment = &da,
 	};
 	vkCmdBeginRendering(cmd, &ri);
-	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
+	VkViewport vp = {0, 0, (float)sc->width, (float)sc->height, 0, 1};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
 	vkCmdSetScissor(cmd, 0, 1, &area);
-	VkDeviceSize zero = 0;
-	vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
-	vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
-	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
-	if (atlas_pipe) {
-		vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, atlas_pipe);
-		vkCmdDraw(cmd, 3, 1, 0, 0);
-	}
+}
+
+/* The depth pre-pass (when the key asks for one), then every draw. */
+static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t ndraw,
+                      bool prepass, const VkPipeline pipes[2], bool ms)
+{
+	VkCommandBuffer cmd = s->cmd;
+	const struct draw *draws = rv->draws;
 	VkPipeline bound = VK_NULL_HANDLE;
-	for (uint32_t i = 0; i < ndraw && key.prepass; i++) {
+	for (uint32_t i = 0; i < ndraw && prepass; i++) {
 		const struct draw *d = &draws[i];
 		if (!d->index_count) continue;
 		VkPipeline p = d->masked ? ctx->pipes.prepass_masked[ms][d->cull_back] : ctx->pipes.prepass[ms][d->cull_back];
@@ -372,8 +404,97 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 		                        &s->texture_sets[d->texture_set], 0, NULL);
 		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
 	}
+}
+
+enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                            struct rnd_error *err)
+{
+	const struct rnd_scene *sc = rv->sc;
+	uint32_t ndraw = rv->ndraw;
+	struct rnd_main_key key;
+	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+	main_key(sc, rv->sp, rv->draws, ndraw, &key);
+	VkPipeline atlas_pipe = VK_NULL_HANDLE;
+	if (key.atlas_view) {
+		enum rnd_result r = rnd_pipelines_main(ctx, &key, &atlas_pipe, err);
+		if (r != RND_OK) return r;
+		ndraw = 0;   /* the picture is the atlas, not the scene */
+	}
+	enum rnd_result r = cull_pipelines(ctx, &key, rv->draws, ndraw, pipes, err);
+	if (r != RND_OK) return r;
+	VkCommandBuffer cmd = s->cmd;
+	bool ms = sc->output.msaa > 1;
+	main_barriers(cmd, s, ms);
+	begin_main(cmd, s, sc, record_band_area(rv), ms);
+	record_bind_geometry(ctx, s);
+	if (atlas_pipe) {
+		vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, atlas_pipe);
+		vkCmdDraw(cmd, 3, 1, 0, 0);
+	}
+	draw_main(ctx, s, rv, ndraw, key.prepass, pipes, ms);
 	vkCmdEndRendering(cmd);
 	return RND_OK;
+}
+
+/* Pass `pass`'s targets cleared (no geometry: Z = +inf, normal and albedo 0, visibility 1)
+ * and the pass begun over area. */
+static void begin_aov_pass(VkCommandBuffer cmd, struct rnd_slot *s, const struct rnd_scene *sc, VkRect2D area,
+                           uint32_t pass)
+{
+	VkRenderingAttachmentInfo ca[UMBRA_AOV_ATTACHMENTS];
+	for (uint32_t a = 0; a < UMBRA_AOV_ATTACHMENTS; a++) {
+		record_image_barrier(cmd, s->aov[a].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+		                     VK_ACCESS_2_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+		VkClearColorValue c = {{1.0f, 1.0f, 1.0f, 1.0f}};
+		if (pass == 0 && a == 0) c = (VkClearColorValue){{INFINITY, 0.0f, 0.0f, 0.0f}};
+		if (pass == 0 && a == 1) c = (VkClearColorValue){{0.0f, 0.0f, 0.0f, 0.0f}};
+		ca[a] = (VkRenderingAttachmentInfo){
+			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->aov[a].view,
+			.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.color = c,
+		};
+	}
+	record_image_barrier(cmd, s->aov_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+	VkRenderingAttachmentInfo da = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->aov_depth.view,
+		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+		.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0},
+	};
+	VkRenderingInfo ri = {
+		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,
+		.colorAttachmentCount = UMBRA_AOV_ATTACHMENTS, .pColorAttachments = ca, .pDepthAttachment = &da,
+	};
+	vkCmdBeginRendering(cmd, &ri);
+	VkViewport vp = {0, 0, (float)sc->width, (float)sc->height, 0, 1};
+	vkCmdSetViewport(cmd, 0, 1, &vp);
+	vkCmdSetScissor(cmd, 0, 1, &area);
+}
+
+/* Copy this pass's targets out before the next pass clears them. */
+static void copy_aov_pass(VkCommandBuffer cmd, struct rnd_slot *s, const struct record_view *rv, VkRect2D area,
+                          uint32_t pass)
+{
+	for (uint32_t a = 0; a < UMBRA_AOV_ATTACHMENTS; a++) {
+		record_image_barrier(cmd, s->aov[a].img, VK_IMAGE_ASPECT_COLOR_BIT, 1,
+		                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+		                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+		VkBufferImageCopy region = {
+			.bufferOffset = rv->aov_offset + (VkDeviceSize)(pass * UMBRA_AOV_ATTACHMENTS + a) * rv->aov_stride +
+			                (VkDeviceSize)area.offset.y * rv->sheet_width * 16,
+			.bufferRowLength = rv->sheet_width,
+			.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+			.imageOffset = {0, area.offset.y, 0}, .imageExtent = {rv->sc->width, area.extent.height, 1},
+		};
+		vkCmdCopyImageToBuffer(cmd, s->aov[a].img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
+	}
 }
 
 enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
@@ -381,8 +502,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 {
 	const struct rnd_scene *sc = rv->sc;
 	VkCommandBuffer cmd = s->cmd;
-	uint32_t w = sc->width, h = sc->height;
-	VkRect2D area = band_area(rv);
+	VkRect2D area = record_band_area(rv);
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
 	main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
@@ -396,53 +516,11 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	key.aov = 1;
 	key.atlas_view = 0;
 	key.prepass = 0;
-	for (uint32_t i = 0; i < rv->ndraw; i++) {
-		uint32_t c = rv->draws[i].cull_back;
-		if (!rv->draws[i].index_count || pipes[c]) continue;
-		key.cull_back = c;
-		enum rnd_result r = rnd_pipelines_main(ctx, &key, &pipes[c], err);
-		if (r != RND_OK) return r;
-	}
-	VkDeviceSize zero = 0;
+	enum rnd_result r = cull_pipelines(ctx, &key, rv->draws, rv->ndraw, pipes, err);
+	if (r != RND_OK) return r;
 	for (uint32_t pass = 0; pass < rv->aov_passes; pass++) {
-		VkRenderingAttachmentInfo ca[UMBRA_AOV_ATTACHMENTS];
-		for (uint32_t a = 0; a < UMBRA_AOV_ATTACHMENTS; a++) {
-			record_image_barrier(cmd, s->aov[a].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-			                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-			                     VK_ACCESS_2_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-			                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-			/* No geometry: Z = +inf, normal and albedo 0, visibility 1. */
-			VkClearColorValue c = {{1.0f, 1.0f, 1.0f, 1.0f}};
-			if (pass == 0 && a == 0) c = (VkClearColorValue){{INFINITY, 0.0f, 0.0f, 0.0f}};
-			if (pass == 0 && a == 1) c = (VkClearColorValue){{0.0f, 0.0f, 0.0f, 0.0f}};
-			ca[a] = (VkRenderingAttachmentInfo){
-				.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->aov[a].view,
-				.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-				.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.color = c,
-			};
-		}
-		record_image_barrier(cmd, s->aov_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-		                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-		                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-		VkRenderingAttachmentInfo da = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->aov_depth.view,
-			.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-			.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE, .clearValue.depthStencil = {0.0f, 0},
-		};
-		VkRenderingInfo ri = {
-			.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,
-			.colorAttachmentCount = UMBRA_AOV_ATTACHMENTS, .pColorAttachments = ca, .pDepthAttachment = &da,
-		};
-		vkCmdBeginRendering(cmd, &ri);
-		VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
-		vkCmdSetViewport(cmd, 0, 1, &vp);
-		vkCmdSetScissor(cmd, 0, 1, &area);
-		vkCmdBindVertexBuffers(cmd, 0, 1, &s->vertices.buf, &zero);
-		vkCmdBindIndexBuffer(cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
-		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
+		begin_aov_pass(cmd, s, sc, area, pass);
+		record_bind_geometry(ctx, s);
 		VkPipeline bound = VK_NULL_HANDLE;
 		uint32_t first_light = pass == 0 ? 0 : 8 + 16 * (pass - 1);
 		for (uint32_t i = 0; i < rv->ndraw; i++) {
@@ -459,81 +537,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
 		}
 		vkCmdEndRendering(cmd);
-		/* Copy this pass's targets out before the next pass clears them. */
-		for (uint32_t a = 0; a < UMBRA_AOV_ATTACHMENTS; a++) {
-			record_image_barrier(cmd, s->aov[a].img, VK_IMAGE_ASPECT_COLOR_BIT, 1,
-			                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-			                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-			                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-			VkBufferImageCopy region = {
-				.bufferOffset = rv->aov_offset + (VkDeviceSize)(pass * UMBRA_AOV_ATTACHMENTS + a) * rv->aov_stride +
-				                (VkDeviceSize)area.offset.y * rv->sheet_width * 16,
-				.bufferRowLength = rv->sheet_width,
-				.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-				.imageOffset = {0, area.offset.y, 0}, .imageExtent = {w, area.extent.height, 1},
-			};
-			vkCmdCopyImageToBuffer(cmd, s->aov[a].img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
-		}
+		copy_aov_pass(cmd, s, rv, area, pass);
 	}
 	return RND_OK;
 }
-
-void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, uint32_t n)
-{
-	VkCommandBuffer cmd = s->cmd;
-	VkDeviceSize off = 0;
-	if (!s->white_ready) {   /* set by render.c once this command buffer has run */
-		/* The slot's 1x1 white texture, bound for untextured draws. */
-		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-		VkClearColorValue white = {{1.0f, 1.0f, 1.0f, 1.0f}};
-		VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-		vkCmdClearColorImage(cmd, s->white.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &white, 1, &range);
-		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-		                     VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-	}
-	for (uint32_t i = 0; i < n; i++) {
-		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-		VkBufferImageCopy region = {
-			.bufferOffset = off, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-			.imageExtent = {tex[i]->width, tex[i]->height, 1},
-		};
-		vkCmdCopyBufferToImage(cmd, s->staging.buf, s->textures[i].img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-		                     VK_ACCESS_2_TRANSFER_WRITE_BIT,
-		                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-		off += (VkDeviceSize)tex[i]->width * tex[i]->height * 4;
-	}
-}
-
-void record_readback(struct rnd_slot *s, const struct record_view *rv)
-{
-	const struct rnd_scene *sc = rv->sc;
-	VkCommandBuffer cmd = s->cmd;
-	record_image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-	              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-	              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-	VkRect2D area = band_area(rv);
-	VkBufferImageCopy region = {
-		.bufferOffset = rv->color_offset + (VkDeviceSize)area.offset.y * rv->sheet_width * rv->pixel_bytes,
-		.bufferRowLength = rv->sheet_width,
-		.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-		.imageOffset = {0, area.offset.y, 0}, .imageExtent = {sc->width, area.extent.height, 1},
-	};
-	vkCmdCopyImageToBuffer(cmd, s->resolve.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
-	VkBufferMemoryBarrier2 bb = {
-		.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT,
-		.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->readback.buf, .size = VK_WHOLE_SIZE,
-	};
-	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
-	vkCmdPipelineBarrier2(cmd, &di);
-}
-

@@ -43,11 +43,23 @@ struct record_view {
 	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
 };
 
+/* The rows of the view that this submit draws (band_y, band_h). */
+VkRect2D record_band_area(const struct record_view *rv);
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
                           VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage,
                           VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
+/* Depth-only passes (shadow maps, the camera depth of contact shadows): begins rendering into
+ * view over (0, 0, w, h), cleared to 1, with that viewport and scissor. */
+void record_begin_depth(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h);
+/* Binds the slot's vertex and index buffers and its set 0 (frame constants, atlases). */
+void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s);
+/* One draw with the shadow (depth-only) pipelines, culling back faces when cull is set; masked
+ * draws get their material index in push->info.x and their texture set. *bound is the
+ * pipeline bound last (VK_NULL_HANDLE at the start of a pass). */
+void record_depth_draw(struct rnd_context *ctx, struct rnd_slot *s, const struct draw *d, int cull,
+                       struct umbra_push *push, VkPipeline *bound);
 /* Copies the staged texels (slot->staging, tightly packed in texture order) into the slot's
- * texture images and leaves them ready for sampling. */
+ * texture images and leaves them ready for sampling (upload.c). */
 void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, uint32_t n);
 /* Shadow views first..end-1 of v->sp (skipped ones left out), each drawn into the slot's
  * scratch map and copied into its atlas tile. */
@@ -57,10 +69,11 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
                             struct rnd_error *err);
 enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
                            struct rnd_error *err);
-/* Copies the band's resolved colour into the readback buffer, then makes it host-visible. */
+/* Copies the band's resolved colour into the readback buffer, then makes it host-visible
+ * (readback.c). */
 void record_readback(struct rnd_slot *s, const struct record_view *v);
 
-/* The public enums as the shaders spell them (umbra_shared.h); the uniforms (render.c) and
+/* The public enums as the shaders spell them (umbra_shared.h); the uniforms (frame.c) and
  * the specialization key (record.c) both use these, so they cannot drift apart. */
 uint32_t record_light_type(enum rnd_light_type t);
 uint32_t record_tonemap(enum rnd_tonemap t);

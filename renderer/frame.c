@@ -1,0 +1,232 @@
+/*
+ * renderer/frame.c — frame constants (see frame.h): what the shaders read of one view, packed
+ * in the layouts of shaders/umbra_shared.h. Four regions of one host-visible buffer, each
+ * aligned for uniform and storage use: the frame block, the materials (storage, as many as
+ * the scene has), the lights and the shadow views (uniform blocks of their declared maximum
+ * size). The mapped buffer keeps the previous render's bytes: every region is cleared first.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "contact.h"
+#include "frame.h"
+#include "material.h"
+#include "record.h"
+
+/* 32 Poisson-disk taps in the unit disk (PCSS blocker search and filtering). */
+static const float POISSON[64] = {
+	-0.975402f, -0.0711386f, -0.920347f, -0.41142f, -0.883908f, 0.217872f, -0.884518f, 0.568041f,
+	-0.811945f, 0.90521f, -0.792474f, -0.779962f, -0.614856f, 0.386578f, -0.580859f, -0.208777f,
+	-0.53795f, 0.716666f, -0.515427f, 0.0899991f, -0.454634f, -0.707938f, -0.420942f, 0.991272f,
+	-0.261147f, 0.588488f, -0.211219f, 0.114841f, -0.146336f, -0.259194f, -0.139439f, -0.888668f,
+	0.0116886f, 0.326395f, 0.0380566f, 0.625477f, 0.0625935f, -0.50853f, 0.125584f, 0.0469069f,
+	0.169469f, -0.997253f, 0.320597f, 0.291055f, 0.359172f, -0.633717f, 0.435713f, -0.250832f,
+	0.507797f, -0.916562f, 0.545763f, 0.730216f, 0.56859f, 0.11655f, 0.743156f, -0.505173f,
+	0.736442f, -0.189734f, 0.843562f, 0.357036f, 0.865413f, -0.763726f, 0.872005f, 0.0483851f,
+};
+
+static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+/* Where each region starts in the slot's parameter buffer. */
+struct params_layout {
+	VkDeviceSize off_frame, off_mat, off_light, off_view, total;
+	uint32_t nmat, nlight, nview;
+};
+
+static void params_layout(const struct rnd_context *ctx, const struct rnd_scene *sc, struct params_layout *lay)
+{
+	VkDeviceSize al = ctx->props.limits.minStorageBufferOffsetAlignment;
+	if (ctx->props.limits.minUniformBufferOffsetAlignment > al) al = ctx->props.limits.minUniformBufferOffsetAlignment;
+	uint32_t nmat = sc->material_count ? sc->material_count : 1;
+	/* Lights and views are uniform blocks of their declared (maximum) size. */
+	uint32_t nlight = UMBRA_MAX_LIGHTS;
+	uint32_t nview = UMBRA_MAX_SHADOW_VIEWS;
+	VkDeviceSize off_frame = 0;
+	VkDeviceSize off_mat = align_up(sizeof(struct umbra_frame), al);
+	VkDeviceSize off_light = align_up(off_mat + nmat * sizeof(struct umbra_material), al);
+	VkDeviceSize off_view = align_up(off_light + nlight * sizeof(struct umbra_light), al);
+	VkDeviceSize total = off_view + nview * sizeof(struct umbra_shadow_view);
+	*lay = (struct params_layout){off_frame, off_mat, off_light, off_view, total, nmat, nlight, nview};
+}
+
+static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const struct rnd_camera_plan *cam,
+                        float exposure)
+{
+	memcpy(f->view_proj, cam->view_proj, sizeof f->view_proj);
+	memcpy(f->view, cam->view, sizeof f->view);
+	memcpy(f->camera_pos, cam->pos, sizeof cam->pos);
+	f->camera_pos[3] = cam->ortho ? 1.0f : 0.0f;
+	memcpy(f->camera_fwd, cam->fwd, sizeof cam->fwd);
+	memcpy(f->background, sc->environment.background, sizeof f->background);
+	for (int k = 0; k < 3; k++) {
+		f->ambient_sky[k] = sc->environment.ambient_sky[k] * sc->environment.ambient_intensity;
+		f->ambient_ground[k] = sc->environment.ambient_ground[k] * sc->environment.ambient_intensity;
+	}
+	f->params[0] = exp2f(exposure);
+	f->params[1] = cam->znear;
+	f->params[2] = cam->zfar;
+	f->mode[0] = record_tonemap(sc->output.tonemap);
+	f->mode[1] = record_debug(sc->output.debug);
+	f->mode[2] = sc->output.debug_light;
+	f->mode[3] = sc->light_count;
+	f->mode2[0] = sc->output.pixels == RND_PIXELS_RGBA32F ? 1u : 0u;
+	f->mode2[1] = sc->output.transparent ? 1u : 0u;
+	/* UMBRA_LIGHT_CULL=0: every pixel shades every light, for the test that culling
+	 * (shading.glsl light_all) leaves the image unchanged. */
+	const char *cull = getenv("UMBRA_LIGHT_CULL");
+	f->mode2[2] = cull && strcmp(cull, "0") == 0 ? 1u : 0u;
+	memcpy(f->poisson, POISSON, sizeof f->poisson);
+	f->depth_lin[0] = cam->proj[10];
+	f->depth_lin[1] = cam->proj[14];
+	f->depth_lin[2] = cam->proj[11];
+	f->depth_lin[3] = cam->proj[15];
+	f->target[0] = (float)sc->width;
+	f->target[1] = (float)sc->height;
+	/* proj[5] = -1/tan(fov/2) (perspective) or -2/height (orthographic): a pixel's world size. */
+	f->target[2] = 2.0f / ((float)sc->height * fabsf(cam->proj[5]));
+	f->target[3] = cam->ortho ? 1.0f : 0.0f;
+}
+
+static void write_materials(struct umbra_material *m, const struct rnd_scene *sc)
+{
+	if (!sc->material_count) {
+		struct rnd_material d;
+		rnd_material_defaults(&d);
+		memcpy(m[0].base_color, d.base_color, sizeof d.base_color);
+		m[0].emissive[3] = d.roughness;
+	}
+	for (uint32_t i = 0; i < sc->material_count; i++) rnd_material_write(&sc->materials[i], &m[i]);
+}
+
+/* Light i of the scene with its shadow plan (views, filter, bias, moments, contact). */
+static void write_light(struct umbra_light *l, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
+                        uint32_t i)
+{
+	const struct rnd_light *in = &sc->lights[i];
+	const struct rnd_light_plan *lp = &sp->lights[i];
+	for (int k = 0; k < 3; k++) l->color[k] = in->color[k] * in->intensity;
+	l->color[3] = (float)record_light_type(in->type);
+	memcpy(l->position, in->position, sizeof in->position);
+	l->position[3] = in->range;
+	float d[3] = {0, -1, 0};
+	if (in->type != RND_LIGHT_POINT) rnd_v3_normalize(d, in->direction);
+	memcpy(l->direction, d, sizeof d);
+	l->direction[3] = cosf(in->outer_angle);
+	l->params[0] = cosf(in->inner_angle);
+	l->params[1] = in->type == RND_LIGHT_DIRECTIONAL ? tanf(in->angular_diameter * 0.5f) : in->radius;
+	l->shadow[0] = lp->first_view;
+	l->shadow[1] = lp->view_count;
+	l->shadow[2] = lp->filter;
+	l->shadow[3] = lp->pcf_radius;
+	l->shadow_params[0] = lp->bias_normal;
+	l->shadow_params[1] = lp->search_texels;
+	l->shadow_params[2] = in->shadow.blend;
+	l->shadow_params[3] = lp->fade_start;
+	l->params[2] = lp->clipmap ? 1.0f : 0.0f;
+	l->params[3] = lp->max_distance;
+	memcpy(l->splits, lp->splits, sizeof lp->splits);
+	if (lp->moments) {
+		float c = lp->evsm_exponent;
+		l->moment_params[0] = lp->evsm ? c : 0.0f;
+		l->moment_params[1] = fminf(fmaxf(in->shadow.vsm_light_bleed, 0.0f), 0.999f);
+		/* Variance floor: a fraction of the warped depth's scale (EVSM) or of the
+		 * depth range (VSM), so flat receivers do not self-shadow. */
+		l->moment_params[2] = lp->evsm ? 1e-4f : 2e-6f;
+	}
+	/* The mapped block keeps the previous render's values: off is written, not assumed. */
+	memset(l->contact, 0, sizeof l->contact);
+	if (rnd_contact_on(sc, sp, i)) rnd_contact_params(&in->shadow, l->contact);
+}
+
+/* Set 0 of the draw pipelines: the four regions, the depth and moment atlases, the camera depth. */
+static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay, bool contact)
+{
+	VkDescriptorBufferInfo bi[4] = {
+		{s->params.buf, lay->off_frame, sizeof(struct umbra_frame)},
+		{s->params.buf, lay->off_mat, lay->nmat * sizeof(struct umbra_material)},
+		{s->params.buf, lay->off_light, lay->nlight * sizeof(struct umbra_light)},
+		{s->params.buf, lay->off_view, lay->nview * sizeof(struct umbra_shadow_view)},
+	};
+	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	/* Without a moment atlas (no storage images) no light uses moments; the binding still
+	 * needs an image. */
+	VkDescriptorImageInfo mi = ctx->atlas_moments.view
+		? (VkDescriptorImageInfo){ctx->moments.sampler, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL}
+		: (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	/* Contact shadows read the view's depth (drawn before the main pass); other renders bind
+	 * the white texture, which their pipelines never read. */
+	VkDescriptorImageInfo di = contact
+		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, s->scene_depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL}
+		: (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	VkWriteDescriptorSet w[7];
+	w[5] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
+	};
+	w[6] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SCENE_DEPTH,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &di,
+	};
+	for (int i = 0; i < 5; i++) {
+		w[i] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
+			.descriptorCount = 1,
+			.descriptorType = rnd_binding_type[i],
+			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
+		};
+	}
+	vkUpdateDescriptorSets(ctx->device, 7, w, 0, NULL);
+}
+
+/* moments.comp: the scratch map in, the blur temporary, the moment atlas out. */
+static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	/* Moment maps read at most maxStorageBufferRange bytes of it (their resolution is capped to
+	 * fit: rnd_moments_max_res); a larger depth-only scratch is never read through this. */
+	VkDeviceSize sb_range = s->scratch_buf.size < ctx->props.limits.maxStorageBufferRange
+	                      ? s->scratch_buf.size : ctx->props.limits.maxStorageBufferRange;
+	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, sb_range};
+	VkDescriptorImageInfo ci[3] = {
+		{VK_NULL_HANDLE, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED},
+		{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
+		{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
+	};
+	VkWriteDescriptorSet cw[3];
+	uint32_t ncw = 0;
+	if (s->scratch_buf.buf)
+		cw[ncw++] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set,
+			.dstBinding = UMBRA_MOMENTS_BINDING_DEPTH, .descriptorCount = 1,
+			.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &sbi,
+		};
+	for (uint32_t i = 1; i < 3; i++) {
+		if (!ci[i].imageView) continue;
+		cw[ncw++] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
+			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &ci[i],
+		};
+	}
+	vkUpdateDescriptorSets(ctx->device, ncw, cw, 0, NULL);
+}
+
+enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
+                                const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
+                                float exposure, bool contact, struct rnd_error *err)
+{
+	struct params_layout lay;
+	params_layout(ctx, sc, &lay);
+	enum rnd_result r = rnd_buffer_reserve(ctx, &s->params, lay.total,
+	                                       VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+	                                       "slot params", err);
+	if (r != RND_OK) return r;
+	uint8_t *base = s->params.map;
+	memset(base, 0, lay.total);
+	write_frame((struct umbra_frame *)(base + lay.off_frame), sc, cam, exposure);
+	write_materials((struct umbra_material *)(base + lay.off_mat), sc);
+	struct umbra_light *l = (struct umbra_light *)(base + lay.off_light);
+	for (uint32_t i = 0; i < sc->light_count; i++) write_light(&l[i], sc, sp, i);
+	memcpy(base + lay.off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));
+	bind_params(ctx, s, &lay, contact);
+	bind_moments(ctx, s);
+	return RND_OK;
+}

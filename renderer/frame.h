@@ -1,0 +1,22 @@
+/*
+ * renderer/frame.h — the frame constants of one view (see frame.c): the umbra_frame block, the
+ * materials, the lights and the shadow views packed into the slot's parameter buffer, and the
+ * slot's descriptor sets pointed at them (set 0 of the draw pipelines, moments.comp's set).
+ *
+ * Called by render.c once per view, after the shadow plan has its atlas tiles and before the
+ * view is recorded. Threading: the slot is the caller's; nothing else is written.
+ */
+#ifndef UMBRA_RENDERER_FRAME_H
+#define UMBRA_RENDERER_FRAME_H
+
+#include "plan.h"
+#include "slot.h"
+
+/* Fills the uniform/storage regions (growing the slot's parameter buffer when needed) and
+ * points the slot's descriptor sets at them. contact: the view draws its camera depth
+ * (slot->scene_depth, bound for contact shadows). */
+enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
+                                const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
+                                float exposure, bool contact, struct rnd_error *err);
+
+#endif

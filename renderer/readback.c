@@ -1,0 +1,142 @@
+/*
+ * renderer/readback.c — the sheet layout and the copy of a finished render out of the slot's
+ * readback buffer (see readback.h): colour pixels (un-premultiplied where PNG expects straight
+ * alpha) and the AOV attachments split into named float planes; and the recorded copy of a
+ * band's resolved colour into that buffer (record_readback).
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "estimate.h"
+#include "readback.h"
+#include "record.h"
+
+void rnd_sheet_init(struct rnd_sheet *sh, const struct rnd_scene *sc)
+{
+	memset(sh, 0, sizeof *sh);
+	sh->views = sc->view_count ? sc->view_count : 1;
+	rnd_sheet_layout(sh->views, &sh->cols, &sh->rows);
+	sh->width = (uint64_t)sh->cols * sc->width;
+	sh->height = (uint64_t)sh->rows * sc->height;
+	sh->px = (size_t)rnd_pixel_bytes(sc->output.pixels);
+	sh->passes = rnd_aov_passes(sc);
+	sh->color_bytes = sh->width * sh->height * sh->px;
+	sh->att_bytes = sh->width * sh->height * 16;
+	sh->readback_bytes = sh->color_bytes + (VkDeviceSize)sh->passes * UMBRA_AOV_ATTACHMENTS * sh->att_bytes;
+}
+
+/* Turns the AOV attachments in the readback buffer (RGBA32F, sheet-sized each) into named
+ * float planes. */
+static enum rnd_result split_aovs(const struct rnd_scene *sc, const float *rb, size_t att_floats, uint32_t npix,
+                                  struct rnd_image *out, struct rnd_error *err)
+{
+	uint32_t aovs = sc->output.aovs;
+	struct { char name[24]; uint32_t att, comp; } plan[RND_MAX_AOV_PLANES];
+	uint32_t n = 0;
+	if (aovs & RND_AOV_SHADOW) {
+		for (uint32_t i = 0; i < sc->light_count; i++) {
+			uint32_t att = i < 8 ? 2 + i / 4 : 4 + (i - 8) / 4, comp = i % 4;
+			snprintf(plan[n].name, sizeof plan[n].name, "shadow.%u", i);
+			plan[n].att = att; plan[n].comp = comp; n++;
+		}
+	}
+	if (aovs & RND_AOV_DEPTH) { snprintf(plan[n].name, 24, "Z"); plan[n].att = 0; plan[n].comp = 0; n++; }
+	if (aovs & RND_AOV_NORMAL) {
+		const char *nm[3] = {"N.X", "N.Y", "N.Z"};
+		for (int k = 0; k < 3; k++) { snprintf(plan[n].name, 24, "%s", nm[k]); plan[n].att = 0; plan[n].comp = 1 + k; n++; }
+	}
+	if (aovs & RND_AOV_ALBEDO) {
+		const char *nm[3] = {"albedo.R", "albedo.G", "albedo.B"};
+		for (int k = 0; k < 3; k++) { snprintf(plan[n].name, 24, "%s", nm[k]); plan[n].att = 1; plan[n].comp = k; n++; }
+	}
+	for (uint32_t p = 0; p < n; p++) {
+		float *plane = malloc((size_t)npix * sizeof(float));
+		if (!plane) return rnd_fail(err, RND_ERR_OOM, "out of memory for AOV '%s'", plan[p].name);
+		const float *src = rb + plan[p].att * att_floats + plan[p].comp;
+		for (uint32_t i = 0; i < npix; i++) plane[i] = src[(size_t)i * 4];
+		out->aov[p] = plane;
+		memcpy(out->aov_names[p], plan[p].name, sizeof out->aov_names[p]);
+		out->aov_count = p + 1;
+	}
+	return RND_OK;
+}
+
+/* 8/16-bit outputs with transparency: straight alpha (PNG's convention) from the premultiplied
+ * resolve. RGBA32F (EXR) stays premultiplied, as EXR expects. */
+static void unpremultiply(void *pixels, uint64_t n, enum rnd_pixel_format f)
+{
+	if (f == RND_PIXELS_RGBA8) {
+		uint8_t *p = pixels;
+		for (uint64_t i = 0; i < n; i++, p += 4) {
+			unsigned a = p[3];
+			if (a == 0 || a == 255) continue;
+			for (int k = 0; k < 3; k++) {
+				unsigned v = (p[k] * 255u + a / 2) / a;
+				p[k] = (uint8_t)(v > 255 ? 255 : v);
+			}
+		}
+	} else if (f == RND_PIXELS_RGBA16) {
+		uint16_t *p = pixels;
+		for (uint64_t i = 0; i < n; i++, p += 4) {
+			uint32_t a = p[3];
+			if (a == 0 || a == 65535) continue;
+			for (int k = 0; k < 3; k++) {
+				uint32_t v = (p[k] * 65535u + a / 2) / a;
+				p[k] = (uint16_t)(v > 65535 ? 65535 : v);
+			}
+		}
+	}
+}
+
+enum rnd_result rnd_readback_image(const struct rnd_slot *s, const struct rnd_scene *sc, const struct rnd_sheet *sh,
+                                   struct rnd_image *out, struct rnd_error *err)
+{
+	uint64_t sheet_w = sh->width, sheet_h = sh->height;
+	size_t px = sh->px;
+	VkDeviceSize color_bytes = sh->color_bytes;
+	out->pixels = malloc(color_bytes);
+	if (!out->pixels) return rnd_fail(err, RND_ERR_OOM, "out of memory for a %llux%llu image",
+	                                 (unsigned long long)sheet_w, (unsigned long long)sheet_h);
+	memcpy(out->pixels, s->readback.map, color_bytes);
+	if (sc->output.transparent && sc->output.debug == RND_DEBUG_NONE) unpremultiply(out->pixels, sheet_w * sheet_h, sc->output.pixels);
+	out->width = (uint32_t)sheet_w;
+	out->height = (uint32_t)sheet_h;
+	out->format = sc->output.pixels;
+	out->stride = sheet_w * px;
+	out->view_count = sh->views;
+	out->view_columns = sh->cols;
+	out->view_width = sc->width;
+	out->view_height = sc->height;
+	enum rnd_result r;
+	if (sh->passes && (r = split_aovs(sc, (const float *)((const uint8_t *)s->readback.map + color_bytes), sh->att_bytes / 4,
+	                                  (uint32_t)(sheet_w * sheet_h), out, err)) != RND_OK) {
+		rnd_image_release(out);
+		return r;
+	}
+	return RND_OK;
+}
+
+void record_readback(struct rnd_slot *s, const struct record_view *rv)
+{
+	const struct rnd_scene *sc = rv->sc;
+	VkCommandBuffer cmd = s->cmd;
+	record_image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+	              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+	              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+	VkRect2D area = record_band_area(rv);
+	VkBufferImageCopy region = {
+		.bufferOffset = rv->color_offset + (VkDeviceSize)area.offset.y * rv->sheet_width * rv->pixel_bytes,
+		.bufferRowLength = rv->sheet_width,
+		.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+		.imageOffset = {0, area.offset.y, 0}, .imageExtent = {sc->width, area.extent.height, 1},
+	};
+	vkCmdCopyImageToBuffer(cmd, s->resolve.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->readback.buf, 1, &region);
+	VkBufferMemoryBarrier2 bb = {
+		.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+		.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT,
+		.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->readback.buf, .size = VK_WHOLE_SIZE,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
+	vkCmdPipelineBarrier2(cmd, &di);
+}
