@@ -21,7 +21,7 @@ uint32_t rnd_aov_passes(const struct rnd_scene *sc)
 	if (!sc->output.aovs) return 0;
 	/* The first pass carries depth, normal, albedo and 8 shadow planes; each further pass 16. */
 	uint32_t n = (sc->output.aovs & RND_AOV_SHADOW) ? sc->light_count : 0;
-	return n <= 8 ? 1 : 1 + (n - 8 + 15) / 16;
+	return UMBRA_AOV_PASSES(n);
 }
 
 uint64_t rnd_pixel_bytes(enum rnd_pixel_format f)

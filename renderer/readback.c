@@ -35,7 +35,7 @@ static enum rnd_result split_aovs(const struct rnd_scene *sc, const float *rb, s
 	uint32_t n = 0;
 	if (aovs & RND_AOV_SHADOW) {
 		for (uint32_t i = 0; i < sc->light_count; i++) {
-			uint32_t att = i < 8 ? 2 + i / 4 : 4 + (i - 8) / 4, comp = i % 4;
+			uint32_t att = UMBRA_AOV_LIGHT_TARGET(i), comp = UMBRA_AOV_LIGHT_COMPONENT(i);
 			snprintf(plan[n].name, sizeof plan[n].name, "shadow.%u", i);
 			plan[n].att = att; plan[n].comp = comp; n++;
 		}

@@ -522,7 +522,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 		begin_aov_pass(cmd, s, sc, area, pass);
 		record_bind_geometry(ctx, s);
 		VkPipeline bound = VK_NULL_HANDLE;
-		uint32_t first_light = pass == 0 ? 0 : 8 + 16 * (pass - 1);
+		uint32_t first_light = UMBRA_AOV_PASS_FIRST_LIGHT(pass);
 		for (uint32_t i = 0; i < rv->ndraw; i++) {
 			const struct draw *d = &rv->draws[i];
 			if (!d->index_count) continue;

@@ -5,7 +5,8 @@
 #include "shading.glsl"
 // AOV pass (single-sample, after the main pass): writes what EXR outputs carry besides colour.
 // Pass 0: (Z, N.x, N.y, N.z), (albedo.rgb, 1), visibility of lights 0..3, lights 4..7.
-// Pass k > 0: visibility of lights 8 + 16(k-1) ... in four vec4s. pc.info.z = first light.
+// Pass k > 0: visibility of lights UMBRA_AOV_PASS_FIRST_LIGHT(k) ... in four vec4s.
+// pc.info.z = first light. The packing is umbra_shared.h's UMBRA_AOV_*.
 // Visibility is the shadow test alone (no N.L, cone or range), 1 where shadows are off.
 
 layout(location = 0) out vec4 o_aov0;
@@ -35,9 +36,9 @@ void main()
 	// One call site of visibility() in a loop the compiler keeps: written out once per light
 	// (8 or 16 copies of every shadow filter), lavapipe's JIT took minutes on this shader
 	// with PCSS lights, inside the render's first submit.
-	float vis[16];
-	uint count = first == 0u ? 8u : 16u;
-	[[dont_unroll]] for (uint k = 0u; k < 16u; k++)
+	float vis[UMBRA_AOV_PASS_LIGHTS];
+	uint count = first == 0u ? UMBRA_AOV_FIRST_PASS_LIGHTS : UMBRA_AOV_PASS_LIGHTS;
+	[[dont_unroll]] for (uint k = 0u; k < UMBRA_AOV_PASS_LIGHTS; k++)
 		vis[k] = k < count ? visibility(first + k, n_geo, receive) : 1.0;
 	if (first == 0u) {
 		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);

@@ -48,6 +48,24 @@
 #define UMBRA_MAX_SHADOW_VIEWS  256   /* directional 1..4 (cascades), spot 1, point 6 */
 #define UMBRA_MAX_MATERIALS     4096
 #define UMBRA_AOV_ATTACHMENTS   4     /* RGBA32F targets of one AOV pass */
+/* AOV light packing (aov.frag writes it, renderer/record.c draws the passes, estimate.c counts
+ * them, readback.c splits the planes): pass 0 holds (Z, N), (albedo, 1) and the visibility of
+ * lights 0..7 in its targets 2 and 3; every further pass the visibility of 16 lights in its four
+ * targets, four lights a target. "Target t of the whole readback" = pass * 4 + attachment. */
+#define UMBRA_AOV_FIRST_PASS_LIGHTS 8u
+#define UMBRA_AOV_PASS_LIGHTS       16u
+/* The first light of AOV pass p (aov.frag's pc.info.z). */
+#define UMBRA_AOV_PASS_FIRST_LIGHT(p) \
+	((p) == 0u ? 0u : UMBRA_AOV_FIRST_PASS_LIGHTS + UMBRA_AOV_PASS_LIGHTS * ((p) - 1u))
+/* The AOV passes that n shadowed lights need (at least 1: pass 0 carries Z, N, albedo). */
+#define UMBRA_AOV_PASSES(n) \
+	((n) <= UMBRA_AOV_FIRST_PASS_LIGHTS ? 1u \
+	 : 1u + ((n) - UMBRA_AOV_FIRST_PASS_LIGHTS + UMBRA_AOV_PASS_LIGHTS - 1u) / UMBRA_AOV_PASS_LIGHTS)
+/* Light i's visibility: target (over all passes) and component. */
+#define UMBRA_AOV_LIGHT_TARGET(i) \
+	((i) < UMBRA_AOV_FIRST_PASS_LIGHTS ? 2u + (i) / 4u \
+	 : UMBRA_AOV_ATTACHMENTS + ((i) - UMBRA_AOV_FIRST_PASS_LIGHTS) / 4u)
+#define UMBRA_AOV_LIGHT_COMPONENT(i) ((i) % 4u)
 
 /* umbra_light.color.w: light type */
 #define UMBRA_LIGHT_DIRECTIONAL 0

@@ -266,6 +266,66 @@ TEST(limits_aov_of_pcss_lights_matches_debug_view)
 	CHECK(rnd_context_validation_messages(ctx) == 0);
 }
 
+/* The shadow AOVs of ten lights take two AOV passes: lights 0..7 in the first pass's last two
+ * targets, 8..9 in the second pass's first target (umbra_shared.h UMBRA_AOV_*: the one packing
+ * that aov.frag writes, record.c draws and readback.c splits). Each light stands elsewhere, so
+ * its plane is its own: shadow.6 (first pass) and shadow.9 (second pass) each agree with their
+ * light's debug view, and differ from their neighbour's. */
+TEST(limits_aov_shadow_planes_of_two_passes_match_debug_views)
+{
+	char doc[4096], lights[2048];
+	size_t n = 0;
+	for (int i = 0; i < 10; i++)
+		n += (size_t)snprintf(lights + n, sizeof lights - n, "%s{'type':'spot','position':[%d,5,%d],'direction':[%d,-5,%d],"
+		                      "'outer_angle':60,'shadow':{'filter':'hard'}}", i ? "," : "", (i % 5) * 2 - 4,
+		                      i < 5 ? -3 : 3, 4 - (i % 5) * 2, i < 5 ? 3 : -3);
+	static const char *const scene =
+		"{'width':48,'height':48,'camera':{'position':[0,9,6],'target':[0,0,0]},"
+		"'objects':[{'shape':'plane','size':[14,14]},{'shape':'box','size':[1.5,3,1.5],"
+		"'transform':{'translation':[0,1.5,0]}}],'lights':[%s],'output':{'msaa':1,%s}}";
+	struct rnd_context *ctx = gpu_ctx();
+	if (!ctx) return;
+	struct rnd_image aov;
+	struct rnd_error err;
+	snprintf(doc, sizeof doc, scene, lights, "'format':'exr','aovs':['shadow']");
+	REQUIRE(render_doc(ctx, doc, &aov, &err) == RND_OK, "%s", err.msg);
+	CHECK(aov.aov_count == 10, "%u planes", aov.aov_count);
+	const uint32_t probe[2] = {6, 9};
+	for (int k = 0; k < 2; k++) {
+		uint32_t li = probe[k];
+		char name[16], other[16];
+		snprintf(name, sizeof name, "shadow.%u", li);
+		snprintf(other, sizeof other, "shadow.%u", li - 1);
+		const float *plane = NULL, *prev = NULL;
+		for (uint32_t i = 0; i < aov.aov_count; i++) {
+			if (!strcmp(aov.aov_names[i], name)) plane = aov.aov[i];
+			if (!strcmp(aov.aov_names[i], other)) prev = aov.aov[i];
+		}
+		CHECK(plane && prev, "no %s or %s plane", name, other);
+		char opts[64];
+		snprintf(opts, sizeof opts, "'debug':'shadow','debug_light':%u", li);
+		snprintf(doc, sizeof doc, scene, lights, opts);
+		struct rnd_image dbg;
+		enum rnd_result r = render_doc(ctx, doc, &dbg, &err);
+		CHECK(r == RND_OK, "%s", err.msg);
+		if (plane && prev && r == RND_OK) {
+			int agree = 0, differ = 0, npx = 48 * 48;
+			for (int j = 0; j < 48; j++)
+				for (int i = 0; i < 48; i++) {
+					int a = (int)lrintf(plane[j * 48 + i] * 255.0f), d = gpu_px8(&dbg, i, j)[0];
+					agree += abs(a - d) <= 1;
+					differ += fabsf(plane[j * 48 + i] - prev[j * 48 + i]) > 0.5f;
+				}
+			CHECK(agree >= 0.99 * npx, "%s agrees with its debug view on %d of %d pixels", name, agree, npx);
+			CHECK(differ >= 20, "%s and %s differ on %d pixels only: the test cannot tell lights apart", name, other,
+			      differ);
+		}
+		if (r == RND_OK) rnd_image_release(&dbg);
+	}
+	rnd_image_release(&aov);
+	CHECK(rnd_context_validation_messages(ctx) == 0);
+}
+
 /* Textures per scene come from the context (desc.max_textures, capped by the device), not a
  * constant: three textured objects render under a limit of 3 and are refused under 2, the
  * error naming the object that brought the third (rnd_error.at / at_index). */
