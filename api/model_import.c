@@ -3,19 +3,20 @@
  * api_model in an arena out. Runs inside the sandboxed importer process (api/sandbox_child.c);
  * the daemon never calls it (the bench does, to measure what isolation costs).
  *
- * Import: Assimp reads the bytes through an aiFileIO that serves only those bytes and the files
- * the daemon found for the model's references (an .obj's mtllib and textures, a .gltf's
- * buffers and images; api/model_refs.h), so the importer never reads from a disk (the
- * sandbox's system-call filter would refuse an open anyway); a name it was not given fails. The node tree is walked with
+ * Import: Assimp reads the bytes through an aiFileIO (api/model_io.c) that serves only those
+ * bytes and the files the daemon found for the model's references (an .obj's mtllib and
+ * textures, a .gltf's buffers and images; api/model_refs.h), so the importer never reads from a
+ * disk (the sandbox's system-call filter would refuse an open anyway); a name it was not given
+ * fails. The node tree is walked with
  * every node's transform (Assimp's aiMatrix4x4 is row-major; ours are column-major), each
  * (node, mesh) pair becoming one instance; meshes keep triangles only.
  *
  * Materials: glTF's core material model (every texture slot, samplers, texture transforms,
  * emissive strength, doubleSided: what Assimp 5.2 does not hand over reliably is read from the
- * document's JSON, api/gltf_material.c), vertex colours, and tangents for normal maps. What a
+ * document's JSON, api/gltf_material.c; the conversion in api/model_material.c), vertex
+ * colours, and tangents for normal maps. What a
  * file asks for and is not drawn becomes the model's warnings.
  */
-#include <ctype.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -31,12 +32,13 @@
 #include <jansson.h>
 #include "errmsg.h"
 #include "gltf_material.h"
+#include "model_conv.h"
 #include "model_import.h"
+#include "model_io.h"
 #include "ply_strips.h"
 #include "umbra/rnd_math.h"
 
 #define MAX_NODE_DEPTH 256
-#define MAX_TEXTURE_PIXELS (64ull << 20)
 
 /* Assimp's C API keeps the last error in one global std::string. In the sandbox each process
  * imports once; in-process callers (the bench) take turns. */
@@ -100,155 +102,10 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
 	return 0;
 }
 
-/* ---- an aiFileIO that serves one buffer and nothing else ---- */
-
+/* The model's own name in the aiFileIO (api/model_io.c): "model.<format>". */
 #define MEM_NAME "model"
 
-struct mem_io {
-	const uint8_t *data;
-	size_t len;
-	char name[32];
-	const struct api_model_file *files;  /* the files the model refers to (api/model_refs.h) */
-	size_t nfiles;
-};
-
-/* Compares a name Assimp asks for with a file's name as the model wrote it: "\\" as "/", no
- * leading "./", %XX decoded (glTF URIs), so "./a%20b.bin" finds "a b.bin". */
-static void name_norm(const char *in, char *out, size_t n)
-{
-	size_t k = 0;
-	while (in[0] == '.' && (in[1] == '/' || in[1] == '\\')) in += 2;
-	for (const char *p = in; *p && k + 1 < n; p++) {
-		unsigned v;
-		if (p[0] == '%' && isxdigit((unsigned char)p[1]) && isxdigit((unsigned char)p[2]) &&
-		    sscanf(p + 1, "%2x", &v) == 1) {
-			out[k++] = (char)v;
-			p += 2;
-		} else {
-			out[k++] = *p == '\\' ? '/' : *p;
-		}
-	}
-	out[k] = 0;
-}
-
-/* The index of the referred file named `name`, or -1. */
-static long file_index(const struct api_model_file *files, size_t n, const char *name)
-{
-	char a[1024], b[1024];
-	name_norm(name, a, sizeof a);
-	for (size_t i = 0; i < n; i++) {
-		name_norm(files[i].name, b, sizeof b);
-		if (!strcmp(a, b)) return (long)i;
-	}
-	return -1;
-}
-
-struct mem_file {
-	struct aiFile f;
-	const uint8_t *data;
-	size_t len, pos;
-};
-
-static size_t mem_read(struct aiFile *f, char *buf, size_t size, size_t count)
-{
-	struct mem_file *m = (struct mem_file *)f->UserData;
-	if (!size || !count) return 0;
-	size_t avail = m->len - m->pos, want = count;
-	if (want > avail / size) want = avail / size;
-	memcpy(buf, m->data + m->pos, want * size);
-	m->pos += want * size;
-	return want;
-}
-
-static size_t mem_write(struct aiFile *f, const char *buf, size_t size, size_t count)
-{
-	(void)f, (void)buf, (void)size, (void)count;
-	return 0;
-}
-
-static size_t mem_tell(struct aiFile *f)
-{
-	return ((struct mem_file *)f->UserData)->pos;
-}
-
-static size_t mem_size(struct aiFile *f)
-{
-	return ((struct mem_file *)f->UserData)->len;
-}
-
-static void mem_flush(struct aiFile *f)
-{
-	(void)f;
-}
-
-static enum aiReturn mem_seek(struct aiFile *f, size_t off, enum aiOrigin origin)
-{
-	struct mem_file *m = (struct mem_file *)f->UserData;
-	size_t base = origin == aiOrigin_SET ? 0 : origin == aiOrigin_CUR ? m->pos : m->len;
-	if (off > m->len - base) return aiReturn_FAILURE;
-	m->pos = base + off;
-	return aiReturn_SUCCESS;
-}
-
-static struct aiFile *mem_open(struct aiFileIO *io, const char *name, const char *mode)
-{
-	struct mem_io *mi = (struct mem_io *)io->UserData;
-	/* Only the model itself and the files it refers to, read-only; Assimp may prefix a
-	 * directory ("./"). */
-	if (mode && strchr(mode, 'w')) return NULL;
-	const char *base = strrchr(name, '/');
-	base = base ? base + 1 : name;
-	long fi = strcmp(base, mi->name) ? file_index(mi->files, mi->nfiles, name) : -2;
-	if (fi == -1) return NULL;
-	struct mem_file *m = calloc(1, sizeof *m);
-	if (!m) return NULL;
-	m->data = fi >= 0 ? mi->files[fi].data : mi->data;
-	m->len = fi >= 0 ? mi->files[fi].len : mi->len;
-	m->f.ReadProc = mem_read;
-	m->f.WriteProc = mem_write;
-	m->f.TellProc = mem_tell;
-	m->f.FileSizeProc = mem_size;
-	m->f.SeekProc = mem_seek;
-	m->f.FlushProc = mem_flush;
-	m->f.UserData = (aiUserData)m;
-	return &m->f;
-}
-
-static void mem_close(struct aiFileIO *io, struct aiFile *f)
-{
-	(void)io;
-	if (f) free(f->UserData);
-}
-
-/* ---- conversion of an aiScene ---- */
-
-struct conv {
-	const struct aiScene *sc;
-	struct api_arena *arena;
-	struct api_model *out;
-	size_t bytes;
-	bool oom;                     /* an allocation failed: over the memory limit, not a bad file */
-	int32_t *mesh_map;            /* Assimp mesh -> our mesh, -1 = skipped (not triangles) */
-	struct rnd_texture **tex;     /* decoded textures: scene->mTextures, then the referred files */
-	const struct api_model_file *files;
-	size_t nfiles;
-	struct api_model_instance *inst;
-	uint32_t ninst, inst_cap;
-	bool gltf;                    /* glb / gltf: every texture slot, glTF material details */
-	struct api_gltf_info gi;      /* those details, and the warnings (filled for glTF only) */
-	const struct rnd_material *mats;
-	const bool *single_sided;     /* by material */
-	char *err;
-	size_t errsize;
-};
-
-static void *conv_alloc(struct conv *c, size_t n, size_t size)
-{
-	void *p = api_arena_calloc(c->arena, n ? n : 1, size);
-	if (p) c->bytes += n * size;
-	else c->oom = true;
-	return p;
-}
+/* ---- conversion of an aiScene (materials and textures: api/model_material.c) ---- */
 
 /* aiMatrix4x4 is row-major (a1..a4 the first row, a4/b4/c4 the translation). */
 static void mat_from_ai(float out[16], const struct aiMatrix4x4 *a)
@@ -277,13 +134,13 @@ static bool any_area(const struct api_model_mesh *m, uint32_t n)
 /* Vertex colours (COLOR_0) and, for a mesh whose material has a normal map, tangents (from
  * the file or made by aiProcess_CalcTangentSpace). aiColor4D and aiVector3D are plain floats. */
 _Static_assert(sizeof(struct aiVector3D) == 12 && sizeof(struct aiColor4D) == 16, "Assimp built with doubles");
-static int convert_extras(struct conv *c, const struct aiMesh *am, struct api_model_mesh *out)
+static int convert_extras(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
 {
 	uint32_t nv = am->mNumVertices;
 	unsigned mi = am->mMaterialIndex < c->sc->mNumMaterials ? am->mMaterialIndex : 0;
 	bool tan = am->mTangents && am->mBitangents && am->mNormals && c->mats[mi].normal_texture;
-	uint8_t *col = am->mColors[0] ? conv_alloc(c, nv, 4) : NULL;
-	float *t = tan ? conv_alloc(c, nv, 4 * sizeof(float)) : NULL;
+	uint8_t *col = am->mColors[0] ? api_conv_alloc(c, nv, 4) : NULL;
+	float *t = tan ? api_conv_alloc(c, nv, 4 * sizeof(float)) : NULL;
 	if ((am->mColors[0] && !col) || (tan && !t))
 		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	if (col) api_vertex_colors((const float *)am->mColors[0], nv, col);
@@ -293,14 +150,14 @@ static int convert_extras(struct conv *c, const struct aiMesh *am, struct api_mo
 	return 0;
 }
 
-static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_model_mesh *out)
+static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
 {
 	uint32_t nv = am->mNumVertices, ntri = 0;
 	for (unsigned f = 0; f < am->mNumFaces; f++) ntri += am->mFaces[f].mNumIndices == 3;
-	float *pos = conv_alloc(c, nv, 3 * sizeof(float));
-	float *nrm = am->mNormals ? conv_alloc(c, nv, 3 * sizeof(float)) : NULL;
-	float *uv = am->mTextureCoords[0] ? conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
-	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
+	float *pos = api_conv_alloc(c, nv, 3 * sizeof(float));
+	float *nrm = am->mNormals ? api_conv_alloc(c, nv, 3 * sizeof(float)) : NULL;
+	float *uv = am->mTextureCoords[0] ? api_conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
+	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? api_conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
 	if (!pos || (am->mNormals && !nrm) || (am->mTextureCoords[0] && !uv) || !idx)
 		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	if (convert_extras(c, am, out) < 0) return -1;
@@ -345,142 +202,7 @@ static int convert_mesh(struct conv *c, const struct aiMesh *am, struct api_mode
 	return 0;
 }
 
-static float clampf(float v, float lo, float hi)
-{
-	return !(v >= lo) ? lo : v > hi ? hi : v;  /* NaN -> lo */
-}
-
-/* The texture that `path` names: an embedded one ("*N" or the embedded file's name), then a
- * file the model refers to (index mNumTextures + k); -1 when none. */
-static int find_texture(const struct conv *c, const char *path)
-{
-	const struct aiScene *sc = c->sc;
-	if (path[0] == '*') {
-		char *end;
-		unsigned long n = strtoul(path + 1, &end, 10);
-		if (*end || end == path + 1 || n >= sc->mNumTextures) return -1;
-		return (int)n;
-	}
-	for (unsigned i = 0; i < sc->mNumTextures; i++) {
-		const char *fn = sc->mTextures[i]->mFilename.data;
-		if (fn[0] && !strcmp(fn, path)) return (int)i;
-	}
-	long k = file_index(c->files, c->nfiles, path);
-	return k < 0 ? -1 : (int)(sc->mNumTextures + (unsigned)k);
-}
-
-static const struct rnd_texture *texture(struct conv *c, int ti)
-{
-	if (c->tex[ti]) return c->tex[ti];
-	unsigned nemb = c->sc->mNumTextures;
-	const struct aiTexture *at = (unsigned)ti < nemb ? c->sc->mTextures[ti] : NULL;
-	const struct api_model_file *file = at ? NULL : &c->files[(unsigned)ti - nemb];
-	struct rnd_texture *t = conv_alloc(c, 1, sizeof *t);
-	if (!t) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
-	if (file || at->mHeight == 0) {
-		/* Compressed: mWidth bytes of a PNG or JPEG file, or a whole file beside the model. */
-		uint8_t *px;
-		uint32_t w, h;
-		char e[200];
-		if (api_image_decode(file ? file->data : (const uint8_t *)at->pcData, file ? file->len : at->mWidth,
-		                     MAX_TEXTURE_PIXELS, &px, &w, &h, e, sizeof e) != API_OK) {
-			if (file) return api_err_set(c->err, c->errsize, "texture \"%.128s\": %s", file->name, e), NULL;
-			return api_err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
-		}
-		uint8_t *copy = conv_alloc(c, (size_t)w * h, 4);
-		if (copy) memcpy(copy, px, (size_t)w * h * 4);
-		free(px);
-		if (!copy) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
-		t->rgba = copy;
-		t->width = w;
-		t->height = h;
-	} else {
-		uint64_t n = (uint64_t)at->mWidth * at->mHeight;
-		if (n > MAX_TEXTURE_PIXELS)
-			return api_err_set(c->err, c->errsize, "embedded texture %d is over the texture size limit", ti), NULL;
-		uint8_t *px = conv_alloc(c, (size_t)n, 4);
-		if (!px) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
-		for (size_t i = 0; i < n; i++) { /* aiTexel is BGRA */
-			px[4 * i] = at->pcData[i].r;
-			px[4 * i + 1] = at->pcData[i].g;
-			px[4 * i + 2] = at->pcData[i].b;
-			px[4 * i + 3] = at->pcData[i].a;
-		}
-		t->rgba = px;
-		t->width = at->mWidth;
-		t->height = at->mHeight;
-	}
-	c->tex[ti] = t;
-	return t;
-}
-
-/* Assimp's texture types per slot, in the order tried (glTF: base colour also as DIFFUSE;
- * metallic-roughness as UNKNOWN, 5.2's name for it; occlusion as LIGHTMAP). */
-static const enum aiTextureType SLOT_TYPES[RND_TEX_SLOTS][3] = {
-	{aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, aiTextureType_NONE},
-	{aiTextureType_UNKNOWN, aiTextureType_METALNESS, aiTextureType_DIFFUSE_ROUGHNESS},
-	{aiTextureType_NORMALS, aiTextureType_NONE, aiTextureType_NONE},
-	{aiTextureType_LIGHTMAP, aiTextureType_AMBIENT_OCCLUSION, aiTextureType_NONE},
-	{aiTextureType_EMISSIVE, aiTextureType_NONE, aiTextureType_NONE},
-};
-
-static int material_textures(struct conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m)
-{
-	struct aiString s;
-	for (uint32_t k = 0; k < (c->gltf ? RND_TEX_SLOTS : 1u); k++) {
-		for (int j = 0; j < 3 && SLOT_TYPES[k][j] != aiTextureType_NONE; j++) {
-			if (aiGetMaterialTexture(am, SLOT_TYPES[k][j], 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS)
-				continue;
-			int ti = find_texture(c, s.data);
-			if (ti < 0) {
-				/* Neither embedded nor among the files the daemon sent with the model. */
-				if (c->gltf) api_gltf_warn(&c->gi, "material %u: texture \"%.60s\" is not in the file (not drawn)", index, s.data);
-				break;
-			}
-			if (!(m->textures[k] = texture(c, ti))) return -1;
-			break;
-		}
-	}
-	return 0;
-}
-
-static int convert_material(struct conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m,
-                            bool *single_sided)
-{
-	rnd_material_defaults(m);
-	*single_sided = false;
-	struct aiString s;
-	/* Formats without materials (stl, ply, obj without mtl) get Assimp's default material:
-	 * the contract's default grey stands in for it, as for every other shape. */
-	if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) != aiReturn_SUCCESS) s.data[0] = 0, s.length = 0;
-	else if (!strcmp(s.data, AI_DEFAULT_MATERIAL_NAME)) return 0;
-	int gi = c->gltf ? api_gltf_material_of(s.data) : -1;
-	struct aiColor4D col;
-	if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
-	    aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS) {
-		const float v[4] = {col.r, col.g, col.b, col.a};
-		for (int k = 0; k < 4; k++) m->base_color[k] = clampf(v[k], 0, k < 3 ? 1e6f : 1);
-	}
-	ai_real f;
-	if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, NULL) == aiReturn_SUCCESS)
-		m->metallic = clampf(f, 0, 1);
-	if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, NULL) == aiReturn_SUCCESS)
-		m->roughness = clampf(f, 0, 1);
-	if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &col) == aiReturn_SUCCESS) {
-		const float v[3] = {col.r, col.g, col.b};
-		for (int k = 0; k < 3; k++) m->emissive[k] = clampf(v[k], 0, 1e6f);
-	}
-	if (aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &s) == aiReturn_SUCCESS) {
-		if (!strcmp(s.data, "MASK")) m->alpha_mode = RND_ALPHA_MASK;
-		if (!strcmp(s.data, "BLEND")) m->alpha_mode = RND_ALPHA_BLEND;   /* drawn dithered */
-		if (aiGetMaterialFloatArray(am, "$mat.gltf.alphaCutoff", 0, 0, &f, NULL) == aiReturn_SUCCESS)
-			m->alpha_cutoff = clampf(f, 0, 1);
-	}
-	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
-	return material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m);
-}
-
-static int walk(struct conv *c, const struct aiNode *node, const float parent[16], int depth)
+static int walk(struct api_conv *c, const struct aiNode *node, const float parent[16], int depth)
 {
 	if (depth > MAX_NODE_DEPTH)
 		return api_err_set(c->err, c->errsize, "the node tree is deeper than %d levels", MAX_NODE_DEPTH), -1;
@@ -511,7 +233,7 @@ static int walk(struct conv *c, const struct aiNode *node, const float parent[16
 	return 0;
 }
 
-static int convert(struct conv *c)
+static int convert(struct api_conv *c)
 {
 	const struct aiScene *sc = c->sc;
 	struct api_model *m = c->out;
@@ -521,16 +243,16 @@ static int convert(struct conv *c)
 		return c->oom = true, api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 
 	uint32_t nmat = sc->mNumMaterials ? sc->mNumMaterials : 1;
-	struct rnd_material *mats = conv_alloc(c, nmat, sizeof *mats);
-	bool *single = conv_alloc(c, nmat, sizeof *single);
+	struct rnd_material *mats = api_conv_alloc(c, nmat, sizeof *mats);
+	bool *single = api_conv_alloc(c, nmat, sizeof *single);
 	if (!mats || !single) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	rnd_material_defaults(&mats[0]);
 	for (unsigned i = 0; i < sc->mNumMaterials; i++)
-		if (convert_material(c, sc->mMaterials[i], i, &mats[i], &single[i]) < 0) return -1;
+		if (api_conv_material(c, sc->mMaterials[i], i, &mats[i], &single[i]) < 0) return -1;
 	c->mats = mats;
 	c->single_sided = single;
 
-	struct api_model_mesh *meshes = conv_alloc(c, sc->mNumMeshes, sizeof *meshes);
+	struct api_model_mesh *meshes = api_conv_alloc(c, sc->mNumMeshes, sizeof *meshes);
 	if (!meshes) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	uint32_t nmesh = 0;
 	for (unsigned i = 0; i < sc->mNumMeshes; i++) {
@@ -551,7 +273,7 @@ static int convert(struct conv *c)
 	rnd_mat4_identity(id);
 	if (sc->mRootNode && walk(c, sc->mRootNode, id, 0) < 0) return -1;
 	if (!c->ninst) return api_err_set(c->err, c->errsize, "no node of the model shows a mesh"), -1;
-	struct api_model_instance *inst = conv_alloc(c, c->ninst, sizeof *inst);
+	struct api_model_instance *inst = api_conv_alloc(c, c->ninst, sizeof *inst);
 	if (!inst) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	memcpy(inst, c->inst, c->ninst * sizeof *inst);
 	uint64_t tris = 0;
@@ -566,7 +288,7 @@ static int convert(struct conv *c)
 	m->triangles = tris;
 	if (c->gi.warnings[0]) {
 		size_t n = strlen(c->gi.warnings) + 1;
-		char *w = conv_alloc(c, n, 1);
+		char *w = api_conv_alloc(c, n, 1);
 		if (!w) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 		memcpy(w, c->gi.warnings, n);
 		m->warnings = w;
@@ -594,7 +316,7 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	bool gltf = format == API_MODEL_GLB || format == API_MODEL_GLTF;
 	json_t *root = NULL;
 	if (gltf && gltf_precheck(data, len, format, &root, err, errsize) < 0) return API_WIRE_BAD_INPUT;
-	struct conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf};
+	struct api_conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf};
 	uint8_t *tagged = NULL;
 	if (gltf) {
 		api_gltf_info_read(root, &c.gi);
@@ -613,9 +335,10 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 		data = strips;
 		len = strips_len;
 	}
-	struct mem_io mi = {.data = data, .len = len, .files = files, .nfiles = nfiles};
+	struct api_mem_io mi = {.data = data, .len = len, .files = files, .nfiles = nfiles};
 	snprintf(mi.name, sizeof mi.name, MEM_NAME ".%s", FORMAT_NAMES[format]);
-	struct aiFileIO io = {.OpenProc = mem_open, .CloseProc = mem_close, .UserData = (aiUserData)&mi};
+	struct aiFileIO io;
+	api_mem_io_init(&mi, &io);
 	struct aiPropertyStore *props = aiCreatePropertyStore();
 	/* Points and lines are dropped by SortByPType: only triangles reach us. */
 	aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);

@@ -1,0 +1,53 @@
+/*
+ * api/model_conv.h — the state of one aiScene's conversion into an api_model, shared by the
+ * two files that do it: api/model_import.c (meshes, nodes, the import itself) and
+ * api/model_material.c (materials and their textures). Private to those two.
+ *
+ * Ownership: what api_conv_alloc returns lives in the caller's arena; mesh_map, tex and inst
+ * are malloc'd by model_import.c and freed there. Threading: one conversion, one thread.
+ */
+#ifndef UMBRA_API_MODEL_CONV_H
+#define UMBRA_API_MODEL_CONV_H
+
+#include <stdbool.h>
+#include <assimp/material.h>
+#include <assimp/scene.h>
+#include "arena.h"
+#include "gltf_material.h"
+#include "model.h"
+
+struct api_conv {
+	const struct aiScene *sc;
+	struct api_arena *arena;
+	struct api_model *out;
+	size_t bytes;
+	bool oom;                     /* an allocation failed: over the memory limit, not a bad file */
+	int32_t *mesh_map;            /* Assimp mesh -> our mesh, -1 = skipped (not triangles) */
+	struct rnd_texture **tex;     /* decoded textures: scene->mTextures, then the referred files */
+	const struct api_model_file *files;
+	size_t nfiles;
+	struct api_model_instance *inst;
+	uint32_t ninst, inst_cap;
+	bool gltf;                    /* glb / gltf: every texture slot, glTF material details */
+	struct api_gltf_info gi;      /* those details, and the warnings (filled for glTF only) */
+	const struct rnd_material *mats;
+	const bool *single_sided;     /* by material */
+	char *err;
+	size_t errsize;
+};
+
+static inline void *api_conv_alloc(struct api_conv *c, size_t n, size_t size)
+{
+	void *p = api_arena_calloc(c->arena, n ? n : 1, size);
+	if (p) c->bytes += n * size;
+	else c->oom = true;
+	return p;
+}
+
+/* Material `index` of the scene into *m (defaults for Assimp's default material), with its
+ * textures decoded into the arena; *single_sided from glTF's doubleSided. -1 with c->err (and
+ * c->oom when an allocation failed) on failure. */
+int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m,
+                      bool *single_sided);
+
+#endif

@@ -1,0 +1,149 @@
+/*
+ * api/model_material.c — an aiScene's materials as rnd_materials (see model_conv.h): glTF's core
+ * material model (every texture slot for glTF, the base colour for the other formats; what
+ * Assimp 5.2 does not hand over reliably comes from api/gltf_material.c), and the textures they
+ * name, embedded or among the files the model refers to, decoded into the import's arena.
+ */
+#include <stdlib.h>
+#include <string.h>
+#include <assimp/cimport.h>
+#include "errmsg.h"
+#include "model_conv.h"
+#include "model_io.h"
+
+#define MAX_TEXTURE_PIXELS (64ull << 20)
+
+static float clampf(float v, float lo, float hi)
+{
+	return !(v >= lo) ? lo : v > hi ? hi : v;  /* NaN -> lo */
+}
+
+/* The texture that `path` names: an embedded one ("*N" or the embedded file's name), then a
+ * file the model refers to (index mNumTextures + k); -1 when none. */
+static int find_texture(const struct api_conv *c, const char *path)
+{
+	const struct aiScene *sc = c->sc;
+	if (path[0] == '*') {
+		char *end;
+		unsigned long n = strtoul(path + 1, &end, 10);
+		if (*end || end == path + 1 || n >= sc->mNumTextures) return -1;
+		return (int)n;
+	}
+	for (unsigned i = 0; i < sc->mNumTextures; i++) {
+		const char *fn = sc->mTextures[i]->mFilename.data;
+		if (fn[0] && !strcmp(fn, path)) return (int)i;
+	}
+	long k = api_model_file_index(c->files, c->nfiles, path);
+	return k < 0 ? -1 : (int)(sc->mNumTextures + (unsigned)k);
+}
+
+static const struct rnd_texture *texture(struct api_conv *c, int ti)
+{
+	if (c->tex[ti]) return c->tex[ti];
+	unsigned nemb = c->sc->mNumTextures;
+	const struct aiTexture *at = (unsigned)ti < nemb ? c->sc->mTextures[ti] : NULL;
+	const struct api_model_file *file = at ? NULL : &c->files[(unsigned)ti - nemb];
+	struct rnd_texture *t = api_conv_alloc(c, 1, sizeof *t);
+	if (!t) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+	if (file || at->mHeight == 0) {
+		/* Compressed: mWidth bytes of a PNG or JPEG file, or a whole file beside the model. */
+		uint8_t *px;
+		uint32_t w, h;
+		char e[200];
+		if (api_image_decode(file ? file->data : (const uint8_t *)at->pcData, file ? file->len : at->mWidth,
+		                     MAX_TEXTURE_PIXELS, &px, &w, &h, e, sizeof e) != API_OK) {
+			if (file) return api_err_set(c->err, c->errsize, "texture \"%.128s\": %s", file->name, e), NULL;
+			return api_err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
+		}
+		uint8_t *copy = api_conv_alloc(c, (size_t)w * h, 4);
+		if (copy) memcpy(copy, px, (size_t)w * h * 4);
+		free(px);
+		if (!copy) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+		t->rgba = copy;
+		t->width = w;
+		t->height = h;
+	} else {
+		uint64_t n = (uint64_t)at->mWidth * at->mHeight;
+		if (n > MAX_TEXTURE_PIXELS)
+			return api_err_set(c->err, c->errsize, "embedded texture %d is over the texture size limit", ti), NULL;
+		uint8_t *px = api_conv_alloc(c, (size_t)n, 4);
+		if (!px) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+		for (size_t i = 0; i < n; i++) { /* aiTexel is BGRA */
+			px[4 * i] = at->pcData[i].r;
+			px[4 * i + 1] = at->pcData[i].g;
+			px[4 * i + 2] = at->pcData[i].b;
+			px[4 * i + 3] = at->pcData[i].a;
+		}
+		t->rgba = px;
+		t->width = at->mWidth;
+		t->height = at->mHeight;
+	}
+	c->tex[ti] = t;
+	return t;
+}
+
+/* Assimp's texture types per slot, in the order tried (glTF: base colour also as DIFFUSE;
+ * metallic-roughness as UNKNOWN, 5.2's name for it; occlusion as LIGHTMAP). */
+static const enum aiTextureType SLOT_TYPES[RND_TEX_SLOTS][3] = {
+	{aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, aiTextureType_NONE},
+	{aiTextureType_UNKNOWN, aiTextureType_METALNESS, aiTextureType_DIFFUSE_ROUGHNESS},
+	{aiTextureType_NORMALS, aiTextureType_NONE, aiTextureType_NONE},
+	{aiTextureType_LIGHTMAP, aiTextureType_AMBIENT_OCCLUSION, aiTextureType_NONE},
+	{aiTextureType_EMISSIVE, aiTextureType_NONE, aiTextureType_NONE},
+};
+
+static int material_textures(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m)
+{
+	struct aiString s;
+	for (uint32_t k = 0; k < (c->gltf ? RND_TEX_SLOTS : 1u); k++) {
+		for (int j = 0; j < 3 && SLOT_TYPES[k][j] != aiTextureType_NONE; j++) {
+			if (aiGetMaterialTexture(am, SLOT_TYPES[k][j], 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS)
+				continue;
+			int ti = find_texture(c, s.data);
+			if (ti < 0) {
+				/* Neither embedded nor among the files the daemon sent with the model. */
+				if (c->gltf) api_gltf_warn(&c->gi, "material %u: texture \"%.60s\" is not in the file (not drawn)", index, s.data);
+				break;
+			}
+			if (!(m->textures[k] = texture(c, ti))) return -1;
+			break;
+		}
+	}
+	return 0;
+}
+
+int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m,
+                      bool *single_sided)
+{
+	rnd_material_defaults(m);
+	*single_sided = false;
+	struct aiString s;
+	/* Formats without materials (stl, ply, obj without mtl) get Assimp's default material:
+	 * the contract's default grey stands in for it, as for every other shape. */
+	if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) != aiReturn_SUCCESS) s.data[0] = 0, s.length = 0;
+	else if (!strcmp(s.data, AI_DEFAULT_MATERIAL_NAME)) return 0;
+	int gi = c->gltf ? api_gltf_material_of(s.data) : -1;
+	struct aiColor4D col;
+	if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &col) == aiReturn_SUCCESS ||
+	    aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &col) == aiReturn_SUCCESS) {
+		const float v[4] = {col.r, col.g, col.b, col.a};
+		for (int k = 0; k < 4; k++) m->base_color[k] = clampf(v[k], 0, k < 3 ? 1e6f : 1);
+	}
+	ai_real f;
+	if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, NULL) == aiReturn_SUCCESS)
+		m->metallic = clampf(f, 0, 1);
+	if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, NULL) == aiReturn_SUCCESS)
+		m->roughness = clampf(f, 0, 1);
+	if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &col) == aiReturn_SUCCESS) {
+		const float v[3] = {col.r, col.g, col.b};
+		for (int k = 0; k < 3; k++) m->emissive[k] = clampf(v[k], 0, 1e6f);
+	}
+	if (aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &s) == aiReturn_SUCCESS) {
+		if (!strcmp(s.data, "MASK")) m->alpha_mode = RND_ALPHA_MASK;
+		if (!strcmp(s.data, "BLEND")) m->alpha_mode = RND_ALPHA_BLEND;   /* drawn dithered */
+		if (aiGetMaterialFloatArray(am, "$mat.gltf.alphaCutoff", 0, 0, &f, NULL) == aiReturn_SUCCESS)
+			m->alpha_cutoff = clampf(f, 0, 1);
+	}
+	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
+	return material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m);
+}
