@@ -15,7 +15,12 @@ BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
 GLSLANG ?= glslangValidator
-PKGS := vulkan jansson libmicrohttpd libpng OpenEXR zlib assimp libjpeg libseccomp
+# The packages of each module (server -> api -> renderer): each compiles with its own packages'
+# cflags only; everything links with all of them.
+PKGS_RENDERER := vulkan
+PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp
+PKGS_SERVER := libmicrohttpd
+PKGS := $(PKGS_RENDERER) $(PKGS_API) $(PKGS_SERVER)
 
 OPT ?= -O2
 SAN ?=
@@ -25,16 +30,23 @@ CFLAGS += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror -Wno-missing-field-initia
 LDFLAGS += -pthread $(SAN)
 # Each module sees only the headers it may use (server -> api -> renderer -> shaders): an
 # include across the layering is a compile error, not a review comment. Tests see everything.
-INC_RENDERER := -Irenderer/include -Irenderer -Ishaders -I$(BUILD)/shaders
-INC_API := -Irenderer/include -Iapi
-INC_SERVER := -Irenderer/include -Iapi -Iserver -I$(BUILD)/www
-INC_TESTS := -Itests/util -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders -I$(BUILD)/www
+# Their packages' cflags likewise (PKG_CFLAGS_* below): the renderer gets Vulkan's, api/ those of
+# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg and libseccomp (meshoptimizer has no .pc),
+# the server libmicrohttpd's.
+INC_RENDERER = -Irenderer/include -Irenderer -Ishaders -I$(BUILD)/shaders $(PKG_CFLAGS_RENDERER)
+INC_API = -Irenderer/include -Iapi $(PKG_CFLAGS_API)
+INC_SERVER = -Irenderer/include -Iapi -Iserver -I$(BUILD)/www $(PKG_CFLAGS_SERVER)
+INC_TESTS = -Itests/util -Irenderer/include -Irenderer -Ishaders -Iapi -Iserver -I$(BUILD)/shaders -I$(BUILD)/www \
+            $(PKG_CFLAGS)
 # pkg-config's answer is checked (pkg-check below), not silenced: a missing package fails the
 # build with pkg-config's own message instead of a confusing compile or link error later.
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_STATUS := $(.SHELLSTATUS)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS))
-CFLAGS += $(PKG_CFLAGS)
+# (Their errors show once, in pkg-check, which runs before any compile.)
+PKG_CFLAGS_RENDERER := $(shell pkg-config --cflags $(PKGS_RENDERER) 2>/dev/null)
+PKG_CFLAGS_API := $(shell pkg-config --cflags $(PKGS_API) 2>/dev/null)
+PKG_CFLAGS_SERVER := $(shell pkg-config --cflags $(PKGS_SERVER) 2>/dev/null)
 # The build's version (in /v1/info and the ETag): the commit, "-dirty" with local changes.
 # Without .git (a container build, a tarball): `make UMBRA_VERSION=...` or a VERSION file.
 ifeq ($(UMBRA_VERSION),)
