@@ -215,15 +215,24 @@ static void texture_name(const char *p, const char *end, char *out, size_t n)
 	if (last) memmove(out, last + 1, strlen(last + 1) + 1);
 }
 
+/* The line of an .obj / .mtl that starts at p: its first non-blank character (returned) and its
+ * end (*eol: the newline, or e). */
+static const char *line_at(const char *p, const char *e, const char **eol)
+{
+	*eol = memchr(p, '\n', (size_t)(e - p));
+	if (!*eol) *eol = e;
+	while (p < *eol && (*p == ' ' || *p == '\t')) p++;
+	return p;
+}
+
 static int mtl_refs(struct ctx *c, const char *mtl_path, const uint8_t *d, size_t len)
 {
 	static const char *const kws[] = {"map_Kd", "map_Ka", "map_Ks", "map_Ke", "map_Ns", "map_d", "map_bump",
 	                                  "map_Bump", "bump", "disp", "decal", "norm", "map_Pr", "map_Pm", NULL};
 	const char *s = (const char *)d, *e = s + len;
 	for (const char *p = s; p < e;) {
-		const char *eol = memchr(p, '\n', (size_t)(e - p));
-		if (!eol) eol = e;
-		while (p < eol && (*p == ' ' || *p == '\t')) p++;
+		const char *eol;
+		p = line_at(p, e, &eol);
 		const char *after;
 		for (int k = 0; kws[k]; k++) {
 			if (!keyword(p, eol, kws[k], &after)) continue;
@@ -243,9 +252,8 @@ static int obj_refs(struct ctx *c, const uint8_t *d, size_t len)
 {
 	const char *s = (const char *)d, *e = s + len;
 	for (const char *p = s; p < e;) {
-		const char *eol = memchr(p, '\n', (size_t)(e - p));
-		if (!eol) eol = e;
-		while (p < eol && (*p == ' ' || *p == '\t')) p++;
+		const char *eol;
+		p = line_at(p, e, &eol);
 		const char *after;
 		if (keyword(p, eol, "mtllib", &after)) {
 			char name[PATH_MAX];

@@ -44,12 +44,8 @@ void record_scene_depth(struct rnd_context *ctx, struct rnd_slot *s, const struc
 {
 	VkCommandBuffer cmd = s->cmd;
 	uint32_t w = rv->sc->width, h = rv->sc->height;
-	record_image_barrier(cmd, s->scene_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-	                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-	record_begin_depth(cmd, s->scene_depth.view, w, h);
+	record_begin_depth(cmd, s->scene_depth.img, s->scene_depth.view, w, h, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+	                   VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
 	vkCmdSetDepthBias(cmd, 0.0f, 0.0f, 0.0f);
 	record_bind_geometry(ctx, s);
 	/* z' = w - z: the reversed-Z camera as the shadow pipelines' near-0 depth. */

@@ -61,29 +61,35 @@ static enum rnd_result split_aovs(const struct rnd_scene *sc, const float *rb, s
 	return RND_OK;
 }
 
+/* One pixel (c[3] alpha, max = the format's 1.0) from premultiplied to straight, rounded. */
+static void straight_alpha(uint32_t c[4], uint32_t max)
+{
+	uint32_t a = c[3];
+	if (a == 0 || a == max) return;
+	for (int k = 0; k < 3; k++) {
+		uint32_t v = (c[k] * max + a / 2) / a;
+		c[k] = v > max ? max : v;
+	}
+}
+
 /* 8/16-bit outputs with transparency: straight alpha (PNG's convention) from the premultiplied
  * resolve. RGBA32F (EXR) stays premultiplied, as EXR expects. */
 static void unpremultiply(void *pixels, uint64_t n, enum rnd_pixel_format f)
 {
+	uint32_t c[4];
 	if (f == RND_PIXELS_RGBA8) {
 		uint8_t *p = pixels;
 		for (uint64_t i = 0; i < n; i++, p += 4) {
-			unsigned a = p[3];
-			if (a == 0 || a == 255) continue;
-			for (int k = 0; k < 3; k++) {
-				unsigned v = (p[k] * 255u + a / 2) / a;
-				p[k] = (uint8_t)(v > 255 ? 255 : v);
-			}
+			for (int k = 0; k < 4; k++) c[k] = p[k];
+			straight_alpha(c, 255u);
+			for (int k = 0; k < 3; k++) p[k] = (uint8_t)c[k];
 		}
 	} else if (f == RND_PIXELS_RGBA16) {
 		uint16_t *p = pixels;
 		for (uint64_t i = 0; i < n; i++, p += 4) {
-			uint32_t a = p[3];
-			if (a == 0 || a == 65535) continue;
-			for (int k = 0; k < 3; k++) {
-				uint32_t v = (p[k] * 65535u + a / 2) / a;
-				p[k] = (uint16_t)(v > 65535 ? 65535 : v);
-			}
+			for (int k = 0; k < 4; k++) c[k] = p[k];
+			straight_alpha(c, 65535u);
+			for (int k = 0; k < 3; k++) p[k] = (uint16_t)c[k];
 		}
 	}
 }

@@ -60,10 +60,16 @@ static float srgb_encode(float c)
 	return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
-/* Begins a depth-only pass over (0, 0, w, h) of view, cleared to 1 (the shadow pipelines' far),
+/* Makes img a depth attachment (after src_stage / src_access of its previous use) and begins a
+ * depth-only pass over (0, 0, w, h) of its view, cleared to 1 (the shadow pipelines' far),
  * with that viewport and scissor. */
-void record_begin_depth(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h)
+void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint32_t w, uint32_t h,
+                        VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access)
 {
+	record_image_barrier(cmd, img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, src_stage, src_access,
+	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 	VkRenderingAttachmentInfo da = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = view,
 		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
@@ -120,12 +126,8 @@ static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const s
 	 * at the tile's own offset would make a map (and the image) depend on where the atlas
 	 * happened to place it. The same request then gives the same bytes whatever the cache
 	 * held before. */
-	record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-	                     VK_ACCESS_2_TRANSFER_READ_BIT,
-	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-	record_begin_depth(cmd, s->shadow_scratch.view, res, res);
+	record_begin_depth(cmd, s->shadow_scratch.img, s->shadow_scratch.view, res, res, VK_PIPELINE_STAGE_2_COPY_BIT,
+	                   VK_ACCESS_2_TRANSFER_READ_BIT);
 	vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
 	/* Masked casters read materials and textures; the set's shadow-map binding is not
 	 * used by the alpha-test shader while the map is a render target. */

@@ -48,9 +48,11 @@ VkRect2D record_band_area(const struct record_view *rv);
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
                           VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage,
                           VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
-/* Depth-only passes (shadow maps, the camera depth of contact shadows): begins rendering into
+/* Depth-only passes (shadow maps, the camera depth of contact shadows): img made a depth
+ * attachment after its previous use (src_stage, src_access), then rendering begun into its
  * view over (0, 0, w, h), cleared to 1, with that viewport and scissor. */
-void record_begin_depth(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h);
+void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint32_t w, uint32_t h,
+                        VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access);
 /* Binds the slot's vertex and index buffers and its set 0 (frame constants, atlases). */
 void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s);
 /* One draw with the shadow (depth-only) pipelines, culling back faces when cull is set; masked
