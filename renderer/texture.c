@@ -25,12 +25,13 @@ uint64_t rnd_texture_chain_bytes(uint32_t w, uint32_t h)
 	return b;
 }
 
-/* sRGB <-> linear for the averaging. ENC_STEPS entries of linear light keep the darkest sRGB
- * steps apart (1/255 encoded is 3e-4 linear; one entry is 6e-5). */
-#define ENC_STEPS 16384
+/* sRGB <-> linear for the averaging, in integers: dec maps an sRGB byte to linear light in
+ * 16 bits; enc maps linear light in 14 bits (the average's top bits) back to the byte. 2^14
+ * steps keep the darkest sRGB steps apart (1/255 encoded is 3.0e-4 linear; a step is 6.1e-5). */
+#define ENC_BITS 14
 struct srgb_tables {
-	float dec[256];
-	uint8_t enc[ENC_STEPS + 1];
+	uint16_t dec[256];
+	uint8_t enc[1 << ENC_BITS];
 };
 
 static struct srgb_tables tables;
@@ -41,10 +42,11 @@ static void tables_once_init(void)
 	struct srgb_tables *t = &tables;
 	for (int i = 0; i < 256; i++) {
 		float c = (float)i / 255.0f;
-		t->dec[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+		float l = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+		t->dec[i] = (uint16_t)lrintf(l * 65535.0f);
 	}
-	for (int i = 0; i <= ENC_STEPS; i++) {
-		float l = (float)i / ENC_STEPS;
+	for (int i = 0; i < (1 << ENC_BITS); i++) {
+		float l = ((float)i + 0.5f) / (float)(1 << ENC_BITS);
 		float c = l <= 0.0031308f ? l * 12.92f : 1.055f * powf(l, 1.0f / 2.4f) - 0.055f;
 		t->enc[i] = (uint8_t)lrintf(c * 255.0f);
 	}
@@ -52,7 +54,7 @@ static void tables_once_init(void)
 
 /* One level from the one above it (sw x sh -> dw x dh). Each destination texel averages the
  * source texels it covers: 2x2, or 3 wide/tall at the last column/row of an odd size, or 1
- * along a side already at 1. */
+ * along a side already at 1. Integer sums, rounded: the same bytes on every machine. */
 static void downsample(const uint8_t *src, uint32_t sw, uint32_t sh, uint8_t *dst, uint32_t dw, uint32_t dh,
                        const struct srgb_tables *t)
 {
@@ -60,18 +62,27 @@ static void downsample(const uint8_t *src, uint32_t sw, uint32_t sh, uint8_t *ds
 		uint32_t y0 = sh == 1 ? 0 : 2 * y, y1 = sh == 1 ? 0 : (y == dh - 1 ? sh - 1 : 2 * y + 1);
 		for (uint32_t x = 0; x < dw; x++) {
 			uint32_t x0 = sw == 1 ? 0 : 2 * x, x1 = sw == 1 ? 0 : (x == dw - 1 ? sw - 1 : 2 * x + 1);
-			float acc[4] = {0, 0, 0, 0};
-			uint32_t n = 0;
-			for (uint32_t yy = y0; yy <= y1; yy++)
-				for (uint32_t xx = x0; xx <= x1; xx++, n++) {
-					const uint8_t *p = src + ((size_t)yy * sw + xx) * 4;
-					for (int c = 0; c < 3; c++) acc[c] += t ? t->dec[p[c]] : p[c] / 255.0f;
-					acc[3] += p[3] / 255.0f;
-				}
 			uint8_t *o = dst + ((size_t)y * dw + x) * 4;
+			if (x1 == x0 + 1 && y1 == y0 + 1) {   /* the common 2x2 box, unrolled */
+				const uint8_t *a = src + ((size_t)y0 * sw + x0) * 4, *b = a + (size_t)sw * 4;
+				for (int c = 0; c < 3; c++)
+					o[c] = t ? t->enc[(t->dec[a[c]] + t->dec[a[c + 4]] + t->dec[b[c]] + t->dec[b[c + 4]] + 2u) >>
+					                  (2 + 16 - ENC_BITS)]
+					         : (uint8_t)((a[c] + a[c + 4] + b[c] + b[c + 4] + 2u) >> 2);
+				o[3] = (uint8_t)((a[3] + a[7] + b[3] + b[7] + 2u) >> 2);
+				continue;
+			}
+			uint32_t acc[4] = {0, 0, 0, 0}, n = (y1 - y0 + 1) * (x1 - x0 + 1);
+			for (uint32_t yy = y0; yy <= y1; yy++) {
+				const uint8_t *p = src + ((size_t)yy * sw + x0) * 4;
+				for (uint32_t xx = x0; xx <= x1; xx++, p += 4) {
+					for (int c = 0; c < 3; c++) acc[c] += t ? t->dec[p[c]] : p[c];
+					acc[3] += p[3];
+				}
+			}
 			for (int c = 0; c < 4; c++) {
-				float v = acc[c] / (float)n;
-				o[c] = t && c < 3 ? t->enc[(int)lrintf(v * ENC_STEPS)] : (uint8_t)lrintf(v * 255.0f);
+				uint32_t v = (acc[c] + n / 2) / n;
+				o[c] = t && c < 3 ? t->enc[v >> (16 - ENC_BITS)] : (uint8_t)v;
 			}
 		}
 	}
