@@ -1,12 +1,14 @@
 /* tests/unit — mip chains built on the CPU (renderer/texture.c): level count and bytes, a
  * black/white checker averaged in linear light for sRGB (188, not 128) and in the stored
- * values for linear data (128), an odd side folding its last texel in, and the time to build a
- * 2048^2 chain (printed, not asserted). */
+ * values for linear data (128), an odd side folding its last texel in, the memory estimate
+ * counting each texture's chain twice (image and staging), and the time to build a 2048^2
+ * chain (printed, not asserted). */
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include "test.h"
 #include "texture.h"
+#include "estimate.h"
 
 TEST(texture_levels_and_chain_bytes)
 {
@@ -60,4 +62,28 @@ TEST(texture_chain_of_2048_timing)
 	CHECK(out[(size_t)w * w * 4] != 0 || out[(size_t)w * w * 4 + 1] != 0, "level 1 is empty");
 	free(in);
 	free(out);
+}
+
+TEST(texture_estimate_counts_mip_chains)
+{
+	static uint8_t texels[4];
+	struct rnd_texture t = {.rgba = texels, .width = 1024, .height = 512};
+	struct rnd_material m[2];
+	rnd_material_defaults(&m[0]);
+	rnd_material_defaults(&m[1]);
+	m[1].base_color_texture = &t;
+	struct rnd_scene sc;
+	memset(&sc, 0, sizeof sc);
+	sc.width = sc.height = 64;
+	sc.materials = m;
+	sc.material_count = 1;
+	struct rnd_estimate a, b;
+	rnd_estimate_scene(&sc, 2048, &a);
+	sc.material_count = 2;
+	rnd_estimate_scene(&sc, 2048, &b);
+	uint64_t chain = rnd_texture_chain_bytes(1024, 512), image = 1024 * 512 * 4;
+	/* 1024x512, 512x256, ... 2x1, 1x1: 4 bytes a texel */
+	CHECK(chain == 2796204 && image == 2097152, "chain %llu", (unsigned long long)chain);
+	CHECK(b.device_bytes - a.device_bytes == 2 * chain, "a 1024x512 texture adds %llu bytes, want 2 x %llu",
+	      (unsigned long long)(b.device_bytes - a.device_bytes), (unsigned long long)chain);
 }

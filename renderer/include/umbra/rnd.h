@@ -381,7 +381,8 @@ uint32_t rnd_context_validation_messages(const struct rnd_context *ctx);
  * admission by memory (umbrad --max-memory) and for limits that no retry can cure. Bytes are
  * upper estimates of what the render holds at its peak. */
 struct rnd_estimate {
-	uint64_t device_bytes;        /* targets, AOV images, readback buffer, geometry, shadow scratch
+	uint64_t device_bytes;        /* targets, AOV images, readback buffer, geometry, shadow scratch,
+	                                 material textures with their mip chains (image + staging)
 	                                 (device memory; on a CPU driver such as lavapipe, host memory) */
 	uint64_t host_bytes;          /* the returned image (colour + AOV planes) and its encoding */
 	uint64_t largest_allocation;  /* the largest single buffer or image */
