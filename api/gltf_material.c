@@ -10,6 +10,8 @@
 
 /* glTF sampler enums (OpenGL's) */
 #define GL_NEAREST 9728
+#define GL_LINEAR 9729
+#define GL_LINEAR_MIPMAP_NEAREST 9985
 #define GL_NEAREST_MIPMAP_NEAREST 9984
 #define GL_NEAREST_MIPMAP_LINEAR 9986
 #define GL_CLAMP_TO_EDGE 33071
@@ -87,6 +89,8 @@ static void read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, co
 		ts->mag_nearest = json_integer_value(json_object_get(sampler, "magFilter")) == GL_NEAREST;
 		json_int_t mf = json_integer_value(json_object_get(sampler, "minFilter"));
 		ts->min_nearest = mf == GL_NEAREST || mf == GL_NEAREST_MIPMAP_NEAREST || mf == GL_NEAREST_MIPMAP_LINEAR;
+		ts->mip = mf == GL_NEAREST || mf == GL_LINEAR ? RND_MIP_NONE
+		        : mf == GL_NEAREST_MIPMAP_NEAREST || mf == GL_LINEAR_MIPMAP_NEAREST ? RND_MIP_NEAREST : RND_MIP_LINEAR;
 	}
 	json_int_t tc = json_integer_value(json_object_get(info, "texCoord"));
 	json_t *tt = json_object_get(json_object_get(info, "extensions"), "KHR_texture_transform");

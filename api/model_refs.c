@@ -109,6 +109,7 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 	if (s->path) {
 		int st;
 		if (api_asset_read(s->root, full, &owned, &len, &st, why, sizeof why) != API_OK) {
+			if (s->optional_obj_files && (kind == REF_MTL || kind == REF_TEXTURE)) return -2;
 			*c->status = st;
 			return api_err_set(c->err, c->errsize, "its %s \"%.128s\" cannot be read: %s", KIND_NAMES[kind], ref,
 			                   why), -1;

@@ -11,7 +11,8 @@
  *     named by the reference ("Avocado.bin", "textures/wood.png"); a "../" reference is a 400;
  *   - inline `data` without parts: nothing can be found; a glTF that needs a file is a 400.
  * An .obj's .mtl or texture missing from the request (inline data, or parts without it: the
- * farm sends the model alone) is left out and said in `warning`; by `path` it is a 400.
+ * farm sends the model alone) is left out and said in `warning`; by `path` it is a 400 unless
+ * the source says optional_obj_files (then it too is left out and said).
  * A reference that cannot be found or read is a 400 whose sentence names it; more than
  * API_MODEL_REFS_MAX files or API_ASSET_MAX_FILE bytes with the model is a 422.
  *
@@ -29,6 +30,7 @@
 #ifndef UMBRA_API_MODEL_REFS_H
 #define UMBRA_API_MODEL_REFS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "api.h"
@@ -41,6 +43,10 @@ struct api_ref_source {
 	const char *path;                 /* ... and the model's path under it (NULL: not by path) */
 	const struct api_part *parts;     /* the request's parts (multipart), or NULL */
 	size_t nparts;
+	/* By path: an .obj's .mtl or texture that cannot be read is left out with a `warning`, as
+	 * for a request without it, instead of a 400 (umbra-render thumb: a thumbnail of what the
+	 * directory has). A name that escapes the root is still a 400. */
+	bool optional_obj_files;
 };
 
 struct api_model_refs {

@@ -80,7 +80,7 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
 		const struct rnd_texture_sampling *ts = &mt->sampling[s];
 		put_u32(b, (uint32_t)ts->wrap_s | (uint32_t)ts->wrap_t << 2 | (uint32_t)ts->mag_nearest << 4 |
-		           (uint32_t)ts->min_nearest << 5 | (uint32_t)ts->transformed << 6);
+		           (uint32_t)ts->min_nearest << 5 | (uint32_t)ts->transformed << 6 | (uint32_t)(ts->mip % 3u) << 7);
 		put(b, ts->transform, sizeof ts->transform);
 	}
 }
@@ -254,7 +254,8 @@ static void *dec_alloc(struct dec *d, size_t n, size_t size)
 
 static bool sampling_ok(uint32_t packed, const float *t)
 {
-	if (packed > 0x7f || (packed & 3) > RND_WRAP_MIRROR || (packed >> 2 & 3) > RND_WRAP_MIRROR) return false;
+	if (packed > 0x1ff || (packed & 3) > RND_WRAP_MIRROR || (packed >> 2 & 3) > RND_WRAP_MIRROR || (packed >> 7) > RND_MIP_NEAREST)
+		return false;
 	for (int k = 0; k < 6; k++)
 		if (!isfinite(t[k]) || fabsf(t[k]) > 1e6f) return false;
 	return true;
@@ -291,6 +292,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 			ts->mag_nearest = packed[s] >> 4 & 1;
 			ts->min_nearest = packed[s] >> 5 & 1;
 			ts->transformed = packed[s] >> 6 & 1;
+			ts->mip = (uint8_t)(packed[s] >> 7 & 3);
 			memcpy(ts->transform, tf[s], sizeof tf[s]);
 		}
 		memcpy(m->base_color, f, 4 * sizeof(float));

@@ -22,7 +22,7 @@
  *                       occlusion_strength reserved (f32, reserved = 0), alpha_mode (u32),
  *                       texture[5] (i32 per rnd_texture_slot, -1 = none), then per slot the
  *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
- *                       transformed << 6 (u32), transform f32[6]
+ *                       transformed << 6 | mip << 7 (u32, enum rnd_mip), transform f32[6]
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
  *                       8 tangents, 16 single-sided), positions f32[3v], normals f32[3v],
  *                       uvs f32[2v], colours u8[4v], tangents f32[4v], indices u32[i]

@@ -7,6 +7,7 @@
  */
 #include "estimate.h"
 #include "mesh.h"
+#include "texture.h"
 
 void rnd_sheet_layout(uint32_t view_count, uint32_t *cols, uint32_t *rows)
 {
@@ -38,6 +39,21 @@ uint32_t rnd_aov_planes(const struct rnd_scene *sc)
 
 static uint64_t max64(uint64_t a, uint64_t b) { return a > b ? a : b; }
 
+/* The material textures' full mip chains (4/3 of their texels). A texture two materials (or
+ * two slots of different colour space) share counts for each: an upper bound, as admission
+ * wants. */
+static uint64_t texture_bytes(const struct rnd_scene *sc)
+{
+	uint64_t b = 0;
+	for (uint32_t i = 0; i < sc->material_count; i++)
+		for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
+			const struct rnd_texture *t = sc->materials[i].textures[k];
+			if (t && t->width <= RND_MAX_TEXTURE_SIDE && t->height <= RND_MAX_TEXTURE_SIDE)
+				b += rnd_texture_chain_bytes(t->width, t->height);
+		}
+	return b;
+}
+
 void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct rnd_estimate *e)
 {
 	uint32_t cols, rows;
@@ -55,6 +71,7 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 		nv += v; ni += x;
 	}
 	uint64_t geometry = nv * sizeof(struct rnd_vertex) + ni * 4;
+	uint64_t textures = texture_bytes(sc);
 
 	/* The largest shadow map drawn (its scratch image and the buffer it is copied through). */
 	uint64_t res = 0;
@@ -66,7 +83,8 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 
 	uint64_t targets = px * pb * (samples > 1 ? 1 + samples : 1) + px * 4 * samples;
 	uint64_t aov_targets = passes ? px * (16 * UMBRA_AOV_ATTACHMENTS + 4) : 0;
-	e->device_bytes = targets + aov_targets + readback + geometry + scratch;
+	/* Each texture twice: its image and the staging buffer that carries it (both with mips). */
+	e->device_bytes = targets + aov_targets + readback + geometry + scratch + 2 * textures;
 	/* The image handed back (colour + float AOV planes) and, at most as large, its encoding. */
 	uint64_t image = colour + sheet * 4 * rnd_aov_planes(sc);
 	e->host_bytes = 2 * image;

@@ -43,13 +43,14 @@ struct rnd_image_res {
 	uint32_t width, height, layers, samples;
 };
 
-/* Samplers of material textures: wrap s (3) x wrap t (3) x mag nearest (2) x min nearest (2);
- * index 0 is repeat / linear (glTF's default, and the white texture's). */
-#define RND_TEXTURE_SAMPLERS 36
+/* Samplers of material textures: mip mode (3, enum rnd_mip) x wrap s (3) x wrap t (3) x mag
+ * nearest (2) x min nearest (2); index 0 is repeat / linear / trilinear (glTF's default, and
+ * the white texture's). */
+#define RND_TEXTURE_SAMPLERS 108
 static inline uint32_t rnd_texture_sampler_index(const struct rnd_texture_sampling *t)
 {
-	return (uint32_t)(t->wrap_s % 3u) * 12u + (uint32_t)(t->wrap_t % 3u) * 4u + (t->mag_nearest ? 2u : 0u) +
-	       (t->min_nearest ? 1u : 0u);
+	return (uint32_t)(t->mip % 3u) * 36u + (uint32_t)(t->wrap_s % 3u) * 12u + (uint32_t)(t->wrap_t % 3u) * 4u +
+	       (t->mag_nearest ? 2u : 0u) + (t->min_nearest ? 1u : 0u);
 }
 
 struct rnd_pipelines {
@@ -152,6 +153,11 @@ enum rnd_result rnd_buffer_reserve(struct rnd_context *ctx, struct rnd_buffer *b
 enum rnd_result rnd_image_create(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h, uint32_t layers,
                                  uint32_t samples, VkImageUsageFlags usage, VkImageAspectFlags aspect,
                                  const char *name, struct rnd_image_res *out, struct rnd_error *err);
+/* As rnd_image_create() with `levels` mip levels (the view sees them all). */
+enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h,
+                                        uint32_t layers, uint32_t samples, uint32_t levels, VkImageUsageFlags usage,
+                                        VkImageAspectFlags aspect, const char *name, struct rnd_image_res *out,
+                                        struct rnd_error *err);
 void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
 
 /* pipelines.c */

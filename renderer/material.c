@@ -5,12 +5,15 @@
  * and the scene's union of those bits specialises mesh.frag (UMBRA_SC_TEXTURES), so an
  * untextured scene runs no texture code at all. Slots a textured material lacks are bound to
  * the slot's white 1x1, which is the neutral value of every multiply (base, metal-rough,
- * occlusion, emissive); the normal map's bit gates its use.
+ * occlusion, emissive); the normal map's bit gates its use. Every image carries its full mip
+ * chain (renderer/texture.c), so a texture far smaller on screen than in the file is averaged,
+ * not aliased; the sampler's rnd_mip decides whether the chain is read.
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "material.h"
+#include "texture.h"
 
 static bool slot_srgb(uint32_t slot)
 {
@@ -154,20 +157,21 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 			draws[i].tex_bits |= UMBRA_TEXBIT_VERTEX_COLOR;
 	}
 	VkDeviceSize bytes = 0, off = 0;
-	for (uint32_t i = 0; i < p->n; i++) bytes += (VkDeviceSize)tex[i]->width * tex[i]->height * 4;
+	for (uint32_t i = 0; i < p->n; i++) bytes += rnd_texture_chain_bytes(tex[i]->width, tex[i]->height);
 	if (p->n && (r = rnd_buffer_reserve(ctx, &s->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "slot staging", err)) != RND_OK)
 		goto done;
 	for (uint32_t i = 0; i < p->n; i++) {
 		char name[48];
 		snprintf(name, sizeof name, "slot %u texture %u", s->index, i);
-		if ((r = rnd_image_create(ctx, p->srgb[i] ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM, tex[i]->width,
-		                          tex[i]->height, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-		                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->textures[i], err)) != RND_OK)
+		uint32_t w = tex[i]->width, h = tex[i]->height;
+		if ((r = rnd_image_create_levels(ctx, p->srgb[i] ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM, w, h, 1,
+		                                 1, rnd_texture_levels(w, h),
+		                                 VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+		                                 VK_IMAGE_ASPECT_COLOR_BIT, name, &s->textures[i], err)) != RND_OK)
 			goto done;
 		s->texture_count = i + 1;
-		size_t sz = (size_t)tex[i]->width * tex[i]->height * 4;
-		memcpy((uint8_t *)s->staging.map + off, tex[i]->rgba, sz);
-		off += sz;
+		rnd_texture_build_chain(tex[i]->rgba, w, h, p->srgb[i], (uint8_t *)s->staging.map + off);
+		off += rnd_texture_chain_bytes(w, h);
 	}
 	write_sets(ctx, s, p);
 	*ntex = p->n;

@@ -95,11 +95,19 @@ enum rnd_result rnd_image_create(struct rnd_context *ctx, VkFormat format, uint3
                                  uint32_t samples, VkImageUsageFlags usage, VkImageAspectFlags aspect,
                                  const char *name, struct rnd_image_res *out, struct rnd_error *err)
 {
+	return rnd_image_create_levels(ctx, format, w, h, layers, samples, 1, usage, aspect, name, out, err);
+}
+
+enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h,
+                                        uint32_t layers, uint32_t samples, uint32_t levels, VkImageUsageFlags usage,
+                                        VkImageAspectFlags aspect, const char *name, struct rnd_image_res *out,
+                                        struct rnd_error *err)
+{
 	VkResult vr;
 	memset(out, 0, sizeof *out);
 	VkImageCreateInfo ici = {
 		.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, .imageType = VK_IMAGE_TYPE_2D, .format = format,
-		.extent = {w, h, 1}, .mipLevels = 1, .arrayLayers = layers, .samples = (VkSampleCountFlagBits)samples,
+		.extent = {w, h, 1}, .mipLevels = levels, .arrayLayers = layers, .samples = (VkSampleCountFlagBits)samples,
 		.tiling = VK_IMAGE_TILING_OPTIMAL, .usage = usage, .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
 		.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
 	};
@@ -127,7 +135,7 @@ enum rnd_result rnd_image_create(struct rnd_context *ctx, VkFormat format, uint3
 	VkImageViewCreateInfo vci = {
 		.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = out->img,
 		.viewType = layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
-		.format = format, .subresourceRange = {aspect, 0, 1, 0, layers},
+		.format = format, .subresourceRange = {aspect, 0, levels, 0, layers},
 	};
 	if ((vr = vkCreateImageView(ctx->device, &vci, NULL, &out->view)) != VK_SUCCESS) {
 		rnd_fail_vk(err, vr, "vkCreateImageView");

@@ -86,8 +86,10 @@ static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *e
 	if ((vr = vkCreateSampler(ctx->device, &sci, NULL, &p->shadow_sampler)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateSampler");
 	RND_NAME(ctx, VK_OBJECT_TYPE_SAMPLER, p->shadow_sampler, "umbra shadow sampler");
-	/* Material textures: glTF sampler wrap and filter modes; no mipmaps are built, so a
-	 * mipmapped minFilter reads as its base filter. */
+	/* Material textures: glTF sampler wrap and filter modes; every texture has its full mip
+	 * chain (renderer/texture.c), and a minFilter without mipmaps reads level 0 only. */
+	static const VkSamplerMipmapMode mipmode[3] = {VK_SAMPLER_MIPMAP_MODE_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST,
+	                                               VK_SAMPLER_MIPMAP_MODE_NEAREST};
 	static const VkSamplerAddressMode wrap[3] = {VK_SAMPLER_ADDRESS_MODE_REPEAT, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
 	                                             VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT};
 	for (uint32_t i = 0; i < RND_TEXTURE_SAMPLERS; i++) {
@@ -95,8 +97,8 @@ static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *e
 			.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
 			.magFilter = (i & 2) ? VK_FILTER_NEAREST : VK_FILTER_LINEAR,
 			.minFilter = (i & 1) ? VK_FILTER_NEAREST : VK_FILTER_LINEAR,
-			.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST, .addressModeU = wrap[i / 12], .addressModeV = wrap[(i / 4) % 3],
-			.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = 0.0f,
+			.mipmapMode = mipmode[i / 36], .addressModeU = wrap[(i / 12) % 3], .addressModeV = wrap[(i / 4) % 3],
+			.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = i / 36 == RND_MIP_NONE ? 0.0f : VK_LOD_CLAMP_NONE,
 		};
 		if ((vr = vkCreateSampler(ctx->device, &tci, NULL, &p->texture_samplers[i])) != VK_SUCCESS)
 			return rnd_fail_vk(err, vr, "vkCreateSampler (textures)");

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include "lod.h"
 #include "mesh.h"
+#include "texture.h"
 #include "upload.h"
 
 enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
@@ -88,19 +89,6 @@ void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, u
 		                     VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
 	}
-	for (uint32_t i = 0; i < n; i++) {
-		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-		VkBufferImageCopy region = {
-			.bufferOffset = off, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-			.imageExtent = {tex[i]->width, tex[i]->height, 1},
-		};
-		vkCmdCopyBufferToImage(cmd, s->staging.buf, s->textures[i].img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-		record_image_barrier(cmd, s->textures[i].img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-		                     VK_ACCESS_2_TRANSFER_WRITE_BIT,
-		                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-		off += (VkDeviceSize)tex[i]->width * tex[i]->height * 4;
-	}
+	for (uint32_t i = 0; i < n; i++)   /* each image's full mip chain, staged by material.c */
+		off += rnd_texture_record_upload(cmd, s->staging.buf, off, s->textures[i].img, tex[i]->width, tex[i]->height);
 }

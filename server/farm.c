@@ -17,6 +17,7 @@
 #include "api.h"
 #include "buf.h"
 #include "farm.h"
+#include "model_refs.h"
 #include "umbra/rnd.h"
 
 enum job_status { JOB_PENDING, JOB_OK, JOB_INVALID, JOB_FAILED, JOB_SKIPPED };
@@ -108,6 +109,45 @@ static int thumb_doc(const struct farm_job *j, const struct farm_opts *o, char *
 	return 0;
 }
 
+/* The parts of a model job: the model as "model", then every file it refers to (a .gltf's
+ * buffers and images, an .obj's .mtl and textures), read from the model's own directory with
+ * api/model_refs.c's rules and that directory as the root (nothing above it, no link out), each
+ * named by its reference, as a multipart request would carry them. An .obj's missing .mtl or
+ * texture is left out (the parse then warns); a .gltf's missing file is the job's error.
+ * 0, or -1 with err set. *parts is malloc'd; refs owns the files' bytes. */
+static int model_parts(const char *input, const uint8_t *bytes, size_t len, struct api_model_refs *refs,
+                       struct api_part **parts, size_t *nparts, char *err, size_t esize)
+{
+	static const enum api_model_format FMT[] = {API_MODEL_GLB, API_MODEL_GLTF, API_MODEL_OBJ, API_MODEL_STL,
+	                                            API_MODEL_PLY};
+	const char *dot = strrchr(input, '.'), *slash = strrchr(input, '/');
+	enum api_model_format fmt = API_MODEL_STL;
+	for (int i = 0; dot && MODEL_EXT[i]; i++)
+		if (!strcasecmp(dot + 1, MODEL_EXT[i])) fmt = FMT[i];
+	char root[PATH_MAX];
+	if (!slash) snprintf(root, sizeof root, ".");
+	else snprintf(root, sizeof root, "%.*s", slash == input ? 1 : (int)(slash - input), input);
+	struct api_ref_source src = {.root = root, .path = slash ? slash + 1 : input, .optional_obj_files = true};
+	int status;
+	char why[400];
+	memset(refs, 0, sizeof *refs);
+	if (api_model_refs_collect(bytes, len, fmt, &src, refs, &status, why, sizeof why) != API_OK) {
+		snprintf(err, esize, "%d %s: %s", status, input, why);
+		return -1;
+	}
+	*parts = calloc(1 + refs->count, sizeof **parts);
+	if (!*parts) {
+		snprintf(err, esize, "out of memory");
+		api_model_refs_release(refs);
+		return -1;
+	}
+	(*parts)[0] = (struct api_part){.name = "model", .data = bytes, .len = len};
+	for (size_t k = 0; k < refs->count; k++)
+		(*parts)[1 + k] = (struct api_part){refs->files[k].name, refs->files[k].data, refs->files[k].len};
+	*nparts = 1 + refs->count;
+	return 0;
+}
+
 /* Parses the job's document into *s and settles its output path. JOB_OK or the failure. */
 static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 {
@@ -130,8 +170,16 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 			free(bytes);
 			return JOB_INVALID;
 		}
-		struct api_part part = {.name = "model", .data = (const uint8_t *)bytes, .len = len};
-		ar = api_scene_parse_parts(doc, strlen(doc), &lim, &part, 1, s, &prob);
+		struct api_model_refs refs;
+		struct api_part *parts;
+		size_t nparts;
+		if (model_parts(j->input, (const uint8_t *)bytes, len, &refs, &parts, &nparts, r->error, sizeof r->error) < 0) {
+			free(bytes);
+			return JOB_INVALID;
+		}
+		ar = api_scene_parse_parts(doc, strlen(doc), &lim, parts, nparts, s, &prob);
+		free(parts);
+		api_model_refs_release(&refs);
 	} else {
 		const char *text = j->json ? j->json : bytes;
 		ar = api_scene_parse(text, j->json ? strlen(j->json) : len, &lim, s, &prob);

@@ -9,7 +9,9 @@
  * One renderer context with `threads` render slots and as many worker threads, each taking the
  * next job, rendering it and writing its file (renamed into place when complete), so every core
  * is busy and the device, pipelines and shadow atlas are set up once. A model job renders the
- * file with `"preset": "thumbnail"` (api/preset.h) as a multipart part. Progress goes to
+ * file with `"preset": "thumbnail"` (api/preset.h) as a multipart part, with the files it refers
+ * to (a .gltf's .bin and images, an .obj's .mtl and textures) read from the model's own
+ * directory as further parts (api/model_refs.h's rules, that directory as the root). Progress goes to
  * stderr: a bar (done/total, images/s, ETA) on a terminal, one line per finished job otherwise.
  * SIGINT / SIGTERM: no new job starts; the renders in flight finish and are written; the rest
  * are reported "skipped". The report (JSON lines, input order) has file, output, status (ok,

@@ -27,10 +27,14 @@ float visibility(uint i, vec3 n_geo, bool receive)
 
 void main()
 {
+	material_derivatives(v_uv);
 	umbra_material m = materials[pc.info.x];
 	vec4 bc = base_color(m);
 	vec3 n_geo = normalize(v_nrm);
 	if (!gl_FrontFacing) n_geo = -n_geo;
+	// N.X/Y/Z: the normal the beauty pass shades with (normal map included); shadows keep
+	// testing with the geometric one, as the beauty pass does.
+	vec3 N = material_normal(m, n_geo, has_tex(m, UMBRA_TEX_NORMAL));
 	bool receive = (pc.info.y & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	uint first = pc.info.z;
 	// One call site of visibility() in a loop the compiler keeps: written out once per light
@@ -42,7 +46,7 @@ void main()
 		vis[k] = k < count ? visibility(first + k, n_geo, receive) : 1.0;
 	if (first == 0u) {
 		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
-		o_aov0 = vec4(z, n_geo);
+		o_aov0 = vec4(z, N);
 		o_aov1 = vec4(bc.rgb, 1.0);
 		o_aov2 = vec4(vis[0], vis[1], vis[2], vis[3]);
 		o_aov3 = vec4(vis[4], vis[5], vis[6], vis[7]);

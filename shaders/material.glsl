@@ -1,6 +1,8 @@
 // shaders/material.glsl — what the main pass (shading.glsl) and the alpha-tested depth passes
-// (masked.frag) share about materials: texture coordinates per slot and the dither of alpha
-// mode BLEND. Included after umbra_shared.h.
+// (masked.frag) share about materials: texture coordinates per slot, texture reads with their
+// mip level, the dither of alpha mode BLEND, and (main and AOV passes: not where the includer
+// defines UMBRA_MATERIAL_DEPTH_PASS) the normal-mapped shading normal. Included after
+// umbra_shared.h (and, in the main passes, after normal_texture and v_tangent).
 
 // The uv that texture slot `slot` reads: KHR_texture_transform as two rows (identity when the
 // material has none).
@@ -8,6 +10,29 @@ vec2 material_uv(umbra_material m, uint slot, vec2 uv)
 {
 	vec4 r0 = m.uvx[2u * slot], r1 = m.uvx[2u * slot + 1u];
 	return vec2(dot(r0.xy, uv) + r0.z, dot(r1.xy, uv) + r1.z);
+}
+
+// The screen-space derivatives of the interpolated uv, taken once by material_derivatives()
+// at the top of main(), in uniform control flow, before any branch on the material. Textures
+// have mip chains, so the level comes from these: implicit derivatives inside `if (the
+// material has this texture)` are undefined where a 2x2 quad's helper lanes do not take the
+// branch, and on lavapipe a helper lane reads the material buffer as zeros, which put a
+// coarse level on every pixel along a triangle edge. Zero (never taken): level 0.
+vec2 material_dx = vec2(0.0), material_dy = vec2(0.0);
+
+void material_derivatives(vec2 uv)
+{
+	material_dx = dFdx(uv);
+	material_dy = dFdy(uv);
+}
+
+// Texture slot `slot` at uv (through the slot's transform), its gradients carried through
+// the same (affine) transform.
+vec4 material_texture(sampler2D s, umbra_material m, uint slot, vec2 uv)
+{
+	vec4 r0 = m.uvx[2u * slot], r1 = m.uvx[2u * slot + 1u];
+	mat2 t = mat2(r0.x, r1.x, r0.y, r1.y);
+	return textureGrad(s, material_uv(m, slot, uv), t * material_dx, t * material_dy);
 }
 
 // Alpha mode BLEND, dithered: an ordered 4x4 (Bayer) threshold per pixel, so a surface of
@@ -29,3 +54,23 @@ bool alpha_keep(umbra_material m, float alpha, vec2 frag)
 	if (m.tex.y == UMBRA_ALPHA_BLEND) return dither_keep(alpha, frag);
 	return true;
 }
+
+#ifndef UMBRA_MATERIAL_DEPTH_PASS
+// The shading normal: the normal map (tangent space, xy times normalTexture.scale) in the
+// frame of the interpolated tangent when `mapped`, else the geometric normal. The main pass
+// shades with it and the AOV pass writes it (N.X/Y/Z), so both show the same surface.
+vec3 material_normal(umbra_material m, vec3 n_geo, bool mapped)
+{
+	if (!mapped) return n_geo;
+	vec3 t = v_tangent.xyz - n_geo * dot(n_geo, v_tangent.xyz);
+	float tl = length(t);
+	if (tl < 1e-4) return n_geo;   // no usable tangent here (degenerate uvs)
+	t /= tl;
+	vec3 b = cross(n_geo, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+	vec3 tn = material_texture(normal_texture, m, UMBRA_TEX_NORMAL, v_uv).xyz * 2.0 - 1.0;
+	tn.xy *= m.params.z;
+	vec3 n = t * tn.x + b * tn.y + n_geo * tn.z;
+	float nl = length(n);
+	return nl > 1e-6 ? n / nl : n_geo;
+}
+#endif

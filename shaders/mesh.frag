@@ -5,37 +5,21 @@
 
 layout(location = 0) out vec4 o_color;
 
-// The shading normal: the normal map (tangent space, xy times normalTexture.scale) in the
-// frame of the interpolated tangent, else the geometric normal.
-vec3 shading_normal(umbra_material m, vec3 n_geo)
-{
-	if (!has_tex(m, UMBRA_TEX_NORMAL)) return n_geo;
-	vec3 t = v_tangent.xyz - n_geo * dot(n_geo, v_tangent.xyz);
-	float tl = length(t);
-	if (tl < 1e-4) return n_geo;   // no usable tangent here (degenerate uvs)
-	t /= tl;
-	vec3 b = cross(n_geo, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-	vec3 tn = texture(normal_texture, material_uv(m, UMBRA_TEX_NORMAL, v_uv)).xyz * 2.0 - 1.0;
-	tn.xy *= m.params.z;
-	vec3 n = t * tn.x + b * tn.y + n_geo * tn.z;
-	float nl = length(n);
-	return nl > 1e-6 ? n / nl : n_geo;
-}
-
 void main()
 {
+	material_derivatives(v_uv);
 	umbra_material m = materials[pc.info.x];
 	uint flags = pc.info.y;
 	vec4 bc = base_color(m);
 	vec3 n_geo = normalize(v_nrm);
 	// Two-sided: back faces shade with the flipped normal.
 	if (!gl_FrontFacing) n_geo = -n_geo;
-	vec3 N = shading_normal(m, n_geo);
+	vec3 N = material_normal(m, n_geo, has_tex(m, UMBRA_TEX_NORMAL));
 	vec3 V = frame.camera_pos.w > 0.5 ? -frame.camera_fwd.xyz : normalize(frame.camera_pos.xyz - v_pos);
 	vec3 base = bc.rgb;
 	float rough = m.emissive.a, metal = m.params.x;
 	if (has_tex(m, UMBRA_TEX_METAL_ROUGH)) {
-		vec4 mr = texture(metal_rough_texture, material_uv(m, UMBRA_TEX_METAL_ROUGH, v_uv));
+		vec4 mr = material_texture(metal_rough_texture, m, UMBRA_TEX_METAL_ROUGH, v_uv);
 		rough *= mr.g;   // glTF: G roughness, B metalness (linear)
 		metal *= mr.b;
 	}
@@ -52,11 +36,11 @@ void main()
 	// Occlusion darkens the ambient (indirect) light only: direct light has its shadows.
 	float ao = 1.0;
 	if (has_tex(m, UMBRA_TEX_OCCLUSION))
-		ao = 1.0 + m.params.w * (texture(occlusion_texture, material_uv(m, UMBRA_TEX_OCCLUSION, v_uv)).r - 1.0);
+		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv).r - 1.0);
 	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * metal) * ao;
 	vec3 emissive = m.emissive.rgb;
 	if (has_tex(m, UMBRA_TEX_EMISSIVE))
-		emissive *= texture(emissive_texture, material_uv(m, UMBRA_TEX_EMISSIVE, v_uv)).rgb;
+		emissive *= material_texture(emissive_texture, m, UMBRA_TEX_EMISSIVE, v_uv).rgb;
 	vec3 radiance = (ambient + lit + emissive) * frame.params.x;
 
 	const uint debug = SC_DEBUG;

@@ -444,7 +444,7 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 vec4 base_color(umbra_material m)
 {
 	vec4 c = m.base_color;
-	if (has_tex(m, UMBRA_TEX_BASE)) c *= texture(base_texture, material_uv(m, UMBRA_TEX_BASE, v_uv));
+	if (has_tex(m, UMBRA_TEX_BASE)) c *= material_texture(base_texture, m, UMBRA_TEX_BASE, v_uv);
 	if ((SC_TEXTURES & UMBRA_TEXBIT_VERTEX_COLOR) != 0u) c *= v_color;
 	if (SC_MASKED != 0u && m.tex.y != UMBRA_ALPHA_OPAQUE && !alpha_keep(m, c.a, gl_FragCoord.xy)) discard;
 	return c;

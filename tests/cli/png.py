@@ -5,6 +5,7 @@ the standard library only, for the shell suites.
   png.py size FILE             -> "W H"
   png.py px FILE X Y           -> "R G B A" of pixel (X, Y) (A = 255 without alpha)
   png.py distinct FILE         -> number of distinct colours
+  png.py tint FILE             -> "RED BLUE": pixels whose red (blue) beats both other channels by 40
 """
 import struct, sys, zlib
 
@@ -54,6 +55,10 @@ def main():
         print(*(list(p) + ([255] if bpp == 3 else [])))
     elif cmd == 'distinct':
         print(len({bytes(r[i:i + bpp]) for r in rows for i in range(0, w * bpp, bpp)}))
+    elif cmd == 'tint':
+        px = [r[i:i + 3] for r in rows for i in range(0, w * bpp, bpp)]
+        print(sum(1 for p in px if p[0] > p[1] + 40 and p[0] > p[2] + 40),
+              sum(1 for p in px if p[2] > p[0] + 40 and p[2] > p[1] + 40))
 
 
 if __name__ == '__main__':

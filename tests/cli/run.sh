@@ -135,6 +135,67 @@ check "thumb: report carries a model's material warnings" \
 check "thumb: no warnings for a model without such data" grep -q '"file":"[^"]*cube.obj".*"warnings":null' "$T/thumbw/report.jsonl"
 check "thumb: summary line" grep -q '3 ok, 1 invalid, 0 failed, 0 skipped of 4' "$T/thumb.err"
 
+# ---- thumb: models with their files beside them (a .gltf's .bin and image, an .obj's .mtl) ----
+# The farm reads what a model refers to from the model's own directory (that directory is the
+# root: a reference above it is the job's 400). A red-textured glTF box must come out red, a
+# blue-.mtl OBJ cube blue; an .obj whose .mtl is missing still renders, with a warning.
+mkdir -p "$T/multi/tex"
+python3 - "$T/multi" <<'PY'
+import json, struct, sys, zlib
+d = sys.argv[1]
+def png(path, rgb, n=4):
+    raw = b''.join(b'\0' + bytes(rgb + (255,)) * n for _ in range(n))
+    ch = lambda k, b: struct.pack('>I', len(b)) + k + b + struct.pack('>I', zlib.crc32(k + b))
+    open(path, 'wb').write(b'\x89PNG\r\n\x1a\n' + ch(b'IHDR', struct.pack('>IIBBBBB', n, n, 8, 6, 0, 0, 0))
+                           + ch(b'IDAT', zlib.compress(raw)) + ch(b'IEND', b''))
+png(d + '/tex/red.png', (255, 0, 0))
+# a unit cube, 12 triangles, flat normals, uv 0
+P, N = [], []
+for ax in range(3):
+    for s in (-1, 1):
+        q = [[0, 0, 0] for _ in range(4)]
+        for k, (a, b) in enumerate(((-1, -1), (1, -1), (1, 1), (-1, 1))):
+            q[k][ax], q[k][(ax + 1) % 3], q[k][(ax + 2) % 3] = s, a, b
+        tri = (0, 1, 2, 0, 2, 3) if s > 0 else (0, 2, 1, 0, 3, 2)
+        for t in tri:
+            P += [c * 0.5 for c in q[t]]
+            n = [0, 0, 0]; n[ax] = s; N += n
+nv = len(P) // 3
+binary = struct.pack('<%df' % len(P), *P) + struct.pack('<%df' % len(N), *N) + bytes(8 * nv)
+open(d + '/box data.bin', 'wb').write(binary)
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "material": 0}]}],
+     "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+     "textures": [{"source": 0}], "images": [{"uri": "tex/red.png"}],
+     "buffers": [{"byteLength": len(binary), "uri": "box%20data.bin"}],
+     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 12 * nv},
+                     {"buffer": 0, "byteOffset": 12 * nv, "byteLength": 12 * nv},
+                     {"buffer": 0, "byteOffset": 24 * nv, "byteLength": 8 * nv}],
+     "accessors": [{"bufferView": 0, "componentType": 5126, "count": nv, "type": "VEC3",
+                    "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
+                   {"bufferView": 1, "componentType": 5126, "count": nv, "type": "VEC3"},
+                   {"bufferView": 2, "componentType": 5126, "count": nv, "type": "VEC2"}]}
+json.dump(g, open(d + '/box.gltf', 'w'))
+g["buffers"][0]["uri"] = "../box%20data.bin"
+json.dump(g, open(d + '/tex/escape.gltf', 'w'))
+PY
+{ echo 'mtllib cube.mtl'; echo 'usemtl blue'; cat "$T/models/cube.obj"; } >"$T/multi/cube.obj"
+printf 'newmtl blue\nKd 0 0 1\n' >"$T/multi/cube.mtl"
+{ echo 'mtllib gone.mtl'; cat "$T/models/cube.obj"; } >"$T/multi/lost.obj"
+cli thumb "$T/multi/box.gltf" "$T/multi/cube.obj" "$T/multi/lost.obj" "$T/multi/tex/escape.gltf" \
+	-o "$T/mthumbs/" --size 64 --no-progress 2>"$T/mthumbs.err"
+rc=$?
+check "thumb multi-file: exit 2 (only the escaping glTF is invalid)" [ $rc = 2 ]
+red=$($PNG tint "$T/mthumbs/box.png" 2>/dev/null | cut -d' ' -f1)
+check "thumb multi-file: the .gltf with a separate .bin and PNG renders red (${red:-none} red pixels)" \
+	[ "${red:-0}" -gt 300 ]
+blue=$($PNG tint "$T/mthumbs/cube.png" 2>/dev/null | cut -d' ' -f2)
+check "thumb multi-file: the .obj reads its .mtl: blue (${blue:-none} blue pixels)" [ "${blue:-0}" -gt 300 ]
+check "thumb multi-file: an .obj without its .mtl renders, and the report says so" \
+	sh -c "[ -s '$T/mthumbs/lost.png' ] && grep -q '\"file\":\"[^\"]*lost.obj\".*\"status\":\"ok\".*gone.mtl' '$T/mthumbs/report.jsonl'"
+check "thumb multi-file: a reference above the model's directory is the job's 400" \
+	grep -q '"file":"[^"]*escape.gltf".*"status":"invalid".*"error":"400 .*box%20data.bin' "$T/mthumbs/report.jsonl"
+
 # --progress forces the bar (as on a terminal): done/total, images/s, ETA, on one line.
 cli thumb "$T/models/cube.obj" "$T/models/tetra.stl" -o "$T/bar" --size 32 --progress 2>"$T/bar.err"
 check "thumb --progress: a bar with done/total, images/s and ETA" \

@@ -72,6 +72,7 @@ struct mglb {
 	float y;                     /* node translation */
 	const float *color;          /* COLOR_0 RGBA float per vertex, or NULL */
 	const float *tangent;        /* TANGENT xyzw per vertex, or NULL */
+	const char *output;          /* the scene's output members, or NULL: no tone map, no MSAA */
 };
 
 static uint8_t *glb_of(const struct mglb *in, size_t *len)
@@ -180,9 +181,10 @@ static bool render_quad(int line, struct rnd_image *img, const struct mglb *g, b
 	                        "'height':%.9g},"
 	                        "'environment':{'background':[0,0,0],'ambient':{'intensity':0}},"
 	                        "'objects':[{'shape':'model','format':'glb','data':'%s'}],"
-	                        "'lights':[%s],'output':{'tonemap':'none','msaa':1}}",
+	                        "'lights':[%s],'output':{%s}}",
 	                        MW, MH, below ? -5 : 5, MORTHO, enc,
-	                        light ? "{'type':'directional','direction':[0,-1,0],'intensity':3.14159265}" : "");
+	                        light ? "{'type':'directional','direction':[0,-1,0],'intensity':3.14159265}" : "",
+	                        g->output ? g->output : "'tonemap':'none','msaa':1");
 	free(enc);
 	return ok;
 }
@@ -322,6 +324,36 @@ TEST(materials_normal_map_tilts_n_dot_l)
 		CHECK(fabs(got - cases[k].want) < 0.02, "%s: %.4f, want %.4f", cases[k].label, got, cases[k].want);
 		rnd_image_release(&img);
 	}
+}
+
+/* The AOV normal (N.X/Y/Z) is the mapped normal the beauty pass shades with: the texel
+ * (218, 128, 218) is (0.7071, 0.0039, 0.7071) in tangent space; with u along +x the frame is
+ * t = +x, b = -z, n = +y, so N = (0.7071, 0.7071, -0.0039) — not the quad's (0, 1, 0). */
+TEST(materials_normal_map_in_the_normal_aov)
+{
+	static const uint8_t tex[4] = {218, 128, 218, 255};
+	struct mglb g = {.material = "{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"normalTexture\":{\"index\":0}}",
+	                 .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+	                 .output = "'format':'exr','aovs':['normal'],'msaa':1"};
+	add_png(&g, tex, 1, 1);
+	struct rnd_image img;
+	bool ok = render_quad(__LINE__, &img, &g, true, false);
+	free_pngs(&g);
+	if (!ok) return;
+	const float *n[3] = {NULL, NULL, NULL};
+	for (uint32_t i = 0; i < img.aov_count; i++)
+		for (int c = 0; c < 3; c++)
+			if (!strcmp(img.aov_names[i], (const char *[]){"N.X", "N.Y", "N.Z"}[c])) n[c] = img.aov[i];
+	if (!n[0] || !n[1] || !n[2]) {
+		CHECK(0, "no N.X/Y/Z planes (%u AOVs)", img.aov_count);
+		rnd_image_release(&img);
+		return;
+	}
+	size_t k = (size_t)(MH / 2 + 5) * MW + MW / 2 + 7;
+	printf("    N at the quad: %.4f %.4f %.4f (want 0.7071 0.7071 -0.0039)\n", n[0][k], n[1][k], n[2][k]);
+	CHECK(fabs(n[0][k] - 0.7071) < 0.01 && fabs(n[1][k] - 0.7071) < 0.01 && fabs(n[2][k] + 0.0039) < 0.01,
+	      "N %.4f %.4f %.4f, want the mapped (0.7071, 0.7071, -0.0039)", n[0][k], n[1][k], n[2][k]);
+	rnd_image_release(&img);
 }
 
 /* ---- occlusion ---- */
@@ -530,4 +562,60 @@ TEST(materials_blend_dithered_half_coverage_half_shadow)
 	rnd_image_release(&op);
 	rnd_image_release(&bl);
 	rnd_image_release(&bl2);
+}
+
+/* ---- mipmaps ---- */
+
+/* A 256^2 black/white checker of single texels (sRGB 0 and 255: linear 0 and 1) as the
+ * emissive texture of the quad, unlit: ~58 pixels show 256 texels, 4.4 texels a pixel. With
+ * the mip chain every pixel reads a level where the checker has averaged out: linear 0.5
+ * (sRGB 188) everywhere. Read from level 0 only (minFilter LINEAR, no mipmaps: what every
+ * sampler did before), the pixels alias between black and white: the same mean over the
+ * quad, but single pixels far from it. Two renders give the same bytes. */
+TEST(materials_mipmaps_average_a_fine_checker)
+{
+	enum { CW = 256 };
+	uint8_t *tex = malloc((size_t)CW * CW * 4);
+	for (int y = 0; y < CW; y++)
+		for (int x = 0; x < CW; x++) {
+			uint8_t v = (x + y) & 1 ? 255 : 0, *p = tex + ((size_t)y * CW + x) * 4;
+			p[0] = p[1] = p[2] = v;
+			p[3] = 255;
+		}
+	static const char *const samplers[3] = {"[{\"wrapS\":33071,\"wrapT\":33071}]",
+	                                        "[{\"wrapS\":33071,\"wrapT\":33071}]",
+	                                        "[{\"minFilter\":9729,\"wrapS\":33071,\"wrapT\":33071}]"};
+	struct rnd_image img[3];
+	int made = 0;
+	for (; made < 3; made++) {
+		struct mglb g = {.material = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0},"
+		                             "\"emissiveFactor\":[1,1,1],\"emissiveTexture\":{\"index\":0}}",
+		                 .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = samplers[made]};
+		add_png(&g, tex, CW, CW);
+		bool ok = render_quad(__LINE__, &img[made], &g, false, false);
+		free_pngs(&g);
+		if (!ok) break;
+	}
+	free(tex);
+	if (made == 3) {
+		double mean[3] = {0, 0, 0}, dev[3] = {0, 0, 0};
+		for (int k = 0; k < 3; k++) {
+			int n = 0;
+			for (int j = 0; j < 35; j++)
+				for (int i = 0; i < 35; i++, n++) {
+					double v = lin_at(&img[k], false, -0.85 + 0.05 * i, -0.85 + 0.05 * j, 1);
+					mean[k] += v;
+					dev[k] = fmax(dev[k], fabs(v - 0.5));
+				}
+			mean[k] /= n;
+		}
+		printf("    mipmapped: mean %.3f, largest |pixel - 0.5| %.3f; level 0 only: mean %.3f, largest %.3f\n",
+		       mean[0], dev[0], mean[2], dev[2]);
+		CHECK(fabs(mean[0] - 0.5) < 0.03, "mipmapped checker mean %.3f, want 0.5 (linear)", mean[0]);
+		CHECK(dev[0] < 0.06, "a mipmapped pixel is %.3f from the checker's average", dev[0]);
+		CHECK(dev[2] > 0.2, "minFilter LINEAR (no mipmaps) should read level 0 and alias; largest deviation %.3f",
+		      dev[2]);
+		CHECK(!memcmp(img[0].pixels, img[1].pixels, img[0].stride * img[0].height), "two renders differ");
+	}
+	for (int k = 0; k < made; k++) rnd_image_release(&img[k]);
 }

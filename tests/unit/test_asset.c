@@ -11,6 +11,7 @@
 #include <unistd.h>
 #include "asset.h"
 #include "model.h"
+#include "model_refs.h"
 #include "test.h"
 
 static void put(const char *dir, const char *name, const char *text)
@@ -185,4 +186,37 @@ TEST(model_files_served_and_keyed)
 	      "%d %s", st, err);
 	api_model_release(ma);
 	api_model_release(mb);
+}
+
+/* An .obj by path whose .mtl is missing: a 400 naming it for the daemon; with
+ * optional_obj_files (umbra-render thumb) it is left out with a warning, and a present .mtl and
+ * its texture are read from the model's directory. */
+TEST(model_refs_optional_obj_files)
+{
+	char base[] = "/tmp/umbra-refs-XXXXXX", root[300];
+	REQUIRE(mkdtemp(base));
+	make_tree(base, root, sizeof root);
+	put(root, "blue.mtl", "newmtl b\nKd 0 0 1\nmap_Kd sub/a.txt\n");
+	static const char lost[] = "mtllib gone.mtl\nv 0 0 0\n", found[] = "mtllib blue.mtl\nv 0 0 0\n";
+	struct api_model_refs r;
+	int st;
+	char err[400];
+	struct api_ref_source src = {.root = root, .path = "m.obj"};
+	CHECK(api_model_refs_collect((const uint8_t *)lost, strlen(lost), API_MODEL_OBJ, &src, &r, &st, err, sizeof err) ==
+	      API_ERR && st == 400 && strstr(err, "gone.mtl"), "%d %s", st, err);
+	api_model_refs_release(&r);
+	src.optional_obj_files = true;
+	CHECK(api_model_refs_collect((const uint8_t *)lost, strlen(lost), API_MODEL_OBJ, &src, &r, &st, err, sizeof err) ==
+	      API_OK && r.count == 0 && strstr(r.warning, "gone.mtl"), "%d %s / %s", st, err, r.warning);
+	api_model_refs_release(&r);
+	CHECK(api_model_refs_collect((const uint8_t *)found, strlen(found), API_MODEL_OBJ, &src, &r, &st, err,
+	                             sizeof err) == API_OK && r.count == 2 && !strcmp(r.files[1].name, "sub/a.txt"),
+	      "%d %s: %zu files", st, err, r.count);
+	api_model_refs_release(&r);
+	/* Still no escape: a .mtl above the root is a 400 either way. */
+	static const char up[] = "mtllib ../outside/secret.txt\n";
+	CHECK(api_model_refs_collect((const uint8_t *)up, strlen(up), API_MODEL_OBJ, &src, &r, &st, err, sizeof err) ==
+	      API_ERR && st == 400, "%d %s", st, err);
+	api_model_refs_release(&r);
+	remove_tree(base);
 }

@@ -79,6 +79,10 @@ enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK, RND_ALPHA_BLEND };
 enum rnd_texture_slot { RND_TEX_BASE, RND_TEX_METAL_ROUGH, RND_TEX_NORMAL, RND_TEX_OCCLUSION, RND_TEX_EMISSIVE,
                         RND_TEX_SLOTS };
 enum rnd_wrap { RND_WRAP_REPEAT, RND_WRAP_CLAMP, RND_WRAP_MIRROR };
+/* Between mip levels (every texture gets its full chain, built at upload): linear (glTF's
+ * *_MIPMAP_LINEAR and an absent minFilter), none (minFilter NEAREST or LINEAR: level 0 only),
+ * nearest (*_MIPMAP_NEAREST). */
+enum rnd_mip { RND_MIP_LINEAR, RND_MIP_NONE, RND_MIP_NEAREST };
 
 /* A decoded texture: RGBA8, rows top to bottom, as stored in the file. The slot that uses it
  * says how it is read: base colour and emissive as sRGB (alpha linear), the others linear. */
@@ -111,6 +115,7 @@ struct rnd_material {
 	struct rnd_texture_sampling {
 		uint8_t wrap_s, wrap_t;             /* enum rnd_wrap */
 		bool mag_nearest, min_nearest;
+		uint8_t mip;                        /* enum rnd_mip */
 		bool transformed;                   /* KHR_texture_transform: uv' = M (u, v, 1) */
 		float transform[6];                 /* rows of M: (m00 m01 m02), (m10 m11 m12) */
 	} sampling[RND_TEX_SLOTS];
@@ -376,7 +381,8 @@ uint32_t rnd_context_validation_messages(const struct rnd_context *ctx);
  * admission by memory (umbrad --max-memory) and for limits that no retry can cure. Bytes are
  * upper estimates of what the render holds at its peak. */
 struct rnd_estimate {
-	uint64_t device_bytes;        /* targets, AOV images, readback buffer, geometry, shadow scratch
+	uint64_t device_bytes;        /* targets, AOV images, readback buffer, geometry, shadow scratch,
+	                                 material textures with their mip chains (image + staging)
 	                                 (device memory; on a CPU driver such as lavapipe, host memory) */
 	uint64_t host_bytes;          /* the returned image (colour + AOV planes) and its encoding */
 	uint64_t largest_allocation;  /* the largest single buffer or image */
