@@ -161,6 +161,15 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// Search radius: the widest penumbra a blocker at the light's near plane could cast here, capped.
 	float search = penumbra_texels(v, size, vec4(v.params.z), zr, texel).x;
 	search = clamp(search, 1.0, L.shadow_params.y);
+	// penumbra_texels of a stored depth d is affine in d in both projections (perspective:
+	// 1 / zb = 1/n - d (f - n) / (n f); orthographic: zb = n + d (f - n)), so the reach test
+	// of a tap is one multiply-add per texel instead of two divisions (view_distance and the
+	// penumbra) per texel: reach(d) = r0 - r1 d, same values up to rounding.
+	float n = v.params.z, f = v.params.w;
+	float k = size / texel;
+	float r0 = is_persp(v) ? k * (zr / n - 1.0) : k * (zr - n);
+	float r1 = is_persp(v) ? k * zr * (f - n) / (n * f) : k * (f - n);
+	r0 += 1.5;
 	float blockers = 0.0, sum_d = 0.0;
 	// Texels of the receiver's own plane must not count as blockers: compare against the
 	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
@@ -172,9 +181,7 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	for (int i = 0; i < 25; i++) {
 		vec2 off = i == 0 ? vec2(0.0) : poisson(i < 9 ? (i - 1) * 4 + 1 : (i - 9) * 2) * (i < 9 ? close : search);
 		vec4 d = gather_tile(rect, p + off);
-		vec4 zb = vec4(view_distance(v, d.x), view_distance(v, d.y), view_distance(v, d.z), view_distance(v, d.w));
-		vec4 reach = penumbra_texels(v, size, zb, zr, texel) + 1.5;
-		vec4 b = step(d, vec4(ref + dot(grad, off) - slack)) * step(vec4(length(off)), reach);
+		vec4 b = step(d, vec4(ref + dot(grad, off) - slack)) * step(vec4(length(off)), r0 - r1 * d);
 		blockers += dot(b, vec4(1.0));
 		sum_d += dot(b, d);
 	}
