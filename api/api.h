@@ -84,6 +84,7 @@ struct api_scene {
 	void *models_;
 	const uint32_t *object_source_; /* document object index of each scene.objects[i] (NULL: i) */
 	const char *views_key_;         /* "views" / "turntable" / NULL */
+	unsigned png_only_;             /* output members given that only a PNG answer uses (scene_views.c) */
 };
 
 /* Parses and validates a scene document. On failure fills p (400: malformed / wrong type /

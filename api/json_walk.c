@@ -125,7 +125,7 @@ const char *api_type_name(const json_t *v)
 
 /* ---- unknown members ---- */
 
-static bool is_free_member(const char *key)
+bool api_free_member(const char *key)
 {
 	return !strcmp(key, "extras") || !strncmp(key, "x-", 2);
 }
@@ -166,7 +166,7 @@ int api_check_members(struct pctx *c, json_t *obj, const char *const *list, cons
 	const char *key;
 	json_t *v;
 	json_object_foreach(obj, key, v) {
-		if (is_free_member(key) || in_list(key, list) || in_list(key, list2)) continue;
+		if (api_free_member(key) || in_list(key, list) || in_list(key, list2)) continue;
 		/* Suggest a member within 2 edits, fewer for short names ("x" is not a typo of "up"). */
 		const char *best = NULL;
 		int bestd = (int)strlen(key) / 2 + 2;

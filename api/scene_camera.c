@@ -20,9 +20,22 @@ int api_parse_camera(struct pctx *c, json_t *j, struct rnd_camera *cam)
 	static const char *const fits[] = {"scene", "objects", NULL};
 	static const struct range fov = {0, 180, true, true}, ev = {-64, 64, false, false},
 	                          margin = {0, 1, false, true};
-	int type = 0, fit = -1, rc;
+	/* A view keeps the root camera's type unless it gives its own (scene_views.c). */
+	int type = cam->type == RND_CAMERA_ORTHOGRAPHIC, fit = -1, rc;
 	if (api_get_enum(c, j, "type", types, &type) < 0 || api_get_enum(c, j, "fit", fits, &fit) < 0) return -1;
 	cam->type = type ? RND_CAMERA_ORTHOGRAPHIC : RND_CAMERA_PERSPECTIVE;
+	/* Members of the other projection, or a placement that fit replaces, would be dropped: the
+	 * document contradicts itself (as direction without fit). */
+	const char *other = type ? "fov_y" : "height";
+	if (json_object_get(j, other))
+		return api_fail_at(c, other, type ? "fov_y is only used by a perspective camera; this camera is "
+		                   "orthographic, framed by height" : "height is only used by an orthographic camera "
+		                   "(type \"orthographic\"); this camera is perspective, framed by fov_y");
+	static const char *const placed[] = {"position", "target", NULL};
+	for (int k = 0; fit >= 0 && placed[k]; k++)
+		if (json_object_get(j, placed[k]))
+			return api_fail_at(c, placed[k], "%s is not used with fit: fit places the camera along direction "
+			                   "(give position and target without fit instead)", placed[k]);
 	if (api_get_vec(c, j, "position", cam->position, 3, 3, 0) < 0 ||
 	    api_get_vec(c, j, "target", cam->target, 3, 3, 0) < 0 ||
 	    api_get_vec(c, j, "up", cam->up, 3, 3, V_NONZERO) < 0 ||
@@ -30,7 +43,7 @@ int api_parse_camera(struct pctx *c, json_t *j, struct rnd_camera *cam)
 	    api_get_float(c, j, "exposure", &ev, &cam->exposure) < 0)
 		return -1;
 	if ((rc = api_get_float(c, j, "height", &R_POS, &cam->height)) < 0) return -1;
-	if (type == 1 && !rc) return api_fail_at(c, "height", "an orthographic camera requires height (world units "
+	if (type == 1 && !rc && !(cam->height > 0)) return api_fail_at(c, "height", "an orthographic camera requires height (world units "
 	                                     "covered by the image height)");
 	double nr = 0, fr = 0;
 	int has_near = api_get_num(c, j, "near", &R_POS, &nr), has_far;

@@ -82,6 +82,8 @@ void api_defer(struct pctx *c, bool unsupported, const char *key, const char *fm
 void api_warn(struct pctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* "an object", "a number"...: for messages. */
 const char *api_type_name(const json_t *v);
+/* `extras` and `x-*`: members any object may carry, never checked. */
+bool api_free_member(const char *key);
 /* Rejects members of obj named in neither list (suggesting a near miss). `what` names obj. */
 int api_check_members(struct pctx *c, json_t *obj, const char *const *list, const char *const *list2,
                       const char *what);
@@ -172,5 +174,11 @@ int api_parse_environment(struct pctx *c, json_t *j, struct rnd_environment *env
 int api_parse_shadow(struct pctx *c, json_t *j, struct rnd_shadow *s, const char *what);
 /* The root `shadows` (object or boolean) over the renderer's defaults. */
 int api_parse_root_shadow(struct pctx *c, json_t *root, struct rnd_shadow *s);
+/* After the lights: shadow settings that contradict their own light (400: `directional` on a
+ * spot or point light's shadow, contact shadows asked of a light whose shadows are off), and
+ * warnings (api_warn) for settings no light uses (pcf_radius without pcf, vsm without a moment
+ * filter, a light size without pcss, contact tuning with contact off, a root default that
+ * every light overrides or none can use). */
+int api_check_shadow_use(struct pctx *c, json_t *root, const struct rnd_scene *sc);
 
 #endif

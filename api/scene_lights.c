@@ -103,7 +103,7 @@ int api_parse_environment(struct pctx *c, json_t *j, struct rnd_environment *env
 int api_parse_lights(struct pctx *c, json_t *root, struct rnd_scene *sc, const struct rnd_shadow *root_shadow)
 {
 	json_t *lights = json_object_get(root, "lights");
-	if (!lights) return 0;
+	if (!lights) return api_check_shadow_use(c, root, sc);
 	if (!json_is_array(lights))
 		return api_fail_at(c, "lights", "lights must be an array, not %s", api_type_name(lights));
 	size_t n = json_array_size(lights);
@@ -124,5 +124,5 @@ int api_parse_lights(struct pctx *c, json_t *root, struct rnd_scene *sc, const s
 	if (rc) return -1;
 	sc->lights = ls;
 	sc->light_count = (uint32_t)n;
-	return 0;
+	return api_check_shadow_use(c, root, sc);
 }

@@ -258,6 +258,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
 	memcpy(s->warnings, c.warnings, sizeof s->warnings);
+	api_set_pixels(s);   /* again: the format's own warnings follow the document's */
 	*out = s;
 	return API_OK;
 }

@@ -6,10 +6,16 @@
  */
 #include <math.h>
 #include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
 #include "scene_internal.h"
 
 static const char *const OUTPUT_MEMBERS[] = {"format", "bit_depth", "transparent", "tonemap", "msaa", "aovs",
                                              "debug", "debug_light", "png_level", NULL};
+/* Output members that only a PNG answer uses, and why an EXR has no use for them. */
+static const char *const PNG_ONLY[] = {"bit_depth", "tonemap", "png_level", NULL};
+static const char *const PNG_ONLY_WHY[] = {"a half-float image; bit_depth 16 is for PNG",
+                                           "linear scene-referred; tonemap is for PNG", "zlib level of a PNG"};
 static const char *const TURNTABLE_MEMBERS[] = {"frames", "elevation", "distance", NULL};
 
 static int parse_views(struct pctx *c, json_t *views, struct rnd_scene *sc)
@@ -71,6 +77,14 @@ int api_parse_cameras(struct pctx *c, json_t *root, struct rnd_scene *sc, struct
 		return api_fail_at(c, "camera", "camera is required (unless views or turntable gives the cameras)");
 	}
 	if (views && turn) return api_fail_at(c, "turntable", "turntable cannot be combined with views");
+	/* The turntable places its own perspective cameras; of the root camera it takes fov_y and
+	 * exposure. Anything else there is valid but unused: said, not dropped silently. */
+	static const char *const unused[] = {"type", "position", "target", "up", "height", "near", "far", "fit",
+	                                     "direction", "margin", NULL};
+	for (int k = 0; turn && cam && unused[k]; k++)
+		if (json_object_get(cam, unused[k]) && (k || sc->camera.type == RND_CAMERA_ORTHOGRAPHIC))
+			api_warn(c, "/camera/%s: not used by the turntable, whose perspective cameras circle the objects "
+			         "(it takes fov_y and exposure from camera)", unused[k]);
 	if (views && parse_views(c, views, sc) < 0) return -1;
 	if (turn && parse_turntable(c, root, tt) < 0) return -1;
 	return 0;
@@ -148,9 +162,16 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 	if ((rc = api_get_enum(c, j, "debug", debugs, &e)) < 0) return -1;
 	if (rc) o->debug = debug_values[e];
 	if (api_get_u32(c, j, "debug_light", 0, UINT32_MAX, &o->debug_light) < 0) return -1;
+	if (json_object_get(j, "debug_light") && o->debug != RND_DEBUG_SHADOW)
+		return api_fail_at(c, "debug_light", "debug_light is only used with debug \"shadow\" (it names the light "
+		                   "whose visibility that view shows)");
 	long long lvl;
 	if ((rc = api_get_int(c, j, "png_level", -1, 9, &lvl)) < 0) return -1;
 	if (rc) s->png_level = (int)lvl;
+	for (int k = 0; PNG_ONLY[k]; k++)
+		if (json_object_get(j, PNG_ONLY[k]) && (k != 0 || s->bit_depth != 8) &&
+		    (k != 1 || o->tonemap != RND_TONEMAP_NONE))
+			s->png_only_ |= 1u << k;
 	json_t *a = json_object_get(j, "aovs");
 	if (a) {
 		size_t old = api_ptr_push(c, "aovs");
@@ -177,8 +198,33 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 	return 0;
 }
 
+/* Says, in s->warnings, which PNG-only output members an EXR answer leaves unused, and takes
+ * the sentence back when the answer becomes a PNG again (the format is chosen last: by
+ * output.format, or by Accept / the CLI's -o name through api_scene_set_format). A warning,
+ * not an error: the same document may be answered in either format. */
+static void sync_png_only(struct api_scene *s)
+{
+	for (int k = 0; PNG_ONLY[k]; k++) {
+		if (!(s->png_only_ & (1u << k))) continue;
+		char line[160];
+		snprintf(line, sizeof line, "/output/%s: not used, the answer is EXR (%s)", PNG_ONLY[k], PNG_ONLY_WHY[k]);
+		char *at = strstr(s->warnings, line);
+		size_t n = strlen(s->warnings), len = strlen(line);
+		if (s->format == API_FORMAT_EXR && !at && n + 2 + len < sizeof s->warnings) {
+			snprintf(s->warnings + n, sizeof s->warnings - n, "%s%s", n ? "; " : "", line);
+		} else if (s->format != API_FORMAT_EXR && at) {
+			/* Cut the sentence with the separator next to it ("; " before, or after when first). */
+			char *from = at, *to = at + len;
+			if (from > s->warnings) from -= 2;
+			else if (!strncmp(to, "; ", 2)) to += 2;
+			memmove(from, to, strlen(to) + 1);
+		}
+	}
+}
+
 void api_set_pixels(struct api_scene *s)
 {
+	sync_png_only(s);
 	if (s->format == API_FORMAT_EXR) s->scene.output.pixels = RND_PIXELS_RGBA32F;
 	else s->scene.output.pixels = s->bit_depth == 16 ? RND_PIXELS_RGBA16 : RND_PIXELS_RGBA8;
 }

@@ -279,6 +279,29 @@ static const struct bad bad_docs[] = {
 	{"{" C ",'objects':[{'shape':'sphere','segments':10000}]}", 422, "/objects/0/segments", "triangles"},
 	{"{" C ",'objects':[{'shape':'sphere','segments':4000},{'shape':'sphere','segments':4000}]}", 422, "/objects/1",
 	 "more than 20000000 triangles"},
+	/* Members the document's own structure makes unused (issue 13 item 4): a 400 at the member,
+	 * as direction without fit. */
+	{"{'camera':{'fit':'scene','position':[1,2,3]},'objects':[]}", 400, "/camera/position", "not used with fit"},
+	{"{'camera':{'fit':'objects','target':[0,0,0]},'objects':[]}", 400, "/camera/target", "not used with fit"},
+	{"{'camera':{'position':[0,0,5],'height':2},'objects':[]}", 400, "/camera/height",
+	 "only used by an orthographic camera"},
+	{"{'camera':{'type':'orthographic','height':2,'fov_y':30},'objects':[]}", 400, "/camera/fov_y",
+	 "only used by a perspective camera"},
+	/* a view keeps the root camera's orthographic type, so its fov_y would be dropped */
+	{"{'camera':{'type':'orthographic','height':2,'position':[0,0,5]},'objects':[],'views':[{'fov_y':30}]}", 400,
+	 "/views/0/fov_y", "only used by a perspective camera"},
+	{BASE ",'lights':[{'type':'spot','position':[0,2,0],'direction':[0,-1,0],'shadow':{'directional':"
+	 "{'cascades':2}}}]}", 400, "/lights/0/shadow/directional", "directional lights only; this is a spot light"},
+	{BASE ",'lights':[{'type':'point','position':[0,2,0],'shadow':{'directional':{}}}]}", 400,
+	 "/lights/0/shadow/directional", "this is a point light"},
+	{BASE ",'lights':[{'type':'point','position':[0,2,0],'shadow':{'enabled':false,'contact':{'enabled':true}}}]}",
+	 400, "/lights/0/shadow/contact/enabled", "shadows, which are off"},
+	{BASE ",'shadows':false,'lights':[{'type':'point','position':[0,2,0],'shadow':{'contact':{'enabled':true}}}]}",
+	 400, "/lights/0/shadow/contact/enabled", "shadows, which are off"},
+	{BASE ",'lights':[{'type':'point','position':[0,1,0]}],'output':{'debug_light':0}}", 400, "/output/debug_light",
+	 "only used with debug \"shadow\""},
+	{BASE ",'lights':[{'type':'point','position':[0,1,0]}],'output':{'debug':'normals','debug_light':0}}", 400,
+	 "/output/debug_light", "only used with debug \"shadow\""},
 };
 
 static void check_bad(const struct bad *b, const struct api_limits *lim, int idx)
@@ -474,6 +497,86 @@ TEST(parse_shadow_merge)
 	REQUIRE(s);
 	CHECK(!s->scene.lights[0].shadow.enabled && s->scene.lights[1].shadow.enabled &&
 	      s->scene.lights[2].shadow.enabled);
+	api_scene_free(s);
+}
+
+/* Settings valid in general but unused by this request's other choices are parsed, and said in
+ * the scene's warnings (Umbra-Warnings, the CLI's stderr) with their pointer, never dropped
+ * silently (issue 13 item 4). Each document: the pointer and a phrase the warning must hold. */
+TEST(parse_unused_settings_warn)
+{
+	static const struct { const char *doc, *pointer, *phrase; } cases[] = {
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'radius':0.1,'shadow':{'pcf_radius':3}}]}",
+		 "/lights/0/shadow/pcf_radius", "filter is \"pcss\""},
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'filter':'evsm','pcf_radius':3}}]}",
+		 "/lights/0/shadow/pcf_radius", "filter is \"evsm\""},
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'vsm':{'blur':4}}}]}",
+		 "/lights/0/shadow/vsm/blur", "filter is \"pcf\""},
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'filter':'vsm','vsm':{'exponent':5}}}]}",
+		 "/lights/0/shadow/vsm/exponent", "for \"evsm\""},
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'radius':0.2,'shadow':{'filter':'pcf'}}]}",
+		 "/lights/0/radius", "no penumbra with filter \"pcf\""},
+		{BASE ",'shadows':{'filter':'hard'},'lights':[{'type':'directional','direction':[0,-1,0],"
+		 "'angular_diameter':2}]}", "/lights/0/angular_diameter", "filter \"hard\""},
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'contact':{'distance':0.2}}}]}",
+		 "/lights/0/shadow/contact/distance", "contact shadows are off"},
+		{BASE ",'lights':[{'type':'directional','direction':[0,-1,0],'shadow':{'directional':{'mode':'clipmap',"
+		 "'cascades':2}}}]}", "/lights/0/shadow/directional/cascades", "mode is \"clipmap\""},
+		{BASE ",'lights':[{'type':'point','position':[0,1,0],'shadow':{'enabled':false,'resolution':512}}]}",
+		 "/lights/0/shadow", "shadows are off"},
+		/* root defaults: said only when no light takes and uses them */
+		{BASE ",'shadows':{'pcf_radius':2,'filter':'pcss'},'lights':[{'type':'point','position':[0,1,0]}]}",
+		 "/shadows/pcf_radius", "light 0: filter is \"pcss\""},
+		{BASE ",'shadows':{'directional':{'cascades':2}},'lights':[{'type':'spot','position':[0,1,0],"
+		 "'direction':[0,-1,0]}]}", "/shadows/directional/cascades", "type is not directional"},
+		{BASE ",'shadows':{'pcf_radius':2},'lights':[{'type':'point','position':[0,1,0],'shadow':{'pcf_radius':1}}]}",
+		 "/shadows/pcf_radius", "light 0 gives its own"},
+		{BASE ",'shadows':{'resolution':1024}}", "/shadows", "no lights"},
+		/* the PNG-only output members when the document itself asks for EXR */
+		{BASE ",'output':{'format':'exr','bit_depth':16}}", "/output/bit_depth", "answer is EXR"},
+		{BASE ",'output':{'format':'exr','tonemap':'aces'}}", "/output/tonemap", "answer is EXR"},
+		/* the turntable's cameras place themselves */
+		{"{'camera':{'position':[0,0,5],'fov_y':30},'objects':[],'turntable':{'frames':2}}", "/camera/position",
+		 "not used by the turntable"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		struct api_scene *s = PARSE_OK(cases[i].doc);
+		if (!s) continue;
+		CHECK(strstr(s->warnings, cases[i].pointer) && strstr(s->warnings, cases[i].phrase), "case %zu: \"%s\"", i,
+		      s->warnings);
+		api_scene_free(s);
+	}
+
+	/* What is used draws no warning: a root default one light of two uses, a filter's own
+	 * settings, contact tuning with contact on, the contract's example. */
+	static const char *const quiet[] = {
+		BASE ",'shadows':{'pcf_radius':2,'vsm':{'blur':3}},'lights':[{'type':'point','position':[0,1,0]},"
+		"{'type':'point','position':[0,1,0],'shadow':{'filter':'evsm','vsm':{'exponent':8}}}]}",
+		BASE ",'lights':[{'type':'directional','direction':[0,-1,0],'angular_diameter':1,'shadow':{'contact':"
+		"{'enabled':true,'steps':8},'directional':{'mode':'cascades','cascades':2}}}]}",
+		BASE ",'shadows':{'enabled':false},'lights':[{'type':'point','position':[0,1,0],'shadow':true}]}",
+		BASE ",'output':{'format':'exr','tonemap':'none','bit_depth':8}}",
+		"{'camera':{'fov_y':30,'exposure':1},'objects':[],'turntable':{'frames':2}}",
+	};
+	for (size_t i = 0; i < sizeof quiet / sizeof quiet[0]; i++) {
+		struct api_scene *s = PARSE_OK(quiet[i]);
+		if (!s) continue;
+		CHECK(!s->warnings[0], "quiet %zu: \"%s\"", i, s->warnings);
+		api_scene_free(s);
+	}
+
+	/* bit_depth 16 with the format chosen later (Accept, the CLI's -o): a warning while the answer
+	 * is EXR, gone again when it is a PNG; never an error that would refuse the EXR. */
+	struct api_scene *s = PARSE_OK(BASE ",'lights':[{'type':'point','position':[0,1,0]}],'output':{'bit_depth':16,"
+	                               "'png_level':3}}");
+	REQUIRE(s);
+	CHECK(!s->warnings[0], "%s", s->warnings);
+	struct api_problem p;
+	CHECK(api_scene_set_format(s, API_FORMAT_EXR, &p) == API_OK);
+	CHECK(strstr(s->warnings, "/output/bit_depth: not used, the answer is EXR") &&
+	      strstr(s->warnings, "/output/png_level"), "%s", s->warnings);
+	CHECK(api_scene_set_format(s, API_FORMAT_PNG, &p) == API_OK);
+	CHECK(!s->warnings[0], "\"%s\"", s->warnings);
 	api_scene_free(s);
 }
 
@@ -827,6 +930,14 @@ TEST(parse_views)
 	REQUIRE(s);
 	CHECK(s->scene.view_count == 2 && s->scene.views[0].position[1] == 2 && s->scene.views[1].target[1] == 1);
 	CHECK(near_f(s->scene.views[0].fov_y, (float)(45 * DEG)) && s->scene.views[0].up[1] == 1);
+	api_scene_free(s);
+
+	/* A view keeps the root camera's type (and height) unless it gives its own. */
+	s = PARSE_OK("{'camera':{'type':'orthographic','height':2,'position':[0,0,5]},'objects':[],"
+	             "'views':[{'position':[0,1,5]},{'type':'perspective','fov_y':50}]}");
+	REQUIRE(s);
+	CHECK(s->scene.views[0].type == RND_CAMERA_ORTHOGRAPHIC && s->scene.views[0].height == 2);
+	CHECK(s->scene.views[1].type == RND_CAMERA_PERSPECTIVE && near_f(s->scene.views[1].fov_y, (float)(50 * DEG)));
 	api_scene_free(s);
 
 	/* A single view is a sheet of one. */
