@@ -36,6 +36,9 @@ int api_parse_material(struct pctx *c, json_t *j, struct rnd_material *m, const 
 	    api_get_vec(c, j, "emissive", m->emissive, 3, 3, V_NONNEG) < 0 ||
 	    api_get_bool(c, j, "shadow_catcher", &m->shadow_catcher) < 0)
 		return -1;
+	/* glTF reads alphaCutoff only in MASK mode: valid, but unused here, so said. */
+	if (json_object_get(j, "alpha_cutoff") && m->alpha_mode != RND_ALPHA_MASK)
+		api_warn(c, "%s/alpha_cutoff: not used, alpha_mode is not \"mask\"", c->ptr);
 	json_t *tex = json_object_get(j, "base_color_texture");
 	if (tex) {
 		size_t old = api_ptr_push(c, "base_color_texture");

@@ -535,6 +535,8 @@ TEST(parse_unused_settings_warn)
 		/* the PNG-only output members when the document itself asks for EXR */
 		{BASE ",'output':{'format':'exr','bit_depth':16}}", "/output/bit_depth", "answer is EXR"},
 		{BASE ",'output':{'format':'exr','tonemap':'aces'}}", "/output/tonemap", "answer is EXR"},
+		/* glTF's alphaCutoff means something only with alpha_mode mask */
+		{BASE ",'materials':{'m':{'alpha_cutoff':0.3}}}", "/materials/m/alpha_cutoff", "alpha_mode is not \"mask\""},
 		/* the turntable's cameras place themselves */
 		{"{'camera':{'position':[0,0,5],'fov_y':30},'objects':[],'turntable':{'frames':2}}", "/camera/position",
 		 "not used by the turntable"},
@@ -557,6 +559,7 @@ TEST(parse_unused_settings_warn)
 		BASE ",'shadows':{'enabled':false},'lights':[{'type':'point','position':[0,1,0],'shadow':true}]}",
 		BASE ",'output':{'format':'exr','tonemap':'none','bit_depth':8}}",
 		"{'camera':{'fov_y':30,'exposure':1},'objects':[],'turntable':{'frames':2}}",
+		BASE ",'materials':{'m':{'alpha_mode':'mask','alpha_cutoff':0.3}}}",
 	};
 	for (size_t i = 0; i < sizeof quiet / sizeof quiet[0]; i++) {
 		struct api_scene *s = PARSE_OK(quiet[i]);
