@@ -1188,7 +1188,8 @@ TEST(lights_debug_atlas_view)
 		return;
 	/* The directional (fit) map holds linear depth: a gradient over the ground with the
 	 * sphere darker; spot / point tiles hold perspective depth (near 1, almost white); texels
-	 * no map holds are 1 (white). */
+	 * no map holds show whatever their page holds (the atlases are not cleared, so pages no
+	 * tile ever used read 0, black: renderer/shadow_cache.c). */
 	long dark = 0, white = 0, n = 0;
 	int mn = 255, mx = 0, levels = 0;
 	bool seen[256] = {false};
