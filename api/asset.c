@@ -18,6 +18,7 @@
 #include <unistd.h>
 #include "asset.h"
 #include "errmsg.h"
+#include "umbra/rnd_math.h"
 
 enum api_result api_asset_check_path(const char *s, char *err, size_t errsize)
 {
@@ -179,8 +180,8 @@ enum api_result api_asset_read(const char *root, const char *path, uint8_t **out
 
 void api_asset_hash(uint64_t *h, const char *name, const uint8_t *data, size_t len)
 {
-	uint64_t x = *h ? *h : 0xcbf29ce484222325ull;
-	for (const char *q = name; q && *q; q++) x = (x ^ (unsigned char)*q) * 0x100000001b3ull;
-	for (size_t i = 0; i < len; i++) x = (x ^ data[i]) * 0x100000001b3ull;
-	*h = x;
+	/* The project's byte-stream hash: the name, then the bytes (as one stream). */
+	uint64_t x = *h ? *h : RND_FNV_SEED;
+	if (name) x = rnd_fnv1a(x, name, strlen(name));
+	*h = rnd_fnv1a(x, data, len);
 }
