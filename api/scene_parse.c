@@ -53,6 +53,45 @@ static int read_asset(struct pctx *c, const char *path, unsigned char **out, siz
 	return 0;
 }
 
+/* The model file's bytes from its one source member `first` (v its value, the pointer already
+ * at it): base64 `data`, a `path` under the asset root (malloc'd: the caller frees it; its
+ * extension may give the format: *f, *given), or a multipart `part` (the request's bytes). */
+static int model_bytes(struct pctx *c, const char *first, json_t *v, const char *const *formats, int *f,
+                       bool *given, unsigned char **out, size_t *out_len)
+{
+	int rc = 0;
+	unsigned char *b = NULL;
+	size_t len = 0;
+	if (!json_is_string(v)) {
+		rc = api_fail(c, "%s must be a string, not %s", first, api_type_name(v));
+	} else if (!strcmp(first, "data")) {
+		if (api_decode_b64_member(c, "data", v, &b, &len) < 0) rc = -1;
+		else if (!len) rc = api_fail(c, "data must not be empty");
+	} else if (!strcmp(first, "path")) {
+		const char *s = json_string_value(v);
+		char perr[200];
+		if (api_asset_check_path(s, perr, sizeof perr) != API_OK) rc = api_fail(c, "%s", perr);
+		else rc = read_asset(c, s, &b, &len);
+		if (!rc && !*given) { /* the extension says what the bytes may not (obj, ascii stl) */
+			const char *dot = strrchr(s, '.');
+			for (int i = 0; dot && formats[i]; i++)
+				if (!strcasecmp(dot + 1, formats[i])) { *f = i; *given = true; }
+		}
+	} else if (!json_string_length(v)) {
+		rc = api_fail(c, "part must name a part of the multipart request");
+	} else {
+		const char *name = json_string_value(v);
+		size_t i = 0;
+		while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
+		if (i == c->nparts) rc = api_fail(c, "part \"%.64s\" is not a part of this request", name);
+		else if (!c->parts[i].len) rc = api_fail(c, "part \"%.64s\" is empty", name);
+		else b = (unsigned char *)c->parts[i].data, len = c->parts[i].len;
+	}
+	*out = b;
+	*out_len = len;
+	return rc;
+}
+
 int api_parse_model(struct pctx *c, json_t *j)
 {
 	static const char *const sources[] = {"data", "path", "part"};
@@ -71,34 +110,9 @@ int api_parse_model(struct pctx *c, json_t *j)
 	bool given = json_object_get(j, "format") != NULL;
 	json_t *v = json_object_get(j, first);
 	size_t old = api_ptr_push(c, first);
-	int rc = 0;
 	unsigned char *b = NULL;
 	size_t len = 0;
-	if (!json_is_string(v)) {
-		rc = api_fail(c, "%s must be a string, not %s", first, api_type_name(v));
-	} else if (!strcmp(first, "data")) {
-		if (api_decode_b64_member(c, "data", v, &b, &len) < 0) rc = -1;
-		else if (!len) rc = api_fail(c, "data must not be empty");
-	} else if (!strcmp(first, "path")) {
-		const char *s = json_string_value(v);
-		char perr[200];
-		if (api_asset_check_path(s, perr, sizeof perr) != API_OK) rc = api_fail(c, "%s", perr);
-		else rc = read_asset(c, s, &b, &len);
-		if (!rc && !given) { /* the extension says what the bytes may not (obj, ascii stl) */
-			const char *dot = strrchr(s, '.');
-			for (int i = 0; dot && formats[i]; i++)
-				if (!strcasecmp(dot + 1, formats[i])) { f = i; given = true; }
-		}
-	} else if (!json_string_length(v)) {
-		rc = api_fail(c, "part must name a part of the multipart request");
-	} else {
-		const char *name = json_string_value(v);
-		size_t i = 0;
-		while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
-		if (i == c->nparts) rc = api_fail(c, "part \"%.64s\" is not a part of this request", name);
-		else if (!c->parts[i].len) rc = api_fail(c, "part \"%.64s\" is empty", name);
-		else b = (unsigned char *)c->parts[i].data, len = c->parts[i].len;
-	}
+	int rc = model_bytes(c, first, v, formats, &f, &given, &b, &len);
 	/* The files it refers to (a .gltf's buffers and images, an .obj's .mtl and textures): read
 	 * here, beside the model or among the request's parts (api/model_refs.h). */
 	struct api_model_refs refs = {0};

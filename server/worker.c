@@ -390,8 +390,88 @@ static bool render_should_yield(void *user)
 	return true;
 }
 
-/* Answers the request; returns the lost context's generation + 1 when its render lost the
- * device (the caller recovers after answering), else 0. */
+/* Parses the request's body and parts into *scp and settles what the answer depends on (its
+ * warnings, its ETag with any asset files, its format). 0: go on and render; 1: the request is
+ * answered already (a problem, or 304 for a matching If-None-Match). *scp, when set, is the
+ * caller's to free either way. */
+static int job_parse(struct srv_server *s, struct srv_request *req, struct api_scene **scp, double *parse_s)
+{
+	struct api_problem p = { 0 };
+	double t0 = srv_now();
+	struct api_part parts[64];
+	size_t nparts = req->part_count < 64 ? req->part_count : 64;
+	for (size_t i = 0; i < nparts; i++)
+		parts[i] = (struct api_part){ req->parts[i].name, req->parts[i].data, req->parts[i].len };
+	enum api_result pr = api_scene_parse_parts(req->body, req->body_len, &s->cfg.limits, parts, nparts, scp, &p);
+	/* The body and parts are no longer needed: give their memory back before the render. */
+	srv_request_drop_body(req);
+	if (pr != API_OK) {
+		job_problem(req, &p);
+		return 1;
+	}
+	struct api_scene *sc = *scp;
+	/* A header value is one line of printable ASCII: file names from a model may hold anything. */
+	for (size_t i = 0; i + 1 < sizeof req->warnings && (req->warnings[i] = sc->warnings[i]); i++)
+		if ((unsigned char)req->warnings[i] < 0x20 || (unsigned char)req->warnings[i] > 0x7e) req->warnings[i] = '?';
+	if (sc->asset_hash) {
+		/* The image depends on files under --asset-root as well as on the body. */
+		srv_etag_format(req->etag, sizeof req->etag, srv_etag_assets(req->etag_hash, sc->asset_hash));
+		if (req->if_none_match[0] && srv_etag_matches(req->if_none_match, req->etag)) {
+			req->status = 304;
+			return 1;
+		}
+	}
+	if ((req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) ||
+	    api_scene_check_output(sc, &p) != API_OK) {
+		job_problem(req, &p);
+		return 1;
+	}
+	*parse_s = srv_now() - t0;
+	srv_metrics_stage(s->metrics, SRV_STAGE_PARSE, *parse_s);
+	return 0;
+}
+
+/* The problem a failed render answers: 504 past the deadline (said differently when the render
+ * was stopped for the requests waiting behind it), 503 on device loss, else the renderer's own
+ * error mapped to its member. */
+static void job_render_failed(struct srv_server *s, struct srv_request *req, const struct api_scene *sc,
+                              enum rnd_result r, const struct rnd_error *err, bool yielded)
+{
+	struct api_problem p = { 0 };
+	double tf = srv_now();
+	srv_metrics_add(s->metrics, SRV_CTR_RENDER_FAILED, 1);
+	if (r == RND_ERR_TIMEOUT)
+		srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
+	if (r == RND_ERR_TIMEOUT && yielded)
+		api_problem_set(&p, 504, "", "the render was stopped %.0f ms after it was queued (%s) so that requests "
+		                "waiting behind it can meet their deadline of %u ms", (tf - req->t_queued) * 1000.0,
+		                err->msg, s->cfg.deadline_ms);
+	else if (r == RND_ERR_TIMEOUT)
+		api_problem_set(&p, 504, "", "the render passed its deadline of %u ms and was stopped %.0f ms after it "
+		                "was queued (%s)", s->cfg.deadline_ms, (tf - req->t_queued) * 1000.0, err->msg);
+	else if (r == RND_ERR_DEVICE_LOST)
+		api_problem_set(&p, 503, "", "the GPU device was lost (%s); the renderer is being recreated, retry",
+		                err->msg);
+	else
+		api_problem_from_render(&p, sc, err, render_status(r));
+	srv_log(SRV_LOG_WARN, "request %s: render failed: %s (%s)", req->id, err->msg, rnd_result_str(r));
+	job_problem(req, &p);
+}
+
+static void job_render_stages(struct srv_server *s, const struct rnd_timings *t)
+{
+	srv_metrics_add(s->metrics, SRV_CTR_RENDER_OK, 1);
+	srv_metrics_add(s->metrics, SRV_CTR_SHADOW_RENDERED, t->shadow_maps_rendered);
+	srv_metrics_add(s->metrics, SRV_CTR_SHADOW_REUSED, t->shadow_maps_reused);
+	srv_metrics_stage(s->metrics, SRV_STAGE_UPLOAD, t->upload_ms / 1000.0);
+	srv_metrics_stage(s->metrics, SRV_STAGE_SHADOW, t->shadow_ms / 1000.0);
+	srv_metrics_stage(s->metrics, SRV_STAGE_MAIN, t->main_ms / 1000.0);
+	srv_metrics_stage(s->metrics, SRV_STAGE_READBACK, t->readback_ms / 1000.0);
+}
+
+/* One request from the queue: parse, admit by memory, render, encode, answer. Returns the
+ * lost context's generation + 1 when its render lost the device (the caller recovers after
+ * answering), else 0. */
 static unsigned job_run(struct srv_server *s, struct srv_request *req)
 {
 	unsigned lost_gen = 0;
@@ -410,37 +490,8 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	uint8_t *bytes = NULL;
 	size_t len = 0;
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
-
-	double t0 = srv_now();
-	struct api_part parts[64];
-	size_t nparts = req->part_count < 64 ? req->part_count : 64;
-	for (size_t i = 0; i < nparts; i++)
-		parts[i] = (struct api_part){ req->parts[i].name, req->parts[i].data, req->parts[i].len };
-	enum api_result pr = api_scene_parse_parts(req->body, req->body_len, &s->cfg.limits, parts, nparts, &sc, &p);
-	/* The body and parts are no longer needed: give their memory back before the render. */
-	srv_request_drop_body(req);
-	if (pr != API_OK) {
-		job_problem(req, &p);
-		return 0;
-	}
-	/* A header value is one line of printable ASCII: file names from a model may hold anything. */
-	for (size_t i = 0; i + 1 < sizeof req->warnings && (req->warnings[i] = sc->warnings[i]); i++)
-		if ((unsigned char)req->warnings[i] < 0x20 || (unsigned char)req->warnings[i] > 0x7e) req->warnings[i] = '?';
-	if (sc->asset_hash) {
-		/* The image depends on files under --asset-root as well as on the body. */
-		srv_etag_format(req->etag, sizeof req->etag, srv_etag_assets(req->etag_hash, sc->asset_hash));
-		if (req->if_none_match[0] && srv_etag_matches(req->if_none_match, req->etag)) {
-			req->status = 304;
-			goto out;
-		}
-	}
-	if ((req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) ||
-	    api_scene_check_output(sc, &p) != API_OK) {
-		job_problem(req, &p);
-		goto out;
-	}
-	double parse_s = srv_now() - t0;
-	srv_metrics_stage(s->metrics, SRV_STAGE_PARSE, parse_s);
+	double parse_s = 0;
+	if (job_parse(s, req, &sc, &parse_s)) goto out;
 
 	double t1 = srv_now();
 	if (past_deadline(s, req, t1)) {
@@ -459,33 +510,10 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	}
 	enum rnd_result r = render(s, &sc->scene, &img, &t, &err, &lost_gen);
 	if (r != RND_OK) {
-		double tf = srv_now();
-		srv_metrics_add(s->metrics, SRV_CTR_RENDER_FAILED, 1);
-		if (r == RND_ERR_TIMEOUT)
-			srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
-		if (r == RND_ERR_TIMEOUT && watch.yielded)
-			api_problem_set(&p, 504, "", "the render was stopped %.0f ms after it was queued (%s) so that requests "
-			                "waiting behind it can meet their deadline of %u ms", (tf - req->t_queued) * 1000.0,
-			                err.msg, s->cfg.deadline_ms);
-		else if (r == RND_ERR_TIMEOUT)
-			api_problem_set(&p, 504, "", "the render passed its deadline of %u ms and was stopped %.0f ms after it "
-			                "was queued (%s)", s->cfg.deadline_ms, (tf - req->t_queued) * 1000.0, err.msg);
-		else if (r == RND_ERR_DEVICE_LOST)
-			api_problem_set(&p, 503, "", "the GPU device was lost (%s); the renderer is being recreated, retry",
-			                err.msg);
-		else
-			api_problem_from_render(&p, sc, &err, render_status(r));
-		srv_log(SRV_LOG_WARN, "request %s: render failed: %s (%s)", req->id, err.msg, rnd_result_str(r));
-		job_problem(req, &p);
+		job_render_failed(s, req, sc, r, &err, watch.yielded);
 		goto out;
 	}
-	srv_metrics_add(s->metrics, SRV_CTR_RENDER_OK, 1);
-	srv_metrics_add(s->metrics, SRV_CTR_SHADOW_RENDERED, t.shadow_maps_rendered);
-	srv_metrics_add(s->metrics, SRV_CTR_SHADOW_REUSED, t.shadow_maps_reused);
-	srv_metrics_stage(s->metrics, SRV_STAGE_UPLOAD, t.upload_ms / 1000.0);
-	srv_metrics_stage(s->metrics, SRV_STAGE_SHADOW, t.shadow_ms / 1000.0);
-	srv_metrics_stage(s->metrics, SRV_STAGE_MAIN, t.main_ms / 1000.0);
-	srv_metrics_stage(s->metrics, SRV_STAGE_READBACK, t.readback_ms / 1000.0);
+	job_render_stages(s, &t);
 
 	double t2 = srv_now();
 	if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
