@@ -188,7 +188,11 @@ void srv_http_stop(struct srv_server *s);
 
 /* worker.c */
 int srv_context_open(struct srv_server *s);         /* create + info; 0 or -1 (logged) */
-int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged) */
+int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged); server/warmup.c */
+/* Renders on the shared context (worker.c). On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the
+ * lost context's generation + 1, and the daemon is marked not ready. */
+enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
+                           struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
 int srv_workers_start(struct srv_server *s);
 void srv_workers_join(struct srv_server *s);        /* after srv_queue_close() */
 int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */

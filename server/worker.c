@@ -1,6 +1,6 @@
 /*
- * umbrad workers: the shared rnd_context (create, warm-up, recovery after a lost device,
- * cache save) and the threads that turn a queued request into an answer:
+ * umbrad workers: the shared rnd_context (create, recovery after a lost device, cache save;
+ * the warm-up is server/warmup.c) and the threads that turn a queued request into an answer:
  *   deadline check -> api_scene_parse -> Accept -> deadline check -> rnd_render -> api_encode
  *   -> deadline check -> srv_request_finish().
  * A worker never touches the request after srv_request_finish().
@@ -129,8 +129,8 @@ static void context_recover(struct srv_server *s, unsigned gen)
 /* Renders on the shared context. On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the lost
  * context's generation + 1 for context_recover(), and the daemon is marked not ready before
  * the lock is let go (so a recovery cannot finish before this mark). */
-static enum rnd_result render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
-                              struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen)
+enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
+                           struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen)
 {
 	pthread_rwlock_rdlock(&s->ctx_lock);
 	unsigned gen = s->ctx_gen;
@@ -191,117 +191,6 @@ int srv_context_close(struct srv_server *s)
 	}
 	pthread_rwlock_unlock(&s->ctx_lock);
 	return (int)msgs;
-}
-
-/* ---- warm-up ---- */
-
-/* lavapipe compiles each pipeline at its first use, and the renderer specialises the main
- * pipeline by MSAA, output (8-bit / linear), the set of light types, the set of shadow filters
- * and cascades. Render one tiny scene per common combination (those of the contract's
- * defaults and of the shared bench scenes) before /readyz says 200. The first must succeed;
- * the others only warn (a renderer without some feature still serves the rest). */
-#define WARM_SCENE(lights, output) \
-	"{\"width\":32,\"height\":32," \
-	"\"camera\":{\"type\":\"perspective\",\"position\":[3,2,3],\"target\":[0,0.5,0],\"fov_y\":45}," \
-	"\"objects\":[{\"shape\":\"plane\",\"size\":[4,4]}," \
-	"{\"shape\":\"box\",\"size\":[1,1,1],\"transform\":{\"translation\":[0,0.5,0]}}," \
-	"{\"shape\":\"sphere\",\"radius\":0.4,\"segments\":8,\"transform\":{\"translation\":[1,0.4,0]}}]," \
-	"\"lights\":[" lights "],\"shadows\":{\"resolution\":64},\"output\":" output "}"
-#define WARM_DIR "{\"type\":\"directional\",\"direction\":[-0.5,-1,-0.3]}"
-#define WARM_SUN "{\"type\":\"directional\",\"direction\":[-0.5,-1,-0.3],\"angular_diameter\":0.53}"
-#define WARM_CSM "{\"type\":\"directional\",\"direction\":[-0.5,-1,-0.3],\"angular_diameter\":0.53," \
-	"\"shadow\":{\"directional\":{\"mode\":\"cascades\",\"cascades\":4}}}"
-#define WARM_SPOT "{\"type\":\"spot\",\"position\":[2,3,1],\"direction\":[-2,-3,-1],\"radius\":0.1}"
-#define WARM_POINT "{\"type\":\"point\",\"position\":[-1,2,1],\"radius\":0.1}"
-#define WARM_POINT_HARD "{\"type\":\"point\",\"position\":[-1,2,1]}"
-#define WARM_VSM "{\"type\":\"directional\",\"direction\":[-0.5,-1,-0.3],\"shadow\":{\"filter\":\"vsm\"}}"
-#define WARM_EVSM "{\"type\":\"spot\",\"position\":[2,3,1],\"direction\":[-2,-3,-1],\"shadow\":{\"filter\":\"evsm\"}}"
-#define PNG1 "{\"format\":\"png\",\"msaa\":1}"
-#define PNG4 "{\"format\":\"png\",\"msaa\":4}"
-#define EXR4 "{\"format\":\"exr\",\"msaa\":4}"
-
-static const struct { const char *name, *json; } warm_scenes[] = {
-	{ "msaa 1, directional pcf", WARM_SCENE(WARM_DIR, PNG1) },
-	{ "msaa 4, directional pcf", WARM_SCENE(WARM_DIR, PNG4) },
-	{ "msaa 1, directional pcss", WARM_SCENE(WARM_SUN, PNG1) },
-	{ "msaa 4, directional pcss", WARM_SCENE(WARM_SUN, PNG4) },
-	{ "msaa 4, cascades pcss", WARM_SCENE(WARM_CSM, PNG4) },
-	{ "msaa 4, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG4) },
-	{ "msaa 1, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG1) },
-	{ "msaa 4, exr", WARM_SCENE(WARM_DIR, EXR4) },
-	{ "msaa 4, vsm+evsm", WARM_SCENE(WARM_VSM "," WARM_EVSM, PNG4) },
-};
-
-#define WARM_COUNT (sizeof warm_scenes / sizeof warm_scenes[0])
-
-static int warm_one(struct srv_server *s, size_t i)
-{
-	double t1 = srv_now();
-	struct api_scene *sc = NULL;
-	struct api_problem p = { 0 };
-	struct api_limits lim = { 0 };
-	struct rnd_image img = { 0 };
-	struct rnd_timings t = { 0 };
-	struct rnd_error err = { 0 };
-	uint8_t *bytes = NULL;
-	size_t len = 0;
-	int ok = 0;
-	if (api_scene_parse(warm_scenes[i].json, strlen(warm_scenes[i].json), &lim, &sc, &p) != API_OK) {
-		char msg[700];
-		api_problem_format(&p, msg, sizeof msg);
-		srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, msg);
-	} else if (render(s, &sc->scene, &img, &t, &err, NULL) != RND_OK) {
-		srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, err.msg);
-	} else if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
-		srv_log(SRV_LOG_WARN, "warm-up '%s': encode: %s", warm_scenes[i].name, p.detail);
-	} else {
-		ok = 1;
-		srv_log(SRV_LOG_INFO, "warm-up '%s': %.0f ms", warm_scenes[i].name, (srv_now() - t1) * 1000);
-	}
-	free(bytes);
-	rnd_image_release(&img);
-	api_scene_free(sc);
-	return ok ? 0 : -1;
-}
-
-struct warm_state {
-	struct srv_server *srv;
-	atomic_uint next;
-};
-
-static void *warm_thread(void *arg)
-{
-	struct warm_state *w = arg;
-	unsigned i;
-	while ((i = atomic_fetch_add(&w->next, 1)) < WARM_COUNT)
-		warm_one(w->srv, i);
-	return NULL;
-}
-
-int srv_warmup(struct srv_server *s)
-{
-	double t0 = srv_now();
-	/* The basic scene alone first, so a renderer that cannot render at all fails fast. */
-	if (warm_one(s, 0) != 0) {
-		srv_log(SRV_LOG_ERROR, "warm-up failed: the renderer cannot render the basic scene");
-		return -1;
-	}
-	/* The rest on as many threads as there are render slots: pipeline compilation (LLVM in
-	 * lavapipe) is single-threaded per pipeline. */
-	struct warm_state w = { .srv = s };
-	atomic_init(&w.next, 1);
-	pthread_t th[16];
-	unsigned n = s->cfg.workers < 16 ? s->cfg.workers : 16, started = 0;
-	for (unsigned i = 1; i < n; i++)
-		if (pthread_create(&th[started], NULL, warm_thread, &w) == 0)
-			started++;
-	warm_thread(&w);
-	for (unsigned i = 0; i < started; i++)
-		pthread_join(th[i], NULL);
-	/* Pipeline compilation leaves tens of MB free in malloc's arenas: give them back. */
-	malloc_trim(0);
-	srv_log(SRV_LOG_INFO, "warm-up done in %.0f ms", (srv_now() - t0) * 1000);
-	return 0;
 }
 
 /* ---- jobs ---- */
@@ -508,7 +397,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 		sc->scene.cancel = render_should_yield;
 		sc->scene.cancel_user = &watch;
 	}
-	enum rnd_result r = render(s, &sc->scene, &img, &t, &err, &lost_gen);
+	enum rnd_result r = srv_render(s, &sc->scene, &img, &t, &err, &lost_gen);
 	if (r != RND_OK) {
 		job_render_failed(s, req, sc, r, &err, watch.yielded);
 		goto out;

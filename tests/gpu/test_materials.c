@@ -9,8 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <png.h>
 #include "gpu_util.h"
+#include "models.h"
 #include "test.h"
 
 static char *b64(const uint8_t *d, size_t n)
@@ -30,28 +30,6 @@ static char *b64(const uint8_t *d, size_t n)
 	}
 	*p = 0;
 	return o;
-}
-
-static void put32(uint8_t *p, uint32_t v)
-{
-	p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
-}
-
-/* An RGBA8 PNG in memory (malloc'd). */
-static uint8_t *png_rgba(const uint8_t *px, int w, int h, size_t *len)
-{
-	png_image img;
-	memset(&img, 0, sizeof img);
-	img.version = PNG_IMAGE_VERSION;
-	img.width = (png_uint_32)w;
-	img.height = (png_uint_32)h;
-	img.format = PNG_FORMAT_RGBA;
-	png_alloc_size_t n = 0;
-	if (!png_image_write_to_memory(&img, NULL, &n, 0, px, 0, NULL)) return NULL;
-	uint8_t *buf = malloc(n);
-	if (!png_image_write_to_memory(&img, buf, &n, 0, px, 0, NULL)) { free(buf); return NULL; }
-	*len = n;
-	return buf;
 }
 
 /* ---- one quad in a .glb ---- */
@@ -138,20 +116,11 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 		in->samplers ? ",\"samplers\":" : "", in->samplers ? in->samplers : "",
 		in->extensions_used ? ",\"extensionsUsed\":" : "", in->extensions_used ? in->extensions_used : "", imgs, "",
 		n, views, accs);
-	size_t jpad = ((size_t)jn + 3) & ~(size_t)3, total = 12 + 8 + jpad + 8 + n;
-	uint8_t *g = calloc(1, total);
-	memcpy(g, "glTF", 4);
-	put32(g + 4, 2);
-	put32(g + 8, (uint32_t)total);
-	put32(g + 12, (uint32_t)jpad);
-	memcpy(g + 16, "JSON", 4);
-	memset(g + 20, ' ', jpad);
-	memcpy(g + 20, json, (size_t)jn);
-	uint8_t *bin = g + 20 + jpad;
-	put32(bin, (uint32_t)n);
-	memcpy(bin + 4, "BIN\0", 4);
-	for (size_t i = 0; i < k; i++) memcpy(bin + 8 + off[i], src[i], sz[i]);
-	*len = total;
+	uint8_t *bin = calloc(1, n ? n : 1);
+	if (!bin) return NULL;
+	for (size_t i = 0; i < k; i++) memcpy(bin + off[i], src[i], sz[i]);
+	uint8_t *g = test_glb_pack(json, (size_t)jn, bin, n, n, len);
+	free(bin);
 	return g;
 }
 
@@ -202,7 +171,7 @@ static double lin_at(const struct rnd_image *img, bool below, double x, double z
 /* A w x h texture of RGBA texels as PNG bytes into g->png[g->npng++]. */
 static void add_png(struct mglb *g, const uint8_t *texels, int w, int h)
 {
-	g->png[g->npng] = png_rgba(texels, w, h, &g->png_len[g->npng]);
+	g->png[g->npng] = test_png_rgba(texels, w, h, &g->png_len[g->npng]);
 	g->npng++;
 }
 
