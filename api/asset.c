@@ -15,6 +15,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
+#include <time.h>
 #include <unistd.h>
 #include "asset.h"
 #include "errmsg.h"
@@ -138,8 +139,61 @@ static int open_asset(const char *root, const char *path, int *status, char *err
 	return open_realpath(rroot, path, err, errsize);
 }
 
-enum api_result api_asset_read(const char *root, const char *path, uint8_t **out, size_t *len, int *status,
+static int64_t now_ns(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_REALTIME, &t);
+	return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
+}
+
+static void stamp_of(const struct stat *st, int64_t seen, struct api_asset_stamp *out)
+{
+	*out = (struct api_asset_stamp){(uint64_t)st->st_dev, (uint64_t)st->st_ino, (uint64_t)st->st_size,
+	                                (int64_t)st->st_mtim.tv_sec * 1000000000 + st->st_mtim.tv_nsec,
+	                                (int64_t)st->st_ctim.tv_sec * 1000000000 + st->st_ctim.tv_nsec, seen};
+}
+
+bool api_asset_stamp_settled(const struct api_asset_stamp *s)
+{
+	int64_t last = s->mtime_ns > s->ctime_ns ? s->mtime_ns : s->ctime_ns;
+	return s->seen_ns - last > API_ASSET_SETTLE_NS;
+}
+
+bool api_asset_stamp_equal(const struct api_asset_stamp *a, const struct api_asset_stamp *b)
+{
+	return a->dev == b->dev && a->ino == b->ino && a->size == b->size && a->mtime_ns == b->mtime_ns &&
+	       a->ctime_ns == b->ctime_ns;
+}
+
+/* fstat of an opened asset, refused as api_asset_read() refuses it. */
+static enum api_result check_file(int fd, const char *path, struct stat *st, char *err, size_t errsize)
+{
+	if (fstat(fd, st) < 0 || !S_ISREG(st->st_mode))
+		return api_err_set(err, errsize, "path \"%.128s\" is not a regular file", path);
+	if ((uint64_t)st->st_size > API_ASSET_MAX_FILE || !st->st_size)
+		return api_err_set(err, errsize, "path \"%.128s\" is empty or larger than %llu bytes", path,
+		                   (unsigned long long)API_ASSET_MAX_FILE);
+	return API_OK;
+}
+
+enum api_result api_asset_stat(const char *root, const char *path, struct api_asset_stamp *out, int *status,
                                char *err, size_t errsize)
+{
+	int fd = open_asset(root, path, status, err, errsize);
+	if (fd < 0) return API_ERR;
+	*status = 400;
+	struct stat st;
+	int64_t seen = now_ns();
+	enum api_result rc = check_file(fd, path, &st, err, errsize);
+	close(fd);
+	if (rc != API_OK) return rc;
+	stamp_of(&st, seen, out);
+	*status = 0;
+	return API_OK;
+}
+
+enum api_result api_asset_read_stamped(const char *root, const char *path, uint8_t **out, size_t *len,
+                                       struct api_asset_stamp *stamp, int *status, char *err, size_t errsize)
 {
 	*out = NULL;
 	*len = 0;
@@ -147,13 +201,10 @@ enum api_result api_asset_read(const char *root, const char *path, uint8_t **out
 	if (fd < 0) return API_ERR;
 	*status = 400;
 	struct stat st;
-	enum api_result rc = API_OK;
 	uint8_t *buf = NULL;
-	if (fstat(fd, &st) < 0 || !S_ISREG(st.st_mode)) {
-		rc = api_err_set(err, errsize, "path \"%.128s\" is not a regular file", path);
-	} else if ((uint64_t)st.st_size > API_ASSET_MAX_FILE || !st.st_size) {
-		rc = api_err_set(err, errsize, "path \"%.128s\" is empty or larger than %llu bytes", path,
-		                 (unsigned long long)API_ASSET_MAX_FILE);
+	int64_t seen = now_ns();
+	enum api_result rc = check_file(fd, path, &st, err, errsize);
+	if (rc != API_OK) {
 	} else if (!(buf = malloc((size_t)st.st_size))) {
 		rc = api_err_set(err, errsize, "path \"%.128s\" is too large to read (out of memory)", path);
 	} else {
@@ -172,16 +223,23 @@ enum api_result api_asset_read(const char *root, const char *path, uint8_t **out
 	}
 	close(fd);
 	if (rc != API_OK) return rc;
+	if (stamp) stamp_of(&st, seen, stamp);
 	*status = 0;
 	*out = buf;
 	*len = (size_t)st.st_size;
 	return API_OK;
 }
 
+enum api_result api_asset_read(const char *root, const char *path, uint8_t **out, size_t *len, int *status,
+                               char *err, size_t errsize)
+{
+	return api_asset_read_stamped(root, path, out, len, NULL, status, err, errsize);
+}
+
 void api_asset_hash(uint64_t *h, const char *name, const uint8_t *data, size_t len)
 {
-	/* The project's byte-stream hash: the name, then the bytes (as one stream). */
+	/* The name as a byte stream, then the bytes a word at a time. */
 	uint64_t x = *h ? *h : RND_FNV_SEED;
 	if (name) x = rnd_fnv1a(x, name, strlen(name));
-	*h = rnd_fnv1a(x, data, len);
+	*h = rnd_hash(x, data, len);
 }

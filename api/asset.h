@@ -28,6 +28,7 @@
 #ifndef UMBRA_API_ASSET_H
 #define UMBRA_API_ASSET_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "api.h"
@@ -50,7 +51,39 @@ enum api_result api_asset_resolve(const char *base, const char *ref, char *out, 
 enum api_result api_asset_read(const char *root, const char *path, uint8_t **out, size_t *len, int *status,
                                char *err, size_t errsize);
 
-/* Folds a file's name and bytes into *h (FNV-1a; *h == 0 starts it): the scene's asset hash, so
+/* What tells one version of a file from another without reading it: device, inode, size and
+ * the modification and status-change times in nanoseconds, as make and rsync trust them. A
+ * write, a rename over the file, a chmod or a touch changes one of them (the status-change
+ * time cannot be set back from user space). */
+struct api_asset_stamp {
+	uint64_t dev, ino, size;
+	int64_t mtime_ns, ctime_ns;
+	int64_t seen_ns;       /* the clock just before the stamp was taken (not compared) */
+};
+/* File times come from a coarse clock (a tick of up to 10 ms): a file changed again within the
+ * tick of its last change keeps its times. A stamp taken less than this long after the file's
+ * last change is "racy" (git's word) and must not stand for the file's bytes. */
+#define API_ASSET_SETTLE_NS 50000000ll
+/* A file read under the root: its path there and its stamp when it was read. */
+struct api_asset_origin {
+	char *path;
+	struct api_asset_stamp stamp;
+};
+
+/* api_asset_read() that also gives the stamp of what it read (taken from the descriptor it
+ * read, so it names that file, not whatever is at the path a moment later). */
+enum api_result api_asset_read_stamped(const char *root, const char *path, uint8_t **out, size_t *len,
+                                       struct api_asset_stamp *stamp, int *status, char *err, size_t errsize);
+/* The stamp of root/path now, with the rules of api_asset_read() (API_ERR: as it would fail). */
+enum api_result api_asset_stat(const char *root, const char *path, struct api_asset_stamp *out, int *status,
+                               char *err, size_t errsize);
+bool api_asset_stamp_equal(const struct api_asset_stamp *a, const struct api_asset_stamp *b);
+/* The file had not changed for API_ASSET_SETTLE_NS when the stamp was taken: any later change
+ * will change the stamp. */
+bool api_asset_stamp_settled(const struct api_asset_stamp *s);
+
+/* Folds a file's name and bytes into *h (*h == 0 starts it; the bytes a word at a time:
+ * rnd_hash, as a 50 MB model is hashed on each read): the scene's asset hash, so
  * an answer that depends on files changes its ETag when they do. */
 void api_asset_hash(uint64_t *h, const char *name, const uint8_t *data, size_t len);
 

@@ -33,6 +33,7 @@ struct model_priv {
 	uint8_t *src;
 	size_t src_len;
 	size_t model_len;             /* of src: the model file; the rest are the files it refers to */
+	uint64_t serial;              /* unique per import: api_model_cache_take() */
 	struct model_priv *prev, *next;
 	bool listed;
 };
@@ -41,6 +42,7 @@ static pthread_mutex_t cache_mu = PTHREAD_MUTEX_INITIALIZER;
 static struct model_priv *lru_head, *lru_tail; /* head = most recently used */
 static uint64_t cache_total, cache_hits, cache_misses;
 static uint64_t cache_limit = 256u << 20;   /* api_model_cache_set_limit() */
+static atomic_uint_fast64_t next_serial = 1;
 
 static const char *const FORMAT_NAMES[] = {"glb", "gltf", "obj", "stl", "ply"};
 
@@ -113,6 +115,7 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 	}
 	atomic_init(&m->refs, 1);
 	m->pub.priv_ = m;
+	m->serial = atomic_fetch_add(&next_serial, 1);
 	size_t bytes = 0;
 	if (api_sandbox_import_bundle(data, len, model_len, nfiles, format, lim, m->arena, &m->pub, &bytes, status, err,
 	                              errsize) != API_OK) {
@@ -288,6 +291,27 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
                               size_t errsize)
 {
 	return api_model_get_files(data, len, NULL, 0, format, lim, out, status, err, errsize);
+}
+
+uint64_t api_model_serial(const struct api_model *pub)
+{
+	return ((const struct model_priv *)pub->priv_)->serial;
+}
+
+struct api_model *api_model_cache_take(uint64_t serial)
+{
+	struct model_priv *hit = NULL;
+	pthread_mutex_lock(&cache_mu);
+	for (struct model_priv *m = lru_head; m && !hit; m = m->next)
+		if (m->serial == serial) hit = m;
+	if (hit) {
+		cache_hits++;
+		lru_unlink(hit);
+		lru_push_front(hit);
+		atomic_fetch_add(&hit->refs, 1);
+	}
+	pthread_mutex_unlock(&cache_mu);
+	return hit ? &hit->pub : NULL;
 }
 
 void api_model_cache_set_limit(uint64_t bytes)

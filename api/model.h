@@ -93,6 +93,13 @@ enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_fo
                               size_t errsize);
 void api_model_release(struct api_model *m);
 
+/* Every import gets a serial number no other import shares. api_model_cache_take() gives a
+ * reference to the cached model of that serial (a cache hit), or NULL when it is no longer
+ * cached (evicted, cleared, or too large to cache): api/model_paths.h finds a model by path
+ * this way without the bytes that key the cache. */
+uint64_t api_model_serial(const struct api_model *m);
+struct api_model *api_model_cache_take(uint64_t serial);
+
 /* A file the model refers to (a .gltf's buffer or image, an .obj's .mtl or texture), named as
  * the referring file writes it; found by api/model_refs.h. */
 struct api_model_file {

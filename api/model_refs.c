@@ -84,6 +84,20 @@ static int push(struct ctx *c, const char *name, const uint8_t *data, size_t len
 	return 0;
 }
 
+static int add_origin(struct ctx *c, const char *path, const struct api_asset_stamp *stamp)
+{
+	struct api_model_refs *r = c->out;
+	struct api_asset_origin *o = realloc(r->origins, (r->norigins + 1) * sizeof *o);
+	char *p = o ? strdup(path) : NULL;
+	if (o) r->origins = o;
+	if (!p) {
+		*c->status = 500;
+		return api_err_set(c->err, c->errsize, "out of memory reading the model's files"), -1;
+	}
+	r->origins[r->norigins++] = (struct api_asset_origin){p, *stamp};
+	return 0;
+}
+
 /* Finds one reference `ref` (as written in the file at `base`), adds it under that name, and
  * returns its index; -1 with the answer set; -2 when it cannot be found in inline data (the
  * caller decides whether that is an error). */
@@ -108,7 +122,8 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 	size_t len = 0;
 	if (s->path) {
 		int st;
-		if (api_asset_read(s->root, full, &owned, &len, &st, why, sizeof why) != API_OK) {
+		struct api_asset_stamp stamp;
+		if (api_asset_read_stamped(s->root, full, &owned, &len, &stamp, &st, why, sizeof why) != API_OK) {
 			if (s->optional_obj_files && (kind == REF_MTL || kind == REF_TEXTURE)) return -2;
 			*c->status = st;
 			return api_err_set(c->err, c->errsize, "its %s \"%.128s\" cannot be read: %s", KIND_NAMES[kind], ref,
@@ -116,6 +131,7 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 		}
 		api_asset_hash(&c->out->asset_hash, full, owned, len);
 		data = owned;
+		if (add_origin(c, full, &stamp) < 0) return free(owned), -1;
 	} else {
 		size_t i = 0;
 		while (i < s->nparts && (!s->parts[i].name || (strcmp(s->parts[i].name, full) && strcmp(s->parts[i].name, ref))))
@@ -299,5 +315,7 @@ void api_model_refs_release(struct api_model_refs *r)
 	}
 	free(r->files);
 	free(r->owned_);
+	for (size_t i = 0; i < r->norigins; i++) free(r->origins[i].path);
+	free(r->origins);
 	memset(r, 0, sizeof *r);
 }

@@ -34,6 +34,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "api.h"
+#include "asset.h"
 #include "model.h"
 
 #define API_MODEL_REFS_MAX 256u
@@ -55,6 +56,9 @@ struct api_model_refs {
 	uint64_t bytes;                   /* of every file */
 	uint64_t asset_hash;              /* files read under the root (api_asset_hash), 0 = none */
 	char warning[256];                /* "" or what was left out (an .obj's missing .mtl, "; " between) */
+	/* By path: every file read under the root, with its stamp (api/model_paths.h) */
+	struct api_asset_origin *origins;
+	size_t norigins;
 	/* private */
 	size_t cap_;
 	unsigned char *owned_;            /* per file: 1 when its bytes are ours to free */

@@ -22,6 +22,7 @@
 #include <strings.h>
 #include "asset.h"
 #include "model.h"
+#include "model_paths.h"
 #include "model_refs.h"
 #include "preset.h"
 #include "scene_internal.h"
@@ -38,18 +39,17 @@ static void model_refs_release(struct model_ref *r)
 }
 
 /* Reads `path` (checked by api_asset_check_path) under the asset root (api/asset.h) into a
- * malloc'd buffer, folding it into the scene's asset hash: the answer depends on the file, not
- * only on the request, so the server's ETag must change when the file does. 0 or -1 (400 at
- * the current pointer, 500 when the root itself is unusable). */
-static int read_asset(struct pctx *c, const char *path, unsigned char **out, size_t *len)
+ * malloc'd buffer, with the file's stamp (api/model_paths.h). 0 or -1 (400 at the current
+ * pointer, 500 when the root itself is unusable). */
+static int read_asset(struct pctx *c, const char *path, unsigned char **out, size_t *len,
+                      struct api_asset_stamp *stamp)
 {
 	char err[300];
 	int status;
-	if (api_asset_read(c->lim->asset_root, path, out, len, &status, err, sizeof err) != API_OK) {
+	if (api_asset_read_stamped(c->lim->asset_root, path, out, len, stamp, &status, err, sizeof err) != API_OK) {
 		api_problem_set(c->p, status, c->ptr, "%s", err);
 		return -1;
 	}
-	api_asset_hash(&c->asset_hash, path, *out, *len);
 	return 0;
 }
 
@@ -57,7 +57,7 @@ static int read_asset(struct pctx *c, const char *path, unsigned char **out, siz
  * at it): base64 `data`, a `path` under the asset root (malloc'd: the caller frees it; its
  * extension may give the format: *f, *given), or a multipart `part` (the request's bytes). */
 static int model_bytes(struct pctx *c, const char *first, json_t *v, const char *const *formats, int *f,
-                       bool *given, unsigned char **out, size_t *out_len)
+                       bool *given, unsigned char **out, size_t *out_len, struct api_asset_stamp *stamp)
 {
 	int rc = 0;
 	unsigned char *b = NULL;
@@ -71,7 +71,7 @@ static int model_bytes(struct pctx *c, const char *first, json_t *v, const char 
 		const char *s = json_string_value(v);
 		char perr[200];
 		if (api_asset_check_path(s, perr, sizeof perr) != API_OK) rc = api_fail(c, "%s", perr);
-		else rc = read_asset(c, s, &b, &len);
+		else rc = read_asset(c, s, &b, &len, stamp);
 		if (!rc && !*given) { /* the extension says what the bytes may not (obj, ascii stl) */
 			const char *dot = strrchr(s, '.');
 			for (int i = 0; dot && formats[i]; i++)
@@ -92,6 +92,63 @@ static int model_bytes(struct pctx *c, const char *first, json_t *v, const char 
 	return rc;
 }
 
+/* Makes m (one reference, given to the scene) the current model. */
+static int attach_model(struct pctx *c, struct api_model *m)
+{
+	struct model_ref *ref = api_arena_alloc(c->arena, sizeof *ref);
+	if (!ref) {
+		api_model_release(m);
+		return api_fail(c, "out of memory");
+	}
+	ref->model = m;
+	ref->next = c->models;
+	c->models = ref;
+	c->cur_model = m;
+	return 0;
+}
+
+/* A model by path imported before from files that have not changed since (api/model_paths.h):
+ * attached without reading them, 1; 0 when there is none (the caller reads and imports). */
+static int model_remembered(struct pctx *c, json_t *v, const struct api_model_path_key *k)
+{
+	char perr[200];
+	if (!json_is_string(v) || !k->root || !k->root[0] ||
+	    api_asset_check_path(json_string_value(v), perr, sizeof perr) != API_OK)
+		return 0;
+	uint64_t h;
+	struct api_model *m = api_model_paths_find(k, &h);
+	if (!m) return 0;
+	api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
+	return attach_model(c, m) < 0 ? -1 : 1;
+}
+
+/* The object's name, else its path, else NULL: what a problem about its model names. */
+static const char *model_label(json_t *j, const char *first, json_t *v)
+{
+	json_t *nm = json_object_get(j, "name");
+	return json_is_string(nm) ? json_string_value(nm) : !strcmp(first, "path") ? json_string_value(v) : NULL;
+}
+
+/* The files a model in b[0..len) refers to (a .gltf's buffers and images, an .obj's .mtl and
+ * textures): read beside the model or among the request's parts (api/model_refs.h). */
+static int model_refs(struct pctx *c, json_t *j, const char *first, json_t *v, const uint8_t *b, size_t len,
+                      enum api_model_format f, struct api_model_refs *refs)
+{
+	struct api_ref_source src = {.root = c->lim->asset_root, .path = !strcmp(first, "path") ? json_string_value(v)
+	                             : NULL, .parts = c->parts, .nparts = c->nparts};
+	char err[400];
+	int status;
+	if (api_model_refs_collect(b, len, f == API_MODEL_SNIFF ? api_model_sniff(b, len) : f, &src, refs, &status, err,
+	                           sizeof err) != API_OK) {
+		const char *what = model_label(j, first, v);
+		if (what) api_problem_set(c->p, status, c->ptr, "model \"%.128s\" cannot be imported: %s", what, err);
+		else api_problem_set(c->p, status, c->ptr, "the model in %s cannot be imported: %s", first, err);
+		return -1;
+	}
+	if (refs->warning[0]) api_warn(c, "%s: %s", c->ptr, refs->warning);
+	return 0;
+}
+
 int api_parse_model(struct pctx *c, json_t *j)
 {
 	static const char *const sources[] = {"data", "path", "part"};
@@ -110,57 +167,43 @@ int api_parse_model(struct pctx *c, json_t *j)
 	bool given = json_object_get(j, "format") != NULL;
 	json_t *v = json_object_get(j, first);
 	size_t old = api_ptr_push(c, first);
+	bool by_path = !strcmp(first, "path");
+	struct api_model_path_key key = {c->lim->asset_root, json_string_value(v), given ? f : -1, false};
+	int rc = by_path ? model_remembered(c, v, &key) : 0;
+	if (rc != 0) {
+		api_ptr_pop(c, old);
+		return rc < 0 ? -1 : 0;
+	}
 	unsigned char *b = NULL;
 	size_t len = 0;
-	int rc = model_bytes(c, first, v, formats, &f, &given, &b, &len);
-	/* The files it refers to (a .gltf's buffers and images, an .obj's .mtl and textures): read
-	 * here, beside the model or among the request's parts (api/model_refs.h). */
+	struct api_asset_stamp stamp;
+	rc = model_bytes(c, first, v, formats, &f, &given, &b, &len, &stamp);
+	enum api_model_format fmt = given ? (enum api_model_format)f : API_MODEL_SNIFF;
 	struct api_model_refs refs = {0};
-	if (rc == 0) {
-		struct api_ref_source src = {.root = c->lim->asset_root, .path = !strcmp(first, "path") ? json_string_value(v)
-		                             : NULL, .parts = c->parts, .nparts = c->nparts};
-		char err[400];
-		int status;
-		if (api_model_refs_collect(b, len, given ? (enum api_model_format)f : api_model_sniff(b, len), &src, &refs,
-		                           &status, err, sizeof err) != API_OK) {
-			json_t *nm = json_object_get(j, "name");
-			const char *what = json_is_string(nm) ? json_string_value(nm) : src.path;
-			if (what) api_problem_set(c->p, status, c->ptr, "model \"%.128s\" cannot be imported: %s", what, err);
-			else api_problem_set(c->p, status, c->ptr, "the model in %s cannot be imported: %s", first, err);
-			rc = -1;
-		} else {
-			if (refs.asset_hash) api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&refs.asset_hash, 8);
-			if (refs.warning[0]) api_warn(c, "%s: %s", c->ptr, refs.warning);
-		}
+	if (rc == 0) rc = model_refs(c, j, first, v, b, len, fmt, &refs);
+	struct api_model *m = NULL;
+	char err[400];
+	int status;
+	if (rc == 0 && api_model_get_files(b, len, refs.files, refs.count, fmt, c->lim, &m, &status, err, sizeof err) !=
+	    API_OK) {
+		/* 400 for a bad file, 422 over the import time/memory limit, 500 when the importer cannot run. */
+		const char *what = model_label(j, first, v);
+		if (what)
+			api_problem_set(c->p, status, c->ptr, "model \"%.128s\" (%s) could not be imported: %s", what, first, err);
+		else api_problem_set(c->p, status, c->ptr, "the model in %s could not be imported: %s", first, err);
+		rc = -1;
 	}
-	if (rc == 0) {
-		struct api_model *m = NULL;
-		char err[400];
-		int status;
-		struct model_ref *ref = api_arena_alloc(c->arena, sizeof *ref);
-		if (!ref) {
-			rc = api_fail(c, "out of memory");
-		} else if (api_model_get_files(b, len, refs.files, refs.count, given ? (enum api_model_format)f : API_MODEL_SNIFF,
-		                               c->lim, &m, &status, err, sizeof err) != API_OK) {
-			/* Named by the object's name, else by its path, else by its source member; 400 for a bad
-			 * file, 422 over the import time/memory limit, 500 when the importer cannot run. */
-			json_t *nm = json_object_get(j, "name");
-			const char *what = json_is_string(nm) ? json_string_value(nm)
-			                   : !strcmp(first, "path") ? json_string_value(v) : NULL;
-			if (what)
-				api_problem_set(c->p, status, c->ptr, "model \"%.128s\" (%s) could not be imported: %s", what, first,
-				                err);
-			else api_problem_set(c->p, status, c->ptr, "the model in %s could not be imported: %s", first, err);
-			rc = -1;
-		} else {
-			ref->model = m;
-			ref->next = c->models;
-			c->models = ref;
-			c->cur_model = m;
-		}
+	if (rc == 0 && by_path) {
+		/* The answer depends on the files, not only on the request: the ETag must change when they do. */
+		uint64_t h = 0;
+		api_asset_hash(&h, key.path, b, len);
+		if (refs.asset_hash) api_asset_hash(&h, NULL, (const uint8_t *)&refs.asset_hash, 8);
+		api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
+		if (!refs.warning[0]) api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
 	}
+	if (rc == 0) rc = attach_model(c, m);
 	api_model_refs_release(&refs);
-	if (!strcmp(first, "path")) free(b);
+	if (by_path) free(b);
 	api_ptr_pop(c, old);
 	return rc < 0 ? -1 : 0;
 }
