@@ -15,7 +15,7 @@
 #include "material.h"
 #include "texture.h"
 
-static bool slot_srgb(uint32_t slot)
+bool rnd_texture_slot_srgb(enum rnd_texture_slot slot)
 {
 	return slot == RND_TEX_BASE || slot == RND_TEX_EMISSIVE;
 }
@@ -90,7 +90,7 @@ static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene 
 		if (!t) continue;
 		if (!t->rgba || !t->width || !t->height || t->width > RND_MAX_TEXTURE_SIDE || t->height > RND_MAX_TEXTURE_SIDE)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", mi, t->width, t->height);
-		int ii = image_of(p, t, slot_srgb(k));
+		int ii = image_of(p, t, rnd_texture_slot_srgb((enum rnd_texture_slot)k));
 		if (ii < 0)
 			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u distinct textures in one scene "
 			                   "(this renderer's limit)", p->max);
@@ -170,7 +170,9 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 		                                 VK_IMAGE_ASPECT_COLOR_BIT, name, &s->textures[i], err)) != RND_OK)
 			goto done;
 		s->texture_count = i + 1;
-		rnd_texture_build_chain(tex[i]->rgba, w, h, p->srgb[i], (uint8_t *)s->staging.map + off);
+		uint8_t *dst = (uint8_t *)s->staging.map + off;
+		if (tex[i]->chain && tex[i]->chain_srgb == p->srgb[i]) memcpy(dst, tex[i]->chain, rnd_texture_chain_bytes(w, h));
+		else rnd_texture_build_chain(tex[i]->rgba, w, h, p->srgb[i], dst);
 		off += rnd_texture_chain_bytes(w, h);
 	}
 	write_sets(ctx, s, p);

@@ -20,17 +20,13 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <vulkan/vulkan.h>
+#include "umbra/rnd.h"
 
 /* Levels of the full chain of a w x h image, down to 1x1: floor(log2(max(w, h))) + 1. */
 uint32_t rnd_texture_levels(uint32_t w, uint32_t h);
 
-/* Bytes of the full RGBA8 chain, levels packed one after the other (level 0 first). */
-uint64_t rnd_texture_chain_bytes(uint32_t w, uint32_t h);
-
-/* Writes the chain of rgba (w x h RGBA8) to out (rnd_texture_chain_bytes() bytes): level 0 as
- * given, each further level the 2x2 box average of the one before (an odd last row or column
- * folds into its neighbour's box), in linear light when srgb (alpha is always linear). */
-void rnd_texture_build_chain(const uint8_t *rgba, uint32_t w, uint32_t h, bool srgb, uint8_t *out);
+/* rnd_texture_chain_bytes(), rnd_texture_build_chain() and rnd_texture_slot_srgb() are public
+ * (umbra/rnd.h): a model's owner may build its chains once (rnd_texture.chain). */
 
 /* Records the copy of one chain from buf at offset into img (created with
  * rnd_texture_levels() levels, layout undefined) and its transition to shader-read; returns

@@ -231,6 +231,11 @@ TEST(model_glb_quad_texture_mask)
 	REQUIRE(m->base_color_texture);
 	CHECK(m->base_color_texture->width == 2 && m->base_color_texture->height == 2);
 	CHECK(!memcmp(m->base_color_texture->rgba, TEX, sizeof TEX), "texels differ");
+	/* Its mip chain built once with the model, as the base colour slot reads it (sRGB). */
+	uint8_t chain[4 * (4 + 1)];
+	rnd_texture_build_chain(TEX, 2, 2, true, chain);
+	CHECK(m->base_color_texture->chain && m->base_color_texture->chain_srgb &&
+	      !memcmp(m->base_color_texture->chain, chain, sizeof chain), "no chain, or not the sRGB chain");
 	api_scene_free(s);
 
 	/* The object's own material replaces the model's. */

@@ -89,7 +89,23 @@ enum rnd_mip { RND_MIP_LINEAR, RND_MIP_NONE, RND_MIP_NEAREST };
 struct rnd_texture {
 	const uint8_t *rgba;
 	uint32_t width, height;
+	/* Optional: the full mip chain as rnd_texture_build_chain() writes it for colour space
+	 * chain_srgb, built once by the owner of a long-lived texture (a cached model) so that
+	 * renders copy it instead of building it (a 2048^2 chain is ~40 ms of CPU). NULL, or read
+	 * by a slot of the other colour space: built at upload. */
+	const uint8_t *chain;
+	bool chain_srgb;
 };
+/* The colour space a slot reads its texture in: base colour and emissive sRGB, the others linear. */
+bool rnd_texture_slot_srgb(enum rnd_texture_slot slot);
+/* Bytes of the full RGBA8 chain of a w x h texture down to 1x1, levels packed one after the
+ * other (level 0 first). */
+uint64_t rnd_texture_chain_bytes(uint32_t w, uint32_t h);
+/* Writes the chain of rgba (w x h RGBA8) to out (rnd_texture_chain_bytes() bytes): level 0 as
+ * given, each further level the 2x2 box average of the one before (an odd last row or column
+ * folds into its neighbour's box), in linear light when srgb (alpha is always linear). Pure;
+ * any thread. */
+void rnd_texture_build_chain(const uint8_t *rgba, uint32_t w, uint32_t h, bool srgb, uint8_t *out);
 
 struct rnd_material {
 	float base_color[4];  /* linear RGBA, default 0.8 0.8 0.8 1 */
