@@ -73,6 +73,35 @@ def targets(name, filt, contact, m):
     return miss
 
 
+def print_compare(path, rows):
+    """Before -> after per row; contact on folded into off where both runs agree on it."""
+    with open(path) as fh:
+        old = {(r["scene"], r["filter"], r["contact"]): r for r in map(json.loads, fh)}
+    keys = [("rmse", "%.4f"), ("iou", "%.3f"), ("disagree_core", "%.4f"), ("missing_contact", "%.4f"),
+            ("false_core", "%.4f")]
+    new = {(r["scene"], r["filter"], r["contact"]): r for r in rows if "error" not in r}
+    print("\n| scene | filter | contact | " + " | ".join(k for k, _ in keys) + " |")
+    print("|---|---|---|" + "---|" * len(keys))
+    for k, r in new.items():
+        b = old.get(k)
+        if b is None:
+            continue
+        off = (k[0], k[1], False)
+        if k[2] and off in new and off in old and all(
+                new[off][m] == r[m] and old[off][m] == b[m] for m, _ in keys):
+            continue    # same as contact off, shown there as "off = on"
+        same_on = not k[2] and (k[0], k[1], True) in new and all(
+            new[(k[0], k[1], True)][m] == r[m] and old.get((k[0], k[1], True), {}).get(m) == b[m] for m, _ in keys)
+        cells = []
+        for m, fmt in keys:
+            cell = (fmt % b[m]) if b[m] == r[m] else (fmt % b[m]) + " → " + (fmt % r[m])
+            if r.get("miss") and m in r["miss"]:
+                cell += "*"
+            cells.append(cell)
+        print("| %s | %s | %s | %s |" % (k[0], k[1], "off = on" if same_on else ("on" if k[2] else "off"),
+                                          " | ".join(cells)))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--render", default=os.path.join(ROOT, "build", "umbra-render"))
@@ -81,6 +110,7 @@ def main():
     ap.add_argument("--filters", help="comma-separated filters (default: all)")
     ap.add_argument("--json", help="also write the rows as JSON lines here")
     ap.add_argument("--extra-shadow", default="{}", help="JSON merged into every light's shadow")
+    ap.add_argument("--compare", help="rows of an earlier --json run: print before -> after")
     a = ap.parse_args()
     names = a.only.split(",") if a.only else ORDER
     filters = a.filters.split(",") if a.filters else FILTERS
@@ -130,6 +160,8 @@ def main():
         print("| %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             r["scene"], r["filter"], "on" if r["contact"] else "off", cell("rmse", "%.4f"), cell("iou", "%.3f"),
             cell("disagree_core", "%.4f"), cell("missing_contact", "%.4f"), cell("false_core", "%.4f"), hf))
+    if a.compare:
+        print_compare(a.compare, rows)
     if a.json:
         with open(a.json, "w") as fh:
             for r in rows:
