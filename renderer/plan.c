@@ -176,6 +176,21 @@ static void depth_range(const float view[16], const struct rnd_aabb *bounds, flo
 	*zmin -= pad; *zmax += pad;
 }
 
+/* An orthographic view of half-width hx and half-height hy; params[0], the texel's world size
+ * the shaders use (normal offset, PCSS, contact distance), is the larger side of a texel. */
+static void ortho_view_rect(struct umbra_shadow_view *v, const float view[16], float cx, float cy, float hx, float hy,
+                            float zmin, float zmax, float res)
+{
+	float proj[16];
+	rnd_mat4_ortho(proj, cx - hx, cx + hx, cy - hy, cy + hy, zmin, zmax);
+	rnd_mat4_mul(v->view_proj, proj, view);
+	v->params[0] = 2.0f * fmaxf(hx, hy) / res;
+	v->params[1] = 0.0f;
+	v->params[2] = zmin;
+	v->params[3] = zmax;
+	v->rect[2] = res;   /* x, y and the atlas size are filled in when the tile is granted */
+}
+
 static void ortho_view(struct umbra_shadow_view *v, const float view[16], float cx, float cy, float half,
                        float zmin, float zmax, float res, const float dir[3])
 {
@@ -236,6 +251,45 @@ static uint32_t light_importance_res(const struct rnd_light *L, const struct rnd
 	float top = L->type == RND_LIGHT_SPOT ? 1024.0f : 512.0f;
 	float want = fmaxf(top * frac, 256.0f);
 	return (uint32_t)want;
+}
+
+/* Tile size a hard spot or point light (no radius, PCF or hard filter) needs so that its
+ * filter kernel, (2r+1) texels, spans at most one pixel where the camera may see what the
+ * light reaches (the corners and centre of the scene bounds, pulled in to the light's reach):
+ * such a light's edge is a step, and a kernel wider than a pixel is blur the light does not
+ * have. The 512-texel cube faces importance gives a full-view point light 3 m above a 12 m
+ * floor made a 3-texel ramp up to ~2 pixels wide on a 128² image; against the traced answer
+ * rmse 0.025, at 1024 0.017. Kept cheap: at most one doubling of the importance choice `base`
+ * (a light keeps its share of the atlas, its shadow pass grows at most 4x), and at most 2048
+ * for a spot, 1024 for a cube face (six of them). 0 = no need. */
+static uint32_t hard_light_res(const struct rnd_light *L, const struct rnd_light_plan *lp, const struct rnd_aabb *b,
+                               const struct rnd_camera_plan *cam, uint32_t height, uint32_t base)
+{
+	if (L->radius > 0 || (lp->filter != UMBRA_FILTER_PCF && lp->filter != UMBRA_FILTER_HARD) || height == 0)
+		return 0;
+	float reach = max_dist(L->position, b);
+	if (L->range > 0 && L->range < reach) reach = L->range;
+	float tan_half = L->type == RND_LIGHT_SPOT ? tanf(fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f)) : 1.0f;
+	float kernel = (float)(lp->filter == UMBRA_FILTER_PCF ? 2 * lp->pcf_radius + 1 : 1);
+	float pix = cam->ortho ? cam->ortho_height / (float)height : 2.0f * tanf(0.5f * cam->fov_y) / (float)height;
+	float want = 0;
+	for (int i = 0; i < 9; i++) {
+		float p[3], d[3];
+		for (int k = 0; k < 3; k++)
+			p[k] = i == 8 ? 0.5f * (b->min[k] + b->max[k]) : (i >> k & 1 ? b->max[k] : b->min[k]);
+		rnd_v3_sub(d, p, L->position);
+		float to_light = rnd_v3_length(d);
+		if (to_light > reach) {
+			for (int k = 0; k < 3; k++) p[k] = L->position[k] + d[k] * (reach / to_light);
+			to_light = reach;
+		}
+		rnd_v3_sub(d, p, cam->pos);
+		float footprint = cam->ortho ? pix : pix * fmaxf(rnd_v3_length(d), cam->znear);
+		/* texel at p: 2 tan_half |p - L| / res <= footprint / kernel */
+		want = fmaxf(want, kernel * 2.0f * tan_half * to_light / footprint);
+	}
+	float cap = fminf(2.0f * (float)base, L->type == RND_LIGHT_SPOT ? 2048.0f : 1024.0f);
+	return (uint32_t)fminf(want, cap);
 }
 
 static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
@@ -380,13 +434,24 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 	if (clipmap) {
 		plan_clipmap(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
 	} else if (!cascades) {
-		/* fit: the light-space box around the scene bounds, square texels */
+		/* fit: the light-space box around the scene bounds. Under a low sun the ground's
+		 * extent across the light's up axis is sin(elevation) of its length, and a square map
+		 * wastes all but that share of its rows (7 degrees: texels 8x longer on the ground
+		 * than across, a PCF ramp of several pixels along every long shadow). So where a
+		 * square map would leave more than half its rows or columns empty, the map is the
+		 * box itself (texels at most 32:1 for a flat scene under a horizon sun). Not below
+		 * that: finer texels make round shapes finer in the map (lod.c: 1/8 texel), which cost
+		 * thumb-512 (sun 60 degrees up, box 1.3:1) ~15 % CPU for no visible change. PCSS sizes
+		 * its disk from one texel size and keeps square texels. */
 		struct rnd_aabb lb;
 		rnd_aabb_transform(&lb, bounds, view);
 		float cx = 0.5f * (lb.min[0] + lb.max[0]), cy = 0.5f * (lb.min[1] + lb.max[1]);
-		float half = 0.5f * fmaxf(lb.max[0] - lb.min[0], lb.max[1] - lb.min[1]);
-		half *= 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
-		ortho_view(next_view(out, i, true), view, cx, cy, half, zmin, zmax, fres, d);
+		float hx = 0.5f * (lb.max[0] - lb.min[0]), hy = 0.5f * (lb.max[1] - lb.min[1]);
+		float hmax = fmaxf(hx, hy);
+		if (lp->filter == UMBRA_FILTER_PCSS || fminf(hx, hy) > 0.5f * hmax) hx = hy = hmax;
+		hx = fmaxf(hx, hmax / 32.0f); hy = fmaxf(hy, hmax / 32.0f);
+		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
+		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
 		lp->max_distance = s->max_distance;
 	} else {
 		plan_cascades(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
@@ -445,13 +510,19 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		if (!s->enabled) continue;
 		/* Tile size: the light's resolution rounded up to a power of two (atlas tiles), else
 		 * by type: a sun map covers the whole view, a spot cone less, a cube face a sixth. */
+		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
 		uint32_t want = s->resolution ? s->resolution
 		              : L->type == RND_LIGHT_DIRECTIONAL ? (uint32_t)DEFAULT_RES : light_importance_res(L, bounds, cam);
+		if (!s->resolution && L->type != RND_LIGHT_DIRECTIONAL) {
+			uint32_t base = 64;
+			while (base < want && base < 8192) base *= 2;
+			uint32_t hard = hard_light_res(L, lp, bounds, cam, scene->height, base);
+			if (hard > want) want = hard;
+		}
 		uint32_t res = 64;
 		while (res < want && res < 8192) res *= 2;
 		lp->resolution = res;
 		if (res > out->resolution) out->resolution = res;
-		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false, clipmap = false;
 		uint32_t ncasc = 1;

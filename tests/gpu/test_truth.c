@@ -148,13 +148,17 @@ static void check_scene(const char *name, double max_rmse, double min_iou, doubl
 			for (int x = 0; x < w; x++) cand[y * w + x] = gpu_px8(&img, x, y)[0] / 255.0f;
 		struct truth_score s;
 		score(truth, cand, mask, edge, w, h, &s);
-		printf("    [%s vs traced reference] %ld valid px, %ld shadowed: rmse %.4f, iou %.4f, disagree_core %.4f; "
-		       "penumbra high-frequency energy %.5f (reference %.5f)\n", name, s.valid, s.shadow, s.rmse, s.iou,
-		       s.disagree_core, s.hf_cand, s.hf_truth);
+		printf("    [%s vs traced reference] %ld valid px, %ld shadowed: rmse %.4f, iou %.4f, disagree_core %.4f, "
+		       "missing_contact %.4f, false_core %.4f; penumbra high-frequency energy %.5f (reference %.5f)\n", name,
+		       s.valid, s.shadow, s.rmse, s.iou, s.disagree_core, s.missing_contact, s.false_core, s.hf_cand,
+		       s.hf_truth);
 		CHECK(s.rmse <= max_rmse, "%s: rmse %.4f > %.4f", name, s.rmse, max_rmse);
 		CHECK(s.iou >= min_iou, "%s: iou %.4f < %.4f", name, s.iou, min_iou);
 		CHECK(s.disagree_core <= max_disagree_core, "%s: disagree_core %.4f > %.4f", name, s.disagree_core,
 		      max_disagree_core);
+		/* issue 13's targets for every scene: no detached shadows at contact, no false darkening */
+		CHECK(s.missing_contact <= 0.05, "%s: missing_contact %.4f > 0.05", name, s.missing_contact);
+		CHECK(s.false_core <= 0.002, "%s: false_core %.4f > 0.002", name, s.false_core);
 		CHECK(s.hf_cand <= max_hf * s.hf_truth, "%s: penumbra high-frequency energy %.4f, over %.1fx the reference's %.4f",
 		      name, s.hf_cand, max_hf, s.hf_truth);
 		rnd_image_release(&img);
@@ -187,6 +191,29 @@ TEST(truth_soft_spot_light_pcss)
 TEST(truth_soft_sun_pcss)
 {
 	check_scene("sun_pcss", 0.01, 0.97, 0.002, 3.0);
+}
+
+/* A hard point light (no radius, the default filter: PCF, radius 1) over the same casters.
+ * Before: rmse 0.0303 (iou 0.979): every shadow edge a pixel-wide ramp moved outwards — a
+ * 1.5-texel normal offset shifted the lookups (o tan(theta) along the floor) and the 512-texel
+ * cube faces made the 3-texel PCF ramp up to ~2 pixels wide at the floor's far corners. After
+ * (no default normal offset, cube faces fine enough that the kernel spans at most a pixel):
+ * rmse 0.0173, iou 0.997. The reference is binary, so it has no penumbra energy to compare. */
+TEST(truth_hard_point_light_default_filter)
+{
+	check_scene("point_hard", 0.02, 0.95, 0.002, 1.0);
+}
+
+/* A hard sun 7 degrees above the horizon over a box, a 10 cm pole and a ball on a 30 m plane
+ * (the default filter). Before: rmse 0.0372, iou 0.959: the 1.5-texel normal offset moved
+ * every lookup o tan(83 deg) ~ 12 texels along the ground, and the square fitted map spent
+ * 7/8 of its rows on empty light space, so its texels were 8x longer on the ground than
+ * across. After (no default normal offset; the map fitted to the light-space box): rmse
+ * 0.0298, iou 0.978. The issue's 0.02 is not met: even an 8192 map gives 0.021 with PCF
+ * radius 1 (0.018 with radius 0), the rest is the kernel's ramp along 1-pixel-wide shadows. */
+TEST(truth_grazing_sun_default_filter)
+{
+	check_scene("grazing_sun", 0.032, 0.97, 0.002, 1.0);
 }
 
 /* ---- contact shadows (issue 13 item 3) ---- */
@@ -277,6 +304,42 @@ TEST(truth_contact_shadows_sun_low_res_map)
 	if (off_img.pixels) rnd_image_release(&off_img);
 	free(off);
 	free(exr);
+	free(truth);
+	free(mask);
+	free(edge);
+	free(doc);
+}
+
+/* The soft spot (radius 0.25, pcss) with contact shadows on must meet the issue's 0.02 for
+ * missing_contact (truth-shadowed pixels within 8 px of a caster left lit). Before: 0.0205
+ * (4 of 195 contact pixels; the map's 1.5-texel default normal offset moved the lookups away
+ * from the casters, which the contact march, hard and short by design, did not give back);
+ * after (no default normal offset): 0.0154, rmse 0.0116 -> 0.0091. */
+TEST(truth_soft_spot_contact_on_meets_missing_contact)
+{
+	const int w = 128, h = 128;
+	size_t len;
+	char *doc = (char *)read_file(TRUTH_DIR "spot_pcss.json", &len);
+	REQUIRE(doc, "cannot read " TRUTH_DIR "spot_pcss.json");
+	float *truth = read_grey(TRUTH_DIR "spot_pcss.vis.png", w, h);
+	float *mask = read_grey(TRUTH_DIR "spot_pcss.mask.png", w, h);
+	float *edge = read_grey(TRUTH_DIR "spot_pcss.edge.png", w, h);
+	char *on = replaced(doc, "\"shadow\": {\"filter\": \"pcss\"}",
+	                    "\"shadow\": {\"filter\": \"pcss\", \"contact\": {\"enabled\": true}}");
+	CHECK(truth && mask && edge, "missing reference images for spot_pcss in " TRUTH_DIR);
+	CHECK(on, "spot_pcss.json lacks the member this test edits");
+	struct rnd_image img = {0};
+	struct truth_score s;
+	if (truth && mask && edge && on && render_scored(on, truth, mask, edge, w, h, &img, &s)) {
+		printf("    [spot_pcss contact on vs traced reference] rmse %.4f, iou %.4f, disagree_core %.4f, "
+		       "missing_contact %.4f, false_core %.4f\n", s.rmse, s.iou, s.disagree_core, s.missing_contact, s.false_core);
+		CHECK(s.missing_contact <= 0.02, "missing_contact %.4f > 0.02", s.missing_contact);
+		CHECK(s.rmse <= 0.02 && s.iou >= 0.95, "rmse %.4f, iou %.4f", s.rmse, s.iou);
+		CHECK(s.disagree_core <= 0.002 && s.false_core <= 0.002, "disagree_core %.4f, false_core %.4f",
+		      s.disagree_core, s.false_core);
+		rnd_image_release(&img);
+	}
+	free(on);
 	free(truth);
 	free(mask);
 	free(edge);

@@ -299,6 +299,50 @@ TEST(plan_fit_covers_scene_bounds)
 		}
 }
 
+/* A sun 7 degrees above a 30 m plane: the bounds' light-space box is ~8:1, and the fitted map
+ * is that box (both axes span the map), not the square around it that left 7/8 of its rows
+ * empty; a sun 60 degrees up (box under 2:1) and PCSS keep square texels. */
+TEST(plan_fit_low_sun_uses_the_light_space_box)
+{
+	struct rnd_aabb box;
+	set_box(&box, -15, 0, -15, 15, 1.2f, 15);
+	static const float low[3] = {-0.794f, -0.1219f, -0.5955f}, high[3] = {-0.5f, -1, -0.3f};
+	for (int t = 0; t < 3; t++) {
+		struct fixture f;
+		fixture_init(&f, 30.0f, RND_LIGHT_DIRECTIONAL);
+		memcpy(f.light.direction, t == 1 ? high : low, sizeof f.light.direction);
+		f.light.shadow.dir_mode = RND_DIR_FIT;
+		if (t == 2) { f.light.angular_diameter = 0.01f; f.light.shadow.filter = RND_FILTER_PCSS; }
+		struct rnd_camera_plan cp;
+		static struct rnd_shadow_plan sp;
+		struct rnd_error err = {0};
+		REQUIRE(rnd_camera_plan(&f.scene.camera, 128, 128, &box, &cp, &err) == RND_OK, "camera: %s", err.msg);
+		REQUIRE(rnd_shadow_plan(&f.scene, &box, &cp, &sp, &err) == RND_OK, "shadow: %s", err.msg);
+		const struct umbra_shadow_view *v = &sp.views[0];
+		double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+		for (int i = 0; i < 8; i++) {
+			double p[3], n[3];
+			corner(&box, i, p);
+			ndc3(v->view_proj, p, n);
+			CHECK(inside_clip(n, 1e-5), "case %d corner %d outside the map", t, i);
+			for (int a = 0; a < 2; a++) { lo[a] = fmin(lo[a], n[a]); hi[a] = fmax(hi[a], n[a]); }
+		}
+		double sx = hi[0] - lo[0], sy = hi[1] - lo[1];
+		const float *m = v->view_proj;   /* half-widths of the view from its row scales */
+		double hx = 1.0 / sqrt((double)m[0] * m[0] + (double)m[4] * m[4] + (double)m[8] * m[8]);
+		double hy = 1.0 / sqrt((double)m[1] * m[1] + (double)m[5] * m[5] + (double)m[9] * m[9]);
+		if (t == 0)
+			CHECK(sx > 1.9 && sy > 1.9 && fmax(hx, hy) > 4.0 * fmin(hx, hy),
+			      "low sun: the bounds span %.3f x %.3f of a %.2f x %.2f map", sx, sy, hx, hy);
+		else
+			CHECK(fabs(hx - hy) < 1e-4 * hx && fmax(sx, sy) > 1.9, "case %d: square map expected, %.3f x %.3f", t, hx,
+			      hy);
+		/* params[0] (the texel size the shaders use) is the larger side of a texel */
+		double texel = 2.0 * fmax(hx, hy) / v->rect[2];
+		CHECK(fabs(v->params[0] - texel) < 1e-4 * texel, "case %d: texel size %g, expected %g", t, v->params[0], texel);
+	}
+}
+
 /* ---- auto mode ------------------------------------------------------------------------------- */
 
 TEST(plan_auto_mode_chooses_fit_or_cascades)
@@ -521,12 +565,20 @@ TEST(plan_shadow_limits_and_errors)
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.resolution == 4096, "resolution %u", sp.resolution);
 	lights[0].shadow.resolution = 0; lights[1].shadow.resolution = 0;
 	/* Without a resolution, a point light's face size follows its share of the view: between
-	 * 256 and 512, a power of two, and a light whose lit region fills the view gets 512. */
+	 * 256 and 512, a power of two, and a light whose lit region fills the view gets 512; a
+	 * hard one (no radius, PCF) up to twice that, 1024 at most. */
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK, "%s", err.msg);
 	for (uint32_t i = 0; i < 2; i++) {
 		uint32_t r = sp.lights[i].resolution;
-		CHECK(r >= 256 && r <= 512 && (r & (r - 1)) == 0, "light %u: face size %u", i, r);
+		CHECK(r >= 256 && r <= 1024 && (r & (r - 1)) == 0, "light %u: face size %u", i, r);
 	}
+	lights[0].radius = lights[1].radius = 0.1f;
+	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK, "%s", err.msg);
+	for (uint32_t i = 0; i < 2; i++) {
+		uint32_t r = sp.lights[i].resolution;
+		CHECK(r >= 256 && r <= 512 && (r & (r - 1)) == 0, "soft light %u: face size %u", i, r);
+	}
+	lights[0].radius = lights[1].radius = 0.0f;
 	/* A resolution that is not a power of two rounds up to the next tile size. */
 	lights[0].shadow.resolution = 1000;
 	CHECK(rnd_shadow_plan(&sc, &b, &cp, &sp, &err) == RND_OK && sp.lights[0].resolution == 1024,
@@ -785,7 +837,15 @@ TEST(plan_light_importance_sets_tile_size)
 	struct rnd_error err = {0};
 	REQUIRE(sp && rnd_camera_plan(&cam, 512, 512, &b, &cp, &err) == RND_OK, "camera: %s", err.msg);
 	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
-	CHECK(sp->lights[0].resolution == 512, "near light face %u", sp->lights[0].resolution);
+	/* Both are hard (no radius, PCF): the near one's faces double so that its 3-texel kernel
+	 * stays within a pixel (cube faces stop at 1024); the small far one's reach (0.3 m) is
+	 * seen from 56 m and needs no more than importance gives it. */
+	CHECK(sp->lights[0].resolution == 1024, "near light face %u", sp->lights[0].resolution);
 	CHECK(sp->lights[1].resolution == 256, "small far light face %u", sp->lights[1].resolution);
+	/* With a radius (PCSS) importance alone decides. */
+	lights[0].radius = lights[1].radius = 0.05f;
+	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
+	CHECK(sp->lights[0].resolution == 512, "near soft light face %u", sp->lights[0].resolution);
+	CHECK(sp->lights[1].resolution == 256, "small far soft light face %u", sp->lights[1].resolution);
 	free(sp);
 }
