@@ -120,7 +120,7 @@ TEST(pcss_bounds_change_no_byte)
 	bounds_doc(doc, sizeof doc, 0.0, "{'msaa':4}");
 	same_with_and_without("beauty", doc);
 	for (int l = 0; l < 4; l++) {
-		char out[96], what[32];
+		char out[96], what[48];
 		snprintf(out, sizeof out, "{'debug':'shadow','debug_light':%d,'msaa':1}", l);
 		snprintf(what, sizeof what, "debug shadow of light %d", l);
 		bounds_doc(doc, sizeof doc, 0.0, out);
