@@ -159,9 +159,11 @@ vec4 penumbra_texels(umbra_shadow_view v, float size, vec4 zb, float zr, float t
 // Cost: the 25-gather search is most of what many soft lights cost (16 spot lights: ~340 of
 // ~540 ms CPU per render; the 32 filter taps ~50 ms). Fewer search taps (13 or 17) doubled the
 // point light's error against the traced reference (test_truth). So the search is skipped
-// where the atlas's depth bounds (pcss_bounds: a few texel fetches) prove its answer: no
+// where the atlas's depth bounds (pcss_bounds: one to five texel fetches) prove its answer: no
 // caster near (lit, 1.0) or every texel in reach a blocker (umbra, 0.0) give the very values
-// the search and filter would; only the rest, near penumbrae, runs them.
+// the search and filter would; only the rest, in and around shadows, runs them (CPU per
+// render: studio-spots 360 -> 319 ms, 16 lights 499 -> 419 ms; lit is proved on most of what
+// a light reaches, umbra only under casters wider than the search's reach).
 float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, float res, vec2 grad)
 {
 	float zr = view_distance(v, ref);
