@@ -11,6 +11,7 @@
 #include "contact.h"
 #include "frame.h"
 #include "material.h"
+#include "moments.h"
 #include "record.h"
 
 /* 32 Poisson-disk taps in the unit disk (PCSS blocker search and filtering). */
@@ -99,8 +100,8 @@ static void write_materials(struct umbra_material *m, const struct rnd_scene *sc
 }
 
 /* Light i of the scene with its shadow plan (views, filter, bias, moments, contact). */
-static void write_light(struct umbra_light *l, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
-                        uint32_t i)
+static void write_light(const struct rnd_context *ctx, struct umbra_light *l, const struct rnd_scene *sc,
+                        const struct rnd_shadow_plan *sp, uint32_t i)
 {
 	const struct rnd_light *in = &sc->lights[i];
 	const struct rnd_light_plan *lp = &sp->lights[i];
@@ -118,6 +119,12 @@ static void write_light(struct umbra_light *l, const struct rnd_scene *sc, const
 	l->shadow[1] = lp->view_count;
 	l->shadow[2] = lp->filter;
 	l->shadow[3] = lp->pcf_radius;
+	/* PCSS: 1 = record.c drew the depth bounds with the maps. UMBRA_PCSS_BOUNDS=0 (read per
+	 * render) leaves them unread, for the test that they change no byte (test_pcss_bounds). */
+	const char *use = getenv("UMBRA_PCSS_BOUNDS");
+	if (lp->filter == UMBRA_FILTER_PCSS)
+		l->shadow[3] = lp->view_count && rnd_bounds_wanted(ctx, lp, (uint32_t)sp->views[lp->first_view].rect[2]) &&
+		               !(use && strcmp(use, "0") == 0);
 	l->shadow_params[0] = lp->bias_normal;
 	l->shadow_params[1] = lp->search_texels;
 	l->shadow_params[2] = in->shadow.blend;
@@ -158,7 +165,11 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 	VkDescriptorImageInfo di = contact
 		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, s->scene_depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL}
 		: (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-	VkWriteDescriptorSet w[7];
+	/* Lights without depth bounds never read them (umbra_light.shadow.w). */
+	VkDescriptorImageInfo bounds_ii = ctx->atlas_bounds.view
+		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL}
+		: ii;
+	VkWriteDescriptorSet w[8];
 	w[5] = (VkWriteDescriptorSet){
 		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
@@ -166,6 +177,10 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 	w[6] = (VkWriteDescriptorSet){
 		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SCENE_DEPTH,
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &di,
+	};
+	w[7] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_DEPTH_BOUNDS,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &bounds_ii,
 	};
 	for (int i = 0; i < 5; i++) {
 		w[i] = (VkWriteDescriptorSet){
@@ -175,10 +190,11 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, 7, w, 0, NULL);
+	vkUpdateDescriptorSets(ctx->device, 8, w, 0, NULL);
 }
 
-/* moments.comp: the scratch map in, the blur temporary, the moment atlas out. */
+/* moments.comp and minmax.comp: the scratch map in, the blur temporary, the moment atlas and
+ * the depth bounds out. */
 static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
 {
 	/* Moment maps read at most maxStorageBufferRange bytes of it (their resolution is capped to
@@ -186,12 +202,12 @@ static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
 	VkDeviceSize sb_range = s->scratch_buf.size < ctx->props.limits.maxStorageBufferRange
 	                      ? s->scratch_buf.size : ctx->props.limits.maxStorageBufferRange;
 	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, sb_range};
-	VkDescriptorImageInfo ci[3] = {
-		{VK_NULL_HANDLE, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED},
-		{VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
-		{VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
+	VkDescriptorImageInfo ci[4] = {
+		[UMBRA_MOMENTS_BINDING_TMP] = {VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
+		[UMBRA_MOMENTS_BINDING_OUT] = {VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
+		[UMBRA_MOMENTS_BINDING_BOUNDS] = {VK_NULL_HANDLE, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
-	VkWriteDescriptorSet cw[3];
+	VkWriteDescriptorSet cw[4];
 	uint32_t ncw = 0;
 	if (s->scratch_buf.buf)
 		cw[ncw++] = (VkWriteDescriptorSet){
@@ -199,8 +215,8 @@ static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
 			.dstBinding = UMBRA_MOMENTS_BINDING_DEPTH, .descriptorCount = 1,
 			.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &sbi,
 		};
-	for (uint32_t i = 1; i < 3; i++) {
-		if (!ci[i].imageView) continue;
+	for (uint32_t i = 0; i < 4; i++) {
+		if (i == UMBRA_MOMENTS_BINDING_DEPTH || !ci[i].imageView) continue;
 		cw[ncw++] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
 			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &ci[i],
@@ -224,7 +240,7 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
 	write_frame((struct umbra_frame *)(base + lay.off_frame), sc, cam, exposure);
 	write_materials((struct umbra_material *)(base + lay.off_mat), sc);
 	struct umbra_light *l = (struct umbra_light *)(base + lay.off_light);
-	for (uint32_t i = 0; i < sc->light_count; i++) write_light(&l[i], sc, sp, i);
+	for (uint32_t i = 0; i < sc->light_count; i++) write_light(ctx, &l[i], sc, sp, i);
 	memcpy(base + lay.off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));
 	bind_params(ctx, s, &lay, contact);
 	bind_moments(ctx, s);

@@ -89,6 +89,7 @@ struct rnd_moments {
 	VkDescriptorSetLayout set_layout;
 	VkPipelineLayout layout;
 	VkPipeline pipeline;                 /* moments.comp */
+	VkPipeline bounds;                   /* minmax.comp: PCSS depth bounds, same layout */
 	VkSampler sampler;                   /* linear, clamp to edge */
 	bool fp32;                           /* R32G32_SFLOAT filterable + storable */
 	bool available;                      /* VSM / EVSM can be offered at all */
@@ -117,6 +118,7 @@ struct rnd_context {
 	struct rnd_shadow_cache *cache;      /* shadow_cache.c */
 	struct rnd_image_res atlas_depth;    /* D32, GENERAL layout, every shadow view is a tile */
 	struct rnd_image_res atlas_moments;  /* VSM / EVSM moments, same tiles */
+	struct rnd_image_res atlas_bounds;   /* PCSS depth bounds: a texel per UMBRA_BOUNDS_BLOCK² block */
 	uint64_t stats_hits, stats_misses;
 	bool has_debug_utils;
 	PFN_vkSetDebugUtilsObjectNameEXT set_object_name;   /* NULL without VK_EXT_debug_utils */

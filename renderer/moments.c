@@ -3,6 +3,8 @@
  * pipeline (shaders/moments.comp) that turns a depth layer into blurred moments, and the
  * recording of its two passes per shadow view. Created once per context; the moment images
  * themselves belong to the render slots (slot.c).
+ * Also PCSS's depth bounds (shaders/minmax.comp): the same kind of pass over the same scratch
+ * copy of a map just drawn, with the same descriptor set and pipeline layout.
  *
  * Format: R32G32_SFLOAT where the device can filter it linearly and store to it, else
  * R16G16_SFLOAT (the EVSM exponent is then clamped so exp(2cd) fits in a half).
@@ -12,6 +14,7 @@
 #include "moments.h"
 #include "record.h"
 #include "moments.comp.spv.h"
+#include "minmax.comp.spv.h"
 
 static bool format_ok(const struct rnd_context *ctx, VkFormat f)
 {
@@ -31,12 +34,13 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 	m->fp32 = format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) && f.shaderStorageImageExtendedFormats;
 	m->available = f.shaderStorageImageWriteWithoutFormat && f.shaderStorageImageExtendedFormats &&
 	               (format_ok(ctx, VK_FORMAT_R32G32_SFLOAT) || format_ok(ctx, VK_FORMAT_R16G16_SFLOAT));
-	VkDescriptorSetLayoutBinding b[3] = {
+	VkDescriptorSetLayoutBinding b[4] = {
 		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_TMP, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
+		{UMBRA_MOMENTS_BINDING_BOUNDS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 	};
-	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 3, .pBindings = b};
+	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 4, .pBindings = b};
 	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &m->set_layout)) != VK_SUCCESS)
 		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (moments)");
 	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, m->set_layout, "moments set layout");
@@ -50,10 +54,11 @@ enum rnd_result rnd_moments_init(struct rnd_context *ctx, struct rnd_error *err)
 		goto fail;
 	}
 	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, m->layout, "moments pipeline layout");
-	const struct { const uint32_t *code; size_t size; VkPipeline *out; const char *name; } progs[1] = {
+	const struct { const uint32_t *code; size_t size; VkPipeline *out; const char *name; } progs[2] = {
 		{spv_moments_comp, sizeof spv_moments_comp, &m->pipeline, "moments blur"},
+		{spv_minmax_comp, sizeof spv_minmax_comp, &m->bounds, "pcss depth bounds"},
 	};
-	for (int i = 0; i < 1; i++) {
+	for (int i = 0; i < 2; i++) {
 		VkShaderModule mod;
 		VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = progs[i].size, .pCode = progs[i].code};
 		if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &mod)) != VK_SUCCESS) {
@@ -94,6 +99,7 @@ void rnd_moments_release(struct rnd_context *ctx)
 	struct rnd_moments *m = &ctx->moments;
 	if (!ctx->device) return;
 	if (m->sampler) vkDestroySampler(ctx->device, m->sampler, NULL);
+	if (m->bounds) vkDestroyPipeline(ctx->device, m->bounds, NULL);
 	if (m->pipeline) vkDestroyPipeline(ctx->device, m->pipeline, NULL);
 	if (m->layout) vkDestroyPipelineLayout(ctx->device, m->layout, NULL);
 	if (m->set_layout) vkDestroyDescriptorSetLayout(ctx->device, m->set_layout, NULL);
@@ -151,4 +157,34 @@ uint32_t rnd_moments_max_res(const struct rnd_context *ctx)
 	uint32_t r = 16384;
 	while (r > 64 && (uint64_t)r * r * 4 > range) r /= 2;
 	return r;
+}
+
+bool rnd_bounds_wanted(const struct rnd_context *ctx, const struct rnd_light_plan *lp, uint32_t res)
+{
+	return lp->filter == UMBRA_FILTER_PCSS && ctx->atlas_bounds.img && res <= rnd_moments_max_res(ctx);
+}
+
+void rnd_bounds_record_view(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v)
+{
+	struct rnd_moments *m = &ctx->moments;
+	VkCommandBuffer cmd = s->cmd;
+	const float *rect = sp->views[v].rect;
+	uint32_t res = (uint32_t)rect[2], blocks = res / UMBRA_BOUNDS_BLOCK;
+	struct rnd_moments_push push = {.info = {(uint32_t)rect[0], (uint32_t)rect[1], 0, 0}, .params = {0, 0, (float)res, 0}};
+	vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->layout, 0, 1, &s->moments_set, 0, NULL);
+	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m->bounds);
+	/* Pass 1 reads the planes of pass 0's neighbouring blocks. This view's tile is its own:
+	 * no other pass of this render touches these blocks. */
+	VkMemoryBarrier2 mb = {
+		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, .srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+		.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, .dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+	};
+	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
+	for (uint32_t pass = 0; pass < 2; pass++) {
+		if (pass) vkCmdPipelineBarrier2(cmd, &di);
+		push.info[2] = pass;
+		vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+		vkCmdDispatch(cmd, (blocks + 7) / 8, (blocks + 7) / 8, 1);   /* 8x8 invocations of one block each */
+	}
 }

@@ -29,4 +29,13 @@ uint32_t rnd_moments_max_res(const struct rnd_context *ctx);
 void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp,
                              uint32_t v, const struct rnd_scene *sc);
 
+/* PCSS depth bounds (UMBRA_BOUNDS_BLOCK in umbra_shared.h) for a light's maps of resolution
+ * res: only PCSS lights get them, and only maps the scratch buffer's storage-buffer range can
+ * hold (the same cap as moment maps). record.c draws them, frame.c tells the shader. */
+bool rnd_bounds_wanted(const struct rnd_context *ctx, const struct rnd_light_plan *lp, uint32_t res);
+/* After shadow view v was drawn and copied to s->scratch_buf (as for moments): its tile's
+ * depth bounds into ctx->atlas_bounds. s->moments_set must point at both. Tiles are
+ * UMBRA_BOUNDS_BLOCK-aligned (at least 64 texels, aligned to their size). */
+void rnd_bounds_record_view(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v);
+
 #endif

@@ -154,9 +154,9 @@ static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const s
 	                     VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
-/* VSM / EVSM: the map as floats for the moment blur (compute shaders cannot read a
- * depth image on lavapipe without it copying the image on every dispatch). The
- * previous view's compute passes must be done reading the buffer. */
+/* VSM / EVSM / PCSS: the map as floats for the moment blur or the depth bounds (compute
+ * shaders cannot read a depth image on lavapipe without it copying the image on every
+ * dispatch). The previous view's compute passes must be done reading the buffer. */
 static void copy_for_moments(struct rnd_slot *s, uint32_t res)
 {
 	VkCommandBuffer cmd = s->cmd;
@@ -214,12 +214,16 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		};
 		vkCmdCopyImage(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, ctx->atlas_depth.img,
 		               VK_IMAGE_LAYOUT_GENERAL, 1, &copy);
-		if (!lp->moments) continue;
+		/* PCSS: the tile's depth bounds, drawn with every map drawn, so a cached map has them
+		 * whenever it is reused (the cache key holds the filter and the resolution). */
+		bool bounds = rnd_bounds_wanted(ctx, lp, res);
+		if (!lp->moments && !bounds) continue;
 		copy_for_moments(s, res);
-		rnd_moments_record_view(ctx, s, sp, v, sc);
+		if (bounds) rnd_bounds_record_view(ctx, s, sp, v);
+		else rnd_moments_record_view(ctx, s, sp, v, sc);
 	}
-	/* The atlas tiles (depth copied in, moments from compute) are read by the main and AOV
-	 * passes. */
+	/* The atlas tiles (depth copied in, moments and bounds from compute) are read by the main
+	 * and AOV passes. */
 	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
 	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
 	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;

@@ -14,6 +14,9 @@
 #include "slot.h"
 
 #define MAX_ENTRIES 1024
+#define MIN_TILE 64
+/* Depth bounds blocks never straddle two tiles (tiles are aligned to their size). */
+_Static_assert(MIN_TILE % UMBRA_BOUNDS_BLOCK == 0, "depth bounds blocks must divide the smallest tile");
 
 struct rnd_cache_entry {
 	uint64_t key;
@@ -52,10 +55,10 @@ static enum rnd_result init_layouts(struct rnd_context *ctx, struct rnd_error *e
 	VkResult vr;
 	VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO, .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
 	if ((vr = vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkBeginCommandBuffer (atlas init)");
-	VkImageMemoryBarrier2 g[2];
+	VkImageMemoryBarrier2 g[3];
 	uint32_t n = 0;
-	const struct rnd_image_res *im[2] = {&ctx->atlas_depth, &ctx->atlas_moments};
-	for (int i = 0; i < 2; i++) {
+	const struct rnd_image_res *im[3] = {&ctx->atlas_depth, &ctx->atlas_moments, &ctx->atlas_bounds};
+	for (int i = 0; i < 3; i++) {
 		if (!im[i]->img) continue;
 		g[n++] = (VkImageMemoryBarrier2){
 			.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = VK_PIPELINE_STAGE_2_NONE,
@@ -84,7 +87,7 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 	uint32_t size = ctx->desc.atlas_size;
 	struct rnd_shadow_cache *c = calloc(1, sizeof *c);
 	if (!c) return rnd_fail(err, RND_ERR_OOM, "out of memory for the shadow cache");
-	if (!rnd_atlas_init(&c->atlas, size, 64)) {
+	if (!rnd_atlas_init(&c->atlas, size, MIN_TILE)) {
 		free(c);
 		return rnd_fail(err, RND_ERR_INVALID, "atlas size %u: must be a power of two between 64 and 16384", size);
 	}
@@ -106,6 +109,13 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 	                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
 	                          "shadow moment atlas", &ctx->atlas_moments, err)) != RND_OK)
 		goto fail;
+	/* PCSS depth bounds (RGBA32F: a storage format every device has), not cleared either: a
+	 * tile's blocks are written with its map (record.c). */
+	if ((r = rnd_image_create(ctx, VK_FORMAT_R32G32B32A32_SFLOAT, size / UMBRA_BOUNDS_BLOCK * UMBRA_BOUNDS_TEXELS,
+	                          size / UMBRA_BOUNDS_BLOCK,
+	                          1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
+	                          "shadow depth bounds", &ctx->atlas_bounds, err)) != RND_OK)
+		goto fail;
 	if ((r = init_layouts(ctx, err)) != RND_OK) goto fail;
 	return RND_OK;
 fail:
@@ -116,6 +126,7 @@ fail:
 void rnd_cache_release_all(struct rnd_context *ctx)
 {
 	struct rnd_shadow_cache *c = ctx->cache;
+	rnd_image_destroy(ctx, &ctx->atlas_bounds);
 	rnd_image_destroy(ctx, &ctx->atlas_moments);
 	rnd_image_destroy(ctx, &ctx->atlas_depth);
 	if (!c) return;
@@ -404,7 +415,8 @@ uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s)
 		/* All or nothing, like the grants: with every map gone the whole atlas is free, so its
 		 * pages go back without knowing how the driver lays texels out in memory. */
 		if (empty && c->touched) {
-			released = release_pages(ctx, &ctx->atlas_depth) + release_pages(ctx, &ctx->atlas_moments);
+			released = release_pages(ctx, &ctx->atlas_depth) + release_pages(ctx, &ctx->atlas_moments) +
+			           release_pages(ctx, &ctx->atlas_bounds);
 			c->touched = false;
 		}
 	}

@@ -2,8 +2,9 @@
  * renderer/shadow_cache.h — the persistent shadow atlases and what lives in them.
  *
  * The context owns one depth atlas (D32) and one moment atlas (two channels, fp32 where the
- * device filters it, else fp16), both atlas_size² texels, created at start-up and kept in
- * GENERAL layout for the life of the process. Every shadow view of every render is a square
+ * device filters it, else fp16), both atlas_size² texels, and the depth bounds of the depth
+ * atlas for PCSS (two RGBA32F texels per UMBRA_BOUNDS_BLOCK² block, umbra_shared.h), created
+ * at start-up and kept in GENERAL layout for the life of the process. Every shadow view of every render is a square
  * tile of these atlases (atlas.c hands them out):
  *   - spot and point lights get cached entries keyed by a hash of everything that shapes their
  *     maps (caster geometry, the light's view matrices, resolution, bias, filter settings);

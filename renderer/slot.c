@@ -89,7 +89,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	VkDescriptorPoolSize sizes[3] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4},
 	};
 	if ((r = pool_with_sets(ctx, sizes, 3, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
 		goto fail_desc_pool;
@@ -111,7 +111,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 		};
 	vkUpdateDescriptorSets(ctx->device, UMBRA_TEX_SLOTS, ww, 0, NULL);
-	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
+	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 3}};
 	if ((r = pool_with_sets(ctx, msizes, 2, 1, &ctx->moments.set_layout, "moments", index, &s->moments_pool,
 	                        &s->moments_set, err)) != RND_OK)
 		goto fail_white;

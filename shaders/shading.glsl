@@ -20,6 +20,7 @@ layout(std140, set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_VIEWS) unif
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sampler2D shadow_atlas;
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2D moment_atlas;
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SCENE_DEPTH) uniform sampler2D scene_depth;
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_DEPTH_BOUNDS) uniform sampler2D depth_bounds;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_METAL_ROUGH_TEXTURE) uniform sampler2D metal_rough_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
@@ -143,6 +144,8 @@ vec4 penumbra_texels(umbra_shadow_view v, float size, vec4 zb, float zr, float t
 	return size * (zr - zb) / texel;
 }
 
+#include "pcss_bounds.glsl"
+
 // PCSS: blocker search over the region that could shade this point, penumbra from the
 // light's size by similar triangles, then a Poisson-disk PCF of that width. The disk is the
 // same for every pixel (not rotated per pixel): across an edge its 32 bilinear taps form a
@@ -155,8 +158,12 @@ vec4 penumbra_texels(umbra_shadow_view v, float size, vec4 zb, float zr, float t
 // receiver.
 // Cost: the 25-gather search is most of what many soft lights cost (16 spot lights: ~340 of
 // ~540 ms CPU per render; the 32 filter taps ~50 ms). Fewer search taps (13 or 17) doubled the
-// point light's error against the traced reference (test_truth); skipping the search exactly
-// where no caster is near needs a min-depth level per atlas tile, which the atlas lacks.
+// point light's error against the traced reference (test_truth). So the search is skipped
+// where the atlas's depth bounds (pcss_bounds: one to five texel fetches) prove its answer: no
+// caster near (lit, 1.0) or every texel in reach a blocker (umbra, 0.0) give the very values
+// the search and filter would; only the rest, in and around shadows, runs them (CPU per
+// render: studio-spots 360 -> 319 ms, 16 lights 499 -> 419 ms; lit is proved on most of what
+// a light reaches, umbra only under casters wider than the search's reach).
 float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, float res, vec2 grad)
 {
 	float zr = view_distance(v, ref);
@@ -178,11 +185,16 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// Texels of the receiver's own plane must not count as blockers: compare against the
 	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
 	float slack = abs(grad.x) + abs(grad.y) + 1e-6;
+	// Search and filter taps stay within `search` texels: the filter's radius comes from the
+	// blockers' depth, never nearer the light than the near plane the search assumed (+1 for
+	// rounding).
+	int known = pcss_bounds(L, p, rect, ref, grad, slack, search + 1.0, r0, r1);
 	// Tap 0 is the point itself and taps 1..8 a close ring (3 texels): where penumbrae are
 	// narrower than the spacing of the wide taps (low casters, contact), they find the blockers
 	// whose penumbra reaches this point; taps 9..24 cover the whole search region.
 	float close = min(search, 3.0);
-	for (int i = 0; i < 25; i++) {
+	int search_taps = known == 0 ? 25 : 0;
+	for (int i = 0; i < search_taps; i++) {
 		vec2 off = i == 0 ? vec2(0.0) : poisson(i < 9 ? (i - 1) * 4 + 1 : (i - 9) * 2) * (i < 9 ? close : search);
 		vec4 d = gather_tile(rect, p + off);
 		vec4 b = step(d, vec4(ref + dot(grad, off) - slack)) * step(vec4(length(off)), r0 - r1 * d);
@@ -203,7 +215,7 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 		vec2 off = poisson(i) * radius;
 		sum += bilinear_compare(p + off, rect, ref + dot(grad, off), res);
 	}
-	return taps == 0 ? 1.0 : sum / 32.0;
+	return known == 2 ? 0.0 : taps == 0 ? 1.0 : sum / 32.0;
 }
 
 // Receiver plane: how the receiver's light-space depth changes per shadow-map texel, so that

@@ -17,11 +17,29 @@
 #define UMBRA_BINDING_SHADOW_MAP     4  /* sampler2D, the depth atlas (R32F): one tile per shadow view */
 #define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
 #define UMBRA_BINDING_SCENE_DEPTH    6  /* sampler2D, the camera view's depth (D32, 1 - reversed Z), contact shadows */
-#define UMBRA_BINDING_COUNT          7
+#define UMBRA_BINDING_DEPTH_BOUNDS   7  /* sampler2D, the depth bounds of the atlas (RGBA32F, texelFetch) */
+#define UMBRA_BINDING_COUNT          8
 /* moments.comp's own set 0 */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
 #define UMBRA_MOMENTS_BINDING_TMP    1
 #define UMBRA_MOMENTS_BINDING_OUT    2
+#define UMBRA_MOMENTS_BINDING_BOUNDS 3  /* minmax.comp (same set and layout): the depth-bounds image */
+#define UMBRA_BOUNDS_TEXELS 2           /* texels per block in the depth-bounds image */
+/* Depth bounds of the depth atlas, for PCSS: per UMBRA_BOUNDS_BLOCK² block of atlas texels (blocks
+ * never straddle tiles: tiles are at least 64 texels and aligned to their size), two texels of
+ * a (2 atlas / block) x (atlas / block) RGBA32F image, block (x, y) at (2x, y) and (2x + 1, y):
+ *   (c, gx, gy, h): the lowest plane under the block's depths and how far the highest lies above
+ *     it: for every texel centre t of the block, m its centre,
+ *     c + gx (t.x - m.x) + gy (t.y - m.y) <= depth(t) <= that + h.
+ *     A plane rather than a plain min / max: a sloped receiver's own depths vary by its slope
+ *     times the block size, which a plain minimum confuses with a caster.
+ *   (lo, hi, 0, 0): the lowest and highest depth of the blocks of the tile up to
+ *     UMBRA_BOUNDS_RING blocks away, so that one fetch bounds everything within that many
+ *     blocks' widths of a point.
+ * Written by minmax.comp right after each PCSS map is drawn (record.c); kept with the atlas,
+ * so a cached map keeps its bounds. */
+#define UMBRA_BOUNDS_BLOCK 16
+#define UMBRA_BOUNDS_RING  2    /* the neighbourhood: blocks this many out (PCSS taps reach 25 texels) */
 /* Set 1: the material's textures, bound per draw (one set per textured material); a white 1x1
  * in every binding the material does not use. Binding = texture slot (UMBRA_TEX_*). */
 #define UMBRA_SET_MATERIAL           1
@@ -156,7 +174,8 @@ struct umbra_light {
 	U_VEC4 direction;        /* xyz normalised travel direction; w cos(outer) */
 	U_VEC4 params;           /* x cos(inner), y size: tan(angular radius) or radius (m),
 	                            z 1 = clipmap levels (else cascades), w max distance (0 = none) */
-	U_UVEC4 shadow;          /* x first view, y view count (0 = unshadowed), z filter, w pcf radius */
+	U_UVEC4 shadow;          /* x first view, y view count (0 = unshadowed), z filter, w pcf radius (PCF);
+	                            PCSS: w 1 = its views' depth bounds are written (UMBRA_BOUNDS_BLOCK) */
 	U_VEC4 shadow_params;    /* x normal offset (texels), y max search radius (texels),
 	                            z blend band (fraction), w fade start (view depth) */
 	U_VEC4 splits;           /* directional cascades: far view depth of cascade 0..3 */

@@ -38,6 +38,8 @@ struct rnd_context *gpu_ctx(void)
 	return g_ctx;
 }
 
+struct rnd_timings gpu_last_timings;
+
 bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char *fmt, ...)
 {
 	memset(img, 0, sizeof *img);
@@ -72,6 +74,8 @@ bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char
 		test_fail_at(file, line, "rnd_render", " %s: %s\n    doc: %s", rnd_result_str(r), err.msg, doc);
 		memset(img, 0, sizeof *img);
 		ok = false;
+	} else {
+		gpu_last_timings = t;
 	}
 	if (after != before) {
 		test_fail_at(file, line, "validation", " %u new Vulkan validation message(s) during this render",

@@ -22,6 +22,8 @@ struct rnd_context *gpu_ctx(void);
 bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
 #define gpu_render(img, ...) gpu_render_at(__FILE__, __LINE__, (img), __VA_ARGS__)
+/* The timings of the last successful gpu_render (shadow maps rendered / reused). */
+extern struct rnd_timings gpu_last_timings;
 
 /* Pixel access: channel c of pixel (i, j) as 0..1 (RGBA8 or RGBA16), or the raw 8-bit value. */
 double gpu_chan(const struct rnd_image *img, int i, int j, int c);
