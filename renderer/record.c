@@ -5,6 +5,7 @@
  * readback.c).
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "moments.h"
 #include "contact.h"
@@ -256,6 +257,7 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	memset(k, 0, sizeof *k);
 	k->format = (uint32_t)sc->output.pixels;
 	k->samples = sc->output.msaa > 1 ? 4 : 1;
+	bool radii_differ = false;
 	for (uint32_t i = 0; i < sc->light_count; i++) {
 		const struct rnd_light_plan *lp = &sp->lights[i];
 		uint32_t type = record_light_type(sc->lights[i].type);
@@ -263,6 +265,18 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 		if (lp->view_count) k->sc[UMBRA_SC_FILTERS] |= 1u << lp->filter;
 		if (type == UMBRA_LIGHT_DIRECTIONAL && lp->view_count > 1) k->sc[UMBRA_SC_CASCADES] = 1;
 		if (rnd_contact_on(sc, sp, i)) k->sc[UMBRA_SC_CONTACT] = 1;
+		if (lp->view_count && lp->filter == UMBRA_FILTER_PCF) {
+			if (k->sc[UMBRA_SC_PCF_RADIUS] && k->sc[UMBRA_SC_PCF_RADIUS] != lp->pcf_radius + 1) radii_differ = true;
+			k->sc[UMBRA_SC_PCF_RADIUS] = lp->pcf_radius + 1;
+		}
+	}
+	if (radii_differ) k->sc[UMBRA_SC_PCF_RADIUS] = 0;
+	/* UMBRA_SPECIALIZE=0 (read per render): every light type and a PCF radius read per light,
+	 * the shader's general path, for the test that the folded one draws the same bytes. */
+	const char *spec = getenv("UMBRA_SPECIALIZE");
+	if (spec && strcmp(spec, "0") == 0) {
+		k->sc[UMBRA_SC_LIGHT_TYPES] = (1u << UMBRA_LIGHT_DIRECTIONAL) | (1u << UMBRA_LIGHT_SPOT) | (1u << UMBRA_LIGHT_POINT);
+		k->sc[UMBRA_SC_PCF_RADIUS] = 0;
 	}
 	k->sc[UMBRA_SC_DEBUG] = record_debug(sc->output.debug);
 	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;
