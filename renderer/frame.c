@@ -89,13 +89,7 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 
 static void write_materials(struct umbra_material *m, const struct rnd_scene *sc)
 {
-	if (!sc->material_count) {
-		struct rnd_material d;
-		rnd_material_defaults(&d);
-		memcpy(m[0].base_color, d.base_color, sizeof d.base_color);
-		m[0].emissive[3] = d.roughness;
-	}
-	for (uint32_t i = 0; i < sc->material_count; i++) rnd_material_write(&sc->materials[i], &m[i]);
+	for (uint32_t i = 0; i < sc->material_count || i == 0; i++) rnd_material_record(sc, i, &m[i]);
 }
 
 /* Light i of the scene with its shadow plan (views, filter, bias, moments, contact). */

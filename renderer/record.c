@@ -9,6 +9,7 @@
 #include <string.h>
 #include "moments.h"
 #include "contact.h"
+#include "material.h"
 #include "record.h"
 
 /* Culling back faces of a closed primitive changes nothing in the picture as long as the
@@ -383,6 +384,21 @@ static void begin_main(VkCommandBuffer cmd, struct rnd_slot *s, const struct rnd
 	vkCmdSetScissor(cmd, 0, 1, &area);
 }
 
+/* The main pass's push constants of draw d: its material head and its flags (mesh.frag). */
+static void main_push(const struct rnd_scene *sc, const struct draw *d, struct umbra_push_main *push)
+{
+	_Static_assert(sizeof(struct umbra_push_main) == sizeof(struct umbra_push), "one push range for every pipeline");
+	struct umbra_material m;
+	rnd_material_record(sc, d->material, &m);
+	memcpy(push->base_color, m.base_color, sizeof m.base_color);
+	memcpy(push->emissive, m.emissive, sizeof m.emissive);
+	memcpy(push->params, m.params, sizeof m.params);
+	memcpy(push->tex, m.tex, sizeof m.tex);
+	push->info[0] = d->material;
+	push->info[1] = d->flags;
+	push->info[2] = push->info[3] = 0;
+}
+
 /* The depth pre-pass (when the key asks for one), then every draw. */
 static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t ndraw,
                       bool prepass, const VkPipeline pipes[2], bool ms)
@@ -413,7 +429,8 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		if (!d->index_count || d->closed != (k < ndraw)) continue;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
+		struct umbra_push_main push;
+		main_push(rv->sc, d, &push);
 		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
 		                   sizeof push, &push);
 		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,

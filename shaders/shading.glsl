@@ -25,7 +25,11 @@ layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_METAL_ROUGH_TEXTURE) un
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_OCCLUSION_TEXTURE) uniform sampler2D occlusion_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_EMISSIVE_TEXTURE) uniform sampler2D emissive_texture;
+#ifdef UMBRA_PUSH_MAIN
+layout(push_constant) uniform PushBlock { umbra_push_main pc; };   // main pass (mesh.frag)
+#else
 layout(push_constant) uniform PushBlock { umbra_push pc; };
+#endif
 
 // Specialization constants: each pipeline variant carries only the code its scene needs.
 // lavapipe executes both sides of a divergent-looking branch under a mask, so dead paths

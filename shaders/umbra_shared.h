@@ -179,4 +179,18 @@ struct umbra_push {
 	U_UVEC4 info;            /* x material index, y UMBRA_DRAW_* flags, z AOV pass: first light */
 };
 
+/* The main pass's push constants (mesh.frag): the same 80 bytes, the draw's material head
+ * (umbra_material's first four members) where the shadow passes have their view-projection
+ * (mesh.vert takes the camera's from the frame block). lavapipe reads push constants once per
+ * draw but gathers a storage-buffer record lane by lane, even at an index the whole draw
+ * shares (thumb-512: ~10 % of the render's instructions). The uv transforms stay in the
+ * materials buffer, read only by textured scenes. */
+struct umbra_push_main {
+	U_VEC4 base_color;
+	U_VEC4 emissive;
+	U_VEC4 params;
+	U_UVEC4 tex;
+	U_UVEC4 info;            /* as umbra_push.info */
+};
+
 #endif
