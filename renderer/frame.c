@@ -141,7 +141,7 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{s->params.buf, lay->off_light, lay->nlight * sizeof(struct umbra_light)},
 		{s->params.buf, lay->off_view, lay->nview * sizeof(struct umbra_shadow_view)},
 	};
-	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	VkDescriptorImageInfo ii = {ctx->pipes.atlas_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
 	/* Without a moment atlas (no storage images) no light uses moments; the binding still
 	 * needs an image. */
 	VkDescriptorImageInfo mi = ctx->atlas_moments.view

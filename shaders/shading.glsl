@@ -70,7 +70,7 @@ vec2 poisson(int i) { vec4 v = frame.poisson[i >> 1]; return (i & 1) == 0 ? v.xy
 // Every shadow view is a tile of the depth atlas: rect = (x, y, size, atlas size) in texels.
 // Gathers the 2x2 texels around tile-local point q, kept inside the tile so filters never
 // read a neighbouring tile (views are widened by the filter footprint, so this only clamps
-// at the very edge).
+// at the very edge) and never a border texel: the atlas's sampler clamps to the edge.
 vec4 gather_tile(vec4 rect, vec2 q)
 {
 	q = clamp(q, vec2(1.0), vec2(rect.z - 1.0));
