@@ -90,13 +90,7 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 
 static void write_materials(struct umbra_material *m, const struct rnd_scene *sc)
 {
-	if (!sc->material_count) {
-		struct rnd_material d;
-		rnd_material_defaults(&d);
-		memcpy(m[0].base_color, d.base_color, sizeof d.base_color);
-		m[0].emissive[3] = d.roughness;
-	}
-	for (uint32_t i = 0; i < sc->material_count; i++) rnd_material_write(&sc->materials[i], &m[i]);
+	for (uint32_t i = 0; i < sc->material_count || i == 0; i++) rnd_material_record(sc, i, &m[i]);
 }
 
 /* Light i of the scene with its shadow plan (views, filter, bias, moments, contact). */
@@ -154,7 +148,7 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{s->params.buf, lay->off_light, lay->nlight * sizeof(struct umbra_light)},
 		{s->params.buf, lay->off_view, lay->nview * sizeof(struct umbra_shadow_view)},
 	};
-	VkDescriptorImageInfo ii = {ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	VkDescriptorImageInfo ii = {ctx->pipes.atlas_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
 	/* Without a moment atlas (no storage images) no light uses moments; the binding still
 	 * needs an image. */
 	VkDescriptorImageInfo mi = ctx->atlas_moments.view

@@ -58,6 +58,7 @@ struct rnd_pipelines {
 	VkDescriptorSetLayout texture_layout; /* set 1: the draw's material textures (UMBRA_TEX_SLOTS bindings) */
 	VkPipelineLayout layout;
 	VkSampler shadow_sampler;            /* nearest, clamp to border white (depth 1 = lit) */
+	VkSampler atlas_sampler;             /* nearest, clamp to edge: the depth atlas's gathers */
 	/* material textures, one per sampling state: see rnd_texture_sampler_index() */
 	VkSampler texture_samplers[RND_TEXTURE_SAMPLERS];
 	/* [cull: 0 none, 1 back] */

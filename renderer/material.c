@@ -20,6 +20,19 @@ bool rnd_texture_slot_srgb(enum rnd_texture_slot slot)
 	return slot == RND_TEX_BASE || slot == RND_TEX_EMISSIVE;
 }
 
+void rnd_material_record(const struct rnd_scene *sc, uint32_t index, struct umbra_material *out)
+{
+	if (sc->material_count) {
+		rnd_material_write(&sc->materials[index], out);
+		return;
+	}
+	struct rnd_material d;
+	rnd_material_defaults(&d);
+	memset(out, 0, sizeof *out);
+	memcpy(out->base_color, d.base_color, sizeof d.base_color);
+	out->emissive[3] = d.roughness;
+}
+
 void rnd_material_write(const struct rnd_material *in, struct umbra_material *out)
 {
 	memset(out, 0, sizeof *out);

@@ -16,6 +16,10 @@
 /* The GPU record of one material (umbra_shared.h). */
 void rnd_material_write(const struct rnd_material *in, struct umbra_material *out);
 
+/* The record of material `index` of sc as the materials buffer holds it (a scene without
+ * materials has one: the defaults, index 0). The main pass pushes its head per draw. */
+void rnd_material_record(const struct rnd_scene *sc, uint32_t index, struct umbra_material *out);
+
 /* Creates the scene's distinct textures (per colour space: base colour and emissive read
  * sRGB, the others linear) in the slot, stages their texels (tex[] in staging order,
  * *ntex of them), writes one set-1 descriptor set per textured material that a draw uses

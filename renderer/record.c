@@ -5,9 +5,11 @@
  * readback.c).
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "moments.h"
 #include "contact.h"
+#include "material.h"
 #include "record.h"
 
 /* Culling back faces of a closed primitive changes nothing in the picture as long as the
@@ -260,6 +262,7 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	memset(k, 0, sizeof *k);
 	k->format = (uint32_t)sc->output.pixels;
 	k->samples = sc->output.msaa > 1 ? 4 : 1;
+	bool radii_differ = false;
 	for (uint32_t i = 0; i < sc->light_count; i++) {
 		const struct rnd_light_plan *lp = &sp->lights[i];
 		uint32_t type = record_light_type(sc->lights[i].type);
@@ -267,6 +270,18 @@ static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 		if (lp->view_count) k->sc[UMBRA_SC_FILTERS] |= 1u << lp->filter;
 		if (type == UMBRA_LIGHT_DIRECTIONAL && lp->view_count > 1) k->sc[UMBRA_SC_CASCADES] = 1;
 		if (rnd_contact_on(sc, sp, i)) k->sc[UMBRA_SC_CONTACT] = 1;
+		if (lp->view_count && lp->filter == UMBRA_FILTER_PCF) {
+			if (k->sc[UMBRA_SC_PCF_RADIUS] && k->sc[UMBRA_SC_PCF_RADIUS] != lp->pcf_radius + 1) radii_differ = true;
+			k->sc[UMBRA_SC_PCF_RADIUS] = lp->pcf_radius + 1;
+		}
+	}
+	if (radii_differ) k->sc[UMBRA_SC_PCF_RADIUS] = 0;
+	/* UMBRA_SPECIALIZE=0 (read per render): every light type and a PCF radius read per light,
+	 * the shader's general path, for the test that the folded one draws the same bytes. */
+	const char *spec = getenv("UMBRA_SPECIALIZE");
+	if (spec && strcmp(spec, "0") == 0) {
+		k->sc[UMBRA_SC_LIGHT_TYPES] = (1u << UMBRA_LIGHT_DIRECTIONAL) | (1u << UMBRA_LIGHT_SPOT) | (1u << UMBRA_LIGHT_POINT);
+		k->sc[UMBRA_SC_PCF_RADIUS] = 0;
 	}
 	k->sc[UMBRA_SC_DEBUG] = record_debug(sc->output.debug);
 	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;
@@ -373,6 +388,21 @@ static void begin_main(VkCommandBuffer cmd, struct rnd_slot *s, const struct rnd
 	vkCmdSetScissor(cmd, 0, 1, &area);
 }
 
+/* The main pass's push constants of draw d: its material head and its flags (mesh.frag). */
+static void main_push(const struct rnd_scene *sc, const struct draw *d, struct umbra_push_main *push)
+{
+	_Static_assert(sizeof(struct umbra_push_main) == sizeof(struct umbra_push), "one push range for every pipeline");
+	struct umbra_material m;
+	rnd_material_record(sc, d->material, &m);
+	memcpy(push->base_color, m.base_color, sizeof m.base_color);
+	memcpy(push->emissive, m.emissive, sizeof m.emissive);
+	memcpy(push->params, m.params, sizeof m.params);
+	memcpy(push->tex, m.tex, sizeof m.tex);
+	push->info[0] = d->material;
+	push->info[1] = d->flags;
+	push->info[2] = push->info[3] = 0;
+}
+
 /* The depth pre-pass (when the key asks for one), then every draw. */
 static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t ndraw,
                       bool prepass, const VkPipeline pipes[2], bool ms)
@@ -403,7 +433,8 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		if (!d->index_count || d->closed != (k < ndraw)) continue;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
+		struct umbra_push_main push;
+		main_push(rv->sc, d, &push);
 		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
 		                   sizeof push, &push);
 		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,

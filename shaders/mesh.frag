@@ -1,14 +1,28 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "umbra_shared.h"
+#define UMBRA_PUSH_MAIN   // the draw's material head arrives in the push constants
 #include "shading.glsl"
 
 layout(location = 0) out vec4 o_color;
 
+// The draw's material: its head from the push constants (one load per draw), the uv
+// transforms from the materials buffer only where a material of the scene has textures.
+umbra_material draw_material()
+{
+	umbra_material m;
+	m.base_color = pc.base_color;
+	m.emissive = pc.emissive;
+	m.params = pc.params;
+	m.tex = pc.tex;
+	if ((SC_TEXTURES & ~UMBRA_TEXBIT_VERTEX_COLOR) != 0u) m.uvx = materials[pc.info.x].uvx;
+	return m;
+}
+
 void main()
 {
 	material_derivatives(v_uv);
-	umbra_material m = materials[pc.info.x];
+	umbra_material m = draw_material();
 	uint flags = pc.info.y;
 	vec4 bc = base_color(m);
 	vec3 n_geo = normalize(v_nrm);

@@ -26,7 +26,11 @@ layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_METAL_ROUGH_TEXTURE) un
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_OCCLUSION_TEXTURE) uniform sampler2D occlusion_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_EMISSIVE_TEXTURE) uniform sampler2D emissive_texture;
+#ifdef UMBRA_PUSH_MAIN
+layout(push_constant) uniform PushBlock { umbra_push_main pc; };   // main pass (mesh.frag)
+#else
 layout(push_constant) uniform PushBlock { umbra_push pc; };
+#endif
 
 // Specialization constants: each pipeline variant carries only the code its scene needs.
 // lavapipe executes both sides of a divergent-looking branch under a mask, so dead paths
@@ -41,6 +45,7 @@ layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any di
 layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 63u;  // bit (1 << UMBRA_TEX_*) | vertex colour
 layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1 << UMBRA_ALPHA_*)
 layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any light marches contact shadows
+layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
 
 layout(location = 0) in vec3 v_pos;
 layout(location = 1) in vec3 v_nrm;
@@ -66,7 +71,7 @@ vec2 poisson(int i) { vec4 v = frame.poisson[i >> 1]; return (i & 1) == 0 ? v.xy
 // Every shadow view is a tile of the depth atlas: rect = (x, y, size, atlas size) in texels.
 // Gathers the 2x2 texels around tile-local point q, kept inside the tile so filters never
 // read a neighbouring tile (views are widened by the filter footprint, so this only clamps
-// at the very edge).
+// at the very edge) and never a border texel: the atlas's sampler clamps to the edge.
 vec4 gather_tile(vec4 rect, vec2 q)
 {
 	q = clamp(q, vec2(1.0), vec2(rect.z - 1.0));
@@ -89,8 +94,12 @@ float bilinear_compare(vec2 p, vec4 rect, float ref, float res)
 // (2r+1)^2 bilinear PCF taps, done as (r+1)^2 gathers over the (2r+2)^2 texel footprint.
 // grad: receiver depth change per texel (receiver-plane bias), so wide kernels on sloped
 // receivers do not shadow the receiver itself.
+// When every PCF light of the scene has the same radius, SC_PCF_RADIUS makes it a constant:
+// the loops unroll and the tap weights fold (a loop with a radius read per light runs with
+// lavapipe's per-lane masks and selects; thumb-512: ~5 % of the render's instructions).
 float pcf(vec2 p, vec4 rect, float ref, float res, int r, vec2 grad)
 {
+	if (SC_PCF_RADIUS != 0u) r = int(SC_PCF_RADIUS) - 1;
 	vec2 q = p - 0.5;
 	vec2 base = floor(q);
 	vec2 f = q - base;
@@ -311,7 +320,10 @@ float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint vi
 	if (L.shadow.y == 0u) return 1.0;
 	uint first = L.shadow.x, count = L.shadow.y;
 	uint type = uint(L.color.w);
-	if (type == UMBRA_LIGHT_POINT) {
+	// Folded away when the scene has no point light: lavapipe runs an `if` under a mask even
+	// when no lane takes it, so this branch's whole shadow lookup (filter included) would cost
+	// every pixel of a sun-lit scene a second lookup.
+	if ((SC_LIGHT_TYPES & (1u << UMBRA_LIGHT_POINT)) != 0u && type == UMBRA_LIGHT_POINT) {
 		vec3 d = pos - L.position.xyz;
 		vec3 ad = abs(d);
 		uint face = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u)
@@ -443,7 +455,9 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 {
 	uint type = uint(L.color.w);
 	atten = 1.0;
-	if ((SC_LIGHT_TYPES & (1u << UMBRA_LIGHT_DIRECTIONAL)) != 0u && type == UMBRA_LIGHT_DIRECTIONAL)
+	// Only directional lights in the scene: the rest is folded away (it would run under a mask).
+	const bool only_sun = SC_LIGHT_TYPES == (1u << UMBRA_LIGHT_DIRECTIONAL);
+	if ((SC_LIGHT_TYPES & (1u << UMBRA_LIGHT_DIRECTIONAL)) != 0u && (only_sun || type == UMBRA_LIGHT_DIRECTIONAL))
 		return -L.direction.xyz;
 	vec3 d = L.position.xyz - pos;
 	float dist2 = max(dot(d, d), 1e-8);

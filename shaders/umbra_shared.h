@@ -123,7 +123,8 @@
 #define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR */
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
-#define UMBRA_SC_COUNT       10
+#define UMBRA_SC_PCF_RADIUS  10   /* 1 + the pcf_radius every PCF-filtered light shares; 0: per light */
+#define UMBRA_SC_COUNT       11
 
 /* umbra_material.params.z flags */
 #define UMBRA_MATERIAL_SHADOW_CATCHER 1u
@@ -195,6 +196,20 @@ struct umbra_shadow_view {
 struct umbra_push {
 	U_MAT4 view_proj;        /* shadow pass: light view-projection */
 	U_UVEC4 info;            /* x material index, y UMBRA_DRAW_* flags, z AOV pass: first light */
+};
+
+/* The main pass's push constants (mesh.frag): the same 80 bytes, the draw's material head
+ * (umbra_material's first four members) where the shadow passes have their view-projection
+ * (mesh.vert takes the camera's from the frame block). lavapipe reads push constants once per
+ * draw but gathers a storage-buffer record lane by lane, even at an index the whole draw
+ * shares (thumb-512: ~10 % of the render's instructions). The uv transforms stay in the
+ * materials buffer, read only by textured scenes. */
+struct umbra_push_main {
+	U_VEC4 base_color;
+	U_VEC4 emissive;
+	U_VEC4 params;
+	U_UVEC4 tex;
+	U_UVEC4 info;            /* as umbra_push.info */
 };
 
 #endif

@@ -1,0 +1,91 @@
+/* tests/gpu — the main pass's specialized paths draw what its general path draws. A scene's
+ * light types and a PCF radius that all its lights share are specialization constants of
+ * mesh.frag (renderer/record.c main_key): with only suns, the point and spot code of the
+ * shadow lookup and of the light direction fold away; with one radius, the PCF loops unroll.
+ * UMBRA_SPECIALIZE=0 (read per render) builds the general variant instead (every light type,
+ * the radius read per light); each scene renders both ways and the images must agree byte for
+ * byte (EXR: float for float). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "gpu_util.h"
+#include "test.h"
+
+/* Renders doc specialized and general; fails when a byte differs or a render fails. */
+static void same_specialized_and_general(const char *what, const char *doc)
+{
+	struct rnd_image fast, general;
+	memset(&fast, 0, sizeof fast);
+	memset(&general, 0, sizeof general);
+	if (!gpu_render(&fast, "%s", doc)) return;
+	setenv("UMBRA_SPECIALIZE", "0", 1);
+	bool ok = gpu_render(&general, "%s", doc);
+	unsetenv("UMBRA_SPECIALIZE");
+	if (ok) {
+		size_t bytes = (size_t)fast.height * fast.stride;
+		CHECK(fast.width == general.width && fast.height == general.height && fast.stride == general.stride,
+		      "%s: image sizes differ", what);
+		long diff = 0;
+		size_t first = 0;
+		const unsigned char *a = fast.pixels, *b = general.pixels;
+		if (fast.height == general.height && fast.stride == general.stride)
+			for (size_t i = 0; i < bytes; i++)
+				if (a[i] != b[i] && !diff++) first = i;
+		CHECK(diff == 0, "%s: the specialized pass changed %ld of %zu bytes (first at byte %zu)", what, diff, bytes,
+		      first);
+		rnd_image_release(&general);
+	}
+	rnd_image_release(&fast);
+}
+
+/* A floor, a sphere, a box on it; `lights` and `output` as JSON members (single quotes). */
+static void spec_doc(char *buf, size_t n, const char *lights, const char *output)
+{
+	snprintf(buf, n,
+	         "{'width':128,'height':96,"
+	         "'camera':{'type':'perspective','position':[4,3,4],'target':[0,0.6,0],'up':[0,1,0],'fov_y':45},"
+	         "'materials':{'m':{'base_color':[0.7,0.6,0.5],'roughness':0.5}},"
+	         "'objects':[{'shape':'plane','size':[10,10]},"
+	         "{'shape':'sphere','radius':0.8,'segments':32,'transform':{'translation':[0,0.8,0]},'material':'m'},"
+	         "{'shape':'box','size':[0.5,1.2,0.5],'transform':{'translation':[1.4,0.6,-0.6]}}],"
+	         "'lights':[%s],'output':%s}",
+	         lights, output);
+}
+
+/* One sun, PCF radius 1 (the thumbnail's case): both the sun-only fold and the radius. */
+TEST(specialize_sun_pcf_same_image)
+{
+	char doc[4096];
+	const char *sun = "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':3,'shadow':{'filter':'pcf'}}";
+	spec_doc(doc, sizeof doc, sun, "{'msaa':4}");
+	same_specialized_and_general("sun pcf msaa 4", doc);
+	spec_doc(doc, sizeof doc, sun, "{'msaa':1,'format':'exr'}");
+	same_specialized_and_general("sun pcf exr", doc);
+	/* Cascades (several views per light) and a wider shared radius. */
+	spec_doc(doc, sizeof doc,
+	         "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':3,"
+	         "'shadow':{'filter':'pcf','pcf_radius':2,'directional':{'mode':'cascades'}}}",
+	         "{'msaa':4}");
+	same_specialized_and_general("sun cascades pcf 2", doc);
+}
+
+/* A spot and a point sharing radius 3 with the sun (radius folded, light types not), then
+ * three different radii (radius read per light) and a point light's cube faces. */
+TEST(specialize_mixed_lights_same_image)
+{
+	char doc[4096];
+	spec_doc(doc, sizeof doc,
+	         "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':2,'shadow':{'filter':'pcf','pcf_radius':3}},"
+	         "{'type':'spot','position':[2,3,1],'direction':[-0.5,-1,-0.2],'outer_angle':40,'intensity':30,"
+	         "'shadow':{'filter':'pcf','pcf_radius':3}},"
+	         "{'type':'point','position':[-1.5,2,1.5],'intensity':20,'shadow':{'filter':'pcf','pcf_radius':3}}",
+	         "{'msaa':4}");
+	same_specialized_and_general("shared radius 3", doc);
+	spec_doc(doc, sizeof doc,
+	         "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':2,'shadow':{'filter':'pcf','pcf_radius':0}},"
+	         "{'type':'spot','position':[2,3,1],'direction':[-0.5,-1,-0.2],'outer_angle':40,'intensity':30,"
+	         "'shadow':{'filter':'pcf','pcf_radius':2}},"
+	         "{'type':'point','position':[-1.5,2,1.5],'intensity':20,'shadow':{'filter':'hard'}}",
+	         "{'msaa':1,'format':'exr'}");
+	same_specialized_and_general("radii 0 and 2, hard", doc);
+}
