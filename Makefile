@@ -132,7 +132,7 @@ $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 # flags.o (+ admit.o, which it calls): the unit tests cover srv_default_workers() (cgroup CPU quota);
 # negotiate.o and buf.o: Accept, Content-Type, ETag and the JSON escaper (test_negotiate.c);
 # queue.o: srv_queue_pop_idle.
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/obj/server/queue.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/gate.o $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/obj/server/queue.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a

@@ -80,6 +80,7 @@ int main(int argc, char **argv)
 	s->metrics = srv_metrics_create();
 	s->queue = srv_queue_create(s->cfg.queue);
 	srv_admit_init(&s->admit, s->cfg.max_memory);
+	srv_gate_init(&s->gate, s->cfg.workers);
 	if (!s->metrics || !s->queue) {
 		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
 		goto out_free;
@@ -133,6 +134,7 @@ out_free:
 	srv_metrics_destroy(s->metrics);
 	srv_admit_destroy(&s->admit);
 	pthread_rwlock_destroy(&s->ctx_lock);
+	srv_gate_destroy(&s->gate);
 	if (exit_code == 0)
 		srv_log(SRV_LOG_INFO, "stopped");
 	return exit_code;

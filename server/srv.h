@@ -10,6 +10,7 @@
  *   conn.c     connection limits and timeouts, HTTP/1.1 framing checks, the listen address
  *   queue.c    the bounded two-level (interactive before bulk) job queue
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
+ *   gate.c     how many renders run on the device at once (--device-renders; 1 on lavapipe)
  *   metrics.c  Prometheus counters, gauges and histograms
  *   log.c      one line per event or request on stderr, text or JSON
  *   buf.c      growable text buffer for the metrics; the JSON string escaper (logs, CLI report)
@@ -36,6 +37,7 @@
 #include <stdint.h>
 
 #include "admit.h"
+#include "gate.h"
 #include "api.h"
 #include "umbra/rnd.h"
 
@@ -56,6 +58,7 @@ struct srv_config {
 	const char *listen;            /* ADDR:PORT, default 127.0.0.1:8080; port 0 = ephemeral */
 	const char *port_file;         /* written with the bound port once listening */
 	unsigned workers;              /* render threads = context slots, default: online CPUs, capped by the CPU quota */
+	unsigned device_renders;       /* renders on the device at once (server/gate.h); 0 = 1 on a CPU device, else workers */
 	unsigned queue;                /* queued renders (not counting those rendering), default 64 */
 	uint64_t max_body;             /* bytes, default 64 MiB */
 	struct api_limits limits;      /* 422 limits */
@@ -100,6 +103,7 @@ struct srv_server {
 	struct srv_queue *queue;
 	struct srv_metrics *metrics;
 	struct srv_admit admit;        /* renders admitted by estimated memory (--max-memory) */
+	struct srv_gate gate;          /* renders on the device at once (--device-renders) */
 
 	/* The shared renderer. Renders hold ctx_lock for reading; recovery after a lost device
 	 * takes it for writing, destroys and recreates the context (ctx_gen counts recreations). */

@@ -64,9 +64,12 @@ int srv_context_open(struct srv_server *s)
 	/* --max-textures as the device grants it: the parser's 422 then comes before the renderer's. */
 	if (s->cfg.limits.max_textures != s->info.max_textures) s->cfg.limits.max_textures = s->info.max_textures;
 	pthread_rwlock_unlock(&s->ctx_lock);
-	srv_log(SRV_LOG_INFO, "device \"%s\", driver \"%s\" %s%s, %u render slots%s", s->info.device_name,
-	        s->info.driver_name, s->info.driver_info, s->info.is_cpu ? " (CPU)" : "", s->cfg.workers,
-	        s->cfg.validation ? ", validation on" : "");
+	unsigned renders = s->cfg.device_renders ? s->cfg.device_renders : s->info.is_cpu ? 1 : s->cfg.workers;
+	if (renders > s->cfg.workers) renders = s->cfg.workers;
+	srv_gate_set_limit(&s->gate, renders);
+	srv_log(SRV_LOG_INFO, "device \"%s\", driver \"%s\" %s%s, %u render slots, %u on the device at once%s",
+	        s->info.device_name, s->info.driver_name, s->info.driver_info, s->info.is_cpu ? " (CPU)" : "",
+	        s->cfg.workers, renders, s->cfg.validation ? ", validation on" : "");
 	return 0;
 }
 
@@ -268,7 +271,8 @@ static bool render_should_yield(void *user)
 {
 	struct render_watch *w = user;
 	struct srv_server *s = w->srv;
-	double oldest = srv_queue_oldest(s->queue);
+	double oldest = srv_queue_oldest(s->queue), gated = srv_gate_oldest(&s->gate);
+	if (gated > 0 && (oldest <= 0 || gated < oldest)) oldest = gated;
 	if (oldest <= 0 || srv_now() < oldest + s->cfg.deadline_ms / 2000.0)
 		return false;
 	uint_fast64_t mark = (uint_fast64_t)(oldest * 1e9), prev = atomic_load(&s->yield_mark);
@@ -397,7 +401,15 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 		sc->scene.cancel = render_should_yield;
 		sc->scene.cancel_user = &watch;
 	}
+	/* One render at a time on a CPU device (server/gate.h); parse and encode stay parallel. */
+	struct srv_gate_waiter gw;
+	if (!srv_gate_enter(&s->gate, &gw, req->t_queued,
+	                    s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0)) {
+		job_deadline(s, req, "while waiting for the device", srv_now());
+		goto out;
+	}
 	enum rnd_result r = srv_render(s, &sc->scene, &img, &t, &err, &lost_gen);
+	srv_gate_leave(&s->gate);
 	if (r != RND_OK) {
 		job_render_failed(s, req, sc, r, &err, watch.yielded);
 		goto out;

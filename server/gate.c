@@ -1,0 +1,85 @@
+/* server/gate — see gate.h. A counting semaphore with a list of its waiters (at most workers - 1
+ * of them, so a linear scan for the oldest is fine). */
+#include <math.h>
+#include <time.h>
+#include "gate.h"
+
+void srv_gate_init(struct srv_gate *g, unsigned limit)
+{
+	pthread_mutex_init(&g->mu, NULL);
+	pthread_condattr_t ca;
+	pthread_condattr_init(&ca);
+	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+	pthread_cond_init(&g->cv, &ca);
+	pthread_condattr_destroy(&ca);
+	g->limit = limit ? limit : 1;
+	g->running = 0;
+	g->waiting = NULL;
+}
+
+void srv_gate_destroy(struct srv_gate *g)
+{
+	pthread_cond_destroy(&g->cv);
+	pthread_mutex_destroy(&g->mu);
+}
+
+void srv_gate_set_limit(struct srv_gate *g, unsigned limit)
+{
+	pthread_mutex_lock(&g->mu);
+	g->limit = limit ? limit : 1;
+	pthread_cond_broadcast(&g->cv);
+	pthread_mutex_unlock(&g->mu);
+}
+
+static void unlink_waiter(struct srv_gate *g, struct srv_gate_waiter *w)
+{
+	for (struct srv_gate_waiter **p = &g->waiting; *p; p = &(*p)->next)
+		if (*p == w) {
+			*p = w->next;
+			return;
+		}
+}
+
+bool srv_gate_enter(struct srv_gate *g, struct srv_gate_waiter *w, double t_queued, double deadline_s)
+{
+	struct timespec until = {0};
+	if (deadline_s > 0) {
+		until.tv_sec = (time_t)deadline_s;
+		until.tv_nsec = (long)((deadline_s - floor(deadline_s)) * 1e9);
+	}
+	pthread_mutex_lock(&g->mu);
+	w->t_queued = t_queued;
+	w->next = g->waiting;
+	g->waiting = w;
+	bool in = true;
+	while (g->running >= g->limit) {
+		if (deadline_s <= 0) {
+			pthread_cond_wait(&g->cv, &g->mu);
+		} else if (pthread_cond_timedwait(&g->cv, &g->mu, &until) != 0 && g->running >= g->limit) {
+			in = false;
+			break;
+		}
+	}
+	unlink_waiter(g, w);
+	if (in) g->running++;
+	pthread_mutex_unlock(&g->mu);
+	return in;
+}
+
+void srv_gate_leave(struct srv_gate *g)
+{
+	pthread_mutex_lock(&g->mu);
+	if (g->running) g->running--;
+	pthread_cond_signal(&g->cv);
+	pthread_mutex_unlock(&g->mu);
+}
+
+double srv_gate_oldest(struct srv_gate *g)
+{
+	pthread_mutex_lock(&g->mu);
+	double oldest = 0;
+	for (const struct srv_gate_waiter *w = g->waiting; w; w = w->next)
+		if (oldest <= 0 || w->t_queued < oldest) oldest = w->t_queued;
+	pthread_mutex_unlock(&g->mu);
+	return oldest;
+}
