@@ -43,6 +43,7 @@ static const struct opt_def opts[] = {
 	{ "import-timeout-ms", OPT_UINT, "MS", "wall-clock and CPU limit of one sandboxed model import (10000)", LIM(import_timeout_ms), 1, 3600000 },
 	{ "import-memory", OPT_SIZE, "BYTES", "memory limit of one sandboxed model import, 0 = none (2G)", LIM(import_memory), 0, UINT64_MAX },
 	{ "max-textures", OPT_UINT, "N", "distinct textures in one scene, capped by the device's limit (256)", LIM(max_textures), 1, 1000000 },
+	{ "warm-up", OPT_STR, "defaults|all", "pipelines compiled before ready: the contract's defaults (MSAA 4, PNG; sun, cascades, spot, point; pcf, pcss), or also MSAA 1, EXR and VSM/EVSM (~14 MB each on lavapipe; otherwise compiled at first use) (defaults)", CFG(warm_up), 0, 0 },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
 	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (8192)", CFG(atlas_size), 0, 16384 },
@@ -282,6 +283,10 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	}
 	if (cfg->atlas_size & (cfg->atlas_size - 1)) {
 		fprintf(stderr, "umbrad: --atlas-size: %u is not a power of two\n", cfg->atlas_size);
+		return -1;
+	}
+	if (cfg->warm_up && strcmp(cfg->warm_up, "defaults") && strcmp(cfg->warm_up, "all")) {
+		fprintf(stderr, "umbrad: --warm-up: '%s' is not defaults or all\n", cfg->warm_up);
 		return -1;
 	}
 	if (cfg->asset_root && access(cfg->asset_root, R_OK | X_OK) != 0) {

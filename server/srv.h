@@ -58,6 +58,7 @@ struct srv_config {
 	const char *listen;            /* ADDR:PORT, default 127.0.0.1:8080; port 0 = ephemeral */
 	const char *port_file;         /* written with the bound port once listening */
 	unsigned workers;              /* render threads = context slots, default: online CPUs, capped by the CPU quota */
+	const char *warm_up;           /* "defaults" (NULL) or "all": server/warmup.c */
 	unsigned device_renders;       /* renders on the device at once (server/gate.h); 0 = 1 on a CPU device, else workers */
 	unsigned queue;                /* queued renders (not counting those rendering), default 64 */
 	uint64_t max_body;             /* bytes, default 64 MiB */

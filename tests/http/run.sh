@@ -50,6 +50,8 @@ check "--help exits 0 and lists the flags" sh -c "[ $rc = 0 ] && grep -q -- '--m
 check "unknown flag exits 2" [ $rc = 2 ]
 UMBRA_WORKERS=zero "$UMBRAD" >/dev/null 2>&1; rc=$?
 check "bad UMBRA_WORKERS exits 2" [ $rc = 2 ]
+"$UMBRAD" --warm-up sometimes >"$T/warm.out" 2>&1; rc=$?
+check "--warm-up other than defaults|all exits 2, naming the flag" sh -c "[ $rc = 2 ] && grep -q -- '--warm-up' '$T/warm.out'"
 
 # ==== main daemon ====
 echo "# starting the main daemon (reps $REPS)"
@@ -61,6 +63,8 @@ if [ "$FIRST_READY" = 503 ]; then
 	check "readyz 503 with Retry-After before ready" grep -qi '^Retry-After:' "$T/main.first-ready.hdr"
 fi
 grep -q "listening on http://127.0.0.1:$(cat "$T/main.port")" "$T/main.log" && ok "start-up log names the bound port" || nok "start-up log names the bound port"
+check "--warm-up defaults: the MSAA 4 variants are warmed, MSAA 1 ones left to first use" \
+	sh -c "grep -q \"warm-up 'msaa 4, directional pcf'\" '$T/main.log' && ! grep -q \"warm-up 'msaa 1\" '$T/main.log'"
 
 # -- GET routes
 c=$(get h /healthz); check "GET /healthz 200" [ "$c" = 200 ]
