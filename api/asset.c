@@ -156,7 +156,8 @@ static void stamp_of(const struct stat *st, int64_t seen, struct api_asset_stamp
 bool api_asset_stamp_settled(const struct api_asset_stamp *s)
 {
 	int64_t last = s->mtime_ns > s->ctime_ns ? s->mtime_ns : s->ctime_ns;
-	return s->seen_ns - last > API_ASSET_SETTLE_NS;
+	bool coarse = s->mtime_ns % 1000000000 == 0 && s->ctime_ns % 1000000000 == 0;
+	return s->seen_ns - last > (coarse ? API_ASSET_SETTLE_COARSE_NS : API_ASSET_SETTLE_NS);
 }
 
 bool api_asset_stamp_equal(const struct api_asset_stamp *a, const struct api_asset_stamp *b)

@@ -60,10 +60,14 @@ struct api_asset_stamp {
 	int64_t mtime_ns, ctime_ns;
 	int64_t seen_ns;       /* the clock just before the stamp was taken (not compared) */
 };
-/* File times come from a coarse clock (a tick of up to 10 ms): a file changed again within the
- * tick of its last change keeps its times. A stamp taken less than this long after the file's
- * last change is "racy" (git's word) and must not stand for the file's bytes. */
-#define API_ASSET_SETTLE_NS 50000000ll
+/* File times come from a coarse clock: the kernel's tick (up to 10 ms) on ext4 or tmpfs, whole
+ * seconds on ext3, HFS+, FAT, sshfs and exports of those (2 s on FAT), and a network file
+ * system's times come from the server's clock. A file changed again within its clock's tick
+ * keeps its times, so a stamp taken less than this long after the file's last change is
+ * "racy" (git's word) and must not stand for the file's bytes: 1 s (covers a server's clock
+ * up to ~1 s behind), 3 s when both times are whole seconds (a coarse file system). */
+#define API_ASSET_SETTLE_NS 1000000000ll
+#define API_ASSET_SETTLE_COARSE_NS 3000000000ll
 /* A file read under the root: its path there and its stamp when it was read. */
 struct api_asset_origin {
 	char *path;

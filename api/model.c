@@ -101,24 +101,36 @@ static void model_free(struct model_priv *m)
 	free(m);
 }
 
-/* Every texture's mip chain, built once here for the colour space of the first slot that reads
- * it (rnd_texture.chain): a cached model's renders then copy the chains instead of building
- * them (DamagedHelmet's five 2048^2 textures: ~220 ms of CPU per render). Best effort: out of
- * memory leaves a texture without one (renders build it as before). */
-static void build_chains(struct api_model *m, struct api_arena *arena, size_t *bytes)
+/* Every texture's mip levels 1.. (rnd_texture.chain), for the colour space of the first slot
+ * that reads it: a cached model's renders then copy them instead of building them
+ * (DamagedHelmet's five 2048^2 textures: ~220 ms of CPU per render). Built only for a model the
+ * cache keeps (get(): they count in its cost), 1/3 of the decoded texels. With build false:
+ * only the bytes they would take. Best effort: out of memory leaves a texture without them. */
+static uint64_t texture_chains(struct api_model *m, struct api_arena *arena, bool build)
 {
+	uint64_t total = 0;
 	for (uint32_t i = 0; i < m->material_count; i++)
 		for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
 			struct rnd_texture *t = (struct rnd_texture *)m->materials[i].textures[k];
 			if (!t || t->chain || !t->rgba) continue;
-			uint64_t n = rnd_texture_chain_bytes(t->width, t->height);
-			uint8_t *chain = api_arena_alloc(arena, (size_t)n);
-			if (!chain) continue;
-			t->chain_srgb = rnd_texture_slot_srgb((enum rnd_texture_slot)k);
-			rnd_texture_build_chain(t->rgba, t->width, t->height, t->chain_srgb, chain);
-			t->chain = chain;
-			*bytes += (size_t)n;
+			bool seen = false;   /* shared by an earlier slot (counted once) */
+			for (uint32_t j = 0; j <= i && !seen; j++)
+				for (uint32_t l = 0; l < (j < i ? RND_TEX_SLOTS : k); l++)
+					if (m->materials[j].textures[l] == t) seen = true;
+			if (seen) continue;
+			size_t base = (size_t)t->width * t->height * 4, n = (size_t)rnd_texture_chain_bytes(t->width, t->height);
+			total += n - base;
+			if (!build) continue;
+			uint8_t *full = malloc(n), *rest = api_arena_alloc(arena, n - base);
+			if (full && rest) {
+				t->chain_srgb = rnd_texture_slot_srgb((enum rnd_texture_slot)k);
+				rnd_texture_build_chain(t->rgba, t->width, t->height, t->chain_srgb, full);
+				memcpy(rest, full + base, n - base);
+				t->chain = rest;
+			}
+			free(full);
 		}
+	return total;
 }
 
 /* Imports through the sandbox (api/sandbox.h): the bytes never meet Assimp in this process. */
@@ -143,7 +155,6 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 		return NULL;
 	}
 	api_model_build_lods(&m->pub, m->arena, &bytes);
-	build_chains(&m->pub, m->arena, &bytes);
 	m->pub.format = format;
 	m->pub.priv_ = m;
 	m->pub.bytes_ = bytes + sizeof *m;
@@ -244,7 +255,8 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	struct model_priv *m = import(data, len, model_len, nfiles, format, lim, status, err, errsize);
 	if (!m) return API_ERR;
 	*status = 0;
-	uint64_t cost = m->pub.bytes_ + len;
+	uint64_t chains = texture_chains(&m->pub, m->arena, false);
+	uint64_t cost = m->pub.bytes_ + len + chains;
 	pthread_mutex_lock(&cache_mu);
 	uint64_t cache_bytes = cache_limit;
 	pthread_mutex_unlock(&cache_mu);
@@ -252,6 +264,7 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 		*out = &m->pub;    /* not cached: the caller's reference is the only one */
 		return API_OK;
 	}
+	texture_chains(&m->pub, m->arena, true);
 	memcpy(m->src, data, len);
 	m->src_len = len;
 	m->model_len = model_len;

@@ -10,8 +10,9 @@
  * request stats the same files; when every stamp is equal it takes the cached model by its
  * serial and adds the same hash. Any change to any of the files (write, replace, touch, chmod),
  * a file gone, or the model evicted from the cache: a miss, and the caller reads as before.
- * Files changed less than API_ASSET_SETTLE_NS before they were read are not trusted by their
- * stamps (a second change within the file system's clock tick keeps the times): such a model
+ * Files changed less than API_ASSET_SETTLE_NS (1 s; 3 s on a file system with whole-second
+ * times) before they were read are not trusted by their stamps (a second change within the
+ * file system's clock tick keeps the times): such a model
  * is imported and used, but remembered only by a later request. Models whose import left something out (an .obj's missing .mtl: a warning) are not
  * remembered, as the missing file may appear.
  *

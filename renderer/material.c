@@ -184,8 +184,13 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 			goto done;
 		s->texture_count = i + 1;
 		uint8_t *dst = (uint8_t *)s->staging.map + off;
-		if (tex[i]->chain && tex[i]->chain_srgb == p->srgb[i]) memcpy(dst, tex[i]->chain, rnd_texture_chain_bytes(w, h));
-		else rnd_texture_build_chain(tex[i]->rgba, w, h, p->srgb[i], dst);
+		if (tex[i]->chain && tex[i]->chain_srgb == p->srgb[i]) {
+			size_t base = (size_t)w * h * 4;
+			memcpy(dst, tex[i]->rgba, base);
+			memcpy(dst + base, tex[i]->chain, rnd_texture_chain_bytes(w, h) - base);
+		} else {
+			rnd_texture_build_chain(tex[i]->rgba, w, h, p->srgb[i], dst);
+		}
 		off += rnd_texture_chain_bytes(w, h);
 	}
 	write_sets(ctx, s, p);

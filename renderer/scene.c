@@ -86,7 +86,7 @@ void rnd_shadow_defaults(struct rnd_shadow *s)
 	s->enabled = true;
 	s->filter = RND_FILTER_AUTO;
 	s->resolution = 0;
-	s->pcf_radius = 1;
+	s->pcf_radius = RND_DEFAULT_PCF_RADIUS;
 	s->bias_set = false;
 	/* Slope-scaled hardware bias for surfaces at grazing light and no normal offset: PCF and
 	 * PCSS compare every tap with the receiver's own plane (receiver-plane depth), which is

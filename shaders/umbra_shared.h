@@ -123,7 +123,7 @@
 #define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR */
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
-#define UMBRA_SC_PCF_RADIUS  10   /* 1 + the pcf_radius every PCF-filtered light shares; 0: per light */
+#define UMBRA_SC_PCF_RADIUS  10   /* 2 when every PCF-filtered light has the default radius 1; 0: read per light */
 #define UMBRA_SC_COUNT       11
 
 /* umbra_material.params.z flags */

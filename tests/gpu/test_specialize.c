@@ -74,16 +74,17 @@ TEST(specialize_sun_pcf_same_image)
 	same_specialized_and_general("sun pcf msaa 4", doc);
 	spec_doc(doc, sizeof doc, sun, "{'msaa':1,'format':'exr'}");
 	same_specialized_and_general("sun pcf exr", doc);
-	/* Cascades (several views per light) and a wider shared radius. */
+	/* Cascades (several views per light), the default radius folded. */
 	spec_doc(doc, sizeof doc,
 	         "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':3,"
-	         "'shadow':{'filter':'pcf','pcf_radius':2,'directional':{'mode':'cascades'}}}",
+	         "'shadow':{'filter':'pcf','pcf_radius':1,'directional':{'mode':'cascades'}}}",
 	         "{'msaa':4}");
 	same_specialized_and_general("sun cascades pcf 2", doc);
 }
 
-/* A spot and a point sharing radius 3 with the sun (radius folded, light types not), then
- * three different radii (radius read per light) and a point light's cube faces. */
+/* A spot and a point sharing the default radius with the sun (radius folded, light types
+ * not), then shared radius 3 (only the default is folded: read per light), then three
+ * different radii (read per light) and a point light's cube faces. */
 TEST(specialize_mixed_lights_same_image)
 {
 	char doc[4096];
@@ -94,6 +95,13 @@ TEST(specialize_mixed_lights_same_image)
 	         "{'type':'point','position':[-1.5,2,1.5],'intensity':20,'shadow':{'filter':'pcf','pcf_radius':3}}",
 	         "{'msaa':4}");
 	same_specialized_and_general("shared radius 3", doc);
+	spec_doc(doc, sizeof doc,
+	         "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':2,'shadow':{'filter':'pcf'}},"
+	         "{'type':'spot','position':[2,3,1],'direction':[-0.5,-1,-0.2],'outer_angle':40,'intensity':30,"
+	         "'shadow':{'filter':'pcf'}},"
+	         "{'type':'point','position':[-1.5,2,1.5],'intensity':20,'shadow':{'filter':'pcf'}}",
+	         "{'msaa':4}");
+	same_specialized_and_general("shared default radius", doc);
 	spec_doc(doc, sizeof doc,
 	         "{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':2,'shadow':{'filter':'pcf','pcf_radius':0}},"
 	         "{'type':'spot','position':[2,3,1],'direction':[-0.5,-1,-0.2],'outer_angle':40,'intensity':30,"

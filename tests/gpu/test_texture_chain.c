@@ -54,9 +54,12 @@ TEST(texture_precomputed_chain_is_sampled)
 	struct api_problem p;
 	REQUIRE(api_scene_parse(doc, strlen(doc), NULL, &s, &p) == API_OK, "%s", p.detail);
 	struct rnd_texture built = {.rgba = rgba, .width = TW, .height = TW};
-	struct rnd_texture given = {.rgba = rgba, .width = TW, .height = TW, .chain = chain, .chain_srgb = true};
-	struct rnd_texture other = {.rgba = rgba, .width = TW, .height = TW, .chain = white_chain, .chain_srgb = true};
-	struct rnd_texture linear = {.rgba = rgba, .width = TW, .height = TW, .chain = white_chain, .chain_srgb = false};
+	/* rnd_texture.chain holds levels 1.. (level 0 is rgba). */
+	const size_t base = (size_t)TW * TW * 4;
+	struct rnd_texture given = {.rgba = rgba, .width = TW, .height = TW, .chain = chain + base, .chain_srgb = true};
+	struct rnd_texture other = {.rgba = rgba, .width = TW, .height = TW, .chain = white_chain + base, .chain_srgb = true};
+	struct rnd_texture linear = {.rgba = rgba, .width = TW, .height = TW, .chain = white_chain + base,
+	                             .chain_srgb = false};
 	struct rnd_image a, b, c, d;
 	if (render_with(s, &built, &a)) {
 		if (render_with(s, &given, &b)) {

@@ -89,10 +89,11 @@ enum rnd_mip { RND_MIP_LINEAR, RND_MIP_NONE, RND_MIP_NEAREST };
 struct rnd_texture {
 	const uint8_t *rgba;
 	uint32_t width, height;
-	/* Optional: the full mip chain as rnd_texture_build_chain() writes it for colour space
-	 * chain_srgb, built once by the owner of a long-lived texture (a cached model) so that
-	 * renders copy it instead of building it (a 2048^2 chain is ~40 ms of CPU). NULL, or read
-	 * by a slot of the other colour space: built at upload. */
+	/* Optional: the mip chain's levels 1.. (level 0 is rgba) as rnd_texture_build_chain() writes
+	 * them after level 0 for colour space chain_srgb, built once by the owner of a long-lived
+	 * texture (a cached model) so that renders copy them instead of building them (a 2048^2
+	 * chain is ~40 ms of CPU); 1/3 of rgba's bytes. NULL, or read by a slot of the other colour
+	 * space: built at upload. */
 	const uint8_t *chain;
 	bool chain_srgb;
 };
@@ -303,6 +304,8 @@ void rnd_material_defaults(struct rnd_material *m);
 void rnd_object_defaults(struct rnd_object *o);     /* identity model, casts/receives, 2-sided */
 void rnd_light_defaults(struct rnd_light *l, enum rnd_light_type type);
 void rnd_shadow_defaults(struct rnd_shadow *s);
+/* The contract's default pcf_radius (kernel 3x3). */
+#define RND_DEFAULT_PCF_RADIUS 1u
 
 /* Triangles the renderer will draw for an object (tessellation of the contract's shapes). */
 uint64_t rnd_object_triangle_count(const struct rnd_object *o);
