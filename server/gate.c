@@ -1,5 +1,5 @@
 /* server/gate — see gate.h. A counting semaphore with a list of its waiters (at most workers - 1
- * of them, so a linear scan for the oldest is fine). */
+ * of them, so linear scans are fine), admitting them in ticket order. */
 #include <math.h>
 #include <time.h>
 #include "gate.h"
@@ -14,6 +14,7 @@ void srv_gate_init(struct srv_gate *g, unsigned limit)
 	pthread_condattr_destroy(&ca);
 	g->limit = limit ? limit : 1;
 	g->running = 0;
+	g->next_ticket = 0;
 	g->waiting = NULL;
 }
 
@@ -29,6 +30,15 @@ void srv_gate_set_limit(struct srv_gate *g, unsigned limit)
 	g->limit = limit ? limit : 1;
 	pthread_cond_broadcast(&g->cv);
 	pthread_mutex_unlock(&g->mu);
+}
+
+/* With mu held: w may enter now (a free place, and no one waiting who came before it). */
+static bool my_turn(const struct srv_gate *g, const struct srv_gate_waiter *w)
+{
+	if (g->running >= g->limit) return false;
+	for (const struct srv_gate_waiter *o = g->waiting; o; o = o->next)
+		if (o->ticket < w->ticket) return false;
+	return true;
 }
 
 static void unlink_waiter(struct srv_gate *g, struct srv_gate_waiter *w)
@@ -49,19 +59,22 @@ bool srv_gate_enter(struct srv_gate *g, struct srv_gate_waiter *w, double t_queu
 	}
 	pthread_mutex_lock(&g->mu);
 	w->t_queued = t_queued;
+	w->ticket = g->next_ticket++;
 	w->next = g->waiting;
 	g->waiting = w;
 	bool in = true;
-	while (g->running >= g->limit) {
+	while (!my_turn(g, w)) {
 		if (deadline_s <= 0) {
 			pthread_cond_wait(&g->cv, &g->mu);
-		} else if (pthread_cond_timedwait(&g->cv, &g->mu, &until) != 0 && g->running >= g->limit) {
+		} else if (pthread_cond_timedwait(&g->cv, &g->mu, &until) != 0 && !my_turn(g, w)) {
 			in = false;
 			break;
 		}
 	}
 	unlink_waiter(g, w);
 	if (in) g->running++;
+	/* Whoever is next in line may be able to enter too (a limit above 1, or this waiter gave up). */
+	pthread_cond_broadcast(&g->cv);
 	pthread_mutex_unlock(&g->mu);
 	return in;
 }
@@ -70,7 +83,7 @@ void srv_gate_leave(struct srv_gate *g)
 {
 	pthread_mutex_lock(&g->mu);
 	if (g->running) g->running--;
-	pthread_cond_signal(&g->cv);
+	pthread_cond_broadcast(&g->cv);   /* the next ticket must wake, whichever thread that is */
 	pthread_mutex_unlock(&g->mu);
 }
 

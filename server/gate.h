@@ -12,7 +12,8 @@
  *   if (srv_gate_enter(&g, &w, req->t_queued, deadline_s)) { render ...; srv_gate_leave(&g); }
  *   else: the deadline passed while waiting (answer 504).
  * srv_gate_oldest(): the queue time of the longest waiter, 0 when none (a long render yields
- * to it as it yields to the queue's oldest request).
+ * to it as it yields to the queue's oldest request). Waiters are admitted in arrival order, so
+ * the slot a yielding render frees goes to the waiter it yielded to, not to a newcomer.
  * Threading: every function is thread-safe; the waiter struct lives on the caller's stack.
  */
 #ifndef UMBRA_SRV_GATE_H
@@ -23,6 +24,7 @@
 
 struct srv_gate_waiter {
 	double t_queued;
+	unsigned long long ticket;    /* arrival order: the gate admits waiters first come, first served */
 	struct srv_gate_waiter *next;
 };
 
@@ -30,6 +32,7 @@ struct srv_gate {
 	pthread_mutex_t mu;
 	pthread_cond_t cv;            /* CLOCK_MONOTONIC, as srv_now() */
 	unsigned limit, running;
+	unsigned long long next_ticket;
 	struct srv_gate_waiter *waiting;
 };
 

@@ -111,3 +111,81 @@ TEST(gate_deadline_oldest_and_limit)
 	srv_gate_leave(&g);
 	srv_gate_destroy(&g);
 }
+
+/* Waiters enter in the order they arrived: three threads queue behind a held gate one after
+ * another, and each records its turn when let in. */
+struct ordered {
+	struct srv_gate *g;
+	atomic_int *turn;
+	int got;
+};
+
+static void *enter_ordered(void *arg)
+{
+	struct ordered *o = arg;
+	struct srv_gate_waiter w;
+	if (srv_gate_enter(o->g, &w, now_s(), 0)) {
+		o->got = atomic_fetch_add(o->turn, 1);
+		usleep(1000);
+		srv_gate_leave(o->g);
+	}
+	return NULL;
+}
+
+static int waiters(struct srv_gate *g)
+{
+	pthread_mutex_lock(&g->mu);
+	int n = 0;
+	for (const struct srv_gate_waiter *w = g->waiting; w; w = w->next) n++;
+	pthread_mutex_unlock(&g->mu);
+	return n;
+}
+
+TEST(gate_first_come_first_served)
+{
+	for (int round = 0; round < 20; round++) {
+		struct srv_gate g;
+		srv_gate_init(&g, 1);
+		struct srv_gate_waiter me;
+		REQUIRE(srv_gate_enter(&g, &me, now_s(), 0));
+		atomic_int turn = 0;
+		struct ordered o[3];
+		pthread_t t[3];
+		for (int i = 0; i < 3; i++) {
+			o[i] = (struct ordered){&g, &turn, -1};
+			pthread_create(&t[i], NULL, enter_ordered, &o[i]);
+			for (int k = 0; k < 2000 && waiters(&g) < i + 1; k++) usleep(100);   /* i + 1 queued */
+		}
+		srv_gate_leave(&g);
+		for (int i = 0; i < 3; i++) pthread_join(t[i], NULL);
+		CHECK(o[0].got == 0 && o[1].got == 1 && o[2].got == 2, "round %d: turns %d %d %d", round, o[0].got,
+		      o[1].got, o[2].got);
+		srv_gate_destroy(&g);
+	}
+}
+
+/* A newcomer does not take the place a leaving holder frees from someone already waiting: the
+ * slot a yielding render frees goes to the request it yielded to. */
+TEST(gate_newcomer_does_not_barge)
+{
+	int barged = 0;
+	for (int round = 0; round < 20; round++) {
+		struct srv_gate g;
+		srv_gate_init(&g, 1);
+		struct srv_gate_waiter me;
+		REQUIRE(srv_gate_enter(&g, &me, now_s(), 0));
+		atomic_int turn = 0;
+		struct ordered a = {&g, &turn, -1};
+		pthread_t t;
+		pthread_create(&t, NULL, enter_ordered, &a);
+		for (int k = 0; k < 2000 && waiters(&g) < 1; k++) usleep(100);
+		srv_gate_leave(&g);
+		REQUIRE(srv_gate_enter(&g, &me, now_s(), 0));   /* at once, as a newcomer */
+		int mine = atomic_fetch_add(&turn, 1);
+		srv_gate_leave(&g);
+		pthread_join(t, NULL);
+		if (mine != 1 || a.got != 0) barged++;
+		srv_gate_destroy(&g);
+	}
+	CHECK(barged == 0, "the newcomer went first in %d of 20 rounds", barged);
+}
