@@ -3,13 +3,13 @@
  */
 #include <errno.h>
 #include <malloc.h>
-#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "admit.h"
+#include "clock.h"
 
 /* After a render that held this much, freed heap memory goes back to the system at once
  * (glibc keeps it otherwise, and RSS would stay at the size of the largest request seen). */
@@ -19,11 +19,7 @@ void srv_admit_init(struct srv_admit *a, uint64_t budget)
 {
 	memset(a, 0, sizeof *a);
 	pthread_mutex_init(&a->mu, NULL);
-	pthread_condattr_t ca;
-	pthread_condattr_init(&ca);
-	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
-	pthread_cond_init(&a->cv, &ca);
-	pthread_condattr_destroy(&ca);
+	srv_cond_init_monotonic(&a->cv);
 	a->budget = budget;
 }
 
@@ -75,8 +71,7 @@ int srv_admit_request(struct srv_admit *a, const struct api_scene *sc, uint64_t 
 	while (a->budget && a->in_use && a->in_use + need > a->budget) {
 		int e;
 		if (deadline > 0) {
-			double whole, frac = modf(deadline, &whole);
-			struct timespec ts = {(time_t)whole, (long)(frac * 1e9)};
+			struct timespec ts = srv_timespec(deadline);
 			e = pthread_cond_timedwait(&a->cv, &a->mu, &ts);
 		} else {
 			e = pthread_cond_wait(&a->cv, &a->mu);

@@ -1,17 +1,13 @@
 /* server/gate — see gate.h. A counting semaphore with a list of its waiters (at most workers - 1
  * of them, so linear scans are fine), admitting them in ticket order. */
-#include <math.h>
 #include <time.h>
+#include "clock.h"
 #include "gate.h"
 
 void srv_gate_init(struct srv_gate *g, unsigned limit)
 {
 	pthread_mutex_init(&g->mu, NULL);
-	pthread_condattr_t ca;
-	pthread_condattr_init(&ca);
-	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
-	pthread_cond_init(&g->cv, &ca);
-	pthread_condattr_destroy(&ca);
+	srv_cond_init_monotonic(&g->cv);
 	g->limit = limit ? limit : 1;
 	g->running = 0;
 	g->next_ticket = 0;
@@ -52,11 +48,7 @@ static void unlink_waiter(struct srv_gate *g, struct srv_gate_waiter *w)
 
 bool srv_gate_enter(struct srv_gate *g, struct srv_gate_waiter *w, double t_queued, double deadline_s)
 {
-	struct timespec until = {0};
-	if (deadline_s > 0) {
-		until.tv_sec = (time_t)deadline_s;
-		until.tv_nsec = (long)((deadline_s - floor(deadline_s)) * 1e9);
-	}
+	struct timespec until = srv_timespec(deadline_s > 0 ? deadline_s : 0);
 	pthread_mutex_lock(&g->mu);
 	w->t_queued = t_queued;
 	w->ticket = g->next_ticket++;

@@ -2,6 +2,7 @@
  * umbrad job queue (see queue.h): two singly linked FIFO lists under one mutex.
  */
 #include "queue.h"
+#include "clock.h"
 
 #include <errno.h>
 #include <math.h>
@@ -30,12 +31,7 @@ struct srv_queue *srv_queue_create(unsigned capacity)
 		return NULL;
 	if (pthread_mutex_init(&q->mu, NULL) != 0)
 		goto err_free;
-	pthread_condattr_t ca;
-	pthread_condattr_init(&ca);
-	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
-	int e = pthread_cond_init(&q->nonempty, &ca);
-	pthread_condattr_destroy(&ca);
-	if (e != 0)
+	if (srv_cond_init_monotonic(&q->nonempty) != 0)
 		goto err_mutex;
 	q->capacity = capacity;
 	q->idle_due = true;

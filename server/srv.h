@@ -11,6 +11,7 @@
  *   queue.c    the bounded two-level (interactive before bulk) job queue
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
  *   gate.c     how many renders run on the device at once (--device-renders; 1 on lavapipe)
+ *   clock.c    monotonic condition variables and deadlines for the queue, admission and gate
  *   metrics.c  Prometheus counters, gauges and histograms
  *   log.c      one line per event or request on stderr, text or JSON
  *   buf.c      growable text buffer for the metrics; the JSON string escaper (logs, CLI report)

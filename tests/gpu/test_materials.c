@@ -12,25 +12,7 @@
 #include "gpu_util.h"
 #include "models.h"
 #include "test.h"
-
-static char *b64(const uint8_t *d, size_t n)
-{
-	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	size_t i = 0;
-	for (; i + 2 < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63]; *p++ = tab[(v >> 6) & 63]; *p++ = tab[v & 63];
-	}
-	if (i < n) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0);
-		*p++ = tab[v >> 18]; *p++ = tab[(v >> 12) & 63];
-		*p++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-		*p++ = '=';
-	}
-	*p = 0;
-	return o;
-}
+#include "util.h"
 
 /* ---- one quad in a .glb ---- */
 
@@ -142,7 +124,7 @@ static bool render_quad(int line, struct rnd_image *img, const struct mglb *g, b
 {
 	size_t n;
 	uint8_t *glb = glb_of(g, &n);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	bool ok = gpu_render_at(__FILE__, line, img,
 	                        "{'width':%d,'height':%d,"
@@ -334,7 +316,7 @@ static bool render_ambient(int line, struct rnd_image *img, const struct mglb *g
 {
 	size_t n;
 	uint8_t *glb = glb_of(g, &n);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	bool ok = gpu_render_at(__FILE__, line, img,
 	                        "{'width':%d,'height':%d,"
@@ -477,7 +459,7 @@ static bool blend_render(int line, struct rnd_image *img, bool blend)
 	                 .y = 1};
 	size_t n;
 	uint8_t *glb = glb_of(&g, &n);
-	char *enc = b64(glb, n);
+	char *enc = test_b64(glb, n);
 	free(glb);
 	bool ok = gpu_render_at(__FILE__, line, img,
 	                        "{'width':%d,'height':%d,"

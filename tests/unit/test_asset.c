@@ -13,17 +13,8 @@
 #include "model.h"
 #include "model_refs.h"
 #include "test.h"
+#include "util.h"
 
-static void put(const char *dir, const char *name, const char *text)
-{
-	char p[1024];
-	snprintf(p, sizeof p, "%s/%s", dir, name);
-	FILE *f = fopen(p, "wb");
-	if (f) {
-		fputs(text, f);
-		fclose(f);
-	}
-}
 
 /* A root with sub/a.txt, outside/secret.txt beside it, and links in and out. */
 static void make_tree(char *base, char *root, size_t n)
@@ -33,10 +24,10 @@ static void make_tree(char *base, char *root, size_t n)
 	mkdir(root, 0700);
 	snprintf(p, sizeof p, "%s/outside", base);
 	mkdir(p, 0700);
-	put(p, "secret.txt", "secret");
+	test_put_file(p, "secret.txt", "secret");
 	snprintf(p, sizeof p, "%s/sub", root);
 	mkdir(p, 0700);
-	put(p, "a.txt", "inside");
+	test_put_file(p, "a.txt", "inside");
 	char target[512], link[512];
 	snprintf(target, sizeof target, "%s/outside/secret.txt", base);
 	snprintf(link, sizeof link, "%s/abs_out.txt", root);
@@ -196,7 +187,7 @@ TEST(model_refs_optional_obj_files)
 	char base[] = "/tmp/umbra-refs-XXXXXX", root[300];
 	REQUIRE(mkdtemp(base));
 	make_tree(base, root, sizeof root);
-	put(root, "blue.mtl", "newmtl b\nKd 0 0 1\nmap_Kd sub/a.txt\n");
+	test_put_file(root, "blue.mtl", "newmtl b\nKd 0 0 1\nmap_Kd sub/a.txt\n");
 	static const char lost[] = "mtllib gone.mtl\nv 0 0 0\n", found[] = "mtllib blue.mtl\nv 0 0 0\n";
 	struct api_model_refs r;
 	int st;

@@ -141,6 +141,15 @@ static int waiters(struct srv_gate *g)
 	return n;
 }
 
+/* Starts a thread that waits at g (held by the caller) and returns once it is queued. */
+static void queue_one(struct srv_gate *g, atomic_int *turn, struct ordered *o, pthread_t *t)
+{
+	*o = (struct ordered){g, turn, -1};
+	int before = waiters(g);
+	pthread_create(t, NULL, enter_ordered, o);
+	for (int k = 0; k < 2000 && waiters(g) <= before; k++) usleep(100);
+}
+
 TEST(gate_first_come_first_served)
 {
 	for (int round = 0; round < 20; round++) {
@@ -151,11 +160,7 @@ TEST(gate_first_come_first_served)
 		atomic_int turn = 0;
 		struct ordered o[3];
 		pthread_t t[3];
-		for (int i = 0; i < 3; i++) {
-			o[i] = (struct ordered){&g, &turn, -1};
-			pthread_create(&t[i], NULL, enter_ordered, &o[i]);
-			for (int k = 0; k < 2000 && waiters(&g) < i + 1; k++) usleep(100);   /* i + 1 queued */
-		}
+		for (int i = 0; i < 3; i++) queue_one(&g, &turn, &o[i], &t[i]);
 		srv_gate_leave(&g);
 		for (int i = 0; i < 3; i++) pthread_join(t[i], NULL);
 		CHECK(o[0].got == 0 && o[1].got == 1 && o[2].got == 2, "round %d: turns %d %d %d", round, o[0].got,
@@ -175,10 +180,9 @@ TEST(gate_newcomer_does_not_barge)
 		struct srv_gate_waiter me;
 		REQUIRE(srv_gate_enter(&g, &me, now_s(), 0));
 		atomic_int turn = 0;
-		struct ordered a = {&g, &turn, -1};
+		struct ordered a;
 		pthread_t t;
-		pthread_create(&t, NULL, enter_ordered, &a);
-		for (int k = 0; k < 2000 && waiters(&g) < 1; k++) usleep(100);
+		queue_one(&g, &turn, &a, &t);
 		srv_gate_leave(&g);
 		REQUIRE(srv_gate_enter(&g, &me, now_s(), 0));   /* at once, as a newcomer */
 		int mine = atomic_fetch_add(&turn, 1);

@@ -11,6 +11,7 @@
 #include "model.h"
 #include "model_paths.h"
 #include "test.h"
+#include "util.h"
 
 static const char CUBE[] =
 	"mtllib cube.mtl\nusemtl paint\n"
@@ -34,13 +35,9 @@ static void settle(const char *path)
 
 static void put(const char *dir, const char *name, const char *text)
 {
+	test_put_file(dir, name, text);
 	char f[400];
 	snprintf(f, sizeof f, "%s/%s", dir, name);
-	FILE *fp = fopen(f, "wb");
-	if (fp) {
-		fputs(text, fp);
-		fclose(fp);
-	}
 	settle(f);
 }
 

@@ -32,3 +32,14 @@ char *test_vdoc(const char *fmt, va_list ap)
 	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
 	return doc;
 }
+
+void test_put_file(const char *dir, const char *name, const char *text)
+{
+	char p[1024];
+	snprintf(p, sizeof p, "%s/%s", dir, name);
+	FILE *f = fopen(p, "wb");
+	if (f) {
+		fputs(text, f);
+		fclose(f);
+	}
+}

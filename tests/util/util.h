@@ -12,6 +12,9 @@
 
 /* Standard base64 (with padding) of d[0..n), NUL-terminated. */
 char *test_b64(const void *d, size_t n);
+/* Writes text to dir/name (created or truncated); a file that cannot be written is left as
+ * it is (the test's own checks then fail on what it reads). */
+void test_put_file(const char *dir, const char *name, const char *text);
 /* A scene document from a printf format in which ' stands for " (so that tests can write
  * "{'width': %d}"). NULL when out of memory. */
 char *test_vdoc(const char *fmt, va_list ap);
