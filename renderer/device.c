@@ -298,7 +298,10 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 		.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &f13,
 		/* depthClamp: casters in front of a cascade's near plane still cast ("pancaking"). */
 		.features = {.depthClamp = have.depthClamp, .depthBiasClamp = have.depthBiasClamp,
-		             .shaderImageGatherExtended = have.shaderImageGatherExtended},
+		             .shaderImageGatherExtended = have.shaderImageGatherExtended,
+		             /* the visibility pass stores r16 from a fragment shader */
+		             .fragmentStoresAndAtomics = have.fragmentStoresAndAtomics,
+		             .shaderStorageImageExtendedFormats = have.shaderStorageImageExtendedFormats},
 	};
 	float prio = 1.0f;
 	VkDeviceQueueCreateInfo qci = {
@@ -325,6 +328,10 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 		ctx->device = VK_NULL_HANDLE;
 		return rnd_fail(err, RND_ERR_NO_DEVICE, "device '%s' cannot render and sample D32_SFLOAT shadow maps", ctx->props.deviceName);
 	}
+	vkGetPhysicalDeviceFormatProperties(ctx->phys, RND_VISIBILITY_FORMAT, &fp);
+	VkFormatFeatureFlags vis_need = VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
+	ctx->visibility_pass = have.fragmentStoresAndAtomics && have.shaderStorageImageExtendedFormats &&
+	                       (fp.optimalTilingFeatures & vis_need) == vis_need;
 	ctx->color_formats[RND_PIXELS_RGBA8] = VK_FORMAT_R8G8B8A8_UNORM;
 	ctx->color_formats[RND_PIXELS_RGBA16] = VK_FORMAT_R16G16B16A16_UNORM;
 	ctx->color_formats[RND_PIXELS_RGBA32F] = VK_FORMAT_R32G32B32A32_SFLOAT;

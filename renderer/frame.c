@@ -163,7 +163,20 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 	VkDescriptorImageInfo bounds_ii = ctx->atlas_bounds.view
 		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL}
 		: ii;
-	VkWriteDescriptorSet w[8];
+	/* The visibility pass's images (visibility.c): only the pipelines of renders that use it
+	 * declare them; other renders bind whatever images the slot has (render.c). */
+	VkDescriptorImageInfo vi[4] = {
+		{ctx->pipes.shadow_sampler, s->surfaces.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.shadow_sampler, s->normals.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.shadow_sampler, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
+		{VK_NULL_HANDLE, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
+	};
+	VkWriteDescriptorSet w[12];
+	for (int i = 0; i < 4; i++)
+		w[8 + i] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SURFACES + i,
+			.descriptorCount = 1, .descriptorType = rnd_binding_type[UMBRA_BINDING_SURFACES + i], .pImageInfo = &vi[i],
+		};
 	w[5] = (VkWriteDescriptorSet){
 		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
 		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
@@ -184,7 +197,7 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, 8, w, 0, NULL);
+	vkUpdateDescriptorSets(ctx->device, 12, w, 0, NULL);
 }
 
 /* moments.comp and minmax.comp: the scratch map in, the blur temporary, the moment atlas and

@@ -14,7 +14,8 @@
 
 /* Fills the uniform/storage regions (growing the slot's parameter buffer when needed) and
  * points the slot's descriptor sets at them. contact: the view draws its camera depth
- * (slot->scene_depth, bound for contact shadows). */
+ * (slot->scene_depth, bound for contact shadows). The slot's visibility-pass images are bound
+ * too (visibility.c): the caller makes sure they exist. */
 enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                 const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
                                 float exposure, bool contact, struct rnd_error *err);

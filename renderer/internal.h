@@ -22,6 +22,11 @@
 #define RND_COLOR_FORMAT_COUNT 3   /* enum rnd_pixel_format */
 #define RND_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
 #define RND_SHADOW_FORMAT VK_FORMAT_D32_SFLOAT
+/* The visibility pass (visibility.c): its surfaces (position, normal: shaders/surface.frag) and
+ * its output (a layer per light, 16 bits: 8 would band smooth penumbrae in the darks; vis.frag's
+ * storage image says r16 too). */
+#define RND_SURFACES_FORMAT VK_FORMAT_R32G32B32A32_SFLOAT
+#define RND_VISIBILITY_FORMAT VK_FORMAT_R16_UNORM
 #define RND_MAX_VARIANTS 1024
 
 /* Map a VkResult to a result + message "what: VK_ERROR_..." */
@@ -68,8 +73,11 @@ struct rnd_pipelines {
 	/* alpha-tested (alpha_mode MASK) variants of the two depth-only passes */
 	VkPipeline shadow_masked[2];
 	VkPipeline prepass_masked[2][2];
+	/* [cull] the surfaces pass of the visibility pass (renderer/visibility.c): single-sample,
+	 * world position and normal per pixel */
+	VkPipeline surfaces[2];
 	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
-	VkShaderModule mesh_vs, mesh_fs, aov_fs;
+	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs;
 	pthread_mutex_t mu;
 	uint32_t variant_count;
 	struct rnd_main_variant {
@@ -80,6 +88,8 @@ struct rnd_pipelines {
 			uint32_t aov;                /* 1 = the AOV pass (aov.frag, 4 x RGBA32F, 1 sample) */
 			uint32_t prepass;            /* 1 = after a depth pre-pass: depth EQUAL, no writes */
 			uint32_t atlas_view;         /* 1 = debug view `atlas` (fullscreen.vert + atlas.frag) */
+			uint32_t vis_pass;           /* 1 = the visibility pass (fullscreen.vert + vis.frag) */
+			uint32_t vis_read;           /* 1 = main pass reading the visibility pass (mesh_vis.frag) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;
@@ -124,6 +134,7 @@ struct rnd_context {
 	bool has_debug_utils;
 	PFN_vkSetDebugUtilsObjectNameEXT set_object_name;   /* NULL without VK_EXT_debug_utils */
 	bool timestamps;                     /* queue supports timestamps */
+	bool visibility_pass;                /* the device can run the visibility pass (visibility.c) */
 	float timestamp_period;              /* ns per tick */
 	VkFormat color_formats[RND_COLOR_FORMAT_COUNT];
 

@@ -19,6 +19,9 @@
 #include "masked.frag.spv.h"
 #include "fullscreen.vert.spv.h"
 #include "atlas.frag.spv.h"
+#include "surface.frag.spv.h"
+#include "vis.frag.spv.h"
+#include "mesh_vis.frag.spv.h"
 
 static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
                                    VkShaderModule *out, struct rnd_error *err)
@@ -39,6 +42,10 @@ const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
 	[UMBRA_BINDING_MOMENTS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_SCENE_DEPTH] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_DEPTH_BOUNDS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_SURFACES] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_SURFACE_NORMALS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_VISIBILITY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_VISIBILITY_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
 };
 
 static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
@@ -126,6 +133,7 @@ struct pipe_desc {
 	bool uv_only;               /* vertex input: position (0), uv (2), colour (3) */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
+	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
 	const VkSpecializationInfo *spec;  /* fragment stage */
 	const char *name;
 };
@@ -188,8 +196,9 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	};
 	VkPipelineDepthStencilStateCreateInfo ds = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-		.depthTestEnable = !d->no_vertices, .depthWriteEnable = !d->after_prepass && !d->no_vertices,
-		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL
+		.depthTestEnable = !d->no_vertices || d->depth_less_ro,
+		.depthWriteEnable = !d->after_prepass && !d->no_vertices,
+		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL : d->depth_less_ro ? VK_COMPARE_OP_LESS
 		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
 	};
 	VkPipelineColorBlendStateCreateInfo cb = {
@@ -227,6 +236,7 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r;
 	VkShaderModule shadow_vs = VK_NULL_HANDLE, masked_vs = VK_NULL_HANDLE, masked_fs = VK_NULL_HANDLE;
+	VkShaderModule surface_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
 	if ((r = make_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
@@ -235,6 +245,12 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	if ((r = make_module(ctx, spv_aov_frag, sizeof spv_aov_frag, "aov.frag", &p->aov_fs, err)) != RND_OK) goto fail;
 	if ((r = make_module(ctx, spv_masked_vert, sizeof spv_masked_vert, "masked.vert", &masked_vs, err)) != RND_OK) goto fail;
 	if ((r = make_module(ctx, spv_masked_frag, sizeof spv_masked_frag, "masked.frag", &masked_fs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_surface_frag, sizeof spv_surface_frag, "surface.frag", &surface_fs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs, err)) != RND_OK)
+		goto fail;
+	if ((r = make_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
+	if ((r = make_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
+		goto fail;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
@@ -271,13 +287,24 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 			if ((r = make_pipeline(ctx, &d, &p->prepass[m][cull], err)) != RND_OK) goto fail;
 		}
 	}
+	/* The visibility pass's surfaces (renderer/visibility.c): what the main pass will shade at
+	 * each pixel centre, single-sample, the main pass's reversed-Z depth test. */
+	for (int cull = 0; cull < 2; cull++) {
+		struct pipe_desc d = {
+			.vs = p->mesh_vs, .fs = surface_fs, .color = RND_SURFACES_FORMAT, .color_count = 2,
+			.depth = RND_DEPTH_FORMAT, .samples = 1, .cull_back = cull, .name = cull ? "surfaces (cull back)" : "surfaces",
+		};
+		if ((r = make_pipeline(ctx, &d, &p->surfaces[cull], err)) != RND_OK) goto fail;
+	}
 	/* These pipelines keep what they need from their modules. */
+	vkDestroyShaderModule(ctx->device, surface_fs, NULL);
 	vkDestroyShaderModule(ctx->device, masked_fs, NULL);
 	vkDestroyShaderModule(ctx->device, masked_vs, NULL);
 	vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
 	return RND_OK;
 
 fail:
+	if (surface_fs) vkDestroyShaderModule(ctx->device, surface_fs, NULL);
 	if (masked_fs) vkDestroyShaderModule(ctx->device, masked_fs, NULL);
 	if (masked_vs) vkDestroyShaderModule(ctx->device, masked_vs, NULL);
 	if (shadow_vs) vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
@@ -307,8 +334,9 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	for (uint32_t i = 0; i < UMBRA_SC_COUNT; i++)
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT, entries, sizeof key->sc, key->sc};
-	char name[96];
-	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u", key->aov ? "aov" : "main",
+	char name[112];
+	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
+	         key->aov ? "aov" : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",
 	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
 	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10]);
 	struct pipe_desc d = {
@@ -335,6 +363,19 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.color_count = UMBRA_AOV_ATTACHMENTS;
 		d.samples = 1;
 		d.after_prepass = false;
+	}
+	if (key->vis_read) d.fs = p->mesh_vis_fs;
+	if (key->vis_pass) {
+		/* Visibility pass: a fullscreen triangle over the surfaces' depth, one sample, its
+		 * results stored to an image (no colour attachment). */
+		d.vs = p->fullscreen_vs;
+		d.fs = p->vis_fs;
+		d.color = VK_FORMAT_UNDEFINED;
+		d.samples = 1;
+		d.no_vertices = true;
+		d.depth_less_ro = true;
+		d.after_prepass = false;
+		d.cull_back = false;
 	}
 	VkPipeline pipe;
 	r = make_pipeline(ctx, &d, &pipe, err);
@@ -378,7 +419,12 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 			if (p->prepass_masked[m][c]) vkDestroyPipeline(ctx->device, p->prepass_masked[m][c], NULL);
 		}
 	}
+	for (int c = 0; c < 2; c++)
+		if (p->surfaces[c]) vkDestroyPipeline(ctx->device, p->surfaces[c], NULL);
 	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
+	if (p->vis_fs) vkDestroyShaderModule(ctx->device, p->vis_fs, NULL);
+	if (p->mesh_vis_fs) vkDestroyShaderModule(ctx->device, p->mesh_vis_fs, NULL);
+	if (p->fullscreen_vs) vkDestroyShaderModule(ctx->device, p->fullscreen_vs, NULL);
 	for (uint32_t i = 0; i < RND_TEXTURE_SAMPLERS; i++)
 		if (p->texture_samplers[i]) vkDestroySampler(ctx->device, p->texture_samplers[i], NULL);
 	if (p->mesh_fs) vkDestroyShaderModule(ctx->device, p->mesh_fs, NULL);

@@ -255,8 +255,7 @@ uint32_t record_debug(enum rnd_debug d)
 	}
 }
 
-/* The specialization key of this scene's main pass (see mesh.frag). */
-static void main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
+void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
                      uint32_t ndraw, struct rnd_main_key *k)
 {
 	memset(k, 0, sizeof *k);
@@ -453,7 +452,8 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	uint32_t ndraw = rv->ndraw;
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
-	main_key(sc, rv->sp, rv->draws, ndraw, &key);
+	record_main_key(sc, rv->sp, rv->draws, ndraw, &key);
+	key.vis_read = rv->vis;
 	VkPipeline atlas_pipe = VK_NULL_HANDLE;
 	if (key.atlas_view) {
 		enum rnd_result r = rnd_pipelines_main(ctx, &key, &atlas_pipe, err);
@@ -545,7 +545,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	VkRect2D area = record_band_area(rv);
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
-	main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
+	record_main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
 	memset(&key.sc[UMBRA_SC_DEBUG], 0, sizeof key.sc[0]);
 	key.sc[UMBRA_SC_DEBUG] = 0;
 	key.sc[UMBRA_SC_LINEAR] = 1;

@@ -41,6 +41,7 @@ struct record_view {
 	 * the whole view, so a band's pixels are exactly those of the unsplit pass). */
 	uint32_t band_y, band_h;       /* band_h 0 = every row */
 	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
+	bool vis;                      /* shadows from the visibility pass (visibility.c), drawn per band */
 };
 
 /* The rows of the view that this submit draws (band_y, band_h). */
@@ -67,6 +68,9 @@ void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, u
  * scratch map and copied into its atlas tile. */
 void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v, uint32_t first,
                     uint32_t end);
+/* The specialization key of this scene's main pass (see mesh.frag). */
+void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
+                     uint32_t ndraw, struct rnd_main_key *k);
 enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
                             struct rnd_error *err);
 enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,

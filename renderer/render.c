@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 #include "contact.h"
+#include "visibility.h"
 #include "estimate.h"
 #include "frame.h"
 #include "lod.h"
@@ -334,6 +335,13 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	if ((r = place_tiles(rq, v, err)) != RND_OK) return r;
 	bool contact = rnd_contact_any(sc, rq->sp);
 	if (contact && (r = rnd_slot_scene_depth(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
+	bool vis = rnd_visibility_wanted(ctx, sc, rq->sp, rq->draws, sc->object_count);
+	/* Without the pass its bindings still need images (lavapipe reads every descriptor of a
+	 * bound set): whatever the slot has, or 1x1 ones. */
+	r = vis ? rnd_slot_visibility(ctx, s, sc->width, sc->height, rnd_visibility_layers(sc), err)
+	        : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 2, err);
+	if (r != RND_OK) return r;
+	if (vis) rq->tm.visibility_views++;
 	if ((r = rnd_frame_write(ctx, s, sc, &cam, rq->sp, camera->exposure, contact, err)) != RND_OK) return r;
 
 	uint32_t col = v % sh->cols, row = v / sh->cols;
@@ -342,6 +350,7 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.sc = sc, .cam = &cam, .sp = rq->sp, .draws = rq->draws, .ndraw = sc->object_count, .aov_passes = sh->passes,
 		.color_offset = cell * sh->px, .aov_offset = sh->color_bytes + cell * 16, .aov_stride = sh->att_bytes,
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = contact,
+		.vis = vis,
 	};
 	return rnd_submit_view(ctx, s, &rv, &rq->pacer, &rq->tm, &rq->gpu_busy, err);
 }

@@ -86,12 +86,13 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		}
 		RND_NAME(ctx, VK_OBJECT_TYPE_QUERY_POOL, s->queries, "slot %u timestamps", index);
 	}
-	VkDescriptorPoolSize sizes[3] = {
+	VkDescriptorPoolSize sizes[4] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 7},
+		{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
 	};
-	if ((r = pool_with_sets(ctx, sizes, 3, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
+	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
 		goto fail_desc_pool;
 	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (1 + ntex) * UMBRA_TEX_SLOTS};
 	for (uint32_t i = 0; i < 1 + ntex; i++) layouts[i] = ctx->pipes.texture_layout;
@@ -153,6 +154,10 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) rnd_image_destroy(ctx, &s->aov[i]);
 	rnd_image_destroy(ctx, &s->aov_depth);
 	rnd_image_destroy(ctx, &s->scene_depth);
+	rnd_image_destroy(ctx, &s->surfaces);
+	rnd_image_destroy(ctx, &s->normals);
+	rnd_image_destroy(ctx, &s->surfaces_depth);
+	rnd_image_destroy(ctx, &s->visibility);
 	rnd_buffer_destroy(ctx, &s->staging);
 	rnd_image_destroy(ctx, &s->resolve);
 	rnd_image_destroy(ctx, &s->depth);
@@ -339,6 +344,13 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 		rnd_image_destroy(ctx, &s->resolve);
 	}
 	if (image_bytes(ctx, &s->scene_depth) > keep) rnd_image_destroy(ctx, &s->scene_depth);
+	if (image_bytes(ctx, &s->surfaces) + image_bytes(ctx, &s->normals) + image_bytes(ctx, &s->surfaces_depth) +
+	        image_bytes(ctx, &s->visibility) > keep) {
+		rnd_image_destroy(ctx, &s->surfaces);
+		rnd_image_destroy(ctx, &s->normals);
+		rnd_image_destroy(ctx, &s->surfaces_depth);
+		rnd_image_destroy(ctx, &s->visibility);
+	}
 	if (image_bytes(ctx, &s->shadow_scratch) + s->scratch_buf.size > keep) {
 		rnd_image_destroy(ctx, &s->shadow_scratch);
 		rnd_buffer_destroy(ctx, &s->scratch_buf);
@@ -362,4 +374,38 @@ enum rnd_result rnd_slot_scene_depth(struct rnd_context *ctx, struct rnd_slot *s
 	return rnd_image_create(ctx, RND_SHADOW_FORMAT, w, h, 1, 1,
 	                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
 	                        VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->scene_depth, err);
+}
+
+enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
+                                    uint32_t layers, struct rnd_error *err)
+{
+	enum rnd_result r;
+	char name[48];
+	if (!s->surfaces.img || s->surfaces.width != w || s->surfaces.height != h) {
+		rnd_image_destroy(ctx, &s->surfaces);
+		rnd_image_destroy(ctx, &s->normals);
+		rnd_image_destroy(ctx, &s->surfaces_depth);
+		struct rnd_image_res *img[2] = {&s->surfaces, &s->normals};
+		for (int i = 0; i < 2; i++) {
+			snprintf(name, sizeof name, "slot %u surface %s", s->index, i ? "normals" : "positions");
+			if ((r = rnd_image_create(ctx, RND_SURFACES_FORMAT, w, h, 1, 1,
+			                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+			                          VK_IMAGE_ASPECT_COLOR_BIT, name, img[i], err)) != RND_OK)
+				return r;
+		}
+		snprintf(name, sizeof name, "slot %u surfaces depth", s->index);
+		if ((r = rnd_image_create(ctx, RND_DEPTH_FORMAT, w, h, 1, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+		                          VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->surfaces_depth, err)) != RND_OK)
+			return r;
+	}
+	/* Layers of the last render's count, at least 2 so that the view is an array (layers beyond
+	 * a render's lights are not read). */
+	if (layers < 2) layers = 2;
+	if (s->visibility.img && s->visibility.width == w && s->visibility.height == h && s->visibility.layers == layers)
+		return RND_OK;
+	rnd_image_destroy(ctx, &s->visibility);
+	snprintf(name, sizeof name, "slot %u visibility", s->index);
+	return rnd_image_create(ctx, RND_VISIBILITY_FORMAT, w, h, layers, 1,
+	                        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, name,
+	                        &s->visibility, err);
 }

@@ -46,6 +46,9 @@ struct rnd_slot {
 	struct rnd_image_res color_ms, depth, resolve;
 	/* the camera view's depth, single-sample, drawn before the main pass for contact shadows */
 	struct rnd_image_res scene_depth;
+	/* the visibility pass (visibility.c): the view's surface positions and normals, their
+	 * depth, the visibility image */
+	struct rnd_image_res surfaces, normals, surfaces_depth, visibility;
 };
 
 /* Makes the colour/depth targets match (format, w, h, samples). */
@@ -60,6 +63,9 @@ enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s
 /* Makes the contact-shadow scene depth image match w x h. */
 enum rnd_result rnd_slot_scene_depth(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
                                      struct rnd_error *err);
+/* Makes the visibility pass's images match a w x h view with `layers` lights (at least 2). */
+enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
+                                    uint32_t layers, struct rnd_error *err);
 /* Destroys the previous render's textures. */
 void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 

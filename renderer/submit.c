@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 #include <time.h>
+#include "visibility.h"
 #include "submit.h"
 #include "contact.h"
 
@@ -307,6 +308,7 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 		band.band_h = rows;
 		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
 		cmd_mark(s, &st, RND_TS_SHADOW_END);
+		if (rv->vis && (r = record_visibility(ctx, s, &band, err)) != RND_OK) goto fail;
 		if ((r = record_main(ctx, s, &band, err)) != RND_OK) goto fail;
 		if (rv->aov_passes && (r = record_aov(ctx, s, &band, err)) != RND_OK) goto fail;
 		cmd_mark(s, &st, RND_TS_MAIN_END);

@@ -1,6 +1,8 @@
-// shaders/shading.glsl — what the main pass (mesh.frag) and the AOV pass (aov.frag) share:
-// bindings, specialization constants, shadow filtering, lighting. Included after
-// umbra_shared.h; the including shader declares its outputs and main().
+// shaders/shading.glsl — what the main pass (mesh.frag, mesh_vis.frag via mesh_main.glsl), the
+// AOV pass (aov.frag) and the visibility pass (vis.frag) share: bindings, specialization
+// constants, shadow filtering, lighting; with material.glsl, pcss_bounds.glsl, visibility.glsl
+// and display.glsl. Included after umbra_shared.h; the including shader declares its outputs
+// and main().
 // Main pass: metallic-roughness shading (Lambert + GGX), hemisphere ambient, directional /
 // spot / point lights in the contract's units, shadow filtering, tone map and encoding.
 //
@@ -21,6 +23,16 @@ layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SHADOW_MAP) uniform sample
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_MOMENTS) uniform sampler2D moment_atlas;
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SCENE_DEPTH) uniform sampler2D scene_depth;
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_DEPTH_BOUNDS) uniform sampler2D depth_bounds;
+#if defined(UMBRA_VIS_PASS) || defined(UMBRA_VIS_READ)
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SURFACES) uniform sampler2D surfaces;
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_SURFACE_NORMALS) uniform sampler2D surface_normals;
+#endif
+#ifdef UMBRA_VIS_READ
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_VISIBILITY) uniform sampler2DArray vis_image;
+#endif
+#ifdef UMBRA_VIS_PASS
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_VISIBILITY_OUT, r16) uniform writeonly image2DArray vis_out;
+#endif
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_METAL_ROUGH_TEXTURE) uniform sampler2D metal_rough_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
@@ -47,11 +59,23 @@ layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1
 layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any light marches contact shadows
 layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
 
+#ifdef UMBRA_VIS_PASS
+// vis.frag: the surface comes from the surfaces image, not from a triangle.
+vec3 v_pos;
+vec3 v_nrm;
+vec2 v_uv;
+vec4 v_color;
+vec4 v_tangent;
+vec2 vis_frag_xy;        // the pixel (centre) this invocation computes, in the view
+vec2 frag_xy() { return vis_frag_xy; }
+#else
 layout(location = 0) in vec3 v_pos;
 layout(location = 1) in vec3 v_nrm;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_color;
 layout(location = 4) in vec4 v_tangent;
+vec2 frag_xy() { return gl_FragCoord.xy; }
+#endif
 #include "material.glsl"
 
 // Whether the material samples texture slot `slot` (and any material of the scene does).
@@ -422,7 +446,7 @@ float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
 	float span = length((cb.xy / cb.w - ca.xy / ca.w) * 0.5 * size);
 	int steps = clamp(int(ceil(span)), 1, int(L.contact.y));
 	float dt = (len - t0) / float(steps);
-	float jitter = ign(gl_FragCoord.xy);
+	float jitter = ign(frag_xy());
 	float z_prev = zs0 + dz * t0;
 	float eps = 1e-3 * px;
 	for (int i = 0; i < steps; i++) {
@@ -476,6 +500,8 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 	return l;
 }
 
+#include "visibility.glsl"
+
 // Base colour times its texture (sRGB texels decode to linear in the sampler) times the
 // vertex colour; alpha MASK discards below the cutoff, BLEND by the dither (material.glsl).
 vec4 base_color(umbra_material m)
@@ -518,6 +544,9 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 		if (reaches || i == frame.mode.z || frame.mode2.z != 0u) reach[i >> 5] |= 1u << (i & 31u);
 	}
 	uvec2 todo = subgroupOr(reach);
+#ifdef UMBRA_VIS_READ
+	ivec2 vis_px = receive ? vis_pixel(n_geo) : ivec2(0);
+#endif
 	while (todo != uvec2(0u)) {
 		uint i = todo.x != 0u ? uint(findLSB(todo.x)) : 32u + uint(findLSB(todo.y));
 		todo[i >> 5] &= ~(1u << (i & 31u));
@@ -527,7 +556,12 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 		vec3 l = light_dir(L, v_pos, atten);
 		float ndl = dot(N, l);
 		uint view = 0u;
-		float vis = SC_FILTERS != 0u && receive ? shadow_visibility(L, v_pos, n_geo, l, view) : 1.0;
+		float vis = 1.0;
+#if defined(UMBRA_VIS_READ)
+		if (SC_FILTERS != 0u && receive && L.shadow.y != 0u) vis = vis_fetch(vis_px, i);
+#elif !defined(UMBRA_VIS_PASS)
+		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, v_pos, n_geo, l, view);
+#endif
 		if (i == frame.mode.z) { debug_vis = vis; debug_view = view; }
 		if (ndl <= 0.0 || atten <= 0.0) continue;
 		vec3 h = normalize(l + V);
@@ -543,48 +577,4 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 	}
 }
 
-vec3 tonemap_neutral(vec3 color)
-{
-	const float start = 0.8 - 0.04;
-	const float desat = 0.15;
-	float x = min(color.r, min(color.g, color.b));
-	float offset = x < 0.08 ? x - 6.25 * x * x : 0.04;
-	color -= offset;
-	float peak = max(color.r, max(color.g, color.b));
-	if (peak < start) return color;
-	const float d = 1.0 - start;
-	float new_peak = 1.0 - d * d / (peak + d - start);
-	color *= new_peak / peak;
-	float g = 1.0 - 1.0 / (desat * (peak - new_peak) + 1.0);
-	return mix(color, vec3(new_peak), g);
-}
-
-vec3 tonemap_aces(vec3 x)   // Narkowicz's fit of the ACES RRT+ODT
-{
-	return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-}
-
-vec3 srgb_encode(vec3 c)
-{
-	c = clamp(c, 0.0, 1.0);
-	return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
-
-vec3 display(vec3 radiance)
-{
-	if (SC_LINEAR != 0u) return radiance;   // linear scene-referred output (EXR)
-	vec3 c = radiance;
-	if (SC_TONEMAP == UMBRA_TONEMAP_NEUTRAL) c = tonemap_neutral(c);
-	else if (SC_TONEMAP == UMBRA_TONEMAP_ACES) c = tonemap_aces(c);
-	return srgb_encode(c);
-}
-
-// Tint per cascade / clipmap level: 0 red, 1 green, 2 blue, 3 yellow, 4 magenta, 5 cyan, ...
-vec3 cascade_tint(uint i)
-{
-	uint k = i % 6u;
-	vec3 c = k == 0u ? vec3(1, 0.3, 0.3) : k == 1u ? vec3(0.3, 1, 0.3) : k == 2u ? vec3(0.3, 0.4, 1)
-	       : k == 3u ? vec3(1, 1, 0.3) : k == 4u ? vec3(1, 0.3, 1) : vec3(0.3, 1, 1);
-	return i >= 6u ? c * 0.6 : c;
-}
-
+#include "display.glsl"

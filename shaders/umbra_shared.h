@@ -18,7 +18,15 @@
 #define UMBRA_BINDING_MOMENTS        5  /* sampler2D, the moment atlas (blurred, linear filtering) */
 #define UMBRA_BINDING_SCENE_DEPTH    6  /* sampler2D, the camera view's depth (D32, 1 - reversed Z), contact shadows */
 #define UMBRA_BINDING_DEPTH_BOUNDS   7  /* sampler2D, the depth bounds of the atlas (RGBA32F, texelFetch) */
-#define UMBRA_BINDING_COUNT          8
+/* The visibility pass (renderer/visibility.c): bound only for the renders that use it, and
+ * declared only by the shaders that read or write it (vis.frag, mesh.frag built as mesh_vis). */
+#define UMBRA_BINDING_SURFACES       8  /* sampler2D (RGBA32F, texelFetch): the world position of the
+                                           surface each pixel centre shows, w 1 (0 = nothing drawn) */
+#define UMBRA_BINDING_SURFACE_NORMALS 9 /* sampler2D (RGBA32F, texelFetch): its geometric normal */
+#define UMBRA_BINDING_VISIBILITY     10 /* sampler2DArray (R16 unorm, texelFetch): layer i = light i's
+                                           visibility of that surface (1 where it does not reach) */
+#define UMBRA_BINDING_VISIBILITY_OUT 11 /* the same image as vis.frag's storage image */
+#define UMBRA_BINDING_COUNT          12
 /* moments.comp's own set 0 */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
 #define UMBRA_MOMENTS_BINDING_TMP    1

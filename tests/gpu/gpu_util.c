@@ -40,6 +40,24 @@ struct rnd_context *gpu_ctx(void)
 
 struct rnd_timings gpu_last_timings;
 
+struct api_scene *gpu_parse(const char *json)
+{
+	char *doc = strdup(json);
+	if (!doc) return NULL;
+	for (char *p = doc; *p; p++)
+		if (*p == '\'') *p = '"';
+	struct api_limits lim;
+	api_limits_defaults(&lim);
+	struct api_scene *s = NULL;
+	struct api_problem prob = {0};
+	if (api_scene_parse(doc, strlen(doc), &lim, &s, &prob) != API_OK) {
+		CHECK(0, "parse: %s: %s", prob.pointer, prob.detail);
+		s = NULL;
+	}
+	free(doc);
+	return s;
+}
+
 bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char *fmt, ...)
 {
 	memset(img, 0, sizeof *img);

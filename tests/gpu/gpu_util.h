@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include "umbra/rnd.h"
 
+struct api_scene;
+
 #define GPU_PI 3.14159265358979323846
 #define GPU_DEG (GPU_PI / 180.0)
 
@@ -22,6 +24,10 @@ struct rnd_context *gpu_ctx(void);
 bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
 #define gpu_render(img, ...) gpu_render_at(__FILE__, __LINE__, (img), __VA_ARGS__)
+/* The scene of `json` (single quotes allowed, default limits), for tests that change its
+ * fields before rnd_render; NULL (and a failed CHECK) when it does not parse. api_scene_free()
+ * it. */
+struct api_scene *gpu_parse(const char *json);
 /* The timings of the last successful gpu_render (shadow maps rendered / reused). */
 extern struct rnd_timings gpu_last_timings;
 

@@ -29,23 +29,6 @@ static uint64_t mono_ns(void)
 	return (uint64_t)t.tv_sec * 1000000000ull + (uint64_t)t.tv_nsec;
 }
 
-static struct api_scene *parse(const char *json)
-{
-	char *doc = strdup(json);
-	if (!doc) return NULL;
-	for (char *p = doc; *p; p++) if (*p == '\'') *p = '"';
-	struct api_limits lim;
-	api_limits_defaults(&lim);
-	struct api_scene *s = NULL;
-	struct api_problem prob = {0};
-	if (api_scene_parse(doc, strlen(doc), &lim, &s, &prob) != API_OK) {
-		CHECK(0, "parse: %s: %s", prob.pointer, prob.detail);
-		s = NULL;
-	}
-	free(doc);
-	return s;
-}
-
 static bool same_image(const struct rnd_image *a, const struct rnd_image *b)
 {
 	if (a->width != b->width || a->height != b->height || a->stride != b->stride || a->aov_count != b->aov_count)
@@ -61,7 +44,7 @@ TEST(faults_bands_give_the_same_bytes)
 {
 	struct rnd_context *ctx = gpu_ctx();
 	REQUIRE(ctx);
-	struct api_scene *s = parse(FAULT_SCENE("256"));
+	struct api_scene *s = gpu_parse(FAULT_SCENE("256"));
 	REQUIRE(s);
 	uint32_t before = rnd_context_validation_messages(ctx);
 	struct rnd_image whole = {0}, bands = {0}, paced = {0};
@@ -97,7 +80,7 @@ TEST(faults_deadline_and_cancel_stop_between_submits)
 {
 	struct rnd_context *ctx = gpu_ctx();
 	REQUIRE(ctx);
-	struct api_scene *s = parse(FAULT_SCENE("512"));
+	struct api_scene *s = gpu_parse(FAULT_SCENE("512"));
 	REQUIRE(s);
 	struct rnd_stats base, after;
 	rnd_context_stats(ctx, &base);
@@ -134,7 +117,7 @@ TEST(faults_injected_oom_gives_atlas_tiles_back)
 	struct rnd_context *ctx = gpu_ctx();
 	REQUIRE(ctx);
 	/* A resolution no other test asks for: these maps are not in the cache yet. */
-	struct api_scene *s = parse(FAULT_SCENE("128"));
+	struct api_scene *s = gpu_parse(FAULT_SCENE("128"));
 	REQUIRE(s);
 	struct rnd_stats base, after;
 	rnd_context_stats(ctx, &base);
@@ -165,7 +148,7 @@ TEST(faults_injected_device_loss_fails_the_context)
 	struct rnd_context *ctx = NULL;
 	struct rnd_error err = {0};
 	REQUIRE(rnd_context_create(&cd, &ctx, &err) == RND_OK, "%s", err.msg);
-	struct api_scene *s = parse(FAULT_SCENE("128"));
+	struct api_scene *s = gpu_parse(FAULT_SCENE("128"));
 	struct rnd_image img = {0};
 	if (s) {
 		rnd_context_inject_fault(ctx, RND_FAULT_DEVICE_LOST, 1);

@@ -352,6 +352,7 @@ struct rnd_timings {
 	double main_ms;       /* main pass + resolve (GPU) */
 	double readback_ms;   /* copy back to host memory */
 	uint32_t shadow_maps_rendered, shadow_maps_reused;
+	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
 };
 
 /* ---- context ---- */

@@ -1,0 +1,18 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "umbra_shared.h"
+// The surfaces pass (single-sample, before the visibility pass): what the main pass will shade
+// at each pixel centre, its world position and geometric normal (mesh.frag's n_geo), in full
+// float: the shadow filters' receiver plane comes from the normal, and a normal rounded to 12
+// bits a component already put acne on a face lit at a grazing angle.
+layout(location = 0) in vec3 v_pos;
+layout(location = 1) in vec3 v_nrm;
+layout(location = 0) out vec4 o_position;
+layout(location = 1) out vec4 o_normal;
+void main()
+{
+	vec3 n = normalize(v_nrm);
+	if (!gl_FrontFacing) n = -n;
+	o_position = vec4(v_pos, 1.0);
+	o_normal = vec4(n, 0.0);
+}
