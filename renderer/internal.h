@@ -26,6 +26,7 @@
  * its output (a layer per light, 16 bits: 8 would band smooth penumbrae in the darks; vis.frag's
  * storage image says r16 too). */
 #define RND_SURFACES_FORMAT VK_FORMAT_R32G32B32A32_SFLOAT
+#define RND_SURFACE_NORMALS_FORMAT VK_FORMAT_R16G16B16A16_SNORM
 #define RND_VISIBILITY_FORMAT VK_FORMAT_R16_UNORM
 #define RND_MAX_VARIANTS 1024
 

@@ -132,6 +132,7 @@ struct pipe_desc {
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
 	bool uv_only;               /* vertex input: position (0), uv (2), colour (3) */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
+	VkFormat color_rest;        /* when set: the format of attachments 1.. */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
 	const VkSpecializationInfo *spec;  /* fragment stage */
@@ -162,7 +163,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	VkFormat formats[UMBRA_AOV_ATTACHMENTS];
 	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
 	for (uint32_t i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) {
-		formats[i] = d->color;
+		formats[i] = i > 0 && d->color_rest ? d->color_rest : d->color;
 		cbas[i] = (VkPipelineColorBlendAttachmentState){.colorWriteMask = 0xf};
 	}
 	VkPipelineVertexInputStateCreateInfo vi = {
@@ -292,6 +293,7 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
 			.vs = p->mesh_vs, .fs = surface_fs, .color = RND_SURFACES_FORMAT, .color_count = 2,
+			.color_rest = RND_SURFACE_NORMALS_FORMAT,
 			.depth = RND_DEPTH_FORMAT, .samples = 1, .cull_back = cull, .name = cull ? "surfaces (cull back)" : "surfaces",
 		};
 		if ((r = make_pipeline(ctx, &d, &p->surfaces[cull], err)) != RND_OK) goto fail;

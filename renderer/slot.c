@@ -388,7 +388,7 @@ enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s,
 		struct rnd_image_res *img[2] = {&s->surfaces, &s->normals};
 		for (int i = 0; i < 2; i++) {
 			snprintf(name, sizeof name, "slot %u surface %s", s->index, i ? "normals" : "positions");
-			if ((r = rnd_image_create(ctx, RND_SURFACES_FORMAT, w, h, 1, 1,
+			if ((r = rnd_image_create(ctx, i ? RND_SURFACE_NORMALS_FORMAT : RND_SURFACES_FORMAT, w, h, 1, 1,
 			                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
 			                          VK_IMAGE_ASPECT_COLOR_BIT, name, img[i], err)) != RND_OK)
 				return r;

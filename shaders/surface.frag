@@ -2,9 +2,10 @@
 #extension GL_GOOGLE_include_directive : require
 #include "umbra_shared.h"
 // The surfaces pass (single-sample, before the visibility pass): what the main pass will shade
-// at each pixel centre, its world position and geometric normal (mesh.frag's n_geo), in full
-// float: the shadow filters' receiver plane comes from the normal, and a normal rounded to 12
-// bits a component already put acne on a face lit at a grazing angle.
+// at each pixel centre, its world position (float) and geometric normal (mesh.frag's n_geo, 16
+// bits a component, renderer/internal.h): the shadow filters' receiver plane comes from the
+// normal, and one rounded to 12-bit octahedral coordinates put acne on a face lit at a grazing
+// angle (studio-spots: a box face speckled; with 16 bits the image is that of float normals).
 layout(location = 0) in vec3 v_pos;
 layout(location = 1) in vec3 v_nrm;
 layout(location = 0) out vec4 o_position;

@@ -22,7 +22,7 @@
  * declared only by the shaders that read or write it (vis.frag, mesh.frag built as mesh_vis). */
 #define UMBRA_BINDING_SURFACES       8  /* sampler2D (RGBA32F, texelFetch): the world position of the
                                            surface each pixel centre shows, w 1 (0 = nothing drawn) */
-#define UMBRA_BINDING_SURFACE_NORMALS 9 /* sampler2D (RGBA32F, texelFetch): its geometric normal */
+#define UMBRA_BINDING_SURFACE_NORMALS 9 /* sampler2D (RGBA16 snorm, texelFetch): its geometric normal */
 #define UMBRA_BINDING_VISIBILITY     10 /* sampler2DArray (R16 unorm, texelFetch): layer i = light i's
                                            visibility of that surface (1 where it does not reach) */
 #define UMBRA_BINDING_VISIBILITY_OUT 11 /* the same image as vis.frag's storage image */

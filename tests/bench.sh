@@ -95,7 +95,8 @@ for i in $( [ $QUICK = 1 ] && echo 1 || echo 1 2 3); do
 done | tee "$log/cold.txt"
 if [ -x "$BUILD/tests/http_bench" ] && [ -f tests/bench/http_bench.sh ]; then
 	echo
-	echo "== HTTP (umbrad over loopback)"
+	echo "== HTTP (umbrad over loopback), between two in-process runs of the same scene (the ratio's other side)"
+	"$BUILD/tests/bench" -n 15 "$SHARED/bench/thumb-256.json" | tee -a "$log/http-inproc.txt"
 	if [ $QUICK = 1 ]; then
 		# 64 requests (~1 s quiet): 16 (~0.2 s) are too few for a steady rate.
 		HTTP_BENCH_CONC=4 HTTP_BENCH_SECONDS=${HTTP_BENCH_SECONDS:-5} HTTP_BENCH_REQUESTS=${HTTP_BENCH_REQUESTS:-64} \
@@ -104,6 +105,7 @@ if [ -x "$BUILD/tests/http_bench" ] && [ -f tests/bench/http_bench.sh ]; then
 	else
 		BUILD=$BUILD SHARED=$SHARED sh tests/bench/http_bench.sh | tee "$log/http.txt"
 	fi
+	"$BUILD/tests/bench" -n 15 "$SHARED/bench/thumb-256.json" | tee -a "$log/http-inproc.txt"
 fi
 echo
 [ -n "${BENCH_BEFORE:-}" ] && python3 tests/bench/ratios.py "$log" before && echo

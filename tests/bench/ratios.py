@@ -10,6 +10,8 @@ Logs (any may be missing; its rows then say "not run"):
               model-1m-path, model-1m
   cold.txt    lines "run i: png X ms, exr+aov Y ms"
   http.txt    tests/bench/http_bench.sh (thumb-256 at concurrency 4) and "umbrad RSS ..." lines
+  http-inproc.txt  build/tests/bench: thumb-256 just before and just after the HTTP rows (the
+              in-process rate the HTTP rate is divided by, so that both see the same load)
   warm-before.txt, cold-before.txt   the same from an older build (BENCH_BEFORE), for "before"
 Usage: ratios.py DIR [before]"""
 import os, re, statistics, sys
@@ -31,11 +33,11 @@ def floor_ms(msaa):
     return statistics.median(v) if v else None
 
 
-def warm_total(scene):
-    """build/tests/bench's median total (ms) of SCENE: the median over every row of that name
-    (one per round)."""
+def warm_total(scene, log=None):
+    """build/tests/bench's median total (ms) of SCENE in LOG (default warm.txt): the median
+    over every row of that name (one per round)."""
     v = []
-    for line in read("warm-before.txt" if before else "warm.txt").splitlines():
+    for line in read(log or ("warm-before.txt" if before else "warm.txt")).splitlines():
         f = line.split()
         if len(f) >= 8 and f[0] == scene:
             v.append(float(f[7]))
@@ -89,7 +91,8 @@ row("1M-tri model, cached, by path / thumb-512", warm_total("model-1m-path.json"
 row("1M-tri model, inline base64 / thumb-512", warm_total("model-1m.json"), ms, t512,
     lambda v: "thumb-512 " + ms(v), 4.0, "le")
 row("cold CLI EXR+AOV / cold PNG", cold("exr+aov"), ms, cold("png"), lambda v: "png " + ms(v), 2.0, "le")
-t256_rate = 1000.0 / t256 if t256 else None
+t256_http = None if before else warm_total("thumb-256.json", "http-inproc.txt")
+t256_rate = 1000.0 / t256_http if t256_http else 1000.0 / t256 if t256 else None
 row("HTTP thumb-256 4 clients / in-process", http_rate("thumb-256.json", 4), lambda v: "%.1f img/s" % v, t256_rate,
     lambda v: "in-proc %.1f img/s" % v, 1.0, "ge")
 rss = rss_mb("after")
