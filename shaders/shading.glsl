@@ -473,6 +473,17 @@ float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint
 
 // ---- shading ---------------------------------------------------------------------------
 
+// Lights as sets of bits (uvec2: UMBRA_MAX_LIGHTS = 64). light_all and the visibility pass
+// walk the set of lights that reach any pixel of a block (subgroupOr) one light at a time.
+void add_light(inout uvec2 set, uint i) { set[i >> 5] |= 1u << (i & 31u); }
+bool has_light(uvec2 set, uint i) { return (set[i >> 5] & (1u << (i & 31u))) != 0u; }
+uint take_light(inout uvec2 set)   // the lowest light of a non-empty set, taken out of it
+{
+	uint i = set.x != 0u ? uint(findLSB(set.x)) : 32u + uint(findLSB(set.y));
+	set[i >> 5] &= ~(1u << (i & 31u));
+	return i;
+}
+
 // Direction towards light L from pos and its attenuation: inverse square with the
 // KHR_lights_punctual range window, and the smooth spot cone.
 vec3 light_dir(umbra_light L, vec3 pos, out float atten)
@@ -541,16 +552,15 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
 		bool reaches = dot(N, l) > 0.0 && atten > 0.0;
-		if (reaches || i == frame.mode.z || frame.mode2.z != 0u) reach[i >> 5] |= 1u << (i & 31u);
+		if (reaches || i == frame.mode.z || frame.mode2.z != 0u) add_light(reach, i);
 	}
 	uvec2 todo = subgroupOr(reach);
 #ifdef UMBRA_VIS_READ
 	ivec2 vis_px = receive ? vis_pixel(n_geo) : ivec2(0);
 #endif
 	while (todo != uvec2(0u)) {
-		uint i = todo.x != 0u ? uint(findLSB(todo.x)) : 32u + uint(findLSB(todo.y));
-		todo[i >> 5] &= ~(1u << (i & 31u));
-		if ((reach[i >> 5] & (1u << (i & 31u))) == 0u) continue;
+		uint i = take_light(todo);
+		if (!has_light(reach, i)) continue;
 		umbra_light L = lights[i];
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);

@@ -16,14 +16,13 @@ void store_visibility(ivec2 px, vec3 n_geo)
 		if (L.shadow.y == 0u) continue;
 		float atten = 0.0;
 		if ((SC_LIGHT_TYPES & (1u << uint(L.color.w))) != 0u) light_dir(L, v_pos, atten);
-		if (atten > 0.0 || frame.mode2.z != 0u) reach[i >> 5] |= 1u << (i & 31u);
+		if (atten > 0.0 || frame.mode2.z != 0u) add_light(reach, i);
 		else imageStore(vis_out, ivec3(px, int(i)), vec4(1.0));
 	}
 	uvec2 todo = subgroupOr(reach);
 	while (todo != uvec2(0u)) {
-		uint i = todo.x != 0u ? uint(findLSB(todo.x)) : 32u + uint(findLSB(todo.y));
-		todo[i >> 5] &= ~(1u << (i & 31u));
-		if ((reach[i >> 5] & (1u << (i & 31u))) == 0u) continue;
+		uint i = take_light(todo);
+		if (!has_light(reach, i)) continue;
 		umbra_light L = lights[i];
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
