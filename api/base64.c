@@ -3,8 +3,10 @@
  *
  * One pass, no lookahead: characters feed a bit accumulator; every 8 bits make a byte. The
  * accumulator keeps at most 13 bits (a leftover below 8 plus 6 new ones) and is masked so it
- * never shifts bits out of its width.
+ * never shifts bits out of its width. Between whole groups (no bits pending) runs of four
+ * alphabet characters are decoded three bytes at a time, which gives the same bytes.
  */
+#include <pthread.h>
 #include "base64.h"
 
 static int b64_value(unsigned char ch)
@@ -15,6 +17,19 @@ static int b64_value(unsigned char ch)
 	if (ch == '+' || ch == '-') return 62;   /* standard or URL-safe alphabet */
 	if (ch == '/' || ch == '_') return 63;
 	return -1;
+}
+
+/* b64_value as a table for the fast path: 0..63, 0xff for anything else (whitespace, '=',
+ * invalid: the general path decides). Built once; b64_value stays the one definition. */
+static uint8_t table[256];
+static pthread_once_t table_once = PTHREAD_ONCE_INIT;
+
+static void table_init(void)
+{
+	for (int ch = 0; ch < 256; ch++) {
+		int v = b64_value((unsigned char)ch);
+		table[ch] = v < 0 ? 0xff : (uint8_t)v;
+	}
 }
 
 size_t api_base64_decoded_max(size_t n)
@@ -30,8 +45,24 @@ enum api_result api_base64_decode(const char *s, size_t n, uint8_t *out, size_t 
 	size_t o = 0, dummy;
 	if (!bad) bad = &dummy;
 	if (out_len) *out_len = 0;
+	pthread_once(&table_once, table_init);
+	const unsigned char *u = (const unsigned char *)s;
 	for (size_t i = 0; i < n; i++) {
-		unsigned char ch = (unsigned char)s[i];
+		/* Fast path, byte-aligned between groups: four alphabet characters make three bytes
+		 * (a 1M-triangle model sent inline is 66 MB of them: 190 -> ~40 ms). Anything else
+		 * (whitespace, padding, a bad byte, the last group) takes the general path below. */
+		while (bits == 0 && !pad && i + 4 <= n && o + 3 <= out_size) {
+			uint32_t a = table[u[i]], b = table[u[i + 1]], c = table[u[i + 2]], d = table[u[i + 3]];
+			if ((a | b | c | d) & 0xc0u) break;
+			uint32_t w = a << 18 | b << 12 | c << 6 | d;
+			out[o] = (uint8_t)(w >> 16);
+			out[o + 1] = (uint8_t)(w >> 8);
+			out[o + 2] = (uint8_t)w;
+			o += 3;
+			i += 4;
+		}
+		if (i == n) break;
+		unsigned char ch = u[i];
 		if (ch == ' ' || ch == '\n' || ch == '\r' || ch == '\t') continue;
 		if (ch == '=') { pad++; continue; }
 		int v = b64_value(ch);

@@ -1,5 +1,6 @@
 /* tests/unit/test_base64.c — api/base64: RFC 4648 vectors, both alphabets, the whitespace and
  * padding policy, errors with their offsets, and the output bound. */
+#include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 #include "base64.h"
@@ -122,4 +123,66 @@ TEST(base64_small_buffer_is_refused_not_overrun)
 	CHECK(len == 0, "len %zu on failure", len);
 	/* NULL out_len and bad are allowed. */
 	CHECK(api_base64_decode("Zm9v", 4, out, sizeof out, NULL, NULL) == API_OK && !memcmp(out, "foo", 3));
+}
+
+/* The policy one character at a time, as the decoder was before its four-at-a-time fast path
+ * (the test's own copy): the fast path must give the same bytes, lengths, errors and offsets. */
+static int ref_value(unsigned char ch)
+{
+	if (ch >= 'A' && ch <= 'Z') return ch - 'A';
+	if (ch >= 'a' && ch <= 'z') return ch - 'a' + 26;
+	if (ch >= '0' && ch <= '9') return ch - '0' + 52;
+	if (ch == '+' || ch == '-') return 62;
+	if (ch == '/' || ch == '_') return 63;
+	return -1;
+}
+
+static bool ref_decode(const char *s, size_t n, uint8_t *out, size_t cap, size_t *len, size_t *bad)
+{
+	uint32_t acc = 0;
+	int bits = 0, pad = 0;
+	size_t o = 0;
+	for (size_t i = 0; i < n; i++) {
+		unsigned char ch = (unsigned char)s[i];
+		if (ch == ' ' || ch == '\n' || ch == '\r' || ch == '\t') continue;
+		if (ch == '=') { pad++; continue; }
+		int v = ref_value(ch);
+		if (v < 0 || pad) { *bad = i; return false; }
+		acc = ((acc << 6) | (uint32_t)v) & 0x3fffu;
+		bits += 6;
+		if (bits >= 8) {
+			bits -= 8;
+			if (o == cap) { *bad = i; return false; }
+			out[o++] = (uint8_t)(acc >> bits);
+		}
+	}
+	if (bits >= 6 || pad > 2) { *bad = n; return false; }
+	*len = o;
+	return true;
+}
+
+TEST(base64_fast_path_matches_one_character_at_a_time)
+{
+	static const char alphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/-_= \n\r\t*\"";
+	uint32_t seed = 7;
+	long mismatches = 0;
+	for (int t = 0; t < 100000; t++) {
+		char s[64];
+		seed = seed * 1103515245u + 12345u;
+		size_t n = (seed >> 16) % 48;
+		for (size_t i = 0; i < n; i++) {
+			seed = seed * 1103515245u + 12345u;
+			uint32_t r = seed >> 8;
+			/* mostly the alphabet, sometimes padding, whitespace or a bad byte */
+			s[i] = r % 100 < 88 ? alphabet[(r >> 8) % 64] : alphabet[64 + (r >> 8) % (sizeof alphabet - 65)];
+		}
+		seed = seed * 1103515245u + 12345u;
+		size_t cap = (seed >> 16) % 3 == 0 ? (seed >> 20) % 40 : api_base64_decoded_max(n);
+		uint8_t a[64], b[64];
+		size_t la = 0, lb = 0, ba = 0, bb = 0;
+		bool ok_a = api_base64_decode(s, n, a, cap, &la, &ba) == API_OK;
+		bool ok_b = ref_decode(s, n, b, cap, &lb, &bb);
+		if (ok_a != ok_b || (ok_a && (la != lb || memcmp(a, b, la))) || (!ok_a && ba != bb)) mismatches++;
+	}
+	CHECK(mismatches == 0, "%ld of 100000 random inputs decoded differently", mismatches);
 }
