@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include "big_strings.h"
 #include "asset.h"
 #include "model.h"
 #include "model_paths.h"
@@ -273,7 +274,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	if (!json) json = "", len = 0;
 
 	json_error_t je;
-	json_t *root = json_loadb(json, len, JSON_REJECT_DUPLICATES, &je);
+	json_t *root = api_json_load(json, len, JSON_REJECT_DUPLICATES, &je);
 	if (!root) {
 		api_problem_set(p, 400, "", "malformed JSON at line %d, column %d: %s", je.line, je.column, je.text);
 		snprintf(p->type, sizeof p->type, PROBLEMS "malformed-json");
