@@ -11,7 +11,7 @@
 #include <string.h>
 #include "big_strings.h"
 
-struct cut { size_t start, end; };   /* the string's bytes, quotes excluded: doc[start..end) */
+#define cut api_big_cut   /* the string's bytes, quotes excluded: doc[start..end) */
 
 /* Whether any byte of the 8 in x is zero (the classic bit trick, exact). */
 static uint64_t zero_byte(uint64_t x)
@@ -88,41 +88,73 @@ static long find_cuts(const char *doc, size_t len, struct cut **out)
 	return (long)n;
 }
 
-/* Puts the cut strings back in place of their placeholders ("\0" and the index). */
-static int restore(json_t *j, const char *doc, const struct cut *cuts, size_t ncut)
+/* The index of the placeholder v stands for, or -1 when v is not one. */
+static long placeholder(const json_t *v, size_t ncut)
+{
+	if (!json_is_string(v) || json_string_length(v) < 2 || json_string_value(v)[0] != 0) return -1;
+	unsigned long k = strtoul(json_string_value(v) + 1, NULL, 10);
+	return k < ncut ? (long)k : -1;
+}
+
+static bool kept(const char *key, const char *const *keep)
+{
+	for (size_t i = 0; keep && keep[i]; i++)
+		if (!strcmp(key, keep[i])) return true;
+	return false;
+}
+
+/* Puts the cut strings back in place of their placeholders, except as members named in keep. */
+static int restore(json_t *j, const char *doc, const struct cut *cuts, size_t ncut, const char *const *keep)
 {
 	if (json_is_object(j)) {
 		const char *key;
 		json_t *val;
 		void *tmp;
 		json_object_foreach_safe(j, tmp, key, val) {
-			if (json_is_string(val) && json_string_length(val) > 1 && json_string_value(val)[0] == 0) {
-				unsigned long k = strtoul(json_string_value(val) + 1, NULL, 10);
-				if (k >= ncut) return -1;
+			long k = placeholder(val, ncut);
+			if (k < 0) {
+				if (restore(val, doc, cuts, ncut, keep) < 0) return -1;
+			} else if (!kept(key, keep)) {
 				json_t *s = json_stringn_nocheck(doc + cuts[k].start, cuts[k].end - cuts[k].start);
 				if (!s || json_object_set_new(j, key, s) < 0) return -1;
-			} else if (restore(val, doc, cuts, ncut) < 0) {
-				return -1;
 			}
 		}
 	} else if (json_is_array(j)) {
 		for (size_t a = 0; a < json_array_size(j); a++) {
 			json_t *val = json_array_get(j, a);
-			if (json_is_string(val) && json_string_length(val) > 1 && json_string_value(val)[0] == 0) {
-				unsigned long k = strtoul(json_string_value(val) + 1, NULL, 10);
-				if (k >= ncut) return -1;
+			long k = placeholder(val, ncut);
+			if (k < 0) {
+				if (restore(val, doc, cuts, ncut, keep) < 0) return -1;
+			} else {
 				json_t *s = json_stringn_nocheck(doc + cuts[k].start, cuts[k].end - cuts[k].start);
 				if (!s || json_array_set_new(j, a, s) < 0) return -1;
-			} else if (restore(val, doc, cuts, ncut) < 0) {
-				return -1;
 			}
 		}
 	}
 	return 0;
 }
 
-json_t *api_json_load(const char *doc, size_t len, size_t flags, json_error_t *err)
+const char *api_big_string(const struct api_big_strings *big, const json_t *v, size_t *len)
 {
+	long k = big ? placeholder(v, big->n) : -1;
+	if (k < 0) {
+		*len = json_string_length(v);
+		return json_string_value(v);
+	}
+	*len = big->cuts[k].end - big->cuts[k].start;
+	return big->doc + big->cuts[k].start;
+}
+
+void api_big_strings_free(struct api_big_strings *big)
+{
+	free(big->cuts);
+	memset(big, 0, sizeof *big);
+}
+
+json_t *api_json_load(const char *doc, size_t len, size_t flags, json_error_t *err, const char *const *keep,
+                      struct api_big_strings *big)
+{
+	memset(big, 0, sizeof *big);
 	struct cut *cuts = NULL;
 	long ncut = len >= API_BIG_STRING ? find_cuts(doc, len, &cuts) : 0;
 	/* The placeholders spell \u0000: a document that does cannot be cut (the cut strings
@@ -154,8 +186,8 @@ json_t *api_json_load(const char *doc, size_t len, size_t flags, json_error_t *e
 	o += len - from;
 	root = json_loadb(copy, o, flags | JSON_ALLOW_NUL, NULL);
 	free(copy);
-	if (root && restore(root, doc, cuts, (size_t)ncut) == 0) {
-		free(cuts);
+	if (root && restore(root, doc, cuts, (size_t)ncut, keep) == 0) {
+		*big = (struct api_big_strings){doc, cuts, (size_t)ncut};
 		return root;
 	}
 	json_decref(root);

@@ -386,8 +386,8 @@ int api_require_object(struct pctx *c, json_t *v, const char *name)
 /* Decodes a base64 member into the arena. Returns 0 or -1 (400 at the current pointer). */
 int api_decode_b64_member(struct pctx *c, const char *name, json_t *v, unsigned char **out, size_t *len)
 {
-	const char *s = json_string_value(v);
-	size_t n = json_string_length(v);
+	size_t n;
+	const char *s = api_big_string(c->big, v, &n);
 	size_t cap = api_base64_decoded_max(n);
 	unsigned char *buf = api_arena_alloc(c->arena, cap);
 	if (!buf) return api_fail(c, "%s is too large to decode (out of memory)", name);

@@ -28,6 +28,7 @@
 #include <jansson.h>
 #include "api.h"
 #include "arena.h"
+#include "big_strings.h"
 
 #define DEG2RAD (3.14159265358979323846 / 180.0)
 #define PROBLEMS "https://umbra.dev/problems/"
@@ -62,6 +63,7 @@ struct pctx {
 	float *ground_margin;
 	size_t cur_object;
 	char warnings[sizeof(((struct api_scene *)0)->warnings)]; /* what is drawn other than asked ("; " between) */
+	const struct api_big_strings *big;  /* base64 members left in the document (api/big_strings.h) */
 };
 
 /* ---- json_walk.c: the pointer, problems, typed members ---- */

@@ -274,7 +274,11 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	if (!json) json = "", len = 0;
 
 	json_error_t je;
-	json_t *root = api_json_load(json, len, JSON_REJECT_DUPLICATES, &je);
+	/* The scene's base64 members, read only by api_decode_b64_member: big ones stay in json. */
+	static const char *const b64_members[] = {"data", "positions", "indices", "normals", "uvs",
+	                                          "base_color_texture", NULL};
+	struct api_big_strings big;
+	json_t *root = api_json_load(json, len, JSON_REJECT_DUPLICATES, &je, b64_members, &big);
 	if (!root) {
 		api_problem_set(p, 400, "", "malformed JSON at line %d, column %d: %s", je.line, je.column, je.text);
 		snprintf(p->type, sizeof p->type, PROBLEMS "malformed-json");
@@ -283,13 +287,15 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	}
 	if (api_preset_apply(&root, p) < 0) {
 		json_decref(root);
+		api_big_strings_free(&big);
 		return API_ERR;
 	}
-	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts};
+	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts, .big = &big};
 	c.arena = api_arena_create();
 	struct api_scene *s = c.arena ? api_arena_alloc(c.arena, sizeof *s) : NULL;
 	if (!s) {
 		json_decref(root);
+		api_big_strings_free(&big);
 		api_arena_destroy(c.arena);
 		return api_problem_set(p, 500, "", "out of memory parsing the scene");
 	}
@@ -302,6 +308,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	int rc = parse_root(&c, root, s);
 	json_decref(c.mat_index);
 	json_decref(root);
+	api_big_strings_free(&big);
 	if (rc == 0 && c.pending) {
 		*p = c.pend;
 		rc = -1;

@@ -33,7 +33,9 @@ static char *doc_with(const char *fmt, size_t big, const char *fill, int nbig)
 static void same_as_jansson(const char *what, const char *doc)
 {
 	json_error_t ea, eb;
-	json_t *a = api_json_load(doc, strlen(doc), JSON_REJECT_DUPLICATES, &ea);
+	struct api_big_strings big;
+	json_t *a = api_json_load(doc, strlen(doc), JSON_REJECT_DUPLICATES, &ea, NULL, &big);
+	api_big_strings_free(&big);
 	json_t *b = json_loadb(doc, strlen(doc), JSON_REJECT_DUPLICATES, &eb);
 	CHECK(!a == !b, "%s: parsed by one and not the other (%s / %s)", what, a ? "ok" : ea.text, b ? "ok" : eb.text);
 	if (a && b) CHECK(json_equal(a, b), "%s: the trees differ", what);
@@ -80,8 +82,9 @@ TEST(big_strings_same_errors_as_jansson)
 		char *d = doc_with(cases[i].fmt, big, cases[i].fill, 1);
 		REQUIRE(d);
 		json_error_t e;
-		json_t *j = api_json_load(d, strlen(d), JSON_REJECT_DUPLICATES, &e);
-		CHECK(!j, "%s: parsed", cases[i].what);
+		struct api_big_strings big;
+		json_t *j = api_json_load(d, strlen(d), JSON_REJECT_DUPLICATES, &e, NULL, &big);
+		CHECK(!j && big.n == 0, "%s: parsed", cases[i].what);
 		json_decref(j);
 		same_as_jansson(cases[i].what, d);
 		free(d);
@@ -132,4 +135,34 @@ TEST(big_strings_scene_with_a_big_inline_mesh)
 	free(doc);
 	free(b64);
 	free(pos);
+}
+
+/* Members named in `keep` stay placeholders that api_big_string() reads from the document; the
+ * other big strings are back in the tree. */
+TEST(big_strings_kept_members_read_from_the_document)
+{
+	const size_t big = API_BIG_STRING + 5;
+	char *d = doc_with("{\"data\":\"%s\",\"other\":\"%s\",\"list\":[\"%s\"],\"small\":\"abc\"}", big, "QUJD", 3);
+	REQUIRE(d);
+	static const char *const keep[] = {"data", "small", NULL};
+	struct api_big_strings bs;
+	json_error_t e;
+	json_t *j = api_json_load(d, strlen(d), 0, &e, keep, &bs);
+	REQUIRE(j);
+	json_t *ref = json_loadb(d, strlen(d), 0, NULL);
+	REQUIRE(ref);
+	const char *want = json_string_value(json_object_get(ref, "data"));
+	size_t n = 0;
+	const char *got = api_big_string(&bs, json_object_get(j, "data"), &n);
+	CHECK(bs.n == 3, "%zu strings cut", bs.n);
+	CHECK(json_string_length(json_object_get(j, "data")) < 16, "the kept member was copied into the tree");
+	CHECK(n == big && !memcmp(got, want, n), "the kept member's bytes differ");
+	CHECK(json_equal(json_object_get(j, "other"), json_object_get(ref, "other")) &&
+	      json_equal(json_object_get(j, "list"), json_object_get(ref, "list")), "the other big strings are not back");
+	got = api_big_string(&bs, json_object_get(j, "small"), &n);
+	CHECK(n == 3 && !memcmp(got, "abc", 3), "a small kept member reads as itself");
+	json_decref(ref);
+	json_decref(j);
+	api_big_strings_free(&bs);
+	free(d);
 }
