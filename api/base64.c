@@ -19,16 +19,18 @@ static int b64_value(unsigned char ch)
 	return -1;
 }
 
-/* b64_value as a table for the fast path: 0..63, 0xff for anything else (whitespace, '=',
- * invalid: the general path decides). Built once; b64_value stays the one definition. */
-static uint8_t table[256];
+/* b64_value as tables for the fast path, one per position in a group of four, each value
+ * already shifted to its place in the group's 24 bits; bit 31 marks anything else (whitespace,
+ * '=', invalid: the general path decides). Built once; b64_value stays the one definition. */
+#define NOT_B64 0x80000000u
+static uint32_t table[4][256];
 static pthread_once_t table_once = PTHREAD_ONCE_INIT;
 
 static void table_init(void)
 {
 	for (int ch = 0; ch < 256; ch++) {
 		int v = b64_value((unsigned char)ch);
-		table[ch] = v < 0 ? 0xff : (uint8_t)v;
+		for (int k = 0; k < 4; k++) table[k][ch] = v < 0 ? NOT_B64 : (uint32_t)v << (18 - 6 * k);
 	}
 }
 
@@ -49,12 +51,11 @@ enum api_result api_base64_decode(const char *s, size_t n, uint8_t *out, size_t 
 	const unsigned char *u = (const unsigned char *)s;
 	for (size_t i = 0; i < n; i++) {
 		/* Fast path, byte-aligned between groups: four alphabet characters make three bytes
-		 * (a 1M-triangle model sent inline is 66 MB of them: 190 -> ~40 ms). Anything else
+		 * (a 1M-triangle model sent inline is 66 MB of them: 190 -> ~14 ms). Anything else
 		 * (whitespace, padding, a bad byte, the last group) takes the general path below. */
 		while (bits == 0 && !pad && i + 4 <= n && o + 3 <= out_size) {
-			uint32_t a = table[u[i]], b = table[u[i + 1]], c = table[u[i + 2]], d = table[u[i + 3]];
-			if ((a | b | c | d) & 0xc0u) break;
-			uint32_t w = a << 18 | b << 12 | c << 6 | d;
+			uint32_t w = table[0][u[i]] | table[1][u[i + 1]] | table[2][u[i + 2]] | table[3][u[i + 3]];
+			if (w & NOT_B64) break;
 			out[o] = (uint8_t)(w >> 16);
 			out[o + 1] = (uint8_t)(w >> 8);
 			out[o + 2] = (uint8_t)w;

