@@ -1,6 +1,7 @@
 /*
  * api/arena — bump allocator over a list of malloc'd chunks (see arena.h).
  */
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,10 +44,12 @@ void api_arena_destroy(struct api_arena *a)
 	free(a);
 }
 
-static struct chunk *chunk_new(size_t size)
+/* zeroed: calloc, which for a large chunk (fresh pages from the kernel) writes nothing, where
+ * malloc + memset wrote a decoded 50 MB model's pages once more before the decoder did. */
+static struct chunk *chunk_new(size_t size, bool zeroed)
 {
 	if (size > SIZE_MAX - sizeof(struct chunk)) return NULL;
-	struct chunk *c = malloc(sizeof(struct chunk) + size);
+	struct chunk *c = zeroed ? calloc(1, sizeof(struct chunk) + size) : malloc(sizeof(struct chunk) + size);
 	if (!c) return NULL;
 	c->next = NULL;
 	c->size = size;
@@ -62,16 +65,15 @@ void *api_arena_alloc(struct api_arena *a, size_t n)
 	n = (n + ARENA_ALIGN - 1) & ~(size_t)(ARENA_ALIGN - 1);
 	if (n > ARENA_CHUNK / 4) {
 		/* A chunk of its own: the current small chunk keeps its free tail. */
-		struct chunk *c = chunk_new(n);
+		struct chunk *c = chunk_new(n, true);
 		if (!c) return NULL;
 		c->used = n;
 		c->next = a->big;
 		a->big = c;
-		memset(c->data, 0, n);
 		return c->data;
 	}
 	if (!a->head || a->head->size - a->head->used < n) {
-		struct chunk *c = chunk_new(ARENA_CHUNK);
+		struct chunk *c = chunk_new(ARENA_CHUNK, false);
 		if (!c) return NULL;
 		c->next = a->head;
 		a->head = c;
