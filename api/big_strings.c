@@ -11,7 +11,6 @@
 #include <string.h>
 #include "big_strings.h"
 
-#define cut api_big_cut   /* the string's bytes, quotes excluded: doc[start..end) */
 
 /* Whether any byte of the 8 in x is zero (the classic bit trick, exact). */
 static uint64_t zero_byte(uint64_t x)
@@ -60,9 +59,9 @@ static size_t string_end(const char *doc, size_t len, size_t i)
 }
 
 /* The big plain string values of doc, in order; their count, or -1 (out of memory). */
-static long find_cuts(const char *doc, size_t len, struct cut **out)
+static long find_cuts(const char *doc, size_t len, struct api_big_cut **out)
 {
-	struct cut *v = NULL;
+	struct api_big_cut *v = NULL;
 	size_t n = 0, cap = 0;
 	size_t i = 0;
 	while (i < len) {
@@ -76,11 +75,11 @@ static long find_cuts(const char *doc, size_t len, struct cut **out)
 		if (!key && end - start >= API_BIG_STRING && plain(doc + start, end - start)) {
 			if (n == cap) {
 				cap = cap ? 2 * cap : 8;
-				struct cut *nv = realloc(v, cap * sizeof *nv);
+				struct api_big_cut *nv = realloc(v, cap * sizeof *nv);
 				if (!nv) { free(v); return -1; }
 				v = nv;
 			}
-			v[n++] = (struct cut){start, end};
+			v[n++] = (struct api_big_cut){start, end};
 		}
 		i = end + 1;
 	}
@@ -103,8 +102,15 @@ static bool kept(const char *key, const char *const *keep)
 	return false;
 }
 
+/* A cut string as jansson's string value: its bytes need no check (plain() passed them). NULL
+ * on failure, which json_*_set_new() refuses. */
+static json_t *cut_string(const char *doc, const struct api_big_cut *c)
+{
+	return json_stringn_nocheck(doc + c->start, c->end - c->start);
+}
+
 /* Puts the cut strings back in place of their placeholders, except as members named in keep. */
-static int restore(json_t *j, const char *doc, const struct cut *cuts, size_t ncut, const char *const *keep)
+static int restore(json_t *j, const char *doc, const struct api_big_cut *cuts, size_t ncut, const char *const *keep)
 {
 	if (json_is_object(j)) {
 		const char *key;
@@ -114,9 +120,8 @@ static int restore(json_t *j, const char *doc, const struct cut *cuts, size_t nc
 			long k = placeholder(val, ncut);
 			if (k < 0) {
 				if (restore(val, doc, cuts, ncut, keep) < 0) return -1;
-			} else if (!kept(key, keep)) {
-				json_t *s = json_stringn_nocheck(doc + cuts[k].start, cuts[k].end - cuts[k].start);
-				if (!s || json_object_set_new(j, key, s) < 0) return -1;
+			} else if (!kept(key, keep) && json_object_set_new(j, key, cut_string(doc, &cuts[k])) < 0) {
+				return -1;
 			}
 		}
 	} else if (json_is_array(j)) {
@@ -125,9 +130,8 @@ static int restore(json_t *j, const char *doc, const struct cut *cuts, size_t nc
 			long k = placeholder(val, ncut);
 			if (k < 0) {
 				if (restore(val, doc, cuts, ncut, keep) < 0) return -1;
-			} else {
-				json_t *s = json_stringn_nocheck(doc + cuts[k].start, cuts[k].end - cuts[k].start);
-				if (!s || json_array_set_new(j, a, s) < 0) return -1;
+			} else if (json_array_set_new(j, a, cut_string(doc, &cuts[k])) < 0) {
+				return -1;
 			}
 		}
 	}
@@ -155,7 +159,7 @@ json_t *api_json_load(const char *doc, size_t len, size_t flags, json_error_t *e
                       struct api_big_strings *big)
 {
 	memset(big, 0, sizeof *big);
-	struct cut *cuts = NULL;
+	struct api_big_cut *cuts = NULL;
 	long ncut = len >= API_BIG_STRING ? find_cuts(doc, len, &cuts) : 0;
 	/* The placeholders spell \u0000: a document that does cannot be cut (the cut strings
 	 * themselves have no backslash, so only the rest needs looking at). */

@@ -345,13 +345,12 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
 	};
-	VkShaderModule fs_vs = VK_NULL_HANDLE, fs_fs = VK_NULL_HANDLE;
+	VkShaderModule fs_fs = VK_NULL_HANDLE;
 	if (key->atlas_view) {
 		/* Debug view of the depth atlas: a fullscreen triangle. */
-		if ((r = make_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &fs_vs, err)) != RND_OK ||
-		    (r = make_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
+		if ((r = make_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
 			goto out_modules;
-		d.vs = fs_vs;
+		d.vs = p->fullscreen_vs;
 		d.fs = fs_fs;
 		d.spec = NULL;
 		d.no_vertices = true;
@@ -383,7 +382,6 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	r = make_pipeline(ctx, &d, &pipe, err);
 out_modules:
 	if (fs_fs) vkDestroyShaderModule(ctx->device, fs_fs, NULL);
-	if (fs_vs) vkDestroyShaderModule(ctx->device, fs_vs, NULL);
 	if (r != RND_OK) return r;
 	pthread_mutex_lock(&p->mu);
 	/* Another render may have made the same variant meanwhile: keep the first. */

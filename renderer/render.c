@@ -338,8 +338,8 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	bool vis = rnd_visibility_wanted(ctx, sc, rq->sp, rq->draws, sc->object_count);
 	/* Without the pass its bindings still need images (lavapipe reads every descriptor of a
 	 * bound set): whatever the slot has, or 1x1 ones. */
-	r = vis ? rnd_slot_visibility(ctx, s, sc->width, sc->height, rnd_visibility_layers(sc), err)
-	        : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 2, err);
+	r = vis ? rnd_slot_visibility(ctx, s, sc->width, sc->height, sc->light_count, err)
+	        : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
 	if (r != RND_OK) return r;
 	if (vis) rq->tm.visibility_views++;
 	if ((r = rnd_frame_write(ctx, s, sc, &cam, rq->sp, camera->exposure, contact, err)) != RND_OK) return r;

@@ -39,11 +39,6 @@
 /* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
 #define RND_VIS_MAX_BYTES (32ull << 20)
 
-uint32_t rnd_visibility_layers(const struct rnd_scene *sc)
-{
-	return sc->light_count < 2 ? 2 : sc->light_count;
-}
-
 bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
                            const struct draw *draws, uint32_t ndraw)
 {
@@ -54,7 +49,7 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 	if (!shadowed) return false;
 	for (uint32_t i = 0; i < ndraw; i++)
 		if (draws[i].index_count && draws[i].masked) return false;
-	if ((uint64_t)sc->width * sc->height * rnd_visibility_layers(sc) * 2 > RND_VIS_MAX_BYTES) return false;
+	if ((uint64_t)sc->width * sc->height * sc->light_count * 2 > RND_VIS_MAX_BYTES) return false;
 	const char *env = getenv("UMBRA_VISIBILITY");
 	if (env && strcmp(env, "0") == 0) return false;
 	if (env && strcmp(env, "1") == 0) return true;

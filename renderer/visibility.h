@@ -4,7 +4,8 @@
  * filtering the shadow maps itself (see visibility.c for why and when).
  *
  * Usage: render.c asks rnd_visibility_wanted() per view, sizes the slot's images
- * (rnd_slot_visibility) and binds them (rnd_frame_write); submit.c records
+ * (rnd_slot_visibility: a layer per light, umbra_shared.h UMBRA_BINDING_VISIBILITY) and binds
+ * them (rnd_frame_write); submit.c records
  * record_visibility() for each band just before record_main(). No state of its own; the
  * images belong to the slot, the pipelines to the context.
  */
@@ -18,8 +19,6 @@
  * the scene allow it at all. */
 bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
                            const struct draw *draws, uint32_t ndraw);
-/* Layers of the visibility image of sc: one per light (umbra_shared.h UMBRA_BINDING_VISIBILITY). */
-uint32_t rnd_visibility_layers(const struct rnd_scene *sc);
 /* The surfaces and visibility passes over rv's band (record_band_area), leaving both images
  * ready for sampling by the main pass. */
 enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
