@@ -344,49 +344,44 @@ float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint vi
 	if (L.shadow.y == 0u) return 1.0;
 	uint first = L.shadow.x, count = L.shadow.y;
 	uint type = uint(L.color.w);
-	// Folded away when the scene has no point light: lavapipe runs an `if` under a mask even
-	// when no lane takes it, so this branch's whole shadow lookup (filter included) would cost
-	// every pixel of a sun-lit scene a second lookup.
+	// The view (cube face, cascade or clipmap level) is chosen first and sampled once: lavapipe
+	// runs both sides of every branch under a mask, so a lookup written per kind of view cost
+	// every light each kind's lookup and filter (main pass with the visibility pass,
+	// studio-spots 135 -> 110 ms, 16 spot and point lights 189 -> 153 ms).
+	uint c = 0u;
+	float t = 0.0;   // blend into view c + 1 (cascade / clipmap borders)
+	float z = dot(pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
 	if ((SC_LIGHT_TYPES & (1u << UMBRA_LIGHT_POINT)) != 0u && type == UMBRA_LIGHT_POINT) {
 		vec3 d = pos - L.position.xyz;
 		vec3 ad = abs(d);
-		uint face = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u)
-		          : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
-		view_out = face;
-		return sample_view(L, first + face, pos, n, to_light);
-	}
-	float z = dot(pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
-	float max_d = L.params.w, fade_start = L.shadow_params.w;
-	if (max_d > 0.0 && z >= max_d) return 1.0;
-	float vis;
-	if (SC_CASCADES == 0u || type != UMBRA_LIGHT_DIRECTIONAL || count == 1u) {
-		vis = sample_view(L, first, pos, n, to_light);
-	} else if (L.params.z > 0.5) {
-		// Clipmap: the finest level that contains the point; blend into the next level over
-		// the outer `blend` fraction of this one.
-		uint c = 0u;
-		float e = view_extent(first, pos);
-		while (c + 1u < count && e > 0.98) { c++; e = view_extent(first + c, pos); }
-		view_out = c;
-		vis = sample_view(L, first + c, pos, n, to_light);
-		float band = max(L.shadow_params.z, 1e-3);
-		float t = clamp((e - (0.98 - band)) / band, 0.0, 1.0);
-		if (t > 0.0 && c + 1u < count) vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light), t);
-	} else {
-		uint c = 0u;
-		while (c + 1u < count && z > L.splits[c]) c++;
-		view_out = c;
-		vis = sample_view(L, first + c, pos, n, to_light);
-		// Blend band at the far end of each cascade: no visible seam between cascades.
-		float prev = c == 0u ? 0.0 : L.splits[c - 1u];
-		float start = L.splits[c] - L.shadow_params.z * (L.splits[c] - prev);
-		if (c + 1u < count && z > start) {
-			float t = clamp((z - start) / max(L.splits[c] - start, 1e-6), 0.0, 1.0);
-			vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light), t);
+		c = ad.x >= ad.y && ad.x >= ad.z ? (d.x > 0.0 ? 0u : 1u)
+		  : ad.y >= ad.z ? (d.y > 0.0 ? 2u : 3u) : (d.z > 0.0 ? 4u : 5u);
+	} else if (SC_CASCADES != 0u && type == UMBRA_LIGHT_DIRECTIONAL && count > 1u) {
+		if (L.params.z > 0.5) {
+			// Clipmap: the finest level that contains the point; blend into the next level over
+			// the outer `blend` fraction of this one.
+			float e = view_extent(first, pos);
+			while (c + 1u < count && e > 0.98) { c++; e = view_extent(first + c, pos); }
+			float band = max(L.shadow_params.z, 1e-3);
+			t = clamp((e - (0.98 - band)) / band, 0.0, 1.0);
+		} else {
+			while (c + 1u < count && z > L.splits[c]) c++;
+			// Blend band at the far end of each cascade: no visible seam between cascades.
+			float prev = c == 0u ? 0.0 : L.splits[c - 1u];
+			float start = L.splits[c] - L.shadow_params.z * (L.splits[c] - prev);
+			t = z > start ? clamp((z - start) / max(L.splits[c] - start, 1e-6), 0.0, 1.0) : 0.0;
 		}
+		if (c + 1u >= count) t = 0.0;
 	}
-	// Distance fade to unshadowed before max distance, so the end of the shadows has no edge.
-	if (max_d > 0.0 && z > fade_start) vis = mix(vis, 1.0, smoothstep(fade_start, max_d, z));
+	view_out = c;
+	float vis = sample_view(L, first + c, pos, n, to_light);
+	if (SC_CASCADES != 0u && t > 0.0) vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light), t);
+	// Distance fade to unshadowed before max distance, so the end of the shadows has no edge
+	// (point lights have none).
+	float max_d = L.params.w, fade_start = L.shadow_params.w;
+	bool fades = type != UMBRA_LIGHT_POINT && max_d > 0.0;
+	if (fades && z >= max_d) return 1.0;
+	if (fades && z > fade_start) vis = mix(vis, 1.0, smoothstep(fade_start, max_d, z));
 	return vis;
 }
 
