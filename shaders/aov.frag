@@ -14,7 +14,7 @@ layout(location = 1) out vec4 o_aov1;
 layout(location = 2) out vec4 o_aov2;
 layout(location = 3) out vec4 o_aov3;
 
-float visibility(uint i, vec3 n_geo, bool receive)
+float visibility(uint i, vec3 n_shadow, bool receive)
 {
 	if (i >= frame.mode.w || !receive || SC_FILTERS == 0u) return 1.0;
 	umbra_light L = lights[i];
@@ -22,18 +22,19 @@ float visibility(uint i, vec3 n_geo, bool receive)
 	float atten;
 	vec3 l = light_dir(L, v_pos, atten);
 	uint view;
-	return shadow_visibility(L, v_pos, n_geo, l, view);
+	return shadow_visibility(L, v_pos, n_shadow, l, view);
 }
 
 void main()
 {
 	material_derivatives(v_uv);
 	umbra_material m = materials[pc.info.x];
-	vec4 bc = base_color(m);
 	vec3 n_geo = normalize(v_nrm);
 	if (!gl_FrontFacing) n_geo = -n_geo;
+	vec3 n_shadow = facet_normal(v_pos, n_geo);   // before base_color's discard
+	vec4 bc = base_color(m);
 	// N.X/Y/Z: the normal the beauty pass shades with (normal map included); shadows keep
-	// testing with the geometric one, as the beauty pass does.
+	// testing with the triangle's plane, as the beauty pass does.
 	vec3 N = material_normal(m, n_geo, has_tex(m, UMBRA_TEX_NORMAL));
 	bool receive = (pc.info.y & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	uint first = pc.info.z;
@@ -43,7 +44,7 @@ void main()
 	float vis[UMBRA_AOV_PASS_LIGHTS];
 	uint count = first == 0u ? UMBRA_AOV_FIRST_PASS_LIGHTS : UMBRA_AOV_PASS_LIGHTS;
 	[[dont_unroll]] for (uint k = 0u; k < UMBRA_AOV_PASS_LIGHTS; k++)
-		vis[k] = k < count ? visibility(first + k, n_geo, receive) : 1.0;
+		vis[k] = k < count ? visibility(first + k, n_shadow, receive) : 1.0;
 	if (first == 0u) {
 		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
 		o_aov0 = vec4(z, N);

@@ -75,6 +75,8 @@ layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_color;
 layout(location = 4) in vec4 v_tangent;
 vec2 frag_xy() { return gl_FragCoord.xy; }
+
+#include "facet.glsl"
 #endif
 #include "material.glsl"
 
@@ -520,8 +522,9 @@ vec4 base_color(umbra_material m)
 }
 
 // Direct light from every light: with and without shadows (the shadow catcher needs both),
-// and the visibility of the debug light.
-void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bool receive,
+// and the visibility of the debug light. N: the shading normal; n_geo: the interpolated one;
+// n_shadow: the plane of the triangle (facet.glsl), for the shadow lookups.
+void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 V, vec3 c_diff, vec3 f0, float rough, bool receive,
                out vec3 lit, out vec3 unshadowed, out float debug_vis, out uint debug_view)
 {
 	float a2 = rough * rough * rough * rough;
@@ -565,7 +568,7 @@ void light_all(vec3 N, vec3 n_geo, vec3 V, vec3 c_diff, vec3 f0, float rough, bo
 #if defined(UMBRA_VIS_READ)
 		if (SC_FILTERS != 0u && receive && L.shadow.y != 0u) vis = vis_fetch(vis_px, i);
 #elif !defined(UMBRA_VIS_PASS)
-		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, v_pos, n_geo, l, view);
+		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, v_pos, n_shadow, l, view);
 #endif
 		if (i == frame.mode.z) { debug_vis = vis; debug_view = view; }
 		if (ndl <= 0.0 || atten <= 0.0) continue;

@@ -4,11 +4,12 @@
 // UMBRA_VIS_READ compiles either half.
 
 #ifdef UMBRA_VIS_PASS
-// vis.frag: every shadowed light's visibility at v_pos (geometric normal n_geo) into layer i
-// of vis_out: the filters' value where the light reaches (range, cone) and 1 elsewhere, so
-// that the main pass finds a value for every light it shades here, at this pixel or a
-// neighbour (vis_pixel). The same block-wide walk as light_all.
-void store_visibility(ivec2 px, vec3 n_geo)
+// vis.frag: every shadowed light's visibility at v_pos (n_shadow: the plane of its triangle, as
+// the main pass hands the filters, facet.glsl) into layer i of vis_out: the filters' value
+// where the light reaches (range, cone) and 1 elsewhere, so that the main pass finds a value
+// for every light it shades here, at this pixel or a neighbour (vis_pixel). The same
+// block-wide walk as light_all.
+void store_visibility(ivec2 px, vec3 n_shadow)
 {
 	uvec2 reach = uvec2(0u);
 	for (uint i = 0u; i < frame.mode.w; i++) {
@@ -27,7 +28,7 @@ void store_visibility(ivec2 px, vec3 n_geo)
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
 		uint view;
-		imageStore(vis_out, ivec3(px, int(i)), vec4(shadow_visibility(L, v_pos, n_geo, l, view)));
+		imageStore(vis_out, ivec3(px, int(i)), vec4(shadow_visibility(L, v_pos, n_shadow, l, view)));
 	}
 }
 #endif
@@ -36,7 +37,10 @@ void store_visibility(ivec2 px, vec3 n_geo)
 // centre shows another surface (at a silhouette, where MSAA shades a surface at pixels its
 // samples only partly cover), then the 4-neighbour nearest this fragment's plane with a
 // normal like its own. A surface thinner than a pixel that no pixel centre shows takes its
-// neighbour's values: it covers part of one pixel.
+// neighbour's values: it covers part of one pixel. n_geo: the interpolated normal, which
+// varies smoothly across the triangles of one surface (the stored normals are the triangles'
+// planes; matched with the fragment's plane, a silhouette of a tessellated cylinder took a
+// neighbour on another facet and came out 8 steps darker than the filters there).
 void vis_candidate(ivec2 q, vec3 n_geo, inout ivec2 best, inout float best_d)
 {
 	q = clamp(q, ivec2(0), ivec2(frame.target.xy) - 1);
