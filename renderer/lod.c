@@ -168,19 +168,34 @@ static void as_asked(const struct rnd_scene *sc, uint32_t *segments)
 
 /* Scene bounds as render.c will find them, from the shapes (tessellated vertices lie on them);
  * obj: without planes and shadow catchers (what `fit: objects` frames). */
-static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, struct rnd_aabb *obj)
+/* World bounds of object i before tessellation (empty for an empty mesh). */
+static void object_bounds(const struct rnd_scene *sc, uint32_t i, struct rnd_aabb *wb)
 {
-	struct rnd_aabb lb, wb;
+	struct rnd_aabb lb;
+	rnd_mesh_local_bounds(&sc->objects[i], &lb);
+	if (rnd_aabb_is_empty(&lb)) *wb = lb;
+	else rnd_aabb_transform(wb, &lb, sc->objects[i].model);
+}
+
+/* The bounds render.c will plan with, estimated from the objects before tessellation: all,
+ * what `fit: objects` frames, and what casts shadows (render.c plane_casters: a plane only
+ * where it may shadow another object). */
+static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, struct rnd_aabb *obj,
+                            struct rnd_aabb *casters)
+{
+	struct rnd_aabb wb;
 	rnd_aabb_empty(all);
 	rnd_aabb_empty(obj);
+	rnd_aabb_empty(casters);
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		const struct rnd_object *o = &sc->objects[i];
-		rnd_mesh_local_bounds(o, &lb);
-		if (rnd_aabb_is_empty(&lb)) continue;
-		rnd_aabb_transform(&wb, &lb, o->model);
+		object_bounds(sc, i, &wb);
+		if (rnd_aabb_is_empty(&wb)) continue;
 		rnd_aabb_union(all, &wb);
 		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
 		if (o->shape != RND_SHAPE_PLANE && !catcher) rnd_aabb_union(obj, &wb);
+		if (o->cast_shadows && !catcher && (o->shape != RND_SHAPE_PLANE || rnd_plane_casts(sc, i)))
+			rnd_aabb_union(casters, &wb);
 	}
 	if (rnd_aabb_is_empty(obj)) *obj = *all;
 }
@@ -198,15 +213,15 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 		as_asked(sc, segments);
 		return;
 	}
-	struct rnd_aabb bounds, obj_bounds;
-	estimate_bounds(sc, &bounds, &obj_bounds);
+	struct rnd_aabb bounds, obj_bounds, casters;
+	estimate_bounds(sc, &bounds, &obj_bounds, &casters);
 	struct rnd_error err;
 	for (uint32_t v = 0; v < nviews; v++) {
 		const struct rnd_camera *camera = sc->view_count ? &sc->views[v] : &sc->camera;
 		struct rnd_camera_plan cam;
 		if (rnd_camera_plan(camera, sc->width, sc->height, camera->fit == RND_FIT_OBJECTS ? &obj_bounds : &bounds, &cam,
 		                    &err) != RND_OK ||
-		    rnd_shadow_plan(sc, &bounds, &cam, scratch, &err) != RND_OK) {
+		    rnd_shadow_plan_with(sc, &bounds, &casters, &cam, NULL, scratch, &err) != RND_OK) {
 			as_asked(sc, segments);
 			return;
 		}
@@ -250,6 +265,22 @@ bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *p
 		}
 		if (fabsf(side) <= eps) return true;        /* grazing: keep it simple, it casts */
 		if (side > 0.0f ? lo < -eps : hi > eps) return true; /* part of the box behind it */
+	}
+	return false;
+}
+
+bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i)
+{
+	if (sc->object_count > 256) return true;
+	for (uint32_t k = 0; k < sc->light_count; k++)
+		if (sc->lights[k].shadow.enabled &&
+		    (sc->lights[k].shadow.filter == RND_FILTER_VSM || sc->lights[k].shadow.filter == RND_FILTER_EVSM))
+			return true;
+	struct rnd_aabb b;
+	for (uint32_t j = 0; j < sc->object_count; j++) {
+		if (j == i) continue;
+		object_bounds(sc, j, &b);
+		if (!rnd_aabb_is_empty(&b) && rnd_plane_may_shadow(sc, &sc->objects[i], &b)) return true;
 	}
 	return false;
 }

@@ -1,7 +1,8 @@
 /*
  * renderer/plan.c — camera and shadow-view planning (see plan.h). Pure math.
  *
- * Directional lights: `fit` is one orthographic map around the whole scene; `cascades` are
+ * Directional lights: `fit` is one orthographic map around what casts shadows, as deep as the
+ * whole scene, with the texels a map of the default size around the whole scene has; `cascades` are
  * camera-centred bounding spheres of the practical split scheme's slices (a sphere around the
  * eye is invariant under camera rotation, so rotating in place moves no cascade), snapped to
  * whole texels in a light basis that does not depend on the camera (translating the camera
@@ -309,7 +310,7 @@ static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, c
 enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                 const struct rnd_camera_plan *cam, struct rnd_shadow_plan *out, struct rnd_error *err)
 {
-	return rnd_shadow_plan_with(scene, bounds, cam, NULL, out, err);
+	return rnd_shadow_plan_with(scene, bounds, NULL, cam, NULL, out, err);
 }
 
 /* The next shadow view, of light i (ortho: depth clamp instead of near-plane culling). */
@@ -417,9 +418,31 @@ static void plan_cascades(const struct rnd_shadow *s, uint32_t i, const float vi
 	}
 }
 
+/* The `fit` map's light-space box around box b (centre cx, cy; half sizes hx, hy). Under a
+ * low sun the ground's extent across the light's up axis is sin(elevation) of its length, and
+ * a square map wastes all but that share of its rows (7 degrees: texels 8x longer on the
+ * ground than across, a PCF ramp of several pixels along every long shadow). So where a
+ * square map would leave more than half its rows or columns empty, the map is the box itself
+ * (texels at most 32:1 for a flat scene under a horizon sun). Not below that: finer texels
+ * make round shapes finer in the map (lod.c: 1/8 texel), which cost thumb-512 (sun 60 degrees
+ * up, box 1.3:1) ~15 % CPU for no visible change. PCSS sizes its disk from one texel size and
+ * keeps square texels. */
+static void fit_box(const float view[16], const struct rnd_aabb *b, uint32_t filter, float *cx, float *cy, float *hx,
+                    float *hy)
+{
+	struct rnd_aabb lb;
+	rnd_aabb_transform(&lb, b, view);
+	*cx = 0.5f * (lb.min[0] + lb.max[0]); *cy = 0.5f * (lb.min[1] + lb.max[1]);
+	*hx = 0.5f * (lb.max[0] - lb.min[0]); *hy = 0.5f * (lb.max[1] - lb.min[1]);
+	float hmax = fmaxf(*hx, *hy);
+	if (filter == UMBRA_FILTER_PCSS || fminf(*hx, *hy) > 0.5f * hmax) *hx = *hy = hmax;
+	*hx = fmaxf(*hx, hmax / 32.0f); *hy = fmaxf(*hy, hmax / 32.0f);
+}
+
 /* A directional light's views: clipmap levels, one fitted map, or cascades. */
 static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, const struct rnd_aabb *bounds,
-                                        const struct rnd_camera_plan *cam, bool clipmap, bool cascades,
+                                        const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
+                                        bool clipmap, bool cascades,
                                         uint32_t ncasc, struct rnd_light_plan *lp, struct rnd_shadow_plan *out,
                                         struct rnd_error *err)
 {
@@ -434,23 +457,46 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 	if (clipmap) {
 		plan_clipmap(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
 	} else if (!cascades) {
-		/* fit: the light-space box around the scene bounds. Under a low sun the ground's
-		 * extent across the light's up axis is sin(elevation) of its length, and a square map
-		 * wastes all but that share of its rows (7 degrees: texels 8x longer on the ground
-		 * than across, a PCF ramp of several pixels along every long shadow). So where a
-		 * square map would leave more than half its rows or columns empty, the map is the
-		 * box itself (texels at most 32:1 for a flat scene under a horizon sun). Not below
-		 * that: finer texels make round shapes finer in the map (lod.c: 1/8 texel), which cost
-		 * thumb-512 (sun 60 degrees up, box 1.3:1) ~15 % CPU for no visible change. PCSS sizes
-		 * its disk from one texel size and keeps square texels. */
-		struct rnd_aabb lb;
-		rnd_aabb_transform(&lb, bounds, view);
-		float cx = 0.5f * (lb.min[0] + lb.max[0]), cy = 0.5f * (lb.min[1] + lb.max[1]);
-		float hx = 0.5f * (lb.max[0] - lb.min[0]), hy = 0.5f * (lb.max[1] - lb.min[1]);
-		float hmax = fmaxf(hx, hy);
-		if (lp->filter == UMBRA_FILTER_PCSS || fminf(hx, hy) > 0.5f * hmax) hx = hy = hmax;
-		hx = fmaxf(hx, hmax / 32.0f); hy = fmaxf(hy, hmax / 32.0f);
+		/* fit: the box (fit_box) of the scene's light-space bounds, the texels it has at
+		 * the light's resolution. */
+		float cx, cy, hx, hy;
+		fit_box(view, bounds, lp->filter, &cx, &cy, &hx, &hy);
+		/* Only the casters' box, deep enough for every receiver (zmin, zmax): a receiver
+		 * outside it has nothing between it and the sun (sample_view: lit outside the view),
+		 * and a thumbnail's sphere over a 10 m floor cleared and rasterised a 2048^2 map of
+		 * which it used a 400^2 corner (thumb-256: the shadow stage 5.4 of 13 ms). The texels
+		 * stay those of the default map around the whole scene, in the smallest tile that holds
+		 * the box and a margin of the filter's reach (PCSS: its search cap) past the casters'
+		 * edge, where their penumbrae fall. No caster: the smallest tile, empty. A light that
+		 * asks for a resolution gets that many texels across the whole scene, as before. */
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
+		if (casters && s->resolution == 0) {
+			float reach = (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : (float)lp->pcf_radius) + 2.0f;
+			/* the whole scene's map: its texels and its texel grid's origin */
+			float tx = 2.0f * hx * grow / fres, ty = 2.0f * hy * grow / fres;
+			float ox = cx - hx * grow, oy = cy - hy * grow;
+			uint32_t res = 64;
+			if (!rnd_aabb_is_empty(casters)) {
+				/* the casters' box and margin in whole texels of that grid, so that every texel
+				 * the smaller map holds is one the whole scene's map held: the same shadows,
+				 * not a grid shifted by a fraction of a texel */
+				struct rnd_aabb lc;
+				rnd_aabb_transform(&lc, casters, view);
+				float x0 = floorf((lc.min[0] - ox) / tx - reach), x1 = ceilf((lc.max[0] - ox) / tx + reach);
+				float y0 = floorf((lc.min[1] - oy) / ty - reach), y1 = ceilf((lc.max[1] - oy) / ty + reach);
+				float need = fmaxf(x1 - x0, y1 - y0);
+				while ((float)res < need && (float)res < fres) res *= 2;
+				if ((float)res < fres) {
+					/* centred on the casters, whole texels from the grid's origin */
+					float sx = floorf(0.5f * (x0 + x1 - (float)res)), sy = floorf(0.5f * (y0 + y1 - (float)res));
+					hx = 0.5f * (float)res * tx; hy = 0.5f * (float)res * ty;
+					cx = ox + sx * tx + hx; cy = oy + sy * ty + hy;
+					grow = 1.0f;
+				}
+			}
+			lp->resolution = res < (uint32_t)fres ? res : (uint32_t)fres;
+			fres = (float)lp->resolution;
+		}
 		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
 		lp->max_distance = s->max_distance;
 	} else {
@@ -492,7 +538,8 @@ static enum rnd_result plan_local(const struct rnd_light *L, uint32_t i, const s
 }
 
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
-                                     const struct rnd_camera_plan *cam, const uint8_t *forced,
+                                     const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
+                                     const uint8_t *forced,
                                      struct rnd_shadow_plan *out, struct rnd_error *err)
 {
 	memset(out, 0, sizeof *out);
@@ -522,7 +569,6 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		uint32_t res = 64;
 		while (res < want && res < 8192) res *= 2;
 		lp->resolution = res;
-		if (res > out->resolution) out->resolution = res;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false, clipmap = false;
 		uint32_t ncasc = 1;
@@ -542,9 +588,11 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 			                   UMBRA_MAX_SHADOW_VIEWS);
 		lp->first_view = out->view_count;
 		lp->view_count = need;
-		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, cam, clipmap, cascades, ncasc, lp, out, err)
-		                                     : plan_local(L, i, bounds, lp, out, err);
+		r = L->type == RND_LIGHT_DIRECTIONAL
+		        ? plan_directional(L, i, bounds, casters, cam, clipmap, cascades, ncasc, lp, out, err)
+		        : plan_local(L, i, bounds, lp, out, err);
 		if (r != RND_OK) return r;
+		if (lp->resolution > out->resolution) out->resolution = lp->resolution;
 	}
 	return RND_OK;
 }

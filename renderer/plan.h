@@ -57,9 +57,13 @@ struct rnd_shadow_plan {
 enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                 const struct rnd_camera_plan *cam, struct rnd_shadow_plan *out, struct rnd_error *err);
 /* The same, with the `auto` directional choice made by the caller: cascades[i] 1 = cascades,
- * 0 = fit (later views of a request keep view 0's choice, so they need the same tiles). */
+ * 0 = fit (later views of a request keep view 0's choice, so they need the same tiles); and
+ * with the bounds of what casts shadows (casters, within bounds; empty: nothing casts), which
+ * a `fit` sun map covers instead of the whole scene, at the same texel size, in a smaller
+ * tile (NULL: the whole scene, as rnd_shadow_plan). */
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
-                                     const struct rnd_camera_plan *cam, const uint8_t *cascades,
+                                     const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
+                                     const uint8_t *cascades,
                                      struct rnd_shadow_plan *out, struct rnd_error *err);
 
 /* Practical split scheme: far distance of each of n cascades between znear and zfar,

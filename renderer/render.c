@@ -82,6 +82,7 @@ struct render {
 	struct rnd_timings tm;
 	struct rnd_aabb bounds;       /* every object: near/far planes, shadow fits */
 	struct rnd_aabb obj_bounds;   /* what `fit: objects` frames */
+	struct rnd_aabb casters;      /* what the shadow pass draws: a `fit` sun map's box */
 	uint64_t geo;                 /* the casters' key: spot/point shadow-cache keys start from it */
 	struct rnd_cache_grant grants[UMBRA_MAX_LIGHTS];
 	uint32_t grant_light[UMBRA_MAX_LIGHTS], req_tiles[UMBRA_MAX_LIGHTS];
@@ -130,18 +131,17 @@ static void frame_bounds(struct render *rq)
 	if (rnd_aabb_is_empty(&rq->obj_bounds)) rq->obj_bounds = rq->bounds;
 }
 
-/* A plane with every other object on its lit side shadows nothing: out of the shadow pass. */
+/* A plane with every other object on its lit side shadows nothing: out of the shadow pass.
+ * Then the bounds of what the pass draws. */
 static void plane_casters(struct render *rq)
 {
 	const struct rnd_scene *sc = rq->sc;
 	struct draw *draws = rq->draws;
-	for (uint32_t i = 0; i < sc->object_count && sc->object_count <= 256; i++) {
-		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
-		bool casts = false;
-		for (uint32_t j = 0; j < sc->object_count && !casts; j++)
-			casts = j != i && rnd_plane_may_shadow(sc, &sc->objects[i], &draws[j].bounds);
-		draws[i].cast = casts;
-	}
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		if (draws[i].cast && sc->objects[i].shape == RND_SHAPE_PLANE) draws[i].cast = rnd_plane_casts(sc, i);
+	rnd_aabb_empty(&rq->casters);
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		if (draws[i].cast) rnd_aabb_union(&rq->casters, &draws[i].bounds);
 }
 
 /* What every spot/point key starts from: the casters' world-space geometry, their
@@ -226,7 +226,8 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		draws[i].cull_back = draws[i].single_sided ||
 		                     (draws[i].closed && record_camera_outside(cam, &draws[i].bounds));
-	if ((r = rnd_shadow_plan_with(sc, &rq->bounds, cam, v ? rq->cascades : NULL, sp, err)) != RND_OK) return r;
+	if ((r = rnd_shadow_plan_with(sc, &rq->bounds, &rq->casters, cam, v ? rq->cascades : NULL, sp, err)) != RND_OK)
+		return r;
 	if (v == 0)
 		for (uint32_t i = 0; i < sc->light_count && i < UMBRA_MAX_LIGHTS; i++)
 			rq->cascades[i] = sc->lights[i].type == RND_LIGHT_DIRECTIONAL && sp->lights[i].view_count > 1 &&

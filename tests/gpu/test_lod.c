@@ -219,3 +219,46 @@ TEST(lod_sphere_facets_cast_no_specks_on_themselves)
 			rnd_image_release(&img);
 		}
 }
+
+/* A sun map fitted to what casts (renderer/plan.c): a sphere on a 40 m ground that casts
+ * nothing gets a small tile on the whole scene's texel grid, so its shadows are those of the
+ * map around the whole scene. The same scene with a small box far out of view at the ground's
+ * corner (the casters' box is then the whole scene, and the tile the default 2048) must give
+ * the same image, for PCF and PCSS. */
+TEST(sun_map_fitted_to_the_casters_changes_no_pixel)
+{
+	static const char *doc =
+		"{\"width\": 256, \"height\": 256, \"camera\": {\"type\": \"perspective\", \"position\": [4, 3, 4],"
+		" \"target\": [0, 0.8, 0], \"up\": [0, 1, 0], \"fov_y\": 40},"
+		" \"objects\": [{\"shape\": \"plane\", \"size\": [40, 40]},"
+		" {\"shape\": \"sphere\", \"radius\": 1, \"segments\": 64, \"transform\": {\"translation\": [0, 1, 0]}},"
+		" {\"shape\": \"box\", \"size\": [1, 2, 0.5], \"transform\": {\"translation\": [1.8, 1, -1.2]}}%s],"
+		" \"lights\": [{\"type\": \"directional\", \"direction\": [-0.5, -1, -0.3], \"angular_diameter\": %s}],"
+		" \"shadows\": {\"filter\": \"%s\"}}";
+	static const char *far_box =
+		", {\"shape\": \"box\", \"size\": [0.2, 0.2, 0.2], \"transform\": {\"translation\": [-19.8, 0.1, 19.8]}}";
+	static const char *filters[][2] = {{"pcf", "0"}, {"pcss", "2"}};
+	for (int f = 0; f < 2; f++) {
+		struct rnd_image small, whole;
+		if (!gpu_render(&small, doc, "", filters[f][1], filters[f][0])) continue;
+		double small_ms = gpu_last_timings.shadow_ms;
+		if (gpu_render(&whole, doc, far_box, filters[f][1], filters[f][0])) {
+			int worst = 0;
+			long differ = 0;
+			for (uint32_t j = 0; j < small.height; j++)
+				for (uint32_t i = 0; i < small.width; i++)
+					for (int c = 0; c < 3; c++) {
+						int d = abs((int)gpu_px8(&small, (int)i, (int)j)[c] - (int)gpu_px8(&whole, (int)i, (int)j)[c]);
+						if (d > worst) worst = d;
+						if (d > 1) differ++;
+					}
+			printf("  %s: %ld channel values differ by more than 1 step (largest %d); shadow stage %.2f ms (casters' "
+			       "tile) vs %.2f ms (whole scene)\n", filters[f][0], differ, worst, small_ms,
+			       gpu_last_timings.shadow_ms);
+			CHECK(worst <= 1, "%s: the casters' map changed %ld channel values by up to %d steps", filters[f][0], differ,
+			      worst);
+			rnd_image_release(&whole);
+		}
+		rnd_image_release(&small);
+	}
+}

@@ -159,3 +159,24 @@ TEST(lod_plane_under_objects_shadows_nothing)
 	sc.lights = &spot;
 	CHECK(rnd_plane_may_shadow(&sc, &obj[0], &above), "point light below the plane");
 }
+
+/* The ground under a thumbnail's sphere casts nothing, judged on the sphere as asked: drawn
+ * with fewer segments, its radius is raised and it dips below the ground, which made the
+ * ground a caster of a 2048^2 map (thumb-256: the shadow stage 5.4 of 13 ms). It does cast
+ * under a sphere that reaches below it, and wherever a light filters with moments (VSM needs
+ * the ground in the map behind the casters' edges). */
+TEST(lod_plane_casts_judged_on_objects_as_asked)
+{
+	struct rnd_scene sc;
+	struct rnd_object obj[2];
+	struct rnd_light sun;
+	thumb(&sc, obj, &sun, 256);
+	CHECK(!rnd_plane_casts(&sc, 0), "a sphere resting on the ground made the ground a caster");
+	obj[1].model[13] = 0.9f;
+	CHECK(rnd_plane_casts(&sc, 0), "a sphere reaching 0.1 below the ground: the ground must cast");
+	obj[1].model[13] = 1.0f;
+	sun.shadow.filter = RND_FILTER_VSM;
+	CHECK(rnd_plane_casts(&sc, 0), "vsm: the ground must be in the map");
+	sun.shadow.filter = RND_FILTER_EVSM;
+	CHECK(rnd_plane_casts(&sc, 0), "evsm: the ground must be in the map");
+}

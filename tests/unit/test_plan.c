@@ -299,6 +299,80 @@ TEST(plan_fit_covers_scene_bounds)
 		}
 }
 
+/* A sun over a 2 m object on a 40 m ground that casts nothing (rnd_shadow_plan_with's
+ * casters): the fitted map is a smaller tile around the casters (a quarter the side, half under
+ * a sun 8 degrees up, whose map is a long box) with the texels of the default
+ * map around the whole scene, on that map's very texel grid (an integer number of its texels
+ * from its origin), with the filter's reach as margin; a light that asks for a resolution keeps
+ * the whole scene; no caster at all gives the smallest tile. */
+TEST(plan_fit_covers_the_casters_on_the_whole_scenes_grid)
+{
+	static const float dirs[][3] = {{-0.5f, -1, -0.3f}, {0.2f, -1, 0.1f}, {1, -0.15f, 0.3f}};
+	static const enum rnd_filter filters[] = {RND_FILTER_PCF, RND_FILTER_PCSS};
+	struct rnd_aabb scene, casters, empty;
+	set_box(&scene, -20, 0, -20, 20, 2, 20);
+	set_box(&casters, 3, 0, -1, 5, 2, 1);
+	rnd_aabb_empty(&empty);
+	for (int di = 0; di < 3; di++)
+		for (int fi = 0; fi < 2; fi++) {
+			struct fixture f;
+			fixture_init(&f, 40.0f, RND_LIGHT_DIRECTIONAL);
+			memcpy(f.light.direction, dirs[di], sizeof f.light.direction);
+			f.light.shadow.dir_mode = RND_DIR_FIT;
+			f.light.shadow.filter = filters[fi];
+			struct rnd_camera_plan cp;
+			static struct rnd_shadow_plan whole, part, asked, none;
+			struct rnd_error err = {0};
+			REQUIRE(rnd_camera_plan(&f.scene.camera, 512, 512, &scene, &cp, &err) == RND_OK, "camera: %s", err.msg);
+			REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &part, &err) == RND_OK, "casters: %s",
+			        err.msg);
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &empty, &cp, NULL, &none, &err) == RND_OK, "none: %s",
+			        err.msg);
+			const struct umbra_shadow_view *w = &whole.views[0], *v = &part.views[0];
+			CHECK(w->rect[2] == 2048.0f && v->rect[2] <= (di == 2 ? 1024.0f : 512.0f) && part.lights[0].resolution == (uint32_t)v->rect[2],
+			      "dir %d filter %d: tiles %g (whole scene) and %g (casters)", di, fi, w->rect[2], v->rect[2]);
+			CHECK(none.views[0].rect[2] == 64.0f, "no caster: tile %g", none.views[0].rect[2]);
+			/* texel size and grid: light-space x, y of a world point in texels of each map */
+			double reach = (filters[fi] == RND_FILTER_PCSS ? 24.0 : (double)part.lights[0].pcf_radius) + 2.0;
+			for (int i = 0; i < 9; i++) {
+				double p[3], nw[3], nv[3];
+				if (i < 8) corner(&casters, i, p);
+				else { p[0] = 4; p[1] = 1; p[2] = 0; }
+				ndc3(w->view_proj, p, nw);
+				ndc3(v->view_proj, p, nv);
+				for (int a = 0; a < 2; a++) {
+					double tw = (nw[a] * 0.5 + 0.5) * w->rect[2], tv = (nv[a] * 0.5 + 0.5) * v->rect[2];
+					CHECK(frac_dist(tw, tv) < 1e-3, "dir %d filter %d point %d axis %d: texel %.4f in the whole map, %.4f "
+					      "in the casters' one: not the same grid", di, fi, i, a, tw, tv);
+					if (i == 8) {
+						/* one texel further along this axis moves one texel in both maps */
+						double q[3] = {p[0], p[1], p[2]}, mw[3], mv[3];
+						double step = 1e-3;
+						q[0] += step;
+						ndc3(w->view_proj, q, mw);
+						ndc3(v->view_proj, q, mv);
+						double dw = (mw[a] - nw[a]) * w->rect[2], dv = (mv[a] - nv[a]) * v->rect[2];
+						CHECK(fabs(dw - dv) <= 1e-3 * fabs(dw) + 1e-9, "dir %d axis %d: texel sizes differ (%g vs %g)", di,
+						      a, dw, dv);
+					}
+					if (i < 8)
+						CHECK(tv >= reach - 1e-3 && tv <= v->rect[2] - reach + 1e-3,
+						      "dir %d filter %d corner %d axis %d at texel %.2f of %g: less than %g texels of margin", di,
+						      fi, i, a, tv, v->rect[2], reach);
+				}
+			}
+			CHECK(fabs(v->params[0] - w->params[0]) <= 1e-5f * w->params[0], "texel world size %g vs %g", v->params[0],
+			      w->params[0]);
+			f.light.shadow.resolution = 1024;
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &asked, &err) == RND_OK, "asked: %s",
+			        err.msg);
+			REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
+			CHECK(!memcmp(&asked.views[0], &whole.views[0], sizeof asked.views[0]),
+			      "dir %d: an asked-for resolution must keep the whole scene's map", di);
+		}
+}
+
 /* A sun 7 degrees above a 30 m plane: the bounds' light-space box is ~8:1, and the fitted map
  * is that box (both axes span the map), not the square around it that left 7/8 of its rows
  * empty; a sun 60 degrees up (box under 2:1) and PCSS keep square texels. */
