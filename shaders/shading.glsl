@@ -315,7 +315,7 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 	float texel = v.params.x * dist;
 	float ndl = clamp(dot(n, to_light), 0.0, 1.0);
 	vec4 lc = lc0 + (v.view_proj * vec4(n, 0.0)) * (L.shadow_params.x * texel * (1.0 - 0.5 * ndl));
-	vec3 sc = lc.xyz / lc.w;
+	vec3 sc = is_persp(v) ? lc.xyz / lc.w : lc.xyz;   // orthographic: w is exactly 1 (three divisions a lookup)
 	if (sc.z > 1.0) return 1.0;            // beyond the light's far plane: nothing recorded there
 	if (any(greaterThan(abs(sc.xy), vec2(1.0)))) return 1.0;   // outside this view: nothing casts
 	vec2 uv = sc.xy * 0.5 + 0.5;
