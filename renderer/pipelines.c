@@ -332,10 +332,14 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	bool full = p->variant_count == RND_MAX_VARIANTS;
 	pthread_mutex_unlock(&p->mu);
 	if (full) return rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
-	VkSpecializationMapEntry entries[UMBRA_SC_COUNT];
-	for (uint32_t i = 0; i < UMBRA_SC_COUNT; i++)
+	/* the key's constants, then UMBRA_SC_SAMPLES: the samples this pipeline rasterises */
+	uint32_t values[UMBRA_SC_COUNT + 1];
+	memcpy(values, key->sc, sizeof key->sc);
+	values[UMBRA_SC_SAMPLES] = key->aov || key->vis_pass ? 1 : key->samples;
+	VkSpecializationMapEntry entries[UMBRA_SC_COUNT + 1];
+	for (uint32_t i = 0; i <= UMBRA_SC_COUNT; i++)
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
-	VkSpecializationInfo spec = {UMBRA_SC_COUNT, entries, sizeof key->sc, key->sc};
+	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
 	char name[112];
 	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
 	         key->aov ? "aov" : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",

@@ -21,3 +21,27 @@ vec3 facet_normal(vec3 pos, vec3 n_geo)
 	if (dot(c, n_geo) < 0.0) c = -c;
 	return dot(c, n_geo) > FACET_SAME ? n_geo : c;
 }
+
+// Where the shadow lookups of a fragment look: pos, or with 4 samples where the fragment
+// covers only some of them, the mean of the covered samples' positions (Vulkan's standard
+// locations), stepped along the triangle's plane by the screen derivatives. MSAA shades a
+// fragment at the pixel centre even where its triangle covers only a corner sample; there pos
+// is the triangle's plane extended beyond its edges, which on a dense or concave mesh lies
+// under the neighbouring triangles and read as shadowed: lines of dark specks along a 124k-
+// triangle OBJ's cheek under a low sun, none at MSAA 1 or in the visibility pass, whose
+// surfaces are drawn with one sample. (lavapipe's centroid interpolation and
+// interpolateAtSample misplace the position and made it worse.) Derivatives: call in uniform
+// control flow, before any discard.
+vec3 covered_position(vec3 pos, uint samples)
+{
+	vec3 dx = dFdx(pos), dy = dFdy(pos);
+	int m = gl_SampleMaskIn[0] & 15;
+	if (samples != 4u || m == 15 || m == 0) return pos;
+	vec2 o = vec2(0.0);
+	o += (m & 1) != 0 ? vec2(-0.125, -0.375) : vec2(0.0);   // (0.375, 0.125) - centre
+	o += (m & 2) != 0 ? vec2(0.375, -0.125) : vec2(0.0);    // (0.875, 0.375)
+	o += (m & 4) != 0 ? vec2(-0.375, 0.125) : vec2(0.0);    // (0.125, 0.625)
+	o += (m & 8) != 0 ? vec2(0.125, 0.375) : vec2(0.0);     // (0.625, 0.875)
+	o /= float(bitCount(m));
+	return pos + dx * o.x + dy * o.y;
+}

@@ -27,6 +27,7 @@ void main()
 	// Two-sided: back faces shade with the flipped normal.
 	if (!gl_FrontFacing) n_geo = -n_geo;
 	vec3 n_shadow = facet_normal(v_pos, n_geo);   // before base_color's discard
+	vec3 p_shadow = covered_position(v_pos, SC_SAMPLES);
 	vec4 bc = base_color(m);
 	vec3 N = material_normal(m, n_geo, has_tex(m, UMBRA_TEX_NORMAL));
 	vec3 V = frame.camera_pos.w > 0.5 ? -frame.camera_fwd.xyz : normalize(frame.camera_pos.xyz - v_pos);
@@ -45,7 +46,7 @@ void main()
 	vec3 lit, unshadowed;
 	float debug_vis;
 	uint debug_view;
-	light_all(N, n_geo, n_shadow, V, c_diff, f0, rough, receive, lit, unshadowed, debug_vis, debug_view);
+	light_all(N, n_geo, n_shadow, p_shadow, V, c_diff, f0, rough, receive, lit, unshadowed, debug_vis, debug_view);
 	float hemi = N.y * 0.5 + 0.5;
 	// Occlusion darkens the ambient (indirect) light only: direct light has its shadows.
 	float ao = 1.0;

@@ -58,6 +58,7 @@ layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 63u;  // bit (1
 layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1 << UMBRA_ALPHA_*)
 layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any light marches contact shadows
 layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
+layout(constant_id = UMBRA_SC_SAMPLES) const uint SC_SAMPLES = 1u;      // samples the pass rasterises
 
 #ifdef UMBRA_VIS_PASS
 // vis.frag: the surface comes from the surfaces image, not from a triangle.
@@ -523,8 +524,9 @@ vec4 base_color(umbra_material m)
 
 // Direct light from every light: with and without shadows (the shadow catcher needs both),
 // and the visibility of the debug light. N: the shading normal; n_geo: the interpolated one;
-// n_shadow: the plane of the triangle (facet.glsl), for the shadow lookups.
-void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 V, vec3 c_diff, vec3 f0, float rough, bool receive,
+// n_shadow, p_shadow: the plane of the triangle and where on it the shadow lookups look
+// (facet.glsl).
+void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 p_shadow, vec3 V, vec3 c_diff, vec3 f0, float rough, bool receive,
                out vec3 lit, out vec3 unshadowed, out float debug_vis, out uint debug_view)
 {
 	float a2 = rough * rough * rough * rough;
@@ -568,7 +570,7 @@ void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 V, vec3 c_diff, vec3 f0, 
 #if defined(UMBRA_VIS_READ)
 		if (SC_FILTERS != 0u && receive && L.shadow.y != 0u) vis = vis_fetch(vis_px, i);
 #elif !defined(UMBRA_VIS_PASS)
-		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, v_pos, n_shadow, l, view);
+		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, p_shadow, n_shadow, l, view);
 #endif
 		if (i == frame.mode.z) { debug_vis = vis; debug_view = view; }
 		if (ndl <= 0.0 || atten <= 0.0) continue;

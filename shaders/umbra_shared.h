@@ -133,6 +133,9 @@
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
 #define UMBRA_SC_PCF_RADIUS  10   /* 2 when every PCF-filtered light has the default radius 1; 0: read per light */
 #define UMBRA_SC_COUNT       11
+/* Not in the key's sc[]: pipelines.c sets it from the pipeline's own sample count (the key
+ * has that already, so it makes no variant of its own). */
+#define UMBRA_SC_SAMPLES     11   /* rasterization samples: 1 or 4 */
 
 /* umbra_material.params.z flags */
 #define UMBRA_MATERIAL_SHADOW_CATCHER 1u

@@ -173,10 +173,8 @@ TEST(lod_model_level_within_bound_of_full_mesh)
  * plane square to the light and left dark specks on the lit top (MSAA 4: 14 pixels, the
  * darkest 169). Every pixel of the sphere facing the sun (n.l > 0.3, away from its silhouette)
  * must read fully lit in the shadow debug view, for PCF and PCSS at MSAA 1 and 4; except, with
- * PCF at MSAA 4, a few pixels a little darker (3, the darkest 213): fragments shaded at a pixel
- * centre outside their triangle, which the visibility pass's single-sample surfaces do not
- * have (lavapipe's centroid and interpolateAtSample misplace the position, so they cannot
- * help). */
+ * PCF at MSAA 4, a pixel or two a little darker (1, at 242; 3 at up to 213 before the lookups
+ * of partly covered fragments moved to their covered samples, facet.glsl). */
 TEST(lod_sphere_facets_cast_no_specks_on_themselves)
 {
 	static const char *filters[][2] = {{"pcf", ""}, {"pcss", ", \"angular_diameter\": 1"}};
@@ -214,7 +212,7 @@ TEST(lod_sphere_facets_cast_no_specks_on_themselves)
 			       facing, dark, worst);
 			CHECK(facing > 3000, "%s msaa %d: %d sun-facing pixels found", filters[f][0], msaa, facing);
 			bool residue = f == 0 && msaa == 4;
-			CHECK(dark <= (residue ? 4 : 0) && worst >= (residue ? 200 : 250),
+			CHECK(dark <= (residue ? 2 : 0) && worst >= (residue ? 235 : 250),
 			      "%s msaa %d: %d sun-facing sphere pixels read shadowed (darkest %d)", filters[f][0], msaa, dark, worst);
 			rnd_image_release(&img);
 		}

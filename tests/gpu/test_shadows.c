@@ -497,3 +497,63 @@ TEST(shadow_disabled_reads_lit)
 		rnd_image_release(&img);
 	}
 }
+
+/* A rough patch of tiny triangles (a 128 x 128 grid over 2 m, heights jittered by a tenth of
+ * a cell, triangles under a pixel) under a sun 60 degrees up: the jitter's slopes stay far
+ * under the sun's, and at MSAA 1 the patch reads lit. MSAA 4 shades a fragment at the pixel
+ * centre even where its triangle covers only a corner sample, and the triangle's plane
+ * extended there lies under its neighbours: before the shadow lookups moved to the covered
+ * samples (facet.glsl covered_position) 268 such pixels read shadowed (the dense-model specks
+ * of a 124k-triangle OBJ). Every pixel of the patch that reads lit with its 8 neighbours at
+ * MSAA 1 must read lit at MSAA 4 too. */
+TEST(no_specks_on_dense_rough_mesh_msaa)
+{
+	enum { N = 128 };
+	size_t cap = (size_t)(N + 1) * (N + 1) * 40 + (size_t)N * N * 6 * 8 + 1024;
+	char *pos = malloc(cap), *idx = malloc(cap);
+	REQUIRE(pos && idx, "out of memory");
+	size_t pn = 0, in = 0;
+	uint32_t seed = 12345;
+	for (int j = 0; j <= N; j++)
+		for (int i = 0; i <= N; i++) {
+			seed = seed * 1664525u + 1013904223u;
+			double h = ((double)(seed >> 8) / 16777216.0 - 0.5) * 0.1 * (2.0 / N);
+			pn += (size_t)snprintf(pos + pn, cap - pn, "%s%.6f,%.6f,%.6f", pn ? "," : "", -1.0 + 2.0 * i / N, h,
+			                       -1.0 + 2.0 * j / N);
+		}
+	for (int j = 0; j < N; j++)
+		for (int i = 0; i < N; i++) {
+			int a = j * (N + 1) + i, b = a + N + 1;
+			in += (size_t)snprintf(idx + in, cap - in, "%s%d,%d,%d,%d,%d,%d", in ? "," : "", a, b, a + 1, a + 1, b, b + 1);
+		}
+	const char *doc = "{'width':160,'height':160,'camera':{'type':'perspective','position':[0,2.2,1.6],'target':[0,0,0],"
+	                  "'up':[0,1,0],'fov_y':40},'objects':[{'shape':'mesh','positions':[%s],'indices':[%s]}],"
+	                  "'lights':[{'type':'directional','direction':[-0.4,-0.866,-0.3]}],"
+	                  "'output':{'debug':'shadow','msaa':%d}}";
+	struct rnd_image one, four;
+	if (gpu_render(&one, doc, pos, idx, 1)) {
+		if (gpu_render(&four, doc, pos, idx, 4)) {
+			long lit = 0, specks = 0;
+			int darkest = 255;
+			for (int j = 1; j + 1 < 160; j++)
+				for (int i = 1; i + 1 < 160; i++) {
+					bool all = true;
+					for (int y = j - 1; y <= j + 1 && all; y++)
+						for (int x = i - 1; x <= i + 1 && all; x++) all = gpu_px8(&one, x, y)[0] == 255;
+					if (!all) continue;
+					lit++;
+					int v = gpu_px8(&four, i, j)[0];
+					if (v < 240) specks++;
+					if (v < darkest) darkest = v;
+				}
+			printf("    %ld pixels lit with their neighbours at MSAA 1; at MSAA 4 %ld of them under 240 (darkest %d)\n", lit,
+			       specks, darkest);
+			CHECK(lit > 5000, "only %ld lit pixels on the patch at MSAA 1", lit);
+			CHECK(specks == 0, "%ld lit pixels read shadowed at MSAA 4 (darkest %d)", specks, darkest);
+			rnd_image_release(&four);
+		}
+		rnd_image_release(&one);
+	}
+	free(pos);
+	free(idx);
+}
