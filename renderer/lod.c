@@ -168,34 +168,51 @@ static void as_asked(const struct rnd_scene *sc, uint32_t *segments)
 
 /* Scene bounds as render.c will find them, from the shapes (tessellated vertices lie on them);
  * obj: without planes and shadow catchers (what `fit: objects` frames). */
-/* World bounds of object i before tessellation (empty for an empty mesh). */
-static void object_bounds(const struct rnd_scene *sc, uint32_t i, struct rnd_aabb *wb)
+void rnd_object_bounds(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *drawn, struct rnd_aabb *out)
 {
 	struct rnd_aabb lb;
+	if (drawn && sc->objects[i].shape == RND_SHAPE_MESH) { *out = *drawn; return; }
 	rnd_mesh_local_bounds(&sc->objects[i], &lb);
-	if (rnd_aabb_is_empty(&lb)) *wb = lb;
-	else rnd_aabb_transform(wb, &lb, sc->objects[i].model);
+	if (rnd_aabb_is_empty(&lb)) *out = lb;
+	else rnd_aabb_transform(out, &lb, sc->objects[i].model);
 }
 
 /* The bounds render.c will plan with, estimated from the objects before tessellation: all,
- * what `fit: objects` frames, and what casts shadows (render.c plane_casters: a plane only
- * where it may shadow another object). */
+ * what `fit: objects` frames, and what casts shadows (a plane only where it may shadow the
+ * other objects: tested against their union, and each other plane). */
 static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, struct rnd_aabb *obj,
                             struct rnd_aabb *casters)
 {
-	struct rnd_aabb wb;
+	struct rnd_aabb wb, solid, other;
 	rnd_aabb_empty(all);
 	rnd_aabb_empty(obj);
 	rnd_aabb_empty(casters);
+	rnd_aabb_empty(&solid);   /* every object but the planes */
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		const struct rnd_object *o = &sc->objects[i];
-		object_bounds(sc, i, &wb);
+		rnd_object_bounds(sc, i, NULL, &wb);
 		if (rnd_aabb_is_empty(&wb)) continue;
 		rnd_aabb_union(all, &wb);
 		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
 		if (o->shape != RND_SHAPE_PLANE && !catcher) rnd_aabb_union(obj, &wb);
-		if (o->cast_shadows && !catcher && (o->shape != RND_SHAPE_PLANE || rnd_plane_casts(sc, i)))
+		if (o->shape == RND_SHAPE_PLANE) continue;
+		rnd_aabb_union(&solid, &wb);
+		if (o->cast_shadows && !catcher) rnd_aabb_union(casters, &wb);
+	}
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct rnd_object *o = &sc->objects[i];
+		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
+		if (o->shape != RND_SHAPE_PLANE || !o->cast_shadows || catcher) continue;
+		bool cast = !rnd_aabb_is_empty(&solid) && rnd_plane_casts(sc, i, &solid);
+		for (uint32_t j = 0; j < sc->object_count && !cast; j++) {
+			if (j == i || sc->objects[j].shape != RND_SHAPE_PLANE) continue;
+			rnd_object_bounds(sc, j, NULL, &other);
+			cast = !rnd_aabb_is_empty(&other) && rnd_plane_casts(sc, i, &other);
+		}
+		if (cast) {
+			rnd_object_bounds(sc, i, NULL, &wb);
 			rnd_aabb_union(casters, &wb);
+		}
 	}
 	if (rnd_aabb_is_empty(obj)) *obj = *all;
 }
@@ -269,18 +286,11 @@ bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *p
 	return false;
 }
 
-bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i)
+bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *b)
 {
-	if (sc->object_count > 256) return true;
 	for (uint32_t k = 0; k < sc->light_count; k++)
 		if (sc->lights[k].shadow.enabled &&
 		    (sc->lights[k].shadow.filter == RND_FILTER_VSM || sc->lights[k].shadow.filter == RND_FILTER_EVSM))
 			return true;
-	struct rnd_aabb b;
-	for (uint32_t j = 0; j < sc->object_count; j++) {
-		if (j == i) continue;
-		object_bounds(sc, j, &b);
-		if (!rnd_aabb_is_empty(&b) && rnd_plane_may_shadow(sc, &sc->objects[i], &b)) return true;
-	}
-	return false;
+	return rnd_plane_may_shadow(sc, &sc->objects[i], b);
 }

@@ -84,14 +84,19 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
  * other objects out of the shadow pass: the ground under a thumbnail costs no depth fill. */
 bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b);
 
-/* Whether plane object i may shadow any other object of sc (rnd_plane_may_shadow), judged on
- * the objects as asked (rnd_mesh_local_bounds), not as tessellated: a sphere resting on the
- * ground whose segments the level of detail lowered has its radius raised (rnd_lod_radius),
- * dips a fraction of a millimetre below the ground, and would make the ground a caster of a
- * shadow no camera above it sees (thumb-256: a 2048^2 map drawn for that). True for scenes of
- * more than 256 objects (not worth the quadratic check), and where a light filters with
- * moments (VSM / EVSM): their blurred moments need what lies behind a caster's edge, the
- * ground, in the map; against the empty map's far depth light bled into the penumbrae. */
-bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i);
+/* World bounds of object i as asked: an analytic shape's own (a sphere of its radius, not the
+ * radius a coarser tessellation raises, rnd_lod_radius), a mesh's `drawn` bounds (its levels
+ * keep a subset of its vertices, so they reach no further) or, when drawn is NULL, those of
+ * its vertices (one pass over them). */
+void rnd_object_bounds(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *drawn, struct rnd_aabb *out);
+
+/* Whether plane object i may cast a shadow onto box b (rnd_plane_may_shadow), b being another
+ * object's bounds as asked (rnd_object_bounds): a sphere resting on the ground whose segments
+ * the level of detail lowered dips a fraction of a millimetre below the ground as drawn, and
+ * made the ground a caster of a shadow no camera above it sees (thumb-256: a 2048^2 map drawn
+ * for that). Always true where a light filters with moments (VSM / EVSM): their blurred
+ * moments need what lies behind a caster's edge, the ground, in the map; against the empty
+ * map's far depth light bled into the penumbrae. */
+bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *b);
 
 #endif

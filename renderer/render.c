@@ -137,8 +137,17 @@ static void plane_casters(struct render *rq)
 {
 	const struct rnd_scene *sc = rq->sc;
 	struct draw *draws = rq->draws;
-	for (uint32_t i = 0; i < sc->object_count; i++)
-		if (draws[i].cast && sc->objects[i].shape == RND_SHAPE_PLANE) draws[i].cast = rnd_plane_casts(sc, i);
+	struct rnd_aabb b;
+	for (uint32_t i = 0; i < sc->object_count && sc->object_count <= 256; i++) {
+		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
+		bool casts = false;
+		for (uint32_t j = 0; j < sc->object_count && !casts; j++) {
+			if (j == i) continue;
+			rnd_object_bounds(sc, j, &draws[j].bounds, &b);
+			casts = !rnd_aabb_is_empty(&b) && rnd_plane_casts(sc, i, &b);
+		}
+		draws[i].cast = casts;
+	}
 	rnd_aabb_empty(&rq->casters);
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		if (draws[i].cast) rnd_aabb_union(&rq->casters, &draws[i].bounds);

@@ -160,23 +160,41 @@ TEST(lod_plane_under_objects_shadows_nothing)
 	CHECK(rnd_plane_may_shadow(&sc, &obj[0], &above), "point light below the plane");
 }
 
-/* The ground under a thumbnail's sphere casts nothing, judged on the sphere as asked: drawn
- * with fewer segments, its radius is raised and it dips below the ground, which made the
- * ground a caster of a 2048^2 map (thumb-256: the shadow stage 5.4 of 13 ms). It does cast
- * under a sphere that reaches below it, and wherever a light filters with moments (VSM needs
- * the ground in the map behind the casters' edges). */
+/* The ground under a thumbnail's sphere casts nothing, judged on the sphere as asked
+ * (rnd_object_bounds): drawn with fewer segments, its radius is raised and it dips below the
+ * ground, which made the ground a caster of a 2048^2 map (thumb-256: the shadow stage 5.4 of
+ * 13 ms). It does cast under a sphere that reaches below it, and wherever a light filters with
+ * moments (VSM needs the ground in the map behind the casters' edges). A mesh's bounds are
+ * those it is drawn with. */
 TEST(lod_plane_casts_judged_on_objects_as_asked)
 {
 	struct rnd_scene sc;
 	struct rnd_object obj[2];
 	struct rnd_light sun;
+	struct rnd_aabb b, dipping = {{-1.001f, -0.001f, -1.001f}, {1.001f, 2.001f, 1.001f}};
 	thumb(&sc, obj, &sun, 256);
-	CHECK(!rnd_plane_casts(&sc, 0), "a sphere resting on the ground made the ground a caster");
+	rnd_object_bounds(&sc, 1, &dipping, &b);
+	CHECK(fabsf(b.min[1]) < 1e-6f && fabsf(b.max[1] - 2.0f) < 1e-6f && fabsf(b.min[0] + 1.0f) < 1e-6f,
+	      "the sphere as asked: y %g..%g, x from %g", b.min[1], b.max[1], b.min[0]);
+	CHECK(!rnd_plane_casts(&sc, 0, &b), "a sphere resting on the ground made the ground a caster");
+	CHECK(rnd_plane_casts(&sc, 0, &dipping), "a box reaching below the ground: the ground must cast");
 	obj[1].model[13] = 0.9f;
-	CHECK(rnd_plane_casts(&sc, 0), "a sphere reaching 0.1 below the ground: the ground must cast");
+	rnd_object_bounds(&sc, 1, NULL, &b);
+	CHECK(rnd_plane_casts(&sc, 0, &b), "a sphere reaching 0.1 below the ground: the ground must cast");
 	obj[1].model[13] = 1.0f;
+	rnd_object_bounds(&sc, 1, NULL, &b);
 	sun.shadow.filter = RND_FILTER_VSM;
-	CHECK(rnd_plane_casts(&sc, 0), "vsm: the ground must be in the map");
+	CHECK(rnd_plane_casts(&sc, 0, &b), "vsm: the ground must be in the map");
 	sun.shadow.filter = RND_FILTER_EVSM;
-	CHECK(rnd_plane_casts(&sc, 0), "evsm: the ground must be in the map");
+	CHECK(rnd_plane_casts(&sc, 0, &b), "evsm: the ground must be in the map");
+	float pos[9] = {0, -0.5f, 0, 1, 1, 0, 0, 1, 1};
+	obj[1].shape = RND_SHAPE_MESH;
+	obj[1].positions = pos;
+	obj[1].vertex_count = 3;
+	obj[1].model[13] = 0.0f;
+	struct rnd_aabb drawn = {{0, 0, 0}, {1, 1, 1}};
+	rnd_object_bounds(&sc, 1, &drawn, &b);
+	CHECK(b.min[1] == 0.0f, "a mesh: the bounds it is drawn with, y from %g", b.min[1]);
+	rnd_object_bounds(&sc, 1, NULL, &b);
+	CHECK(b.min[1] == -0.5f, "a mesh without drawn bounds: its vertices, y from %g", b.min[1]);
 }
