@@ -166,8 +166,6 @@ static void as_asked(const struct rnd_scene *sc, uint32_t *segments)
 		segments[i] = has_levels(&sc->objects[i]) ? 0 : sc->objects[i].segments;
 }
 
-/* Scene bounds as render.c will find them, from the shapes (tessellated vertices lie on them);
- * obj: without planes and shadow catchers (what `fit: objects` frames). */
 void rnd_object_bounds(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *drawn, struct rnd_aabb *out)
 {
 	struct rnd_aabb lb;
@@ -177,9 +175,10 @@ void rnd_object_bounds(const struct rnd_scene *sc, uint32_t i, const struct rnd_
 	else rnd_aabb_transform(out, &lb, sc->objects[i].model);
 }
 
-/* The bounds render.c will plan with, estimated from the objects before tessellation: all,
- * what `fit: objects` frames, and what casts shadows (a plane only where it may shadow the
- * other objects: tested against their union, and each other plane). */
+/* The bounds render.c will plan with, estimated from the objects as asked (tessellated
+ * vertices lie on the shapes): all; obj, without planes and shadow catchers (what `fit:
+ * objects` frames); and what casts shadows (a plane only where it may shadow the other
+ * objects: tested against their union, and each other plane). */
 static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, struct rnd_aabb *obj,
                             struct rnd_aabb *casters)
 {
