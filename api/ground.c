@@ -15,6 +15,17 @@ void api_object_bounds(const struct rnd_object *o, double lo[3], double hi[3])
 		/* The transformed vertices themselves: a rotated mesh's corners of its local box would
 		 * reach below its lowest vertex. */
 		if (!o->positions) return;
+		/* Known local bounds under a matrix without rotation or shear (each world axis a scale
+		 * of one local axis): their image is exact, and no pass over the vertices is needed. */
+		if (o->mesh_bounds && o->vertex_count && M(m, 0, 1) == 0.0 && M(m, 0, 2) == 0.0 && M(m, 1, 0) == 0.0 &&
+		    M(m, 1, 2) == 0.0 && M(m, 2, 0) == 0.0 && M(m, 2, 1) == 0.0) {
+			for (int k = 0; k < 3; k++) {
+				double a = M(m, k, k) * o->mesh_bounds[k] + M(m, k, 3), b = M(m, k, k) * o->mesh_bounds[3 + k] + M(m, k, 3);
+				lo[k] = fmin(lo[k], fmin(a, b));
+				hi[k] = fmax(hi[k], fmax(a, b));
+			}
+			return;
+		}
 		/* The matrix in locals and branch-free min / max: this runs over every vertex of a
 		 * model on every request that frames or grounds it (1M triangles: ~10 -> ~3 ms). */
 		double r[3][4], l[3], h[3];

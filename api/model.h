@@ -60,6 +60,7 @@ struct api_model_mesh {
 	const struct rnd_mesh_lod *lods;
 	uint32_t lod_count;
 	bool closed;              /* watertight and wound outward (api/model_lod.h) */
+	float bounds[6];          /* min xyz, max xyz of positions (api/model_lod.h, with the levels) */
 };
 
 /* A node's use of a mesh: one rnd_object. */

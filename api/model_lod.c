@@ -370,10 +370,25 @@ static bool mesh_closed(const struct api_model_mesh *me)
 	return closed;
 }
 
+/* min xyz, max xyz of the mesh's positions (0 for a mesh without vertices). */
+static void mesh_bounds(struct api_model_mesh *me)
+{
+	float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+	for (uint32_t v = 0; v < me->vertex_count; v++) {
+		const float *p = me->positions + 3 * (size_t)v;
+		for (int k = 0; k < 3; k++) {
+			lo[k] = v == 0 || p[k] < lo[k] ? p[k] : lo[k];
+			hi[k] = v == 0 || p[k] > hi[k] ? p[k] : hi[k];
+		}
+	}
+	for (int k = 0; k < 3; k++) { me->bounds[k] = lo[k]; me->bounds[3 + k] = hi[k]; }
+}
+
 void api_model_build_lods(struct api_model *m, struct api_arena *arena, size_t *bytes)
 {
 	for (uint32_t i = 0; i < m->mesh_count; i++) {
 		struct api_model_mesh *me = (struct api_model_mesh *)&m->meshes[i]; /* ours until shared */
+		mesh_bounds(me);
 		if (!me->normals || !me->indices || !me->index_count) continue;
 		me->closed = mesh_closed(me);
 		if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES) mesh_lods(me, arena, bytes);

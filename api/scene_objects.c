@@ -283,6 +283,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 				o->lod_count = me->lod_count;
 			}
 			o->closed = me->closed;
+			o->mesh_bounds = me->vertex_count ? me->bounds : NULL;
 			/* glTF doubleSided: false culls back faces (the object can only add sidedness). */
 			o->double_sided = o->double_sided && !me->single_sided;
 			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);

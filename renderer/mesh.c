@@ -340,8 +340,12 @@ void rnd_mesh_local_bounds(const struct rnd_object *o, struct rnd_aabb *out)
 	case RND_SHAPE_SPHERE: h[0] = h[1] = h[2] = o->radius; break;
 	case RND_SHAPE_CYLINDER: h[0] = h[2] = o->radius; h[1] = 0.5f * o->height; break;
 	case RND_SHAPE_MESH:
-		if (o->positions)
+		if (o->mesh_bounds && o->vertex_count) {
+			memcpy(out->min, o->mesh_bounds, sizeof out->min);
+			memcpy(out->max, o->mesh_bounds + 3, sizeof out->max);
+		} else if (o->positions) {
 			for (uint32_t i = 0; i < o->vertex_count; i++) rnd_aabb_add_point(out, o->positions + 3 * i);
+		}
 		return;
 	default:
 		return;

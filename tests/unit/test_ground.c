@@ -2,6 +2,7 @@
  * the ground's height is checked against bounds computed here from first principles (the
  * transformed corners of a box, the transformed vertices of a mesh, the lowest point of a
  * scaled sphere), through api_ground_place and through the scene parser. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -233,5 +234,47 @@ TEST(ground_under_an_imported_model_with_two_meshes)
 	      g->size[0]);
 	for (uint32_t i = 0; i + 1 < sc->object_count; i++)
 		CHECK(sc->objects[i].shape == RND_SHAPE_MESH, "object %u is one of the model's meshes", i);
+	/* The model's meshes carry their local bounds (api_model_mesh.bounds): mesh a's vertices
+	 * span x 0..1, y -0.5..1, z 0..0. */
+	const float *mb = sc->objects[0].mesh_bounds;
+	CHECK(mb && mb[0] == 0.0f && mb[1] == -0.5f && mb[2] == 0.0f && mb[3] == 1.0f && mb[4] == 1.0f && mb[5] == 0.0f,
+	      "mesh a's bounds %g %g %g .. %g %g %g", mb ? mb[0] : -1, mb ? mb[1] : -1, mb ? mb[2] : -1, mb ? mb[3] : -1,
+	      mb ? mb[4] : -1, mb ? mb[5] : -1);
 	api_scene_free(s);
+}
+
+/* A mesh's known local bounds stand in for its vertices under a matrix without rotation (a
+ * negative scale included), with the very same result; under a rotation the vertices decide
+ * (the bounds are then deliberately wrong here, and must not be used). */
+TEST(object_bounds_of_a_mesh_with_known_bounds)
+{
+	static const float pos[] = {0, -0.5f, 0, 1, 0, 0.25f, 0, 1, 1, 0.5f, 0.5f, -2};
+	static const float known[6] = {0, -0.5f, -2, 1, 1, 1}, wrong[6] = {-9, -9, -9, 9, 9, 9};
+	struct rnd_object a, b;
+	rnd_object_defaults(&a);
+	a.shape = RND_SHAPE_MESH;
+	a.positions = pos;
+	a.vertex_count = 4;
+	const float t[3] = {1, 2, 3}, axis[3] = {0, 1, 0}, sc[3] = {2, -3, 0.5f};
+	trs(a.model, t, axis, 0.0f, sc);
+	b = a;
+	b.mesh_bounds = known;
+	double lo_a[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_a[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+	double lo_b[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_b[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+	api_object_bounds(&a, lo_a, hi_a);
+	api_object_bounds(&b, lo_b, hi_b);
+	for (int k = 0; k < 3; k++)
+		CHECK(lo_a[k] == lo_b[k] && hi_a[k] == hi_b[k], "axis %d: vertices %g..%g, known bounds %g..%g", k, lo_a[k],
+		      hi_a[k], lo_b[k], hi_b[k]);
+	CHECK(near_d(lo_b[1], 2.0 - 3.0) && near_d(hi_b[1], 2.0 + 1.5), "y %g..%g, expected -1..3.5", lo_b[1], hi_b[1]);
+	trs(a.model, t, axis, (float)M_PI / 4, sc);
+	b = a;
+	b.mesh_bounds = wrong;
+	double lo_r[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_r[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+	double lo_w[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_w[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+	api_object_bounds(&a, lo_r, hi_r);
+	api_object_bounds(&b, lo_w, hi_w);
+	for (int k = 0; k < 3; k++)
+		CHECK(lo_r[k] == lo_w[k] && hi_r[k] == hi_w[k], "rotated, axis %d: %g..%g from the vertices, %g..%g given "
+		      "wrong bounds", k, lo_r[k], hi_r[k], lo_w[k], hi_w[k]);
 }
