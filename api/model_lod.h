@@ -19,7 +19,8 @@
 
 /* Builds the levels of every mesh of m with at least API_LOD_MIN_TRIANGLES triangles into
  * arena; adds their size to *bytes. A level that cannot be built (out of memory) ends that
- * mesh's list: fewer levels are always correct, only slower. Also sets each mesh's `closed`:
+ * mesh's list: fewer levels are always correct, only slower. Also sets each mesh's `bounds`
+ * (min and max of its positions) and `closed`:
  * welded by position, every edge is shared by exactly two triangles that run it in opposite
  * directions, and the enclosed volume is positive (wound outward), so the renderer may cull
  * back faces when the camera is outside it. Out of memory: not closed. */

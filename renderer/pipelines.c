@@ -332,10 +332,10 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	bool full = p->variant_count == RND_MAX_VARIANTS;
 	pthread_mutex_unlock(&p->mu);
 	if (full) return rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
-	/* the key's constants, then UMBRA_SC_SAMPLES: the samples this pipeline rasterises */
+	/* the key's constants, then UMBRA_SC_SAMPLES: the samples this pipeline rasterises (d's,
+	 * set below once the pass is known) */
 	uint32_t values[UMBRA_SC_COUNT + 1];
 	memcpy(values, key->sc, sizeof key->sc);
-	values[UMBRA_SC_SAMPLES] = key->aov || key->vis_pass ? 1 : key->samples;
 	VkSpecializationMapEntry entries[UMBRA_SC_COUNT + 1];
 	for (uint32_t i = 0; i <= UMBRA_SC_COUNT; i++)
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
@@ -382,6 +382,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.after_prepass = false;
 		d.cull_back = false;
 	}
+	values[UMBRA_SC_SAMPLES] = d.samples;
 	VkPipeline pipe;
 	r = make_pipeline(ctx, &d, &pipe, err);
 out_modules:

@@ -243,6 +243,13 @@ TEST(ground_under_an_imported_model_with_two_meshes)
 	api_scene_free(s);
 }
 
+/* api_object_bounds of o alone (from empty bounds). */
+static void bounds_of(const struct rnd_object *o, double lo[3], double hi[3])
+{
+	for (int k = 0; k < 3; k++) { lo[k] = DBL_MAX; hi[k] = -DBL_MAX; }
+	api_object_bounds(o, lo, hi);
+}
+
 /* A mesh's known local bounds stand in for its vertices under a matrix without rotation (a
  * negative scale included), with the very same result; under a rotation the vertices decide
  * (the bounds are then deliberately wrong here, and must not be used). */
@@ -259,10 +266,9 @@ TEST(object_bounds_of_a_mesh_with_known_bounds)
 	trs(a.model, t, axis, 0.0f, sc);
 	b = a;
 	b.mesh_bounds = known;
-	double lo_a[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_a[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-	double lo_b[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_b[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-	api_object_bounds(&a, lo_a, hi_a);
-	api_object_bounds(&b, lo_b, hi_b);
+	double lo_a[3], hi_a[3], lo_b[3], hi_b[3];
+	bounds_of(&a, lo_a, hi_a);
+	bounds_of(&b, lo_b, hi_b);
 	for (int k = 0; k < 3; k++)
 		CHECK(lo_a[k] == lo_b[k] && hi_a[k] == hi_b[k], "axis %d: vertices %g..%g, known bounds %g..%g", k, lo_a[k],
 		      hi_a[k], lo_b[k], hi_b[k]);
@@ -270,10 +276,9 @@ TEST(object_bounds_of_a_mesh_with_known_bounds)
 	trs(a.model, t, axis, (float)M_PI / 4, sc);
 	b = a;
 	b.mesh_bounds = wrong;
-	double lo_r[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_r[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-	double lo_w[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi_w[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-	api_object_bounds(&a, lo_r, hi_r);
-	api_object_bounds(&b, lo_w, hi_w);
+	double lo_r[3], hi_r[3], lo_w[3], hi_w[3];
+	bounds_of(&a, lo_r, hi_r);
+	bounds_of(&b, lo_w, hi_w);
 	for (int k = 0; k < 3; k++)
 		CHECK(lo_r[k] == lo_w[k] && hi_r[k] == hi_w[k], "rotated, axis %d: %g..%g from the vertices, %g..%g given "
 		      "wrong bounds", k, lo_r[k], hi_r[k], lo_w[k], hi_w[k]);
