@@ -68,7 +68,7 @@ int api_parse_shadow(struct pctx *c, json_t *j, struct rnd_shadow *s, const char
 	if (rc) {
 		static const char *const precisions[] = {"auto", "fp32", "fp16", NULL};
 		static const enum rnd_vsm_precision prec_values[] = {RND_VSM_AUTO, RND_VSM_FP32, RND_VSM_FP16};
-		static const struct range blur = {0, 64, false, false}, expo = {0, 42, true, false};
+		static const struct range blur = {0, RND_MAX_VSM_BLUR, false, false}, expo = {0, 42, true, false};
 		int pr = -1;
 		rc = api_get_enum(c, sub, "precision", precisions, &pr) < 0 ||
 		     api_get_float(c, sub, "blur", &blur, &s->vsm_blur) < 0 ||

@@ -133,6 +133,7 @@ static void write_light(const struct rnd_context *ctx, struct umbra_light *l, co
 		/* Variance floor: a fraction of the warped depth's scale (EVSM) or of the
 		 * depth range (VSM), so flat receivers do not self-shadow. */
 		l->moment_params[2] = lp->evsm ? 1e-4f : 2e-6f;
+		l->moment_params[3] = lp->moment_edge;
 	}
 	/* The mapped block keeps the previous render's values: off is written, not assumed. */
 	memset(l->contact, 0, sizeof l->contact);

@@ -202,11 +202,12 @@ static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, st
 		const struct rnd_object *o = &sc->objects[i];
 		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
 		if (o->shape != RND_SHAPE_PLANE || !o->cast_shadows || catcher) continue;
-		bool cast = !rnd_aabb_is_empty(&solid) && rnd_plane_casts(sc, i, &solid);
+		/* as render.c's casters' box: planes drawn only for moment maps stay out of it */
+		bool cast = !rnd_aabb_is_empty(&solid) && rnd_plane_may_shadow(sc, o, &solid);
 		for (uint32_t j = 0; j < sc->object_count && !cast; j++) {
 			if (j == i || sc->objects[j].shape != RND_SHAPE_PLANE) continue;
 			rnd_object_bounds(sc, j, NULL, &other);
-			cast = !rnd_aabb_is_empty(&other) && rnd_plane_casts(sc, i, &other);
+			cast = !rnd_aabb_is_empty(&other) && rnd_plane_may_shadow(sc, o, &other);
 		}
 		if (cast) {
 			rnd_object_bounds(sc, i, NULL, &wb);

@@ -16,6 +16,9 @@
 #include "moments.comp.spv.h"
 #include "minmax.comp.spv.h"
 
+/* moments.comp holds a blur's whole reach in workgroup memory: every radius a scene may ask. */
+_Static_assert(RND_MAX_VSM_BLUR <= UMBRA_MOMENTS_MAX_RADIUS, "moments.comp's workgroup rows hold the widest blur");
+
 static bool format_ok(const struct rnd_context *ctx, VkFormat f)
 {
 	VkFormatProperties fp;
@@ -124,10 +127,15 @@ void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const 
 	VkCommandBuffer cmd = s->cmd;
 	const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
 	const float *rect = sp->views[v].rect;
-	uint32_t res = (uint32_t)rect[2], groups = (res + 63) / 64;   /* 8x8 invocations of 8x8 texels */
+	/* Tiles are powers of two of at least 64 texels: whole workgroups of UMBRA_MOMENTS_ROWS rows
+	 * of UMBRA_MOMENTS_SPAN texels (moments.comp). */
+	uint32_t res = (uint32_t)rect[2];
 	float blur = sc->lights[sp->view_light[v]].shadow.vsm_blur;
+	/* api/ rejects a blur over RND_MAX_VSM_BLUR; a library caller asking more gets the widest */
+	uint32_t radius = (uint32_t)ceilf(fmaxf(blur, 0.0f));
+	if (radius > UMBRA_MOMENTS_MAX_RADIUS) radius = UMBRA_MOMENTS_MAX_RADIUS;
 	struct rnd_moments_push push = {
-		.info = {(uint32_t)rect[0], (uint32_t)rect[1], 0, (uint32_t)ceilf(blur)},
+		.info = {(uint32_t)rect[0], (uint32_t)rect[1], 0, radius},
 		.params = {lp->evsm ? lp->evsm_exponent : 0.0f, fmaxf(blur * 0.5f, 0.5f), (float)res, 0},
 		.proj = {sp->views[v].params[2], sp->views[v].params[3], sp->views[v].params[1], 0},
 	};
@@ -147,7 +155,7 @@ void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const 
 		vkCmdPipelineBarrier2(cmd, &di);
 		push.info[2] = pass;
 		vkCmdPushConstants(cmd, m->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-		vkCmdDispatch(cmd, groups, groups, 1);
+		vkCmdDispatch(cmd, res / UMBRA_MOMENTS_SPAN, res / UMBRA_MOMENTS_ROWS, 1);
 	}
 }
 

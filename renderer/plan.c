@@ -471,7 +471,14 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		 * asks for a resolution gets that many texels across the whole scene, as before. */
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
 		if (casters && s->resolution == 0) {
-			float reach = (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : (float)lp->pcf_radius) + 2.0f;
+			/* Moments: the blur clamps at the tile's edge, where the ground's depth goes on
+			 * rising or falling beyond it: within a blur's reach of the edge its moments lean
+			 * to one side and a lit ground reads dark (a 20-texel line at blur 64). That band
+			 * is read as lit (lp->moment_edge), so the casters keep a blur's reach from it
+			 * besides their own blur's: what lies there has no caster within a blur of it. */
+			float blur = ceilf(fmaxf(s->vsm_blur, 0.0f));
+			float reach = (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels
+			               : lp->moments ? 2.0f * blur + 1.0f : (float)lp->pcf_radius) + 2.0f;
 			/* the whole scene's map: its texels and its texel grid's origin */
 			float tx = 2.0f * hx * grow / fres, ty = 2.0f * hy * grow / fres;
 			float ox = cx - hx * grow, oy = cy - hy * grow;
@@ -492,6 +499,7 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 					hx = 0.5f * (float)res * tx; hy = 0.5f * (float)res * ty;
 					cx = ox + sx * tx + hx; cy = oy + sy * ty + hy;
 					grow = 1.0f;
+					if (lp->moments) lp->moment_edge = blur + 1.0f;
 				}
 			}
 			lp->resolution = res < (uint32_t)fres ? res : (uint32_t)fres;

@@ -38,6 +38,8 @@ struct rnd_light_plan {
 	bool moments;                              /* VSM / EVSM: moment maps are built from the depth */
 	bool evsm;
 	float evsm_exponent;                       /* 0 = by precision (render.c decides) */
+	float moment_edge;                         /* texels along a `fit` sun map's edge read as lit: a
+	                                              moment map fitted to the casters (plan.c) */
 	bool fp16;                                 /* vsm.precision fp16 asked for */
 	uint32_t resolution;                       /* tile size asked for (power of two) */
 };

@@ -290,7 +290,12 @@ vec2 receiver_gradient(umbra_shadow_view v, vec3 pos, vec3 n, vec4 lc0, float h,
 // variance floor and light-bleed reduction trade softness against leaks.
 float moments(umbra_light L, umbra_shadow_view v, vec2 uv, vec4 rect, float ref)
 {
-	vec2 m = texture(moment_atlas, (rect.xy + clamp(uv * rect.z, vec2(0.5), vec2(rect.z - 0.5))) / rect.w).xy;
+	vec2 tp = uv * rect.z;
+	// A sun map fitted to its casters: no caster lies within a blur of this band along its
+	// edge, where the blur's clamp skews the ground's moments (plan.c moment_edge).
+	float edge = L.moment_params.w;
+	if (any(lessThan(tp, vec2(edge))) || any(greaterThan(tp, vec2(rect.z - edge)))) return 1.0;
+	vec2 m = texture(moment_atlas, (rect.xy + clamp(tp, vec2(0.5), vec2(rect.z - 0.5))) / rect.w).xy;
 	if (is_persp(v)) ref = (view_distance(v, ref) - v.params.z) / (v.params.w - v.params.z);   // as moments.comp
 	float c = L.moment_params.x;
 	float t = c > 0.0 ? exp(c * ref) : ref;

@@ -32,6 +32,11 @@
 #define UMBRA_MOMENTS_BINDING_TMP    1
 #define UMBRA_MOMENTS_BINDING_OUT    2
 #define UMBRA_MOMENTS_BINDING_BOUNDS 3  /* minmax.comp (same set and layout): the depth-bounds image */
+/* moments.comp: a workgroup blurs UMBRA_MOMENTS_ROWS rows of UMBRA_MOMENTS_SPAN texels each,
+ * reading UMBRA_MOMENTS_MAX_RADIUS more on either side from workgroup memory. */
+#define UMBRA_MOMENTS_SPAN 64
+#define UMBRA_MOMENTS_ROWS 8
+#define UMBRA_MOMENTS_MAX_RADIUS 64
 #define UMBRA_BOUNDS_TEXELS 2           /* texels per block in the depth-bounds image */
 /* Depth bounds of the depth atlas, for PCSS: per UMBRA_BOUNDS_BLOCK² block of atlas texels (blocks
  * never straddle tiles: tiles are at least 64 texels and aligned to their size), two texels of
@@ -191,7 +196,8 @@ struct umbra_light {
 	U_VEC4 shadow_params;    /* x normal offset (texels), y max search radius (texels),
 	                            z blend band (fraction), w fade start (view depth) */
 	U_VEC4 splits;           /* directional cascades: far view depth of cascade 0..3 */
-	U_VEC4 moment_params;    /* x EVSM exponent (0 = VSM), y light-bleed reduction, z min variance */
+	U_VEC4 moment_params;    /* x EVSM exponent (0 = VSM), y light-bleed reduction, z min variance,
+	                            w texels along the map's edge that read as lit (plan.c moment_edge) */
 	U_VEC4 contact;          /* contact shadows: x ray length (world, 0 = from the map's texel), y steps,
 	                            z thickness (view depth, world units; 0 = default), w 1 = on */
 };

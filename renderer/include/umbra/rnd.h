@@ -328,6 +328,7 @@ bool rnd_object_frames(const struct rnd_object *o, const struct rnd_material *ma
 #define RND_MAX_SHEET_SIDE 65536u        /* pixels per side of the sheet of several views */
 #define RND_MAX_SHEET_PIXELS (1ull << 28)
 #define RND_MAX_TEXTURE_SIDE 16384u      /* texels per side of one texture */
+#define RND_MAX_VSM_BLUR 64u             /* shadow.vsm_blur, texels (the moments blur's widest kernel) */
 
 /* The sheet of several views: ceil(sqrt(n)) columns, as many rows as needed (n = 0 means 1);
  * unused cells count in its size. */
@@ -356,6 +357,7 @@ struct rnd_timings {
 	double main_ms;       /* main pass + resolve (GPU) */
 	double readback_ms;   /* copy back to host memory */
 	uint32_t shadow_maps_rendered, shadow_maps_reused;
+	uint64_t shadow_texels;     /* texels of the shadow maps drawn (each map res x res) */
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
 };
 
