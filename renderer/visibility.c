@@ -18,8 +18,8 @@
  * surface, up to 16-bit storage (tests/gpu/test_visibility.c). A surface thinner than a pixel
  * that no centre shows takes its neighbour's shadow: it covers part of a pixel.
  *
- * When: scenes with at least two shadowed lights and enough small triangles to pay for the
- * passes (rnd_visibility_wanted), no debug view (the views show the filters' own work) and no
+ * When: scenes with at least two lights with wide filters (PCSS, PCF of radius 4 or more) and
+ * enough small triangles to pay for the passes (rnd_visibility_wanted), no debug view (the views show the filters' own work) and no
  * alpha-tested material (the surfaces pass does not cut out texels, so what shows through them
  * would take the cut-out surface's shadow). UMBRA_VISIBILITY=0 turns it off, =1 on where the
  * device and the scene allow it.
@@ -33,8 +33,18 @@
  * block per triangle touching it, and costs a surfaces pass and a main pass of its own. A floor
  * alone: 15 % slower; spheres of 16 segments (~600 triangles facing the camera): 4 % faster; of
  * 32 (~2,200): 11 %; of 64 (~8,300): 20 % (4 and 16 spot lights: 23 %, 18 %). So: at least one
- * such triangle per 512 pixels. One shadowed light: the filters cost less than the passes. */
+ * such triangle per 512 pixels. One shadowed light: the filters cost less than the passes.
+ * Only wide filters pay for it: studio-spots' seven lights all hard made the main pass 49 ms
+ * without the pass and 65 with it; PCF radius 1: 57 / 68, 2: 81 / 84, 3: 97 / 97, 5: 143 /
+ * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
 #define RND_VIS_MIN_LIGHTS 2u
+#define RND_VIS_MIN_PCF_RADIUS 4u
+
+/* A filter costly enough per pixel that running it once per pixel pays for the passes. */
+static bool wide_filter(const struct rnd_light_plan *lp)
+{
+	return lp->filter == UMBRA_FILTER_PCSS || (lp->filter == UMBRA_FILTER_PCF && lp->pcf_radius >= RND_VIS_MIN_PCF_RADIUS);
+}
 #define RND_VIS_PIXELS_PER_FACE 512u
 /* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
 #define RND_VIS_MAX_BYTES (32ull << 20)
@@ -43,9 +53,12 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
                            const struct draw *draws, uint32_t ndraw)
 {
 	if (!ctx->visibility_pass || sc->output.debug != RND_DEBUG_NONE) return false;
-	uint32_t shadowed = 0;
+	uint32_t shadowed = 0, wide = 0;
 	for (uint32_t i = 0; i < sc->light_count; i++)
-		if (sp->lights[i].view_count) shadowed++;
+		if (sp->lights[i].view_count) {
+			shadowed++;
+			if (wide_filter(&sp->lights[i])) wide++;
+		}
 	if (!shadowed) return false;
 	for (uint32_t i = 0; i < ndraw; i++)
 		if (draws[i].index_count && draws[i].masked) return false;
@@ -57,7 +70,7 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 	uint64_t faces = 0;
 	for (uint32_t i = 0; i < ndraw; i++)
 		faces += draws[i].index_count / 3 / (draws[i].cull_back ? 2 : 1);
-	return shadowed >= RND_VIS_MIN_LIGHTS && faces * RND_VIS_PIXELS_PER_FACE >= (uint64_t)sc->width * sc->height;
+	return wide >= RND_VIS_MIN_LIGHTS && faces * RND_VIS_PIXELS_PER_FACE >= (uint64_t)sc->width * sc->height;
 }
 
 /* Pass 1: the surfaces of the band's rows, cleared to 0 (nothing drawn); their depth stays an

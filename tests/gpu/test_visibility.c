@@ -165,6 +165,17 @@ TEST(visibility_pass_stays_off_where_it_cannot_help)
 		CHECK(views == 0, "one light: the pass ran by default");
 		rnd_image_release(&img);
 	}
+	/* five lights over small triangles, but one-fetch filters: cheaper than the passes */
+	static const char *narrow[] = {"'hard'", "'vsm'", "'pcf','pcf_radius':1"};
+	for (int f = 0; f < 3; f++) {
+		char extra[128];
+		snprintf(extra, sizeof extra, ",'shadows':{'filter':%s}", narrow[f]);
+		vis_doc(doc, sizeof doc, persp, mixed, extra);
+		if (render_vis(&img, NULL, doc, &views)) {
+			CHECK(views == 0, "filter %s: the pass ran by default", narrow[f]);
+			rnd_image_release(&img);
+		}
+	}
 	vis_doc(doc, sizeof doc, persp, mixed, ",'output':{'debug':'shadow','debug_light':1}");
 	if (render_vis(&img, "1", doc, &views)) {
 		CHECK(views == 0, "debug view: the pass ran");
