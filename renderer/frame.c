@@ -201,36 +201,42 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 	vkUpdateDescriptorSets(ctx->device, 12, w, 0, NULL);
 }
 
-/* moments.comp and minmax.comp: the scratch map in, the blur temporary, the moment atlas and
- * the depth bounds out. */
+/* minmax.comp: the scratch map in, the depth bounds out. moments.frag: the depth atlas and the
+ * blur temporary in (the moment atlas is its pass 1's attachment). */
 static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
 {
-	/* Moment maps read at most maxStorageBufferRange bytes of it (their resolution is capped to
-	 * fit: rnd_moments_max_res); a larger depth-only scratch is never read through this. */
+	/* Bounds are drawn only for maps within maxStorageBufferRange bytes (rnd_bounds_wanted); a
+	 * larger depth-only scratch is never read through this. */
 	VkDeviceSize sb_range = s->scratch_buf.size < ctx->props.limits.maxStorageBufferRange
 	                      ? s->scratch_buf.size : ctx->props.limits.maxStorageBufferRange;
 	VkDescriptorBufferInfo sbi = {s->scratch_buf.buf, 0, sb_range};
-	VkDescriptorImageInfo ci[4] = {
-		[UMBRA_MOMENTS_BINDING_TMP] = {VK_NULL_HANDLE, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
-		[UMBRA_MOMENTS_BINDING_OUT] = {VK_NULL_HANDLE, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL},
-		[UMBRA_MOMENTS_BINDING_BOUNDS] = {VK_NULL_HANDLE, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL},
+	VkDescriptorImageInfo bi = {VK_NULL_HANDLE, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL};
+	VkDescriptorImageInfo fi[2] = {
+		[UMBRA_MOMENTS_BINDING_DEPTH] = {ctx->moments.nearest, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL},
+		[UMBRA_MOMENTS_BINDING_BLUR] = {ctx->moments.nearest, s->moments_tmp.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
-	VkWriteDescriptorSet cw[4];
-	uint32_t ncw = 0;
+	VkWriteDescriptorSet w[4];
+	uint32_t n = 0;
 	if (s->scratch_buf.buf)
-		cw[ncw++] = (VkWriteDescriptorSet){
+		w[n++] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set,
-			.dstBinding = UMBRA_MOMENTS_BINDING_DEPTH, .descriptorCount = 1,
+			.dstBinding = UMBRA_MINMAX_BINDING_DEPTH, .descriptorCount = 1,
 			.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &sbi,
 		};
-	for (uint32_t i = 0; i < 4; i++) {
-		if (i == UMBRA_MOMENTS_BINDING_DEPTH || !ci[i].imageView) continue;
-		cw[ncw++] = (VkWriteDescriptorSet){
-			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set, .dstBinding = i,
-			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &ci[i],
+	if (ctx->atlas_bounds.view)
+		w[n++] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->moments_set,
+			.dstBinding = UMBRA_MINMAX_BINDING_BOUNDS, .descriptorCount = 1,
+			.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &bi,
 		};
-	}
-	vkUpdateDescriptorSets(ctx->device, ncw, cw, 0, NULL);
+	/* The blur set only once the slot has a temporary: only renders with moment maps bind it. */
+	if (s->blur_set && s->moments_tmp.view)
+		for (uint32_t i = 0; i < 2; i++)
+			w[n++] = (VkWriteDescriptorSet){
+				.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->blur_set, .dstBinding = i,
+				.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &fi[i],
+			};
+	vkUpdateDescriptorSets(ctx->device, n, w, 0, NULL);
 }
 
 enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,

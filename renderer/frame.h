@@ -1,7 +1,7 @@
 /*
  * renderer/frame.h — the frame constants of one view (see frame.c): the umbra_frame block, the
  * materials, the lights and the shadow views packed into the slot's parameter buffer, and the
- * slot's descriptor sets pointed at them (set 0 of the draw pipelines, moments.comp's set).
+ * slot's descriptor sets pointed at them (set 0 of the draw pipelines, minmax.comp's and moments.frag's sets).
  *
  * Called by render.c once per view, after the shadow plan has its atlas tiles and before the
  * view is recorded. Threading: the slot is the caller's; nothing else is written.

@@ -98,12 +98,16 @@ struct rnd_pipelines {
 };
 
 struct rnd_moments {
-	VkDescriptorSetLayout set_layout;
+	VkDescriptorSetLayout set_layout;    /* minmax.comp: the scratch map, the depth bounds */
 	VkPipelineLayout layout;
-	VkPipeline pipeline;                 /* moments.comp */
-	VkPipeline bounds;                   /* minmax.comp: PCSS depth bounds, same layout */
+	VkPipeline bounds;                   /* minmax.comp: PCSS depth bounds */
+	VkDescriptorSetLayout blur_set_layout; /* moments.frag: the depth atlas, the blur temporary */
+	VkPipelineLayout blur_layout;
+	VkPipeline blur_x[2][2];             /* moments.frag pass 0 into the temporary [EVSM][perspective] */
+	VkPipeline blur_y;                   /* moments.frag pass 1 into the moment atlas */
 	VkSampler sampler;                   /* linear, clamp to edge */
-	bool fp32;                           /* R32G32_SFLOAT filterable + storable */
+	VkSampler nearest;                   /* moments.frag's texel fetches */
+	bool fp32;                           /* R32G32_SFLOAT filterable + renderable */
 	bool available;                      /* VSM / EVSM can be offered at all */
 };
 
@@ -178,6 +182,12 @@ void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
 /* pipelines.c */
 enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err);
 void rnd_pipelines_release(struct rnd_context *ctx);
+/* A pipeline for a fullscreen pass (shaders/fullscreen.vert and fs): no vertex input, no depth,
+ * one colour attachment of format `color`, dynamic viewport and scissor; `layout` the caller's.
+ * Needs rnd_pipelines_init(); the caller destroys it. */
+enum rnd_result rnd_pipeline_fullscreen(struct rnd_context *ctx, VkShaderModule fs, VkFormat color, VkPipelineLayout layout,
+                                        const VkSpecializationInfo *spec, const char *name, VkPipeline *out,
+                                        struct rnd_error *err);
 /* The descriptor type of each binding of the main set (UMBRA_BINDING_* of umbra_shared.h): one
  * table for the set layout and for the descriptor writes (render.c). */
 extern const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT];

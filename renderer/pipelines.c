@@ -136,6 +136,7 @@ struct pipe_desc {
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
 	const VkSpecializationInfo *spec;  /* fragment stage */
+	VkPipelineLayout layout;    /* VK_NULL_HANDLE: the main passes' (ctx->pipes.layout) */
 	const char *name;
 };
 
@@ -220,7 +221,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.stageCount = d->fs ? 2 : 1, .pStages = stages,
 		.pVertexInputState = &vi, .pInputAssemblyState = &ia, .pViewportState = &vp, .pRasterizationState = &rs,
 		.pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb, .pDynamicState = &dy,
-		.layout = ctx->pipes.layout,
+		.layout = d->layout ? d->layout : ctx->pipes.layout,
 	};
 	VkResult vr = vkCreateGraphicsPipelines(ctx->device, ctx->pipeline_cache, 1, &ci, NULL, out);
 	if (vr != VK_SUCCESS) {
@@ -230,6 +231,17 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	}
 	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE, *out, "%s", d->name);
 	return RND_OK;
+}
+
+enum rnd_result rnd_pipeline_fullscreen(struct rnd_context *ctx, VkShaderModule fs, VkFormat color, VkPipelineLayout layout,
+                                        const VkSpecializationInfo *spec, const char *name, VkPipeline *out,
+                                        struct rnd_error *err)
+{
+	struct pipe_desc d = {
+		.vs = ctx->pipes.fullscreen_vs, .fs = fs, .color = color, .samples = 1, .no_vertices = true, .spec = spec,
+		.layout = layout, .name = name,
+	};
+	return make_pipeline(ctx, &d, out, err);
 }
 
 enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err)

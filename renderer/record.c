@@ -156,10 +156,10 @@ static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const s
 	                     VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
-/* VSM / EVSM / PCSS: the map as floats for the moment blur or the depth bounds (compute
- * shaders cannot read a depth image on lavapipe without it copying the image on every
- * dispatch). The previous view's compute passes must be done reading the buffer. */
-static void copy_for_moments(struct rnd_slot *s, uint32_t res)
+/* PCSS: the map as floats for the depth bounds (compute shaders cannot read a depth image on
+ * lavapipe without it copying the image on every dispatch). The previous view's compute
+ * passes must be done reading the buffer. */
+static void copy_for_bounds(struct rnd_slot *s, uint32_t res)
 {
 	VkCommandBuffer cmd = s->cmd;
 	VkBufferMemoryBarrier2 bb = {
@@ -197,9 +197,10 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
 		.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, .srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT,
 		.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
-		                VK_PIPELINE_STAGE_2_COPY_BIT,
+		                VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
 		.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-		                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
+		                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |
+		                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
 	};
 	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
 	vkCmdPipelineBarrier2(cmd, &di);
@@ -218,16 +219,19 @@ void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct re
 		               VK_IMAGE_LAYOUT_GENERAL, 1, &copy);
 		/* PCSS: the tile's depth bounds, drawn with every map drawn, so a cached map has them
 		 * whenever it is reused (the cache key holds the filter and the resolution). */
-		bool bounds = rnd_bounds_wanted(ctx, lp, res);
-		if (!lp->moments && !bounds) continue;
-		copy_for_moments(s, res);
-		if (bounds) rnd_bounds_record_view(ctx, s, sp, v);
-		else rnd_moments_record_view(ctx, s, sp, v, sc);
+		if (rnd_bounds_wanted(ctx, lp, res)) {
+			copy_for_bounds(s, res);
+			rnd_bounds_record_view(ctx, s, sp, v);
+		}
+		/* VSM / EVSM: from the tile just copied into the depth atlas */
+		rnd_moments_record_view(ctx, s, sp, v, sc);
 	}
-	/* The atlas tiles (depth copied in, moments and bounds from compute) are read by the main
-	 * and AOV passes. */
-	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
-	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
+	/* The atlas tiles (depth copied in, moments drawn, bounds from compute) are read by the
+	 * main and AOV passes. */
+	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT |
+	                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |
+	                   VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
 	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 	vkCmdPipelineBarrier2(cmd, &di);

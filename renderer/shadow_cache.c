@@ -106,7 +106,7 @@ enum rnd_result rnd_cache_init(struct rnd_context *ctx, struct rnd_error *err)
 		goto fail;
 	if (ctx->moments.available &&
 	    (r = rnd_image_create(ctx, rnd_moments_format(ctx, false), size, size, 1, 1,
-	                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
+	                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
 	                          "shadow moment atlas", &ctx->atlas_moments, err)) != RND_OK)
 		goto fail;
 	/* PCSS depth bounds (RGBA32F: a storage format every device has), not cleared either: a

@@ -112,10 +112,15 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 		};
 	vkUpdateDescriptorSets(ctx->device, UMBRA_TEX_SLOTS, ww, 0, NULL);
-	VkDescriptorPoolSize msizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 3}};
-	if ((r = pool_with_sets(ctx, msizes, 2, 1, &ctx->moments.set_layout, "moments", index, &s->moments_pool,
-	                        &s->moments_set, err)) != RND_OK)
+	VkDescriptorPoolSize msizes[3] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+	                                  {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2}};
+	VkDescriptorSetLayout mlayouts[2] = {ctx->moments.set_layout, ctx->moments.blur_set_layout};
+	VkDescriptorSet msets[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+	if ((r = pool_with_sets(ctx, msizes, 3, ctx->moments.available ? 2 : 1, mlayouts, "moments", index, &s->moments_pool,
+	                        msets, err)) != RND_OK)
 		goto fail_white;
+	s->moments_set = msets[0];
+	s->blur_set = msets[1];
 	free(layouts);
 	*out = s;
 	return RND_OK;
@@ -300,8 +305,9 @@ enum rnd_result rnd_slot_moments_tmp(struct rnd_context *ctx, struct rnd_slot *s
 	s->moments_initialised = false;
 	char name[48];
 	snprintf(name, sizeof name, "slot %u moments blur", s->index);
-	return rnd_image_create(ctx, VK_FORMAT_R32G32_SFLOAT, res, res, 1, 1, VK_IMAGE_USAGE_STORAGE_BIT,
-	                        VK_IMAGE_ASPECT_COLOR_BIT, name, &s->moments_tmp, err);
+	return rnd_image_create(ctx, VK_FORMAT_R32G32_SFLOAT, res, res, 1, 1,
+	                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, name,
+	                        &s->moments_tmp, err);
 }
 
 enum rnd_result rnd_slot_shadow_scratch(struct rnd_context *ctx, struct rnd_slot *s, uint32_t res, struct rnd_error *err)

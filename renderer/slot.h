@@ -39,10 +39,11 @@ struct rnd_slot {
 	struct rnd_image_res moments_tmp;
 	/* shadow maps are drawn here at the origin, then copied into their atlas tile */
 	struct rnd_image_res shadow_scratch;
-	struct rnd_buffer scratch_buf;    /* the scratch map as floats, read by the compute passes */
+	struct rnd_buffer scratch_buf;    /* the scratch map as floats, read by minmax.comp */
 	bool moments_initialised;     /* moments_tmp is in GENERAL layout */
 	VkDescriptorPool moments_pool;
-	VkDescriptorSet moments_set;
+	VkDescriptorSet moments_set;  /* minmax.comp's: the scratch buffer, the depth bounds */
+	VkDescriptorSet blur_set;     /* moments.frag's: the depth atlas, moments_tmp (none without moments) */
 	struct rnd_image_res color_ms, depth, resolve;
 	/* the camera view's depth, single-sample, drawn before the main pass for contact shadows */
 	struct rnd_image_res scene_depth;

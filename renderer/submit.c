@@ -266,9 +266,9 @@ static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *
 		/* The blur temporary's contents never carry over: take it from UNDEFINED each time. */
 		if (s->moments_tmp.img)
 			record_image_barrier(s->cmd, s->moments_tmp.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-			                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-			                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+			                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+			                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
 		record_shadows(ctx, s, rv, v, end);
 		cmd_mark(s, st, RND_TS_SHADOW_END);
 		double wall;

@@ -14,8 +14,8 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 // Read four floats at a time (rows of a block are 16-byte aligned): lavapipe loads lane by lane
 // when the lanes' addresses differ, so a quarter of the loads is most of the saving.
-layout(std430, set = 0, binding = UMBRA_MOMENTS_BINDING_DEPTH) readonly buffer Scratch { vec4 scratch[]; };
-layout(set = 0, binding = UMBRA_MOMENTS_BINDING_BOUNDS, rgba32f) uniform image2D bounds_img;
+layout(std430, set = 0, binding = UMBRA_MINMAX_BINDING_DEPTH) readonly buffer Scratch { vec4 scratch[]; };
+layout(set = 0, binding = UMBRA_MINMAX_BINDING_BOUNDS, rgba32f) uniform image2D bounds_img;
 layout(push_constant) uniform Push {
 	uvec4 info;   // x, y: tile offset in the atlas (texels); z pass
 	vec4 params;  // z tile size (texels)

@@ -27,16 +27,12 @@
                                            visibility of that surface (1 where it does not reach) */
 #define UMBRA_BINDING_VISIBILITY_OUT 11 /* the same image as vis.frag's storage image */
 #define UMBRA_BINDING_COUNT          12
-/* moments.comp's own set 0 */
-#define UMBRA_MOMENTS_BINDING_DEPTH  0  /* storage buffer: the scratch map, res x res floats */
-#define UMBRA_MOMENTS_BINDING_TMP    1
-#define UMBRA_MOMENTS_BINDING_OUT    2
-#define UMBRA_MOMENTS_BINDING_BOUNDS 3  /* minmax.comp (same set and layout): the depth-bounds image */
-/* moments.comp: a workgroup blurs UMBRA_MOMENTS_ROWS rows of UMBRA_MOMENTS_SPAN texels each,
- * reading UMBRA_MOMENTS_MAX_RADIUS more on either side from workgroup memory. */
-#define UMBRA_MOMENTS_SPAN 64
-#define UMBRA_MOMENTS_ROWS 8
-#define UMBRA_MOMENTS_MAX_RADIUS 64
+/* moments.frag's own set 0 (renderer/moments.c) */
+#define UMBRA_MOMENTS_BINDING_DEPTH  0  /* sampler2D: the depth atlas (pass 0 reads the view's tile) */
+#define UMBRA_MOMENTS_BINDING_BLUR   1  /* sampler2D: the slot's blur temporary (pass 1 reads it) */
+/* minmax.comp's own set 0 */
+#define UMBRA_MINMAX_BINDING_DEPTH   0  /* storage buffer: the scratch map, res x res floats */
+#define UMBRA_MINMAX_BINDING_BOUNDS  1  /* the depth-bounds image */
 #define UMBRA_BOUNDS_TEXELS 2           /* texels per block in the depth-bounds image */
 /* Depth bounds of the depth atlas, for PCSS: per UMBRA_BOUNDS_BLOCK² block of atlas texels (blocks
  * never straddle tiles: tiles are at least 64 texels and aligned to their size), two texels of
