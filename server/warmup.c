@@ -37,6 +37,9 @@
 #define WARM_POINT_HARD "{\"type\":\"point\",\"position\":[-1,2,1]}"
 #define WARM_VSM "{\"type\":\"directional\",\"direction\":[-0.5,-1,-0.3],\"shadow\":{\"filter\":\"vsm\"}}"
 #define WARM_EVSM "{\"type\":\"spot\",\"position\":[2,3,1],\"direction\":[-2,-3,-1],\"shadow\":{\"filter\":\"evsm\"}}"
+/* the moments blur's other two variants (renderer/moments.c): evsm in a sun's map, vsm in a spot's */
+#define WARM_EVSM_SUN "{\"type\":\"directional\",\"direction\":[0.5,-1,0.3],\"shadow\":{\"filter\":\"evsm\"}}"
+#define WARM_VSM_SPOT "{\"type\":\"spot\",\"position\":[-2,3,1],\"direction\":[2,-3,-1],\"shadow\":{\"filter\":\"vsm\"}}"
 #define PNG1 "{\"format\":\"png\",\"msaa\":1}"
 #define PNG4 "{\"format\":\"png\",\"msaa\":4}"
 #define EXR4 "{\"format\":\"exr\",\"msaa\":4}"
@@ -51,7 +54,7 @@ static const struct { const char *name, *json; } warm_scenes[] = {
 	{ "msaa 1, directional pcss", WARM_SCENE(WARM_SUN, PNG1) },
 	{ "msaa 1, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG1) },
 	{ "msaa 4, exr", WARM_SCENE(WARM_DIR, EXR4) },
-	{ "msaa 4, vsm+evsm", WARM_SCENE(WARM_VSM "," WARM_EVSM, PNG4) },
+	{ "msaa 4, vsm+evsm", WARM_SCENE(WARM_VSM "," WARM_EVSM "," WARM_EVSM_SUN "," WARM_VSM_SPOT, PNG4) },
 };
 
 #define WARM_DEFAULTS 4u
