@@ -202,7 +202,8 @@ static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, st
 		const struct rnd_object *o = &sc->objects[i];
 		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
 		if (o->shape != RND_SHAPE_PLANE || !o->cast_shadows || catcher) continue;
-		/* as render.c's casters' box: planes drawn only for moment maps stay out of it */
+		/* as render.c's casters' box, on geometry alone (it also leaves out a ground whose
+		 * shadow no camera sees: that map keeps the whole scene's texel size, all this needs) */
 		bool cast = !rnd_aabb_is_empty(&solid) && rnd_plane_may_shadow(sc, o, &solid);
 		for (uint32_t j = 0; j < sc->object_count && !cast; j++) {
 			if (j == i || sc->objects[j].shape != RND_SHAPE_PLANE) continue;
@@ -286,11 +287,101 @@ bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *p
 	return false;
 }
 
-bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *b)
+/* Whether the points of box b on the far side of `plane` from a camera are all hidden from it by
+ * the plane's own quad (opaque, drawn both sides): every line of sight to them crosses the
+ * plane inside the quad. The part of b beyond the plane is convex and so is its central (or,
+ * orthographic, parallel) projection onto the plane, so its corners decide: b's corners
+ * beyond the plane and where b's edges cross it. False unless the camera is strictly on the
+ * plane's side `side` (sign along the plane's normal n through p0). */
+static bool quad_hides(const struct rnd_object *plane, const float n[3], const float p0[3], float side,
+                       const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
+{
+	float inv[16], cp[3];
+	if (!rnd_mat4_invert(inv, plane->model)) return false;
+	rnd_v3_sub(cp, cam->pos, p0);
+	if (side * rnd_v3_dot(n, cp) <= 0.0f) return false;
+	if (cam->ortho && side * rnd_v3_dot(n, cam->fwd) >= 0.0f) return false;   /* looking away from it */
+	float c[8][3], sd[8];
+	for (int k = 0; k < 8; k++) {
+		float d[3];
+		for (int a = 0; a < 3; a++) c[k][a] = k >> a & 1 ? b->max[a] : b->min[a];
+		rnd_v3_sub(d, c[k], p0);
+		sd[k] = side * rnd_v3_dot(n, d);
+	}
+	/* margins: the quad's edge shrunk by 1e-4 of its size, a crossing counted from 1e-6 */
+	float hx = 0.5f * plane->size[0] * (1.0f - 1e-4f), hz = 0.5f * plane->size[2] * (1.0f - 1e-4f);
+	float x[8 + 12][3];   /* the corners of b's part beyond the plane */
+	int nx = 0;
+	for (int k = 0; k < 8; k++) {
+		if (sd[k] < 0.0f) memcpy(x[nx++], c[k], sizeof x[0]);
+		for (int a = 0; a < 3; a++) {
+			int j = k | 1 << a;
+			if (j == k || (sd[k] < 0.0f) == (sd[j] < 0.0f)) continue;
+			float t = sd[k] / (sd[k] - sd[j]);
+			for (int m = 0; m < 3; m++) x[nx][m] = c[k][m] + t * (c[j][m] - c[k][m]);
+			nx++;
+		}
+	}
+	for (int k = 0; k < nx; k++) {
+		/* along the line of sight to x, onto the plane */
+		float dir[3], q[3], lq[3], dx[3];
+		if (cam->ortho) memcpy(dir, cam->fwd, sizeof dir);
+		else rnd_v3_sub(dir, x[k], cam->pos);
+		float dn = rnd_v3_dot(n, dir);
+		if (fabsf(dn) < 1e-12f) return false;
+		rnd_v3_sub(dx, p0, x[k]);
+		float t = rnd_v3_dot(n, dx) / dn;
+		for (int m = 0; m < 3; m++) q[m] = x[k][m] + t * dir[m];
+		rnd_mat4_mul_point(lq, inv, q);
+		if (fabsf(lq[0]) > hx || fabsf(lq[2]) > hz) return false;
+	}
+	return true;
+}
+
+bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
+                               const struct rnd_camera_plan *cams, uint32_t ncam)
+{
+	float nm[16], n[3], up[3] = {0.0f, 1.0f, 0.0f}, p0[3] = {plane->model[12], plane->model[13], plane->model[14]};
+	bool opaque = !sc->material_count || sc->materials[plane->material].alpha_mode == RND_ALPHA_OPAQUE;
+	if (!opaque || !ncam) return rnd_plane_may_shadow(sc, plane, b);
+	if (!rnd_mat4_normal_matrix(nm, plane->model)) return true;
+	rnd_mat4_mul_dir(n, nm, up);
+	if (!rnd_v3_normalize(n, n)) return true;
+	float lo = 0.0f, hi = 0.0f;
+	for (int k = 0; k < 3; k++) {
+		float a = n[k] * (b->min[k] - p0[k]), c = n[k] * (b->max[k] - p0[k]);
+		lo += a < c ? a : c;
+		hi += a < c ? c : a;
+	}
+	const float eps = 1e-4f;
+	for (uint32_t i = 0; i < sc->light_count; i++) {
+		const struct rnd_light *L = &sc->lights[i];
+		if (!L->shadow.enabled) continue;
+		float side;
+		if (L->type == RND_LIGHT_DIRECTIONAL) side = -rnd_v3_dot(n, L->direction);
+		else {
+			float d[3];
+			rnd_v3_sub(d, L->position, p0);
+			side = rnd_v3_dot(n, d);
+		}
+		if (fabsf(side) <= eps) return true;
+		if (side > 0.0f ? lo >= -eps : hi <= eps) continue;    /* nothing of b behind it */
+		for (uint32_t v = 0; v < ncam; v++)
+			if (!quad_hides(plane, n, p0, side > 0.0f ? 1.0f : -1.0f, b, &cams[v])) return true;
+	}
+	return false;
+}
+
+bool rnd_moments_need_ground(const struct rnd_scene *sc)
 {
 	for (uint32_t k = 0; k < sc->light_count; k++)
 		if (sc->lights[k].shadow.enabled &&
 		    (sc->lights[k].shadow.filter == RND_FILTER_VSM || sc->lights[k].shadow.filter == RND_FILTER_EVSM))
 			return true;
-	return rnd_plane_may_shadow(sc, &sc->objects[i], b);
+	return false;
+}
+
+bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *b)
+{
+	return rnd_moments_need_ground(sc) || rnd_plane_may_shadow(sc, &sc->objects[i], b);
 }

@@ -132,30 +132,48 @@ static void frame_bounds(struct render *rq)
 }
 
 /* A plane with every other object on its lit side shadows nothing: out of the shadow pass,
- * unless a light filters with moments, whose blur needs the ground behind a caster's edge in
- * the map (rnd_plane_casts). Then the box of what casts, which sizes a `fit` sun map: a plane
- * drawn only for the moments' sake stays out of it. It is the receiver around the casters,
- * not a caster; inside the box's tile it is drawn, outside it the sun is unblocked anyway.
- * Counted, it made a VSM thumbnail's sun map cover the whole 10 m floor: a 2048^2 map whose
- * moments cost ~100 ms on lavapipe, for shadows within a 256^2 corner. */
+ * and so is one whose shadow falls only where no camera of the render sees it, on the parts
+ * of objects sunk into it (rnd_plane_may_shadow_seen; studio-spots' boxes stand 24 cm deep in
+ * its floor: in its maps the floor cost a whole-scene sun map and made the PCSS bounds' lit
+ * proofs harder, ~10 % of the render). Unless a light filters with moments, whose blur needs
+ * the ground behind a caster's edge in the map (rnd_plane_casts). Then the box of what casts,
+ * which sizes a `fit` sun map: a plane drawn only for the moments' sake stays out of it. It is
+ * the receiver around the casters, not a caster; inside the box's tile it is drawn, outside it
+ * the sun is unblocked anyway. Counted, it made a VSM thumbnail's sun map cover the whole
+ * 10 m floor: a 2048^2 map whose moments cost ~100 ms on lavapipe, for shadows within a 256^2
+ * corner. */
+#define RND_PLANE_CAMERAS 8u   /* renders of more views judge planes on geometry alone */
 static void plane_casters(struct render *rq)
 {
 	const struct rnd_scene *sc = rq->sc;
 	struct draw *draws = rq->draws;
 	struct rnd_aabb b;
+	struct rnd_camera_plan cams[RND_PLANE_CAMERAS];
+	struct rnd_error err;
+	uint32_t nviews = sc->view_count ? sc->view_count : 1, ncam = 0;
+	for (uint32_t v = 0; v < nviews && nviews <= RND_PLANE_CAMERAS; v++) {
+		const struct rnd_camera *camera = sc->view_count ? &sc->views[v] : &sc->camera;
+		const struct rnd_aabb *fb = camera->fit == RND_FIT_OBJECTS ? &rq->obj_bounds : &rq->bounds;
+		if (rnd_camera_plan(camera, sc->width, sc->height, fb, &cams[ncam], &err) != RND_OK) {
+			ncam = 0;
+			break;
+		}
+		ncam++;
+	}
+	bool moments = rnd_moments_need_ground(sc);
 	bool fill_only[256] = {false};
 	for (uint32_t i = 0; i < sc->object_count && sc->object_count <= 256; i++) {
 		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
-		bool casts = false, shadows = false;
-		for (uint32_t j = 0; j < sc->object_count && !shadows; j++) {
+		bool other = false, seen = false;
+		for (uint32_t j = 0; j < sc->object_count && !seen; j++) {
 			if (j == i) continue;
 			rnd_object_bounds(sc, j, &draws[j].bounds, &b);
 			if (rnd_aabb_is_empty(&b)) continue;
-			casts = casts || rnd_plane_casts(sc, i, &b);
-			shadows = rnd_plane_may_shadow(sc, &sc->objects[i], &b);
+			other = true;
+			seen = rnd_plane_may_shadow_seen(sc, &sc->objects[i], &b, cams, ncam);
 		}
-		draws[i].cast = casts;
-		fill_only[i] = casts && !shadows;
+		draws[i].cast = seen || (other && moments);
+		fill_only[i] = draws[i].cast && !seen;
 	}
 	rnd_aabb_empty(&rq->casters);
 	for (uint32_t i = 0; i < sc->object_count; i++)

@@ -266,3 +266,39 @@ TEST(sun_map_fitted_to_the_casters_changes_no_pixel)
 		rnd_image_release(&small);
 	}
 }
+
+/* Boxes standing 30 cm deep in the ground, seen from above: the ground's shadow on their buried
+ * parts shows nowhere, so it stays out of the sun's map, which fits the boxes as it does boxes
+ * resting on the ground (the same texels drawn; with the ground in it, the whole scene's), and
+ * the picture is theirs. */
+TEST(ground_under_sunk_objects_casts_nothing)
+{
+	static const char *doc =
+		"{\"width\": 192, \"height\": 128, \"camera\": {\"type\": \"perspective\", \"position\": [5, 4, 6],"
+		" \"target\": [0, 0.5, 0], \"up\": [0, 1, 0], \"fov_y\": 40},"
+		" \"objects\": [{\"shape\": \"plane\", \"size\": [20, 20]},"
+		" {\"shape\": \"box\", \"size\": [1, %s, 1], \"transform\": {\"translation\": [0, %s, 0]}},"
+		" {\"shape\": \"box\", \"size\": [0.6, %s, 0.6], \"transform\": {\"translation\": [1.5, %s, -1]}}],"
+		" \"lights\": [{\"type\": \"directional\", \"direction\": [-0.5, -1, -0.3], \"angular_diameter\": 1}],"
+		" \"shadows\": {\"directional\": {\"mode\": \"fit\"}}}";
+	struct rnd_image resting, sunk;
+	if (!gpu_render(&resting, doc, "1", "0.5", "2", "1")) return;
+	uint64_t resting_texels = gpu_last_timings.shadow_texels;
+	if (gpu_render(&sunk, doc, "1.3", "0.35", "2.3", "0.85")) {
+		CHECK(gpu_last_timings.shadow_texels == resting_texels, "sunk: %llu shadow texels, resting: %llu",
+		      (unsigned long long)gpu_last_timings.shadow_texels, (unsigned long long)resting_texels);
+		/* The lines where the boxes meet the ground differ: a face cut by the depth test there
+		 * versus a face ending there (8 pixels, as many with the ground in the map). */
+		long differ = 0;
+		for (uint32_t j = 0; j < sunk.height; j++)
+			for (uint32_t i = 0; i < sunk.width; i++)
+				for (int c = 0; c < 3; c++)
+					if (abs((int)gpu_px8(&sunk, (int)i, (int)j)[c] - (int)gpu_px8(&resting, (int)i, (int)j)[c]) > 2) {
+						differ++;
+						break;
+					}
+		CHECK(differ * 1000 <= (long)sunk.width * sunk.height, "%ld pixels of sunk boxes differ from resting ones", differ);
+		rnd_image_release(&sunk);
+	}
+	rnd_image_release(&resting);
+}

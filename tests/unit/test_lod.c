@@ -198,3 +198,56 @@ TEST(lod_plane_casts_judged_on_objects_as_asked)
 	rnd_object_bounds(&sc, 1, NULL, &b);
 	CHECK(b.min[1] == -0.5f, "a mesh without drawn bounds: its vertices, y from %g", b.min[1]);
 }
+
+/* The camera of sc looking from pos at target (orthographic when height > 0), planned. */
+static struct rnd_camera_plan plan_from(struct rnd_scene *sc, float x, float y, float z, float tx, float ty, float tz,
+                                        float height)
+{
+	float pos[3] = {x, y, z}, tgt[3] = {tx, ty, tz};
+	memcpy(sc->camera.position, pos, sizeof pos);
+	memcpy(sc->camera.target, tgt, sizeof tgt);
+	sc->camera.type = height > 0 ? RND_CAMERA_ORTHOGRAPHIC : RND_CAMERA_PERSPECTIVE;
+	sc->camera.height = height;
+	struct rnd_aabb bounds = {{-5, -1, -5}, {5, 2, 5}};
+	struct rnd_camera_plan cam;
+	struct rnd_error err;
+	memset(&cam, 0, sizeof cam);
+	CHECK(rnd_camera_plan(&sc->camera, sc->width, sc->height, &bounds, &cam, &err) == RND_OK, "%s", err.msg);
+	return cam;
+}
+
+/* The ground's shadow on the part of an object sunk into it shows to no camera above the ground
+ * (studio-spots' boxes): the ground need not cast. It does where a camera can see that part:
+ * from below, past the ground's edge, through an alpha-tested ground, or when the object sticks
+ * out beyond the ground; and with any one of several views. */
+TEST(lod_plane_shadow_on_sunk_parts_is_seen_by_no_camera_above)
+{
+	struct rnd_scene sc;
+	struct rnd_object obj[2];
+	struct rnd_light sun;
+	thumb(&sc, obj, &sun, 256);
+	struct rnd_aabb sunk = {{-1, -0.5f, -1}, {1, 2, 1}}, edge = {{4.2f, -0.5f, -1}, {5.4f, 1, 1}};
+	struct rnd_camera_plan cam[2];
+	cam[0] = plan_from(&sc, 4, 3, 4, 0, 0.8f, 0, 0);
+	CHECK(rnd_plane_may_shadow(&sc, &obj[0], &sunk), "geometry alone: the ground shadows the sunk part");
+	CHECK(!rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam, 1), "camera above: the sunk part is hidden");
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam, 0), "no camera: judged on geometry");
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &edge, cam, 1), "an object beyond the ground's edge");
+	cam[1] = plan_from(&sc, 4, -3, 4, 0, 0, 0, 0);
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam + 1, 1), "camera below the ground");
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam, 2), "two views, one below");
+	cam[1] = plan_from(&sc, 30, 0.5f, 0, 0, 0, 0, 0);
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam + 1, 1), "a low camera sees under the ground's edge");
+	cam[1] = plan_from(&sc, 0, 10, 0.01f, 0, 0, 0, 6);
+	CHECK(!rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam + 1, 1), "orthographic from above: hidden");
+	struct rnd_material m;
+	rnd_material_defaults(&m);
+	m.alpha_mode = RND_ALPHA_MASK;
+	sc.materials = &m;
+	sc.material_count = 1;
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam, 1), "an alpha-tested ground hides nothing");
+	sc.material_count = 0;
+	sun.direction[1] = 1.0f;   /* from below: the shadow falls on the parts above the ground */
+	struct rnd_aabb resting = {{-1, 0, -1}, {1, 2, 1}};
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &resting, cam, 1), "sun from below, camera above");
+}
