@@ -257,36 +257,6 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 		if (is_round(&sc->objects[i]) && segments[i] < 3) segments[i] = 3;
 }
 
-bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b)
-{
-	float nm[16], n[3], up[3] = {0.0f, 1.0f, 0.0f}, p0[3] = {plane->model[12], plane->model[13], plane->model[14]};
-	if (!rnd_mat4_normal_matrix(nm, plane->model)) return true;
-	rnd_mat4_mul_dir(n, nm, up);
-	if (!rnd_v3_normalize(n, n)) return true;
-	/* Signed distances of the box from the plane: the corner farthest on each side. */
-	float lo = 0.0f, hi = 0.0f;
-	for (int k = 0; k < 3; k++) {
-		float a = n[k] * (b->min[k] - p0[k]), c = n[k] * (b->max[k] - p0[k]);
-		lo += a < c ? a : c;
-		hi += a < c ? c : a;
-	}
-	const float eps = 1e-4f;
-	for (uint32_t i = 0; i < sc->light_count; i++) {
-		const struct rnd_light *L = &sc->lights[i];
-		if (!L->shadow.enabled) continue;
-		float side; /* > 0: the light is on the normal's side */
-		if (L->type == RND_LIGHT_DIRECTIONAL) side = -rnd_v3_dot(n, L->direction);
-		else {
-			float d[3];
-			rnd_v3_sub(d, L->position, p0);
-			side = rnd_v3_dot(n, d);
-		}
-		if (fabsf(side) <= eps) return true;        /* grazing: keep it simple, it casts */
-		if (side > 0.0f ? lo < -eps : hi > eps) return true; /* part of the box behind it */
-	}
-	return false;
-}
-
 /* Whether the points of box b on the far side of `plane` from a camera are all hidden from it by
  * the plane's own quad (opaque, drawn both sides): every line of sight to them crosses the
  * plane inside the quad. The part of b beyond the plane is convex and so is its central (or,
@@ -338,15 +308,16 @@ static bool quad_hides(const struct rnd_object *plane, const float n[3], const f
 	return true;
 }
 
-bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
-                               const struct rnd_camera_plan *cams, uint32_t ncam)
+/* rnd_plane_may_shadow (ncam 0) and rnd_plane_may_shadow_seen in one: for each shadowed light,
+ * whether part of b lies behind the plane from it, and then whether a camera may see that part. */
+static bool plane_shadows(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
+                          const struct rnd_camera_plan *cams, uint32_t ncam)
 {
 	float nm[16], n[3], up[3] = {0.0f, 1.0f, 0.0f}, p0[3] = {plane->model[12], plane->model[13], plane->model[14]};
-	bool opaque = !sc->material_count || sc->materials[plane->material].alpha_mode == RND_ALPHA_OPAQUE;
-	if (!opaque || !ncam) return rnd_plane_may_shadow(sc, plane, b);
 	if (!rnd_mat4_normal_matrix(nm, plane->model)) return true;
 	rnd_mat4_mul_dir(n, nm, up);
 	if (!rnd_v3_normalize(n, n)) return true;
+	/* Signed distances of the box from the plane: the corner farthest on each side. */
 	float lo = 0.0f, hi = 0.0f;
 	for (int k = 0; k < 3; k++) {
 		float a = n[k] * (b->min[k] - p0[k]), c = n[k] * (b->max[k] - p0[k]);
@@ -357,20 +328,34 @@ bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_obje
 	for (uint32_t i = 0; i < sc->light_count; i++) {
 		const struct rnd_light *L = &sc->lights[i];
 		if (!L->shadow.enabled) continue;
-		float side;
+		float side; /* > 0: the light is on the normal's side */
 		if (L->type == RND_LIGHT_DIRECTIONAL) side = -rnd_v3_dot(n, L->direction);
 		else {
 			float d[3];
 			rnd_v3_sub(d, L->position, p0);
 			side = rnd_v3_dot(n, d);
 		}
-		if (fabsf(side) <= eps) return true;
-		if (side > 0.0f ? lo >= -eps : hi <= eps) continue;    /* nothing of b behind it */
+		if (fabsf(side) <= eps) return true;        /* grazing: keep it simple, it casts */
+		if (side > 0.0f ? lo >= -eps : hi <= eps) continue;  /* nothing of the box behind it */
+		if (!ncam) return true;
 		for (uint32_t v = 0; v < ncam; v++)
 			if (!quad_hides(plane, n, p0, side > 0.0f ? 1.0f : -1.0f, b, &cams[v])) return true;
 	}
 	return false;
 }
+
+bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b)
+{
+	return plane_shadows(sc, plane, b, NULL, 0);
+}
+
+bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
+                               const struct rnd_camera_plan *cams, uint32_t ncam)
+{
+	bool opaque = !sc->material_count || sc->materials[plane->material].alpha_mode == RND_ALPHA_OPAQUE;
+	return plane_shadows(sc, plane, b, cams, opaque ? ncam : 0);
+}
+
 
 bool rnd_moments_need_ground(const struct rnd_scene *sc)
 {
