@@ -261,16 +261,27 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
  * the plane's own quad (opaque, drawn both sides): every line of sight to them crosses the
  * plane inside the quad. The part of b beyond the plane is convex and so is its central (or,
  * orthographic, parallel) projection onto the plane, so its corners decide: b's corners
- * beyond the plane and where b's edges cross it. False unless the camera is strictly on the
- * plane's side `side` (sign along the plane's normal n through p0). */
+ * beyond the plane and where b's edges cross it. False unless the camera's whole near
+ * rectangle is strictly on the plane's side `side` (sign along the plane's normal n through
+ * p0): a camera whose near plane cuts the ground sees under it. A one-sided plane hides
+ * nothing here (culled from behind, and a mirroring transform turns its front). */
 static bool quad_hides(const struct rnd_object *plane, const float n[3], const float p0[3], float side,
                        const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
 {
-	float inv[16], cp[3];
-	if (!rnd_mat4_invert(inv, plane->model)) return false;
-	rnd_v3_sub(cp, cam->pos, p0);
-	if (side * rnd_v3_dot(n, cp) <= 0.0f) return false;
+	float inv[16], right[3];
+	if (!plane->double_sided || !rnd_mat4_invert(inv, plane->model)) return false;
 	if (cam->ortho && side * rnd_v3_dot(n, cam->fwd) >= 0.0f) return false;   /* looking away from it */
+	rnd_v3_cross(right, cam->fwd, cam->up);
+	if (!rnd_v3_normalize(right, right)) return false;
+	float hh = cam->ortho ? 0.5f * (cam->ortho_height > 0 ? cam->ortho_height : 1.0f) : cam->znear * tanf(0.5f * cam->fov_y);
+	float hw = hh * cam->aspect;
+	for (int k = 0; k < 4; k++) {
+		float q[3];
+		for (int a = 0; a < 3; a++)
+			q[a] = cam->pos[a] + cam->fwd[a] * cam->znear + right[a] * (k & 1 ? hw : -hw) + cam->up[a] * (k & 2 ? hh : -hh) -
+			       p0[a];
+		if (side * rnd_v3_dot(n, q) <= 0.0f) return false;
+	}
 	float c[8][3], sd[8];
 	for (int k = 0; k < 8; k++) {
 		float d[3];

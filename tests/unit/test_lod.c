@@ -218,8 +218,9 @@ static struct rnd_camera_plan plan_from(struct rnd_scene *sc, float x, float y, 
 
 /* The ground's shadow on the part of an object sunk into it shows to no camera above the ground
  * (studio-spots' boxes): the ground need not cast. It does where a camera can see that part:
- * from below, past the ground's edge, through an alpha-tested ground, or when the object sticks
- * out beyond the ground; and with any one of several views. */
+ * from below, past the ground's edge, through an alpha-tested or one-sided ground, through the
+ * ground where the camera's near plane cuts it, or when the object sticks out beyond the
+ * ground; and with any one of several views. */
 TEST(lod_plane_shadow_on_sunk_parts_is_seen_by_no_camera_above)
 {
 	struct rnd_scene sc;
@@ -240,6 +241,13 @@ TEST(lod_plane_shadow_on_sunk_parts_is_seen_by_no_camera_above)
 	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam + 1, 1), "a low camera sees under the ground's edge");
 	cam[1] = plan_from(&sc, 0, 10, 0.01f, 0, 0, 0, 6);
 	CHECK(!rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam + 1, 1), "orthographic from above: hidden");
+	sc.camera.near = 0.5f;   /* the near plane cuts the ground: the camera sees under it */
+	cam[1] = plan_from(&sc, 2, 0.2f, 2, 0, 0, 0, 0);
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam + 1, 1), "near plane through the ground");
+	sc.camera.near = 0.0f;
+	obj[0].double_sided = false;
+	CHECK(rnd_plane_may_shadow_seen(&sc, &obj[0], &sunk, cam, 1), "a one-sided ground hides nothing");
+	obj[0].double_sided = true;
 	struct rnd_material m;
 	rnd_material_defaults(&m);
 	m.alpha_mode = RND_ALPHA_MASK;
