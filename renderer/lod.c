@@ -376,8 +376,3 @@ bool rnd_moments_need_ground(const struct rnd_scene *sc)
 			return true;
 	return false;
 }
-
-bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *b)
-{
-	return rnd_moments_need_ground(sc) || rnd_plane_may_shadow(sc, &sc->objects[i], b);
-}

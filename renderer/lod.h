@@ -93,20 +93,16 @@ void rnd_object_bounds(const struct rnd_scene *sc, uint32_t i, const struct rnd_
 /* rnd_plane_may_shadow, less the shadows no camera of the render sees: where the part of b
  * behind an opaque plane (from a light) is hidden from every camera of cams[ncam] by the
  * plane's own quad, the plane's shadow on it cannot show (objects sunk into the ground: their
- * buried parts). Cameras: the render's views; none = rnd_plane_may_shadow. */
+ * buried parts). Cameras: the render's views; none = rnd_plane_may_shadow. render.c passes
+ * each other object's bounds as asked (rnd_object_bounds): a sphere resting on the ground
+ * whose segments the level of detail lowered dips a fraction of a millimetre below the ground
+ * as drawn, and had made the ground a caster (thumb-256: a 2048^2 map drawn for that). */
 bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
                                const struct rnd_camera_plan *cams, uint32_t ncam);
 
-/* Whether plane object i may cast a shadow onto box b (rnd_plane_may_shadow), b being another
- * object's bounds as asked (rnd_object_bounds): a sphere resting on the ground whose segments
- * the level of detail lowered dips a fraction of a millimetre below the ground as drawn, and
- * made the ground a caster of a shadow no camera above it sees (thumb-256: a 2048^2 map drawn
- * for that). Always true where a light filters with moments (VSM / EVSM): their blurred
- * moments need what lies behind a caster's edge, the ground, in the map; against the empty
- * map's far depth light bled into the penumbrae. */
-bool rnd_plane_casts(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *b);
-/* Whether a light of sc filters with moments (VSM / EVSM): planes then stay in the shadow pass
- * (rnd_plane_casts). */
+/* Whether a light of sc filters with moments (VSM / EVSM): their blurred moments need what lies
+ * behind a caster's edge, the ground, in the map (against the empty map's far depth light bled
+ * into the penumbrae), so render.c keeps every plane in the shadow pass. */
 bool rnd_moments_need_ground(const struct rnd_scene *sc);
 
 #endif

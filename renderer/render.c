@@ -135,8 +135,8 @@ static void frame_bounds(struct render *rq)
  * and so is one whose shadow falls only where no camera of the render sees it, on the parts
  * of objects sunk into it (rnd_plane_may_shadow_seen; studio-spots' boxes stand 24 cm deep in
  * its floor: in its maps the floor cost a whole-scene sun map and made the PCSS bounds' lit
- * proofs harder, ~10 % of the render). Unless a light filters with moments, whose blur needs
- * the ground behind a caster's edge in the map (rnd_plane_casts). Then the box of what casts,
+ * proofs harder, a few % of the render). Unless a light filters with moments, whose blur
+ * needs the ground behind a caster's edge in the map (rnd_moments_need_ground). Then the box of what casts,
  * which sizes a `fit` sun map: a plane drawn only for the moments' sake stays out of it. It is
  * the receiver around the casters, not a caster; inside the box's tile it is drawn, outside it
  * the sun is unblocked anyway. Counted, it made a VSM thumbnail's sun map cover the whole

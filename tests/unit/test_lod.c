@@ -176,17 +176,18 @@ TEST(lod_plane_casts_judged_on_objects_as_asked)
 	rnd_object_bounds(&sc, 1, &dipping, &b);
 	CHECK(fabsf(b.min[1]) < 1e-6f && fabsf(b.max[1] - 2.0f) < 1e-6f && fabsf(b.min[0] + 1.0f) < 1e-6f,
 	      "the sphere as asked: y %g..%g, x from %g", b.min[1], b.max[1], b.min[0]);
-	CHECK(!rnd_plane_casts(&sc, 0, &b), "a sphere resting on the ground made the ground a caster");
-	CHECK(rnd_plane_casts(&sc, 0, &dipping), "a box reaching below the ground: the ground must cast");
+	CHECK(!rnd_plane_may_shadow(&sc, &obj[0], &b), "a sphere resting on the ground made the ground a caster");
+	CHECK(rnd_plane_may_shadow(&sc, &obj[0], &dipping), "a box reaching below the ground: the ground must cast");
 	obj[1].model[13] = 0.9f;
 	rnd_object_bounds(&sc, 1, NULL, &b);
-	CHECK(rnd_plane_casts(&sc, 0, &b), "a sphere reaching 0.1 below the ground: the ground must cast");
+	CHECK(rnd_plane_may_shadow(&sc, &obj[0], &b), "a sphere reaching 0.1 below the ground: the ground must cast");
 	obj[1].model[13] = 1.0f;
 	rnd_object_bounds(&sc, 1, NULL, &b);
+	CHECK(!rnd_moments_need_ground(&sc), "no moments filter: the ground need not be in the map");
 	sun.shadow.filter = RND_FILTER_VSM;
-	CHECK(rnd_plane_casts(&sc, 0, &b), "vsm: the ground must be in the map");
+	CHECK(rnd_moments_need_ground(&sc), "vsm: the ground must be in the map");
 	sun.shadow.filter = RND_FILTER_EVSM;
-	CHECK(rnd_plane_casts(&sc, 0, &b), "evsm: the ground must be in the map");
+	CHECK(rnd_moments_need_ground(&sc), "evsm: the ground must be in the map");
 	float pos[9] = {0, -0.5f, 0, 1, 1, 0, 0, 1, 1};
 	obj[1].shape = RND_SHAPE_MESH;
 	obj[1].positions = pos;
