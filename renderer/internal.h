@@ -182,6 +182,9 @@ void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
 /* pipelines.c */
 enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err);
 void rnd_pipelines_release(struct rnd_context *ctx);
+/* A named shader module of SPIR-V code (size bytes); the caller destroys it. */
+enum rnd_result rnd_shader_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
+                                  VkShaderModule *out, struct rnd_error *err);
 /* A pipeline for a fullscreen pass (shaders/fullscreen.vert and fs): no vertex input, no depth,
  * one colour attachment of format `color`, dynamic viewport and scissor; `layout` the caller's.
  * Needs rnd_pipelines_init(); the caller destroys it. */

@@ -5,9 +5,10 @@
  * (rnd_lod_radius), deviate from it by at most half the sagitta of their segments (the latitude
  * step of a sphere equals its longitude step, so one circle rule covers both), scaled by the
  * model's largest axis scale. Centring matters: chords all inside shrink a silhouette by the
- * whole sagitta, which measurably blurs it (tests/bench/edge_error.c). That error is compared with the world size of a pixel at the
- * point of the object nearest each camera, and of a texel at the point nearest each shadow
- * view; the object gets the segments the tightest of them needs, never more than asked for.
+ * whole sagitta, which measurably blurs it (tests/bench/edge_error.c). That error is compared
+ * with the world size of a pixel at the point of the object nearest each camera, and of a texel
+ * at the point nearest each shadow view; the object gets the segments the tightest of them
+ * needs, never more than asked for. Also which planes cast shadows (rnd_plane_may_shadow*).
  */
 #include <math.h>
 #include <string.h>
@@ -257,19 +258,42 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 		if (is_round(&sc->objects[i]) && segments[i] < 3) segments[i] = 3;
 }
 
-/* Whether the points of box b on the far side of `plane` from a camera are all hidden from it by
- * the plane's own quad (opaque, drawn both sides): every line of sight to them crosses the
- * plane inside the quad. The part of b beyond the plane is convex and so is its central (or,
- * orthographic, parallel) projection onto the plane, so its corners decide: b's corners
- * beyond the plane and where b's edges cross it. False unless the camera's whole near
- * rectangle is strictly on the plane's side `side` (sign along the plane's normal n through
- * p0): a camera whose near plane cuts the ground sees under it. A one-sided plane hides
- * nothing here (culled from behind, and a mirroring transform turns its front). */
-static bool quad_hides(const struct rnd_object *plane, const float n[3], const float p0[3], float side,
-                       const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
+/* The corners of the part of box b behind the plane (n through p0) from side `side` (the sign
+ * along n of the light's side): b's corners behind it and where b's edges cross it. Returns
+ * how many (at most 8 + 12). */
+static int part_behind(const struct rnd_aabb *b, const float n[3], const float p0[3], float side, float x[20][3])
 {
-	float inv[16], right[3];
-	if (!plane->double_sided || !rnd_mat4_invert(inv, plane->model)) return false;
+	float c[8][3], sd[8];
+	for (int k = 0; k < 8; k++) {
+		float d[3];
+		for (int a = 0; a < 3; a++) c[k][a] = k >> a & 1 ? b->max[a] : b->min[a];
+		rnd_v3_sub(d, c[k], p0);
+		sd[k] = side * rnd_v3_dot(n, d);
+	}
+	int nx = 0;
+	for (int k = 0; k < 8; k++) {
+		if (sd[k] < 0.0f) memcpy(x[nx++], c[k], sizeof x[0]);
+		for (int a = 0; a < 3; a++) {
+			int j = k | 1 << a;
+			if (j == k || (sd[k] < 0.0f) == (sd[j] < 0.0f)) continue;
+			float t = sd[k] / (sd[k] - sd[j]);
+			for (int m = 0; m < 3; m++) x[nx][m] = c[k][m] + t * (c[j][m] - c[k][m]);
+			nx++;
+		}
+	}
+	return nx;
+}
+
+/* Whether the points x[nx] behind `plane` (part_behind) are all hidden from a camera by the
+ * plane's own quad (opaque): every line of sight to them crosses the plane inside the quad.
+ * The part of a box behind the plane is convex and so is its central (or, orthographic,
+ * parallel) projection onto the plane, so its corners decide. False unless the camera's whole
+ * near rectangle is strictly on the plane's side `side`: a camera whose near plane cuts the
+ * ground sees under it. inv: the inverse of the plane's model matrix. */
+static bool quad_hides(const struct rnd_object *plane, const float inv[16], const float n[3], const float p0[3],
+                       float side, float x[][3], int nx, const struct rnd_camera_plan *cam)
+{
+	float right[3];
 	if (cam->ortho && side * rnd_v3_dot(n, cam->fwd) >= 0.0f) return false;   /* looking away from it */
 	rnd_v3_cross(right, cam->fwd, cam->up);
 	if (!rnd_v3_normalize(right, right)) return false;
@@ -282,27 +306,8 @@ static bool quad_hides(const struct rnd_object *plane, const float n[3], const f
 			       p0[a];
 		if (side * rnd_v3_dot(n, q) <= 0.0f) return false;
 	}
-	float c[8][3], sd[8];
-	for (int k = 0; k < 8; k++) {
-		float d[3];
-		for (int a = 0; a < 3; a++) c[k][a] = k >> a & 1 ? b->max[a] : b->min[a];
-		rnd_v3_sub(d, c[k], p0);
-		sd[k] = side * rnd_v3_dot(n, d);
-	}
-	/* margins: the quad's edge shrunk by 1e-4 of its size, a crossing counted from 1e-6 */
+	/* the quad's edge shrunk by 1e-4 of its size */
 	float hx = 0.5f * plane->size[0] * (1.0f - 1e-4f), hz = 0.5f * plane->size[2] * (1.0f - 1e-4f);
-	float x[8 + 12][3];   /* the corners of b's part beyond the plane */
-	int nx = 0;
-	for (int k = 0; k < 8; k++) {
-		if (sd[k] < 0.0f) memcpy(x[nx++], c[k], sizeof x[0]);
-		for (int a = 0; a < 3; a++) {
-			int j = k | 1 << a;
-			if (j == k || (sd[k] < 0.0f) == (sd[j] < 0.0f)) continue;
-			float t = sd[k] / (sd[k] - sd[j]);
-			for (int m = 0; m < 3; m++) x[nx][m] = c[k][m] + t * (c[j][m] - c[k][m]);
-			nx++;
-		}
-	}
 	for (int k = 0; k < nx; k++) {
 		/* along the line of sight to x, onto the plane */
 		float dir[3], q[3], lq[3], dx[3];
@@ -320,10 +325,14 @@ static bool quad_hides(const struct rnd_object *plane, const float n[3], const f
 }
 
 /* rnd_plane_may_shadow (ncam 0) and rnd_plane_may_shadow_seen in one: for each shadowed light,
- * whether part of b lies behind the plane from it, and then whether a camera may see that part. */
+ * whether part of b lies behind the plane from it, and then whether a camera may see that part.
+ * A one-sided plane hides nothing (culled from behind, and a mirroring transform turns its
+ * front). */
 static bool plane_shadows(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
                           const struct rnd_camera_plan *cams, uint32_t ncam)
 {
+	float inv[16];
+	if (ncam && (!plane->double_sided || !rnd_mat4_invert(inv, plane->model))) ncam = 0;
 	float nm[16], n[3], up[3] = {0.0f, 1.0f, 0.0f}, p0[3] = {plane->model[12], plane->model[13], plane->model[14]};
 	if (!rnd_mat4_normal_matrix(nm, plane->model)) return true;
 	rnd_mat4_mul_dir(n, nm, up);
@@ -349,8 +358,10 @@ static bool plane_shadows(const struct rnd_scene *sc, const struct rnd_object *p
 		if (fabsf(side) <= eps) return true;        /* grazing: keep it simple, it casts */
 		if (side > 0.0f ? lo >= -eps : hi <= eps) continue;  /* nothing of the box behind it */
 		if (!ncam) return true;
+		float x[20][3], sgn = side > 0.0f ? 1.0f : -1.0f;
+		int nx = part_behind(b, n, p0, sgn, x);
 		for (uint32_t v = 0; v < ncam; v++)
-			if (!quad_hides(plane, n, p0, side > 0.0f ? 1.0f : -1.0f, b, &cams[v])) return true;
+			if (!quad_hides(plane, inv, n, p0, sgn, x, nx, &cams[v])) return true;
 	}
 	return false;
 }
@@ -366,7 +377,6 @@ bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_obje
 	bool opaque = !sc->material_count || sc->materials[plane->material].alpha_mode == RND_ALPHA_OPAQUE;
 	return plane_shadows(sc, plane, b, cams, opaque ? ncam : 0);
 }
-
 
 bool rnd_moments_need_ground(const struct rnd_scene *sc)
 {

@@ -27,37 +27,52 @@ static bool format_ok(const struct rnd_context *ctx, VkFormat f)
 	return (fp.optimalTilingFeatures & need) == need;
 }
 
+/* A set layout of the two bindings b and a pipeline layout with it and the push constants
+ * (struct rnd_moments_push) for `stage`; `what` names them. */
+static enum rnd_result make_layouts(struct rnd_context *ctx, const VkDescriptorSetLayoutBinding b[2], VkShaderStageFlags stage,
+                                    const char *what, VkDescriptorSetLayout *set, VkPipelineLayout *layout,
+                                    struct rnd_error *err)
+{
+	VkResult vr;
+	char call[80];
+	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 2, .pBindings = b};
+	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, set)) != VK_SUCCESS) {
+		snprintf(call, sizeof call, "vkCreateDescriptorSetLayout (%s)", what);
+		return rnd_fail_vk(err, vr, call);
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, *set, "%s set layout", what);
+	VkPushConstantRange pcr = {stage, 0, sizeof(struct rnd_moments_push)};
+	VkPipelineLayoutCreateInfo lci = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 1, .pSetLayouts = set,
+		.pushConstantRangeCount = 1, .pPushConstantRanges = &pcr,
+	};
+	if ((vr = vkCreatePipelineLayout(ctx->device, &lci, NULL, layout)) != VK_SUCCESS) {
+		snprintf(call, sizeof call, "vkCreatePipelineLayout (%s)", what);
+		return rnd_fail_vk(err, vr, call);
+	}
+	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, *layout, "%s pipeline layout", what);
+	return RND_OK;
+}
+
 /* minmax.comp: its set (the scratch map, the depth bounds), layout and pipeline. */
 static enum rnd_result init_bounds(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_moments *m = &ctx->moments;
-	VkResult vr;
-	VkDescriptorSetLayoutBinding b[2] = {
+	const VkDescriptorSetLayoutBinding b[2] = {
 		{UMBRA_MINMAX_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 		{UMBRA_MINMAX_BINDING_BOUNDS, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL},
 	};
-	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 2, .pBindings = b};
-	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &m->set_layout)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (depth bounds)");
-	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, m->set_layout, "depth bounds set layout");
-	VkPushConstantRange pcr = {VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(struct rnd_moments_push)};
-	VkPipelineLayoutCreateInfo lci = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 1, .pSetLayouts = &m->set_layout,
-		.pushConstantRangeCount = 1, .pPushConstantRanges = &pcr,
-	};
-	if ((vr = vkCreatePipelineLayout(ctx->device, &lci, NULL, &m->layout)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreatePipelineLayout (depth bounds)");
-	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, m->layout, "depth bounds pipeline layout");
 	VkShaderModule mod;
-	VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = sizeof spv_minmax_comp, .pCode = spv_minmax_comp};
-	if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &mod)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreateShaderModule (minmax.comp)");
+	enum rnd_result r;
+	if ((r = make_layouts(ctx, b, VK_SHADER_STAGE_COMPUTE_BIT, "depth bounds", &m->set_layout, &m->layout, err)) != RND_OK ||
+	    (r = rnd_shader_module(ctx, spv_minmax_comp, sizeof spv_minmax_comp, "minmax.comp", &mod, err)) != RND_OK)
+		return r;
 	VkComputePipelineCreateInfo cci = {
 		.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
 		.stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = mod, .pName = "main"},
 		.layout = m->layout,
 	};
-	vr = vkCreateComputePipelines(ctx->device, ctx->pipeline_cache, 1, &cci, NULL, &m->bounds);
+	VkResult vr = vkCreateComputePipelines(ctx->device, ctx->pipeline_cache, 1, &cci, NULL, &m->bounds);
 	vkDestroyShaderModule(ctx->device, mod, NULL);
 	if (vr != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkCreateComputePipelines (minmax.comp)");
 	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE, m->bounds, "pcss depth bounds");
@@ -69,28 +84,16 @@ static enum rnd_result init_bounds(struct rnd_context *ctx, struct rnd_error *er
 static enum rnd_result init_blur(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_moments *m = &ctx->moments;
-	VkResult vr;
-	VkDescriptorSetLayoutBinding b[2] = {
+	const VkDescriptorSetLayoutBinding b[2] = {
 		{UMBRA_MOMENTS_BINDING_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, NULL},
 		{UMBRA_MOMENTS_BINDING_BLUR, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, NULL},
 	};
-	VkDescriptorSetLayoutCreateInfo dci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 2, .pBindings = b};
-	if ((vr = vkCreateDescriptorSetLayout(ctx->device, &dci, NULL, &m->blur_set_layout)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreateDescriptorSetLayout (moments)");
-	RND_NAME(ctx, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, m->blur_set_layout, "moments set layout");
-	VkPushConstantRange pcr = {VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(struct rnd_moments_push)};
-	VkPipelineLayoutCreateInfo lci = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, .setLayoutCount = 1, .pSetLayouts = &m->blur_set_layout,
-		.pushConstantRangeCount = 1, .pPushConstantRanges = &pcr,
-	};
-	if ((vr = vkCreatePipelineLayout(ctx->device, &lci, NULL, &m->blur_layout)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreatePipelineLayout (moments)");
-	RND_NAME(ctx, VK_OBJECT_TYPE_PIPELINE_LAYOUT, m->blur_layout, "moments pipeline layout");
 	VkShaderModule fs;
-	VkShaderModuleCreateInfo mci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = sizeof spv_moments_frag, .pCode = spv_moments_frag};
-	if ((vr = vkCreateShaderModule(ctx->device, &mci, NULL, &fs)) != VK_SUCCESS)
-		return rnd_fail_vk(err, vr, "vkCreateShaderModule (moments.frag)");
-	enum rnd_result r = RND_OK;
+	enum rnd_result r;
+	if ((r = make_layouts(ctx, b, VK_SHADER_STAGE_FRAGMENT_BIT, "moments", &m->blur_set_layout, &m->blur_layout, err)) !=
+	        RND_OK ||
+	    (r = rnd_shader_module(ctx, spv_moments_frag, sizeof spv_moments_frag, "moments.frag", &fs, err)) != RND_OK)
+		return r;
 	VkSpecializationMapEntry e[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
 	for (uint32_t v = 0; v < 5 && r == RND_OK; v++) {
 		uint32_t pass = v == 4, warp = v & 1, persp = v >> 1 & 1, data[3] = {pass, pass ? 0 : warp, pass ? 0 : persp};

@@ -23,8 +23,8 @@
 #include "vis.frag.spv.h"
 #include "mesh_vis.frag.spv.h"
 
-static enum rnd_result make_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
-                                   VkShaderModule *out, struct rnd_error *err)
+enum rnd_result rnd_shader_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
+                                  VkShaderModule *out, struct rnd_error *err)
 {
 	VkShaderModuleCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, .codeSize = size, .pCode = code};
 	VkResult vr = vkCreateShaderModule(ctx->device, &ci, NULL, out);
@@ -252,17 +252,17 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	VkShaderModule surface_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_mesh_vert, sizeof spv_mesh_vert, "mesh.vert", &p->mesh_vs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_mesh_frag, sizeof spv_mesh_frag, "mesh.frag", &p->mesh_fs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_aov_frag, sizeof spv_aov_frag, "aov.frag", &p->aov_fs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_masked_vert, sizeof spv_masked_vert, "masked.vert", &masked_vs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_masked_frag, sizeof spv_masked_frag, "masked.frag", &masked_fs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_surface_frag, sizeof spv_surface_frag, "surface.frag", &surface_fs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs, err)) != RND_OK)
+	if ((r = rnd_shader_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_mesh_vert, sizeof spv_mesh_vert, "mesh.vert", &p->mesh_vs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_mesh_frag, sizeof spv_mesh_frag, "mesh.frag", &p->mesh_fs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_aov_frag, sizeof spv_aov_frag, "aov.frag", &p->aov_fs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_masked_vert, sizeof spv_masked_vert, "masked.vert", &masked_vs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_masked_frag, sizeof spv_masked_frag, "masked.frag", &masked_fs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_surface_frag, sizeof spv_surface_frag, "surface.frag", &surface_fs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs, err)) != RND_OK)
 		goto fail;
-	if ((r = make_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
-	if ((r = make_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
+	if ((r = rnd_shader_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
+	if ((r = rnd_shader_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
 		goto fail;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
@@ -364,7 +364,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	VkShaderModule fs_fs = VK_NULL_HANDLE;
 	if (key->atlas_view) {
 		/* Debug view of the depth atlas: a fullscreen triangle. */
-		if ((r = make_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
+		if ((r = rnd_shader_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
 			goto out_modules;
 		d.vs = p->fullscreen_vs;
 		d.fs = fs_fs;

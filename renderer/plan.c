@@ -2,12 +2,11 @@
  * renderer/plan.c — camera and shadow-view planning (see plan.h). Pure math.
  *
  * Directional lights: `fit` is one orthographic map around what casts shadows, as deep as the
- * whole scene, with the texels a map of the default size around the whole scene has; `cascades` are
- * camera-centred bounding spheres of the practical split scheme's slices (a sphere around the
- * eye is invariant under camera rotation, so rotating in place moves no cascade), snapped to
- * whole texels in a light basis that does not depend on the camera (translating the camera
- * moves shadows by whole texels: no shimmer); their depth range covers the scene bounds and
- * depth clamp pancakes casters in front of the near plane.
+ * scene, with the texels of the default map around the whole scene; `cascades` are camera-
+ * centred bounding spheres of the practical split scheme's slices (rotating the camera in place
+ * moves no cascade), snapped to whole texels in a light basis that does not depend on the
+ * camera (translating it moves shadows by whole texels: no shimmer); their depth range covers
+ * the scene bounds and depth clamp pancakes casters in front of the near plane.
  */
 #include <math.h>
 #include <string.h>
@@ -439,12 +438,48 @@ static void fit_box(const float view[16], const struct rnd_aabb *b, uint32_t fil
 	*hx = fmaxf(*hx, hmax / 32.0f); *hy = fmaxf(*hy, hmax / 32.0f);
 }
 
+/* A `fit` map (centre cx, cy; half sizes hx, hy; margin grow; fres texels) cut down to the
+ * casters' box, as deep as before: a receiver outside it has nothing between it and the sun.
+ * (thumb-256 drew a 2048^2 map and used a 400^2 corner.) Same texels, on the same grid (a
+ * shifted grid moved the truth test's PCSS score), in the smallest tile holding the box and
+ * the filter's reach. A moment blur clamps at the tile's edge and a lit ground read dark within
+ * a blur of it: that band reads as lit (moment_edge), the casters keep a blur away from it. */
+static void fit_casters(const struct rnd_shadow *s, const float view[16], const struct rnd_aabb *casters,
+                        struct rnd_light_plan *lp, float *fres, float *cx, float *cy, float *hx, float *hy, float *grow)
+{
+	float blur = ceilf(fmaxf(s->vsm_blur, 0.0f));
+	float reach = (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels
+	               : lp->moments ? 2.0f * blur + 1.0f : (float)lp->pcf_radius) + 2.0f;
+	/* the whole scene's map: its texels and its texel grid's origin */
+	float tx = 2.0f * *hx * *grow / *fres, ty = 2.0f * *hy * *grow / *fres;
+	float ox = *cx - *hx * *grow, oy = *cy - *hy * *grow;
+	uint32_t res = 64;
+	if (!rnd_aabb_is_empty(casters)) {
+		/* the casters' box and margin in whole texels of that grid */
+		struct rnd_aabb lc;
+		rnd_aabb_transform(&lc, casters, view);
+		float x0 = floorf((lc.min[0] - ox) / tx - reach), x1 = ceilf((lc.max[0] - ox) / tx + reach);
+		float y0 = floorf((lc.min[1] - oy) / ty - reach), y1 = ceilf((lc.max[1] - oy) / ty + reach);
+		float need = fmaxf(x1 - x0, y1 - y0);
+		while ((float)res < need && (float)res < *fres) res *= 2;
+		if ((float)res < *fres) {
+			/* centred on the casters, whole texels from the grid's origin */
+			float sx = floorf(0.5f * (x0 + x1 - (float)res)), sy = floorf(0.5f * (y0 + y1 - (float)res));
+			*hx = 0.5f * (float)res * tx; *hy = 0.5f * (float)res * ty;
+			*cx = ox + sx * tx + *hx; *cy = oy + sy * ty + *hy;
+			*grow = 1.0f;
+			if (lp->moments) lp->moment_edge = blur + 1.0f;
+		}
+	}
+	lp->resolution = res < (uint32_t)*fres ? res : (uint32_t)*fres;
+	*fres = (float)lp->resolution;
+}
+
 /* A directional light's views: clipmap levels, one fitted map, or cascades. */
 static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, const struct rnd_aabb *bounds,
                                         const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
-                                        bool clipmap, bool cascades,
-                                        uint32_t ncasc, struct rnd_light_plan *lp, struct rnd_shadow_plan *out,
-                                        struct rnd_error *err)
+                                        bool clipmap, bool cascades, uint32_t ncasc, struct rnd_light_plan *lp,
+                                        struct rnd_shadow_plan *out, struct rnd_error *err)
 {
 	const struct rnd_shadow *s = &L->shadow;
 	float fres = (float)lp->resolution;
@@ -458,53 +493,11 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		plan_clipmap(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
 	} else if (!cascades) {
 		/* fit: the box (fit_box) of the scene's light-space bounds, the texels it has at
-		 * the light's resolution. */
+		 * the light's resolution; then, unless the light asks for a resolution, the casters'. */
 		float cx, cy, hx, hy;
 		fit_box(view, bounds, lp->filter, &cx, &cy, &hx, &hy);
-		/* Only the casters' box, deep enough for every receiver (zmin, zmax): a receiver
-		 * outside it has nothing between it and the sun (sample_view: lit outside the view),
-		 * and a thumbnail's sphere over a 10 m floor cleared and rasterised a 2048^2 map of
-		 * which it used a 400^2 corner (thumb-256: the shadow stage 5.4 of 13 ms). The texels
-		 * stay those of the default map around the whole scene, in the smallest tile that holds
-		 * the box and a margin of the filter's reach (PCSS: its search cap) past the casters'
-		 * edge, where their penumbrae fall. No caster: the smallest tile, empty. A light that
-		 * asks for a resolution gets that many texels across the whole scene, as before. */
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
-		if (casters && s->resolution == 0) {
-			/* Moments: the blur clamps at the tile's edge, where the ground's depth goes on
-			 * rising or falling beyond it: within a blur's reach of the edge its moments lean
-			 * to one side and a lit ground reads dark (a 20-texel line at blur 64). That band
-			 * is read as lit (lp->moment_edge), so the casters keep a blur's reach from it
-			 * besides their own blur's: what lies there has no caster within a blur of it. */
-			float blur = ceilf(fmaxf(s->vsm_blur, 0.0f));
-			float reach = (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels
-			               : lp->moments ? 2.0f * blur + 1.0f : (float)lp->pcf_radius) + 2.0f;
-			/* the whole scene's map: its texels and its texel grid's origin */
-			float tx = 2.0f * hx * grow / fres, ty = 2.0f * hy * grow / fres;
-			float ox = cx - hx * grow, oy = cy - hy * grow;
-			uint32_t res = 64;
-			if (!rnd_aabb_is_empty(casters)) {
-				/* the casters' box and margin in whole texels of that grid, so that every texel
-				 * the smaller map holds is one the whole scene's map held: the same shadows,
-				 * not a grid shifted by a fraction of a texel */
-				struct rnd_aabb lc;
-				rnd_aabb_transform(&lc, casters, view);
-				float x0 = floorf((lc.min[0] - ox) / tx - reach), x1 = ceilf((lc.max[0] - ox) / tx + reach);
-				float y0 = floorf((lc.min[1] - oy) / ty - reach), y1 = ceilf((lc.max[1] - oy) / ty + reach);
-				float need = fmaxf(x1 - x0, y1 - y0);
-				while ((float)res < need && (float)res < fres) res *= 2;
-				if ((float)res < fres) {
-					/* centred on the casters, whole texels from the grid's origin */
-					float sx = floorf(0.5f * (x0 + x1 - (float)res)), sy = floorf(0.5f * (y0 + y1 - (float)res));
-					hx = 0.5f * (float)res * tx; hy = 0.5f * (float)res * ty;
-					cx = ox + sx * tx + hx; cy = oy + sy * ty + hy;
-					grow = 1.0f;
-					if (lp->moments) lp->moment_edge = blur + 1.0f;
-				}
-			}
-			lp->resolution = res < (uint32_t)fres ? res : (uint32_t)fres;
-			fres = (float)lp->resolution;
-		}
+		if (casters && s->resolution == 0) fit_casters(s, view, casters, lp, &fres, &cx, &cy, &hx, &hy, &grow);
 		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
 		lp->max_distance = s->max_distance;
 	} else {
@@ -596,9 +589,8 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 			                   UMBRA_MAX_SHADOW_VIEWS);
 		lp->first_view = out->view_count;
 		lp->view_count = need;
-		r = L->type == RND_LIGHT_DIRECTIONAL
-		        ? plan_directional(L, i, bounds, casters, cam, clipmap, cascades, ncasc, lp, out, err)
-		        : plan_local(L, i, bounds, lp, out, err);
+		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, casters, cam, clipmap, cascades, ncasc, lp, out, err)
+		                                     : plan_local(L, i, bounds, lp, out, err);
 		if (r != RND_OK) return r;
 		if (lp->resolution > out->resolution) out->resolution = lp->resolution;
 	}

@@ -136,10 +136,10 @@ static void frame_bounds(struct render *rq)
  * of objects sunk into it (rnd_plane_may_shadow_seen; studio-spots' boxes stand 24 cm deep in
  * its floor: in its maps the floor cost a whole-scene sun map and made the PCSS bounds' lit
  * proofs harder, a few % of the render). Unless a light filters with moments, whose blur
- * needs the ground behind a caster's edge in the map (rnd_moments_need_ground). Then the box of what casts,
- * which sizes a `fit` sun map: a plane drawn only for the moments' sake stays out of it. It is
- * the receiver around the casters, not a caster; inside the box's tile it is drawn, outside it
- * the sun is unblocked anyway. Counted, it made a VSM thumbnail's sun map cover the whole
+ * needs the ground behind a caster's edge in the map (rnd_moments_need_ground). Then the box
+ * of what casts, which sizes a `fit` sun map: a plane drawn only for the moments' sake stays
+ * out of it. It is the receiver around the casters, not a caster; inside the box's tile it is
+ * drawn, outside it the sun is unblocked anyway. Counted, it made a VSM thumbnail's sun map cover the whole
  * 10 m floor: a 2048^2 map whose moments cost ~100 ms on lavapipe, for shadows within a 256^2
  * corner. */
 #define RND_PLANE_CAMERAS 8u   /* renders of more views judge planes on geometry alone */

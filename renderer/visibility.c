@@ -19,10 +19,10 @@
  * that no centre shows takes its neighbour's shadow: it covers part of a pixel.
  *
  * When: scenes with at least two lights with wide filters (PCSS, PCF of radius 4 or more) and
- * enough small triangles to pay for the passes (rnd_visibility_wanted), no debug view (the views show the filters' own work) and no
- * alpha-tested material (the surfaces pass does not cut out texels, so what shows through them
- * would take the cut-out surface's shadow). UMBRA_VISIBILITY=0 turns it off, =1 on where the
- * device and the scene allow it.
+ * enough small triangles to pay for the passes (rnd_visibility_wanted), no debug view (the
+ * views show the filters' own work) and no alpha-tested material (the surfaces pass does not
+ * cut out texels, so what shows through them would take the cut-out surface's shadow).
+ * UMBRA_VISIBILITY=0 turns it off, =1 on where the device and the scene allow it.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -39,15 +39,15 @@
  * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
 #define RND_VIS_MIN_LIGHTS 2u
 #define RND_VIS_MIN_PCF_RADIUS 4u
+#define RND_VIS_PIXELS_PER_FACE 512u
+/* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
+#define RND_VIS_MAX_BYTES (32ull << 20)
 
 /* A filter costly enough per pixel that running it once per pixel pays for the passes. */
 static bool wide_filter(const struct rnd_light_plan *lp)
 {
 	return lp->filter == UMBRA_FILTER_PCSS || (lp->filter == UMBRA_FILTER_PCF && lp->pcf_radius >= RND_VIS_MIN_PCF_RADIUS);
 }
-#define RND_VIS_PIXELS_PER_FACE 512u
-/* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
-#define RND_VIS_MAX_BYTES (32ull << 20)
 
 bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
                            const struct draw *draws, uint32_t ndraw)

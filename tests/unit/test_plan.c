@@ -67,6 +67,14 @@ static void fixture_init(struct fixture *f, float size, enum rnd_light_type type
 
 static void set3(float v[3], float x, float y, float z) { v[0] = x; v[1] = y; v[2] = z; }
 
+/* fixture_init with a sun along dir and a single `fit` map. */
+static void fixture_fit_sun(struct fixture *f, float size, const float dir[3])
+{
+	fixture_init(f, size, RND_LIGHT_DIRECTIONAL);
+	memcpy(f->light.direction, dir, sizeof f->light.direction);
+	f->light.shadow.dir_mode = RND_DIR_FIT;
+}
+
 /* Camera at pos looking at target, explicit near/far (0 = derived). */
 static void camera_at(struct rnd_camera *c, float px, float py, float pz, float tx, float ty, float tz,
                       float znear, float zfar)
@@ -261,9 +269,7 @@ TEST(plan_fit_covers_scene_bounds)
 	for (int bi = 0; bi < 2; bi++)
 		for (int di = 0; di < 6; di++) {
 			struct fixture f;
-			fixture_init(&f, 1.0f, RND_LIGHT_DIRECTIONAL);
-			memcpy(f.light.direction, dirs[di], sizeof f.light.direction);
-			f.light.shadow.dir_mode = RND_DIR_FIT;
+			fixture_fit_sun(&f, 1.0f, dirs[di]);
 			f.light.shadow.resolution = 1024;
 			struct rnd_camera_plan cp;
 			static struct rnd_shadow_plan sp;
@@ -316,9 +322,7 @@ TEST(plan_fit_covers_the_casters_on_the_whole_scenes_grid)
 	for (int di = 0; di < 3; di++)
 		for (int fi = 0; fi < 2; fi++) {
 			struct fixture f;
-			fixture_init(&f, 40.0f, RND_LIGHT_DIRECTIONAL);
-			memcpy(f.light.direction, dirs[di], sizeof f.light.direction);
-			f.light.shadow.dir_mode = RND_DIR_FIT;
+			fixture_fit_sun(&f, 40.0f, dirs[di]);
 			f.light.shadow.filter = filters[fi];
 			struct rnd_camera_plan cp;
 			static struct rnd_shadow_plan whole, part, asked, none;
@@ -383,9 +387,7 @@ TEST(plan_fit_low_sun_uses_the_light_space_box)
 	static const float low[3] = {-0.794f, -0.1219f, -0.5955f}, high[3] = {-0.5f, -1, -0.3f};
 	for (int t = 0; t < 3; t++) {
 		struct fixture f;
-		fixture_init(&f, 30.0f, RND_LIGHT_DIRECTIONAL);
-		memcpy(f.light.direction, t == 1 ? high : low, sizeof f.light.direction);
-		f.light.shadow.dir_mode = RND_DIR_FIT;
+		fixture_fit_sun(&f, 30.0f, t == 1 ? high : low);
 		if (t == 2) { f.light.angular_diameter = 0.01f; f.light.shadow.filter = RND_FILTER_PCSS; }
 		struct rnd_camera_plan cp;
 		static struct rnd_shadow_plan sp;
