@@ -14,6 +14,7 @@
 #include <string.h>
 #include "lod.h"
 #include "mesh.h"
+#include "proxy.h"
 
 #define PI_F 3.14159265358979323846f
 
@@ -217,6 +218,24 @@ static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, st
 		}
 	}
 	if (rnd_aabb_is_empty(obj)) *obj = *all;
+}
+
+void rnd_lod_proxies(const struct rnd_scene *sc, uint32_t nviews, const uint32_t *segments, struct rnd_proxy *proxies)
+{
+	memset(proxies, 0, sc->object_count * sizeof *proxies);
+	/* One camera at a position the request gives (fit: none), which the render's own plan
+	 * keeps exactly: the proxy's outline is where that camera's rays graze the sphere. */
+	if (nviews != 1 || sc->view_count > 1 || sc->exact_segments) return;
+	struct rnd_aabb bounds, obj_bounds, casters;
+	estimate_bounds(sc, &bounds, &obj_bounds, &casters);
+	struct rnd_camera_plan cam;
+	struct rnd_error err;
+	const struct rnd_camera *camera = sc->view_count ? &sc->views[0] : &sc->camera;
+	if (camera->fit != RND_FIT_NONE || rnd_camera_plan(camera, sc->width, sc->height, &bounds, &cam, &err) != RND_OK)
+		return;
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		if (sc->objects[i].shape == RND_SHAPE_SPHERE)
+			rnd_proxy_plan(sc, &sc->objects[i], &cam, (float)sc->width, (float)sc->height, segments[i], &proxies[i]);
 }
 
 void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shadow_plan *scratch, uint32_t *segments)

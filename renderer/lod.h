@@ -78,6 +78,12 @@ void rnd_lod_apply(struct rnd_object *o, uint32_t lod);
 void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shadow_plan *scratch,
                     uint32_t *segments);
 
+/* Fills proxies[i] for every object of the scene (rnd_proxy_plan, renderer/proxy.h: a sphere
+ * the one camera of the request sees from a given position, tessellated with segments[i] by
+ * rnd_lod_choose()); zeroed (none) for the rest and for renders of several views. */
+struct rnd_proxy;
+void rnd_lod_proxies(const struct rnd_scene *sc, uint32_t nviews, const uint32_t *segments, struct rnd_proxy *proxies);
+
 /* Whether plane object `plane` may cast a shadow of any shadowed light of sc onto the box b (an
  * object's world bounds): false when b lies wholly on the lit side of the plane for every such
  * light (a flat plane never shadows itself). render.c leaves a plane that shadows none of the

@@ -429,7 +429,7 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		}
 		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
 		                        &s->texture_sets[d->texture_set], 0, NULL);
-		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+		record_draw_camera(cmd, d);
 	}
 	/* Closed primitives first, open surfaces (planes, meshes) after: what a ground plane
 	 * hides behind objects then fails the early depth test instead of being shaded. */
@@ -445,7 +445,7 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		                   sizeof push, &push);
 		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
 		                        &s->texture_sets[d->texture_set], 0, NULL);
-		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+		record_draw_camera(cmd, d);
 	}
 }
 
@@ -578,7 +578,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 			                   sizeof push, &push);
 			vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
 			                        &s->texture_sets[d->texture_set], 0, NULL);
-			vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+			record_draw_camera(cmd, d);
 		}
 		vkCmdEndRendering(cmd);
 		copy_aov_pass(cmd, s, rv, area, pass);

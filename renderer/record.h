@@ -12,6 +12,8 @@
 /* One object's draw, made by render.c's upload. */
 struct draw {
 	uint32_t first_index, index_count;
+	uint32_t cam_first_index, cam_index_count;   /* what the camera passes draw: the same, or a
+	                                                sphere's proxy (UMBRA_DRAW_SPHERE, proxy.h) */
 	uint32_t first_vertex, vertex_count;
 	struct rnd_aabb bounds;
 	uint32_t material;
@@ -23,6 +25,12 @@ struct draw {
 	uint32_t texture_set; /* slot->texture_sets index: 0 = white, 1 + i = textured material i */
 	uint32_t tex_bits;    /* (1 << UMBRA_TEX_*) its material samples | UMBRA_TEXBIT_VERTEX_COLOR */
 };
+
+/* Draws what the camera passes draw of d (cam_first_index, cam_index_count). */
+static inline void record_draw_camera(VkCommandBuffer cmd, const struct draw *d)
+{
+	vkCmdDrawIndexed(cmd, d->cam_index_count, 1, d->cam_first_index, 0, 0);
+}
 
 /* Everything the recorders need to know about this view. */
 struct record_view {

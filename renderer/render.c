@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 #include "contact.h"
+#include "proxy.h"
 #include "visibility.h"
 #include "estimate.h"
 #include "frame.h"
@@ -76,6 +77,7 @@ struct render {
 	struct draw *draws;
 	struct rnd_shadow_plan *sp;
 	uint32_t *lod;
+	struct rnd_proxy *proxies;     /* what the camera draws of each sphere (proxy.h) */
 	const struct rnd_texture **tex;
 	uint32_t ntex;
 	struct rnd_pacer pacer;
@@ -108,15 +110,21 @@ static enum rnd_result arena_init(struct render *rq, struct rnd_error *err)
 	const struct rnd_scene *sc = rq->sc;
 	size_t draws_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct draw);
 	size_t lod_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(uint32_t);
-	size_t tex_off = (draws_bytes + sizeof(struct rnd_shadow_plan) + lod_bytes + 15) & ~(size_t)15;
+	size_t proxy_off = (draws_bytes + sizeof(struct rnd_shadow_plan) + lod_bytes + 15) & ~(size_t)15;
+	size_t proxy_bytes = (sc->object_count ? sc->object_count : 1) * sizeof(struct rnd_proxy);
+	size_t tex_off = (proxy_off + proxy_bytes + 15) & ~(size_t)15;
 	void *arena = malloc(tex_off + rq->ctx->max_textures * sizeof(void *));
 	if (!arena) return rnd_fail(err, RND_ERR_OOM, "out of memory for %u objects", sc->object_count);
 	rq->arena = arena;
 	rq->draws = arena;
 	rq->sp = (struct rnd_shadow_plan *)((char *)arena + draws_bytes);
 	rq->lod = (uint32_t *)((char *)rq->sp + sizeof *rq->sp);
+	rq->proxies = (struct rnd_proxy *)((char *)arena + proxy_off);
 	rq->tex = (const struct rnd_texture **)((char *)arena + tex_off);
 	rnd_lod_choose(sc, rq->sheet.views, rq->sp, rq->lod);
+	rnd_lod_proxies(sc, rq->sheet.views, rq->lod, rq->proxies);
+	for (uint32_t i = 0; i < sc->object_count; i++)
+		if (rq->proxies[i].outline) rq->tm.sphere_proxies++;
 	return RND_OK;
 }
 
@@ -219,7 +227,7 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	double t0 = now_ms();
 	rnd_pacer_init(&rq->pacer, sc);
 	if ((r = rnd_pacer_check(&rq->pacer, err)) != RND_OK) return r;
-	if ((r = rnd_upload_scene(ctx, s, sc, &rq->pacer, rq->lod, rq->draws, &rq->bounds, err)) != RND_OK) return r;
+	if ((r = rnd_upload_scene(ctx, s, sc, &rq->pacer, rq->lod, rq->proxies, rq->draws, &rq->bounds, err)) != RND_OK) return r;
 	frame_bounds(rq);
 	if ((r = rnd_material_textures(ctx, s, sc, rq->draws, rq->tex, &rq->ntex, err)) != RND_OK) return r;
 	rq->tm.upload_ms = now_ms() - t0;
@@ -259,9 +267,10 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 		c2.fit = RND_FIT_NONE;
 		if ((r = rnd_camera_plan(&c2, sc->width, sc->height, &rq->bounds, cam, err)) != RND_OK) return r;
 	}
+	/* A sphere's proxy has no back: its slivers along the outline must not be culled. */
 	for (uint32_t i = 0; i < sc->object_count; i++)
-		draws[i].cull_back = draws[i].single_sided ||
-		                     (draws[i].closed && record_camera_outside(cam, &draws[i].bounds));
+		draws[i].cull_back = !(draws[i].flags & UMBRA_DRAW_SPHERE) &&
+		                     (draws[i].single_sided || (draws[i].closed && record_camera_outside(cam, &draws[i].bounds)));
 	if ((r = rnd_shadow_plan_with(sc, &rq->bounds, &rq->casters, cam, v ? rq->cascades : NULL, sp, err)) != RND_OK)
 		return r;
 	if (v == 0)

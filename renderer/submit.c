@@ -293,7 +293,7 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 
 	bool split = p->slice_ms > 0 || sc->band_rows;
 	uint64_t tris = 0;
-	for (uint32_t i = 0; i < rv->ndraw; i++) tris += rv->draws[i].index_count / 3;
+	for (uint32_t i = 0; i < rv->ndraw; i++) tris += rv->draws[i].cam_index_count / 3;
 	double est_row = sc->width * px_units(rv) * EST_MS_PER_PIXEL_UNIT;
 	double est_fixed = (double)tris * EST_MS_PER_TRIANGLE * (1 + rv->aov_passes);
 	/* Down to single rows: with many soft-shadowed lights and AOVs one row of a large image

@@ -7,12 +7,13 @@
 #include <stdio.h>
 #include "lod.h"
 #include "mesh.h"
+#include "proxy.h"
 #include "texture.h"
 #include "upload.h"
 
 enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                                 const struct rnd_pacer *pacer, const uint32_t *lod, struct draw *draws,
-                                 struct rnd_aabb *bounds, struct rnd_error *err)
+                                 const struct rnd_pacer *pacer, const uint32_t *lod, const struct rnd_proxy *proxies,
+                                 struct draw *draws, struct rnd_aabb *bounds, struct rnd_error *err)
 {
 	uint64_t nv = 0, ni = 0;
 	for (uint32_t i = 0; i < sc->object_count; i++) {
@@ -20,6 +21,8 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		struct rnd_object o = sc->objects[i];
 		rnd_lod_apply(&o, lod[i]); /* renderer/lod.h: no finer than the output can show */
 		rnd_mesh_counts(&o, &v, &x);
+		nv += v; ni += x;
+		rnd_proxy_counts(&proxies[i], &v, &x);
 		nv += v; ni += x;
 	}
 	if (nv > UINT32_MAX || ni > UINT32_MAX)
@@ -50,13 +53,16 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 			snprintf(m, sizeof m, "%s", err->msg);
 			return rnd_fail(err, r, "object %u: %s", i, m);
 		}
-		d->first_index = ibase;
-		d->index_count = x;
+		d->first_index = d->cam_first_index = ibase;
+		d->index_count = d->cam_index_count = x;
 		d->first_vertex = vbase;
 		d->vertex_count = v;
+		vbase += v; ibase += x;
+		bool proxy = proxies[i].outline > 0;
 		d->material = sc->material_count ? o->material : 0;
 		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
-		d->flags = (o->receive_shadows ? UMBRA_DRAW_RECEIVE_SHADOWS : 0) | (catcher ? UMBRA_DRAW_SHADOW_CATCHER : 0);
+		d->flags = (o->receive_shadows ? UMBRA_DRAW_RECEIVE_SHADOWS : 0) | (catcher ? UMBRA_DRAW_SHADOW_CATCHER : 0) |
+		           (proxy ? UMBRA_DRAW_SPHERE : 0);
 		/* A shadow catcher receives shadows and casts none (contract §7). */
 		d->cast = o->cast_shadows && !catcher;
 		/* MASK and dithered BLEND both take the alpha-tested depth passes. */
@@ -65,8 +71,18 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		d->single_sided = !o->double_sided;
 		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
 		            (o->shape == RND_SHAPE_MESH && o->closed);
-		d->cull_back = d->single_sided;
+		d->cull_back = d->single_sided && !proxy;
 		rnd_aabb_union(bounds, &d->bounds);
+	}
+	/* The camera's proxies of spheres after every mesh: where the meshes lie in the buffers (which
+	 * the shadow cache's keys hash, render.c caster_key) does not depend on the camera. */
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		uint32_t v, x;
+		rnd_proxy_counts(&proxies[i], &v, &x);
+		if (!x) continue;
+		rnd_proxy_write(&proxies[i], vtx + vbase, idx + ibase, vbase);
+		draws[i].cam_first_index = ibase;
+		draws[i].cam_index_count = x;
 		vbase += v; ibase += x;
 	}
 	return RND_OK;

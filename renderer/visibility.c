@@ -117,7 +117,11 @@ static void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const s
 		if (!d->index_count) continue;
 		VkPipeline p = ctx->pipes.surfaces[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
+		/* surface.frag reads the draw's flags (a sphere's proxy). */
+		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
+		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+		                   sizeof push, &push);
+		record_draw_camera(cmd, d);
 	}
 	vkCmdEndRendering(cmd);
 	for (int i = 0; i < 2; i++)

@@ -23,11 +23,9 @@ void main()
 	material_derivatives(v_uv);
 	umbra_material m = draw_material();
 	uint flags = pc.info.y;
-	vec3 n_geo = normalize(v_nrm);
-	// Two-sided: back faces shade with the flipped normal.
-	if (!gl_FrontFacing) n_geo = -n_geo;
-	vec3 n_shadow = facet_normal(v_pos, n_geo);   // before base_color's discard
-	vec3 p_shadow = covered_position(v_pos, SC_SAMPLES);
+	vec3 n_geo, p_shadow, n_shadow;   // before base_color's discard
+	surface_at(in_pos, v_nrm, v_uv, flags, SC_SAMPLES, frame.camera_pos, frame.camera_fwd.xyz, v_pos, n_geo, p_shadow,
+	           n_shadow);
 	vec4 bc = base_color(m);
 	vec3 N = material_normal(m, n_geo, has_tex(m, UMBRA_TEX_NORMAL));
 	vec3 V = frame.camera_pos.w > 0.5 ? -frame.camera_fwd.xyz : normalize(frame.camera_pos.xyz - v_pos);

@@ -70,7 +70,8 @@ vec4 v_tangent;
 vec2 vis_frag_xy;        // the pixel (centre) this invocation computes, in the view
 vec2 frag_xy() { return vis_frag_xy; }
 #else
-layout(location = 0) in vec3 v_pos;
+layout(location = 0) in vec3 in_pos;
+vec3 v_pos;              // what main() shades: in_pos, or on an analytic sphere (facet.glsl surface_at)
 layout(location = 1) in vec3 v_nrm;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_color;

@@ -7,15 +7,19 @@
 // renderer/internal.h): the shadow filters' receiver plane comes from that normal, and one
 // rounded to 12-bit octahedral coordinates put acne on a face lit at a grazing angle
 // (studio-spots: a box face speckled; with 16 bits the image is that of float normals).
-layout(location = 0) in vec3 v_pos;
+layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_FRAME) uniform FrameBlock { umbra_frame frame; };
+layout(push_constant) uniform PushBlock { umbra_push pc; };
+layout(location = 0) in vec3 in_pos;
 layout(location = 1) in vec3 v_nrm;
+layout(location = 2) in vec2 v_uv;
 layout(location = 0) out vec4 o_position;
 layout(location = 1) out vec4 o_normal;
 #include "facet.glsl"
 void main()
 {
-	vec3 n = normalize(v_nrm);
-	if (!gl_FrontFacing) n = -n;
-	o_position = vec4(v_pos, 1.0);
-	o_normal = vec4(facet_normal(v_pos, n), 0.0);
+	vec3 pos, n_geo, p_shadow, n_shadow;
+	surface_at(in_pos, v_nrm, v_uv, pc.info.y, 1u, frame.camera_pos, frame.camera_fwd.xyz, pos, n_geo, p_shadow,
+	           n_shadow);
+	o_position = vec4(p_shadow, 1.0);   // where its shadow lookups look: pos, or raised by a proxy's lift
+	o_normal = vec4(n_shadow, 0.0);
 }

@@ -120,6 +120,7 @@
 /* umbra_push.info.y (main pass): per-draw flags */
 #define UMBRA_DRAW_RECEIVE_SHADOWS 1u
 #define UMBRA_DRAW_SHADOW_CATCHER  2u
+#define UMBRA_DRAW_SPHERE          4u   /* the camera passes draw an analytic sphere's proxy (renderer/proxy.h) */
 
 /* Specialization constant ids of mesh.frag (see renderer/pipelines.c rnd_main_key). */
 #define UMBRA_SC_FILTERS     0

@@ -302,3 +302,72 @@ TEST(ground_under_sunk_objects_casts_nothing)
 	}
 	rnd_image_release(&resting);
 }
+
+/* Whether a ray through some point within `reach` pixels of pixel (i, j)'s centre grazes past
+ * the sphere while another meets it: the pixel lies on the sphere's outline. */
+static bool near_outline(const struct gpu_cam *cam, int i, int j, v3 c, double r, double reach)
+{
+	int hits = 0;
+	for (int k = 0; k < 9; k++) {
+		v3 o, d;
+		gpu_cam_ray(cam, i + 0.5 + reach * (k % 3 - 1), j + 0.5 + reach * (k / 3 - 1), &o, &d);
+		hits += gpu_ray_sphere(o, d, c, r, 1e-6) >= 0;
+	}
+	return hits != 0 && hits != 9;
+}
+
+/* A sphere's proxy (renderer/proxy.h): the camera draws a cap of a few hundred triangles and
+ * shades the true sphere under it. Against the tessellated sphere (the level of detail's,
+ * within 1/32 pixel), a glossy sphere under a soft sun and a soft spot (MSAA 4): pixels off its outline
+ * differ by at most a few levels (the true surface against chords within 1/32 pixel: a
+ * highlight moves a little), only outline pixels by more (which samples a 1/32-pixel outline
+ * covers), and few of those. */
+TEST(sphere_proxy_shades_the_true_sphere)
+{
+	static const char *doc =
+		"{'width': 256, 'height': 256, 'camera': {'type': 'perspective', 'position': [3.2, 2.2, 3.0],"
+		" 'target': [0, 0.9, 0], 'up': [0, 1, 0], 'fov_y': 40},"
+		" 'materials': {'glossy': {'base_color': [0.8, 0.25, 0.2], 'roughness': 0.25}},"
+		" 'objects': [{'shape': 'plane', 'size': [10, 10]},"
+		" {'shape': 'sphere', 'radius': 1, 'segments': 316, 'material': 'glossy', 'transform': {'translation': [0, 1, 0]}}],"
+		" 'lights': [{'type': 'directional', 'direction': [-0.5, -1, -0.3], 'angular_diameter': 2},"
+		" {'type': 'spot', 'position': [1.5, 3.5, -1], 'direction': [-1.5, -3.5, 1], 'intensity': 30, 'radius': 0.1,"
+		" 'outer_angle': 40}]}";
+	struct rnd_image proxy, full;
+	if (!gpu_render(&proxy, doc, 0)) return;
+	CHECK(gpu_last_timings.sphere_proxies == 1, "the sphere is drawn as a proxy (%u)", gpu_last_timings.sphere_proxies);
+	setenv("UMBRA_SPHERE_PROXY", "0", 1);
+	bool ok = gpu_render(&full, doc, 0);
+	unsetenv("UMBRA_SPHERE_PROXY");
+	if (!ok) { rnd_image_release(&proxy); return; }
+	CHECK(gpu_last_timings.sphere_proxies == 0, "UMBRA_SPHERE_PROXY=0: no proxy (%u)", gpu_last_timings.sphere_proxies);
+	struct gpu_cam cam;
+	gpu_cam_persp(&cam, v3_make(3.2, 2.2, 3.0), v3_make(0, 0.9, 0), v3_make(0, 1, 0), 40, 256, 256);
+	v3 centre = v3_make(0, 1, 0);
+	int off_worst = 0, on_worst = 0, on_changed = 0, on_count = 0, sphere_px = 0;
+	for (int j = 0; j < 256; j++)
+		for (int i = 0; i < 256; i++) {
+			int d = 0;
+			for (int c = 0; c < 3; c++) {
+				int e = abs((int)gpu_px8(&proxy, i, j)[c] - (int)gpu_px8(&full, i, j)[c]);
+				if (e > d) d = e;
+			}
+			if (near_outline(&cam, i, j, centre, 1.0, 1.0)) {
+				on_count++;
+				if (d > on_worst) on_worst = d;
+				if (d > 8) on_changed++;
+			} else {
+				v3 o, dir;
+				gpu_cam_ray(&cam, i + 0.5, j + 0.5, &o, &dir);
+				sphere_px += gpu_ray_sphere(o, dir, centre, 1.0, 1e-6) >= 0;
+				if (d > off_worst) off_worst = d;
+			}
+		}
+	printf("  proxy vs 316 segments: %d sphere pixels off the outline differ by <= %d; %d outline pixels by <= %d, %d by > 8\n",
+	       sphere_px, off_worst, on_count, on_worst, on_changed);
+	CHECK(sphere_px > 10000, "the sphere covers %d pixels", sphere_px);
+	CHECK(off_worst <= 3, "off the outline a pixel differs by %d", off_worst);
+	CHECK(on_changed * 10 <= on_count, "%d of %d outline pixels differ by more than 8", on_changed, on_count);
+	rnd_image_release(&proxy);
+	rnd_image_release(&full);
+}

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 #include "test.h"
+#include "thumb_scene.h"
 #include "lod.h"
 
 #define PI_D 3.14159265358979323846
@@ -87,32 +88,6 @@ TEST(lod_object_segments_never_exceed_what_was_asked)
 	CHECK(rnd_lod_object_segments(&o, 0.01f, 0.03125f) == 316, "boxes are not touched");
 }
 
-/* thumb-512 in C: a plane, a 316-segment unit sphere at y = 1, a sun, camera (4, 3, 4). */
-static void thumb(struct rnd_scene *sc, struct rnd_object obj[2], struct rnd_light *sun, uint32_t size)
-{
-	rnd_scene_defaults(sc);
-	sc->width = sc->height = size;
-	float pos[3] = {4, 3, 4}, tgt[3] = {0, 0.8f, 0};
-	memcpy(sc->camera.position, pos, sizeof pos);
-	memcpy(sc->camera.target, tgt, sizeof tgt);
-	sc->camera.fov_y = (float)(40 * PI_D / 180);
-	rnd_object_defaults(&obj[0]);
-	obj[0].shape = RND_SHAPE_PLANE;
-	obj[0].size[0] = obj[0].size[2] = 10;
-	rnd_object_defaults(&obj[1]);
-	obj[1].shape = RND_SHAPE_SPHERE;
-	obj[1].radius = 1;
-	obj[1].segments = 316;
-	obj[1].model[13] = 1;
-	rnd_light_defaults(sun, RND_LIGHT_DIRECTIONAL);
-	float d[3] = {-0.5f, -1, -0.3f};
-	memcpy(sun->direction, d, sizeof d);
-	sc->objects = obj;
-	sc->object_count = 2;
-	sc->lights = sun;
-	sc->light_count = 1;
-}
-
 TEST(lod_choose_thumbnail_sphere_meets_pixel_bound)
 {
 	struct rnd_scene sc;
@@ -120,7 +95,7 @@ TEST(lod_choose_thumbnail_sphere_meets_pixel_bound)
 	struct rnd_light sun;
 	static struct rnd_shadow_plan scratch;
 	uint32_t seg[2], again[2], big[2];
-	thumb(&sc, obj, &sun, 512);
+	thumb_scene(&sc, obj, &sun, 512);
 	rnd_lod_choose(&sc, 1, &scratch, seg);
 	rnd_lod_choose(&sc, 1, &scratch, again);
 	CHECK(seg[0] == obj[0].segments, "the plane keeps its segments (%u)", seg[0]);
@@ -131,7 +106,7 @@ TEST(lod_choose_thumbnail_sphere_meets_pixel_bound)
 	double d = sqrt(16.0 + 4.0 + 16.0) - 1.0, pw = 2.0 * d * tan(20 * PI_D / 180) / 512.0;
 	CHECK(centred_error(1.0, seg[1]) <= pw / 32.0 * 1.01, "%u segments deviate %g > %g", seg[1],
 	      centred_error(1.0, seg[1]), pw / 32.0);
-	thumb(&sc, obj, &sun, 2048);
+	thumb_scene(&sc, obj, &sun, 2048);
 	rnd_lod_choose(&sc, 1, &scratch, big);
 	CHECK(big[1] > seg[1], "a larger image needs more: %u at 2048, %u at 512", big[1], seg[1]);
 	sc.exact_segments = true;
@@ -144,7 +119,7 @@ TEST(lod_plane_under_objects_shadows_nothing)
 	struct rnd_scene sc;
 	struct rnd_object obj[2];
 	struct rnd_light sun;
-	thumb(&sc, obj, &sun, 256);
+	thumb_scene(&sc, obj, &sun, 256);
 	struct rnd_aabb above = {{-1, 0, -1}, {1, 2, 1}}, through = {{-1, -0.5f, -1}, {1, 2, 1}};
 	CHECK(!rnd_plane_may_shadow(&sc, &obj[0], &above), "sun from above, sphere resting on the plane");
 	CHECK(rnd_plane_may_shadow(&sc, &obj[0], &through), "an object reaching below the plane");
@@ -172,7 +147,7 @@ TEST(lod_plane_casts_judged_on_objects_as_asked)
 	struct rnd_object obj[2];
 	struct rnd_light sun;
 	struct rnd_aabb b, dipping = {{-1.001f, -0.001f, -1.001f}, {1.001f, 2.001f, 1.001f}};
-	thumb(&sc, obj, &sun, 256);
+	thumb_scene(&sc, obj, &sun, 256);
 	rnd_object_bounds(&sc, 1, &dipping, &b);
 	CHECK(fabsf(b.min[1]) < 1e-6f && fabsf(b.max[1] - 2.0f) < 1e-6f && fabsf(b.min[0] + 1.0f) < 1e-6f,
 	      "the sphere as asked: y %g..%g, x from %g", b.min[1], b.max[1], b.min[0]);
@@ -227,7 +202,7 @@ TEST(lod_plane_shadow_on_sunk_parts_is_seen_by_no_camera_above)
 	struct rnd_scene sc;
 	struct rnd_object obj[2];
 	struct rnd_light sun;
-	thumb(&sc, obj, &sun, 256);
+	thumb_scene(&sc, obj, &sun, 256);
 	struct rnd_aabb sunk = {{-1, -0.5f, -1}, {1, 2, 1}}, edge = {{4.2f, -0.5f, -1}, {5.4f, 1, 1}};
 	struct rnd_camera_plan cam[2];
 	cam[0] = plan_from(&sc, 4, 3, 4, 0, 0.8f, 0, 0);

@@ -359,6 +359,7 @@ struct rnd_timings {
 	uint32_t shadow_maps_rendered, shadow_maps_reused;
 	uint64_t shadow_texels;     /* texels of the shadow maps drawn (each map res x res) */
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
+	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
 };
 
 /* ---- context ---- */

@@ -1,0 +1,193 @@
+/*
+ * renderer/proxy.c — a camera's cap of few triangles for an analytic sphere (see proxy.h).
+ *
+ * The cap is a pole facing the camera and rings of vertices around the axis from the sphere's
+ * centre towards the camera, out to the outline (the circle where the camera's rays graze the
+ * sphere). Neighbouring vertices inside are at most `step` apart (their chords lie within
+ * RND_PROXY_STEP_PIXELS of the sphere), each ring with as few vertices as that allows; the
+ * outline ring has as many as lod.h's pixel bound asks of the sphere's outline, raised so its
+ * chords straddle the outline as the tessellated sphere's do (rnd_lod_radius). Rings of
+ * different counts are zipped by angle.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "lod.h"
+#include "proxy.h"
+
+#define PI_D 3.14159265358979323846
+/* The widest step inside, radians: far below it a chord's depth error is what limits. */
+#define RND_PROXY_MAX_STEP 0.5
+/* Fewest vertices of an inner ring. */
+#define RND_PROXY_MIN_RING 6u
+
+/* Whether sc's scene and o's material allow a proxy at all (see proxy.h). */
+static bool proxy_allowed(const struct rnd_scene *sc, const struct rnd_object *o)
+{
+	const char *env = getenv("UMBRA_SPHERE_PROXY");
+	if (env && strcmp(env, "0") == 0) return false;
+	if (o->shape != RND_SHAPE_SPHERE) return false;
+	if (sc->material_count) {
+		const struct rnd_material *m = &sc->materials[o->material];
+		if (m->alpha_mode != RND_ALPHA_OPAQUE) return false;
+		for (int k = 0; k < RND_TEX_SLOTS; k++)
+			if (m->textures[k]) return false;
+	}
+	for (uint32_t i = 0; i < sc->light_count; i++)
+		if (sc->lights[i].shadow.enabled && sc->lights[i].shadow.contact_enabled) return false;
+	return true;
+}
+
+/* The uniform scale of o's model (no shear); 0 when it scales its axes differently. */
+static double uniform_scale(const float m[16])
+{
+	double c[3][3], l[3];
+	for (int i = 0; i < 3; i++) {
+		for (int k = 0; k < 3; k++) c[i][k] = m[4 * i + k];
+		l[i] = sqrt(c[i][0] * c[i][0] + c[i][1] * c[i][1] + c[i][2] * c[i][2]);
+	}
+	if (!(l[0] > 0.0)) return 0.0;
+	for (int i = 0; i < 3; i++) {
+		if (fabs(l[i] / l[0] - 1.0) > 1e-4) return 0.0;
+		int j = (i + 1) % 3;
+		if (fabs(c[i][0] * c[j][0] + c[i][1] * c[j][1] + c[i][2] * c[j][2]) > 1e-4 * l[0] * l[0]) return 0.0;
+	}
+	return l[0];
+}
+
+bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, const struct rnd_camera_plan *cam, float w,
+                    float h, uint32_t segments, struct rnd_proxy *out)
+{
+	memset(out, 0, sizeof *out);
+	if (!proxy_allowed(sc, o)) return false;
+	double scale = uniform_scale(o->model);
+	double r = fabs((double)o->radius) * scale;
+	if (!(r > 0.0) || !isfinite(r)) return false;
+	double c[3] = {o->model[12], o->model[13], o->model[14]}, a[3], dist = 0.0;
+	if (cam->ortho) {
+		for (int k = 0; k < 3; k++) a[k] = -cam->fwd[k];
+		dist = INFINITY;
+	} else {
+		for (int k = 0; k < 3; k++) {
+			a[k] = cam->pos[k] - c[k];
+			dist += a[k] * a[k];
+		}
+		dist = sqrt(dist);
+		/* Outside the sphere, its nearest point beyond the near plane. */
+		double ahead = -(a[0] * cam->fwd[0] + a[1] * cam->fwd[1] + a[2] * cam->fwd[2]);
+		if (!(dist > 1.001 * r) || !(ahead - r > 1.01 * cam->znear)) return false;
+		for (int k = 0; k < 3; k++) a[k] /= dist;
+	}
+	float fc[3] = {(float)c[0], (float)c[1], (float)c[2]};
+	float pw = rnd_lod_pixel_world(cam->view_proj, w, h, fc, (float)r, cam->ortho ? 0.0f : cam->znear);
+	if (!(pw > 0.0f) || !isfinite(pw)) return false;
+	double edge = cam->ortho ? 0.5 * PI_D : acos(r / dist);
+	double rho = r * sin(edge);
+	uint32_t n = rnd_lod_circle_segments((float)rho, RND_LOD_PIXEL_ERROR * pw);
+	/* Fewer segments than the outline needs were asked for: the facets are what was asked. */
+	if (n == UINT32_MAX || n > segments || n > (1u << 16)) return false;
+	if (n < 8) n = 8;
+	double depth = (double)RND_PROXY_STEP_PIXELS * pw;
+	/* A triangle's plane dips deepest at the centre of its circumcircle, whose angular radius is
+	 * about the triangle's longest side over sqrt(2) for the right triangles of a ring pair
+	 * and somewhat more where rings of different counts are zipped: sides of `step` keep it
+	 * within acos(1 - depth / r) (tests/unit/test_proxy.c measures the deepest). */
+	double step = depth >= r ? RND_PROXY_MAX_STEP : acos(1.0 - depth / r);
+	if (step > RND_PROXY_MAX_STEP) step = RND_PROXY_MAX_STEP;
+	uint32_t rings = (uint32_t)ceil(edge / step);
+	if (rings < 2) rings = 2;
+	out->outline = n;
+	out->rings = rings;
+	out->step = (float)step;
+	for (int k = 0; k < 3; k++) {
+		out->centre[k] = fc[k];
+		out->axis[k] = (float)a[k];
+	}
+	out->radius = (float)r;
+	out->edge = (float)edge;
+	out->outline_radius = (float)(2.0 * rho / (1.0 + cos(PI_D / n)));
+	out->lift = (float)(((double)rnd_lod_radius(fabsf(o->radius), segments, o->segments) - fabs((double)o->radius)) * scale);
+	return true;
+}
+
+/* Vertices of ring j (1..rings; the last is the outline). */
+static uint32_t ring_count(const struct rnd_proxy *p, uint32_t j)
+{
+	if (j == p->rings) return p->outline;
+	double theta = p->edge * (double)j / p->rings;
+	double n = ceil(2.0 * PI_D * sin(theta) / p->step);
+	uint32_t c = n < RND_PROXY_MIN_RING ? RND_PROXY_MIN_RING : (uint32_t)n;
+	return c < p->outline ? c : p->outline;
+}
+
+void rnd_proxy_counts(const struct rnd_proxy *p, uint32_t *vertex_count, uint32_t *index_count)
+{
+	*vertex_count = *index_count = 0;
+	if (!p->outline) return;
+	uint32_t nv = 1, tris = ring_count(p, 1);
+	for (uint32_t j = 1; j <= p->rings; j++) {
+		nv += ring_count(p, j);
+		if (j < p->rings) tris += ring_count(p, j) + ring_count(p, j + 1);
+	}
+	*vertex_count = nv;
+	*index_count = 3 * tris;
+}
+
+static void put_vertex(struct rnd_vertex *v, const struct rnd_proxy *p, const double pos[3])
+{
+	memset(v, 0, sizeof *v);
+	for (int k = 0; k < 3; k++) {
+		v->pos[k] = (float)pos[k];
+		v->nrm[k] = (float)(pos[k] - p->centre[k]);   /* the centre, for the fragment shaders */
+	}
+	v->uv[0] = p->radius;
+	v->uv[1] = p->lift;
+	memset(v->color, 255, sizeof v->color);
+	v->tangent[0] = 127;
+	v->tangent[3] = 127;
+}
+
+void rnd_proxy_write(const struct rnd_proxy *p, struct rnd_vertex *v, uint32_t *idx, uint32_t base_vertex)
+{
+	if (!p->outline) return;
+	/* u, w across the axis with u x w = axis: angles run counter-clockwise seen from the camera. */
+	double a[3] = {p->axis[0], p->axis[1], p->axis[2]}, t[3] = {1, 0, 0}, u[3], w[3];
+	if (fabs(a[0]) > 0.9) t[0] = 0, t[1] = 1;
+	u[0] = t[1] * a[2] - t[2] * a[1], u[1] = t[2] * a[0] - t[0] * a[2], u[2] = t[0] * a[1] - t[1] * a[0];
+	double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+	for (int k = 0; k < 3; k++) u[k] /= lu;
+	w[0] = a[1] * u[2] - a[2] * u[1], w[1] = a[2] * u[0] - a[0] * u[2], w[2] = a[0] * u[1] - a[1] * u[0];
+	double pos[3];
+	for (int k = 0; k < 3; k++) pos[k] = p->centre[k] + p->radius * a[k];
+	put_vertex(&v[0], p, pos);
+	uint32_t nv = 1, ni = 0, prev_first = 0, prev_n = 1;
+	for (uint32_t j = 1; j <= p->rings; j++) {
+		uint32_t n = ring_count(p, j), first = nv;
+		double theta = p->edge * (double)j / p->rings;
+		double along = p->radius * cos(theta), across = j == p->rings ? p->outline_radius : p->radius * sin(theta);
+		for (uint32_t i = 0; i < n; i++) {
+			double phi = 2.0 * PI_D * i / n, cu = cos(phi) * across, cw = sin(phi) * across;
+			for (int k = 0; k < 3; k++) pos[k] = p->centre[k] + along * a[k] + cu * u[k] + cw * w[k];
+			put_vertex(&v[nv++], p, pos);
+		}
+		/* Zip the previous ring (the pole: one vertex) to this one by angle. */
+		uint32_t i = 0, k = 0;
+		while (i < prev_n || k < n) {
+			uint32_t ai = base_vertex + prev_first + i % prev_n, bk = base_vertex + first + k % n;
+			bool outer = k < n && (i >= prev_n || (uint64_t)(k + 1) * prev_n <= (uint64_t)(i + 1) * n);
+			if (prev_n == 1) outer = true;
+			idx[ni++] = ai;
+			idx[ni++] = bk;
+			if (outer) {
+				idx[ni++] = base_vertex + first + (k + 1) % n;
+				k++;
+			} else {
+				idx[ni++] = base_vertex + prev_first + (i + 1) % prev_n;
+				i++;
+			}
+			if (prev_n == 1 && k == n) break;
+		}
+		prev_first = first;
+		prev_n = n;
+	}
+}
