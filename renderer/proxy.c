@@ -63,19 +63,21 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 	double scale = uniform_scale(o->model);
 	double r = fabs((double)o->radius) * scale;
 	if (!(r > 0.0) || !isfinite(r)) return false;
-	double c[3] = {o->model[12], o->model[13], o->model[14]}, a[3], dist = 0.0;
+	double c[3] = {o->model[12], o->model[13], o->model[14]}, a[3], dist = 0.0, ahead = 0.0;
+	for (int k = 0; k < 3; k++) {
+		a[k] = cam->pos[k] - c[k];
+		dist += a[k] * a[k];
+		ahead -= a[k] * cam->fwd[k];
+	}
+	dist = sqrt(dist);
+	/* Wholly beyond the near plane (which would cut the cap and show that it has no back), and
+	 * the camera outside the sphere. */
+	if (!(ahead - r > 1.01 * cam->znear)) return false;
 	if (cam->ortho) {
 		for (int k = 0; k < 3; k++) a[k] = -cam->fwd[k];
 		dist = INFINITY;
 	} else {
-		for (int k = 0; k < 3; k++) {
-			a[k] = cam->pos[k] - c[k];
-			dist += a[k] * a[k];
-		}
-		dist = sqrt(dist);
-		/* Outside the sphere, its nearest point beyond the near plane. */
-		double ahead = -(a[0] * cam->fwd[0] + a[1] * cam->fwd[1] + a[2] * cam->fwd[2]);
-		if (!(dist > 1.001 * r) || !(ahead - r > 1.01 * cam->znear)) return false;
+		if (!(dist > 1.001 * r)) return false;
 		for (int k = 0; k < 3; k++) a[k] /= dist;
 	}
 	float fc[3] = {(float)c[0], (float)c[1], (float)c[2]};

@@ -213,4 +213,9 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	plan(&sc, 1, p);
 	CHECK(p[1].outline > 0 && fabsf(p[1].edge - (float)(PI_D / 2)) < 1e-6f,
 	      "orthographic: a proxy out to the equator (%g rad)", p[1].edge);
+	float in_ortho[3] = {0, 1, 0.5f}, ahead[3] = {0, 1, -1};
+	memcpy(sc.camera.position, in_ortho, sizeof in_ortho);
+	memcpy(sc.camera.target, ahead, sizeof ahead);
+	plan(&sc, 1, p);
+	CHECK(p[1].outline == 0, "orthographic camera whose near plane cuts the sphere: no proxy");
 }
