@@ -223,15 +223,17 @@ static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, st
 void rnd_lod_proxies(const struct rnd_scene *sc, uint32_t nviews, const uint32_t *segments, struct rnd_proxy *proxies)
 {
 	memset(proxies, 0, sc->object_count * sizeof *proxies);
-	/* One camera at a position the request gives (fit: none), which the render's own plan
-	 * keeps exactly: the proxy's outline is where that camera's rays graze the sphere. */
+	/* One camera: the proxy's outline is where its rays graze the sphere. A fitted one is placed
+	 * here from the estimated bounds, as rnd_lod_choose() places it; render.c confirms that
+	 * its own placement agrees (rnd_proxy_fits). */
 	if (nviews != 1 || sc->view_count > 1 || sc->exact_segments) return;
 	struct rnd_aabb bounds, obj_bounds, casters;
 	estimate_bounds(sc, &bounds, &obj_bounds, &casters);
 	struct rnd_camera_plan cam;
 	struct rnd_error err;
 	const struct rnd_camera *camera = sc->view_count ? &sc->views[0] : &sc->camera;
-	if (camera->fit != RND_FIT_NONE || rnd_camera_plan(camera, sc->width, sc->height, &bounds, &cam, &err) != RND_OK)
+	if (rnd_camera_plan(camera, sc->width, sc->height, camera->fit == RND_FIT_OBJECTS ? &obj_bounds : &bounds, &cam,
+	                    &err) != RND_OK)
 		return;
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		if (sc->objects[i].shape == RND_SHAPE_SPHERE)

@@ -55,23 +55,18 @@ static double uniform_scale(const float m[16])
 	return l[0];
 }
 
-bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, const struct rnd_camera_plan *cam, float w,
-                    float h, uint32_t segments, struct rnd_proxy *out)
+/* Places proxy p (its sphere, outline count and lift set) for camera cam: the axis, the
+ * outline's angle and raised radius, the eye. False where the camera is inside the sphere or
+ * the near plane cuts it (which would cut the cap and show that it has no back). */
+static bool place(struct rnd_proxy *p, const struct rnd_camera_plan *cam)
 {
-	memset(out, 0, sizeof *out);
-	if (!proxy_allowed(sc, o)) return false;
-	double scale = uniform_scale(o->model);
-	double r = fabs((double)o->radius) * scale;
-	if (!(r > 0.0) || !isfinite(r)) return false;
-	double c[3] = {o->model[12], o->model[13], o->model[14]}, a[3], dist = 0.0, ahead = 0.0;
+	double r = p->radius, a[3], dist = 0.0, ahead = 0.0;
 	for (int k = 0; k < 3; k++) {
-		a[k] = cam->pos[k] - c[k];
+		a[k] = (double)cam->pos[k] - p->centre[k];
 		dist += a[k] * a[k];
 		ahead -= a[k] * cam->fwd[k];
 	}
 	dist = sqrt(dist);
-	/* Wholly beyond the near plane (which would cut the cap and show that it has no back), and
-	 * the camera outside the sphere. */
 	if (!(ahead - r > 1.01 * cam->znear)) return false;
 	if (cam->ortho) {
 		for (int k = 0; k < 3; k++) a[k] = -cam->fwd[k];
@@ -80,15 +75,35 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 		if (!(dist > 1.001 * r)) return false;
 		for (int k = 0; k < 3; k++) a[k] /= dist;
 	}
-	float fc[3] = {(float)c[0], (float)c[1], (float)c[2]};
-	float pw = rnd_lod_pixel_world(cam->view_proj, w, h, fc, (float)r, cam->ortho ? 0.0f : cam->znear);
-	if (!(pw > 0.0f) || !isfinite(pw)) return false;
 	double edge = cam->ortho ? 0.5 * PI_D : acos(r / dist);
-	double rho = r * sin(edge);
-	uint32_t n = rnd_lod_circle_segments((float)rho, RND_LOD_PIXEL_ERROR * pw);
+	for (int k = 0; k < 3; k++) {
+		p->axis[k] = (float)a[k];
+		p->eye[k] = cam->pos[k];
+	}
+	p->edge = (float)edge;
+	p->outline_radius = (float)(2.0 * r * sin(edge) / (1.0 + cos(PI_D / p->outline)));
+	p->ortho = cam->ortho;
+	return true;
+}
+
+bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, const struct rnd_camera_plan *cam, float w,
+                    float h, uint32_t segments, struct rnd_proxy *out)
+{
+	memset(out, 0, sizeof *out);
+	if (!proxy_allowed(sc, o)) return false;
+	double scale = uniform_scale(o->model);
+	double r = fabs((double)o->radius) * scale;
+	if (!(r > 0.0) || !isfinite(r)) return false;
+	struct rnd_proxy p = {.radius = (float)r, .outline = 8};
+	for (int k = 0; k < 3; k++) p.centre[k] = o->model[12 + k];
+	if (!place(&p, cam)) return false;
+	float pw = rnd_lod_pixel_world(cam->view_proj, w, h, p.centre, p.radius, cam->ortho ? 0.0f : cam->znear);
+	if (!(pw > 0.0f) || !isfinite(pw)) return false;
+	uint32_t n = rnd_lod_circle_segments(p.radius * sinf(p.edge), RND_LOD_PIXEL_ERROR * pw);
 	/* Fewer segments than the outline needs were asked for: the facets are what was asked. */
 	if (n == UINT32_MAX || n > segments || n > (1u << 16)) return false;
-	if (n < 8) n = 8;
+	p.outline = n < 8 ? 8 : n;
+	place(&p, cam);   /* the outline's radius for that count */
 	double depth = (double)RND_PROXY_STEP_PIXELS * pw;
 	/* A triangle's plane dips deepest at the centre of its circumcircle, whose angular radius is
 	 * about the triangle's longest side over sqrt(2) for the right triangles of a ring pair
@@ -96,27 +111,48 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 	 * within acos(1 - depth / r) (tests/unit/test_proxy.c measures the deepest). */
 	double step = depth >= r ? RND_PROXY_MAX_STEP : acos(1.0 - depth / r);
 	if (step > RND_PROXY_MAX_STEP) step = RND_PROXY_MAX_STEP;
-	uint32_t rings = (uint32_t)ceil(edge / step);
-	if (rings < 2) rings = 2;
-	out->outline = n;
-	out->rings = rings;
-	out->step = (float)step;
-	for (int k = 0; k < 3; k++) {
-		out->centre[k] = fc[k];
-		out->axis[k] = (float)a[k];
-	}
-	out->radius = (float)r;
-	out->edge = (float)edge;
-	out->outline_radius = (float)(2.0 * rho / (1.0 + cos(PI_D / n)));
-	out->lift = (float)(((double)rnd_lod_radius(fabsf(o->radius), segments, o->segments) - fabs((double)o->radius)) * scale);
+	p.step = (float)step;
+	p.rings = (uint32_t)ceil(p.edge / step);
+	if (p.rings < 2) p.rings = 2;
+	p.count_edge = p.edge;
+	p.pixel = pw;
+	p.lift = (float)(((double)rnd_lod_radius(fabsf(o->radius), segments, o->segments) - fabs((double)o->radius)) * scale);
+	*out = p;
 	return true;
+}
+
+bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam)
+{
+	if (rnd_proxy_fits(p, cam)) return true;
+	/* The counts stay (the vertices and indices the render reserved): the camera moved by a
+	 * small fraction of the sphere's size, the pixel and the step with it. */
+	if (!place(p, cam)) {
+		p->outline = 0;
+		return false;
+	}
+	return true;
+}
+
+bool rnd_proxy_fits(const struct rnd_proxy *p, const struct rnd_camera_plan *cam)
+{
+	if (!p->outline || cam->ortho != p->ortho) return false;
+	/* The grazing circle moves by about the eye's move times R / d (perspective), or R times the
+	 * direction's turn (orthographic). */
+	double move = 0.0, d = 0.0;
+	for (int k = 0; k < 3; k++) {
+		double e = cam->ortho ? -cam->fwd[k] - p->axis[k] : cam->pos[k] - p->eye[k];
+		move += e * e;
+		d += ((double)p->eye[k] - p->centre[k]) * ((double)p->eye[k] - p->centre[k]);
+	}
+	double shift = sqrt(move) * p->radius / (cam->ortho ? 1.0 : sqrt(d));
+	return shift <= p->pixel / 128.0;
 }
 
 /* Vertices of ring j (1..rings; the last is the outline). */
 static uint32_t ring_count(const struct rnd_proxy *p, uint32_t j)
 {
 	if (j == p->rings) return p->outline;
-	double theta = p->edge * (double)j / p->rings;
+	double theta = p->count_edge * (double)j / p->rings;
 	double n = ceil(2.0 * PI_D * sin(theta) / p->step);
 	uint32_t c = n < RND_PROXY_MIN_RING ? RND_PROXY_MIN_RING : (uint32_t)n;
 	return c < p->outline ? c : p->outline;

@@ -13,8 +13,9 @@
  * most RND_PROXY_STEP_PIXELS apart in depth error; the shadow passes keep the tessellated
  * sphere.
  *
- * A sphere gets a proxy (rnd_proxy_plan) when one camera renders it (single view), from a
- * fixed position (fit: none), outside it and clear of the near plane; when its model scales it
+ * A sphere gets a proxy (rnd_proxy_plan) when one camera renders it (single view), from
+ * outside it and clear of the near plane (a fitted camera: when the render's own placement
+ * agrees with the plan's, rnd_proxy_fits); when its model scales it
  * uniformly; when its material has no texture and is opaque (the proxy carries no uv), and no
  * light marches contact shadows (they march the camera's depth, which the proxy holds only to
  * within its bound). Otherwise, and with UMBRA_SPHERE_PROXY=0, the sphere's mesh is drawn.
@@ -45,14 +46,28 @@ struct rnd_proxy {
 	float centre[3], radius; /* the sphere, world */
 	float axis[3];           /* unit, from the centre towards the camera */
 	float edge;              /* angle of the outline from the axis: acos(radius / distance) */
+	float count_edge;        /* the edge the rings' vertex counts were planned with (they stay) */
 	float outline_radius;    /* radius of the outline ring, raised so its chords straddle it */
 	float lift;              /* how far the shadow passes' tessellated sphere reaches outside it */
+	float eye[3];            /* the camera it was planned for: position (perspective) */
+	float pixel;             /* world size of a pixel at the sphere's nearest point */
+	bool ortho;
 };
 
 /* Whether sphere o of sc gets a proxy for camera cam (w x h pixels; segments: what the level of
  * detail tessellates it with) and its shape; false (out->outline 0) where the mesh is drawn. */
 bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, const struct rnd_camera_plan *cam, float w,
                     float h, uint32_t segments, struct rnd_proxy *out);
+
+/* Whether cam, the camera a render actually draws with, is the one p was planned for: up to a
+ * move of the outline by 1/128 pixel. A fitted camera is placed from the tessellated shapes'
+ * bounds, which the plan (lod.c) estimated from the shapes as asked. */
+bool rnd_proxy_fits(const struct rnd_proxy *p, const struct rnd_camera_plan *cam);
+
+/* Makes p that of camera cam where it was planned for another (rnd_proxy_fits): the same
+ * counts of vertices and indices, placed for cam. False (p->outline 0: draw the mesh) where cam
+ * is inside the sphere or its near plane cuts it. */
+bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam);
 
 /* Vertices and indices of proxy p (0 when none). */
 void rnd_proxy_counts(const struct rnd_proxy *p, uint32_t *vertex_count, uint32_t *index_count);

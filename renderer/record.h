@@ -14,6 +14,7 @@ struct draw {
 	uint32_t first_index, index_count;
 	uint32_t cam_first_index, cam_index_count;   /* what the camera passes draw: the same, or a
 	                                                sphere's proxy (UMBRA_DRAW_SPHERE, proxy.h) */
+	uint32_t cam_first_vertex;                   /* the proxy's first vertex */
 	uint32_t first_vertex, vertex_count;
 	struct rnd_aabb bounds;
 	uint32_t material;

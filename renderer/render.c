@@ -267,6 +267,23 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 		c2.fit = RND_FIT_NONE;
 		if ((r = rnd_camera_plan(&c2, sc->width, sc->height, &rq->bounds, cam, err)) != RND_OK) return r;
 	}
+	/* A proxy planned for a camera other than this one (a fitted camera, placed here from the
+	 * tessellated shapes' bounds, lod.c from the shapes as asked): placed again for this one,
+	 * in the same vertices (nothing of this render has been submitted yet); where it cannot be
+	 * (this camera inside the sphere, or its near plane cutting it), the sphere's mesh. */
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		struct draw *d = &draws[i];
+		if (!(d->flags & UMBRA_DRAW_SPHERE) || rnd_proxy_fits(&rq->proxies[i], cam)) continue;
+		if (rnd_proxy_refit(&rq->proxies[i], cam)) {
+			rnd_proxy_write(&rq->proxies[i], (struct rnd_vertex *)rq->s->vertices.map + d->cam_first_vertex,
+			                (uint32_t *)rq->s->indices.map + d->cam_first_index, d->cam_first_vertex);
+			continue;
+		}
+		d->flags &= ~UMBRA_DRAW_SPHERE;
+		d->cam_first_index = d->first_index;
+		d->cam_index_count = d->index_count;
+		rq->tm.sphere_proxies--;
+	}
 	/* A sphere's proxy has no back: its slivers along the outline must not be culled. */
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		draws[i].cull_back = !(draws[i].flags & UMBRA_DRAW_SPHERE) &&

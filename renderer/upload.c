@@ -83,6 +83,7 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		rnd_proxy_write(&proxies[i], vtx + vbase, idx + ibase, vbase);
 		draws[i].cam_first_index = ibase;
 		draws[i].cam_index_count = x;
+		draws[i].cam_first_vertex = vbase;
 		vbase += v; ibase += x;
 	}
 	return RND_OK;

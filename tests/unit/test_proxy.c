@@ -204,9 +204,44 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	CHECK(p[1].outline == 0, "camera inside the sphere: no proxy");
 	float pos[3] = {4, 3, 4};
 	memcpy(sc.camera.position, pos, sizeof pos);
+	/* A fitted camera: planned from the estimated bounds; the render keeps the proxy only where
+	 * its own camera is that one (rnd_proxy_fits). */
 	sc.camera.fit = RND_FIT_OBJECTS;
+	float dir[3] = {-1, -0.6f, -1};
+	memcpy(sc.camera.fit_direction, dir, sizeof dir);
 	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "framed on the objects: no proxy");
+	CHECK(p[1].outline > 0, "framed on the objects: a proxy");
+	struct rnd_camera_plan cam;
+	struct rnd_error err;
+	struct rnd_aabb b;
+	rnd_aabb_empty(&b);
+	float lo[3] = {-1, 0, -1}, hi[3] = {1, 2, 1};
+	rnd_aabb_add_point(&b, lo);
+	rnd_aabb_add_point(&b, hi);
+	if (rnd_camera_plan(&sc.camera, sc.width, sc.height, &b, &cam, &err) == RND_OK) {
+		CHECK(rnd_proxy_fits(&p[1], &cam), "the camera fitted to the sphere's own box: the planned one");
+		cam.pos[0] += 0.01f;
+		CHECK(!rnd_proxy_fits(&p[1], &cam), "a camera 1 cm away: not the planned one");
+		/* Placed again for it: the same counts, the outline where its rays graze the sphere. */
+		struct rnd_proxy q = p[1];
+		uint32_t nv0, ni0, nv1, ni1;
+		rnd_proxy_counts(&q, &nv0, &ni0);
+		CHECK(rnd_proxy_refit(&q, &cam) && rnd_proxy_fits(&q, &cam), "refit for the camera 1 cm away");
+		rnd_proxy_counts(&q, &nv1, &ni1);
+		CHECK(nv0 == nv1 && ni0 == ni1, "refit keeps the counts: %u/%u then %u/%u", nv0, ni0, nv1, ni1);
+		double dd = 0.0;
+		for (int k = 0; k < 3; k++) dd += (cam.pos[k] - (k == 1)) * (cam.pos[k] - (k == 1));
+		CHECK(fabs(q.edge - acos(1.0 / sqrt(dd))) < 1e-6, "refit outline at %g rad, expected %g", q.edge,
+		      acos(1.0 / sqrt(dd)));
+		struct rnd_camera_plan inside = cam;
+		float centre[3] = {0, 1, 0};
+		memcpy(inside.pos, centre, sizeof centre);
+		CHECK(!rnd_proxy_refit(&q, &inside) && q.outline == 0, "refit for a camera inside the sphere: none");
+		cam.ortho = true;
+		CHECK(!rnd_proxy_fits(&p[1], &cam), "an orthographic camera: not the planned one");
+	} else {
+		CHECK(0, "camera plan: %s", err.msg);
+	}
 	sc.camera.fit = RND_FIT_NONE;
 	sc.camera.type = RND_CAMERA_ORTHOGRAPHIC;
 	sc.camera.height = 3;
