@@ -11,6 +11,7 @@
  * needs, never more than asked for. Also which planes cast shadows (rnd_plane_may_shadow*).
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "lod.h"
 #include "mesh.h"
@@ -226,7 +227,9 @@ void rnd_lod_proxies(const struct rnd_scene *sc, uint32_t nviews, const uint32_t
 	/* One camera: the proxy's outline is where its rays graze the sphere. A fitted one is placed
 	 * here from the estimated bounds, as rnd_lod_choose() places it; render.c confirms that
 	 * its own placement agrees (rnd_proxy_fits). */
-	if (nviews != 1 || sc->view_count > 1 || sc->exact_segments) return;
+	if (nviews != 1 || sc->view_count > 1 || sc->exact_segments || sc->output.debug == RND_DEBUG_ATLAS) return;
+	const char *env = getenv("UMBRA_SPHERE_PROXY");   /* 0: the meshes (tests, comparisons) */
+	if (env && strcmp(env, "0") == 0) return;
 	struct rnd_aabb bounds, obj_bounds, casters;
 	estimate_bounds(sc, &bounds, &obj_bounds, &casters);
 	struct rnd_camera_plan cam;

@@ -20,12 +20,15 @@
 #define RND_PROXY_MAX_STEP 0.5
 /* Fewest vertices of an inner ring. */
 #define RND_PROXY_MIN_RING 6u
+/* Most rings (step >= pi / 2 / 128: a sphere of ~10^5 pixels' radius). */
+#define RND_PROXY_MAX_RINGS 128u
+
+static uint32_t rings_of(const struct rnd_proxy *p, double edge, double theta[RND_PROXY_MAX_RINGS + 1],
+                         uint32_t count[RND_PROXY_MAX_RINGS + 1]);
 
 /* Whether sc's scene and o's material allow a proxy at all (see proxy.h). */
 static bool proxy_allowed(const struct rnd_scene *sc, const struct rnd_object *o)
 {
-	const char *env = getenv("UMBRA_SPHERE_PROXY");
-	if (env && strcmp(env, "0") == 0) return false;
 	if (o->shape != RND_SHAPE_SPHERE) return false;
 	if (sc->material_count) {
 		const struct rnd_material *m = &sc->materials[o->material];
@@ -68,6 +71,7 @@ static bool place(struct rnd_proxy *p, const struct rnd_camera_plan *cam)
 	}
 	dist = sqrt(dist);
 	if (!(ahead - r > 1.01 * cam->znear)) return false;
+	if (cam->user_far > 0.0f && !(ahead + r < cam->zfar)) return false;   /* a far plane through it */
 	if (cam->ortho) {
 		for (int k = 0; k < 3; k++) a[k] = -cam->fwd[k];
 		dist = INFINITY;
@@ -100,9 +104,10 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 	float pw = rnd_lod_pixel_world(cam->view_proj, w, h, p.centre, p.radius, cam->ortho ? 0.0f : cam->znear);
 	if (!(pw > 0.0f) || !isfinite(pw)) return false;
 	uint32_t n = rnd_lod_circle_segments(p.radius * sinf(p.edge), RND_LOD_PIXEL_ERROR * pw);
+	if (n < 8) n = 8;
 	/* Fewer segments than the outline needs were asked for: the facets are what was asked. */
 	if (n == UINT32_MAX || n > segments || n > (1u << 16)) return false;
-	p.outline = n < 8 ? 8 : n;
+	p.outline = n;
 	place(&p, cam);   /* the outline's radius for that count */
 	double depth = (double)RND_PROXY_STEP_PIXELS * pw;
 	/* A triangle's plane dips deepest at the centre of its circumcircle, whose angular radius is
@@ -112,10 +117,11 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 	double step = depth >= r ? RND_PROXY_MAX_STEP : acos(1.0 - depth / r);
 	if (step > RND_PROXY_MAX_STEP) step = RND_PROXY_MAX_STEP;
 	p.step = (float)step;
-	p.rings = (uint32_t)ceil(p.edge / step);
-	if (p.rings < 2) p.rings = 2;
 	p.count_edge = p.edge;
 	p.pixel = pw;
+	double theta[RND_PROXY_MAX_RINGS + 1];
+	uint32_t count[RND_PROXY_MAX_RINGS + 1];
+	p.rings = rings_of(&p, p.edge, theta, count);
 	p.lift = (float)(((double)rnd_lod_radius(fabsf(o->radius), segments, o->segments) - fabs((double)o->radius)) * scale);
 	*out = p;
 	return true;
@@ -123,13 +129,16 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 
 bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam)
 {
-	if (rnd_proxy_fits(p, cam)) return true;
-	/* The counts stay (the vertices and indices the render reserved): the camera moved by a
-	 * small fraction of the sphere's size, the pixel and the step with it. */
-	if (!place(p, cam)) {
+	/* Placed again even where it fits: the render's near and far planes come from the
+	 * tessellated bounds too. The counts stay (the vertices and indices the render reserved):
+	 * the camera moved by a small fraction of the sphere's size, the pixel and the step with it. */
+	bool fits = rnd_proxy_fits(p, cam);
+	struct rnd_proxy q = *p;
+	if (!place(&q, cam)) {
 		p->outline = 0;
 		return false;
 	}
+	if (!fits) *p = q;
 	return true;
 }
 
@@ -148,24 +157,38 @@ bool rnd_proxy_fits(const struct rnd_proxy *p, const struct rnd_camera_plan *cam
 	return shift <= p->pixel / 128.0;
 }
 
-/* Vertices of ring j (1..rings; the last is the outline). */
-static uint32_t ring_count(const struct rnd_proxy *p, uint32_t j)
+/* Rings 1..rings (the last the outline at `edge`): theta[j] evenly spaced, at most `step`
+ * apart, each with count[j] vertices at most `step` apart (never more than the outline). Near
+ * the outline the view ray grazes the sphere, so a chord's dip along the normal is many times
+ * that along the ray, which the depth test compares: for thumb-512 up to 6 pixels there, the
+ * tessellated sphere's own chords up to 9 (tests/unit/test_proxy.c measures both). Counts come
+ * from the planned edge, so that a proxy placed again (another edge) keeps them. Returns rings. */
+static uint32_t rings_of(const struct rnd_proxy *p, double edge, double theta[RND_PROXY_MAX_RINGS + 1],
+                         uint32_t count[RND_PROXY_MAX_RINGS + 1])
 {
-	if (j == p->rings) return p->outline;
-	double theta = p->count_edge * (double)j / p->rings;
-	double n = ceil(2.0 * PI_D * sin(theta) / p->step);
-	uint32_t c = n < RND_PROXY_MIN_RING ? RND_PROXY_MIN_RING : (uint32_t)n;
-	return c < p->outline ? c : p->outline;
+	double plan = p->count_edge;
+	double k = ceil(plan / p->step);
+	uint32_t rings = k < 2.0 ? 2u : k > RND_PROXY_MAX_RINGS ? RND_PROXY_MAX_RINGS : (uint32_t)k;
+	for (uint32_t j = 1; j <= rings; j++) {
+		theta[j] = edge * j / rings;
+		double n = ceil(2.0 * PI_D * sin(plan * j / rings) / p->step);
+		uint32_t c = n < RND_PROXY_MIN_RING ? RND_PROXY_MIN_RING : n > p->outline ? p->outline : (uint32_t)n;
+		count[j] = j == rings ? p->outline : c;
+	}
+	return rings;
 }
 
 void rnd_proxy_counts(const struct rnd_proxy *p, uint32_t *vertex_count, uint32_t *index_count)
 {
 	*vertex_count = *index_count = 0;
 	if (!p->outline) return;
-	uint32_t nv = 1, tris = ring_count(p, 1);
-	for (uint32_t j = 1; j <= p->rings; j++) {
-		nv += ring_count(p, j);
-		if (j < p->rings) tris += ring_count(p, j) + ring_count(p, j + 1);
+	double theta[RND_PROXY_MAX_RINGS + 1];
+	uint32_t count[RND_PROXY_MAX_RINGS + 1];
+	uint32_t rings = rings_of(p, p->edge, theta, count);
+	uint32_t nv = 1, tris = count[1];
+	for (uint32_t j = 1; j <= rings; j++) {
+		nv += count[j];
+		if (j < rings) tris += count[j] + count[j + 1];
 	}
 	*vertex_count = nv;
 	*index_count = 3 * tris;
@@ -176,7 +199,9 @@ static void put_vertex(struct rnd_vertex *v, const struct rnd_proxy *p, const do
 	memset(v, 0, sizeof *v);
 	for (int k = 0; k < 3; k++) {
 		v->pos[k] = (float)pos[k];
-		v->nrm[k] = (float)(pos[k] - p->centre[k]);   /* the centre, for the fragment shaders */
+		/* the centre, for the fragment shaders: from the rounded position, so that position
+		 * minus normal gives it back to the float of the centre (a small sphere far out) */
+		v->nrm[k] = (float)((double)v->pos[k] - p->centre[k]);
 	}
 	v->uv[0] = p->radius;
 	v->uv[1] = p->lift;
@@ -198,11 +223,14 @@ void rnd_proxy_write(const struct rnd_proxy *p, struct rnd_vertex *v, uint32_t *
 	double pos[3];
 	for (int k = 0; k < 3; k++) pos[k] = p->centre[k] + p->radius * a[k];
 	put_vertex(&v[0], p, pos);
+	double thetas[RND_PROXY_MAX_RINGS + 1];
+	uint32_t count[RND_PROXY_MAX_RINGS + 1];
+	uint32_t rings = rings_of(p, p->edge, thetas, count);
 	uint32_t nv = 1, ni = 0, prev_first = 0, prev_n = 1;
-	for (uint32_t j = 1; j <= p->rings; j++) {
-		uint32_t n = ring_count(p, j), first = nv;
-		double theta = p->edge * (double)j / p->rings;
-		double along = p->radius * cos(theta), across = j == p->rings ? p->outline_radius : p->radius * sin(theta);
+	for (uint32_t j = 1; j <= rings; j++) {
+		uint32_t n = count[j], first = nv;
+		double theta = thetas[j];
+		double along = p->radius * cos(theta), across = j == rings ? p->outline_radius : p->radius * sin(theta);
 		for (uint32_t i = 0; i < n; i++) {
 			double phi = 2.0 * PI_D * i / n, cu = cos(phi) * across, cw = sin(phi) * across;
 			for (int k = 0; k < 3; k++) pos[k] = p->centre[k] + along * a[k] + cu * u[k] + cw * w[k];

@@ -41,7 +41,7 @@
 
 struct rnd_proxy {
 	uint32_t outline;        /* segments of the outline ring; 0: no proxy, draw the mesh */
-	uint32_t rings;          /* rings after the pole; the last is the outline */
+	uint32_t rings;          /* rings after the pole; the last is the outline (proxy.c ring_distances) */
 	float step;              /* largest angle between neighbouring vertices inside (radians) */
 	float centre[3], radius; /* the sphere, world */
 	float axis[3];           /* unit, from the centre towards the camera */

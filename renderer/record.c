@@ -297,7 +297,7 @@ void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
 		k->sc[UMBRA_SC_TEXTURES] |= draws[i].tex_bits;
 		if (draws[i].masked) k->sc[UMBRA_SC_MASKED] |= 1u << (uint32_t)sc->materials[draws[i].material].alpha_mode;
-		if (!draws[i].cull_back) dense += draws[i].index_count / 3;
+		if (!draws[i].cull_back) dense += draws[i].cam_index_count / 3;
 	}
 	/* A depth pre-pass pays off where many small two-sided triangles would each shade whole
 	 * 4x4 blocks only to be hidden (lavapipe shades per triangle); closed primitives seen from

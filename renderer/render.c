@@ -273,10 +273,12 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 	 * (this camera inside the sphere, or its near plane cutting it), the sphere's mesh. */
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		struct draw *d = &draws[i];
-		if (!(d->flags & UMBRA_DRAW_SPHERE) || rnd_proxy_fits(&rq->proxies[i], cam)) continue;
+		if (!(d->flags & UMBRA_DRAW_SPHERE)) continue;
+		bool moved = !rnd_proxy_fits(&rq->proxies[i], cam);
 		if (rnd_proxy_refit(&rq->proxies[i], cam)) {
-			rnd_proxy_write(&rq->proxies[i], (struct rnd_vertex *)rq->s->vertices.map + d->cam_first_vertex,
-			                (uint32_t *)rq->s->indices.map + d->cam_first_index, d->cam_first_vertex);
+			if (moved)
+				rnd_proxy_write(&rq->proxies[i], (struct rnd_vertex *)rq->s->vertices.map + d->cam_first_vertex,
+				                (uint32_t *)rq->s->indices.map + d->cam_first_index, d->cam_first_vertex);
 			continue;
 		}
 		d->flags &= ~UMBRA_DRAW_SPHERE;
@@ -284,6 +286,7 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 		d->cam_index_count = d->index_count;
 		rq->tm.sphere_proxies--;
 	}
+	for (uint32_t i = 0; i < sc->object_count; i++) rq->tm.camera_triangles += draws[i].cam_index_count / 3;
 	/* A sphere's proxy has no back: its slivers along the outline must not be culled. */
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		draws[i].cull_back = !(draws[i].flags & UMBRA_DRAW_SPHERE) &&

@@ -71,7 +71,7 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		d->single_sided = !o->double_sided;
 		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
 		            (o->shape == RND_SHAPE_MESH && o->closed);
-		d->cull_back = d->single_sided && !proxy;
+		d->cull_back = d->single_sided;
 		rnd_aabb_union(bounds, &d->bounds);
 	}
 	/* The camera's proxies of spheres after every mesh: where the meshes lie in the buffers (which

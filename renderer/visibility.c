@@ -66,10 +66,11 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 	const char *env = getenv("UMBRA_VISIBILITY");
 	if (env && strcmp(env, "0") == 0) return false;
 	if (env && strcmp(env, "1") == 0) return true;
-	/* Faces the camera may see: a back-face culled closed shape shows about half its triangles. */
+	/* Faces the camera may see: a back-face culled closed shape shows about half its triangles,
+	 * a sphere's proxy all of its own. */
 	uint64_t faces = 0;
 	for (uint32_t i = 0; i < ndraw; i++)
-		faces += draws[i].index_count / 3 / (draws[i].cull_back ? 2 : 1);
+		faces += draws[i].cam_index_count / 3 / (draws[i].cull_back ? 2 : 1);
 	return wide >= RND_VIS_MIN_LIGHTS && faces * RND_VIS_PIXELS_PER_FACE >= (uint64_t)sc->width * sc->height;
 }
 

@@ -14,7 +14,8 @@ layout(location = 1) out vec4 o_aov1;
 layout(location = 2) out vec4 o_aov2;
 layout(location = 3) out vec4 o_aov3;
 
-float visibility(uint i, vec3 n_shadow, bool receive)
+// p_shadow, n_shadow: where the lookups look (facet.glsl surface_at), as the beauty pass's.
+float visibility(uint i, vec3 p_shadow, vec3 n_shadow, bool receive)
 {
 	if (i >= frame.mode.w || !receive || SC_FILTERS == 0u) return 1.0;
 	umbra_light L = lights[i];
@@ -22,7 +23,7 @@ float visibility(uint i, vec3 n_shadow, bool receive)
 	float atten;
 	vec3 l = light_dir(L, v_pos, atten);
 	uint view;
-	return shadow_visibility(L, v_pos, n_shadow, l, view);
+	return shadow_visibility(L, p_shadow, n_shadow, l, view);
 }
 
 void main()
@@ -44,7 +45,7 @@ void main()
 	float vis[UMBRA_AOV_PASS_LIGHTS];
 	uint count = first == 0u ? UMBRA_AOV_FIRST_PASS_LIGHTS : UMBRA_AOV_PASS_LIGHTS;
 	[[dont_unroll]] for (uint k = 0u; k < UMBRA_AOV_PASS_LIGHTS; k++)
-		vis[k] = k < count ? visibility(first + k, n_shadow, receive) : 1.0;
+		vis[k] = k < count ? visibility(first + k, p_shadow, n_shadow, receive) : 1.0;
 	if (first == 0u) {
 		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
 		o_aov0 = vec4(z, N);

@@ -175,47 +175,77 @@ TEST(lod_model_level_within_bound_of_full_mesh)
  * must read fully lit in the shadow debug view, for PCF and PCSS at MSAA 1 and 4; except, with
  * PCF at MSAA 4, a pixel or two a little darker (1, at 242; 3 at up to 213 before the lookups
  * of partly covered fragments moved to their covered samples, facet.glsl). */
-TEST(lod_sphere_facets_cast_no_specks_on_themselves)
+/* Over the sun-facing pixels of thumb-256's sphere well inside its outline (the ray meets it at
+ * more than 1/4 rad), the visibility img shows (the shadow debug view's 8 bits, or the AOV
+ * plane `plane`): how many pixels (*facing), how many below `lit` (returned), the lowest. */
+static int shadowed_facing(const struct rnd_image *img, const float *plane, double lit, int *facing, double *lowest)
 {
-	static const char *filters[][2] = {{"pcf", ""}, {"pcss", ", \"angular_diameter\": 1"}};
 	v3 sun = v3_norm(v3_make(0.5, 1, 0.3)), centre = v3_make(0, 1, 0);
 	struct gpu_cam cam;
 	gpu_cam_persp(&cam, v3_make(4, 3, 4), v3_make(0, 0.8, 0), v3_make(0, 1, 0), 40, 256, 256);
+	int dark = 0;
+	*facing = 0;
+	*lowest = 1.0;
+	for (int j = 0; j < 256; j++)
+		for (int i = 0; i < 256; i++) {
+			v3 o, d;
+			gpu_cam_ray(&cam, i + 0.5, j + 0.5, &o, &d);
+			double t = gpu_ray_sphere(o, d, centre, 1.0, 1e-6);
+			if (t < 0 || gpu_ray_sphere(o, d, centre, 0.97, 1e-6) < 0) continue;
+			v3 n = v3_norm(v3_sub(v3_add(o, v3_scale(d, t)), centre));
+			if (v3_dot(n, sun) <= 0.3) continue;
+			(*facing)++;
+			double v = plane ? plane[(size_t)j * 256 + i] : gpu_px8(img, i, j)[0] / 255.0;
+			if (v < lit) dark++;
+			if (v < *lowest) *lowest = v;
+		}
+	return dark;
+}
+
+TEST(lod_sphere_facets_cast_no_specks_on_themselves)
+{
+	static const char *filters[][2] = {{"pcf", ""}, {"pcss", ", 'angular_diameter': 1"}};
+	static const char *fmt =
+		"{'width': 256, 'height': 256, 'camera': {'type': 'perspective', 'position': [4, 3, 4],"
+		" 'target': [0, 0.8, 0], 'up': [0, 1, 0], 'fov_y': 40},"
+		" 'objects': [{'shape': 'plane', 'size': [10, 10]},"
+		" {'shape': 'sphere', 'radius': 1, 'segments': 316, 'transform': {'translation': [0, 1, 0]}}],"
+		" 'lights': [{'type': 'directional', 'direction': [-0.5, -1, -0.3]%s}],"
+		" 'shadows': {'filter': '%s'}, 'output': %s}";
 	for (int f = 0; f < 2; f++)
 		for (int msaa = 1; msaa <= 4; msaa += 3) {
 			struct rnd_image img;
-			if (!gpu_render(&img,
-			                "{\"width\": 256, \"height\": 256, \"camera\": {\"type\": \"perspective\", \"position\": [4, 3, 4],"
-			                " \"target\": [0, 0.8, 0], \"up\": [0, 1, 0], \"fov_y\": 40},"
-			                " \"objects\": [{\"shape\": \"plane\", \"size\": [10, 10]},"
-			                " {\"shape\": \"sphere\", \"radius\": 1, \"segments\": 316, \"transform\": {\"translation\": [0, 1, 0]}}],"
-			                " \"lights\": [{\"type\": \"directional\", \"direction\": [-0.5, -1, -0.3]%s}],"
-			                " \"shadows\": {\"filter\": \"%s\"}, \"output\": {\"debug\": \"shadow\", \"msaa\": %d}}",
-			                filters[f][1], filters[f][0], msaa))
-				continue;
-			int facing = 0, dark = 0, worst = 255;
-			for (int j = 0; j < 256; j++)
-				for (int i = 0; i < 256; i++) {
-					v3 o, d;
-					gpu_cam_ray(&cam, i + 0.5, j + 0.5, &o, &d);
-					double t = gpu_ray_sphere(o, d, centre, 1.0, 1e-6);
-					/* well inside the silhouette: the ray meets the sphere at more than 1/4 rad */
-					if (t < 0 || gpu_ray_sphere(o, d, centre, 0.97, 1e-6) < 0) continue;
-					v3 n = v3_norm(v3_sub(v3_add(o, v3_scale(d, t)), centre));
-					if (v3_dot(n, sun) <= 0.3) continue;
-					facing++;
-					int v = gpu_px8(&img, i, j)[0];
-					if (v < 250) dark++;
-					if (v < worst) worst = v;
-				}
-			printf("  %s, msaa %d: %d sun-facing sphere pixels, %d darker than 250 (darkest %d)\n", filters[f][0], msaa,
-			       facing, dark, worst);
-			CHECK(facing > 3000, "%s msaa %d: %d sun-facing pixels found", filters[f][0], msaa, facing);
-			bool residue = f == 0 && msaa == 4;
-			CHECK(dark <= (residue ? 2 : 0) && worst >= (residue ? 235 : 250),
-			      "%s msaa %d: %d sun-facing sphere pixels read shadowed (darkest %d)", filters[f][0], msaa, dark, worst);
+			char out[64];
+			snprintf(out, sizeof out, "{'debug': 'shadow', 'msaa': %d}", msaa);
+			if (!gpu_render(&img, fmt, filters[f][1], filters[f][0], out)) continue;
+			int facing;
+			double lowest;
+			int dark = shadowed_facing(&img, NULL, 250 / 255.0, &facing, &lowest);
+			printf("  %s, msaa %d: %d sun-facing sphere pixels, %d darker than 250 (darkest %.0f)\n", filters[f][0], msaa,
+			       facing, dark, lowest * 255);
+			CHECK(facing > 3000 && dark == 0, "%s msaa %d: %d of %d sun-facing sphere pixels read shadowed (darkest %.0f)",
+			      filters[f][0], msaa, dark, facing, lowest * 255);
 			rnd_image_release(&img);
 		}
+	/* The shadow AOV looks where the beauty pass looks: a sphere's proxy raised by its mesh's
+	 * lift (facet.glsl surface_at), not the true surface inside the facets. */
+	for (int f = 0; f < 2; f++) {
+		struct rnd_image img;
+		if (!gpu_render(&img, fmt, filters[f][1], filters[f][0], "{'format': 'exr', 'aovs': ['shadow'], 'msaa': 1}"))
+			continue;
+		CHECK(gpu_last_timings.sphere_proxies == 1, "%s: the sphere is a proxy", filters[f][0]);
+		const float *vis = NULL;
+		for (uint32_t k = 0; k < img.aov_count; k++)
+			if (!strcmp(img.aov_names[k], "shadow.0")) vis = img.aov[k];
+		int facing = 0, dark = -1;
+		double lowest = 0.0;
+		if (vis) dark = shadowed_facing(&img, vis, 0.98, &facing, &lowest);
+		printf("  %s, shadow AOV: %d sun-facing sphere pixels, %d below 0.98 (lowest %.3f)\n", filters[f][0], facing, dark,
+		       lowest);
+		CHECK(facing > 3000 && dark == 0, "%s shadow AOV: %d of %d sun-facing sphere pixels shadowed (lowest %.3f)",
+		      filters[f][0], dark, facing, lowest);
+		rnd_image_release(&img);
+	}
 }
 
 /* A sun map fitted to what casts (renderer/plan.c): a sphere on a 40 m ground that casts
@@ -331,11 +361,16 @@ static int compare_proxy(const char *doc, const struct gpu_cam *cam, v3 c, doubl
 	*on_count = *on_changed = *sphere_px = 0;
 	if (!gpu_render(&proxy, doc, 0)) return 255;
 	CHECK(gpu_last_timings.sphere_proxies == 1, "the sphere is drawn as a proxy (%u)", gpu_last_timings.sphere_proxies);
+	uint64_t proxy_tris = gpu_last_timings.camera_triangles;
 	setenv("UMBRA_SPHERE_PROXY", "0", 1);
 	bool ok = gpu_render(&full, doc, 0);
 	unsetenv("UMBRA_SPHERE_PROXY");
 	if (!ok) { rnd_image_release(&proxy); return 255; }
 	CHECK(gpu_last_timings.sphere_proxies == 0, "UMBRA_SPHERE_PROXY=0: no proxy (%u)", gpu_last_timings.sphere_proxies);
+	/* What the camera's passes drew: the proxy (a few hundred triangles), not the mesh. */
+	CHECK(proxy_tris < 2000 && proxy_tris * 4 < gpu_last_timings.camera_triangles,
+	      "the camera drew %llu triangles with the proxy, %llu with the mesh", (unsigned long long)proxy_tris,
+	      (unsigned long long)gpu_last_timings.camera_triangles);
 	int off_worst = 0;
 	for (int j = 0; j < (int)proxy.height; j++)
 		for (int i = 0; i < (int)proxy.width; i++) {
@@ -361,24 +396,42 @@ static int compare_proxy(const char *doc, const struct gpu_cam *cam, v3 c, doubl
 
 TEST(sphere_proxy_shades_the_true_sphere)
 {
-	static const char *doc =
-		"{'width': 256, 'height': 256, 'camera': {'type': 'perspective', 'position': [3.2, 2.2, 3.0],"
-		" 'target': [0, 0.9, 0], 'up': [0, 1, 0], 'fov_y': 40},"
+	/* %s: the camera; %d: MSAA samples */
+	static const char *fmt =
+		"{'width': 256, 'height': 256, 'camera': %s,"
 		" 'materials': {'glossy': {'base_color': [0.8, 0.25, 0.2], 'roughness': 0.25}},"
 		" 'objects': [{'shape': 'plane', 'size': [10, 10]},"
 		" {'shape': 'sphere', 'radius': 1, 'segments': 316, 'material': 'glossy', 'transform': {'translation': [0, 1, 0]}}],"
 		" 'lights': [{'type': 'directional', 'direction': [-0.5, -1, -0.3], 'angular_diameter': 2},"
 		" {'type': 'spot', 'position': [1.5, 3.5, -1], 'direction': [-1.5, -3.5, 1], 'intensity': 30, 'radius': 0.1,"
-		" 'outer_angle': 40}]}";
-	struct gpu_cam cam;
-	gpu_cam_persp(&cam, v3_make(3.2, 2.2, 3.0), v3_make(0, 0.9, 0), v3_make(0, 1, 0), 40, 256, 256);
-	int on_count, on_changed, sphere_px;
-	int off_worst = compare_proxy(doc, &cam, v3_make(0, 1, 0), 1.0, &on_count, &on_changed, &sphere_px);
-	printf("  proxy vs mesh: %d sphere pixels off the outline, all pixels off it within %d; %d outline pixels, %d by > 8\n",
-	       sphere_px, off_worst, on_count, on_changed);
-	CHECK(sphere_px > 10000, "the sphere covers %d pixels", sphere_px);
-	CHECK(off_worst <= 3, "off the outline a pixel differs by %d", off_worst);
-	CHECK(on_changed * 10 <= on_count, "%d of %d outline pixels differ by more than 8", on_changed, on_count);
+		" 'outer_angle': 40}], 'output': {'msaa': %d}}";
+	static const char *persp = "{'type': 'perspective', 'position': [3.2, 2.2, 3.0], 'target': [0, 0.9, 0], 'fov_y': 40}";
+	static const char *ortho = "{'type': 'orthographic', 'position': [3.2, 2.2, 3.0], 'target': [0, 0.9, 0], 'height': 3}";
+	/* two soft lights: the visibility pass computes the shadows (surface.frag's sphere), or
+	 * with it off the main pass does (mesh_main.glsl's); and an orthographic camera at MSAA 1 */
+	static const struct { bool ortho; int msaa; const char *vis; } runs[] = {{false, 4, NULL}, {false, 4, "0"}, {true, 1, NULL}};
+	for (int k = 0; k < 3; k++) {
+		char doc[2048];
+		snprintf(doc, sizeof doc, fmt, runs[k].ortho ? ortho : persp, runs[k].msaa);
+		struct gpu_cam cam;
+		if (runs[k].ortho)
+			gpu_cam_ortho(&cam, v3_make(3.2, 2.2, 3.0), v3_make(0, 0.9, 0), v3_make(0, 1, 0), 3, 256, 256);
+		else
+			gpu_cam_persp(&cam, v3_make(3.2, 2.2, 3.0), v3_make(0, 0.9, 0), v3_make(0, 1, 0), 40, 256, 256);
+		if (runs[k].vis) setenv("UMBRA_VISIBILITY", runs[k].vis, 1);
+		int on_count, on_changed, sphere_px;
+		int off_worst = compare_proxy(doc, &cam, v3_make(0, 1, 0), 1.0, &on_count, &on_changed, &sphere_px);
+		unsetenv("UMBRA_VISIBILITY");
+		if (!runs[k].ortho)
+			CHECK(gpu_last_timings.visibility_views == (runs[k].vis ? 0u : 1u), "run %d: visibility pass %u", k,
+			      gpu_last_timings.visibility_views);
+		printf("  %s msaa %d%s, proxy vs mesh: %d sphere pixels off the outline, all pixels off it within %d; %d outline"
+		       " pixels, %d by > 8\n", runs[k].ortho ? "orthographic" : "perspective", runs[k].msaa,
+		       runs[k].vis ? ", no visibility pass" : "", sphere_px, off_worst, on_count, on_changed);
+		CHECK(sphere_px > 8000, "run %d: the sphere covers %d pixels", k, sphere_px);
+		CHECK(off_worst <= 3, "run %d: off the outline a pixel differs by %d", k, off_worst);
+		CHECK(on_changed * 10 <= on_count, "run %d: %d of %d outline pixels differ by more than 8", k, on_changed, on_count);
+	}
 }
 
 /* The thumbnail preset frames the objects (`fit`): the proxy is planned with the camera placed

@@ -27,6 +27,35 @@ static double dist3(const float a[3], const double b[3])
 	return sqrt(d0 * d0 + d1 * d1 + d2 * d2);
 }
 
+/* How far behind the unit sphere at c the triangle q lies along view rays (from eye, or along
+ * fwd when orthographic) through its centroid and the middles of its sides, where they meet it. */
+static double behind_along_rays(const double q[3][3], const double c[3], const double eye[3], const double fwd[3],
+                                bool ortho)
+{
+	double worst = 0.0;
+	for (int m = 0; m < 4; m++) {
+		double x[3], o[3], dir[3], ld = 0.0;
+		for (int a = 0; a < 3; a++) {
+			x[a] = m == 3 ? (q[0][a] + q[1][a] + q[2][a]) / 3.0 : 0.5 * (q[m][a] + q[(m + 1) % 3][a]);
+			dir[a] = ortho ? fwd[a] : x[a] - eye[a];
+			ld += dir[a] * dir[a];
+		}
+		ld = sqrt(ld);
+		double b = 0.0, cc = 0.0;
+		for (int a = 0; a < 3; a++) {
+			dir[a] /= ld;
+			o[a] = x[a] - c[a];
+			b += o[a] * dir[a];
+			cc += o[a] * o[a];
+		}
+		double disc = b * b - (cc - 1.0);
+		if (disc < 0.0) continue;   /* past the outline: nothing of the sphere on that ray */
+		double behind = b + sqrt(disc);   /* from the sphere's near side forward to x */
+		if (behind > worst) worst = behind;
+	}
+	return worst;
+}
+
 /* Checks sc's sphere (object 1, radius 1 at (0, 1, 0)) and its proxy; returns its triangles. */
 static uint32_t check_proxy(const char *what, const struct rnd_scene *sc)
 {
@@ -65,6 +94,27 @@ static uint32_t check_proxy(const char *what, const struct rnd_scene *sc)
 	rnd_lod_choose(sc, 1, &scratch, seg);
 	rnd_lod_apply(&lo, seg[1]);
 	rnd_mesh_counts(&lo, &mv, &mi);
+	/* The tessellated sphere's own error along the view rays, front faces only, for scale. */
+	struct rnd_vertex *mvx = malloc(mv * sizeof *mvx);
+	uint32_t *mix = malloc(mi * sizeof *mix);
+	struct rnd_aabb mb;
+	struct rnd_error merr;
+	rnd_aabb_empty(&mb);
+	double mesh_ray = 0.0;
+	if (rnd_mesh_write(&lo, mvx, mix, 0, &mb, &merr) == RND_OK)
+		for (uint32_t t = 0; t < mi; t += 3) {
+			double q[3][3], to_eye = 0.0, u[3], x[3];
+			for (int k = 0; k < 3; k++)
+				for (int a = 0; a < 3; a++) q[k][a] = mvx[mix[t + k]].pos[a];
+			for (int a = 0; a < 3; a++) u[a] = q[1][a] - q[0][a], x[a] = q[2][a] - q[0][a];
+			double n[3] = {u[1] * x[2] - u[2] * x[1], u[2] * x[0] - u[0] * x[2], u[0] * x[1] - u[1] * x[0]};
+			for (int a = 0; a < 3; a++) to_eye += n[a] * (ortho ? -fwd[a] : eye[a] - q[0][a]);
+			if (to_eye <= 0.0) continue;
+			double br = behind_along_rays((const double(*)[3])q, c, eye, fwd, ortho);
+			if (br > mesh_ray) mesh_ray = br;
+		}
+	free(mvx);
+	free(mix);
 	/* Outline: where the camera's rays graze the sphere, at acos(R / d) from the axis. */
 	double edge = ortho ? 0.5 * PI_D : acos(1.0 / d), rho = sin(edge);
 	CHECK(fabs(p[1].edge - edge) < 1e-5, "%s: outline at %g rad, expected %g", what, p[1].edge, edge);
@@ -94,7 +144,7 @@ static uint32_t check_proxy(const char *what, const struct rnd_scene *sc)
 	CHECK(bad_pos == 0, "%s: %u vertices off the sphere or off the outline", what, bad_pos);
 	CHECK(p[1].lift >= 0.0f && p[1].lift <= 1.0f - cosf((float)PI_D / (float)seg[1]), "%s: lift %g", what, p[1].lift);
 	uint32_t back = 0, deep = 0, out_of_range = 0;
-	double worst = 0.0;
+	double worst = 0.0, ray_worst = 0.0;
 	for (uint32_t t = 0; t < ni; t += 3) {
 		double q[3][3];
 		for (int k = 0; k < 3; k++) {
@@ -109,6 +159,10 @@ static uint32_t check_proxy(const char *what, const struct rnd_scene *sc)
 		double ln = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), to_eye = 0.0;
 		for (int a = 0; a < 3; a++) to_eye += n[a] * (ortho ? -fwd[a] : eye[a] - q[0][a]);
 		if (!(to_eye > 0.0)) back++;
+		/* how far behind the sphere the proxy lies along the view ray (what the depth test
+		 * compares) */
+		double br = behind_along_rays((const double(*)[3])q, c, eye, fwd, ortho);
+		if (br > ray_worst) ray_worst = br;
 		/* how far inside the sphere the triangle's plane dips: R - distance of the centre */
 		double plane = fabs(n[0] * (c[0] - q[0][0]) + n[1] * (c[1] - q[0][1]) + n[2] * (c[2] - q[0][2])) / ln;
 		if (1.0 - plane > worst) worst = 1.0 - plane;
@@ -116,8 +170,13 @@ static uint32_t check_proxy(const char *what, const struct rnd_scene *sc)
 	}
 	uint32_t unused = 0;
 	for (uint32_t i = 0; i < nv; i++) unused += !used[i];
-	printf("    %s: proxy %u triangles (outline %u segments, %u rings), mesh %u; deepest chord %.2f pixel (bound %.2f)\n",
-	       what, ni / 3, p[1].outline, p[1].rings, mi / 3, worst / pw, RND_PROXY_STEP_PIXELS);
+	printf("    %s: proxy %u triangles (outline %u segments, %u rings), mesh %u; deepest chord %.2f pixel, along the"
+	       " view ray %.2f (the mesh's %.2f; bound %.2f)\n",
+	       what, ni / 3, p[1].outline, p[1].rings, mi / 3, worst / pw, ray_worst / pw, mesh_ray / pw, RND_PROXY_STEP_PIXELS);
+	/* Near the outline the view rays graze the sphere and any chord lies far behind it along
+	 * them (what the depth test compares): no farther than the tessellated sphere's chords. */
+	CHECK(ray_worst <= mesh_ray * 1.01, "%s: the proxy lies %g pixel behind the sphere along a view ray, the mesh %g",
+	      what, ray_worst / pw, mesh_ray / pw);
 	CHECK(out_of_range == 0 && unused == 0, "%s: %u indices out of range, %u vertices unused", what, out_of_range, unused);
 	CHECK(back == 0, "%s: %u of %u triangles face away from the camera", what, back, ni / 3);
 	CHECK(deep == 0, "%s: %u triangles dip deeper than the bound (deepest %g pixel)", what, deep, worst / pw);
@@ -159,8 +218,20 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	struct rnd_proxy p[2];
 	struct rnd_material m;
 	thumb_scene(&sc, obj, &sun, 512);
+	struct rnd_camera views[2] = {sc.camera, sc.camera};
+	views[1].position[0] = -4.0f;
+	sc.views = views;
+	sc.view_count = 2;
 	plan(&sc, 2, p);
 	CHECK(p[1].outline == 0, "two views: no proxy");
+	sc.views = NULL;
+	sc.view_count = 0;
+	sc.camera.near = 5.0f;   /* the sphere's centre is 5.4 away: the near plane cuts it */
+	plan(&sc, 1, p);
+	CHECK(p[1].outline == 0, "a near plane through the sphere: no proxy");
+	sc.camera.near = 0.0f;
+	plan(&sc, 1, p);
+	CHECK(p[1].outline > 0, "the same camera with a derived near plane: a proxy");
 	sc.exact_segments = true;
 	plan(&sc, 1, p);
 	CHECK(p[1].outline == 0, "exact segments: no proxy");

@@ -360,6 +360,7 @@ struct rnd_timings {
 	uint64_t shadow_texels;     /* texels of the shadow maps drawn (each map res x res) */
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
 	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
+	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
 };
 
 /* ---- context ---- */
