@@ -24,9 +24,14 @@ EOF2
 }
 scene 64 64 1 32 "" >"$T/small.json"
 scene 64 48 1 32 "" >"$T/small-64x48.json"
-# The flood scene must keep one worker busy for a while on lavapipe.
+# The flood scene must keep one worker busy for a while on lavapipe; the priority check's
+# occupier must outlast the queueing of the two requests behind it (0.3 s and two curls'
+# start-up) by a margin: five soft suns over 2048^2, ~1 s warm (one hard-edged sun took
+# ~0.3 s since spheres are drawn as proxies, too close).
 scene 512 512 4 256 ', "x-flood": 1' | sed 's/"resolution": 512/"resolution": 2048/' >"$T/slow.json"
-scene 2048 2048 4 256 ', "x-flood": 2' | sed 's/"resolution": 512/"resolution": 2048/' >"$T/slower.json"
+scene 2048 2048 4 256 ', "x-flood": 2' | sed 's/"resolution": 512/"resolution": 2048/' |
+	sed 's/"shadow": {"filter": "pcf"}/"angular_diameter": 3, "shadow": {"filter": "pcss"}/' |
+	sed 's/"lights": \[\(.*\)\],$/"lights": [\1, \1, \1, \1, \1],/' >"$T/slower.json"
 scene 2000 2000 1 32 "" >"$T/pixels.json"
 scene 64 64 1 2048 "" >"$T/triangles.json"
 sed 's/"resolution": 512/"resolution": 4096/' "$T/small.json" >"$T/shadowres.json"
