@@ -210,6 +210,14 @@ TEST(proxy_of_a_sphere_lies_on_it_and_faces_the_camera)
 	check_proxy("orthographic", &sc);
 }
 
+/* Plans sc's proxies (nviews views) and checks whether the sphere (object 1) got one. */
+static void expect_proxy(const struct rnd_scene *sc, uint32_t nviews, bool want, const char *what)
+{
+	struct rnd_proxy p[2];
+	plan(sc, nviews, p);
+	CHECK((p[1].outline > 0) == want, "%s: %s", what, want ? "no proxy" : "a proxy");
+}
+
 TEST(proxy_only_where_the_sphere_is_what_it_seems)
 {
 	struct rnd_scene sc;
@@ -222,27 +230,21 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	views[1].position[0] = -4.0f;
 	sc.views = views;
 	sc.view_count = 2;
-	plan(&sc, 2, p);
-	CHECK(p[1].outline == 0, "two views: no proxy");
+	expect_proxy(&sc, 2, false, "two views: no proxy");
 	sc.views = NULL;
 	sc.view_count = 0;
 	sc.camera.near = 5.0f;   /* the sphere's centre is 5.4 away: the near plane cuts it */
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "a near plane through the sphere: no proxy");
+	expect_proxy(&sc, 1, false, "a near plane through the sphere: no proxy");
 	sc.camera.near = 0.0f;
-	plan(&sc, 1, p);
-	CHECK(p[1].outline > 0, "the same camera with a derived near plane: a proxy");
+	expect_proxy(&sc, 1, true, "the same camera with a derived near plane: a proxy");
 	sc.exact_segments = true;
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "exact segments: no proxy");
+	expect_proxy(&sc, 1, false, "exact segments: no proxy");
 	sc.exact_segments = false;
 	obj[1].segments = 24;   /* fewer than a 120-pixel outline needs: the facets were asked for */
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "24 segments asked: no proxy");
+	expect_proxy(&sc, 1, false, "24 segments asked: no proxy");
 	obj[1].segments = 316;
 	obj[1].model[0] = 1.5f;   /* an ellipsoid */
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "non-uniform scale: no proxy");
+	expect_proxy(&sc, 1, false, "non-uniform scale: no proxy");
 	obj[1].model[0] = obj[1].model[5] = obj[1].model[10] = 1.5f;
 	plan(&sc, 1, p);
 	CHECK(p[1].outline > 0 && fabsf(p[1].radius - 1.5f) < 1e-6f, "uniform scale 1.5: proxy of radius %g", p[1].radius);
@@ -251,19 +253,15 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	sc.materials = &m;
 	sc.material_count = 1;
 	obj[0].material = obj[1].material = 0;
-	plan(&sc, 1, p);
-	CHECK(p[1].outline > 0, "plain material: proxy");
+	expect_proxy(&sc, 1, true, "plain material: proxy");
 	m.alpha_mode = RND_ALPHA_BLEND;
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "blended material: no proxy");
+	expect_proxy(&sc, 1, false, "blended material: no proxy");
 	m.alpha_mode = RND_ALPHA_OPAQUE;
 	m.textures[RND_TEX_NORMAL] = (const struct rnd_texture *)&m;   /* only its presence is read */
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "textured material: no proxy");
+	expect_proxy(&sc, 1, false, "textured material: no proxy");
 	m.textures[RND_TEX_NORMAL] = NULL;
 	sun.shadow.contact_enabled = true;
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "contact shadows: no proxy");
+	expect_proxy(&sc, 1, false, "contact shadows: no proxy");
 	sun.shadow.contact_enabled = false;
 	setenv("UMBRA_SPHERE_PROXY", "0", 1);
 	plan(&sc, 1, p);
@@ -271,8 +269,7 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	CHECK(p[1].outline == 0, "UMBRA_SPHERE_PROXY=0: no proxy");
 	float inside[3] = {0, 1.2f, 0.1f};
 	memcpy(sc.camera.position, inside, sizeof inside);
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "camera inside the sphere: no proxy");
+	expect_proxy(&sc, 1, false, "camera inside the sphere: no proxy");
 	float pos[3] = {4, 3, 4};
 	memcpy(sc.camera.position, pos, sizeof pos);
 	/* A fitted camera: planned from the estimated bounds; the render keeps the proxy only where
@@ -322,6 +319,5 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 	float in_ortho[3] = {0, 1, 0.5f}, ahead[3] = {0, 1, -1};
 	memcpy(sc.camera.position, in_ortho, sizeof in_ortho);
 	memcpy(sc.camera.target, ahead, sizeof ahead);
-	plan(&sc, 1, p);
-	CHECK(p[1].outline == 0, "orthographic camera whose near plane cuts the sphere: no proxy");
+	expect_proxy(&sc, 1, false, "orthographic camera whose near plane cuts the sphere: no proxy");
 }
