@@ -202,11 +202,19 @@ static void walk_free(struct walk *k)
 	free(k->queue);
 }
 
+/* Squared distance from p to o + t e. */
+static float d2_along(const float p[3], const float o[3], const float e[3], float t)
+{
+	float d[3];
+	for (int i = 0; i < 3; i++) d[i] = p[i] - (o[i] + t * e[i]);
+	return rnd_v3_dot(d, d);
+}
+
 /* Squared distance from p to triangle abc (the closest point by its region: vertex, edge or
  * face; Ericson, Real-Time Collision Detection 5.1.5). */
 static float point_triangle_d2(const float p[3], const float a[3], const float b[3], const float c[3])
 {
-	float ab[3], ac[3], ap[3], bp[3], cp[3], q[3], d[3];
+	float ab[3], ac[3], bc[3], ap[3], bp[3], cp[3];
 	rnd_v3_sub(ab, b, a);
 	rnd_v3_sub(ac, c, a);
 	rnd_v3_sub(ap, p, a);
@@ -216,33 +224,19 @@ static float point_triangle_d2(const float p[3], const float a[3], const float b
 	float d3 = rnd_v3_dot(ab, bp), d4 = rnd_v3_dot(ac, bp);
 	if (d3 >= 0.0f && d4 <= d3) return rnd_v3_dot(bp, bp);
 	float vc = d1 * d4 - d3 * d2;
-	if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
-		float t = d1 / (d1 - d3);
-		for (int i = 0; i < 3; i++) q[i] = a[i] + t * ab[i];
-		rnd_v3_sub(d, p, q);
-		return rnd_v3_dot(d, d);
-	}
+	if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return d2_along(p, a, ab, d1 / (d1 - d3));
 	rnd_v3_sub(cp, p, c);
 	float d5 = rnd_v3_dot(ab, cp), d6 = rnd_v3_dot(ac, cp);
 	if (d6 >= 0.0f && d5 <= d6) return rnd_v3_dot(cp, cp);
 	float vb = d5 * d2 - d1 * d6;
-	if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
-		float t = d2 / (d2 - d6);
-		for (int i = 0; i < 3; i++) q[i] = a[i] + t * ac[i];
-		rnd_v3_sub(d, p, q);
-		return rnd_v3_dot(d, d);
-	}
+	if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return d2_along(p, a, ac, d2 / (d2 - d6));
 	float va = d3 * d6 - d5 * d4;
-	if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f) {
-		float t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-		for (int i = 0; i < 3; i++) q[i] = b[i] + t * (c[i] - b[i]);
-		rnd_v3_sub(d, p, q);
-		return rnd_v3_dot(d, d);
-	}
-	float den = 1.0f / (va + vb + vc), v = vb * den, wv = vc * den;
+	rnd_v3_sub(bc, c, b);
+	if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f) return d2_along(p, b, bc, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+	float den = 1.0f / (va + vb + vc), v = vb * den, wv = vc * den, q[3];
 	for (int i = 0; i < 3; i++) q[i] = a[i] + ab[i] * v + ac[i] * wv;
-	rnd_v3_sub(d, p, q);
-	return rnd_v3_dot(d, d);
+	rnd_v3_sub(ap, p, q);
+	return rnd_v3_dot(ap, ap);
 }
 
 /* How far a level (idx: ni indices into w) is from the full mesh: the largest distance of its

@@ -119,26 +119,23 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
 	p.step = (float)step;
 	p.count_edge = p.edge;
 	p.pixel = pw;
-	double theta[RND_PROXY_MAX_RINGS + 1];
-	uint32_t count[RND_PROXY_MAX_RINGS + 1];
-	p.rings = rings_of(&p, p.edge, theta, count);
 	p.lift = (float)(((double)rnd_lod_radius(fabsf(o->radius), segments, o->segments) - fabs((double)o->radius)) * scale);
 	*out = p;
 	return true;
 }
 
-bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam)
+bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam, bool *moved)
 {
 	/* Placed again even where it fits: the render's near and far planes come from the
 	 * tessellated bounds too. The counts stay (the vertices and indices the render reserved):
 	 * the camera moved by a small fraction of the sphere's size, the pixel and the step with it. */
-	bool fits = rnd_proxy_fits(p, cam);
+	*moved = !rnd_proxy_fits(p, cam);
 	struct rnd_proxy q = *p;
 	if (!place(&q, cam)) {
 		p->outline = 0;
 		return false;
 	}
-	if (!fits) *p = q;
+	if (*moved) *p = q;
 	return true;
 }
 

@@ -41,7 +41,6 @@
 
 struct rnd_proxy {
 	uint32_t outline;        /* segments of the outline ring; 0: no proxy, draw the mesh */
-	uint32_t rings;          /* rings after the pole; the last is the outline (proxy.c ring_distances) */
 	float step;              /* largest angle between neighbouring vertices inside (radians) */
 	float centre[3], radius; /* the sphere, world */
 	float axis[3];           /* unit, from the centre towards the camera */
@@ -64,10 +63,11 @@ bool rnd_proxy_plan(const struct rnd_scene *sc, const struct rnd_object *o, cons
  * bounds, which the plan (lod.c) estimated from the shapes as asked. */
 bool rnd_proxy_fits(const struct rnd_proxy *p, const struct rnd_camera_plan *cam);
 
-/* Makes p that of camera cam where it was planned for another (rnd_proxy_fits): the same
- * counts of vertices and indices, placed for cam. False (p->outline 0: draw the mesh) where cam
- * is inside the sphere or its near plane cuts it. */
-bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam);
+/* Makes p that of camera cam where it was planned for another (rnd_proxy_fits; *moved then
+ * true: its vertices must be written again): the same counts of vertices and indices, placed
+ * for cam. False (p->outline 0: draw the mesh) where cam is inside the sphere or its near or
+ * far plane cuts it. */
+bool rnd_proxy_refit(struct rnd_proxy *p, const struct rnd_camera_plan *cam, bool *moved);
 
 /* Vertices and indices of proxy p (0 when none). */
 void rnd_proxy_counts(const struct rnd_proxy *p, uint32_t *vertex_count, uint32_t *index_count);

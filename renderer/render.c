@@ -274,8 +274,8 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		struct draw *d = &draws[i];
 		if (!(d->flags & UMBRA_DRAW_SPHERE)) continue;
-		bool moved = !rnd_proxy_fits(&rq->proxies[i], cam);
-		if (rnd_proxy_refit(&rq->proxies[i], cam)) {
+		bool moved;
+		if (rnd_proxy_refit(&rq->proxies[i], cam, &moved)) {
 			if (moved)
 				rnd_proxy_write(&rq->proxies[i], (struct rnd_vertex *)rq->s->vertices.map + d->cam_first_vertex,
 				                (uint32_t *)rq->s->indices.map + d->cam_first_index, d->cam_first_vertex);

@@ -31,8 +31,7 @@ void main()
 	material_derivatives(v_uv);
 	umbra_material m = materials[pc.info.x];
 	vec3 n_geo, p_shadow, n_shadow;   // before base_color's discard
-	surface_at(in_pos, v_nrm, v_uv, pc.info.y, 1u, frame.camera_pos, frame.camera_fwd.xyz, v_pos, n_geo, p_shadow,
-	           n_shadow);
+	surface_at(in_pos, v_nrm, v_uv, pc.info.y, 1u, v_pos, n_geo, p_shadow, n_shadow);
 	vec4 bc = base_color(m);
 	// N.X/Y/Z: the normal the beauty pass shades with (normal map included); shadows keep
 	// testing with the triangle's plane, as the beauty pass does.

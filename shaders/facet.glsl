@@ -1,6 +1,6 @@
 // shaders/facet.glsl — the surface a fragment shades and the one the shadow maps hold there, for
-// the stages that draw triangles (mesh_main.glsl, aov.frag, surface.frag): included after their
-// inputs (in_pos, v_nrm, v_uv). surface_at() is what they call.
+// the stages that draw triangles (mesh_main.glsl, aov.frag, surface.frag): included after the
+// frame block (the camera) and their inputs (in_pos, v_nrm, v_uv). surface_at() is what they call.
 
 // The plane of the triangle being drawn at position pos (from screen derivatives, exact for a
 // flat triangle), facing like n_geo. Shadow lookups take their receiver plane and normal
@@ -57,10 +57,10 @@ vec4 proxy_sphere(vec3 pos, vec3 nrm, vec2 uv)
 
 // The point of sphere s nearest the camera on the view ray through p (a point of the proxy,
 // which lies on that ray); where the ray passes just outside the sphere (the outline's chords
-// straddle it), the sphere's point nearest the ray. cam_pos.w > 0.5: orthographic along fwd.
-vec3 sphere_point(vec3 p, vec4 s, vec4 cam_pos, vec3 fwd)
+// straddle it), the sphere's point nearest the ray.
+vec3 sphere_point(vec3 p, vec4 s)
 {
-	vec3 d = cam_pos.w > 0.5 ? fwd : normalize(p - cam_pos.xyz);
+	vec3 d = frame.camera_pos.w > 0.5 ? frame.camera_fwd.xyz : normalize(p - frame.camera_pos.xyz);
 	vec3 oc = p - s.xyz;
 	float b = dot(oc, d);
 	float disc = b * b - (dot(oc, oc) - s.w * s.w);
@@ -71,8 +71,8 @@ vec3 sphere_point(vec3 p, vec4 s, vec4 cam_pos, vec3 fwd)
 // What a fragment of a draw with `flags` shades (pos, n_geo) and where its shadow lookups look
 // (p_shadow, n_shadow): as interpolated and from its triangle, or on the true sphere of a
 // proxy. Derivatives: call in uniform control flow, before any discard.
-void surface_at(vec3 in_p, vec3 nrm, vec2 uv, uint flags, uint samples, vec4 cam_pos, vec3 fwd, out vec3 pos,
-                out vec3 n_geo, out vec3 p_shadow, out vec3 n_shadow)
+void surface_at(vec3 in_p, vec3 nrm, vec2 uv, uint flags, uint samples, out vec3 pos, out vec3 n_geo,
+                out vec3 p_shadow, out vec3 n_shadow)
 {
 	pos = in_p;
 	n_geo = normalize(nrm);
@@ -81,10 +81,10 @@ void surface_at(vec3 in_p, vec3 nrm, vec2 uv, uint flags, uint samples, vec4 cam
 	p_shadow = covered_position(in_p, samples);
 	if ((flags & UMBRA_DRAW_SPHERE) != 0u) {
 		vec4 s = proxy_sphere(in_p, nrm, uv);
-		pos = sphere_point(in_p, s, cam_pos, fwd);
+		pos = sphere_point(in_p, s);
 		n_geo = n_shadow = (pos - s.xyz) / s.w;
 		// The shadow maps hold the tessellated sphere, out to `lift` beyond this one (proxy.h).
-		p_shadow = sphere_point(p_shadow, s, cam_pos, fwd);
+		p_shadow = sphere_point(p_shadow, s);
 		p_shadow += normalize(p_shadow - s.xyz) * uv.y;
 	}
 }

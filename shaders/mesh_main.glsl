@@ -24,8 +24,7 @@ void main()
 	umbra_material m = draw_material();
 	uint flags = pc.info.y;
 	vec3 n_geo, p_shadow, n_shadow;   // before base_color's discard
-	surface_at(in_pos, v_nrm, v_uv, flags, SC_SAMPLES, frame.camera_pos, frame.camera_fwd.xyz, v_pos, n_geo, p_shadow,
-	           n_shadow);
+	surface_at(in_pos, v_nrm, v_uv, flags, SC_SAMPLES, v_pos, n_geo, p_shadow, n_shadow);
 	vec4 bc = base_color(m);
 	vec3 N = material_normal(m, n_geo, has_tex(m, UMBRA_TEX_NORMAL));
 	vec3 V = frame.camera_pos.w > 0.5 ? -frame.camera_fwd.xyz : normalize(frame.camera_pos.xyz - v_pos);

@@ -18,8 +18,7 @@ layout(location = 1) out vec4 o_normal;
 void main()
 {
 	vec3 pos, n_geo, p_shadow, n_shadow;
-	surface_at(in_pos, v_nrm, v_uv, pc.info.y, 1u, frame.camera_pos, frame.camera_fwd.xyz, pos, n_geo, p_shadow,
-	           n_shadow);
+	surface_at(in_pos, v_nrm, v_uv, pc.info.y, 1u, pos, n_geo, p_shadow, n_shadow);
 	o_position = vec4(p_shadow, 1.0);   // where its shadow lookups look: pos, or raised by a proxy's lift
 	o_normal = vec4(n_shadow, 0.0);
 }

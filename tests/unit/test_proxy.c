@@ -170,9 +170,9 @@ static uint32_t check_proxy(const char *what, const struct rnd_scene *sc)
 	}
 	uint32_t unused = 0;
 	for (uint32_t i = 0; i < nv; i++) unused += !used[i];
-	printf("    %s: proxy %u triangles (outline %u segments, %u rings), mesh %u; deepest chord %.2f pixel, along the"
+	printf("    %s: proxy %u triangles (outline %u segments), mesh %u; deepest chord %.2f pixel, along the"
 	       " view ray %.2f (the mesh's %.2f; bound %.2f)\n",
-	       what, ni / 3, p[1].outline, p[1].rings, mi / 3, worst / pw, ray_worst / pw, mesh_ray / pw, RND_PROXY_STEP_PIXELS);
+	       what, ni / 3, p[1].outline, mi / 3, worst / pw, ray_worst / pw, mesh_ray / pw, RND_PROXY_STEP_PIXELS);
 	/* Near the outline the view rays graze the sphere and any chord lies far behind it along
 	 * them (what the depth test compares): no farther than the tessellated sphere's chords. */
 	CHECK(ray_worst <= mesh_ray * 1.01, "%s: the proxy lies %g pixel behind the sphere along a view ray, the mesh %g",
@@ -294,7 +294,8 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 		struct rnd_proxy q = p[1];
 		uint32_t nv0, ni0, nv1, ni1;
 		rnd_proxy_counts(&q, &nv0, &ni0);
-		CHECK(rnd_proxy_refit(&q, &cam) && rnd_proxy_fits(&q, &cam), "refit for the camera 1 cm away");
+		bool moved = false;
+		CHECK(rnd_proxy_refit(&q, &cam, &moved) && moved && rnd_proxy_fits(&q, &cam), "refit for the camera 1 cm away");
 		rnd_proxy_counts(&q, &nv1, &ni1);
 		CHECK(nv0 == nv1 && ni0 == ni1, "refit keeps the counts: %u/%u then %u/%u", nv0, ni0, nv1, ni1);
 		double dd = 0.0;
@@ -304,7 +305,7 @@ TEST(proxy_only_where_the_sphere_is_what_it_seems)
 		struct rnd_camera_plan inside = cam;
 		float centre[3] = {0, 1, 0};
 		memcpy(inside.pos, centre, sizeof centre);
-		CHECK(!rnd_proxy_refit(&q, &inside) && q.outline == 0, "refit for a camera inside the sphere: none");
+		CHECK(!rnd_proxy_refit(&q, &inside, &moved) && q.outline == 0, "refit for a camera inside the sphere: none");
 		cam.ortho = true;
 		CHECK(!rnd_proxy_fits(&p[1], &cam), "an orthographic camera: not the planned one");
 	} else {
