@@ -18,8 +18,9 @@
  * surface, up to 16-bit storage (tests/gpu/test_visibility.c). A surface thinner than a pixel
  * that no centre shows takes its neighbour's shadow: it covers part of a pixel.
  *
- * When: scenes with at least two lights with wide filters (PCSS, PCF of radius 4 or more) and
- * enough small triangles to pay for the passes (rnd_visibility_wanted), no debug view (the
+ * When: scenes with lights with wide filters (PCSS, PCF of radius 4 or more) and enough small
+ * triangles to pay for the passes (rnd_visibility_wanted: more for one such light than for
+ * several), no debug view (the
  * views show the filters' own work) and no alpha-tested material (the surfaces pass does not
  * cut out texels, so what shows through them would take the cut-out surface's shadow).
  * UMBRA_VISIBILITY=0 turns it off, =1 on where the device and the scene allow it.
@@ -33,13 +34,18 @@
  * block per triangle touching it, and costs a surfaces pass and a main pass of its own. A floor
  * alone: 15 % slower; spheres of 16 segments (~600 triangles facing the camera): 4 % faster; of
  * 32 (~2,200): 11 %; of 64 (~8,300): 20 % (4 and 16 spot lights: 23 %, 18 %). So: at least one
- * such triangle per 512 pixels. One shadowed light: the filters cost less than the passes.
+ * such triangle per 512 pixels. One wide light: one per 64 pixels (below).
  * Only wide filters pay for it: studio-spots' seven lights all hard made the main pass 49 ms
  * without the pass and 65 with it; PCF radius 1: 57 / 68, 2: 81 / 84, 3: 97 / 97, 5: 143 /
  * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
-#define RND_VIS_MIN_LIGHTS 2u
 #define RND_VIS_MIN_PCF_RADIUS 4u
 #define RND_VIS_PIXELS_PER_FACE 512u
+/* One wide light pays for the passes only over denser meshes (measured, thumbnail preset with
+ * its one PCSS sun, 512²; main pass without / with): a sphere of 64 segments (~2,000 faces
+ * towards the camera, one per 130 pixels) 28.4 / 28.3 ms, 128 segments (one per 32) 36.9 /
+ * 32.6, a 10k-triangle STL (one per 52) 34.4 / 32.0, the 124k-triangle ogre OBJ's 49k level
+ * 97 / 80, nefertiti's 95 / 69; a 16-segment sphere (one per 500) 20.9 / 24.6. */
+#define RND_VIS_PIXELS_PER_FACE_ONE_LIGHT 16u
 /* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
 #define RND_VIS_MAX_BYTES (32ull << 20)
 
@@ -71,7 +77,9 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 	uint64_t faces = 0;
 	for (uint32_t i = 0; i < ndraw; i++)
 		faces += draws[i].cam_index_count / 3 / (draws[i].cull_back ? 2 : 1);
-	return wide >= RND_VIS_MIN_LIGHTS && faces * RND_VIS_PIXELS_PER_FACE >= (uint64_t)sc->width * sc->height;
+	uint64_t px = (uint64_t)sc->width * sc->height;
+	if (wide >= 2) return faces * RND_VIS_PIXELS_PER_FACE >= px;
+	return wide == 1 && faces * RND_VIS_PIXELS_PER_FACE_ONE_LIGHT >= px;
 }
 
 /* Pass 1: the surfaces of the band's rows, cleared to 0 (nothing drawn); their depth stays an
