@@ -73,8 +73,11 @@ int main(int argc, char **argv)
 	struct rnd_info info;
 	rnd_context_info(ctx, &info);
 	printf("device: %s (%s), %d runs per scene after 1 warm-up, medians in ms\n", info.device_name, info.driver_name, n);
-	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s %9s\n", "scene", "parse", "upload", "shadow", "main", "readback",
-	       "encode", "total", "img/s", "KiB", "maps r/k");
+	/* After the times (last run): shadow maps rendered / kept from an earlier request, the
+	 * texels of the maps drawn (millions), the triangles the camera's passes draw (thousands)
+	 * and whether the visibility pass ran (renderer/visibility.c). */
+	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s %9s %6s %8s %3s\n", "scene", "parse", "upload", "shadow", "main",
+	       "readback", "encode", "total", "img/s", "KiB", "maps r/k", "Mtexel", "cam ktri", "vis");
 	int rc = 0;
 	for (int a = first; a < argc; a++) {
 		size_t len;
@@ -83,6 +86,7 @@ int main(int argc, char **argv)
 		double *t = calloc((size_t)(n * S_COUNT), sizeof *t);
 		size_t bytes_out = 0;
 		uint32_t maps_rendered = 0, maps_reused = 0;
+		struct rnd_timings last = {0};
 		struct api_limits lim;
 		api_limits_defaults(&lim);
 		lim.max_triangles = 0;
@@ -110,6 +114,7 @@ int main(int argc, char **argv)
 			bytes_out = olen;
 			maps_rendered = tm.shadow_maps_rendered;
 			maps_reused = tm.shadow_maps_reused;
+			last = tm;
 			rnd_image_release(&img);
 			api_scene_free(s);
 			if (i < 0) continue;
@@ -129,8 +134,9 @@ int main(int argc, char **argv)
 				col[s] = median(v, m);
 				printf(" %8.2f", col[s]);
 			}
-			/* maps: shadow maps rendered / kept from an earlier request (last run) */
-			printf(" %8.1f %8zu %4u/%-4u\n", 1000.0 / col[S_TOTAL], bytes_out / 1024, maps_rendered, maps_reused);
+			printf(" %8.1f %8zu %4u/%-4u %6.2f %8.1f %3u\n", 1000.0 / col[S_TOTAL], bytes_out / 1024, maps_rendered,
+			       maps_reused, (double)last.shadow_texels / 1e6, (double)last.camera_triangles / 1e3,
+			       last.visibility_views);
 		}
 		free(t);
 		free(json);
