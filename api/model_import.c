@@ -30,6 +30,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <jansson.h>
+#include <meshoptimizer.h>
 #include "errmsg.h"
 #include "gltf_material.h"
 #include "model_conv.h"
@@ -150,14 +151,11 @@ static int convert_extras(struct api_conv *c, const struct aiMesh *am, struct ap
 	return 0;
 }
 
-static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
+/* Fills convert_mesh's arrays; sets out->index_count (and its colours and tangents). */
+static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out, float *pos, float *nrm,
+                        float *uv, uint32_t *idx)
 {
-	uint32_t nv = am->mNumVertices, ntri = 0;
-	for (unsigned f = 0; f < am->mNumFaces; f++) ntri += am->mFaces[f].mNumIndices == 3;
-	float *pos = api_conv_alloc(c, nv, 3 * sizeof(float));
-	float *nrm = am->mNormals ? api_conv_alloc(c, nv, 3 * sizeof(float)) : NULL;
-	float *uv = am->mTextureCoords[0] ? api_conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
-	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? api_conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
+	uint32_t nv = am->mNumVertices;
 	if (!pos || (am->mNormals && !nrm) || (am->mTextureCoords[0] && !uv) || !idx)
 		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	if (convert_extras(c, am, out) < 0) return -1;
@@ -191,14 +189,54 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 			idx[k++] = face->mIndices[j];
 		}
 	}
+	out->index_count = k;
+	return 0;
+}
+
+/* Joins the bit-identical vertices of a mesh of positions and normals (c->join; -0 counted as
+ * 0, which a normal's cross product often gives), in place: corners where facets of one plane
+ * meet become one vertex. Without memory for the table the vertices stay apart: the same
+ * picture. */
+static uint32_t join_vertices(struct api_conv *c, float *pos, float *nrm, uint32_t nv, uint32_t *idx, uint32_t ni)
+{
+	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
+	if (!remap) return nv;
+	for (size_t i = 0; i < 3 * (size_t)nv; i++) {
+		pos[i] += 0.0f;
+		nrm[i] += 0.0f;
+	}
+	struct meshopt_Stream st[2] = {{pos, 12, 12}, {nrm, 12, 12}};
+	uint32_t unique = (uint32_t)meshopt_generateVertexRemapMulti(remap, NULL, nv, nv, st, 2);
+	/* new ids follow first occurrences: remap[v] <= v, so moving down in order is safe */
+	for (uint32_t v = 0; v < nv; v++)
+		if (remap[v] != v) {
+			memcpy(pos + 3 * (size_t)remap[v], pos + 3 * (size_t)v, 12);
+			memcpy(nrm + 3 * (size_t)remap[v], nrm + 3 * (size_t)v, 12);
+		}
+	for (uint32_t i = 0; i < ni; i++) idx[i] = remap[idx[i]];
+	c->bytes -= (size_t)(nv - unique) * 24;   /* the arrays' tails go unused */
+	free(remap);
+	return unique;
+}
+
+static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
+{
+	uint32_t nv = am->mNumVertices, ntri = 0;
+	for (unsigned f = 0; f < am->mNumFaces; f++) ntri += am->mFaces[f].mNumIndices == 3;
+	float *pos = api_conv_alloc(c, nv, 3 * sizeof(float));
+	float *nrm = am->mNormals ? api_conv_alloc(c, nv, 3 * sizeof(float)) : NULL;
+	float *uv = am->mTextureCoords[0] ? api_conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
+	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? api_conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
+	if (convert_data(c, am, out, pos, nrm, uv, idx) < 0) return -1;
 	out->positions = pos;
 	out->normals = nrm;
 	out->uvs = uv;
 	out->single_sided = c->single_sided[am->mMaterialIndex < c->sc->mNumMaterials ? am->mMaterialIndex : 0];
 	out->indices = idx;
 	out->vertex_count = nv;
-	out->index_count = k;
 	out->material = am->mMaterialIndex;
+	if (c->join && nrm && !uv && !out->colors && !out->tangents && nv)
+		out->vertex_count = join_vertices(c, pos, nrm, nv, idx, out->index_count);
 	return 0;
 }
 
@@ -316,7 +354,8 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	bool gltf = format == API_MODEL_GLB || format == API_MODEL_GLTF;
 	json_t *root = NULL;
 	if (gltf && gltf_precheck(data, len, format, &root, err, errsize) < 0) return API_WIRE_BAD_INPUT;
-	struct api_conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf};
+	struct api_conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf,
+	                     .join = format == API_MODEL_STL};
 	uint8_t *tagged = NULL;
 	if (gltf) {
 		api_gltf_info_read(root, &c.gi);
@@ -346,9 +385,13 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	unsigned flags = aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
 	                 aiProcess_SortByPType | aiProcess_ValidateDataStructure;
 	/* STL facet normals are often wrong (opposite the winding, or zero): flat normals from the
-	 * winding instead, as STL viewers shade them. */
+	 * winding instead, as STL viewers shade them. Each facet's corners then differ by normal
+	 * from their neighbours', so joining identical vertices finds next to nothing (Assimp's
+	 * documentation: senseless with GenNormals) and cost a 1M-triangle STL ~1 s; the renderer
+	 * welds by position itself where it needs to (model_lod.c). */
 	if (format == API_MODEL_STL)
-		flags = (flags & ~(unsigned)aiProcess_GenSmoothNormals) | aiProcess_DropNormals | aiProcess_GenNormals;
+		flags = (flags & ~(unsigned)(aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)) |
+		        aiProcess_DropNormals | aiProcess_GenNormals;
 	/* Normal maps need tangents: the file's, or made from the uvs where it has none. */
 	if (gltf) flags |= aiProcess_CalcTangentSpace;
 	enum api_wire_status st = API_WIRE_OK;

@@ -86,6 +86,7 @@ struct grid {
 	float lo[3], cell;
 	uint32_t dim[3];
 	uint32_t *start, *items;  /* counting-sorted vertex ids per cell */
+	float *ipos;              /* their positions, in that order (a row of cells is one run) */
 };
 
 static uint32_t cell_of(const struct grid *g, const float p[3], int k)
@@ -128,6 +129,9 @@ static bool grid_build(struct grid *g, const struct welded *w)
 	for (size_t c = cells; c > 0; c--) g->start[c] = g->start[c - 1];
 	g->start[0] = 0;
 	free(id);
+	g->ipos = malloc(w->count * 3 * sizeof *g->ipos);
+	if (!g->ipos) return false;
+	for (size_t i = 0; i < w->count; i++) memcpy(g->ipos + 3 * i, w->pos + 3 * (size_t)g->items[i], 3 * sizeof *g->ipos);
 	return true;
 }
 
@@ -139,20 +143,24 @@ static float surface_distance(const struct grid *g, const struct welded *w, cons
 	uint32_t c[3] = {cell_of(g, p, 0), cell_of(g, p, 1), cell_of(g, p, 2)};
 	float best = INFINITY;
 	uint32_t bv = 0;
-	for (int r = 1; r <= 4 && best == INFINITY; r++)
-	for (int dz = -r; dz <= r; dz++)
-		for (int dy = -r; dy <= r; dy++)
-			for (int dx = -r; dx <= r; dx++) {
-				int64_t x = (int64_t)c[0] + dx, y = (int64_t)c[1] + dy, z = (int64_t)c[2] + dz;
-				if (x < 0 || y < 0 || z < 0 || x >= g->dim[0] || y >= g->dim[1] || z >= g->dim[2]) continue;
-				size_t cell = ((size_t)z * g->dim[1] + (size_t)y) * g->dim[0] + (size_t)x;
-				for (uint32_t i = g->start[cell]; i < g->start[cell + 1]; i++) {
-					float d[3];
-					rnd_v3_sub(d, p, w->pos + 3 * (size_t)g->items[i]);
-					float dd = rnd_v3_dot(d, d);
+	for (uint32_t r = 1; r <= 4 && best == INFINITY; r++) {
+		uint32_t lo[3], hi[3];
+		for (int k = 0; k < 3; k++) {
+			lo[k] = c[k] > r ? c[k] - r : 0;
+			hi[k] = c[k] + r < g->dim[k] ? c[k] + r : g->dim[k] - 1;
+		}
+		for (uint32_t z = lo[2]; z <= hi[2]; z++)
+			for (uint32_t y = lo[1]; y <= hi[1]; y++) {
+				/* cells lo[0]..hi[0] of this row: one run of items */
+				size_t row = ((size_t)z * g->dim[1] + y) * g->dim[0];
+				for (uint32_t i = g->start[row + lo[0]], e = g->start[row + hi[0] + 1]; i < e; i++) {
+					const float *q = g->ipos + 3 * (size_t)i;
+					float d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
+					float dd = d0 * d0 + d1 * d1 + d2 * d2;
 					if (dd < best) { best = dd; bv = g->items[i]; }
 				}
 			}
+	}
 	if (best == INFINITY) return 4.0f * g->cell; /* far from every vertex: at least this coarse */
 	float d[3];
 	rnd_v3_sub(d, p, w->pos + 3 * (size_t)bv);
@@ -299,7 +307,11 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 				k->fseen[f] = k->stamp;
 				const uint32_t *fi = k->idx + 3 * (size_t)f;
 				const float *a = w->pos + 3 * (size_t)fi[0], *b = w->pos + 3 * (size_t)fi[1], *c = w->pos + 3 * (size_t)fi[2];
-				for (int q = 0; q < 4; q++) best[q] = fminf(best[q], point_triangle_d2(s[q], a, b, c));
+				float most = 0.0f;
+				for (int q = 0; q < 4; q++) most = fmaxf(most, best[q] = fminf(best[q], point_triangle_d2(s[q], a, b, c)));
+				/* Every sample already this near a face: the rest of the walk can only find
+				 * nearer ones, and this triangle cannot raise the level's worst. */
+				if (most <= worst2) { head = tail; break; }
 				for (int j = 0; j < 3; j++) {
 					uint32_t x = fi[j];
 					if (k->vseen[x] == k->stamp) continue;
@@ -428,14 +440,17 @@ static size_t drop_degenerate(const struct welded *w, uint32_t *idx, size_t ni)
 	return out;
 }
 
-static void mesh_lods(struct api_model_mesh *me, struct api_arena *arena, size_t *bytes)
+/* me's levels from its welded vertices w and indices cur (ni = me->index_count; cur is
+ * overwritten). */
+static void mesh_lods(struct api_model_mesh *me, const struct welded *wp, uint32_t *cur, struct api_arena *arena,
+                      size_t *bytes)
 {
+	const struct welded w = *wp;
 	struct rnd_mesh_lod *lods = api_arena_calloc(arena, API_LOD_LEVELS, sizeof *lods);
-	uint32_t *cur = malloc((size_t)me->index_count * sizeof *cur), *next = malloc((size_t)me->index_count * sizeof *next);
-	struct welded w = {0};
+	uint32_t *caller = cur, *next = malloc((size_t)me->index_count * sizeof *next);
 	struct grid g = {0};
 	struct walk k = {0};
-	if (!lods || !cur || !next || !weld(me, cur, &w) || !grid_build(&g, &w) || !walk_build(&k, &w, cur, me->index_count))
+	if (!lods || !next || !grid_build(&g, &w) || !walk_build(&k, &w, cur, me->index_count))
 		goto done;
 	size_t ni = me->index_count;
 	float prev = 0.0f;
@@ -458,55 +473,69 @@ done:
 	walk_free(&k);
 	free(g.start);
 	free(g.items);
-	free(w.pos);
-	free(w.nrm);
-	free(w.rep);
-	free(cur);
-	free(next);
+	free(g.ipos);
+	/* cur and next trade places per level: free whichever of them is not the caller's */
+	free(cur == caller ? next : cur);
 }
 
-static int cmp_u64(const void *a, const void *b)
+/* Sorts a[n] (tmp: n more) in 16-bit digits from the lowest, skipping digits every key shares:
+ * qsort's call per comparison and a bsearch per edge were a third of a 1M-triangle STL's
+ * closedness check. Returns where the sorted keys are (a or tmp). */
+static uint64_t *radix_sort_u64(uint64_t *a, uint64_t *tmp, size_t n, size_t *count)
 {
-	uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-	return x < y ? -1 : x > y;
+	for (int shift = 0; shift < 64; shift += 16) {
+		memset(count, 0, 65536 * sizeof *count);
+		for (size_t i = 0; i < n; i++) count[(a[i] >> shift) & 0xffff]++;
+		if (n && count[(a[0] >> shift) & 0xffff] == n) continue;   /* one digit for all */
+		size_t sum = 0;
+		for (size_t d = 0; d < 65536; d++) {
+			size_t c = count[d];
+			count[d] = sum;
+			sum += c;
+		}
+		for (size_t i = 0; i < n; i++) tmp[count[(a[i] >> shift) & 0xffff]++] = a[i];
+		uint64_t *t = a; a = tmp; tmp = t;
+	}
+	return a;
 }
 
 bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos)
 {
-	uint64_t *e = malloc((ni ? ni : 1) * sizeof *e);
-	if (!e) return false;
+	size_t cap = ni ? ni : 1;
+	uint64_t *e = malloc(cap * sizeof *e), *r = malloc(cap * sizeof *r), *tmp = malloc(cap * sizeof *tmp);
+	size_t *count = malloc(65536 * sizeof *count);
+	bool closed = false;
+	if (!e || !r || !tmp || !count) goto out;
 	size_t ne = 0;
 	double vol = 0.0;
 	for (size_t t = 0; t + 2 < ni; t += 3) {
 		uint32_t v[3] = {idx[t], idx[t + 1], idx[t + 2]};
 		if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue;
-		for (int k = 0; k < 3; k++) e[ne++] = (uint64_t)v[k] << 32 | v[(k + 1) % 3];
+		for (int k = 0; k < 3; k++) {
+			e[ne] = (uint64_t)v[k] << 32 | v[(k + 1) % 3];
+			r[ne++] = (uint64_t)v[(k + 1) % 3] << 32 | v[k];
+		}
 		const float *a = pos + 3 * (size_t)v[0], *b = pos + 3 * (size_t)v[1], *c = pos + 3 * (size_t)v[2];
 		vol += (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
 		       (double)a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
 		       (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0]);
 	}
-	qsort(e, ne, sizeof *e, cmp_u64);
-	bool closed = ne > 0 && vol > 0.0;
-	for (size_t i = 0; closed && i < ne; i++) {
-		uint64_t rev = e[i] << 32 | e[i] >> 32;
-		/* each directed edge once, and its reverse present: two triangles per edge, opposite ways */
-		closed = !(i && e[i] == e[i - 1]) && bsearch(&rev, e, ne, sizeof *e, cmp_u64);
+	closed = ne > 0 && vol > 0.0;
+	if (!closed) goto out;
+	/* Each directed edge once, and the reversed edges the same set: every edge is run by two
+	 * triangles, opposite ways. */
+	const uint64_t *se = radix_sort_u64(e, tmp, ne, count);
+	for (size_t i = 1; closed && i < ne; i++) closed = se[i] != se[i - 1];
+	if (closed) {
+		uint64_t *other = se == e ? tmp : e;   /* the buffer se does not occupy */
+		const uint64_t *sr = radix_sort_u64(r, other, ne, count);
+		closed = memcmp(se, sr, ne * sizeof *se) == 0;
 	}
+out:
 	free(e);
-	return closed;
-}
-
-/* Welds me by position and tells api_mesh_closed(); meshes that get levels are welded there. */
-static bool mesh_closed(const struct api_model_mesh *me)
-{
-	uint32_t *idx = malloc((size_t)me->index_count * sizeof *idx);
-	struct welded w = {0};
-	bool closed = idx && weld(me, idx, &w) && api_mesh_closed(idx, me->index_count, w.pos);
-	free(w.pos);
-	free(w.nrm);
-	free(w.rep);
-	free(idx);
+	free(r);
+	free(tmp);
+	free(count);
 	return closed;
 }
 
@@ -530,7 +559,16 @@ void api_model_build_lods(struct api_model *m, struct api_arena *arena, size_t *
 		struct api_model_mesh *me = (struct api_model_mesh *)&m->meshes[i]; /* ours until shared */
 		mesh_bounds(me);
 		if (!me->normals || !me->indices || !me->index_count) continue;
-		me->closed = mesh_closed(me);
-		if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES) mesh_lods(me, arena, bytes);
+		/* welded by position once, for both */
+		uint32_t *idx = malloc((size_t)me->index_count * sizeof *idx);
+		struct welded w = {0};
+		if (idx && weld(me, idx, &w)) {
+			me->closed = api_mesh_closed(idx, me->index_count, w.pos);
+			if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES) mesh_lods(me, &w, idx, arena, bytes);
+		}
+		free(w.pos);
+		free(w.nrm);
+		free(w.rep);
+		free(idx);
 	}
 }

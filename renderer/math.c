@@ -57,36 +57,6 @@ uint64_t rnd_hash(uint64_t h, const void *data, size_t len)
 	return h;
 }
 
-float rnd_v3_dot(const float a[3], const float b[3])
-{
-	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-void rnd_v3_cross(float out[3], const float a[3], const float b[3])
-{
-	float r[3] = {
-		a[1] * b[2] - a[2] * b[1],
-		a[2] * b[0] - a[0] * b[2],
-		a[0] * b[1] - a[1] * b[0],
-	};
-	memcpy(out, r, sizeof r);
-}
-
-void rnd_v3_sub(float out[3], const float a[3], const float b[3])
-{
-	for (int i = 0; i < 3; i++) out[i] = a[i] - b[i];
-}
-
-void rnd_v3_add(float out[3], const float a[3], const float b[3])
-{
-	for (int i = 0; i < 3; i++) out[i] = a[i] + b[i];
-}
-
-void rnd_v3_scale(float out[3], const float a[3], float s)
-{
-	for (int i = 0; i < 3; i++) out[i] = a[i] * s;
-}
-
 float rnd_v3_length(const float a[3])
 {
 	return sqrtf(rnd_v3_dot(a, a));

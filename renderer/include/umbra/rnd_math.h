@@ -33,11 +33,36 @@ uint64_t rnd_fnv1a(uint64_t h, const void *data, size_t len);
  * cache; not streaming, not security). */
 uint64_t rnd_hash(uint64_t h, const void *data, size_t len);
 
-float rnd_v3_dot(const float a[3], const float b[3]);
-void rnd_v3_cross(float out[3], const float a[3], const float b[3]);
-void rnd_v3_sub(float out[3], const float a[3], const float b[3]);
-void rnd_v3_add(float out[3], const float a[3], const float b[3]);
-void rnd_v3_scale(float out[3], const float a[3], float s);
+/* Defined here, inline: api/'s mesh work (model_lod.c's level error, ~40 % of a 124k-triangle
+ * OBJ's import) called them across translation units, one call per dot product. */
+static inline float rnd_v3_dot(const float a[3], const float b[3])
+{
+	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void rnd_v3_cross(float out[3], const float a[3], const float b[3])
+{
+	float x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+	out[0] = x;
+	out[1] = y;
+	out[2] = z;
+}
+
+static inline void rnd_v3_sub(float out[3], const float a[3], const float b[3])
+{
+	for (int i = 0; i < 3; i++) out[i] = a[i] - b[i];
+}
+
+static inline void rnd_v3_add(float out[3], const float a[3], const float b[3])
+{
+	for (int i = 0; i < 3; i++) out[i] = a[i] + b[i];
+}
+
+static inline void rnd_v3_scale(float out[3], const float a[3], float s)
+{
+	for (int i = 0; i < 3; i++) out[i] = a[i] * s;
+}
+
 float rnd_v3_length(const float a[3]);
 /* Returns false (and leaves out = a) when |a| is 0 or not finite. */
 bool rnd_v3_normalize(float out[3], const float a[3]);
