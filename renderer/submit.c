@@ -11,9 +11,16 @@
 
 /* Cost model for the first band and for grouping shadow views, in lavapipe milliseconds (a
  * GPU is faster: the model then only makes the first band smaller than needed, and measured
- * times take over from the second band on). Deliberately high: an underestimate would let one
- * submit run long past a deadline. */
-#define EST_MS_PER_PIXEL_UNIT 3e-4   /* one pixel, one unit of shading (see px_units) */
+ * times take over from the second band on). On the high side: an underestimate lets one submit
+ * run past a deadline. But not far: every band redraws every triangle (and repeats the
+ * visibility pass's), and the measured rows are never trusted below a quarter of the estimate
+ * (rnd_pacer_band_rows). Calibrated on 26 bench scenes (ninth landing): the main pass's
+ * estimate is 0.6x (five stacked layers of small two-sided triangles) to 4.5x (16 soft lights)
+ * of its time, mostly 1-2.5x. It had been 20-200x since the filters got cheaper, and under
+ * umbrad's default 30 s deadline (slices of 1 s) a render of 0.1-0.3 s was cut into many bands:
+ * the ogre OBJ under three soft lights 140 -> 262 ms, 16 soft lights 141 -> 166 ms. */
+#define EST_MS_PER_PIXEL_UNIT 1.5e-5 /* one pixel, one unit of shading (see px_units) */
+#define EST_MS_PER_BAND 3.0          /* a band's clears, resolve and copy */
 #define EST_MS_PER_TRIANGLE 3e-4     /* main pass: vertex work, repeated in every band */
 #define EST_MS_PER_TEXEL 5e-6        /* shadow map clear, raster, copy into the atlas */
 #define EST_MS_PER_CASTER 1e-4       /* depth-only triangle */
@@ -41,7 +48,9 @@ void rnd_pacer_init(struct rnd_pacer *p, const struct rnd_scene *sc)
 	if (sc->deadline_ns) {
 		uint64_t now = now_ns();
 		double left = sc->deadline_ns > now ? (double)(sc->deadline_ns - now) / 1e6 : 0.0;
-		p->slice_ms = fmin(1000.0, fmax(50.0, left / 4));
+		/* An eighth of the time left, at most a second: a render that yields to the requests
+		 * behind it (at half their deadline) stops within a slice, with room for theirs. */
+		p->slice_ms = fmin(1000.0, fmax(50.0, left / 8));
 	} else if (sc->cancel) {
 		p->slice_ms = 1000.0;
 	}
@@ -222,7 +231,7 @@ static double est_shadow_view_ms(const struct record_view *rv, uint32_t v, uint6
 	return res * res * EST_MS_PER_TEXEL + (double)casters * EST_MS_PER_CASTER;
 }
 
-/* Shading work per pixel, in units of an unshadowed light's. */
+/* Shading work per pixel, in units of a hard-shadowed light's. */
 static double px_units(const struct record_view *rv)
 {
 	const struct rnd_scene *sc = rv->sc;
@@ -231,14 +240,18 @@ static double px_units(const struct record_view *rv)
 		const struct rnd_light_plan *lp = &rv->sp->lights[i];
 		if (!lp->view_count) { u += 0.5; continue; }
 		switch (lp->filter) {
-		case UMBRA_FILTER_PCF: u += 1 + lp->pcf_radius; break;
-		case UMBRA_FILTER_PCSS: u += 20; break;
+		case UMBRA_FILTER_PCF: u += 1 + 0.5 * lp->pcf_radius; break;
+		case UMBRA_FILTER_PCSS: u += 4; break;
 		case UMBRA_FILTER_MOMENTS: u += 1.5; break;
 		default: u += 1; break;
 		}
+		if (lp->view_count > 1 && sc->lights[i].type == RND_LIGHT_DIRECTIONAL) u += 2;   /* cascades, levels */
+		if (rnd_contact_on(sc, rv->sp, i)) u += 4;                                       /* the march */
 	}
+	if (rv->vis) u += 4;   /* the visibility pass's own passes */
 	if (sc->output.msaa > 1) u *= 1.5;
-	return u * (1 + rv->aov_passes);
+	if (sc->output.pixels == RND_PIXELS_RGBA32F) u *= 1.5;   /* float targets, resolve and copy */
+	return u * (1 + 3 * rv->aov_passes);
 }
 
 /* ---- one view ---- */
@@ -295,7 +308,8 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 	uint64_t tris = 0;
 	for (uint32_t i = 0; i < rv->ndraw; i++) tris += rv->draws[i].cam_index_count / 3;
 	double est_row = sc->width * px_units(rv) * EST_MS_PER_PIXEL_UNIT;
-	double est_fixed = (double)tris * EST_MS_PER_TRIANGLE * (1 + rv->aov_passes);
+	/* lavapipe shades each triangle's 4x4 blocks: a triangle costs more where a pixel does */
+	double est_fixed = EST_MS_PER_BAND + (double)tris * EST_MS_PER_TRIANGLE * (1 + px_units(rv) / 4);
 	/* Down to single rows: with many soft-shadowed lights and AOVs one row of a large image
 	 * can take a second on lavapipe. */
 	uint32_t min_rows = 1;
