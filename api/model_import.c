@@ -193,28 +193,44 @@ static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_
 	return 0;
 }
 
-/* Joins the bit-identical vertices of a mesh of positions and normals (c->join; -0 counted as
- * 0, which a normal's cross product often gives), in place: corners where facets of one plane
- * meet become one vertex. Without memory for the table the vertices stay apart: the same
- * picture. */
-static uint32_t join_vertices(struct api_conv *c, float *pos, float *nrm, uint32_t nv, uint32_t *idx, uint32_t ni)
+/* Joins the corners of a mesh of positions and normals (and colours: an STL's per-facet
+ * colours) that share a position, a colour and a normal to within 2^-14 (coplanar facets'
+ * normals, normalised cross products of different edges, differ in their last bits), in place:
+ * corners where facets of one plane meet become one vertex, as Assimp's join made them.
+ * Returns the vertices left; without memory for the tables they all stay (the same picture). */
+struct join_key {
+	float pos[3];
+	int16_t nrm[3];
+	uint8_t col[4];
+	int16_t pad;   /* zero: meshoptimizer compares every byte */
+};
+
+static uint32_t join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
 {
 	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
-	if (!remap) return nv;
-	for (size_t i = 0; i < 3 * (size_t)nv; i++) {
-		pos[i] += 0.0f;
-		nrm[i] += 0.0f;
+	struct join_key *key = calloc(nv, sizeof *key);
+	if (!remap || !key) {
+		free(remap);
+		free(key);
+		return nv;
 	}
-	struct meshopt_Stream st[2] = {{pos, 12, 12}, {nrm, 12, 12}};
-	uint32_t unique = (uint32_t)meshopt_generateVertexRemapMulti(remap, NULL, nv, nv, st, 2);
+	for (uint32_t v = 0; v < nv; v++) {
+		for (int k = 0; k < 3; k++) {
+			key[v].pos[k] = pos[3 * (size_t)v + (size_t)k] + 0.0f;   /* -0 is 0 */
+			key[v].nrm[k] = (int16_t)lrintf(nrm[3 * (size_t)v + (size_t)k] * 16384.0f);
+		}
+		if (col) memcpy(key[v].col, col + 4 * (size_t)v, 4);
+	}
+	uint32_t unique = (uint32_t)meshopt_generateVertexRemap(remap, NULL, nv, key, nv, sizeof *key);
+	free(key);
 	/* new ids follow first occurrences: remap[v] <= v, so moving down in order is safe */
 	for (uint32_t v = 0; v < nv; v++)
 		if (remap[v] != v) {
 			memcpy(pos + 3 * (size_t)remap[v], pos + 3 * (size_t)v, 12);
 			memcpy(nrm + 3 * (size_t)remap[v], nrm + 3 * (size_t)v, 12);
+			if (col) memcpy(col + 4 * (size_t)remap[v], col + 4 * (size_t)v, 4);
 		}
 	for (uint32_t i = 0; i < ni; i++) idx[i] = remap[idx[i]];
-	c->bytes -= (size_t)(nv - unique) * 24;   /* the arrays' tails go unused */
 	free(remap);
 	return unique;
 }
@@ -235,8 +251,9 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 	out->indices = idx;
 	out->vertex_count = nv;
 	out->material = am->mMaterialIndex;
-	if (c->join && nrm && !uv && !out->colors && !out->tangents && nv)
-		out->vertex_count = join_vertices(c, pos, nrm, nv, idx, out->index_count);
+	/* the colours are ours (the arena) until the model is shared */
+	if (c->join && nrm && !uv && !out->tangents && nv)
+		out->vertex_count = join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
 	return 0;
 }
 

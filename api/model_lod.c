@@ -5,9 +5,9 @@
  * level) to a target twice the previous, starting at 1/16384 of the mesh's extent. A level's
  * error is measured here against the full mesh (level_error), in object units: meshoptimizer's
  * own figure leaves out how far the new triangles' insides are from the surface. The measure
- * is the distance from the nearest full-mesh vertex's tangent plane, and where that could be the
- * level's worst, the exact distance from the full mesh's faces around the triangle, met walking
- * its surface (another part close by or a crease misled the first). Every level gets its own vertex
+ * is the distance from the nearest full-mesh vertex's tangent plane, and where that comes within
+ * half the level's worst, the exact distance from the full mesh's faces around the triangle,
+ * met walking its surface (another part close by or a crease misled the first). Every level gets its own vertex
  * arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
  * position (weld), so a level's normals are computed from its own triangles with a crease angle
  * (write_level) and its uvs are those of each position's first vertex: a texture seam of a
@@ -277,7 +277,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 		 * cheap estimate (surface_distance), which can understate (another part close by, a
 		 * crease), comes within half the level's worst. From the worst itself levels came out
 		 * up to ~25 % low (the beast OBJ's third: 0.61 against 0.79); from half of it they match
-		 * the walk run everywhere but for two of the ogre's, for 10-20 % more import time (the
+		 * the walk run everywhere but for two of the ogre's, for 10-25 % more import time (the
 		 * walk everywhere: +50-90 %). */
 		bool any = false;
 		for (int q = 0; q < 4; q++) {
@@ -444,7 +444,7 @@ static size_t drop_degenerate(const struct welded *w, uint32_t *idx, size_t ni)
 	return out;
 }
 
-/* me's levels from its welded vertices w and indices cur (ni = me->index_count; cur is
+/* me's levels from its welded vertices *wp and indices cur (me->index_count of them; cur is
  * overwritten). */
 static void mesh_lods(struct api_model_mesh *me, const struct welded *wp, uint32_t *cur, struct api_arena *arena,
                       size_t *bytes)
@@ -482,22 +482,22 @@ done:
 	free(cur == caller ? next : cur);
 }
 
-/* Sorts a[n] (tmp: n more) in 16-bit digits from the lowest, skipping digits every key shares:
- * qsort's call per comparison and a bsearch per edge were a third of a 1M-triangle STL's
- * closedness check. Returns where the sorted keys are (a or tmp). */
-static uint64_t *radix_sort_u64(uint64_t *a, uint64_t *tmp, size_t n, size_t *count)
+/* Sorts a[n] (tmp: n more) a byte at a time from the lowest, skipping bytes every key shares
+ * (the high ones of vertex ids): qsort's call per comparison and a bsearch per edge were a
+ * third of a 1M-triangle STL's closedness check. Returns where the sorted keys are (a or tmp). */
+static uint64_t *radix_sort_u64(uint64_t *a, uint64_t *tmp, size_t n)
 {
-	for (int shift = 0; shift < 64; shift += 16) {
-		memset(count, 0, 65536 * sizeof *count);
-		for (size_t i = 0; i < n; i++) count[(a[i] >> shift) & 0xffff]++;
-		if (n && count[(a[0] >> shift) & 0xffff] == n) continue;   /* one digit for all */
+	for (int shift = 0; shift < 64; shift += 8) {
+		size_t count[256] = {0};
+		for (size_t i = 0; i < n; i++) count[(a[i] >> shift) & 0xff]++;
+		if (n && count[(a[0] >> shift) & 0xff] == n) continue;   /* one value for all */
 		size_t sum = 0;
-		for (size_t d = 0; d < 65536; d++) {
+		for (int d = 0; d < 256; d++) {
 			size_t c = count[d];
 			count[d] = sum;
 			sum += c;
 		}
-		for (size_t i = 0; i < n; i++) tmp[count[(a[i] >> shift) & 0xffff]++] = a[i];
+		for (size_t i = 0; i < n; i++) tmp[count[(a[i] >> shift) & 0xff]++] = a[i];
 		uint64_t *t = a; a = tmp; tmp = t;
 	}
 	return a;
@@ -506,19 +506,15 @@ static uint64_t *radix_sort_u64(uint64_t *a, uint64_t *tmp, size_t n, size_t *co
 bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos)
 {
 	size_t cap = ni ? ni : 1;
-	uint64_t *e = malloc(cap * sizeof *e), *r = malloc(cap * sizeof *r), *tmp = malloc(cap * sizeof *tmp);
-	size_t *count = malloc(65536 * sizeof *count);
+	uint64_t *e = malloc(cap * sizeof *e), *tmp = malloc(cap * sizeof *tmp), *r = NULL;
 	bool closed = false;
-	if (!e || !r || !tmp || !count) goto out;
+	if (!e || !tmp) goto out;
 	size_t ne = 0;
 	double vol = 0.0;
 	for (size_t t = 0; t + 2 < ni; t += 3) {
 		uint32_t v[3] = {idx[t], idx[t + 1], idx[t + 2]};
 		if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue;
-		for (int k = 0; k < 3; k++) {
-			e[ne] = (uint64_t)v[k] << 32 | v[(k + 1) % 3];
-			r[ne++] = (uint64_t)v[(k + 1) % 3] << 32 | v[k];
-		}
+		for (int k = 0; k < 3; k++) e[ne++] = (uint64_t)v[k] << 32 | v[(k + 1) % 3];
 		const float *a = pos + 3 * (size_t)v[0], *b = pos + 3 * (size_t)v[1], *c = pos + 3 * (size_t)v[2];
 		vol += (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
 		       (double)a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
@@ -528,18 +524,18 @@ bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos)
 	if (!closed) goto out;
 	/* Each directed edge once, and the reversed edges the same set: every edge is run by two
 	 * triangles, opposite ways. */
-	const uint64_t *se = radix_sort_u64(e, tmp, ne, count);
+	const uint64_t *se = radix_sort_u64(e, tmp, ne);
 	for (size_t i = 1; closed && i < ne; i++) closed = se[i] != se[i - 1];
-	if (closed) {
-		uint64_t *other = se == e ? tmp : e;   /* the buffer se does not occupy */
-		const uint64_t *sr = radix_sort_u64(r, other, ne, count);
-		closed = memcmp(se, sr, ne * sizeof *se) == 0;
-	}
+	if (!closed) goto out;
+	uint64_t *other = se == e ? tmp : e;   /* the buffer se does not occupy */
+	r = malloc(cap * sizeof *r);
+	if (!r) { closed = false; goto out; }
+	for (size_t i = 0; i < ne; i++) r[i] = se[i] << 32 | se[i] >> 32;
+	closed = memcmp(se, radix_sort_u64(r, other, ne), ne * sizeof *se) == 0;
 out:
 	free(e);
-	free(r);
 	free(tmp);
-	free(count);
+	free(r);
 	return closed;
 }
 

@@ -20,9 +20,9 @@
  *
  * When: scenes with lights with wide filters (PCSS, PCF of radius 4 or more) and enough small
  * triangles to pay for the passes (rnd_visibility_wanted: more for one such light than for
- * several), no debug view (the
- * views show the filters' own work) and no alpha-tested material (the surfaces pass does not
- * cut out texels, so what shows through them would take the cut-out surface's shadow).
+ * several), no debug view (the views show the filters' own work) and no alpha-tested material
+ * (the surfaces pass does not cut out texels, so what shows through them would take the
+ * cut-out surface's shadow).
  * UMBRA_VISIBILITY=0 turns it off, =1 on where the device and the scene allow it.
  */
 #include <stdlib.h>
@@ -34,17 +34,20 @@
  * block per triangle touching it, and costs a surfaces pass and a main pass of its own. A floor
  * alone: 15 % slower; spheres of 16 segments (~600 triangles facing the camera): 4 % faster; of
  * 32 (~2,200): 11 %; of 64 (~8,300): 20 % (4 and 16 spot lights: 23 %, 18 %). So: at least one
- * such triangle per 512 pixels. One wide light: one per 64 pixels (below).
+ * such triangle per 512 pixels. One wide light: one per 16 pixels (below).
  * Only wide filters pay for it: studio-spots' seven lights all hard made the main pass 49 ms
  * without the pass and 65 with it; PCF radius 1: 57 / 68, 2: 81 / 84, 3: 97 / 97, 5: 143 /
  * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
 #define RND_VIS_MIN_PCF_RADIUS 4u
 #define RND_VIS_PIXELS_PER_FACE 512u
-/* One wide light pays for the passes only over denser meshes (measured, thumbnail preset with
- * its one PCSS sun, 512²; main pass without / with): a sphere of 64 segments (~2,000 faces
- * towards the camera, one per 130 pixels) 28.4 / 28.3 ms, 128 segments (one per 32) 36.9 /
- * 32.6, a 10k-triangle STL (one per 52) 34.4 / 32.0, the 124k-triangle ogre OBJ's 49k level
- * 97 / 80, nefertiti's 95 / 69; a 16-segment sphere (one per 500) 20.9 / 24.6. */
+/* One wide light pays for the passes only over dense meshes. Measured, the thumbnail preset
+ * with its one PCSS sun, 512², whole render without / with the pass: the 124k-triangle ogre
+ * OBJ's 49k level 115 / 101 ms, nefertiti 113 / 86, beast 88 / 73, a 100k-triangle STL sphere's
+ * level 60 / 55 (main pass alone: ogre 97 / 80, nefertiti 95 / 69); about even: a sphere of
+ * 128 segments (one face towards the camera per 32 pixels) 49.1 / 48.6, a 10k-triangle STL
+ * (one per 52) 46.7 / 44.6 and 43.6 / 44.0, 64 segments (one per 130) 39.7 / 39.5; worse: 16
+ * segments (one per 500) 31.9 / 35.1, thumb-512's tessellated sphere (one per 47) main pass
+ * 17.3 / 19.4. So one per 16 pixels, where it clearly pays. */
 #define RND_VIS_PIXELS_PER_FACE_ONE_LIGHT 16u
 /* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
 #define RND_VIS_MAX_BYTES (32ull << 20)

@@ -85,8 +85,7 @@ int main(int argc, char **argv)
 		if (!json) { fprintf(stderr, "bench: cannot read %s\n", argv[a]); rc = 1; continue; }
 		double *t = calloc((size_t)(n * S_COUNT), sizeof *t);
 		size_t bytes_out = 0;
-		uint32_t maps_rendered = 0, maps_reused = 0;
-		struct rnd_timings last = {0};
+		struct rnd_timings last = {0};   /* of the last run */
 		struct api_limits lim;
 		api_limits_defaults(&lim);
 		lim.max_triangles = 0;
@@ -112,8 +111,6 @@ int main(int argc, char **argv)
 			else free(out);
 			double t3 = now_ms();
 			bytes_out = olen;
-			maps_rendered = tm.shadow_maps_rendered;
-			maps_reused = tm.shadow_maps_reused;
 			last = tm;
 			rnd_image_release(&img);
 			api_scene_free(s);
@@ -134,8 +131,8 @@ int main(int argc, char **argv)
 				col[s] = median(v, m);
 				printf(" %8.2f", col[s]);
 			}
-			printf(" %8.1f %8zu %4u/%-4u %6.2f %8.1f %3u\n", 1000.0 / col[S_TOTAL], bytes_out / 1024, maps_rendered,
-			       maps_reused, (double)last.shadow_texels / 1e6, (double)last.camera_triangles / 1e3,
+			printf(" %8.1f %8zu %4u/%-4u %6.2f %8.1f %3u\n", 1000.0 / col[S_TOTAL], bytes_out / 1024,
+			       last.shadow_maps_rendered, last.shadow_maps_reused, (double)last.shadow_texels / 1e6, (double)last.camera_triangles / 1e3,
 			       last.visibility_views);
 		}
 		free(t);

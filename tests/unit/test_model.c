@@ -194,43 +194,6 @@ TEST(model_stl_tetrahedron_sniffed)
 	api_scene_free(s);
 }
 
-/* An STL's facets arrive with flat normals from their winding, so corners are one vertex only
- * where facets of one plane meet: a square of two facets is 4 vertices, a third facet folded up
- * along the square's edge keeps its own 3 (Assimp's join did this; it is off for STL, umbra
- * joins bit-identical corners itself, model_import.c). */
-TEST(model_stl_joins_the_corners_of_coplanar_facets)
-{
-	const float tri[3][3][3] = {
-		{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}},
-		{{1, 0, 0}, {0, 0, 1}, {1, 0, 1}},
-		{{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}},
-	};
-	uint8_t stl[84 + 3 * 50] = {0};
-	uint32_t n = 3;
-	memcpy(stl + 84 - 4, &n, 4);
-	for (int t = 0; t < 3; t++)
-		memcpy(stl + 84 + 50 * t + 12, tri[t], sizeof tri[t]);   /* normal left zero: from the winding */
-	struct api_problem p;
-	struct api_scene *s = parse_model(stl, sizeof stl, "", &p);
-	REQUIRE(s, "parse failed: %d %s: %s", p.status, p.pointer, p.detail);
-	const struct rnd_scene *sc = &s->scene;
-	REQUIRE(sc->object_count == 1, "%u objects", sc->object_count);
-	const struct rnd_object *o = &sc->objects[0];
-	CHECK(o->vertex_count == 7 && o->index_count == 9, "%u vertices %u indices", o->vertex_count, o->index_count);
-	/* every facet still has its own corners, at their positions */
-	for (uint32_t t = 0; o->indices && t < 3 && t * 3 + 2 < o->index_count; t++)
-		for (int k = 0; k < 3; k++) {
-			uint32_t v = o->indices[3 * t + (uint32_t)k];
-			REQUIRE(v < o->vertex_count);
-			const float *q = o->positions + 3 * (size_t)v;
-			bool found = false;
-			for (int u = 0; u < 3; u++)
-				found |= near_f(q[0], tri[t][u][0]) && near_f(q[1], tri[t][u][1]) && near_f(q[2], tri[t][u][2]);
-			CHECK(found, "facet %u corner %d at (%g, %g, %g) is none of its own", t, k, q[0], q[1], q[2]);
-		}
-	api_scene_free(s);
-}
-
 TEST(model_glb_quad_texture_mask)
 {
 	size_t n;

@@ -1,0 +1,84 @@
+/* tests/unit — STL import (api/model_import.c): facets arrive with flat normals made from their
+ * winding, so a corner is one vertex only where facets of one plane meet. Assimp's join is off
+ * for STL (it searched a 1M-triangle file for ~1 s and found next to nothing); umbra joins the
+ * corners itself, normals compared to within 2^-14: two coplanar facets of a tilted plane get
+ * normals that differ in their last bits. */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "api.h"
+#include "model.h"
+#include "test.h"
+
+/* A binary STL of `n` facets (corners tri[t][0..2], normals left zero) into out. */
+static size_t stl_of(uint8_t *out, const float (*tri)[3][3], uint32_t n)
+{
+	memset(out, 0, 84 + 50 * (size_t)n);
+	memcpy(out + 80, &n, 4);
+	for (uint32_t t = 0; t < n; t++) memcpy(out + 84 + 50 * (size_t)t + 12, tri[t], sizeof tri[t]);
+	return 84 + 50 * (size_t)n;
+}
+
+static struct api_model *import_stl(const uint8_t *d, size_t len)
+{
+	struct api_limits l;
+	api_limits_defaults(&l);
+	struct api_model *m = NULL;
+	char err[300];
+	int st;
+	if (api_model_get(d, len, API_MODEL_STL, &l, &m, &st, err, sizeof err) != API_OK) {
+		printf("    import failed: %s\n", err);
+		return NULL;
+	}
+	return m;
+}
+
+/* Every facet keeps its own three corners, at their positions. */
+static void corners_kept(const struct api_model_mesh *me, const float (*tri)[3][3], uint32_t n)
+{
+	REQUIRE(me->index_count == 3 * n, "%u indices for %u facets", me->index_count, n);
+	for (uint32_t t = 0; t < n; t++)
+		for (int k = 0; k < 3; k++) {
+			uint32_t v = me->indices[3 * t + (uint32_t)k];
+			REQUIRE(v < me->vertex_count);
+			const float *q = me->positions + 3 * (size_t)v;
+			CHECK(!memcmp(q, tri[t][k], 12), "facet %u corner %d moved to (%g, %g, %g)", t, k, q[0], q[1], q[2]);
+		}
+}
+
+TEST(stl_joins_the_corners_of_coplanar_facets)
+{
+	/* a square of two facets on the floor and a third folded up along its edge */
+	const float tri[3][3][3] = {
+		{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}},
+		{{1, 0, 0}, {0, 0, 1}, {1, 0, 1}},
+		{{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}},
+	};
+	uint8_t stl[84 + 3 * 50];
+	struct api_model *m = import_stl(stl, stl_of(stl, tri, 3));
+	REQUIRE(m && m->mesh_count == 1);
+	const struct api_model_mesh *me = &m->meshes[0];
+	CHECK(me->vertex_count == 7, "%u vertices: the square's 4, the folded facet's own 3", me->vertex_count);
+	corners_kept(me, tri, 3);
+	api_model_release(m);
+}
+
+TEST(stl_joins_coplanar_facets_of_a_tilted_plane)
+{
+	/* The quad p0 p1 p2 p3 lies in one plane, but its facets' normalised cross products differ in
+	 * the last bit of y (0.26726124 against 0.26726127): compared bit for bit they stayed 6
+	 * vertices. */
+	const float p[4][3] = {{0, 0, 0}, {0.1f, 2 * 0.1f, 0}, {0.1f, 5 * 0.1f, 0.1f}, {0, 3 * 0.1f, 0.1f}};
+	float tri[2][3][3];
+	const int f[2][3] = {{0, 3, 1}, {1, 3, 2}};
+	for (int t = 0; t < 2; t++)
+		for (int k = 0; k < 3; k++) memcpy(tri[t][k], p[f[t][k]], 12);
+	uint8_t stl[84 + 2 * 50];
+	struct api_model *m = import_stl(stl, stl_of(stl, (const float (*)[3][3])tri, 2));
+	REQUIRE(m && m->mesh_count == 1);
+	const struct api_model_mesh *me = &m->meshes[0];
+	CHECK(me->vertex_count == 4, "%u vertices for a quad of two facets", me->vertex_count);
+	corners_kept(me, (const float (*)[3][3])tri, 2);
+	api_model_release(m);
+}
