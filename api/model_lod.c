@@ -259,8 +259,9 @@ static float point_triangle_d2(const float p[3], const float a[3], const float b
  * cheap estimate alone had been the measure: a nearest vertex found in space can belong to
  * another part close by (an eyeball in its socket) or sit on a crease of the triangle's own
  * face, and every level of the 124k-triangle ogre OBJ measured 0.29 of its 12-unit height that
- * way, so none was ever drawn. meshoptimizer's own error measures the kept vertices against the removed faces' planes
- * and says nothing of the new triangles' insides: on a sphere it claims 6x less than this. */
+ * way, so none was ever drawn. meshoptimizer's own error measures the kept vertices against
+ * the removed faces' planes and says nothing of the new triangles' insides: on a sphere it
+ * claims 6x less than this. */
 static float level_error(const struct grid *g, struct walk *k, const struct welded *w, const uint32_t *idx, size_t ni)
 {
 	float worst2 = 0.0f;
