@@ -58,6 +58,18 @@ static bool wide_filter(const struct rnd_light_plan *lp)
 	return lp->filter == UMBRA_FILTER_PCSS || (lp->filter == UMBRA_FILTER_PCF && lp->pcf_radius >= RND_VIS_MIN_PCF_RADIUS);
 }
 
+uint64_t rnd_visibility_bytes(const struct rnd_scene *sc)
+{
+	if (sc->output.debug != RND_DEBUG_NONE) return 0;
+	bool shadowed = false;
+	for (uint32_t i = 0; i < sc->light_count; i++) shadowed |= sc->lights[i].shadow.enabled;
+	uint64_t px = (uint64_t)sc->width * sc->height;
+	if (!shadowed || px * sc->light_count * 2 > RND_VIS_MAX_BYTES) return 0;
+	/* rnd_slot_visibility's images: surfaces RGBA32F, normals RGBA16 SNORM, their depth D32,
+	 * an R16 layer per light (internal.h) */
+	return px * (16 + 8 + 4 + 2ull * sc->light_count);
+}
+
 bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
                            const struct draw *draws, uint32_t ndraw)
 {
@@ -71,7 +83,7 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 	if (!shadowed) return false;
 	for (uint32_t i = 0; i < ndraw; i++)
 		if (draws[i].index_count && draws[i].masked) return false;
-	if ((uint64_t)sc->width * sc->height * sc->light_count * 2 > RND_VIS_MAX_BYTES) return false;
+	if (!rnd_visibility_bytes(sc)) return false;   /* over the size cap */
 	const char *env = getenv("UMBRA_VISIBILITY");
 	if (env && strcmp(env, "0") == 0) return false;
 	if (env && strcmp(env, "1") == 0) return true;

@@ -19,6 +19,10 @@
  * the scene allow it at all. */
 bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
                            const struct draw *draws, uint32_t ndraw);
+/* The bytes of the slot's images the pass would take for a view of sc, 0 where it cannot run
+ * at all (no shadowed light, a debug view, a view too large): what a render may need beyond
+ * its targets (estimate.c counts it, before the plan says whether the pass runs). */
+uint64_t rnd_visibility_bytes(const struct rnd_scene *sc);
 /* The surfaces and visibility passes over rv's band (record_band_area), leaving both images
  * ready for sampling by the main pass. */
 enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
