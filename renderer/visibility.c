@@ -47,7 +47,9 @@
  * 128 segments (one face towards the camera per 32 pixels) 49.1 / 48.6, a 10k-triangle STL
  * (one per 52) 46.7 / 44.6 and 43.6 / 44.0, 64 segments (one per 130) 39.7 / 39.5; worse: 16
  * segments (one per 500) 31.9 / 35.1, thumb-512's tessellated sphere (one per 47) main pass
- * 17.3 / 19.4. So one per 16 pixels, where it clearly pays. */
+ * 17.3 / 19.4. So one per 16 pixels, where it clearly pays; and only with MSAA, which shades
+ * a pixel once per triangle touching it: at MSAA 1 one triangle shades each pixel, and the
+ * ogre's thumbnail took 53-57 ms without the pass, 59-60 with it. */
 #define RND_VIS_PIXELS_PER_FACE_ONE_LIGHT 16u
 /* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
 #define RND_VIS_MAX_BYTES (32ull << 20)
@@ -94,7 +96,7 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 		faces += draws[i].cam_index_count / 3 / (draws[i].cull_back ? 2 : 1);
 	uint64_t px = (uint64_t)sc->width * sc->height;
 	if (wide >= 2) return faces * RND_VIS_PIXELS_PER_FACE >= px;
-	return wide == 1 && faces * RND_VIS_PIXELS_PER_FACE_ONE_LIGHT >= px;
+	return wide == 1 && sc->output.msaa > 1 && faces * RND_VIS_PIXELS_PER_FACE_ONE_LIGHT >= px;
 }
 
 /* Pass 1: the surfaces of the band's rows, cleared to 0 (nothing drawn); their depth stays an

@@ -245,6 +245,16 @@ TEST(visibility_pass_one_soft_light_over_a_dense_mesh)
 		rnd_image_release(&img);
 	}
 	same_with_and_without("a dense mesh under one soft sun", doc);
+	/* at MSAA 1 each pixel is shaded by one triangle: nothing for the pass to save */
+	char *one = malloc(strlen(doc) + 64);
+	REQUIRE(one, "out of memory");
+	memcpy(one, doc, strlen(doc) - 1);
+	strcpy(one + strlen(doc) - 1, ",'output':{'msaa':1}}");
+	if (render_vis(&img, NULL, one, &views)) {
+		CHECK(views == 0, "one soft sun at MSAA 1: the pass ran");
+		rnd_image_release(&img);
+	}
+	free(one);
 	free(doc);
 	/* the same patch of 8 x 8 cells: the filters cost less than the passes */
 	doc = dense_doc(8, soft_sun);
