@@ -4,7 +4,7 @@
 # tests/bench/http_bench.c when missing) on the $SHARED/bench scenes at concurrency 1, 2, 4, 8,
 # prints the daemon's RSS when ready and after the rows, then stops it with SIGTERM. Numbers only;
 # nothing is asserted.
-# Env: BUILD, SHARED, HTTP_BENCH_CONC (1,2,4,8), HTTP_BENCH_REQUESTS (16),
+# Env: BUILD, SHARED, HTTP_BENCH_CONC (1,2,4,8), HTTP_BENCH_REQUESTS (16), HTTP_BENCH_WARMUP (1),
 #      HTTP_BENCH_SECONDS (15 per row), HTTP_BENCH_SCENES (default: every $SHARED/bench/*.json).
 set -eu
 BUILD=${BUILD:-build}
@@ -33,7 +33,8 @@ rss() { echo "umbrad RSS $1: $(awk '/^VmRSS/ {print $2}' "/proc/$pid/status") kB
 rss ready
 echo "umbrad $(curl -s "$url/v1/info" | sed -n 's/.*"device": *"\([^"]*\)".*/device: \1/p'), $(nproc) CPUs"
 # shellcheck disable=SC2086
-"$BENCH" -c "${HTTP_BENCH_CONC:-1,2,4,8}" -n "${HTTP_BENCH_REQUESTS:-16}" -t "${HTTP_BENCH_SECONDS:-15}" "$url" \
+"$BENCH" -c "${HTTP_BENCH_CONC:-1,2,4,8}" -n "${HTTP_BENCH_REQUESTS:-16}" -t "${HTTP_BENCH_SECONDS:-15}" \
+	-w "${HTTP_BENCH_WARMUP:-1}" "$url" \
 	${HTTP_BENCH_SCENES:-"$SHARED"/bench/*.json} || status=$?
 rss after
 curl -s "$url/metrics" | grep -E '^umbra_(stage_seconds_(sum|count)|queue_wait_seconds_(sum|count)|shadow_maps_re)' || true
