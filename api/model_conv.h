@@ -29,7 +29,7 @@ struct api_conv {
 	struct api_model_instance *inst;
 	uint32_t ninst, inst_cap;
 	bool gltf;                    /* glb / gltf: every texture slot, glTF material details */
-	bool join;                    /* join bit-identical vertices here (STL: Assimp's join is off) */
+	bool join;                    /* join corners equal to rounding here (STL: Assimp's join is off) */
 	struct api_gltf_info gi;      /* those details, and the warnings (filled for glTF only) */
 	const struct rnd_material *mats;
 	const bool *single_sided;     /* by material */

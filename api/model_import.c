@@ -193,11 +193,7 @@ static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_
 	return 0;
 }
 
-/* Joins the corners of a mesh of positions and normals (and colours: an STL's per-facet
- * colours) that share a position, a colour and a normal to within 2^-14 (coplanar facets'
- * normals, normalised cross products of different edges, differ in their last bits), in place:
- * corners where facets of one plane meet become one vertex, as Assimp's join made them.
- * Returns the vertices left; without memory for the tables they all stay (the same picture). */
+/* What join_vertices compares of a corner. */
 struct join_key {
 	float pos[3];
 	int16_t nrm[3];
@@ -205,6 +201,11 @@ struct join_key {
 	int16_t pad;   /* zero: meshoptimizer compares every byte */
 };
 
+/* Joins the corners of a mesh of positions and normals (and colours: an STL's per-facet
+ * colours) that share a position, a colour and a normal to within 2^-14 (coplanar facets'
+ * normals, normalised cross products of different edges, differ in their last bits), in place:
+ * corners where facets of one plane meet become one vertex, as Assimp's join made them.
+ * Returns the vertices left; without memory for the tables they all stay (the same picture). */
 static uint32_t join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
 {
 	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
@@ -402,10 +403,10 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	unsigned flags = aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
 	                 aiProcess_SortByPType | aiProcess_ValidateDataStructure;
 	/* STL facet normals are often wrong (opposite the winding, or zero): flat normals from the
-	 * winding instead, as STL viewers shade them. Each facet's corners then differ by normal
-	 * from their neighbours', so joining identical vertices finds next to nothing (Assimp's
-	 * documentation: senseless with GenNormals) and cost a 1M-triangle STL ~1 s; the renderer
-	 * welds by position itself where it needs to (model_lod.c). */
+	 * winding instead, as STL viewers shade them. Assimp's join of identical vertices compares
+	 * them by searching space (its documentation: senseless with GenNormals) and cost a
+	 * 1M-triangle STL ~1 s; convert_mesh joins the corners of coplanar facets by hashing
+	 * (join_vertices, 0.25 s), and model_lod.c welds by position where it needs to. */
 	if (format == API_MODEL_STL)
 		flags = (flags & ~(unsigned)(aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)) |
 		        aiProcess_DropNormals | aiProcess_GenNormals;

@@ -7,8 +7,8 @@
  * own figure leaves out how far the new triangles' insides are from the surface. The measure
  * is the distance from the nearest full-mesh vertex's tangent plane, and where that comes within
  * half the level's worst, the exact distance from the full mesh's faces around the triangle,
- * met walking its surface (another part close by or a crease misled the first). Every level gets its own vertex
- * arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
+ * met walking its surface (another part close by or a crease misled the first). Every level
+ * gets its own vertex arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
  * position (weld), so a level's normals are computed from its own triangles with a crease angle
  * (write_level) and its uvs are those of each position's first vertex: a texture seam of a
  * coarse level can show the wrong side's uvs (a thumbnail rarely can tell).
@@ -445,30 +445,29 @@ static size_t drop_degenerate(const struct welded *w, uint32_t *idx, size_t ni)
 	return out;
 }
 
-/* me's levels from its welded vertices *wp and indices cur (me->index_count of them; cur is
+/* me's levels from its welded vertices w and indices cur (me->index_count of them; cur is
  * overwritten). */
-static void mesh_lods(struct api_model_mesh *me, const struct welded *wp, uint32_t *cur, struct api_arena *arena,
+static void mesh_lods(struct api_model_mesh *me, const struct welded *w, uint32_t *cur, struct api_arena *arena,
                       size_t *bytes)
 {
-	const struct welded w = *wp;
 	struct rnd_mesh_lod *lods = api_arena_calloc(arena, API_LOD_LEVELS, sizeof *lods);
 	uint32_t *caller = cur, *next = malloc((size_t)me->index_count * sizeof *next);
 	struct grid g = {0};
 	struct walk k = {0};
-	if (!lods || !next || !grid_build(&g, &w) || !walk_build(&k, &w, cur, me->index_count))
+	if (!lods || !next || !grid_build(&g, w) || !walk_build(&k, w, cur, me->index_count))
 		goto done;
 	size_t ni = me->index_count;
 	float prev = 0.0f;
 	uint32_t n = 0;
 	for (unsigned level = 0; level < API_LOD_LEVELS; level++) {
-		size_t got = meshopt_simplify(next, cur, ni, w.pos, w.count, 12, 3, api_lod_level_error(level), 0, NULL);
+		size_t got = meshopt_simplify(next, cur, ni, w->pos, w->count, 12, 3, api_lod_level_error(level), 0, NULL);
 		if (got < 3) break;
 		/* Not worth a level under a quarter fewer triangles: try the next error on the same input. */
 		if (got * 4 > ni * 3) continue;
-		got = drop_degenerate(&w, next, got);
+		got = drop_degenerate(w, next, got);
 		/* measured against the full mesh; never less than a finer level's */
-		float e = fmaxf(level_error(&g, &k, &w, next, got), prev);
-		if (!write_level(arena, me, &w, next, got, &lods[n], bytes)) break;
+		float e = fmaxf(level_error(&g, &k, w, next, got), prev);
+		if (!write_level(arena, me, w, next, got, &lods[n], bytes)) break;
 		lods[n++].error = prev = e;
 		uint32_t *t = cur; cur = next; next = t;
 		ni = got;

@@ -17,8 +17,9 @@
  * (rnd_pacer_band_rows). Calibrated on 26 bench scenes (ninth landing): the main pass's
  * estimate is 0.6x (five stacked layers of small two-sided triangles) to 4.5x (16 soft lights)
  * of its time, mostly 1-2.5x. It had been 20-200x since the filters got cheaper, and under
- * umbrad's default 30 s deadline (slices of 1 s) a render of 0.1-0.3 s was cut into many bands:
- * the ogre OBJ under three soft lights 140 -> 262 ms, 16 soft lights 141 -> 166 ms. */
+ * umbrad's default 30 s deadline (slices of 1 s) a render of 0.02-0.3 s was cut into bands: the
+ * ogre OBJ under three soft lights took 262 ms instead of 140, 16 soft lights 166 instead of
+ * 141. */
 #define EST_MS_PER_PIXEL_UNIT 1.5e-5 /* one pixel, one unit of shading (see px_units) */
 #define EST_MS_PER_BAND 3.0          /* a band's clears, resolve and copy */
 #define EST_MS_PER_TRIANGLE 3e-4     /* main pass: vertex work, repeated in every band */
@@ -307,9 +308,10 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 	bool split = p->slice_ms > 0 || sc->band_rows;
 	uint64_t tris = 0;
 	for (uint32_t i = 0; i < rv->ndraw; i++) tris += rv->draws[i].cam_index_count / 3;
-	double est_row = sc->width * px_units(rv) * EST_MS_PER_PIXEL_UNIT;
+	double units = px_units(rv);
+	double est_row = sc->width * units * EST_MS_PER_PIXEL_UNIT;
 	/* lavapipe shades each triangle's 4x4 blocks: a triangle costs more where a pixel does */
-	double est_fixed = EST_MS_PER_BAND + (double)tris * EST_MS_PER_TRIANGLE * (1 + px_units(rv) / 4);
+	double est_fixed = EST_MS_PER_BAND + (double)tris * EST_MS_PER_TRIANGLE * (1 + units / 4);
 	/* Down to single rows: with many soft-shadowed lights and AOVs one row of a large image
 	 * can take a second on lavapipe. */
 	uint32_t min_rows = 1;
