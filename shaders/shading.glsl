@@ -100,9 +100,14 @@ vec2 poisson(int i) { vec4 v = frame.poisson[i >> 1]; return (i & 1) == 0 ? v.xy
 // Gathers the 2x2 texels around tile-local point q, kept inside the tile so filters never
 // read a neighbouring tile (views are widened by the filter footprint, so this only clamps
 // at the very edge) and never a border texel: the atlas's sampler clamps to the edge.
+// The 2x2 are chosen in tile space (q snapped to the texel corner between them), so the
+// gather reads an exact atlas coordinate: from a fractional q, which texels it read depended
+// on the rounding of the tile's position plus q, and the same request could differ by a step
+// at a rare pixel between a fresh process and a daemon whose cached maps had put the tile
+// elsewhere (the ogre OBJ's thumbnail: one pixel, CLI against umbrad).
 vec4 gather_tile(vec4 rect, vec2 q)
 {
-	q = clamp(q, vec2(1.0), vec2(rect.z - 1.0));
+	q = clamp(floor(q - 0.5) + 1.0, vec2(1.0), vec2(rect.z - 1.0));
 	return textureGather(shadow_atlas, (rect.xy + q) / rect.w);
 }
 
