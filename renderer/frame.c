@@ -14,16 +14,19 @@
 #include "moments.h"
 #include "record.h"
 
-/* 32 Poisson-disk taps in the unit disk (PCSS blocker search and filtering). */
+/* 32 Poisson-disk taps in the unit disk (PCSS blocker search and filtering; the longest lies a
+ * little outside it, at 1.216: umbra_frame.params.w, how far the taps reach). The even ones, the search's wide ring (shaders/shading.glsl
+ * pcss), come in ascending length: the search takes only the first of them that can reach a
+ * blocker (pcss_bounds' rho), a prefix. The filter takes all 32. */
 static const float POISSON[64] = {
-	-0.975402f, -0.0711386f, -0.920347f, -0.41142f, -0.883908f, 0.217872f, -0.884518f, 0.568041f,
-	-0.811945f, 0.90521f, -0.792474f, -0.779962f, -0.614856f, 0.386578f, -0.580859f, -0.208777f,
-	-0.53795f, 0.716666f, -0.515427f, 0.0899991f, -0.454634f, -0.707938f, -0.420942f, 0.991272f,
-	-0.261147f, 0.588488f, -0.211219f, 0.114841f, -0.146336f, -0.259194f, -0.139439f, -0.888668f,
-	0.0116886f, 0.326395f, 0.0380566f, 0.625477f, 0.0625935f, -0.50853f, 0.125584f, 0.0469069f,
-	0.169469f, -0.997253f, 0.320597f, 0.291055f, 0.359172f, -0.633717f, 0.435713f, -0.250832f,
-	0.507797f, -0.916562f, 0.545763f, 0.730216f, 0.56859f, 0.11655f, 0.743156f, -0.505173f,
-	0.736442f, -0.189734f, 0.843562f, 0.357036f, 0.865413f, -0.763726f, 0.872005f, 0.0483851f,
+	-0.146336f, -0.259194f, -0.920347f, -0.41142f, 0.0116886f, 0.326395f, -0.884518f, 0.568041f,
+	0.0625935f, -0.50853f, -0.792474f, -0.779962f, 0.56859f, 0.11655f, -0.580859f, -0.208777f,
+	-0.261147f, 0.588488f, -0.515427f, 0.0899991f, -0.614856f, 0.386578f, -0.420942f, 0.991272f,
+	0.359172f, -0.633717f, -0.211219f, 0.114841f, 0.736442f, -0.189734f, -0.139439f, -0.888668f,
+	-0.454634f, -0.707938f, 0.0380566f, 0.625477f, -0.53795f, 0.716666f, 0.125584f, 0.0469069f,
+	-0.883908f, 0.217872f, 0.320597f, 0.291055f, -0.975402f, -0.0711386f, 0.435713f, -0.250832f,
+	0.169469f, -0.997253f, 0.545763f, 0.730216f, 0.507797f, -0.916562f, 0.743156f, -0.505173f,
+	0.865413f, -0.763726f, 0.843562f, 0.357036f, -0.811945f, 0.90521f, 0.872005f, 0.0483851f,
 };
 
 static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
@@ -77,6 +80,10 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	const char *cull = getenv("UMBRA_LIGHT_CULL");
 	f->mode2[2] = cull && strcmp(cull, "0") == 0 ? 1u : 0u;
 	memcpy(f->poisson, POISSON, sizeof f->poisson);
+	float longest = 0.0f;
+	for (int i = 0; i < 32; i++)
+		longest = fmaxf(longest, sqrtf(POISSON[2 * i] * POISSON[2 * i] + POISSON[2 * i + 1] * POISSON[2 * i + 1]));
+	f->params[3] = longest;
 	f->depth_lin[0] = cam->proj[10];
 	f->depth_lin[1] = cam->proj[14];
 	f->depth_lin[2] = cam->proj[11];

@@ -8,8 +8,9 @@
  *  1. surfaces: the view's draws, single-sample, write what the main pass will shade at each
  *     pixel centre, world position and geometric normal (shaders/surface.frag);
  *  2. visibility: a fullscreen pass runs shading.glsl's shadow_visibility() for every shadowed
- *     light reaching that surface and writes the results, four lights per row band of a
- *     W x (H x bands) RGBA16 image (umbra_shared.h UMBRA_VIS_*);
+ *     light reaching that surface and writes the results, a layer per light of an R16 image
+ *     array (umbra_shared.h UMBRA_BINDING_VISIBILITY; four lights per RGBA16 texel, one store
+ *     and one fetch per four lights, measured no faster on studio-spots);
  *  3. the main pass (SC_VISIBILITY) reads a light's value instead of filtering: at its own
  *     pixel when the surface there is its own (within half a pixel of its plane, the same
  *     normal), else at the 4-neighbour that is (MSAA shades a surface at silhouette pixels whose

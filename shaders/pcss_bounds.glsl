@@ -21,15 +21,19 @@
 // One fetch bounds everything near p (its block's neighbourhood); the lit test then reads the
 // planes of the blocks within rho of p, usually just p's own. lavapipe: the loops' trip counts
 // are 0 where the light has no bounds or the test is settled.
-int pcss_bounds(umbra_light L, vec2 p, vec4 rect, float ref, vec2 grad, float slack, float reach, float r0, float r1)
+// reach_max: no tap farther than this from p finds a blocker (1e30 where the bounds say nothing).
+int pcss_bounds(umbra_light L, vec2 p, vec4 rect, float ref, vec2 grad, float slack, float reach, float r0, float r1,
+                out float reach_max)
 {
 	const int B = UMBRA_BOUNDS_BLOCK, T = UMBRA_BOUNDS_TEXELS;
 	const float EPS = 1e-6;   // float rounding of both sides (depths 0..1), a few ulp of 1
 	const float WIN = 1.0 + 1.0 / 64.0;
 	float half_b = 0.5 * float(B - 1);   // texel centres of a block: its centre +- half_b
-	// Taps read texels within reach + 1.5 of p (gather_tile's clamp only moves them nearer),
-	// all inside the neighbourhood of p's block when that reaches UMBRA_BOUNDS_RING blocks out.
-	bool usable = L.shadow.w != 0u && reach + 2.5 <= float(B * UMBRA_BOUNDS_RING);
+	// Taps read texels within reach + 1.5 of p per axis (gather_tile's clamp only moves them
+	// nearer), all inside the neighbourhood of p's block when that reaches UMBRA_BOUNDS_RING
+	// blocks out, at least B * UMBRA_BOUNDS_RING texels from p (PCSS's widest search, 24 texels
+	// times the longest tap 1.216, + 1 for rounding: 30.2).
+	bool usable = L.shadow.w != 0u && reach + 1.5 <= float(B * UMBRA_BOUNDS_RING);
 	ivec2 tile = ivec2(rect.xy) / B;
 	ivec2 own = min(ivec2(p) / B, ivec2(int(rect.z) / B - 1));
 	vec2 near = vec2(0.0, 1e30);   // lowest and highest depth around p
@@ -40,6 +44,7 @@ int pcss_bounds(umbra_light L, vec2 p, vec4 rect, float ref, vec2 grad, float sl
 	// reach(d) = r0 - r1 d is computed from terms of |r0|, |r1| (1e3 for a small light far
 	// away): its rounding, relative to those, plus a little.
 	float rho = max(r0 - r1 * near.x + 1e-5 * (abs(r0) + abs(r1)) + 0.01, 0.0) + WIN;
+	reach_max = usable ? rho : 1e30;
 	ivec2 q0 = ivec2(floor(p - rho)) / B, q1 = ivec2(floor(p + rho)) / B;
 	int nx = q1.x - q0.x + 1, ny = q1.y - q0.y + 1;
 	// A tap that gather_tile clamps lies more than rho from p when p is this far from the

@@ -161,7 +161,7 @@ struct umbra_frame {
 	U_VEC4 background;       /* linear rgba */
 	U_VEC4 ambient_sky;      /* rgb already times intensity */
 	U_VEC4 ambient_ground;
-	U_VEC4 params;           /* x exposure multiplier, y near, z far, w unused */
+	U_VEC4 params;           /* x exposure multiplier, y near, z far, w the longest Poisson tap (PCSS) */
 	U_UVEC4 mode;            /* x tonemap, y debug, z debug light, w light count */
 	U_UVEC4 mode2;           /* x 1 = linear output (no tone map / sRGB), y transparent,
 	                            z 1 = light culling off (UMBRA_LIGHT_CULL=0, tests) */

@@ -110,3 +110,46 @@ TEST(specialize_mixed_lights_same_image)
 	         "{'msaa':1,'format':'exr'}");
 	same_specialized_and_general("radii 0 and 2, hard", doc);
 }
+
+/* Byte differences of two renders of the same size (-1: sizes differ). */
+static long differing_bytes(const struct rnd_image *a, const struct rnd_image *b)
+{
+	if (a->width != b->width || a->height != b->height || a->stride != b->stride) return -1;
+	const unsigned char *pa = a->pixels, *pb = b->pixels;
+	long diff = 0;
+	for (size_t i = 0; i < (size_t)a->height * a->stride; i++) diff += pa[i] != pb[i];
+	return diff;
+}
+
+/* Lights of different filters in one scene: the filters' code is shared by one variant, and
+ * pcf() runs for every light under a mask with its radius read per light (-1, no tap, for the
+ * others; shading.glsl sample_view). Each light's shadow (debug view) must be what it is when
+ * the light is alone, where its filter is the scene's only one (PCF: the folded radius). */
+TEST(specialize_mixed_filters_same_shadow)
+{
+	static const char *const light[3] = {
+		"{'type':'directional','direction':[-0.5,-1,-0.3],'intensity':2,'angular_diameter':3}",
+		"{'type':'spot','position':[2,3,1],'direction':[-0.5,-1,-0.2],'outer_angle':40,'intensity':30,'radius':0.1}",
+		"{'type':'point','position':[-1.5,2,1.5],'intensity':20}",   /* no radius: PCF, default radius */
+	};
+	char lights[1024], out[128], doc[4096];
+	snprintf(lights, sizeof lights, "%s,%s,%s", light[0], light[1], light[2]);
+	for (int k = 0; k < 3; k++) {
+		struct rnd_image mixed, alone;
+		snprintf(out, sizeof out, "{'debug':'shadow','debug_light':%d}", k);
+		spec_doc(doc, sizeof doc, lights, out);
+		if (!gpu_render(&mixed, "%s", doc)) return;
+		spec_doc(doc, sizeof doc, light[k], "{'debug':'shadow','debug_light':0}");
+		if (gpu_render(&alone, "%s", doc)) {
+			const unsigned char *p = alone.pixels;
+			long dark = 0;
+			for (uint32_t y = 0; y < alone.height; y++)
+				for (uint32_t x = 0; x < alone.width; x++) dark += p[(size_t)y * alone.stride + 4 * x] < 128;
+			CHECK(dark > 50, "light %d: casts almost no shadow alone (%ld pixels), the test sees nothing", k, dark);
+			long diff = differing_bytes(&mixed, &alone);
+			CHECK(diff == 0, "light %d: its shadow beside the others differs from alone in %ld bytes", k, diff);
+			rnd_image_release(&alone);
+		}
+		rnd_image_release(&mixed);
+	}
+}
