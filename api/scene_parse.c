@@ -301,6 +301,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	}
 	s->arena_ = c.arena;
 	rnd_scene_defaults(&s->scene);
+	s->scene.max_shadow_resolution = limits->max_shadow_resolution;   /* the renderer's own choices too */
 	s->format = API_FORMAT_PNG;
 	s->bit_depth = 8;
 	s->png_level = -1;

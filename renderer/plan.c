@@ -567,8 +567,11 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 			uint32_t hard = hard_light_res(L, lp, bounds, cam, scene->height, base);
 			if (hard > want) want = hard;
 		}
+		/* A power of two, at most 8192; one the renderer chooses also within the scene's cap
+		 * (an explicit resolution over it was refused by the parser). */
+		uint32_t cap = s->resolution || !scene->max_shadow_resolution ? 8192 : scene->max_shadow_resolution;
 		uint32_t res = 64;
-		while (res < want && res < 8192) res *= 2;
+		while (res < want && res * 2 <= cap && res < 8192) res *= 2;
 		lp->resolution = res;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false, clipmap = false;

@@ -36,7 +36,7 @@ static const struct opt_def opts[] = {
 	{ "max-pixels", OPT_SIZE, "N", "largest width*height, 0 = no limit (16777216)", LIM(max_pixels), 0, UINT64_MAX },
 	{ "max-triangles", OPT_SIZE, "N", "most triangles after tessellation, 0 = no limit (20M)", LIM(max_triangles), 0, UINT64_MAX },
 	{ "max-lights", OPT_UINT, "N", "most lights, 0 = no limit (64)", LIM(max_lights), 0, UINT32_MAX },
-	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
+	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, asked for or chosen by the renderer, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
 	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
 	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to (none: `path` is a 400)", CFG(asset_root), 0, 0 },
 	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", CFG(model_cache_bytes), 0, UINT64_MAX },

@@ -355,6 +355,8 @@ TEST(parse_limits_configured)
 	struct api_scene *s = NULL;
 	const char *ok = q(BASE ",'width':10,'height':100,'shadows':{'resolution':4096}}");
 	CHECK(api_scene_parse(ok, strlen(ok), &lim, &s, &p) == API_OK, "%s", p.detail);
+	/* The limit also bounds what the renderer chooses where a scene gives no resolution. */
+	CHECK(s && s->scene.max_shadow_resolution == 4096, "scene's cap %u", s ? s->scene.max_shadow_resolution : 0);
 	api_scene_free(s);
 	/* 0 = unlimited */
 	memset(&lim, 0, sizeof lim);

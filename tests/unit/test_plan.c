@@ -923,5 +923,27 @@ TEST(plan_light_importance_sets_tile_size)
 	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
 	CHECK(sp->lights[0].resolution == 512, "near soft light face %u", sp->lights[0].resolution);
 	CHECK(sp->lights[1].resolution == 256, "small far soft light face %u", sp->lights[1].resolution);
+	/* A server's cap bounds the renderer's choices (the power of two at or below it): the hard
+	 * near light's 1024 and a sun's default 2048 come down to 512 under a cap of 700; an
+	 * explicit resolution is the parser's to refuse, not the planner's to change. */
+	lights[0].radius = lights[1].radius = 0;
+	struct rnd_light sun;
+	rnd_light_defaults(&sun, RND_LIGHT_DIRECTIONAL);
+	struct rnd_light three[3] = {lights[0], lights[1], sun};
+	sc.lights = three;
+	sc.light_count = 3;
+	sc.max_shadow_resolution = 700;
+	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
+	CHECK(sp->lights[0].resolution == 512, "capped near light face %u", sp->lights[0].resolution);
+	CHECK(sp->lights[1].resolution == 256, "capped small light face %u", sp->lights[1].resolution);
+	CHECK(sp->lights[2].resolution == 512, "capped sun %u", sp->lights[2].resolution);
+	sc.max_shadow_resolution = 0;
+	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
+	CHECK(sp->lights[0].resolution == 1024 && sp->lights[2].resolution == 2048, "uncapped: near %u, sun %u",
+	      sp->lights[0].resolution, sp->lights[2].resolution);
+	three[0].shadow.resolution = 1024;
+	sc.max_shadow_resolution = 700;
+	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
+	CHECK(sp->lights[0].resolution == 1024, "explicit resolution under a cap %u", sp->lights[0].resolution);
 	free(sp);
 }

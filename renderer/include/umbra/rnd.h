@@ -299,6 +299,10 @@ struct rnd_scene {
 	 * than the output can show (renderer/lod.h: within 1/32 pixel and 1/8 shadow texel); true:
 	 * exactly `segments` and every mesh in full (tests, comparisons). */
 	bool exact_segments;
+	/* The largest map side (texels) the renderer may choose for a light whose shadow has no
+	 * `resolution` of its own, 0 = no cap (8192): a server's limit on shadow resolution
+	 * (api/ sets it from umbrad's --max-shadow-resolution) bounds the defaults too. */
+	uint32_t max_shadow_resolution;
 };
 
 /* Contract defaults: 512x512, perspective camera at (0,0,5) looking at the origin, default
