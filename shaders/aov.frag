@@ -23,7 +23,7 @@ float visibility(uint i, vec3 p_shadow, vec3 n_shadow, bool receive)
 	float atten;
 	vec3 l = light_dir(L, v_pos, atten);
 	uint view;
-	return shadow_visibility(L, p_shadow, n_shadow, l, view);
+	return shadow_visibility(L, p_shadow, n_shadow, l, SC_FILTERS, view);
 }
 
 void main()

@@ -134,9 +134,9 @@ float bilinear_compare(vec2 p, vec4 rect, float ref, float res)
 // every light (lavapipe runs an `if` for all of a block under a mask) with r = -1 for the
 // others, and unrolled gathers would run for all of them (studio-spots, six PCSS lights and
 // one PCF: CPU per render -7 % with the radius read per light).
-float pcf(vec2 p, vec4 rect, float ref, float res, int r, vec2 grad)
+float pcf(vec2 p, vec4 rect, float ref, float res, int r, vec2 grad, uint filters)
 {
-	if (SC_PCF_RADIUS != 0u && SC_FILTERS == (1u << UMBRA_FILTER_PCF)) r = int(SC_PCF_RADIUS) - 1;
+	if (SC_PCF_RADIUS != 0u && filters == (1u << UMBRA_FILTER_PCF)) r = int(SC_PCF_RADIUS) - 1;
 	vec2 q = p - 0.5;
 	vec2 base = floor(q);
 	vec2 f = q - base;
@@ -326,7 +326,7 @@ float moments(umbra_light L, umbra_shadow_view v, vec2 uv, vec4 rect, float ref)
 }
 
 // Visibility of light L at pos (geometric normal n) in one shadow view vi.
-float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
+float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light, uint filters)
 {
 	umbra_shadow_view v = views[vi];
 	float res = v.rect.z;
@@ -346,13 +346,13 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light)
 	float ref = clamp(sc.z, 0.0, 1.0);     // depth clamp: casters before the near plane pancake to 0
 	vec4 rect = v.rect;
 	uint filt = L.shadow.z;
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, rect, ref, res);
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, receiver_gradient(v, pos, n, lc0, texel, res));
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, rect, ref);
+	if ((filters & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, rect, ref, res);
+	if ((filters & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, receiver_gradient(v, pos, n, lc0, texel, res));
+	if ((filters & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, rect, ref);
 	// r -1 (no tap) for a light of another filter: pcf() runs for it under a mask (see pcf()).
-	if ((SC_FILTERS & (1u << UMBRA_FILTER_PCF)) != 0u)
+	if ((filters & (1u << UMBRA_FILTER_PCF)) != 0u)
 		return pcf(tp, rect, ref, res, filt == UMBRA_FILTER_PCF ? int(L.shadow.w) : -1,
-		           receiver_gradient(v, pos, n, lc0, texel, res));
+		           receiver_gradient(v, pos, n, lc0, texel, res), filters);
 	return 1.0;
 }
 
@@ -366,7 +366,7 @@ float view_extent(uint vi, vec3 pos)
 // Visibility of light L at world position pos with geometric normal n: picks the cube face,
 // cascade or clipmap level, blends across cascade / level borders, fades out towards the
 // light's max distance. view_out: the cascade / level / face used (debug views).
-float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint view_out)
+float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, uint filters, out uint view_out)
 {
 	view_out = 0u;
 	if (L.shadow.y == 0u) return 1.0;
@@ -402,8 +402,8 @@ float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint vi
 		if (c + 1u >= count) t = 0.0;
 	}
 	view_out = c;
-	float vis = sample_view(L, first + c, pos, n, to_light);
-	if (SC_CASCADES != 0u && t > 0.0) vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light), t);
+	float vis = sample_view(L, first + c, pos, n, to_light, filters);
+	if (SC_CASCADES != 0u && t > 0.0) vis = mix(vis, sample_view(L, first + c + 1u, pos, n, to_light, filters), t);
 	// Distance fade to unshadowed before max distance, so the end of the shadows has no edge
 	// (point lights have none).
 	float max_d = L.params.w, fade_start = L.shadow_params.w;
@@ -487,9 +487,9 @@ float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
 }
 
 // Visibility of light L: its shadow map, and where asked, contact shadows (the smaller of the two).
-float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, out uint view_out)
+float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, uint filters, out uint view_out)
 {
-	float vis = map_visibility(L, pos, n, to_light, view_out);
+	float vis = map_visibility(L, pos, n, to_light, filters, view_out);
 	if (SC_CONTACT != 0u && L.contact.w > 0.5 && vis > 0.0) vis = min(vis, contact_visibility(L, pos, n, to_light));
 	return vis;
 }
@@ -595,7 +595,7 @@ void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 p_shadow, vec3 V, vec3 c_
 #if defined(UMBRA_VIS_READ)
 		if (SC_FILTERS != 0u && receive && L.shadow.y != 0u) vis = vis_fetch(vis_px, i);
 #elif !defined(UMBRA_VIS_PASS)
-		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, p_shadow, n_shadow, l, view);
+		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, p_shadow, n_shadow, l, SC_FILTERS, view);
 #endif
 		if (i == frame.mode.z) { debug_vis = vis; debug_view = view; }
 		if (ndl <= 0.0 || atten <= 0.0) continue;

@@ -4,23 +4,10 @@
 // UMBRA_VIS_READ compiles either half.
 
 #ifdef UMBRA_VIS_PASS
-// vis.frag: every shadowed light's visibility at v_pos (n_shadow: the plane of its triangle, as
-// the main pass hands the filters, facet.glsl) into layer i of vis_out: the filters' value
-// where the light reaches (range, cone) and 1 elsewhere, so that the main pass finds a value
-// for every light it shades here, at this pixel or a neighbour (vis_pixel). The same
-// block-wide walk as light_all.
-void store_visibility(ivec2 px, vec3 n_shadow)
+// Walks the lights in todo that reach this pixel (reach), storing each one's visibility, with
+// the code of `filters` only (a constant: sample_view's dispatch folds to those filters).
+void store_walk(ivec2 px, vec3 n_shadow, uvec2 reach, uvec2 todo, uint filters)
 {
-	uvec2 reach = uvec2(0u);
-	for (uint i = 0u; i < frame.mode.w; i++) {
-		umbra_light L = lights[i];
-		if (L.shadow.y == 0u) continue;
-		float atten = 0.0;
-		if ((SC_LIGHT_TYPES & (1u << uint(L.color.w))) != 0u) light_dir(L, v_pos, atten);
-		if (atten > 0.0 || frame.mode2.z != 0u) add_light(reach, i);
-		else imageStore(vis_out, ivec3(px, int(i)), vec4(1.0));
-	}
-	uvec2 todo = subgroupOr(reach);
 	while (todo != uvec2(0u)) {
 		uint i = take_light(todo);
 		if (!has_light(reach, i)) continue;
@@ -28,8 +15,34 @@ void store_visibility(ivec2 px, vec3 n_shadow)
 		float atten;
 		vec3 l = light_dir(L, v_pos, atten);
 		uint view;
-		imageStore(vis_out, ivec3(px, int(i)), vec4(shadow_visibility(L, v_pos, n_shadow, l, view)));
+		imageStore(vis_out, ivec3(px, int(i)), vec4(shadow_visibility(L, v_pos, n_shadow, l, filters, view)));
 	}
+}
+
+// vis.frag: every shadowed light's visibility at v_pos (n_shadow: the plane of its triangle, as
+// the main pass hands the filters, facet.glsl) into layer i of vis_out: the filters' value
+// where the light reaches (range, cone) and 1 elsewhere, so that the main pass finds a value
+// for every light it shades here, at this pixel or a neighbour (vis_pixel). The same
+// block-wide walk as light_all, in two: the PCSS lights, then the others. One walk ran every
+// filter of the scene for every light (lavapipe runs both sides of an `if` under a mask), and
+// code the light does not take still cost: studio-spots (six PCSS lights, one PCF) CPU per
+// render ... with PCF's code beside PCSS's, ... in walks of their own.
+void store_visibility(ivec2 px, vec3 n_shadow)
+{
+	const uint PCSS = 1u << UMBRA_FILTER_PCSS;
+	uvec2 reach = uvec2(0u), soft = uvec2(0u);
+	for (uint i = 0u; i < frame.mode.w; i++) {
+		umbra_light L = lights[i];
+		if (L.shadow.y == 0u) continue;
+		if (L.shadow.z == UMBRA_FILTER_PCSS) add_light(soft, i);
+		float atten = 0.0;
+		if ((SC_LIGHT_TYPES & (1u << uint(L.color.w))) != 0u) light_dir(L, v_pos, atten);
+		if (atten > 0.0 || frame.mode2.z != 0u) add_light(reach, i);
+		else imageStore(vis_out, ivec3(px, int(i)), vec4(1.0));
+	}
+	uvec2 todo = subgroupOr(reach);
+	store_walk(px, n_shadow, reach, todo & soft, SC_FILTERS & PCSS);
+	store_walk(px, n_shadow, reach, todo & ~soft, SC_FILTERS & ~PCSS);
 }
 #endif
 #ifdef UMBRA_VIS_READ
