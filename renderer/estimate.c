@@ -77,7 +77,8 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 	/* The largest shadow map drawn (its scratch image and the buffer it is copied through). */
 	uint64_t res = 0;
 	for (uint32_t i = 0; i < sc->light_count; i++) {
-		uint32_t r = sc->lights[i].shadow.resolution ? sc->lights[i].shadow.resolution : 2048;
+		uint32_t want = sc->lights[i].shadow.resolution;
+		uint32_t r = rnd_shadow_map_side(want, want != 0, sc->max_shadow_resolution);
 		res = max64(res, r > atlas_size ? atlas_size : r);
 	}
 	uint64_t scratch = res * res * 4 * 2;

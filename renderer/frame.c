@@ -14,10 +14,11 @@
 #include "moments.h"
 #include "record.h"
 
-/* 32 Poisson-disk taps in the unit disk (PCSS blocker search and filtering; the longest lies a
- * little outside it, at 1.216: umbra_frame.params.w, how far the taps reach). The even ones, the search's wide ring (shaders/shading.glsl
- * pcss), come in ascending length: the search takes only the first of them that can reach a
- * blocker (pcss_bounds' rho), a prefix. The filter takes all 32. */
+/* 32 Poisson-disk taps around the unit disk (PCSS blocker search and filtering; nine lie a
+ * little outside it, the longest at 1.216: umbra_frame.params.w, how far the taps reach). The
+ * even ones, the search's wide ring (shaders/shading.glsl pcss), come in ascending length: the
+ * search takes only those that can reach a blocker (pcss_bounds' bound), a prefix
+ * (tests/unit/test_plan.c checks the order). The filter takes all 32. */
 static const float POISSON[64] = {
 	-0.146336f, -0.259194f, -0.920347f, -0.41142f, 0.0116886f, 0.326395f, -0.884518f, 0.568041f,
 	0.0625935f, -0.50853f, -0.792474f, -0.779962f, 0.56859f, 0.11655f, -0.580859f, -0.208777f,
@@ -28,6 +29,14 @@ static const float POISSON[64] = {
 	0.169469f, -0.997253f, 0.545763f, 0.730216f, 0.507797f, -0.916562f, 0.743156f, -0.505173f,
 	0.865413f, -0.763726f, 0.843562f, 0.357036f, -0.811945f, 0.90521f, 0.872005f, 0.0483851f,
 };
+
+const float *rnd_frame_poisson(float *longest)
+{
+	float l = 0.0f;
+	for (int i = 0; i < 32; i++) l = fmaxf(l, sqrtf(POISSON[2 * i] * POISSON[2 * i] + POISSON[2 * i + 1] * POISSON[2 * i + 1]));
+	*longest = l;
+	return POISSON;
+}
 
 static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
@@ -79,11 +88,7 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	 * (shading.glsl light_all) leaves the image unchanged. */
 	const char *cull = getenv("UMBRA_LIGHT_CULL");
 	f->mode2[2] = cull && strcmp(cull, "0") == 0 ? 1u : 0u;
-	memcpy(f->poisson, POISSON, sizeof f->poisson);
-	float longest = 0.0f;
-	for (int i = 0; i < 32; i++)
-		longest = fmaxf(longest, sqrtf(POISSON[2 * i] * POISSON[2 * i] + POISSON[2 * i + 1] * POISSON[2 * i + 1]));
-	f->params[3] = longest;
+	memcpy(f->poisson, rnd_frame_poisson(&f->params[3]), sizeof f->poisson);
 	f->depth_lin[0] = cam->proj[10];
 	f->depth_lin[1] = cam->proj[14];
 	f->depth_lin[2] = cam->proj[11];

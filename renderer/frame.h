@@ -20,4 +20,8 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
                                 const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
                                 float exposure, bool contact, struct rnd_error *err);
 
+/* The 32 Poisson-disk taps of the frame block (x, y pairs; PCSS's search and filter), and the
+ * longest tap's length (umbra_frame.params.w). Tests check the order the search relies on. */
+const float *rnd_frame_poisson(float *longest);
+
 #endif

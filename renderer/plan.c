@@ -13,7 +13,15 @@
 #include "error.h"
 #include "plan.h"
 
-static const float DEFAULT_RES = 2048.0f;
+
+uint32_t rnd_shadow_map_side(uint32_t want, bool asked, uint32_t cap)
+{
+	if (!want) want = RND_DEFAULT_SHADOW_RESOLUTION;
+	if (asked || !cap || cap > 8192) cap = 8192;
+	uint32_t side = 64;
+	while (side < want && side * 2 <= cap) side *= 2;
+	return side;
+}
 
 static void reverse_z(float m[16])
 {
@@ -560,19 +568,14 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		 * by type: a sun map covers the whole view, a spot cone less, a cube face a sixth. */
 		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
 		uint32_t want = s->resolution ? s->resolution
-		              : L->type == RND_LIGHT_DIRECTIONAL ? (uint32_t)DEFAULT_RES : light_importance_res(L, bounds, cam);
+		              : L->type == RND_LIGHT_DIRECTIONAL ? RND_DEFAULT_SHADOW_RESOLUTION : light_importance_res(L, bounds, cam);
 		if (!s->resolution && L->type != RND_LIGHT_DIRECTIONAL) {
 			uint32_t base = 64;
 			while (base < want && base < 8192) base *= 2;
 			uint32_t hard = hard_light_res(L, lp, bounds, cam, scene->height, base);
 			if (hard > want) want = hard;
 		}
-		/* A power of two, at most 8192; one the renderer chooses also within the scene's cap
-		 * (an explicit resolution over it was refused by the parser). */
-		uint32_t cap = s->resolution || !scene->max_shadow_resolution ? 8192 : scene->max_shadow_resolution;
-		uint32_t res = 64;
-		while (res < want && res * 2 <= cap && res < 8192) res *= 2;
-		lp->resolution = res;
+		lp->resolution = rnd_shadow_map_side(want, s->resolution != 0, scene->max_shadow_resolution);
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false, clipmap = false;
 		uint32_t ncasc = 1;

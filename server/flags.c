@@ -281,6 +281,11 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		usage(stderr);
 		return -1;
 	}
+	if (cfg->limits.max_shadow_resolution && cfg->limits.max_shadow_resolution < 64) {
+		fprintf(stderr, "umbrad: --max-shadow-resolution: %u is under the smallest map, 64 (0: no limit)\n",
+		        cfg->limits.max_shadow_resolution);
+		return -1;
+	}
 	if (cfg->atlas_size & (cfg->atlas_size - 1)) {
 		fprintf(stderr, "umbrad: --atlas-size: %u is not a power of two\n", cfg->atlas_size);
 		return -1;

@@ -31,8 +31,8 @@ int pcss_bounds(umbra_light L, vec2 p, vec4 rect, float ref, vec2 grad, float sl
 	float half_b = 0.5 * float(B - 1);   // texel centres of a block: its centre +- half_b
 	// Taps read texels within reach + 1.5 of p per axis (gather_tile's clamp only moves them
 	// nearer), all inside the neighbourhood of p's block when that reaches UMBRA_BOUNDS_RING
-	// blocks out, at least B * UMBRA_BOUNDS_RING texels from p (PCSS's widest search, 24 texels
-	// times the longest tap 1.216, + 1 for rounding: 30.2).
+	// blocks out, at least B * UMBRA_BOUNDS_RING texels from p (pcss() passes its search radius,
+	// plan.c's search_texels at most, times the longest tap, frame.params.w, + 1 for rounding).
 	bool usable = L.shadow.w != 0u && reach + 1.5 <= float(B * UMBRA_BOUNDS_RING);
 	ivec2 tile = ivec2(rect.xy) / B;
 	ivec2 own = min(ivec2(p) / B, ivec2(int(rect.z) / B - 1));

@@ -129,14 +129,15 @@ float bilinear_compare(vec2 p, vec4 rect, float ref, float res)
 // receivers do not shadow the receiver itself.
 // When every PCF light of the scene has the same radius, SC_PCF_RADIUS makes it a constant:
 // the loops unroll and the tap weights fold (a loop with a radius read per light runs with
-// lavapipe's per-lane masks and selects; thumb-512: ~5 % of the render's instructions). Only
-// where PCF is the scene's only filter: beside other filters, sample_view calls pcf() for
-// every light (lavapipe runs an `if` for all of a block under a mask) with r = -1 for the
-// others, and unrolled gathers would run for all of them (studio-spots, six PCSS lights and
-// one PCF: CPU per render -7 % with the radius read per light).
+// lavapipe's per-lane masks and selects; thumb-512: ~5 % of the render's instructions). Not
+// where PCSS lights share the code (filters: what the caller's walk dispatches, a constant):
+// sample_view calls pcf() for them too under a mask (lavapipe runs an `if` for all of a block)
+// with r = -1, and unrolled gathers would run for every one of them (studio-spots, measured
+// when its visibility pass still walked all lights in one: CPU per render -6 % with the radius
+// read per light). r < 0: no tap, and a value (0) that the caller never uses.
 float pcf(vec2 p, vec4 rect, float ref, float res, int r, vec2 grad, uint filters)
 {
-	if (SC_PCF_RADIUS != 0u && filters == (1u << UMBRA_FILTER_PCF)) r = int(SC_PCF_RADIUS) - 1;
+	if (SC_PCF_RADIUS != 0u && (filters & (1u << UMBRA_FILTER_PCSS)) == 0u) r = int(SC_PCF_RADIUS) - 1;
 	vec2 q = p - 0.5;
 	vec2 base = floor(q);
 	vec2 f = q - base;
@@ -232,7 +233,7 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
 	float slack = abs(grad.x) + abs(grad.y) + 1e-6;
 	// Search and filter taps stay within `search` texels times the longest tap (frame.params.w,
-	// 1.216): the filter's radius comes from the blockers' depth, never nearer the light than
+	// renderer/frame.c): the filter's radius comes from the blockers' depth, never nearer the light than
 	// the near plane the search assumed (+1 for rounding).
 	float reach_max;
 	int known = pcss_bounds(L, p, rect, ref, grad, slack, search * frame.params.w + 1.0, r0, r1, reach_max);
@@ -241,7 +242,9 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// whose penumbra reaches this point; taps 9..24 cover the whole search region, in ascending
 	// distance (frame.c). A tap farther than reach_max cannot find a blocker (the lowest depth
 	// around p caps every texel's reach), so the search stops before the first such wide tap:
-	// the same blockers, the same bytes (test_pcss_bounds). Around low casters most wide taps
+	// the same blockers and sums (test_pcss_bounds: the same bytes as with the bounds unread;
+	// putting the wide taps in that order changed the order of the sums, and no picture tried
+	// changed a byte). Around low casters most wide taps
 	// lie beyond it (studio-spots: CPU per render -6 %; a model under one sun: no change).
 	float close = min(search, 3.0);
 	int wide = 0;
@@ -349,7 +352,7 @@ float sample_view(umbra_light L, uint vi, vec3 pos, vec3 n, vec3 to_light, uint 
 	if ((filters & (1u << UMBRA_FILTER_HARD)) != 0u && filt == UMBRA_FILTER_HARD) return hard(tp, rect, ref, res);
 	if ((filters & (1u << UMBRA_FILTER_PCSS)) != 0u && filt == UMBRA_FILTER_PCSS) return pcss(L, v, tp, rect, ref, res, receiver_gradient(v, pos, n, lc0, texel, res));
 	if ((filters & (1u << UMBRA_FILTER_MOMENTS)) != 0u && filt == UMBRA_FILTER_MOMENTS) return moments(L, v, uv, rect, ref);
-	// r -1 (no tap) for a light of another filter: pcf() runs for it under a mask (see pcf()).
+	// r -1 (no tap) for a light of another filter, which pcf() runs for under a mask (see pcf()).
 	if ((filters & (1u << UMBRA_FILTER_PCF)) != 0u)
 		return pcf(tp, rect, ref, res, filt == UMBRA_FILTER_PCF ? int(L.shadow.w) : -1,
 		           receiver_gradient(v, pos, n, lc0, texel, res), filters);

@@ -48,7 +48,7 @@
  * Written by minmax.comp right after each PCSS map is drawn (record.c); kept with the atlas,
  * so a cached map keeps its bounds. */
 #define UMBRA_BOUNDS_BLOCK 16
-#define UMBRA_BOUNDS_RING  2    /* the neighbourhood: blocks this many out (PCSS taps reach 25 texels) */
+#define UMBRA_BOUNDS_RING  2    /* the neighbourhood: blocks this many out (PCSS's taps reach ~30 texels, pcss_bounds) */
 /* Set 1: the material's textures, bound per draw (one set per textured material); a white 1x1
  * in every binding the material does not use. Binding = texture slot (UMBRA_TEX_*). */
 #define UMBRA_SET_MATERIAL           1

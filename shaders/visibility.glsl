@@ -26,7 +26,7 @@ void store_walk(ivec2 px, vec3 n_shadow, uvec2 reach, uvec2 todo, uint filters)
 // block-wide walk as light_all, in two: the PCSS lights, then the others. One walk ran every
 // filter of the scene for every light (lavapipe runs both sides of an `if` under a mask), and
 // code the light does not take still cost: studio-spots (six PCSS lights, one PCF) CPU per
-// render ... with PCF's code beside PCSS's, ... in walks of their own.
+// render 220 ms with PCF's code beside PCSS's, 210 in walks of their own (the same bytes).
 void store_visibility(ivec2 px, vec3 n_shadow)
 {
 	const uint PCSS = 1u << UMBRA_FILTER_PCSS;

@@ -38,3 +38,31 @@ TEST(estimate_counts_the_visibility_pass)
 	CHECK(huge_on.device_bytes == huge_off.device_bytes && rnd_visibility_bytes(&sc) == 0,
 	      "an 8192² view of three lights counted the pass");
 }
+
+/* The largest map's scratch image and copy buffer (4 bytes a texel each) follow the sizes the
+ * planner draws: a server's cap on shadow resolution bounds the default 2048 too, and an asked
+ * resolution is drawn at the power of two above it. */
+TEST(estimate_follows_the_map_sizes)
+{
+	struct rnd_light l;
+	memset(&l, 0, sizeof l);
+	l.type = RND_LIGHT_DIRECTIONAL;
+	l.shadow.enabled = true;
+	struct rnd_scene sc;
+	memset(&sc, 0, sizeof sc);
+	sc.width = sc.height = 64;
+	sc.lights = &l;
+	sc.light_count = 1;
+	sc.output.debug = RND_DEBUG_SHADOW;   /* no visibility pass in the figures */
+	struct rnd_estimate def, capped, asked;
+	rnd_estimate_scene(&sc, 8192, &def);
+	sc.max_shadow_resolution = 512;
+	rnd_estimate_scene(&sc, 8192, &capped);
+	CHECK(def.device_bytes - capped.device_bytes == (2048ull * 2048 - 512ull * 512) * 8,
+	      "the cap took %llu bytes off", (unsigned long long)(def.device_bytes - capped.device_bytes));
+	l.shadow.resolution = 1500;
+	rnd_estimate_scene(&sc, 8192, &asked);
+	CHECK(asked.device_bytes - capped.device_bytes == (2048ull * 2048 - 512ull * 512) * 8,
+	      "1500 asked counts as a 2048 map: %llu bytes over the capped default",
+	      (unsigned long long)(asked.device_bytes - capped.device_bytes));
+}

@@ -351,6 +351,12 @@ TEST(parse_limits_configured)
 	check_bad(&res2, &lim, 3);
 	const struct bad px = {BASE ",'width':10,'height':101}", 422, "/height", "1010 pixels"};
 	check_bad(&px, &lim, 4);
+	/* maps are powers of two: 3000 is drawn at 4096, over a limit of 3000 */
+	lim.max_shadow_resolution = 3000;
+	const struct bad round = {BASE ",'width':10,'height':10,'shadows':{'resolution':3000}}", 422,
+	                          "/shadows/resolution", "drawn as 4096"};
+	check_bad(&round, &lim, 5);
+	lim.max_shadow_resolution = 4096;
 	struct api_problem p;
 	struct api_scene *s = NULL;
 	const char *ok = q(BASE ",'width':10,'height':100,'shadows':{'resolution':4096}}");

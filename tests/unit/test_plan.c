@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "test.h"
+#include "frame.h"
 #include "plan.h"
 
 #define PI_D 3.14159265358979323846
@@ -946,4 +947,37 @@ TEST(plan_light_importance_sets_tile_size)
 	REQUIRE(rnd_shadow_plan(&sc, &b, &cp, sp, &err) == RND_OK, "plan: %s", err.msg);
 	CHECK(sp->lights[0].resolution == 1024, "explicit resolution under a cap %u", sp->lights[0].resolution);
 	free(sp);
+}
+
+/* The map sides the planner draws (rnd_shadow_map_side): a resolution asked for rounds up to a
+ * power of two (what the parser holds against a server's limit); one the renderer chooses
+ * stays at or below the cap. */
+TEST(plan_shadow_map_side)
+{
+	CHECK(rnd_shadow_map_side(1000, true, 0) == 1024, "asked 1000 -> %u", rnd_shadow_map_side(1000, true, 0));
+	CHECK(rnd_shadow_map_side(1000, true, 512) == 1024, "an asked size ignores the cap");
+	CHECK(rnd_shadow_map_side(0, false, 0) == RND_DEFAULT_SHADOW_RESOLUTION, "the default");
+	CHECK(rnd_shadow_map_side(0, false, 1000) == 512, "default under a cap of 1000 -> %u", rnd_shadow_map_side(0, false, 1000));
+	CHECK(rnd_shadow_map_side(0, false, 64) == 64, "default under a cap of 64");
+	CHECK(rnd_shadow_map_side(100000, true, 0) == 8192 && rnd_shadow_map_side(10, true, 0) == 64, "the bounds 64..8192");
+}
+
+/* PCSS's blocker search stops at the first of its wide taps (the even entries of the frame's
+ * Poisson table) that lies beyond what any blocker can reach (shaders/shading.glsl pcss): that
+ * is exact only while those taps come in ascending length. And params.w, how far the taps
+ * reach (pcss_bounds), is the longest of all 32. */
+TEST(plan_poisson_wide_taps_ascend)
+{
+	float longest = 0;
+	const float *t = rnd_frame_poisson(&longest);
+	float prev = 0, worst = 0;
+	for (int i = 0; i < 32; i++) {
+		float len = sqrtf(t[2 * i] * t[2 * i] + t[2 * i + 1] * t[2 * i + 1]);
+		if (len > worst) worst = len;
+		if (i % 2 == 0) {
+			CHECK(len >= prev, "wide tap %d (entry %d) is shorter than the one before: %g < %g", i / 2, i, len, prev);
+			prev = len;
+		}
+	}
+	CHECK(longest == worst && longest > 1.0f, "longest tap %g, table's %g", longest, worst);
 }

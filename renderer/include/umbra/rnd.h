@@ -315,6 +315,14 @@ void rnd_shadow_defaults(struct rnd_shadow *s);
 /* The contract's default pcf_radius (kernel 3x3). */
 #define RND_DEFAULT_PCF_RADIUS 1u
 
+/* The side of the shadow map (an atlas tile, a power of two from 64 to 8192) for a light whose
+ * resolution is `want`: the power of two at or above it where the request gave it (the
+ * parser compares that with a server's limit), at or below `cap` (0 = none) where the renderer
+ * chose it itself (want 0: the default, RND_DEFAULT_SHADOW_RESOLUTION). Spot and point lights
+ * without a resolution get sizes by importance (plan.c), at most this. */
+uint32_t rnd_shadow_map_side(uint32_t want, bool asked, uint32_t cap);
+#define RND_DEFAULT_SHADOW_RESOLUTION 2048u
+
 /* Triangles the renderer will draw for an object (tessellation of the contract's shapes). */
 uint64_t rnd_object_triangle_count(const struct rnd_object *o);
 
