@@ -311,9 +311,11 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 	return RND_OK;
 }
 
-/* Tiles: granted once per request. Spot and point maps are keyed for reuse by later
- * requests; directional maps are transient. Later views re-render only the maps that
- * follow the camera (cascades, clipmap levels) into the same tiles. */
+/* Tiles: granted once per request. Maps that do not follow the camera (spot and point
+ * lights, a sun's one `fit` map) are keyed for reuse by later requests: the casters' geometry,
+ * the light's filter and bias and its views (where the map looks, at what resolution) make
+ * the key; cascades and clipmap levels are transient. Later views re-render only the maps
+ * that follow the camera into the same tiles. */
 static enum rnd_result grant_tiles(struct render *rq, struct rnd_error *err)
 {
 	struct rnd_context *ctx = rq->ctx;
@@ -325,7 +327,7 @@ static enum rnd_result grant_tiles(struct render *rq, struct rnd_error *err)
 		const struct rnd_light_plan *lp = &sp->lights[i];
 		if (!lp->view_count) continue;
 		uint64_t key = 0;
-		if (sc->lights[i].type != RND_LIGHT_DIRECTIONAL) {
+		if (sc->lights[i].type != RND_LIGHT_DIRECTIONAL || (lp->view_count == 1 && !lp->clipmap)) {
 			float k[8] = {lp->bias_constant, lp->bias_slope, (float)lp->resolution, (float)lp->filter,
 			              lp->moments ? (lp->evsm ? lp->evsm_exponent : -1.0f) : 0.0f,
 			              lp->moments ? sc->lights[i].shadow.vsm_blur : 0.0f, (float)sc->lights[i].type, 0};

@@ -1058,6 +1058,63 @@ TEST(lights_shadow_cache_reuse)
 	rnd_image_release(&b);
 }
 
+/* A sun's one `fit` map does not follow the camera: like a spot's, it is kept for later
+ * requests of the same casters and light (renderer/render.c grant_tiles), and what a reused map
+ * draws is what a fresh one draws. Boxes and a plane only: their triangles do not depend on the
+ * camera (a sphere's tessellation does, and with it the casters' key). Cascades follow the
+ * camera and are drawn by every request. */
+#define SUN_REUSE_SCENE                                                                                     \
+	"{'width':96,'height':96,'camera':{'type':'perspective','position':[%d,5,6],'target':[0,0.4,0],"         \
+	"'up':[0,1,0],'fov_y':50},'objects':[{'shape':'plane','size':[8,8]},"                                   \
+	"{'shape':'box','size':[0.8,0.8,0.8],'transform':{'translation':[%.9g,0.4,0.00071]}},"                  \
+	"{'shape':'box','size':[0.4,1.2,0.4],'transform':{'translation':[1.2,0.6,-0.9]}}],"                     \
+	"'lights':[{'type':'directional','direction':[-0.4,-1,-0.3],"                                           \
+	"'shadow':{'filter':'pcf','directional':{'mode':'%s'}}}],"                                              \
+	"'output':{'debug':'shadow','msaa':1}}"
+
+TEST(lights_shadow_cache_reuses_a_fitted_sun)
+{
+	struct rnd_context *ctx = gpu_ctx();
+	REQUIRE(ctx);
+	struct rnd_timings t;
+	struct rnd_image a, b, fresh_b, moved;
+	REQUIRE(lrender(ctx, &a, &t, SUN_REUSE_SCENE, 5, -0.9, "fit") == R_OK);
+	CHECK(t.shadow_maps_rendered == 1, "first request: rendered %u", t.shadow_maps_rendered);
+	rnd_image_release(&a);
+	/* Another camera, the same casters: the map is kept. */
+	REQUIRE(lrender(ctx, &b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit") == R_OK);
+	CHECK(t.shadow_maps_rendered == 0 && t.shadow_maps_reused == 1, "other camera: rendered %u reused %u, expected 0 / 1",
+	      t.shadow_maps_rendered, t.shadow_maps_reused);
+	struct rnd_context *fresh = make_ctx(0, __LINE__);
+	if (fresh) {
+		if (lrender(fresh, &fresh_b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit") == R_OK) {
+			CHECK(t.shadow_maps_rendered == 1, "fresh context: rendered %u", t.shadow_maps_rendered);
+			int md;
+			long nd = image_diff(&b, &fresh_b, 0, &md);
+			CHECK(nd == 0, "the kept sun map draws %ld px differently from a fresh one (max %d)", nd, md);
+			rnd_image_release(&fresh_b);
+		}
+		rnd_context_destroy(fresh);
+	}
+	/* A caster moved: drawn again, and its shadow moved with it. */
+	if (lrender(ctx, &moved, &t, SUN_REUSE_SCENE, -5, -0.5, "fit") == R_OK) {
+		CHECK(t.shadow_maps_rendered == 1 && t.shadow_maps_reused == 0, "box moved: rendered %u reused %u",
+		      t.shadow_maps_rendered, t.shadow_maps_reused);
+		int md;
+		CHECK(image_diff(&b, &moved, 8, &md) > 20, "moving the box did not move its shadow");
+		rnd_image_release(&moved);
+	}
+	rnd_image_release(&b);
+	/* Cascades follow the camera: every request draws them. */
+	for (int k = 0; k < 2; k++) {
+		struct rnd_image c;
+		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, 5, -0.9, "cascades") != R_OK) break;
+		CHECK(t.shadow_maps_rendered == 4 && t.shadow_maps_reused == 0, "cascades, request %d: rendered %u reused %u", k,
+		      t.shadow_maps_rendered, t.shadow_maps_reused);
+		rnd_image_release(&c);
+	}
+}
+
 /* ======================================================================================== */
 /* 6. Sixteen shadowed lights, and a tiny atlas                                              */
 /* ======================================================================================== */
@@ -1130,7 +1187,7 @@ TEST(lights_sixteen_lights_tiny_atlas)
 		CHECK(t.shadow_maps_rendered == 39 && t.shadow_maps_reused == 0, "tiny atlas: rendered %u reused %u",
 		      t.shadow_maps_rendered, t.shadow_maps_reused);
 		CHECK(st.atlas_occupancy > 0 && st.atlas_occupancy <= 1, "occupancy %.4f", st.atlas_occupancy);
-		CHECK(st.cached_maps == 12, "cached maps %u, expected 12 (8 spots + 4 points)", st.cached_maps);
+		CHECK(st.cached_maps == 15, "cached maps %u, expected 15 (8 spots + 4 points + 3 fitted suns)", st.cached_maps);
 		if (have_big) {
 			/* Lower resolution, same shadows: lit / shadowed agree on most pixels. */
 			long n = 0, agree = 0;
@@ -1146,16 +1203,17 @@ TEST(lights_sixteen_lights_tiny_atlas)
 		}
 		/* Again: the atlas was over-committed, so the maps were drawn below the resolution the
 		 * lights ask for. Tile sizes are planned from the request alone (not from what the cache
-		 * holds), so the same request plans the same smaller maps and reuses all 12 spot/point
-		 * maps (32 views); only the 7 directional views render again — to the same bytes. */
+		 * holds), so the same request plans the same smaller maps and reuses the 12 spot/point
+		 * maps (32 views) and the 3 fitted suns' (which do not follow the camera); only the
+		 * cascaded sun's 4 views render again — to the same bytes. */
 		if (lrender(ctx, &tiny2, &t, "%s", doc) == R_OK) {
 			rnd_context_stats(ctx, &st);
 			printf("    [16 lights, atlas 512] again: rendered %u, reused %u; hits %llu, misses %llu; occupancy %.4f\n",
 			       t.shadow_maps_rendered, t.shadow_maps_reused, (unsigned long long)st.shadow_cache_hits,
 			       (unsigned long long)st.shadow_cache_misses, st.atlas_occupancy);
-			CHECK(t.shadow_maps_reused == 32 && t.shadow_maps_rendered == 7, "again: rendered %u reused %u, expected 7 / 32",
+			CHECK(t.shadow_maps_reused == 35 && t.shadow_maps_rendered == 4, "again: rendered %u reused %u, expected 4 / 35",
 			      t.shadow_maps_rendered, t.shadow_maps_reused);
-			CHECK(st.shadow_cache_hits == 12 && st.shadow_cache_misses == 12, "hits %llu misses %llu, expected 12 / 12",
+			CHECK(st.shadow_cache_hits == 15 && st.shadow_cache_misses == 15, "hits %llu misses %llu, expected 15 / 15",
 			      (unsigned long long)st.shadow_cache_hits, (unsigned long long)st.shadow_cache_misses);
 			int md;
 			long nd = image_diff(&tiny, &tiny2, 0, &md);
