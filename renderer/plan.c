@@ -595,6 +595,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 			                   UMBRA_MAX_SHADOW_VIEWS);
 		lp->first_view = out->view_count;
 		lp->view_count = need;
+		lp->follows_camera = cascades || clipmap;
 		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, casters, cam, clipmap, cascades, ncasc, lp, out, err)
 		                                     : plan_local(L, i, bounds, lp, out, err);
 		if (r != RND_OK) return r;

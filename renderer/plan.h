@@ -33,6 +33,8 @@ struct rnd_light_plan {
 	float splits[4];                           /* cascades: far view depth of each */
 	float search_texels;                       /* PCSS blocker search cap */
 	bool clipmap;                              /* views are clipmap levels (else cascades / one map) */
+	bool follows_camera;                       /* a sun's cascades or clipmap levels, however many:
+	                                              drawn for every view, never kept (render.c) */
 	float max_distance;                        /* view depth where shadows end (0 = never) */
 	float fade_start;                          /* view depth where the fade to unshadowed starts */
 	bool moments;                              /* VSM / EVSM: moment maps are built from the depth */

@@ -295,8 +295,7 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 		return r;
 	if (v == 0)
 		for (uint32_t i = 0; i < sc->light_count && i < UMBRA_MAX_LIGHTS; i++)
-			rq->cascades[i] = sc->lights[i].type == RND_LIGHT_DIRECTIONAL && sp->lights[i].view_count > 1 &&
-			                  !sp->lights[i].clipmap;
+			rq->cascades[i] = sp->lights[i].follows_camera && !sp->lights[i].clipmap;
 	bool any_moments = false;
 	for (uint32_t i = 0; i < sc->light_count; i++)
 		if (sp->lights[i].moments && sp->lights[i].view_count) any_moments = true;
@@ -327,7 +326,7 @@ static enum rnd_result grant_tiles(struct render *rq, struct rnd_error *err)
 		const struct rnd_light_plan *lp = &sp->lights[i];
 		if (!lp->view_count) continue;
 		uint64_t key = 0;
-		if (sc->lights[i].type != RND_LIGHT_DIRECTIONAL || (lp->view_count == 1 && !lp->clipmap)) {
+		if (!lp->follows_camera) {
 			float k[8] = {lp->bias_constant, lp->bias_slope, (float)lp->resolution, (float)lp->filter,
 			              lp->moments ? (lp->evsm ? lp->evsm_exponent : -1.0f) : 0.0f,
 			              lp->moments ? sc->lights[i].shadow.vsm_blur : 0.0f, (float)sc->lights[i].type, 0};
@@ -357,7 +356,6 @@ static enum rnd_result grant_tiles(struct render *rq, struct rnd_error *err)
 static enum rnd_result place_tiles(struct render *rq, uint32_t v, struct rnd_error *err)
 {
 	struct rnd_context *ctx = rq->ctx;
-	const struct rnd_scene *sc = rq->sc;
 	struct rnd_shadow_plan *sp = rq->sp;
 	const struct rnd_cache_grant *grants = rq->grants;
 	enum rnd_result r;
@@ -367,8 +365,9 @@ static enum rnd_result place_tiles(struct render *rq, uint32_t v, struct rnd_err
 		if (lp->view_count != rq->req_tiles[k])
 			return rnd_fail(err, RND_ERR_INVALID, "light %u: view %u needs %u shadow tiles, view 0 had %u",
 			                rq->grant_light[k], v, lp->view_count, rq->req_tiles[k]);
-		bool follows_camera = sc->lights[rq->grant_light[k]].type == RND_LIGHT_DIRECTIONAL && lp->view_count > 1;
-		bool skip = grants[k].hit || (v > 0 && !follows_camera);
+		/* One cascade or clipmap level follows the camera too (it used to be taken for a fit
+		 * map here: a sheet's later views read view 0's map through their own projection). */
+		bool skip = grants[k].hit || (v > 0 && !lp->follows_camera);
 		for (uint32_t t = 0; t < lp->view_count; t++) {
 			float *rect = sp->views[lp->first_view + t].rect;
 			rect[0] = (float)grants[k].tile[t].x;

@@ -1063,13 +1063,13 @@ TEST(lights_shadow_cache_reuse)
  * draws is what a fresh one draws. Boxes and a plane only: their triangles do not depend on the
  * camera (a sphere's tessellation does, and with it the casters' key). Cascades follow the
  * camera and are drawn by every request. */
+#define SUN_REUSE_CAM "{'type':'perspective','position':[%d,5,6],'target':[0,0.4,0],'up':[0,1,0],'fov_y':50}"
 #define SUN_REUSE_SCENE                                                                                     \
-	"{'width':96,'height':96,'camera':{'type':'perspective','position':[%d,5,6],'target':[0,0.4,0],"         \
-	"'up':[0,1,0],'fov_y':50},'objects':[{'shape':'plane','size':[8,8]},"                                   \
+	"{'width':96,'height':96,'camera':" SUN_REUSE_CAM ",'objects':[{'shape':'plane','size':[8,8]},"        \
 	"{'shape':'box','size':[0.8,0.8,0.8],'transform':{'translation':[%.9g,0.4,0.00071]}},"                  \
 	"{'shape':'box','size':[0.4,1.2,0.4],'transform':{'translation':[1.2,0.6,-0.9]}}],"                     \
-	"'lights':[{'type':'directional','direction':[-0.4,-1,-0.3],"                                           \
-	"'shadow':{'filter':'pcf','directional':{'mode':'%s'}}}],"                                              \
+	"'lights':[{'type':'directional','direction':[0.5,-1,0.4],"                                           \
+	"'shadow':{'filter':'pcf','directional':{'mode':'%s'%s}}}],"                                            \
 	"'output':{'debug':'shadow','msaa':1}}"
 
 TEST(lights_shadow_cache_reuses_a_fitted_sun)
@@ -1078,16 +1078,16 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 	REQUIRE(ctx);
 	struct rnd_timings t;
 	struct rnd_image a, b, fresh_b, moved;
-	REQUIRE(lrender(ctx, &a, &t, SUN_REUSE_SCENE, 5, -0.9, "fit") == R_OK);
+	REQUIRE(lrender(ctx, &a, &t, SUN_REUSE_SCENE, 5, -0.9, "fit", "") == R_OK);
 	CHECK(t.shadow_maps_rendered == 1, "first request: rendered %u", t.shadow_maps_rendered);
 	rnd_image_release(&a);
 	/* Another camera, the same casters: the map is kept. */
-	REQUIRE(lrender(ctx, &b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit") == R_OK);
+	REQUIRE(lrender(ctx, &b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit", "") == R_OK);
 	CHECK(t.shadow_maps_rendered == 0 && t.shadow_maps_reused == 1, "other camera: rendered %u reused %u, expected 0 / 1",
 	      t.shadow_maps_rendered, t.shadow_maps_reused);
 	struct rnd_context *fresh = make_ctx(0, __LINE__);
 	if (fresh) {
-		if (lrender(fresh, &fresh_b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit") == R_OK) {
+		if (lrender(fresh, &fresh_b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit", "") == R_OK) {
 			CHECK(t.shadow_maps_rendered == 1, "fresh context: rendered %u", t.shadow_maps_rendered);
 			int md;
 			long nd = image_diff(&b, &fresh_b, 0, &md);
@@ -1097,7 +1097,7 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 		rnd_context_destroy(fresh);
 	}
 	/* A caster moved: drawn again, and its shadow moved with it. */
-	if (lrender(ctx, &moved, &t, SUN_REUSE_SCENE, -5, -0.5, "fit") == R_OK) {
+	if (lrender(ctx, &moved, &t, SUN_REUSE_SCENE, -5, -0.5, "fit", "") == R_OK) {
 		CHECK(t.shadow_maps_rendered == 1 && t.shadow_maps_reused == 0, "box moved: rendered %u reused %u",
 		      t.shadow_maps_rendered, t.shadow_maps_reused);
 		int md;
@@ -1108,11 +1108,52 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 	/* Cascades follow the camera: every request draws them. */
 	for (int k = 0; k < 2; k++) {
 		struct rnd_image c;
-		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, 5, -0.9, "cascades") != R_OK) break;
+		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, 5, -0.9, "cascades", "") != R_OK) break;
 		CHECK(t.shadow_maps_rendered == 4 && t.shadow_maps_reused == 0, "cascades, request %d: rendered %u reused %u", k,
 		      t.shadow_maps_rendered, t.shadow_maps_reused);
 		rnd_image_release(&c);
 	}
+	/* One cascade is one map too, and it follows the camera all the same: never kept. */
+	for (int k = 0; k < 2; k++) {
+		struct rnd_image c;
+		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, k ? -5 : 5, -0.9, "cascades", ",'cascades':1") != R_OK) break;
+		CHECK(t.shadow_maps_rendered == 1 && t.shadow_maps_reused == 0, "one cascade, request %d: rendered %u reused %u", k,
+		      t.shadow_maps_rendered, t.shadow_maps_reused);
+		rnd_image_release(&c);
+	}
+}
+
+/* A sheet of two views under a sun of one cascade: each view draws the cascade around its own
+ * camera (it follows the camera however many cascades there are; with one, later views used
+ * to be planned as a fit map and read view 0's cascade through it). Each cell is what a
+ * single-view request of that camera draws. Boxes only: the views' tessellation is the same. */
+TEST(lights_sheet_redraws_a_single_cascade_per_view)
+{
+	static const char *const scene =
+		"'objects':[{'shape':'plane','size':[8,8]},"
+		"{'shape':'box','size':[0.8,0.8,0.8],'transform':{'translation':[-0.9,0.4,0]}},"
+		"{'shape':'box','size':[0.4,1.2,0.4],'transform':{'translation':[1.2,0.6,-0.9]}}],"
+		"'lights':[{'type':'directional','direction':[0.5,-1,0.4],"
+		"'shadow':{'filter':'pcf','directional':{'mode':'cascades','cascades':1}}}],"
+		"'output':{'debug':'shadow','msaa':1}}";
+	struct rnd_image sheet, one[2];
+	REQUIRE(lrender(NULL, &sheet, NULL, "{'width':96,'height':96,'views':[" SUN_REUSE_CAM "," SUN_REUSE_CAM "],%s", 5, -5,
+	                scene) == R_OK);
+	CHECK(sheet.width == 192 && sheet.height == 96, "sheet %ux%u", sheet.width, sheet.height);
+	for (int k = 0; k < 2; k++) {
+		if (lrender(NULL, &one[k], NULL, "{'width':96,'height':96,'camera':" SUN_REUSE_CAM ",%s", k ? -5 : 5, scene) != R_OK)
+			continue;
+		long diff = 0, shadowed = 0;
+		for (uint32_t j = 0; j < 96; j++)
+			for (uint32_t i = 0; i < 96; i++) {
+				diff += val8(&sheet, 96 * (uint32_t)k + i, j) != val8(&one[k], i, j);
+				shadowed += val8(&one[k], i, j) < 128;
+			}
+		CHECK(shadowed > 50, "view %d: almost no shadow (%ld px): the test sees nothing", k, shadowed);
+		CHECK(diff == 0, "view %d of the sheet differs from its single-view render in %ld px", k, diff);
+		rnd_image_release(&one[k]);
+	}
+	rnd_image_release(&sheet);
 }
 
 /* ======================================================================================== */
