@@ -1069,7 +1069,7 @@ TEST(lights_shadow_cache_reuse)
 	"{'shape':'box','size':[0.8,0.8,0.8],'transform':{'translation':[%.9g,0.4,0.00071]}},"                  \
 	"{'shape':'box','size':[0.4,1.2,0.4],'transform':{'translation':[1.2,0.6,-0.9]}}],"                     \
 	"'lights':[{'type':'directional','direction':[0.5,-1,0.4],"                                           \
-	"'shadow':{'filter':'pcf','directional':{'mode':'%s'%s}}}],"                                            \
+	"'shadow':{'filter':'%s','directional':{'mode':'%s'%s}}}],"                                             \
 	"'output':{'debug':'shadow','msaa':1}}"
 
 TEST(lights_shadow_cache_reuses_a_fitted_sun)
@@ -1078,16 +1078,16 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 	REQUIRE(ctx);
 	struct rnd_timings t;
 	struct rnd_image a, b, fresh_b, moved;
-	REQUIRE(lrender(ctx, &a, &t, SUN_REUSE_SCENE, 5, -0.9, "fit", "") == R_OK);
+	REQUIRE(lrender(ctx, &a, &t, SUN_REUSE_SCENE, 5, -0.9, "pcf", "fit", "") == R_OK);
 	CHECK(t.shadow_maps_rendered == 1, "first request: rendered %u", t.shadow_maps_rendered);
 	rnd_image_release(&a);
 	/* Another camera, the same casters: the map is kept. */
-	REQUIRE(lrender(ctx, &b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit", "") == R_OK);
+	REQUIRE(lrender(ctx, &b, &t, SUN_REUSE_SCENE, -5, -0.9, "pcf", "fit", "") == R_OK);
 	CHECK(t.shadow_maps_rendered == 0 && t.shadow_maps_reused == 1, "other camera: rendered %u reused %u, expected 0 / 1",
 	      t.shadow_maps_rendered, t.shadow_maps_reused);
 	struct rnd_context *fresh = make_ctx(0, __LINE__);
 	if (fresh) {
-		if (lrender(fresh, &fresh_b, &t, SUN_REUSE_SCENE, -5, -0.9, "fit", "") == R_OK) {
+		if (lrender(fresh, &fresh_b, &t, SUN_REUSE_SCENE, -5, -0.9, "pcf", "fit", "") == R_OK) {
 			CHECK(t.shadow_maps_rendered == 1, "fresh context: rendered %u", t.shadow_maps_rendered);
 			int md;
 			long nd = image_diff(&b, &fresh_b, 0, &md);
@@ -1097,7 +1097,7 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 		rnd_context_destroy(fresh);
 	}
 	/* A caster moved: drawn again, and its shadow moved with it. */
-	if (lrender(ctx, &moved, &t, SUN_REUSE_SCENE, -5, -0.5, "fit", "") == R_OK) {
+	if (lrender(ctx, &moved, &t, SUN_REUSE_SCENE, -5, -0.5, "pcf", "fit", "") == R_OK) {
 		CHECK(t.shadow_maps_rendered == 1 && t.shadow_maps_reused == 0, "box moved: rendered %u reused %u",
 		      t.shadow_maps_rendered, t.shadow_maps_reused);
 		int md;
@@ -1108,15 +1108,34 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 	/* Cascades follow the camera: every request draws them. */
 	for (int k = 0; k < 2; k++) {
 		struct rnd_image c;
-		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, 5, -0.9, "cascades", "") != R_OK) break;
+		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, 5, -0.9, "pcf", "cascades", "") != R_OK) break;
 		CHECK(t.shadow_maps_rendered == 4 && t.shadow_maps_reused == 0, "cascades, request %d: rendered %u reused %u", k,
 		      t.shadow_maps_rendered, t.shadow_maps_reused);
 		rnd_image_release(&c);
 	}
+	/* Moment maps (EVSM, PCSS: the depth bounds) kept and reused draw what fresh ones draw. */
+	static const char *const kept_filters[] = {"evsm", "pcss"};
+	for (int f = 0; f < 2; f++) {
+		struct rnd_image warm, cold;
+		struct rnd_context *ctx2 = make_ctx(0, __LINE__);
+		if (!ctx2) break;
+		if (lrender(ctx, &warm, &t, SUN_REUSE_SCENE, 5, -0.9, kept_filters[f], "fit", "") == R_OK) rnd_image_release(&warm);
+		if (lrender(ctx, &warm, &t, SUN_REUSE_SCENE, -5, -0.9, kept_filters[f], "fit", "") == R_OK) {
+			CHECK(t.shadow_maps_reused == 1, "%s: other camera reused %u", kept_filters[f], t.shadow_maps_reused);
+			if (lrender(ctx2, &cold, &t, SUN_REUSE_SCENE, -5, -0.9, kept_filters[f], "fit", "") == R_OK) {
+				int md;
+				long nd = image_diff(&warm, &cold, 0, &md);
+				CHECK(nd == 0, "%s: the kept map draws %ld px differently from a fresh one (max %d)", kept_filters[f], nd, md);
+				rnd_image_release(&cold);
+			}
+			rnd_image_release(&warm);
+		}
+		rnd_context_destroy(ctx2);
+	}
 	/* One cascade is one map too, and it follows the camera all the same: never kept. */
 	for (int k = 0; k < 2; k++) {
 		struct rnd_image c;
-		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, k ? -5 : 5, -0.9, "cascades", ",'cascades':1") != R_OK) break;
+		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, k ? -5 : 5, -0.9, "pcf", "cascades", ",'cascades':1") != R_OK) break;
 		CHECK(t.shadow_maps_rendered == 1 && t.shadow_maps_reused == 0, "one cascade, request %d: rendered %u reused %u", k,
 		      t.shadow_maps_rendered, t.shadow_maps_reused);
 		rnd_image_release(&c);
