@@ -1132,6 +1132,14 @@ TEST(lights_shadow_cache_reuses_a_fitted_sun)
 		}
 		rnd_context_destroy(ctx2);
 	}
+	/* `auto` over a scene this small chooses the fit map: kept as well. */
+	for (int k = 0; k < 2; k++) {
+		struct rnd_image c;
+		if (lrender(ctx, &c, &t, SUN_REUSE_SCENE, k ? -5 : 5, -0.7, "pcf", "auto", "") != R_OK) break;
+		CHECK(t.shadow_maps_rendered + t.shadow_maps_reused == 1 && t.shadow_maps_reused == (uint32_t)k,
+		      "auto, request %d: rendered %u reused %u", k, t.shadow_maps_rendered, t.shadow_maps_reused);
+		rnd_image_release(&c);
+	}
 	/* One cascade is one map too, and it follows the camera all the same: never kept. */
 	for (int k = 0; k < 2; k++) {
 		struct rnd_image c;
