@@ -13,7 +13,6 @@
 #include "error.h"
 #include "plan.h"
 
-
 uint32_t rnd_shadow_map_side(uint32_t want, bool asked, uint32_t cap)
 {
 	if (!want) want = RND_DEFAULT_SHADOW_RESOLUTION;

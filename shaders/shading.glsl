@@ -233,8 +233,8 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// plane's depth at each tap, with slack for the 2x2 footprint of a gather.
 	float slack = abs(grad.x) + abs(grad.y) + 1e-6;
 	// Search and filter taps stay within `search` texels times the longest tap (frame.params.w,
-	// renderer/frame.c): the filter's radius comes from the blockers' depth, never nearer the light than
-	// the near plane the search assumed (+1 for rounding).
+	// renderer/frame.c): the filter's radius comes from the blockers' depth, never nearer the
+	// light than the near plane the search assumed (+1 for rounding).
 	float reach_max;
 	int known = pcss_bounds(L, p, rect, ref, grad, slack, search * frame.params.w + 1.0, r0, r1, reach_max);
 	// Tap 0 is the point itself and taps 1..8 a close ring (3 texels): where penumbrae are
@@ -244,8 +244,8 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	// around p caps every texel's reach), so the search stops before the first such wide tap:
 	// the same blockers and sums (test_pcss_bounds: the same bytes as with the bounds unread;
 	// putting the wide taps in that order changed the order of the sums, and no picture tried
-	// changed a byte). Around low casters most wide taps
-	// lie beyond it (studio-spots: CPU per render -6 %; a model under one sun: no change).
+	// changed a byte). Around low casters most wide taps lie beyond it (studio-spots: CPU per
+	// render -6 %; a model under one sun: no change).
 	float close = min(search, 3.0);
 	int wide = 0;
 	while (known == 0 && wide < 16 && length(poisson(2 * wide)) * search <= reach_max) wide++;
