@@ -1,6 +1,7 @@
 /*
- * renderer/plan.h — per-render CPU planning: the camera (view, reversed-Z projection, derived
- * near/far) and the shadow views of every light (fit, cascades, spot cone, point cube faces).
+ * renderer/plan.h — per-render CPU planning: the camera (camera.c: view, reversed-Z projection,
+ * derived near/far) and the shadow views of every light (plan.c: fit, cascades, spot cone,
+ * point cube faces).
  *
  * Pure math: no Vulkan calls, no allocation; unit-tested in tests/unit/test_plan.c.
  */

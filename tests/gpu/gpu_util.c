@@ -235,3 +235,14 @@ bool gpu_near_edge(const uint8_t *cls, int w, int h, int i, int j, int band)
 	}
 	return false;
 }
+
+long gpu_bytes_differ(const struct rnd_image *a, const struct rnd_image *b, size_t *first)
+{
+	if (a->width != b->width || a->height != b->height || a->stride != b->stride) return -1;
+	const unsigned char *pa = a->pixels, *pb = b->pixels;
+	size_t n = (size_t)a->height * a->stride;
+	long diff = 0;
+	for (size_t i = 0; i < n; i++)
+		if (pa[i] != pb[i] && !diff++ && first) *first = i;
+	return diff;
+}

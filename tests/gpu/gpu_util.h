@@ -80,4 +80,7 @@ enum { GPU_CLS_BG = 0, GPU_CLS_OBJ = 1, GPU_CLS_LIT = 2, GPU_CLS_SHADOW = 3, GPU
  * distance `band`. */
 bool gpu_near_edge(const uint8_t *cls, int w, int h, int i, int j, int band);
 
+/* Bytes of a and b that differ (-1 when their sizes differ); *first (may be NULL): the first. */
+long gpu_bytes_differ(const struct rnd_image *a, const struct rnd_image *b, size_t *first);
+
 #endif

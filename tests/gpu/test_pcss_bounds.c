@@ -16,18 +16,6 @@
 #include "gpu_util.h"
 #include "test.h"
 
-/* Bytes of a and b that differ (-1 when their sizes differ). */
-static long bytes_differ(const struct rnd_image *a, const struct rnd_image *b, size_t *first)
-{
-	if (a->width != b->width || a->height != b->height || a->stride != b->stride) return -1;
-	const unsigned char *pa = a->pixels, *pb = b->pixels;
-	size_t n = (size_t)a->height * a->stride;
-	long diff = 0;
-	for (size_t i = 0; i < n; i++)
-		if (pa[i] != pb[i] && !diff++) *first = i;
-	return diff;
-}
-
 /* Renders doc with the bounds read, then with them unread; fails when a byte differs. */
 static void same_with_and_without(const char *what, const char *doc)
 {
@@ -38,7 +26,7 @@ static void same_with_and_without(const char *what, const char *doc)
 	unsetenv("UMBRA_PCSS_BOUNDS");
 	if (ok) {
 		size_t first = 0;
-		long diff = bytes_differ(&on, &off, &first);
+		long diff = gpu_bytes_differ(&on, &off, &first);
 		CHECK(diff == 0, "%s: the depth bounds changed %ld bytes (first at byte %zu)", what, diff, first);
 		rnd_image_release(&off);
 	}
@@ -136,7 +124,7 @@ TEST(pcss_bounds_cached_map_same_bytes)
 		CHECK(gpu_last_timings.shadow_maps_reused >= 8, "expected the cached maps, %u reused",
 		      gpu_last_timings.shadow_maps_reused);
 		size_t first = 0;
-		long diff = bytes_differ(&fresh, &again, &first);
+		long diff = gpu_bytes_differ(&fresh, &again, &first);
 		CHECK(diff == 0, "a reused map gave %ld other bytes (first at byte %zu)", diff, first);
 		rnd_image_release(&again);
 	}

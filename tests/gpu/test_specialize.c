@@ -111,16 +111,6 @@ TEST(specialize_mixed_lights_same_image)
 	same_specialized_and_general("radii 0 and 2, hard", doc);
 }
 
-/* Byte differences of two renders of the same size (-1: sizes differ). */
-static long differing_bytes(const struct rnd_image *a, const struct rnd_image *b)
-{
-	if (a->width != b->width || a->height != b->height || a->stride != b->stride) return -1;
-	const unsigned char *pa = a->pixels, *pb = b->pixels;
-	long diff = 0;
-	for (size_t i = 0; i < (size_t)a->height * a->stride; i++) diff += pa[i] != pb[i];
-	return diff;
-}
-
 /* Lights of different filters in one scene: the filters' code is shared by one variant, and
  * pcf() runs for every light under a mask with its radius read per light (-1, no tap, for the
  * others; shading.glsl sample_view). Each light's shadow (debug view) must be what it is when
@@ -146,7 +136,7 @@ TEST(specialize_mixed_filters_same_shadow)
 			for (uint32_t y = 0; y < alone.height; y++)
 				for (uint32_t x = 0; x < alone.width; x++) dark += p[(size_t)y * alone.stride + 4 * x] < 128;
 			CHECK(dark > 50, "light %d: casts almost no shadow alone (%ld pixels), the test sees nothing", k, dark);
-			long diff = differing_bytes(&mixed, &alone);
+			long diff = gpu_bytes_differ(&mixed, &alone, NULL);
 			CHECK(diff == 0, "light %d: its shadow beside the others differs from alone in %ld bytes", k, diff);
 			rnd_image_release(&alone);
 		}
