@@ -1,8 +1,8 @@
 // shaders/shading.glsl — what the main pass (mesh.frag, mesh_vis.frag via mesh_main.glsl), the
 // AOV pass (aov.frag) and the visibility pass (vis.frag) share: bindings, specialization
-// constants, shadow filtering, lighting; with material.glsl, pcss_bounds.glsl, visibility.glsl
-// and display.glsl. Included after umbra_shared.h; the including shader declares its outputs
-// and main().
+// constants, shadow filtering, lighting; with material.glsl, pcss_bounds.glsl, contact.glsl,
+// visibility.glsl and display.glsl. Included after umbra_shared.h; the including shader
+// declares its outputs and main().
 // Main pass: metallic-roughness shading (Lambert + GGX), hemisphere ambient, directional /
 // spot / point lights in the contract's units, shadow filtering, tone map and encoding.
 //
@@ -416,78 +416,7 @@ float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, uint filter
 	return vis;
 }
 
-// Per-pixel jitter of the contact ray's steps (interleaved gradient noise of the pixel):
-// deterministic, so the same request gives the same bytes; it turns banding into fine grain.
-float ign(vec2 px) { return fract(52.9829189 * fract(dot(px, vec2(0.06711056, 0.00583715)))); }
-
-// View depth (world units along the camera's forward axis) of the scene depth texels d
-// (1 - reversed-Z NDC depth, see contact.c): z_view = (B - ndc D) / (ndc C - A) with
-// frame.depth_lin = (A, B, C, D), so perspective and orthographic cameras alike.
-vec4 scene_view_depth(vec4 d)
-{
-	vec4 ndc = 1.0 - d;
-	vec4 l = frame.depth_lin;
-	return -(l.y - ndc * l.w) / (ndc * l.z - l.x);
-}
-
-// Contact shadows: march from pos towards the light through the view's depth buffer, over
-// L.contact.x world units (0: CONTACT_TEXELS texels of the light's map at pos, the zone next
-// to a caster that the map's bias and filter cannot resolve, and at least CONTACT_PX pixels).
-// Every depth texel stands for a slab `thickness` deep behind the surface it saw (L.contact.z,
-// world units of view depth; 0: CONTACT_THICK_PX pixels' world size at pos); a step is
-// occluded when the ray's segment since the previous step meets the slabs around its end and
-// lies behind all four texels there (textureGather). Segments, not points: no step skips a
-// thin slab, so the thickness can be small, and rays passing behind a thin caster (in view)
-// are not taken for rays through it. All four texels: a ray beside a silhouette, or above a
-// planar receiver (whose depth the four texels bracket), is never occluded by it; a caster
-// narrower than two pixels casts no contact shadow (its map shadow stays). At most
-// L.contact.y steps, and no more than the ray's length in pixels: a step within one pixel
-// reads the same texels again.
-const float CONTACT_TEXELS = 8.0;
-const float CONTACT_PX = 4;
-const float CONTACT_THICK_PX = 1.0;
-float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
-{
-	vec3 cam = frame.camera_pos.xyz, fwd = frame.camera_fwd.xyz;
-	float z0 = max(dot(pos - cam, fwd), 1e-4);
-	float px = frame.target.z * (frame.target.w > 0.5 ? 1.0 : z0);   // world size of a pixel at pos
-	bool local = uint(L.color.w) != UMBRA_LIGHT_DIRECTIONAL;
-	float to_l = local ? length(L.position.xyz - pos) : 1e30;
-	umbra_shadow_view v = views[L.shadow.x];
-	float texel = is_persp(v) ? v.params.x * to_l : v.params.x;
-	float len = L.contact.x > 0.0 ? L.contact.x : max(CONTACT_TEXELS * texel, CONTACT_PX * px);
-	len = min(len, to_l);
-	float thick = L.contact.z > 0.0 ? L.contact.z : CONTACT_THICK_PX * px;
-	// Off the receiver by half a pixel along the normal, and the march begins a pixel out:
-	// the receiver's own depth texels stay behind the ray.
-	vec3 start = pos + n * (0.5 * px);
-	float t0 = px;
-	if (len <= t0) return 1.0;
-	// The ray is linear in clip space and in view depth: c(t) = c0 + t dc, z(t) = zs0 + t dz.
-	vec4 c0 = frame.view_proj * vec4(start, 1.0), dc = frame.view_proj * vec4(to_light, 0.0);
-	float zs0 = dot(start - cam, fwd), dz = dot(to_light, fwd);
-	if (dc.w < 0.0) len = min(len, (c0.w - 1e-4 * c0.w) / -dc.w);   // stop before the camera plane
-	vec4 ca = c0 + dc * t0, cb = c0 + dc * len;
-	vec2 size = frame.target.xy;
-	float span = length((cb.xy / cb.w - ca.xy / ca.w) * 0.5 * size);
-	int steps = clamp(int(ceil(span)), 1, int(L.contact.y));
-	float dt = (len - t0) / float(steps);
-	float jitter = ign(frag_xy());
-	float z_prev = zs0 + dz * t0;
-	float eps = 1e-3 * px;
-	for (int i = 0; i < steps; i++) {
-		float t = t0 + dt * (float(i) + jitter);
-		vec4 c = c0 + dc * t;
-		vec2 uv = c.xy / c.w * 0.5 + 0.5;
-		if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) break;
-		vec4 zs = scene_view_depth(textureGather(scene_depth, uv));
-		float zp = zs0 + dz * t;
-		float lo = min(z_prev, zp), hi = max(z_prev, zp);
-		if (all(lessThan(zs, vec4(hi - eps))) && any(greaterThan(zs, vec4(lo - thick)))) return 0.0;
-		z_prev = zp;
-	}
-	return 1.0;
-}
+#include "contact.glsl"
 
 // Visibility of light L: its shadow map, and where asked, contact shadows (the smaller of the two).
 float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, uint filters, out uint view_out)
