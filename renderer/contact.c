@@ -2,7 +2,7 @@
  * renderer/contact.c — contact shadows (contract §3 `shadows.contact`): which lights march them,
  * their parameters, and the camera-view depth they march against.
  *
- * The fragment shaders (shading.glsl contact_visibility, in mesh.frag and aov.frag) walk from
+ * The fragment shaders (contact.glsl contact_visibility, in mesh.frag and aov.frag) walk from
  * the shaded point towards each light that asks for them, through this depth, and take the
  * smaller of the march's and the shadow map's visibility. The depth is a single-sample pass
  * of the view drawn once per view before the main pass (and before any band of it), with the
@@ -33,7 +33,7 @@ bool rnd_contact_any(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 void rnd_contact_params(const struct rnd_shadow *sh, float out[4])
 {
 	/* 0 distance / thickness = the shader's defaults: 8 texels of the light's map at the
-	 * point, 2 pixels' world size at the point (see shading.glsl contact_visibility). */
+	 * point, 2 pixels' world size at the point (see contact.glsl contact_visibility). */
 	out[0] = sh->contact_distance;
 	out[1] = (float)(sh->contact_steps ? sh->contact_steps : 16);
 	out[2] = sh->contact_thickness;
