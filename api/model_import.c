@@ -231,7 +231,7 @@ static uint32_t join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv,
 			memcpy(nrm + 3 * (size_t)remap[v], nrm + 3 * (size_t)v, 12);
 			if (col) memcpy(col + 4 * (size_t)remap[v], col + 4 * (size_t)v, 4);
 		}
-	for (uint32_t i = 0; i < ni; i++) idx[i] = remap[idx[i]];
+	meshopt_remapIndexBuffer(idx, idx, ni, remap);
 	free(remap);
 	return unique;
 }

@@ -487,9 +487,12 @@ done:
  * third of a 1M-triangle STL's closedness check. Returns where the sorted keys are (a or tmp). */
 static uint64_t *radix_sort_u64(uint64_t *a, uint64_t *tmp, size_t n)
 {
+	/* Every byte's histogram in one read: a pass moves the keys, not their byte counts. */
+	size_t counts[8][256] = {{0}};
+	for (size_t i = 0; i < n; i++)
+		for (int b = 0; b < 8; b++) counts[b][(a[i] >> (8 * b)) & 0xff]++;
 	for (int shift = 0; shift < 64; shift += 8) {
-		size_t count[256] = {0};
-		for (size_t i = 0; i < n; i++) count[(a[i] >> shift) & 0xff]++;
+		size_t *count = counts[shift / 8];
 		if (n && count[(a[0] >> shift) & 0xff] == n) continue;   /* one value for all */
 		size_t sum = 0;
 		for (int d = 0; d < 256; d++) {

@@ -28,17 +28,14 @@ int api_parse_shadow(struct pctx *c, json_t *j, struct rnd_shadow *s, const char
 	if (api_get_bool(c, j, "enabled", &s->enabled) < 0) return -1;
 	if ((rc = api_get_enum(c, j, "filter", filters, &e)) < 0) return -1;
 	if (rc) s->filter = filter_values[e];
-	if ((rc = api_get_u32(c, j, "resolution", 64, 8192, &s->resolution)) < 0) return -1;
+	if ((rc = api_get_u32(c, j, "resolution", RND_MIN_SHADOW_RESOLUTION, RND_MAX_SHADOW_RESOLUTION, &s->resolution)) < 0) return -1;
 	/* What is drawn is the power of two at or above it (an atlas tile). */
 	uint32_t side = rc ? rnd_shadow_map_side(s->resolution, true, 0) : 0;
 	if (rc && c->lim->max_shadow_resolution && side > c->lim->max_shadow_resolution) {
-		if (side == s->resolution)
-			api_defer(c, false, "resolution", "shadow resolution %u is over this server's limit of %u", s->resolution,
-			          c->lim->max_shadow_resolution);
-		else
-			api_defer(c, false, "resolution",
-			          "shadow resolution %u (drawn as %u: maps are powers of two) is over this server's limit of %u",
-			          s->resolution, side, c->lim->max_shadow_resolution);
+		char drawn[64] = "";
+		if (side != s->resolution) snprintf(drawn, sizeof drawn, " (drawn as %u: maps are powers of two)", side);
+		api_defer(c, false, "resolution", "shadow resolution %u%s is over this server's limit of %u", s->resolution,
+		          drawn, c->lim->max_shadow_resolution);
 	}
 	if (api_get_u32(c, j, "pcf_radius", 0, 5, &s->pcf_radius) < 0) return -1;
 

@@ -16,8 +16,8 @@
 uint32_t rnd_shadow_map_side(uint32_t want, bool asked, uint32_t cap)
 {
 	if (!want) want = RND_DEFAULT_SHADOW_RESOLUTION;
-	if (asked || !cap || cap > 8192) cap = 8192;
-	uint32_t side = 64;
+	if (asked || !cap || cap > RND_MAX_SHADOW_RESOLUTION) cap = RND_MAX_SHADOW_RESOLUTION;
+	uint32_t side = RND_MIN_SHADOW_RESOLUTION;
 	while (side < want && side * 2 <= cap) side *= 2;
 	return side;
 }

@@ -85,7 +85,7 @@ struct render {
 	struct rnd_aabb bounds;       /* every object: near/far planes, shadow fits */
 	struct rnd_aabb obj_bounds;   /* what `fit: objects` frames */
 	struct rnd_aabb casters;      /* what the shadow pass draws: a `fit` sun map's box */
-	uint64_t geo;                 /* the casters' key: spot/point shadow-cache keys start from it */
+	uint64_t geo;                 /* the casters' key: cached maps' keys start from it */
 	struct rnd_cache_grant grants[UMBRA_MAX_LIGHTS];
 	uint32_t grant_light[UMBRA_MAX_LIGHTS], req_tiles[UMBRA_MAX_LIGHTS];
 	uint32_t ngrant;
@@ -188,7 +188,7 @@ static void plane_casters(struct render *rq)
 		if (draws[i].cast && !(i < 256 && fill_only[i])) rnd_aabb_union(&rq->casters, &draws[i].bounds);
 }
 
-/* What every spot/point key starts from: the casters' world-space geometry, their
+/* What every cached map's key starts from: the casters' world-space geometry, their
  * culling and alpha masks (with texture content), and the scene bounds (far planes). */
 static uint64_t caster_key(const struct render *rq)
 {

@@ -14,7 +14,7 @@
 #include "slot.h"
 
 #define MAX_ENTRIES 1024
-#define MIN_TILE 64
+#define MIN_TILE RND_MIN_SHADOW_RESOLUTION   /* the smallest map is the smallest tile */
 /* Depth bounds blocks never straddle two tiles (tiles are aligned to their size). */
 _Static_assert(MIN_TILE % UMBRA_BOUNDS_BLOCK == 0, "depth bounds blocks must divide the smallest tile");
 
@@ -186,13 +186,13 @@ static uint32_t free_slot(struct rnd_shadow_cache *c)
  * tiles together fit in the atlas. False when even 64² tiles do not fit. */
 static bool plan_resolutions(const struct rnd_cache_request *req, uint32_t n, uint32_t atlas, uint32_t res[])
 {
-	for (uint32_t k = 0; k < n; k++) res[k] = req[k].res < 64 ? 64 : req[k].res > atlas ? atlas : req[k].res;
+	for (uint32_t k = 0; k < n; k++) res[k] = req[k].res < MIN_TILE ? MIN_TILE : req[k].res > atlas ? atlas : req[k].res;
 	for (;;) {
 		uint64_t need = 0;
 		uint32_t big = n;
 		for (uint32_t k = 0; k < n; k++) {
 			need += (uint64_t)req[k].tiles * res[k] * res[k];
-			if (res[k] > 64 && (big == n || res[k] > res[big])) big = k;
+			if (res[k] > MIN_TILE && (big == n || res[k] > res[big])) big = k;
 		}
 		if (need <= (uint64_t)atlas * atlas) return true;
 		if (big == n) return false;

@@ -6,11 +6,12 @@
  * atlas for PCSS (two RGBA32F texels per UMBRA_BOUNDS_BLOCK² block, umbra_shared.h), created
  * at start-up and kept in GENERAL layout for the life of the process. Every shadow view of every render is a square
  * tile of these atlases (atlas.c hands them out):
- *   - spot and point lights get cached entries keyed by a hash of everything that shapes their
- *     maps (caster geometry, the light's view matrices, resolution, bias, filter settings);
- *     a later request with the same key reuses the tiles and skips their shadow passes;
- *   - directional lights get transient tiles (their maps follow the camera), freed at the end
- *     of the render.
+ *   - maps that do not follow the camera (spot and point lights, a sun's `fit` map) get cached
+ *     entries keyed by a hash of everything that shapes them (caster geometry, the light's view
+ *     matrices, resolution, bias, filter settings); a later request with the same key reuses
+ *     the tiles and skips their shadow passes;
+ *   - cascades and clipmap levels get transient tiles (they follow the camera), freed at the
+ *     end of the render.
  * A request's tile sizes are planned against the whole atlas (largest halved first, never below
  * 64), so they never depend on the cache's history; unreferenced entries are evicted oldest
  * first to make room, and a request that does not fit next to other running renders waits for

@@ -281,9 +281,9 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		usage(stderr);
 		return -1;
 	}
-	if (cfg->limits.max_shadow_resolution && cfg->limits.max_shadow_resolution < 64) {
-		fprintf(stderr, "umbrad: --max-shadow-resolution: %u is under the smallest map, 64 (0: no limit)\n",
-		        cfg->limits.max_shadow_resolution);
+	if (cfg->limits.max_shadow_resolution && cfg->limits.max_shadow_resolution < RND_MIN_SHADOW_RESOLUTION) {
+		fprintf(stderr, "umbrad: --max-shadow-resolution: %u is under the smallest map, %u (0: no limit)\n",
+		        cfg->limits.max_shadow_resolution, RND_MIN_SHADOW_RESOLUTION);
 		return -1;
 	}
 	if (cfg->atlas_size & (cfg->atlas_size - 1)) {

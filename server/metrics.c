@@ -293,7 +293,7 @@ static void write_device(struct srv_buf *b, struct srv_server *s)
 	write_gauge(b, "umbra_atlas_size_texels", "Texels per side of the shadow atlas.", st.atlas_size);
 	write_gauge(b, "umbra_atlas_occupancy_ratio", "Share of shadow-atlas texels held by tiles.", st.atlas_occupancy);
 	write_gauge(b, "umbra_atlas_tiles", "Tiles in the shadow atlas.", st.atlas_tiles);
-	write_gauge(b, "umbra_shadow_cache_maps", "Spot/point shadow maps kept for reuse.", st.cached_maps);
+	write_gauge(b, "umbra_shadow_cache_maps", "Shadow maps kept for reuse (spot, point, a sun's fit map).", st.cached_maps);
 	write_counter(b, "umbra_shadow_cache_hits_total", "Lights whose shadow passes were skipped (cache hits).",
 	              st.shadow_cache_hits);
 	write_counter(b, "umbra_shadow_cache_misses_total", "Lights whose shadow passes were rendered (cache misses).",

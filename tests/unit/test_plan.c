@@ -1,4 +1,4 @@
-/* tests — renderer/plan.c: camera planning, cascade splits, shadow views (fit, cascades, spot,
+/* tests — renderer/camera.c and plan.c: camera planning, cascade splits, shadow views (fit, cascades, spot,
  * point cube faces) and frustum culling, checked against values computed here independently. */
 #include <math.h>
 #include <stdlib.h>

@@ -315,12 +315,15 @@ void rnd_shadow_defaults(struct rnd_shadow *s);
 /* The contract's default pcf_radius (kernel 3x3). */
 #define RND_DEFAULT_PCF_RADIUS 1u
 
-/* The side of the shadow map (an atlas tile, a power of two from 64 to 8192) for a light whose
- * resolution is `want`: the power of two at or above it where the request gave it (the
- * parser compares that with a server's limit), at or below `cap` (0 = none) where the renderer
- * chose it itself (want 0: the default, RND_DEFAULT_SHADOW_RESOLUTION). Spot and point lights
- * without a resolution get sizes by importance (plan.c), at most this. */
+/* The side of the shadow map (an atlas tile, a power of two from RND_MIN_SHADOW_RESOLUTION to
+ * RND_MAX_SHADOW_RESOLUTION) for a light whose resolution is `want`: the power of two at or
+ * above it where the request gave it (the parser compares that with a server's limit), at or
+ * below `cap` (0 = none) where the renderer chose it itself (want 0: the default,
+ * RND_DEFAULT_SHADOW_RESOLUTION). Spot and point lights without a resolution get sizes by
+ * importance (plan.c), at most this. */
 uint32_t rnd_shadow_map_side(uint32_t want, bool asked, uint32_t cap);
+#define RND_MIN_SHADOW_RESOLUTION 64u
+#define RND_MAX_SHADOW_RESOLUTION 8192u
 #define RND_DEFAULT_SHADOW_RESOLUTION 2048u
 
 /* Triangles the renderer will draw for an object (tessellation of the contract's shapes). */
@@ -438,7 +441,7 @@ struct rnd_stats {
 	uint32_t atlas_size;
 	double atlas_occupancy;          /* share of atlas texels held by tiles, 0..1 */
 	uint32_t atlas_tiles;
-	uint32_t cached_maps;            /* spot / point shadow maps kept for reuse */
+	uint32_t cached_maps;            /* shadow maps kept for reuse (spot, point, a sun's fit map) */
 	uint64_t shadow_cache_hits;      /* lights whose shadow passes were skipped */
 	uint64_t shadow_cache_misses;
 };
