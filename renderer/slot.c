@@ -404,9 +404,8 @@ enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s,
 		                          VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->surfaces_depth, err)) != RND_OK)
 			return r;
 	}
-	/* Layers of the last render's count, at least 2 so that the view is an array (layers beyond
-	 * a render's lights are not read). */
-	if (layers < 2) layers = 2;
+	/* Layers of the last render's count */
+	if (layers < RND_VIS_MIN_LAYERS) layers = RND_VIS_MIN_LAYERS;
 	if (s->visibility.img && s->visibility.width == w && s->visibility.height == h && s->visibility.layers == layers)
 		return RND_OK;
 	rnd_image_destroy(ctx, &s->visibility);

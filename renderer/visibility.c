@@ -69,8 +69,9 @@ uint64_t rnd_visibility_bytes(const struct rnd_scene *sc)
 	uint64_t px = (uint64_t)sc->width * sc->height;
 	if (!shadowed || px * sc->light_count * 2 > RND_VIS_MAX_BYTES) return 0;
 	/* rnd_slot_visibility's images: surfaces RGBA32F, normals RGBA16 SNORM, their depth D32,
-	 * an R16 layer per light (internal.h) */
-	return px * (16 + 8 + 4 + 2ull * sc->light_count);
+	 * an R16 layer per light, at least RND_VIS_MIN_LAYERS (internal.h) */
+	uint32_t layers = sc->light_count < RND_VIS_MIN_LAYERS ? RND_VIS_MIN_LAYERS : sc->light_count;
+	return px * (16 + 8 + 4 + 2ull * layers);
 }
 
 bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,

@@ -37,6 +37,14 @@ TEST(estimate_counts_the_visibility_pass)
 	rnd_estimate_scene(&sc, 2048, &huge_on);
 	CHECK(huge_on.device_bytes == huge_off.device_bytes && rnd_visibility_bytes(&sc) == 0,
 	      "an 8192² view of three lights counted the pass");
+	/* one light: the image still has two layers (rnd_slot_visibility makes an array of them) */
+	sc.width = 320;
+	sc.height = 200;
+	sc.lights = &l[1];
+	sc.light_count = 1;
+	want = 320ull * 200 * (16 + 8 + 4 + 2 * 2);
+	CHECK(rnd_visibility_bytes(&sc) == want, "one light: %llu bytes, want %llu",
+	      (unsigned long long)rnd_visibility_bytes(&sc), (unsigned long long)want);
 }
 
 /* The largest map's scratch image and copy buffer (4 bytes a texel each) follow the sizes the
