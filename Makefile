@@ -6,6 +6,7 @@
 #   make fuzz       libFuzzer targets in build/fuzz (clang); make test runs each briefly
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench, the floor, the ratio table
 #   make bench-quick  only the ratio table's rows (BENCH_ONLY=ratios)
+#   make bench-farm   only the farm benchmark on new models: farm CLI, umbrad c=4, f3d (BENCH_ONLY=farm)
 #   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
@@ -86,6 +87,8 @@ all: $(BINS)
 
 deps:
 	@sh deploy/install-deps.sh
+bench-deps:
+	@sh deploy/install-deps.sh --bench
 
 pkg-check:
 	@[ "$(PKG_STATUS)" = 0 ] || { echo "pkg-config cannot find every one of: $(PKGS) (make deps installs them)"; \
@@ -158,12 +161,18 @@ soak: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) UMBRA_VALIDATION=1 sh tests/http/soak.sh
 
-bench: deps bench-tools
+bench: bench-deps bench-tools
 	@BUILD=$(BUILD) SHARED=$(SHARED) sh tests/bench.sh
 
 # Only what the ratio table needs, fewer runs (a few minutes instead of a quarter of an hour).
-bench-quick: deps bench-tools
+bench-quick: bench-deps bench-tools
 	@BUILD=$(BUILD) SHARED=$(SHARED) BENCH_ONLY=ratios sh tests/bench.sh
+
+# The farm benchmark on new models alone (tests/bench/farm_bench.py); needs only the binaries.
+.PHONY: bench-farm bench-deps
+bench-farm: bench-deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) SHARED=$(SHARED) BENCH_ONLY=farm sh tests/bench.sh
 
 # The floor (../shared/floor, read-only) builds out of tree into $(BUILD)/floor.
 bench-tools:

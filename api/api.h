@@ -60,10 +60,34 @@ struct api_limits {
 	/* Distinct textures in one scene (the renderer's rnd_info.max_textures: its desc's value
 	 * capped by the device); over it is a 422 at the object that brought one too many. */
 	uint32_t max_textures;           /* default RND_DEFAULT_MAX_TEXTURES (256); 0 = the default */
+	/* Not a server limit: what one request can show, set by the scene parser on its own copy
+	 * (the largest side of its images, pixels). A model imported for it does no work beyond
+	 * that: one level of detail for that size (api/model_lod.h). 0 = unknown (none). */
+	uint32_t output_side;
 };
 void api_limits_defaults(struct api_limits *l);
 
 enum api_format { API_FORMAT_PNG, API_FORMAT_EXR };
+
+/* Where the time of a request's model imports went, ms (Server-Timing's model-* stages; the
+ * importer measures its own in the sandbox, api/model.c the daemon's). */
+enum api_import_stage {
+	API_IMPORT_READ,       /* the model's bytes: base64, the file by path, the multipart part */
+	API_IMPORT_PARSE,      /* the importer's parse and conversion (Assimp, or api/stl_import.c) */
+	API_IMPORT_TEXTURES,   /* its texture decoding */
+	API_IMPORT_CLOSED,     /* its closedness check (welding included) */
+	API_IMPORT_LEVEL,      /* its one level of detail for the request (api/model_lod.h) */
+	API_IMPORT_TRANSFER,   /* the sandbox round trip less the importer's work: fork, socket copies */
+	API_IMPORT_VALIDATE,   /* the daemon's check and copy of the reply (api/model_wire.h) */
+	API_IMPORT_MIPS,       /* mip chains for a model the cache keeps */
+	API_IMPORT_STAGES
+};
+struct api_import_times {
+	float ms[API_IMPORT_STAGES];
+	uint32_t imports;      /* models imported for the request */
+	uint32_t hits;         /* models found in the cache */
+};
+extern const char *const API_IMPORT_STAGE_NAMES[API_IMPORT_STAGES];   /* "model-read", ... */
 
 struct api_scene {
 	struct rnd_scene scene;     /* ready for rnd_render() */
@@ -79,6 +103,7 @@ struct api_scene {
 	 * the request, material data of a model that is not drawn as its file says. The server sends
 	 * it as the Umbra-Warnings header, the CLI on stderr. */
 	char warnings[1024];
+	struct api_import_times import;   /* the request's model imports, summed (zero without models) */
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;

@@ -7,6 +7,7 @@
  * error manager below turns that into an API_ERR with the library's message.
  */
 #include <setjmp.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,8 +75,9 @@ static void jpeg_quiet(j_common_ptr cinfo, int level)
 	(void)level;
 }
 
-static enum api_result decode_jpeg(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
-                                   uint32_t *w, uint32_t *h, char *err, size_t errsize)
+static enum api_result decode_jpeg(const uint8_t *data, size_t len, uint64_t max_pixels, uint32_t min_side,
+                                   uint8_t **rgba, uint32_t *w, uint32_t *h, uint32_t *stored_side, char *err,
+                                   size_t errsize)
 {
 	struct jpeg_decompress_struct cinfo;
 	struct jpeg_err jerr;
@@ -104,6 +106,14 @@ static enum api_result decode_jpeg(const uint8_t *data, size_t len, uint64_t max
 		jpeg_destroy_decompress(&cinfo);
 		return err_set(err, errsize, "JPEG: %s", "the image is empty or over the texture size limit");
 	}
+	/* libjpeg's scaled decode (the IDCT at 1/2, 1/4 or 1/8): a 2048^2 texture for a 256^2
+	 * thumbnail costs the decode of a 512^2 one. */
+	uint32_t side = cinfo.image_width > cinfo.image_height ? cinfo.image_width : cinfo.image_height;
+	*stored_side = side;
+	cinfo.scale_num = 1;
+	cinfo.scale_denom = 1;
+	while (min_side && cinfo.scale_denom < 8 && (side + cinfo.scale_denom * 2 - 1) / (cinfo.scale_denom * 2) >= min_side)
+		cinfo.scale_denom *= 2;
 	jpeg_start_decompress(&cinfo);
 	uint32_t width = cinfo.output_width, height = cinfo.output_height;
 	int comps = cinfo.output_components;
@@ -144,15 +154,34 @@ static enum api_result decode_jpeg(const uint8_t *data, size_t len, uint64_t max
 	return API_OK;
 }
 
-enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
-                                 uint32_t *width, uint32_t *height, char *err, size_t errsize)
+enum api_result api_image_decode_fit(const uint8_t *data, size_t len, uint64_t max_pixels, uint32_t min_side,
+                                     bool srgb, uint8_t **rgba, uint32_t *width, uint32_t *height,
+                                     uint32_t *stored_side, char *err, size_t errsize)
 {
 	*rgba = NULL;
 	*width = *height = 0;
+	if (stored_side) *stored_side = 0;
 	if (!max_pixels) max_pixels = DEFAULT_MAX_PIXELS;
-	if (data && len >= 8 && !memcmp(data, "\x89PNG\r\n\x1a\n", 8))
-		return decode_png(data, len, max_pixels, rgba, width, height, err, errsize);
-	if (data && len >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff)
-		return decode_jpeg(data, len, max_pixels, rgba, width, height, err, errsize);
-	return err_set(err, errsize, "%s", "the image is neither PNG nor JPEG");
+	enum api_result r = API_ERR;
+	uint32_t stored = 0;
+	if (data && len >= 8 && !memcmp(data, "\x89PNG\r\n\x1a\n", 8)) {
+		r = decode_png(data, len, max_pixels, rgba, width, height, err, errsize);
+		stored = *width > *height ? *width : *height;
+		/* the levels the renderer's mip chain would have had there (the same bytes) */
+		uint32_t levels = 0;
+		for (uint32_t s = stored; min_side && s / 2 >= min_side; s /= 2) levels++;
+		if (r == API_OK) rnd_texture_reduce(*rgba, width, height, srgb, levels);
+	} else if (data && len >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff) {
+		r = decode_jpeg(data, len, max_pixels, min_side, rgba, width, height, &stored, err, errsize);
+	} else {
+		return err_set(err, errsize, "%s", "the image is neither PNG nor JPEG");
+	}
+	if (r == API_OK && stored_side) *stored_side = stored;
+	return r;
+}
+
+enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
+                                 uint32_t *width, uint32_t *height, char *err, size_t errsize)
+{
+	return api_image_decode_fit(data, len, max_pixels, 0, false, rgba, width, height, NULL, err, errsize);
 }

@@ -17,9 +17,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "errmsg.h"
 #include "arena.h"
 #include "model.h"
+#include "model_levels.h"
 #include "model_lod.h"
 #include "umbra/rnd_math.h"
 #include "sandbox.h"
@@ -45,6 +47,18 @@ static uint64_t cache_limit = 256u << 20;   /* api_model_cache_set_limit() */
 static atomic_uint_fast64_t next_serial = 1;
 
 static const char *const FORMAT_NAMES[] = {"glb", "gltf", "obj", "stl", "ply"};
+
+const char *const API_IMPORT_STAGE_NAMES[API_IMPORT_STAGES] = {
+	"model-read", "model-parse", "model-textures", "model-closed", "model-lod", "model-transfer", "model-validate",
+	"model-mips",
+};
+
+double api_clock_ms(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
 
 const char *api_model_format_name(enum api_model_format f)
 {
@@ -96,6 +110,8 @@ enum api_model_format api_model_sniff(const uint8_t *d, size_t len)
 static void model_free(struct model_priv *m)
 {
 	if (!m) return;
+	api_levels_free(&m->pub);
+	pthread_mutex_destroy(&m->pub.levels_mu_);
 	api_arena_destroy(m->arena);
 	free(m->src);
 	free(m);
@@ -146,6 +162,7 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 		return NULL;
 	}
 	atomic_init(&m->refs, 1);
+	pthread_mutex_init(&m->pub.levels_mu_, NULL);
 	m->pub.priv_ = m;
 	m->serial = atomic_fetch_add(&next_serial, 1);
 	size_t bytes = 0;
@@ -154,8 +171,10 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 		model_free(m);
 		return NULL;
 	}
-	api_model_build_lods(&m->pub, m->arena, &bytes);
+	/* The importer marked the meshes closed and built the one level this request can use; the
+	 * rest of the levels come later, for a model drawn again (api/model_levels.h). */
 	m->pub.format = format;
+	m->pub.level_side = lim ? lim->output_side : 0;
 	m->pub.priv_ = m;
 	m->pub.bytes_ = bytes + sizeof *m;
 	return m;
@@ -183,14 +202,55 @@ static void lru_push_front(struct model_priv *m)
 	cache_total += m->pub.bytes_;
 }
 
+/* Whether textures decoded for class c (api_texture_class; 0 = as stored) leave every
+ * texture of at most max texels as stored. */
+static bool none_reduced(uint32_t max, uint32_t c)
+{
+	return !c || (uint64_t)max < 2ull * API_TEXTURE_SIDE_PER_PIXEL * c;
+}
+
+/* Whether m's textures are the ones a fresh import for images of `side` decodes: the same
+ * class, or neither class reduces any of them (the same request, the same bytes). */
+static bool textures_cover(const struct model_priv *m, uint32_t side)
+{
+	uint32_t c = api_texture_class(side), mc = m->pub.texture_side, max = m->pub.texture_max;
+	return !max || c == mc || (none_reduced(max, c) && none_reduced(max, mc));
+}
+
+uint32_t api_texture_class(uint32_t side)
+{
+	uint32_t c = 1;
+	while (side && c < side && c < (1u << 30)) c <<= 1;
+	return side ? c : 0;
+}
+
 static struct model_priv *lru_find(uint64_t h, const uint8_t *data, size_t len, size_t model_len,
-                                   enum api_model_format f)
+                                   enum api_model_format f, uint32_t side)
 {
 	for (struct model_priv *m = lru_head; m; m = m->next)
 		if (m->hash == h && m->src_len == len && m->model_len == model_len && m->pub.format == f &&
-		    !memcmp(m->src, data, len))
+		    textures_cover(m, side) && !memcmp(m->src, data, len))
 			return m;
 	return NULL;
+}
+
+/* With cache_mu held: unlists the entries for the same bytes as m whose requests m serves (a
+ * model imported again for larger images replaces one whose textures were decoded smaller
+ * when m's are the same: neither reduces them); returns them as a list for release_list(). */
+static struct model_priv *unlist_covered(const struct model_priv *m)
+{
+	struct model_priv *out = NULL;
+	for (struct model_priv *o = lru_head, *n; o; o = n) {
+		n = o->next;
+		if (o == m || o->hash != m->hash || o->src_len != m->src_len || o->model_len != m->model_len ||
+		    o->pub.format != m->pub.format || !textures_cover(m, o->pub.texture_side) ||
+		    memcmp(o->src, m->src, m->src_len))
+			continue;
+		lru_unlink(o);
+		o->next = out;
+		out = o;
+	}
+	return out;
 }
 
 void api_model_release(struct api_model *pub)
@@ -229,14 +289,15 @@ static void release_list(struct model_priv *list)
  * bundle lays them out: the key covers the files too), importing it on a miss. */
 static enum api_result get(const uint8_t *data, size_t len, size_t model_len, size_t nfiles,
                            enum api_model_format format, const struct api_limits *lim, struct api_model **out,
-                           int *status, char *err, size_t errsize)
+                           bool *was_hit, int *status, char *err, size_t errsize)
 {
 	/* Word at a time: a cached 50 MB model is hashed on every request that names it (byte at a
 	 * time that alone took ~50 ms); the whole buffer is at hand, so no need to stream. */
 	uint64_t h = rnd_hash(RND_FNV_SEED ^ (uint64_t)format, data, len);
 
+	uint32_t side = lim ? lim->output_side : 0;
 	pthread_mutex_lock(&cache_mu);
-	struct model_priv *hit = lru_find(h, data, len, model_len, format);
+	struct model_priv *hit = lru_find(h, data, len, model_len, format, side);
 	if (hit) {
 		cache_hits++;
 		lru_unlink(hit);
@@ -247,6 +308,8 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	}
 	pthread_mutex_unlock(&cache_mu);
 	if (hit) {
+		api_levels_on_hit(&hit->pub, lim);
+		*was_hit = true;
 		*out = &hit->pub;
 		*status = 0;
 		return API_OK;
@@ -256,6 +319,7 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	if (!m) return API_ERR;
 	*status = 0;
 	uint64_t chains = texture_chains(&m->pub, m->arena, false);
+	double t0 = api_clock_ms();
 	uint64_t cost = m->pub.bytes_ + len + chains;
 	pthread_mutex_lock(&cache_mu);
 	uint64_t cache_bytes = cache_limit;
@@ -265,6 +329,7 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 		return API_OK;
 	}
 	texture_chains(&m->pub, m->arena, true);
+	m->pub.times.ms[API_IMPORT_MIPS] = (float)(api_clock_ms() - t0);
 	memcpy(m->src, data, len);
 	m->src_len = len;
 	m->model_len = model_len;
@@ -274,13 +339,20 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	struct model_priv *evicted = NULL;
 	pthread_mutex_lock(&cache_mu);
 	/* Another request may have imported the same bytes meanwhile: use the listed one. */
-	struct model_priv *dup = lru_find(h, data, len, model_len, format);
+	struct model_priv *dup = lru_find(h, data, len, model_len, format, side);
 	if (dup) {
 		atomic_fetch_add(&dup->refs, 1);
 	} else {
+		struct model_priv *older = unlist_covered(m);
 		lru_push_front(m);
 		atomic_fetch_add(&m->refs, 1); /* the cache's reference */
 		evicted = evict_over_limit(m);
+		if (older) {   /* both lists end in NULL: join them for one release */
+			struct model_priv *t = older;
+			while (t->next) t = t->next;
+			t->next = evicted;
+			evicted = older;
+		}
 	}
 	pthread_mutex_unlock(&cache_mu);
 	release_list(evicted);
@@ -292,9 +364,10 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	return API_OK;
 }
 
-enum api_result api_model_get_files(const uint8_t *data, size_t len, const struct api_model_file *files,
+enum api_result api_model_get_timed(const uint8_t *data, size_t len, const struct api_model_file *files,
                                     size_t nfiles, enum api_model_format format, const struct api_limits *lim,
-                                    struct api_model **out, int *status, char *err, size_t errsize)
+                                    struct api_model **out, struct api_import_times *times, int *status, char *err,
+                                    size_t errsize)
 {
 	*out = NULL;
 	*status = 400;
@@ -308,17 +381,38 @@ enum api_result api_model_get_files(const uint8_t *data, size_t len, const struc
 	if (format < API_MODEL_GLB || format > API_MODEL_PLY)
 		return api_err_set(err, errsize, "the file is not a recognisable glb, gltf, obj, stl or ply model "
 		               "(give format to say which)");
-	if (!nfiles) return get(data, len, len, 0, format, lim, out, status, err, errsize);
-	size_t blen;
-	uint8_t *bundle = api_sbx_bundle_encode(data, len, files, nfiles, &blen);
-	if (!bundle) {
-		*status = 422;
-		return api_err_set(err, errsize, "the model and its files are too large to import (out of memory)");
+	bool hit = false;
+	enum api_result rc;
+	if (!nfiles) {
+		rc = get(data, len, len, 0, format, lim, out, &hit, status, err, errsize);
+	} else {
+		size_t blen;
+		uint8_t *bundle = api_sbx_bundle_encode(data, len, files, nfiles, &blen);
+		if (!bundle) {
+			*status = 422;
+			return api_err_set(err, errsize, "the model and its files are too large to import (out of memory)");
+		}
+		rc = get(bundle, blen, len, nfiles, format, lim, out, &hit, status, err, errsize);
+		free(bundle);
 	}
-	enum api_result rc = get(bundle, blen, len, nfiles, format, lim, out, status, err, errsize);
-	free(bundle);
+	if (rc == API_OK && times) {
+		if (hit) times->hits++;
+		else {
+			for (int k = 0; k < API_IMPORT_STAGES; k++) times->ms[k] += (*out)->times.ms[k];
+			times->imports++;
+		}
+	}
 	return rc;
 }
+
+enum api_result api_model_get_files(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                    size_t nfiles, enum api_model_format format, const struct api_limits *lim,
+                                    struct api_model **out, int *status, char *err, size_t errsize)
+{
+	return api_model_get_timed(data, len, files, nfiles, format, lim, out, NULL, status, err, errsize);
+}
+
+
 
 enum api_result api_model_get(const uint8_t *data, size_t len, enum api_model_format format,
                               const struct api_limits *lim, struct api_model **out, int *status, char *err,
@@ -332,7 +426,7 @@ uint64_t api_model_serial(const struct api_model *pub)
 	return ((const struct model_priv *)pub->priv_)->serial;
 }
 
-struct api_model *api_model_cache_take(uint64_t serial)
+struct api_model *api_model_cache_take(uint64_t serial, const struct api_limits *lim)
 {
 	struct model_priv *hit = NULL;
 	pthread_mutex_lock(&cache_mu);
@@ -345,7 +439,24 @@ struct api_model *api_model_cache_take(uint64_t serial)
 		atomic_fetch_add(&hit->refs, 1);
 	}
 	pthread_mutex_unlock(&cache_mu);
+	if (hit) api_levels_on_hit(&hit->pub, lim);
 	return hit ? &hit->pub : NULL;
+}
+
+void api_model_charge_(struct api_model *pub, size_t bytes)
+{
+	struct model_priv *m = pub->priv_;
+	pthread_mutex_lock(&cache_mu);
+	bool listed = m->listed;
+	if (listed) lru_unlink(m);
+	pub->bytes_ += bytes;
+	struct model_priv *evicted = NULL;
+	if (listed) {
+		lru_push_front(m);
+		evicted = evict_over_limit(m);
+	}
+	pthread_mutex_unlock(&cache_mu);
+	release_list(evicted);
 }
 
 void api_model_cache_set_limit(uint64_t bytes)

@@ -34,6 +34,8 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include "api.h"
 
@@ -43,6 +45,10 @@ enum api_model_format {
 };
 
 #define API_MODEL_MAX_WARNINGS 1000u
+/* Texels a texture keeps per pixel of the request's image-size class (api_texture_class): it
+ * is halved while it stays at least this many times as large (a 2048^2 JPEG for a 256^2
+ * thumbnail: 512^2). An atlas whose visible part is half of it still has a texel per pixel. */
+#define API_TEXTURE_SIDE_PER_PIXEL 2u
 
 /* One geometry array set (an Assimp mesh, triangles only). */
 struct api_model_mesh {
@@ -56,11 +62,12 @@ struct api_model_mesh {
 	uint32_t vertex_count, index_count;
 	uint32_t material;        /* index into api_model.materials */
 	bool single_sided;        /* its material says doubleSided: false (back faces culled) */
-	/* Simplified levels (api/model_lod.h), finest first; set once after import, then immutable. */
+	/* The simplified level for images of the model's level_side (api/model_lod.h), or none;
+	 * other sizes' levels: api_model_mesh_lods(). */
 	const struct rnd_mesh_lod *lods;
 	uint32_t lod_count;
-	bool closed;              /* watertight and wound outward (api/model_lod.h) */
-	float bounds[6];          /* min xyz, max xyz of positions (api/model_lod.h, with the levels) */
+	bool closed;              /* watertight and wound outward (api/model_lod.h, set by the importer) */
+	float bounds[6];          /* min xyz, max xyz of positions (api_mesh_bounds) */
 };
 
 /* A node's use of a mesh: one rnd_object. */
@@ -78,10 +85,31 @@ struct api_model {
 	 * joined by "; " (printable ASCII, at most API_MODEL_MAX_WARNINGS bytes), or NULL. */
 	const char *warnings;
 	enum api_model_format format;
+	/* Its textures were decoded for images of the class texture_side (api_texture_class of the
+	 * importing request's output_side; 0 = as stored); the largest of them is texture_max
+	 * texels on its larger side as stored (0: no texture). */
+	uint32_t texture_side, texture_max;
+	uint32_t level_side;      /* the meshes' own lods are for images of this side (0: none built) */
+	struct api_import_times times;   /* the import's stages (imports = 1), or zero */
 	/* private */
-	size_t bytes_;            /* what the cache charges for it */
+	size_t bytes_;            /* what the cache charges for it (cache_mu, api/model.c) */
 	void *priv_;
+	/* api/model_levels.c: other sizes' levels, a list that only grows; its builders' lock */
+	_Atomic(struct api_size_levels *) levels_;
+	pthread_mutex_t levels_mu_;
 };
+
+/* The levels of one mesh (arena memory). */
+struct api_mesh_levels {
+	const struct rnd_mesh_lod *lods;
+	uint32_t count;
+};
+
+/* The levels (*count of them, 0 or 1) of mesh `mesh` of m for images of `side`
+ * (api_limits.output_side): the import's for its own side, else those built when the cached
+ * model was first drawn at that side (api/model_levels.h); none for side 0. */
+const struct rnd_mesh_lod *api_model_mesh_lods(const struct api_model *m, uint32_t mesh, uint32_t side,
+                                               uint32_t *count);
 
 /* Imports (or finds in the cache) the model in data[0..len). format API_MODEL_SNIFF tells it
  * from the bytes. The cache is bounded by api_model_cache_set_limit() (api.h). From lim (NULL =
@@ -99,7 +127,7 @@ void api_model_release(struct api_model *m);
  * cached (evicted, cleared, or too large to cache): api/model_paths.h finds a model by path
  * this way without the bytes that key the cache. */
 uint64_t api_model_serial(const struct api_model *m);
-struct api_model *api_model_cache_take(uint64_t serial);
+struct api_model *api_model_cache_take(uint64_t serial, const struct api_limits *lim);
 
 /* A file the model refers to (a .gltf's buffer or image, an .obj's .mtl or texture), named as
  * the referring file writes it; found by api/model_refs.h. */
@@ -114,6 +142,16 @@ enum api_result api_model_get_files(const uint8_t *data, size_t len, const struc
                                     size_t nfiles, enum api_model_format format, const struct api_limits *lim,
                                     struct api_model **out, int *status, char *err, size_t errsize);
 
+/* CLOCK_MONOTONIC in milliseconds: what the import's stages are measured with. */
+double api_clock_ms(void);
+
+/* api_model_get_files() that also adds the import's stage times to *times (times->imports + 1),
+ * or counts a cache hit (times->hits + 1); times may be NULL. */
+enum api_result api_model_get_timed(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                    size_t nfiles, enum api_model_format format, const struct api_limits *lim,
+                                    struct api_model **out, struct api_import_times *times, int *status, char *err,
+                                    size_t errsize);
+
 /* Tells the format from the bytes; API_MODEL_SNIFF when it cannot. */
 enum api_model_format api_model_sniff(const uint8_t *data, size_t len);
 const char *api_model_format_name(enum api_model_format f);
@@ -126,5 +164,19 @@ const char *api_model_format_name(enum api_model_format f);
  * with a sentence in err. */
 enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
                                  uint32_t *width, uint32_t *height, char *err, size_t errsize);
+/* The same, no larger than it must be for a larger side of at least min_side (0 = as stored):
+ * halved while it stays that large, a JPEG by libjpeg's scaled decode (the IDCT at 1/2, 1/4,
+ * 1/8: it costs what decoding the smaller image costs), a PNG after the
+ * decode into the level the renderer's mip chain has there (rnd_texture_reduce: in linear light
+ * for an srgb slot, the same bytes), halved k times where 2^k <= larger side / min_side; a JPEG's
+ * scaled IDCT filters in the stored colour space. *stored_side (may be NULL): the larger side
+ * as stored. */
+enum api_result api_image_decode_fit(const uint8_t *data, size_t len, uint64_t max_pixels, uint32_t min_side,
+                                     bool srgb, uint8_t **rgba, uint32_t *width, uint32_t *height,
+                                     uint32_t *stored_side, char *err, size_t errsize);
+/* The class of image sizes textures are decoded for: side rounded up to a power of two (0 for
+ * 0: as stored). A texture of larger side L is halved while L / 2 >= API_TEXTURE_SIDE_PER_PIXEL
+ * times the class, so requests of one class decode every texture alike. */
+uint32_t api_texture_class(uint32_t side);
 
 #endif

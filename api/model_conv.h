@@ -1,7 +1,8 @@
 /*
  * api/model_conv.h — the state of one aiScene's conversion into an api_model, shared by the
  * two files that do it: api/model_import.c (meshes, nodes, the import itself) and
- * api/model_material.c (materials and their textures). Private to those two.
+ * api/model_material.c (materials and their textures). Private to those two (and
+ * api/stl_import.c, for api_join_vertices).
  *
  * Ownership: what api_conv_alloc returns lives in the caller's arena; mesh_map, tex and inst
  * are malloc'd by model_import.c and freed there. Threading: one conversion, one thread.
@@ -33,6 +34,9 @@ struct api_conv {
 	struct api_gltf_info gi;      /* those details, and the warnings (filled for glTF only) */
 	const struct rnd_material *mats;
 	const bool *single_sided;     /* by material */
+	uint32_t texture_side;        /* decode textures for this class of images (0 = as stored) ... */
+	uint32_t texture_max;         /* ... the largest one's larger side as stored */
+	double texture_ms;            /* time spent decoding them */
 	char *err;
 	size_t errsize;
 };
@@ -44,6 +48,14 @@ static inline void *api_conv_alloc(struct api_conv *c, size_t n, size_t size)
 	else c->oom = true;
 	return p;
 }
+
+/* Joins the corners of a mesh of positions and normals (and colours: an STL's per-facet
+ * colours) that share a position, a colour and a normal to within 2^-14 (coplanar facets'
+ * normals, normalised cross products of different edges, differ in their last bits), in place:
+ * corners where facets of one plane meet become one vertex, as Assimp's join made them.
+ * Returns the vertices left; without memory for the tables they all stay (the same picture).
+ * (api/model_import.c; api/stl_import.c uses it too.) */
+uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni);
 
 /* Material `index` of the scene into *m (defaults for Assimp's default material), with its
  * textures decoded into the arena; *single_sided from glTF's doubleSided. -1 with c->err (and

@@ -36,7 +36,9 @@
 #include "model_conv.h"
 #include "model_import.h"
 #include "model_io.h"
+#include "model_lod.h"
 #include "ply_strips.h"
+#include "stl_import.h"
 #include "umbra/rnd_math.h"
 
 #define MAX_NODE_DEPTH 256
@@ -201,12 +203,7 @@ struct join_key {
 	int16_t pad;   /* zero: meshoptimizer compares every byte */
 };
 
-/* Joins the corners of a mesh of positions and normals (and colours: an STL's per-facet
- * colours) that share a position, a colour and a normal to within 2^-14 (coplanar facets'
- * normals, normalised cross products of different edges, differ in their last bits), in place:
- * corners where facets of one plane meet become one vertex, as Assimp's join made them.
- * Returns the vertices left; without memory for the tables they all stay (the same picture). */
-static uint32_t join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
+uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
 {
 	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
 	struct join_key *key = calloc(nv, sizeof *key);
@@ -254,7 +251,7 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 	out->material = am->mMaterialIndex;
 	/* the colours are ours (the arena) until the model is shared */
 	if (c->join && nrm && !uv && !out->tangents && nv)
-		out->vertex_count = join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
+		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
 	return 0;
 }
 
@@ -357,12 +354,32 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
                                             struct api_arena *arena, struct api_model *out, size_t *bytes,
                                             char *err, size_t errsize)
 {
-	return api_model_import_files(data, len, NULL, 0, format, arena, out, bytes, err, errsize);
+	enum api_wire_status st = api_model_import_files(data, len, NULL, 0, format, 0, arena, out, bytes, err, errsize);
+	if (st == API_WIRE_OK) api_model_finish_import(out, 0, arena, bytes);
+	return st;
 }
 
 enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, const struct api_model_file *files,
-                                            size_t nfiles, enum api_model_format format, struct api_arena *arena,
-                                            struct api_model *out, size_t *bytes, char *err, size_t errsize)
+                                            size_t nfiles, enum api_model_format format, uint32_t output_side,
+                                            struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
+                                            size_t errsize)
+{
+	double t0 = api_clock_ms();
+	memset(out, 0, sizeof *out);
+	*bytes = 0;
+	int st = API_STL_NOT_MINE;
+	if (format == API_MODEL_STL && data) st = api_stl_import_binary(data, len, arena, out, bytes, err, errsize);
+	if (st == API_STL_NOT_MINE)
+		st = api_model_import_assimp(data, len, files, nfiles, format, output_side, arena, out, bytes, err, errsize);
+	out->times.ms[API_IMPORT_PARSE] = (float)(api_clock_ms() - t0) - out->times.ms[API_IMPORT_TEXTURES];
+	out->times.imports = 1;
+	return (enum api_wire_status)st;
+}
+
+enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                             size_t nfiles, enum api_model_format format, uint32_t output_side,
+                                             struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
+                                             size_t errsize)
 {
 	memset(out, 0, sizeof *out);
 	*bytes = 0;
@@ -373,7 +390,7 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	json_t *root = NULL;
 	if (gltf && gltf_precheck(data, len, format, &root, err, errsize) < 0) return API_WIRE_BAD_INPUT;
 	struct api_conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf,
-	                     .join = format == API_MODEL_STL};
+	                     .join = format == API_MODEL_STL, .texture_side = api_texture_class(output_side)};
 	uint8_t *tagged = NULL;
 	if (gltf) {
 		api_gltf_info_read(root, &c.gi);
@@ -434,6 +451,9 @@ c.sc = sc;
 	c.files = files;
 	c.nfiles = nfiles;
 	int rc = convert(&c);
+	out->texture_side = c.texture_side;
+	out->texture_max = c.texture_max;
+	out->times.ms[API_IMPORT_TEXTURES] = (float)c.texture_ms;
 	api_gltf_info_free(&c.gi);
 	free(c.mesh_map);
 	free(c.tex);

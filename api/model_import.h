@@ -24,9 +24,17 @@ enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enu
                                             char *err, size_t errsize);
 
 /* The same with the files the model refers to (names as the model writes them): Assimp's
- * file system and the texture lookup serve them from memory. */
+ * file system and the texture lookup serve them from memory; textures decoded for images of
+ * output_side (api_image_decode_fit; 0 = as stored); out->times: its parse and textures. */
 enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, const struct api_model_file *files,
-                                            size_t nfiles, enum api_model_format format, struct api_arena *arena,
-                                            struct api_model *out, size_t *bytes, char *err, size_t errsize);
+                                            size_t nfiles, enum api_model_format format, uint32_t output_side,
+                                            struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
+                                            size_t errsize);
+/* The same through Assimp whatever the format: api_model_import_files() reads a plain binary
+ * STL itself (api/stl_import.h); tests compare the two. */
+enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, const struct api_model_file *files,
+                                             size_t nfiles, enum api_model_format format, uint32_t output_side,
+                                             struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
+                                             size_t errsize);
 
 #endif

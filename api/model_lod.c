@@ -1,8 +1,10 @@
 /*
  * api/model_lod.c — meshoptimizer levels of detail of imported meshes (see model_lod.h).
  *
- * Each level simplifies the previous one (a million triangles are read once, not once per
- * level) to a target twice the previous, starting at 1/16384 of the mesh's extent. A level's
+ * A mesh gets one level for each size of image it is drawn at (api_lod_import_error), each
+ * simplified from the full mesh in one step: a pure function of the mesh and that size, so a
+ * request draws the same triangles whether its model was just imported or long cached (the
+ * same request, the same bytes). A level's
  * error is measured here against the full mesh (level_error), in object units: meshoptimizer's
  * own figure leaves out how far the new triangles' insides are from the surface. The measure
  * is the distance from the nearest full-mesh vertex's tangent plane, and where that comes within
@@ -19,13 +21,6 @@
 #include <string.h>
 #include "model_lod.h"
 #include "umbra/rnd_math.h"
-
-float api_lod_level_error(unsigned level)
-{
-	float e = 1.0f / 16384.0f;
-	for (unsigned i = 0; i < level; i++) e *= 2.0f;
-	return e;
-}
 
 /* A mesh welded by position: what the simplifier works on. meshoptimizer treats vertices at
  * the same position as attribute seams it must keep, so a flat-shaded file (an STL shares no
@@ -107,8 +102,13 @@ static bool grid_build(struct grid *g, const struct welded *w)
 			hi[k] = fmaxf(hi[k], w->pos[3 * v + k]);
 		}
 	float ext = fmaxf(fmaxf(hi[0] - g->lo[0], hi[1] - g->lo[1]), hi[2] - g->lo[2]);
-	/* about two vertices per cell of a surface: cells of extent / sqrt(count / 2) */
+	/* about two vertices per cell of a surface: cells of extent / sqrt(count / 2); but at most
+	 * 8 cells a vertex in all (a surface fills few of a volume's cells: for a 1M-triangle mesh
+	 * the rule alone made 125M cells, half a gigabyte to clear, 12 % of its import) */
 	g->cell = fmaxf(ext / sqrtf((float)w->count * 0.5f), 1e-12f);
+	double volume = 1.0, cap = 8.0 * (double)w->count + 64.0;
+	for (int k = 0; k < 3; k++) volume *= (double)(hi[k] - g->lo[k]) / g->cell + 1.0;
+	if (volume > cap) g->cell *= (float)cbrt(volume / cap);
 	size_t cells = 1;
 	for (int k = 0; k < 3; k++) {
 		g->dim[k] = (uint32_t)fminf((hi[k] - g->lo[k]) / g->cell + 1.0f, 1024.0f);
@@ -445,43 +445,6 @@ static size_t drop_degenerate(const struct welded *w, uint32_t *idx, size_t ni)
 	return out;
 }
 
-/* me's levels from its welded vertices w and indices cur (me->index_count of them; cur is
- * overwritten). */
-static void mesh_lods(struct api_model_mesh *me, const struct welded *w, uint32_t *cur, struct api_arena *arena,
-                      size_t *bytes)
-{
-	struct rnd_mesh_lod *lods = api_arena_calloc(arena, API_LOD_LEVELS, sizeof *lods);
-	uint32_t *caller = cur, *next = malloc((size_t)me->index_count * sizeof *next);
-	struct grid g = {0};
-	struct walk k = {0};
-	if (!lods || !next || !grid_build(&g, w) || !walk_build(&k, w, cur, me->index_count))
-		goto done;
-	size_t ni = me->index_count;
-	float prev = 0.0f;
-	uint32_t n = 0;
-	for (unsigned level = 0; level < API_LOD_LEVELS; level++) {
-		size_t got = meshopt_simplify(next, cur, ni, w->pos, w->count, 12, 3, api_lod_level_error(level), 0, NULL);
-		if (got < 3) break;
-		/* Not worth a level under a quarter fewer triangles: try the next error on the same input. */
-		if (got * 4 > ni * 3) continue;
-		got = drop_degenerate(w, next, got);
-		/* measured against the full mesh; never less than a finer level's */
-		float e = fmaxf(level_error(&g, &k, w, next, got), prev);
-		if (!write_level(arena, me, w, next, got, &lods[n], bytes)) break;
-		lods[n++].error = prev = e;
-		uint32_t *t = cur; cur = next; next = t;
-		ni = got;
-	}
-	if (n) { me->lods = lods; me->lod_count = n; }
-done:
-	walk_free(&k);
-	free(g.start);
-	free(g.items);
-	free(g.ipos);
-	/* cur and next trade places per level: free whichever of them is not the caller's */
-	free(cur == caller ? next : cur);
-}
-
 /* Sorts a[n] (tmp: n more) a byte at a time from the lowest, skipping bytes every key shares
  * (the high ones of vertex ids): qsort's call per comparison and a bsearch per edge were a
  * third of a 1M-triangle STL's closedness check. Returns where the sorted keys are (a or tmp). */
@@ -542,8 +505,7 @@ out:
 	return closed;
 }
 
-/* min xyz, max xyz of the mesh's positions (0 for a mesh without vertices). */
-static void mesh_bounds(struct api_model_mesh *me)
+void api_mesh_bounds(struct api_model_mesh *me)
 {
 	float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
 	for (uint32_t v = 0; v < me->vertex_count; v++) {
@@ -556,22 +518,110 @@ static void mesh_bounds(struct api_model_mesh *me)
 	for (int k = 0; k < 3; k++) { me->bounds[k] = lo[k]; me->bounds[3 + k] = hi[k]; }
 }
 
-void api_model_build_lods(struct api_model *m, struct api_arena *arena, size_t *bytes)
+/* Welds me by position into idx and w (the caller frees w's arrays); false when out of memory. */
+static bool welded_mesh(const struct api_model_mesh *me, uint32_t *idx, struct welded *w)
+{
+	return me->normals && me->indices && me->index_count && idx && weld(me, idx, w);
+}
+
+static void welded_free(struct welded *w)
+{
+	free(w->pos);
+	free(w->nrm);
+	free(w->rep);
+}
+
+/* The largest side of w's bounds: what meshoptimizer's relative errors are relative to. */
+static float welded_extent(const struct welded *w)
+{
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (size_t v = 0; v < w->count; v++)
+		for (int k = 0; k < 3; k++) {
+			lo[k] = fminf(lo[k], w->pos[3 * v + k]);
+			hi[k] = fmaxf(hi[k], w->pos[3 * v + k]);
+		}
+	return fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+}
+
+/* One level of me (welded w, indices cur) within relative error `want` as measured
+ * (level_error), simplified in one step from the full mesh: what the request that imports the
+ * model can use, without the levels in between. meshoptimizer's target is its own figure, which
+ * the measure exceeds (2-3x on a bumpy sphere): aimed at a quarter of `want`, and once more,
+ * closer, when that measured over. None when it would not save a quarter of the triangles. */
+static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, const uint32_t *cur, float want,
+                           struct api_arena *arena, size_t *bytes)
+{
+	struct rnd_mesh_lod *lod = api_arena_calloc(arena, 1, sizeof *lod);
+	uint32_t *next = malloc((size_t)me->index_count * sizeof *next);
+	struct grid g = {0};
+	struct walk k = {0};
+	size_t ni = me->index_count;
+	float extent = welded_extent(w), target = 0.25f * want;
+	if (!lod || !next || !(extent > 0.0f) || !grid_build(&g, w) || !walk_build(&k, w, cur, ni)) goto done;
+	for (int attempt = 0; attempt < 2; attempt++) {
+		size_t got = meshopt_simplify(next, cur, ni, w->pos, w->count, 12, 3, target, 0, NULL);
+		if (got < 3 || got * 4 > ni * 3) break;
+		got = drop_degenerate(w, next, got);
+		float e = got >= 3 ? level_error(&g, &k, w, next, got) : INFINITY;
+		if (e <= want * extent || attempt == 1) {
+			if (got >= 3 && e <= want * extent && write_level(arena, me, w, next, got, lod, bytes)) {
+				lod->error = e;
+				me->lods = lod;
+				me->lod_count = 1;
+			}
+			break;
+		}
+		target *= 0.8f * want * extent / e;
+	}
+done:
+	walk_free(&k);
+	free(g.start);
+	free(g.items);
+	free(g.ipos);
+	free(next);
+}
+
+/* The one level of every mesh of m that wants one, for images of output_side, and with
+ * `closed` set too when mark_closed: one weld a mesh for both. */
+static void finish(struct api_model *m, uint32_t output_side, bool mark_closed, struct api_arena *arena, size_t *bytes)
 {
 	for (uint32_t i = 0; i < m->mesh_count; i++) {
 		struct api_model_mesh *me = (struct api_model_mesh *)&m->meshes[i]; /* ours until shared */
-		mesh_bounds(me);
-		if (!me->normals || !me->indices || !me->index_count) continue;
-		/* welded by position once, for both */
-		uint32_t *idx = malloc((size_t)me->index_count * sizeof *idx);
+		bool level = output_side && api_mesh_wants_levels(me);
+		if (!mark_closed && !level) continue;
+		double t0 = api_clock_ms();
+		uint32_t *idx = me->index_count ? malloc((size_t)me->index_count * sizeof *idx) : NULL;
 		struct welded w = {0};
-		if (idx && weld(me, idx, &w)) {
-			me->closed = api_mesh_closed(idx, me->index_count, w.pos);
-			if (me->index_count / 3 >= API_LOD_MIN_TRIANGLES) mesh_lods(me, &w, idx, arena, bytes);
-		}
-		free(w.pos);
-		free(w.nrm);
-		free(w.rep);
+		bool welded = welded_mesh(me, idx, &w);
+		if (mark_closed) me->closed = welded && api_mesh_closed(idx, me->index_count, w.pos);
+		double t1 = api_clock_ms();
+		if (welded && level) mesh_one_level(me, &w, idx, api_lod_import_error(output_side), arena, bytes);
+		m->times.ms[API_IMPORT_CLOSED] += (float)(t1 - t0);
+		m->times.ms[API_IMPORT_LEVEL] += (float)(api_clock_ms() - t1);
+		welded_free(&w);
 		free(idx);
 	}
+}
+
+void api_model_finish_import(struct api_model *m, uint32_t output_side, struct api_arena *arena, size_t *bytes)
+{
+	finish(m, output_side, true, arena, bytes);
+}
+
+void api_model_build_level(struct api_model *m, uint32_t output_side, struct api_arena *arena, size_t *bytes)
+{
+	finish(m, output_side, false, arena, bytes);
+}
+
+float api_lod_import_error(uint32_t output_side)
+{
+	/* The renderer's bound (RND_LOD_MESH_PIXEL_ERROR, half a pixel) for a mesh that spans 70 %
+	 * of the image, as a thumbnail frames it; the renderer draws the level only where it fits
+	 * its bound (pixels and shadow texels as they are), else the full mesh. */
+	return output_side ? 0.35f / (float)output_side : 0.0f;
+}
+
+bool api_mesh_wants_levels(const struct api_model_mesh *me)
+{
+	return me->index_count / 3 >= API_LOD_MIN_TRIANGLES && me->normals && !me->colors && !me->tangents;
 }

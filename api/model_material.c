@@ -37,7 +37,10 @@ static int find_texture(const struct api_conv *c, const char *path)
 	return k < 0 ? -1 : (int)(sc->mNumTextures + (unsigned)k);
 }
 
-static const struct rnd_texture *texture(struct api_conv *c, int ti)
+/* Texture ti (decoded once; the first slot that reads it decides): for a sampler with mip
+ * levels no larger than the request's images need (api_image_decode_fit), else as stored (a
+ * minFilter without mipmaps reads level 0, aliasing and all, as the file asks). */
+static const struct rnd_texture *texture(struct api_conv *c, int ti, enum rnd_texture_slot slot, bool mipmapped)
 {
 	if (c->tex[ti]) return c->tex[ti];
 	unsigned nemb = c->sc->mNumTextures;
@@ -50,8 +53,15 @@ static const struct rnd_texture *texture(struct api_conv *c, int ti)
 		uint8_t *px;
 		uint32_t w, h;
 		char e[200];
-		if (api_image_decode(file ? file->data : (const uint8_t *)at->pcData, file ? file->len : at->mWidth,
-		                     MAX_TEXTURE_PIXELS, &px, &w, &h, e, sizeof e) != API_OK) {
+		uint32_t stored;
+		double t0 = api_clock_ms();
+		enum api_result r = api_image_decode_fit(file ? file->data : (const uint8_t *)at->pcData,
+		                                         file ? file->len : at->mWidth, MAX_TEXTURE_PIXELS,
+		                                         mipmapped ? c->texture_side * API_TEXTURE_SIDE_PER_PIXEL : 0,
+		                                         rnd_texture_slot_srgb(slot), &px, &w, &h, &stored, e, sizeof e);
+		c->texture_ms += api_clock_ms() - t0;
+		if (r == API_OK && stored > c->texture_max) c->texture_max = stored;
+		if (r != API_OK) {
 			if (file) return api_err_set(c->err, c->errsize, "texture \"%.128s\": %s", file->name, e), NULL;
 			return api_err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
 		}
@@ -105,7 +115,8 @@ static int material_textures(struct api_conv *c, const struct aiMaterial *am, ui
 				if (c->gltf) api_gltf_warn(&c->gi, "material %u: texture \"%.60s\" is not in the file (not drawn)", index, s.data);
 				break;
 			}
-			if (!(m->textures[k] = texture(c, ti))) return -1;
+			if (!(m->textures[k] = texture(c, ti, (enum rnd_texture_slot)k, m->sampling[k].mip != RND_MIP_NONE)))
+				return -1;
 			break;
 		}
 	}

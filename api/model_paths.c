@@ -60,14 +60,15 @@ static bool unchanged(const char *root, const struct entry *e)
 	return true;
 }
 
-struct api_model *api_model_paths_find(const struct api_model_path_key *k, uint64_t *files_hash)
+struct api_model *api_model_paths_find(const struct api_model_path_key *k, const struct api_limits *lim,
+                                       uint64_t *files_hash)
 {
 	char *key = key_of(k);
 	if (!key) return NULL;
 	struct api_model *m = NULL;
 	pthread_mutex_lock(&mu);
 	struct entry **slot = slot_of(key);
-	if (slot && unchanged(k->root, *slot) && (m = api_model_cache_take((*slot)->serial))) {
+	if (slot && unchanged(k->root, *slot) && (m = api_model_cache_take((*slot)->serial, lim))) {
 		(*slot)->used = ++tick;
 		*files_hash = (*slot)->files_hash;
 		hits++;

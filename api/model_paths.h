@@ -18,7 +18,7 @@
  *
  * Usage (api/scene_parse.c):
  *   struct api_model_path_key k = {root, path, format_or_minus_1, optional};
- *   struct api_model *m = api_model_paths_find(&k, &hash);   // NULL: read and import, then
+ *   struct api_model *m = api_model_paths_find(&k, lim, &hash);   // NULL: read and import, then
  *   api_model_paths_remember(&k, &stamp, refs.origins, refs.norigins, m, hash);
  *
  * Bounds: API_MODEL_PATHS_MAX entries, least recently used replaced; models of more than
@@ -45,8 +45,10 @@ struct api_model_path_key {
 };
 
 /* A reference to the model remembered for k whose files are unchanged, and the hash its files
- * add to the scene's asset hash; NULL when there is none. */
-struct api_model *api_model_paths_find(const struct api_model_path_key *k, uint64_t *files_hash);
+ * add to the scene's asset hash; NULL when there is none. A hit is a cache hit: lim's import
+ * limits bound the build of its levels (api/model_levels.h). */
+struct api_model *api_model_paths_find(const struct api_model_path_key *k, const struct api_limits *lim,
+                                       uint64_t *files_hash);
 /* Remembers m (imported from the model file stamped `stamp` and the files of `refs`). Failing
  * to remember (out of memory, too many files) only costs the next request a read. */
 void api_model_paths_remember(const struct api_model_path_key *k, const struct api_asset_stamp *stamp,

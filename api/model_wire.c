@@ -85,6 +85,22 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 	}
 }
 
+static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh *me)
+{
+	put_u32(b, me->lod_count);
+	for (uint32_t l = 0; l < me->lod_count; l++) {
+		const struct rnd_mesh_lod *lv = &me->lods[l];
+		put_u32(b, lv->vertex_count);
+		put_u32(b, lv->index_count);
+		put_u32(b, lv->uvs ? 1u : 0u);
+		put(b, &lv->error, 4);
+		put(b, lv->positions, (size_t)lv->vertex_count * 12);
+		put(b, lv->normals, (size_t)lv->vertex_count * 12);
+		if (lv->uvs) put(b, lv->uvs, (size_t)lv->vertex_count * 8);
+		put(b, lv->indices, (size_t)lv->index_count * 4);
+	}
+}
+
 void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 {
 	/* Textures are shared between materials by pointer: each goes once, by its first index. */
@@ -103,6 +119,9 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 	}
 	size_t wlen = m->warnings ? strlen(m->warnings) : 0;
 	if (wlen > API_MODEL_MAX_WARNINGS) wlen = API_MODEL_MAX_WARNINGS;
+	put(b, &m->times.ms[API_IMPORT_PARSE], 4 * sizeof(float));   /* parse, textures, closed, level */
+	put_u32(b, m->texture_side);
+	put_u32(b, m->texture_max);
 	put_u32(b, ntex);
 	put_u32(b, m->material_count);
 	put_u32(b, m->mesh_count);
@@ -117,13 +136,14 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 		put_u32(b, me->index_count);
 		put_u32(b, me->material);
 		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u) | (me->colors ? 4u : 0u) | (me->tangents ? 8u : 0u) |
-		           (me->single_sided ? 16u : 0u));
+		           (me->single_sided ? 16u : 0u) | (me->closed ? 32u : 0u) | (me->lod_count ? 64u : 0u));
 		put(b, me->positions, (size_t)me->vertex_count * 12);
 		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
 		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
 		if (me->colors) put(b, me->colors, (size_t)me->vertex_count * 4);
 		if (me->tangents) put(b, me->tangents, (size_t)me->vertex_count * 16);
 		put(b, me->indices, (size_t)me->index_count * 4);
+		if (me->lod_count) put_mesh_levels(b, me);
 	}
 	for (uint32_t i = 0; i < m->instance_count; i++) {
 		put_u32(b, m->instances[i].mesh);
@@ -191,7 +211,7 @@ enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_k
 	if (!take_u32(&r, &ver) || !take_u32(&r, &k) || !take_u32(&r, &st) || !take_u32(&r, &n))
 		return bad(&r, "the header is cut short");
 	if (ver != API_WIRE_VERSION) return bad(&r, "version %u", ver);
-	if (k != API_WIRE_MODEL && k != API_WIRE_IMAGE) return bad(&r, "kind %u", k);
+	if (k != API_WIRE_MODEL && k != API_WIRE_IMAGE && k != API_WIRE_LEVELS) return bad(&r, "kind %u", k);
 	if (st > API_WIRE_OVER_MEMORY) return bad(&r, "status %u", st);
 	if (n > API_WIRE_MAX_MESSAGE || n > r.left) return bad(&r, "message of %u bytes", n);
 	if (st != API_WIRE_OK && (n != r.left || !n)) return bad(&r, "a failure without (only) a message");
@@ -307,12 +327,15 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 	return API_OK;
 }
 
+static enum api_result decode_mesh_levels(struct dec *d, uint32_t i, const struct api_model_mesh *me,
+                                          struct api_mesh_levels *out);
+
 static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, struct api_model_mesh *me)
 {
 	uint32_t nv, ni, mat, flags;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &mat) || !take_u32(&d->r, &flags))
 		return bad(&d->r, "mesh %u is cut short", i);
-	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 31)
+	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 127)
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
 	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
 	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u is cut short", i);
@@ -336,7 +359,15 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 		if (idx[k] >= nv) return bad(&d->r, "mesh %u: index %u refers to vertex %u of %u", i, k, idx[k], nv);
 	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .uvs = uv, .colors = col, .tangents = tan,
 	                              .indices = idx, .vertex_count = nv, .index_count = ni, .material = mat,
-	                              .single_sided = (flags & 16) != 0};
+	                              .single_sided = (flags & 16) != 0, .closed = (flags & 32) != 0};
+	api_mesh_bounds(me);
+	if (flags & 64) {
+		/* the level the importer built for the request (api_model_finish_import) */
+		struct api_mesh_levels lv;
+		if (decode_mesh_levels(d, i, me, &lv) != API_OK) return API_ERR;
+		me->lods = lv.lods;
+		me->lod_count = lv.count;
+	}
 	return API_OK;
 }
 
@@ -345,7 +376,12 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
                                       char *err, size_t errsize)
 {
 	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
-	uint32_t ntex, nmat, nmesh, ninst, nwarn;
+	uint32_t ntex, nmat, nmesh, ninst, nwarn, tside, tmax;
+	float times[4];
+	if (!take(&d.r, times, sizeof times) || !take_u32(&d.r, &tside) || !take_u32(&d.r, &tmax))
+		return bad(&d.r, "the counts are cut short");
+	for (int k = 0; k < 4; k++)
+		if (!isfinite(times[k]) || times[k] < 0 || times[k] > 1e8f) return bad(&d.r, "a stage time of %g ms", (double)times[k]);
 	if (!take_u32(&d.r, &ntex) || !take_u32(&d.r, &nmat) || !take_u32(&d.r, &nmesh) || !take_u32(&d.r, &ninst) ||
 	    !take_u32(&d.r, &nwarn))
 		return bad(&d.r, "the counts are cut short");
@@ -397,6 +433,87 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 	out->material_count = nmat;
 	out->triangles = tris;
 	out->warnings = warn;
+	out->texture_side = tside;
+	out->texture_max = tmax;
+	memset(&out->times, 0, sizeof out->times);
+	memcpy(&out->times.ms[API_IMPORT_PARSE], times, sizeof times);
+	out->times.imports = 1;
+	*bytes = d.bytes;
+	return API_OK;
+}
+
+/* ---- levels of detail (API_WIRE_LEVELS) ---- */
+
+void api_wire_put_levels(struct api_wire_buf *b, const struct api_model *m)
+{
+	put_u32(b, m->mesh_count);
+	for (uint32_t i = 0; i < m->mesh_count; i++) put_mesh_levels(b, &m->meshes[i]);
+}
+
+/* One level of mesh `me` (the one it simplifies): coarser than what it follows (fewer indices),
+ * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs only where
+ * the mesh has them, and an error no finer than the previous level's. */
+static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const struct api_model_mesh *me,
+                                    uint32_t max_indices, float min_error, struct rnd_mesh_lod *out)
+{
+	uint32_t nv, ni, flags;
+	float error;
+	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &flags) || !take(&d->r, &error, 4))
+		return bad(&d->r, "mesh %u level %u is cut short", i, l);
+	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 1 || ((flags & 1) && !me->uvs) ||
+	    !isfinite(error) || error < min_error)
+		return bad(&d->r, "mesh %u level %u: %u vertices, %u indices, flags %u, error %g", i, l, nv, ni, flags,
+		           (double)error);
+	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0);
+	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u level %u is cut short", i, l);
+	float *pos = dec_alloc(d, nv, 12), *nrm = dec_alloc(d, nv, 12), *uv = flags & 1 ? dec_alloc(d, nv, 8) : NULL;
+	uint32_t *idx = dec_alloc(d, ni, 4);
+	if (!pos || !nrm || ((flags & 1) && !uv) || !idx) return bad(&d->r, "out of memory");
+	take(&d->r, pos, (size_t)nv * 12);
+	take(&d->r, nrm, (size_t)nv * 12);
+	if (uv) take(&d->r, uv, (size_t)nv * 8);
+	take(&d->r, idx, (size_t)ni * 4);
+	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)))
+		return bad(&d->r, "mesh %u level %u has a value that is not finite", i, l);
+	for (uint32_t v = 0; v < nv; v++)
+		for (int k = 0; k < 3; k++)
+			if (pos[3 * (size_t)v + (size_t)k] < me->bounds[k] || pos[3 * (size_t)v + (size_t)k] > me->bounds[3 + k])
+				return bad(&d->r, "mesh %u level %u: vertex %u lies outside the mesh", i, l, v);
+	for (uint32_t k = 0; k < ni; k++)
+		if (idx[k] >= nv) return bad(&d->r, "mesh %u level %u: index %u refers to vertex %u of %u", i, l, k, idx[k], nv);
+	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error};
+	return API_OK;
+}
+
+/* A mesh's levels (level_count, then each level) into *out. */
+static enum api_result decode_mesh_levels(struct dec *d, uint32_t i, const struct api_model_mesh *me,
+                                          struct api_mesh_levels *out)
+{
+	uint32_t count;
+	if (!take_u32(&d->r, &count) || count > API_LOD_LEVELS) return bad(&d->r, "mesh %u: levels", i);
+	struct rnd_mesh_lod *lv = count ? dec_alloc(d, count, sizeof *lv) : NULL;
+	if (count && !lv) return bad(&d->r, "out of memory");
+	uint32_t max_indices = me->index_count;
+	float min_error = 0.0f;
+	for (uint32_t l = 0; l < count; l++) {
+		if (decode_level(d, i, l, me, max_indices, min_error, &lv[l]) != API_OK) return API_ERR;
+		max_indices = lv[l].index_count;
+		min_error = lv[l].error;
+	}
+	*out = (struct api_mesh_levels){lv, count};
+	return API_OK;
+}
+
+enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, const struct api_model_mesh *const *meshes,
+                                       uint32_t nmesh, struct api_arena *arena, struct api_mesh_levels *out,
+                                       size_t *bytes, char *err, size_t errsize)
+{
+	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
+	uint32_t n = 0;
+	if (!take_u32(&d.r, &n) || n != nmesh) return bad(&d.r, "levels of %u meshes for %u", n, nmesh);
+	for (uint32_t i = 0; i < nmesh; i++)
+		if (decode_mesh_levels(&d, i, meshes[i], &out[i]) != API_OK) return API_ERR;
+	if (d.r.left) return bad(&d.r, "%zu bytes after the last level", d.r.left);
 	*bytes = d.bytes;
 	return API_OK;
 }

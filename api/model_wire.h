@@ -15,7 +15,9 @@
  *   header   "UMBRAIMP" version kind status msg_len, then msg_len bytes of message
  *            (status != OK: the reply ends there)
  *   image    width height, width*height*4 bytes RGBA8
- *   model    texture_count material_count mesh_count instance_count warnings_len,
+ *   model    the importer's stage times f32[4] (parse, textures, closed, level: ms, finite, >= 0),
+ *            texture_side texture_max (u32: api_model's),
+ *            texture_count material_count mesh_count instance_count warnings_len,
  *            warnings_len bytes of warnings (printable ASCII, at most API_MODEL_MAX_WARNINGS)
  *            textures:  width height, width*height*4 bytes RGBA8
  *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff normal_scale
@@ -24,10 +26,14 @@
  *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
  *                       transformed << 6 | mip << 7 (u32, enum rnd_mip), transform f32[6]
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
- *                       8 tangents, 16 single-sided), positions f32[3v], normals f32[3v],
- *                       uvs f32[2v], colours u8[4v], tangents f32[4v], indices u32[i]
+ *                       8 tangents, 16 single-sided, 32 closed, 64 levels), positions f32[3v],
+ *                       normals f32[3v], uvs f32[2v], colours u8[4v], tangents f32[4v], indices
+ *                       u32[i], then with flag 64 the mesh's levels as below (level_count ...)
  *            instances: mesh (u32), model matrix f32[16] (column-major)
  *   Nothing may follow the last instance.
+ *   levels   (a levels-of-detail job: its input is a model, its reply this) mesh_count, then per
+ *            mesh level_count (at most API_LOD_LEVELS), per level vertex_count index_count
+ *            flags(1 uvs) error(f32), positions f32[3v], normals f32[3v], uvs f32[2v], indices u32[i]
  *
  * Usage (parent): api_wire_header(); then api_wire_decode_model() / _image() on the body.
  * Usage (child):  struct api_wire_buf b = {0}; api_wire_put_model(&b, model); write b.data.
@@ -40,12 +46,13 @@
 #include <stdint.h>
 #include "arena.h"
 #include "model.h"
+#include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 2u
+#define API_WIRE_VERSION 3u
 #define API_WIRE_MAX_MESSAGE 1024u
 
-enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2 };
+enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2, API_WIRE_LEVELS = 3 };
 /* What the importer says about the input (a crash says nothing: see api/sandbox.h). */
 enum api_wire_status { API_WIRE_OK = 0, API_WIRE_BAD_INPUT = 1, API_WIRE_OVER_MEMORY = 2 };
 
@@ -75,6 +82,13 @@ enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_k
 enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct api_arena *arena,
                                       uint64_t max_texture_pixels, struct api_model *out, size_t *bytes,
                                       char *err, size_t errsize);
+void api_wire_put_levels(struct api_wire_buf *b, const struct api_model *m);
+/* Decodes a levels body for meshes[0..nmesh) (those the job was sent, in that order; their
+ * bounds set) into out[nmesh]: every level coarser than the one before, its vertices inside the
+ * mesh's bounds, its error no smaller than the one before. */
+enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, const struct api_model_mesh *const *meshes,
+                                       uint32_t nmesh, struct api_arena *arena, struct api_mesh_levels *out,
+                                       size_t *bytes, char *err, size_t errsize);
 /* Decodes an image body into malloc'd RGBA8 (*rgba, you free it). */
 enum api_result api_wire_decode_image(const uint8_t *body, size_t len, uint64_t max_pixels, uint8_t **rgba,
                                       uint32_t *w, uint32_t *h, char *err, size_t errsize);

@@ -4,6 +4,7 @@
  * answer. The helper's side is api/sandbox_child.c.
  */
 #include <errno.h>
+#include <math.h>
 #include <fcntl.h>
 #include <limits.h>
 #include <poll.h>
@@ -19,8 +20,10 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#include "model_lod.h"
 #include "model_wire.h"
 #include "sandbox.h"
+#include "umbra/rnd_math.h"
 
 extern char **environ;
 
@@ -360,13 +363,20 @@ enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_l
 	*status = 0;
 	struct api_sbx_request rq = {.kind = API_WIRE_MODEL, .format = (uint32_t)format,
 	                             .max_pixels = MAX_TEXTURE_PIXELS, .input_len = bundle_len, .model_len = len,
-	                             .file_count = (uint32_t)nfiles};
+	                             .file_count = (uint32_t)nfiles, .output_side = lim ? lim->output_side : 0};
 	uint8_t *reply;
 	const uint8_t *body;
 	size_t blen;
+	double t0 = api_clock_ms();
 	if (run_job(&rq, bundle, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
+	double t1 = api_clock_ms();
 	enum api_result rc = api_wire_decode_model(body, blen, arena, MAX_TEXTURE_PIXELS, out, bytes, err, errsize);
 	if (rc != API_OK) *status = 400;
+	/* the round trip less what the importer says it spent (its clock is this machine's) */
+	float work = 0;
+	for (int k = API_IMPORT_PARSE; k <= API_IMPORT_LEVEL; k++) work += out->times.ms[k];
+	out->times.ms[API_IMPORT_TRANSFER] = fmaxf((float)(t1 - t0) - work, 0.0f);
+	out->times.ms[API_IMPORT_VALIDATE] = (float)(api_clock_ms() - t1);
 	out->format = format;
 	free(reply);
 	return rc;
@@ -378,6 +388,73 @@ enum api_result api_sandbox_import_model(const uint8_t *data, size_t len, enum a
                                          size_t errsize)
 {
 	return api_sandbox_import_bundle(data, len, len, 0, format, lim, arena, out, bytes, status, err, errsize);
+}
+
+enum api_result api_sandbox_build_levels(const struct api_model *m, uint32_t side, const struct api_limits *lim,
+                                         struct api_arena *arena, struct api_mesh_levels *out, size_t *bytes,
+                                         int *status, char *err, size_t errsize)
+{
+	*status = 0;
+	*bytes = 0;
+	memset(out, 0, m->mesh_count * sizeof *out);
+	/* The input: the meshes that want levels, as a model of their own (one plain material,
+	 * an instance each), in the wire format the importer answers in. */
+	struct api_model_mesh *meshes = calloc(m->mesh_count, sizeof *meshes);
+	const struct api_model_mesh **sent = calloc(m->mesh_count, sizeof *sent);
+	struct api_model_instance *inst = calloc(m->mesh_count, sizeof *inst);
+	uint32_t *which = calloc(m->mesh_count, sizeof *which), n = 0;
+	struct api_mesh_levels *got = calloc(m->mesh_count, sizeof *got);
+	struct rnd_material mat;
+	rnd_material_defaults(&mat);
+	struct api_wire_buf in = {0};
+	enum api_result rc = API_ERR;
+	if (!meshes || !sent || !inst || !which || !got) {
+		fail(status, 500, err, errsize, "out of memory building levels of detail");
+		goto out;
+	}
+	for (uint32_t i = 0; i < m->mesh_count; i++) {
+		if (!api_mesh_wants_levels(&m->meshes[i])) continue;
+		meshes[n] = m->meshes[i];
+		meshes[n].material = 0;
+		meshes[n].lods = NULL;
+		meshes[n].lod_count = 0;
+		sent[n] = &m->meshes[i];
+		rnd_mat4_identity(inst[n].model);
+		inst[n].mesh = n;
+		which[n++] = i;
+	}
+	if (!n) {
+		rc = API_OK;
+		goto out;
+	}
+	struct api_model job = {.meshes = meshes, .mesh_count = n, .instances = inst, .instance_count = n,
+	                        .materials = &mat, .material_count = 1};
+	api_wire_put_model(&in, &job);
+	if (in.failed) {
+		fail(status, 500, err, errsize, "out of memory building levels of detail");
+		goto out;
+	}
+	struct api_sbx_request rq = {.kind = API_WIRE_LEVELS, .max_pixels = 1, .input_len = in.len, .model_len = in.len,
+	                             .output_side = side};
+	uint8_t *reply;
+	const uint8_t *body;
+	size_t blen;
+	if (run_job(&rq, in.data, lim, &reply, &body, &blen, status, err, errsize) != API_OK) goto out;
+	rc = api_wire_decode_levels(body, blen, sent, n, arena, got, bytes, err, errsize);
+	free(reply);
+	if (rc != API_OK) {
+		*status = 400;
+		goto out;
+	}
+	for (uint32_t k = 0; k < n; k++) out[which[k]] = got[k];
+out:
+	api_wire_buf_release(&in);
+	free(meshes);
+	free(sent);
+	free(inst);
+	free(which);
+	free(got);
+	return rc;
 }
 
 uint8_t *api_sbx_bundle_encode(const uint8_t *model, size_t len, const struct api_model_file *files, size_t n,

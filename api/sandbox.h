@@ -61,6 +61,12 @@ enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_l
                                           enum api_model_format format, const struct api_limits *lim,
                                           struct api_arena *arena, struct api_model *out, size_t *bytes,
                                           int *status, char *err, size_t errsize);
+/* The levels of detail for images of `side` of m's meshes that want them (api/model_lod.h),
+ * built in a child under lim's import limits like an import, validated (api_wire_decode_levels)
+ * into arena: out[i] for mesh i (count 0 for the others); *bytes = what the arena holds. */
+enum api_result api_sandbox_build_levels(const struct api_model *m, uint32_t side, const struct api_limits *lim,
+                                         struct api_arena *arena, struct api_mesh_levels *out, size_t *bytes,
+                                         int *status, char *err, size_t errsize);
 /* Decodes a PNG or JPEG (at most max_pixels) into malloc'd RGBA8 (*rgba, you free it). */
 enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64_t max_pixels,
                                          const struct api_limits *lim, uint8_t **rgba, uint32_t *w, uint32_t *h,
@@ -100,7 +106,7 @@ struct api_sbx_request {
 	uint64_t input_len;     /* bytes that follow on the data socket */
 	uint64_t model_len;     /* model: the model file's bytes at the start of the input ... */
 	uint32_t file_count;    /* ... followed by this many files (api_sbx_bundle_encode) */
-	uint32_t reserved;
+	uint32_t output_side;   /* model: api_limits.output_side (api_model_finish_import) */
 };
 
 /* A model's input with the files it refers to: the model's bytes, then per file

@@ -27,6 +27,7 @@
 #include <unistd.h>
 #include <jansson.h>
 #include "model_import.h"
+#include "model_lod.h"
 #include "model_wire.h"
 #include "sandbox.h"
 
@@ -122,6 +123,19 @@ static void do_job(const struct api_sbx_request *rq, const uint8_t *in, struct a
 	struct api_arena *arena = api_arena_create();
 	struct api_model m;
 	size_t bytes;
+	if (rq->kind == API_WIRE_LEVELS) {
+		/* The meshes that want levels, as a model (api_sandbox_build_levels). */
+		enum api_wire_status st = API_WIRE_BAD_INPUT;
+		if (!arena) st = API_WIRE_OVER_MEMORY, snprintf(err, sizeof err, "out of memory");
+		else if (api_wire_decode_model(in, rq->input_len, arena, 1, &m, &bytes, err, sizeof err) == API_OK)
+			st = API_WIRE_OK;
+		for (uint32_t i = 0; st == API_WIRE_OK && i < m.mesh_count; i++)
+			api_mesh_bounds((struct api_model_mesh *)&m.meshes[i]);
+		if (st == API_WIRE_OK) api_model_build_level(&m, rq->output_side, arena, &bytes);
+		api_wire_put_header(out, API_WIRE_LEVELS, st, err);
+		if (st == API_WIRE_OK) api_wire_put_levels(out, &m);
+		return;
+	}
 	/* The model's bytes, then the files it refers to (api_sbx_bundle_encode). */
 	struct api_model_file *files = calloc(rq->file_count + 1u, sizeof *files);
 	enum api_wire_status st = API_WIRE_OVER_MEMORY;
@@ -129,7 +143,9 @@ static void do_job(const struct api_sbx_request *rq, const uint8_t *in, struct a
 	else if (api_sbx_bundle_decode(in, rq->input_len, rq->model_len, rq->file_count, files) < 0)
 		st = API_WIRE_BAD_INPUT, snprintf(err, sizeof err, "the importer's input is inconsistent");
 	else st = api_model_import_files(in, rq->model_len, files, rq->file_count, (enum api_model_format)rq->format,
-	                                 arena, &m, &bytes, err, sizeof err);
+	                                 rq->output_side, arena, &m, &bytes, err, sizeof err);
+	/* Closedness and the request's one level of detail, here under the import's limits. */
+	if (st == API_WIRE_OK) api_model_finish_import(&m, rq->output_side, arena, &bytes);
 	api_wire_put_header(out, API_WIRE_MODEL, st, err);
 	if (st == API_WIRE_OK) api_wire_put_model(out, &m);
 	/* No api_arena_destroy: the process ends right after the reply. */

@@ -40,7 +40,9 @@ struct pctx {
 	struct api_arena *arena;
 	struct api_problem *p;
 	const struct api_limits *lim;
+	struct api_limits lim_own;    /* *lim with this request's output_side (parse_root); lim points here then */
 	uint64_t asset_hash;          /* FNV-1a of every file read under the asset root */
+	struct api_import_times import;   /* the models' imports (api_scene.import) */
 	char ptr[sizeof(((struct api_problem *)0)->pointer)];
 	size_t len;
 	/* The first deferred 422 (limit or unsupported feature). */

@@ -117,8 +117,9 @@ static int model_remembered(struct pctx *c, json_t *v, const struct api_model_pa
 	    api_asset_check_path(json_string_value(v), perr, sizeof perr) != API_OK)
 		return 0;
 	uint64_t h;
-	struct api_model *m = api_model_paths_find(k, &h);
+	struct api_model *m = api_model_paths_find(k, c->lim, &h);
 	if (!m) return 0;
+	c->import.hits++;
 	api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
 	return attach_model(c, m) < 0 ? -1 : 1;
 }
@@ -178,15 +179,17 @@ int api_parse_model(struct pctx *c, json_t *j)
 	unsigned char *b = NULL;
 	size_t len = 0;
 	struct api_asset_stamp stamp;
+	double t0 = api_clock_ms();
 	rc = model_bytes(c, first, v, formats, &f, &given, &b, &len, &stamp);
 	enum api_model_format fmt = given ? (enum api_model_format)f : API_MODEL_SNIFF;
 	struct api_model_refs refs = {0};
 	if (rc == 0) rc = model_refs(c, j, first, v, b, len, fmt, &refs);
+	c->import.ms[API_IMPORT_READ] += (float)(api_clock_ms() - t0);   /* the model and the files it names */
 	struct api_model *m = NULL;
 	char err[400];
 	int status;
-	if (rc == 0 && api_model_get_files(b, len, refs.files, refs.count, fmt, c->lim, &m, &status, err, sizeof err) !=
-	    API_OK) {
+	if (rc == 0 && api_model_get_timed(b, len, refs.files, refs.count, fmt, c->lim, &m, &c->import, &status, err,
+	                                   sizeof err) != API_OK) {
 		/* 400 for a bad file, 422 over the import time/memory limit, 500 when the importer cannot run. */
 		const char *what = model_label(j, first, v);
 		if (what)
@@ -224,6 +227,10 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 	if (api_get_u32(c, root, "width", 1, RND_MAX_DIMENSION, &sc->width) < 0 ||
 	    api_get_u32(c, root, "height", 1, RND_MAX_DIMENSION, &sc->height) < 0)
 		return -1;
+	/* Models imported for this request need show no more than its images can (api.h). */
+	c->lim_own = *c->lim;
+	c->lim_own.output_side = sc->width > sc->height ? sc->width : sc->height;
+	c->lim = &c->lim_own;
 	json_t *objs = json_object_get(root, "objects");
 	if (!objs) return api_fail_at(c, "objects", "objects is required (it may be an empty array)");
 	if (!json_is_array(objs)) return api_fail_at(c, "objects", "objects must be an array, not %s", api_type_name(objs));
@@ -323,6 +330,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
+	s->import = c.import;
 	memcpy(s->warnings, c.warnings, sizeof s->warnings);
 	api_set_pixels(s);   /* again: the format's own warnings follow the document's */
 	*out = s;

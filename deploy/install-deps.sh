@@ -3,8 +3,11 @@
 # Idempotent: does nothing (and needs no root) when every package is present.
 # Usage: deploy/install-deps.sh            (make run / make test call it)
 #        deploy/install-deps.sh --no-test-tools   (no browser test tools: deploy/Dockerfile)
+#        deploy/install-deps.sh --bench   (the test tools and the benchmark's: make bench)
 # Test tools: Debian's chromium for the playground's browser test (tests/browser/, driven by
-# puppeteer-core from npm), and nodejs/npm when no node or npm is on the PATH.
+# puppeteer-core from npm), and nodejs/npm when no node or npm is on the PATH. Benchmark tools:
+# f3d under Xvfb (xvfb, xauth) and cjpeg (libjpeg-turbo-progs) for the farm benchmark
+# (tests/bench/farm_*.py): f3d brings VTK and OpenCASCADE, which `make test` does not need.
 set -eu
 
 # clang + libclang-rt-14-dev: make fuzz (libFuzzer's libclang_rt.fuzzer*.a and the sanitizer
@@ -18,6 +21,8 @@ libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev libmeshoptimizer-dev xxd
 # chromium and node for the playground's browser test, clang + libFuzzer for the fuzz targets.
 if [ "${1:-}" != "--no-test-tools" ]; then
   PKGS="$PKGS haproxy python3-yaml chromium clang libclang-rt-14-dev"
+  # make bench: f3d + Xvfb (the peer renderer of the farm benchmark), cjpeg (its JPEG textures)
+  [ "${1:-}" = "--bench" ] && PKGS="$PKGS f3d xvfb xauth libjpeg-turbo-progs"
   command -v node >/dev/null 2>&1 || PKGS="$PKGS nodejs"
   command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi

@@ -149,6 +149,7 @@ static void need_in_view(const struct rnd_scene *sc, const float vp[16], float w
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		const struct rnd_object *o = &sc->objects[i];
 		if ((!is_round(o) && !has_levels(o)) || (casters_only && !o->cast_shadows)) continue;
+		if (has_levels(o) && mesh_err <= 0.0f) continue;
 		float c[3], bound, scale;
 		object_sphere(o, c, &bound, &scale);
 		float pw = rnd_lod_pixel_world(vp, w, h, c, bound, near_w);
@@ -274,6 +275,7 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 			const struct umbra_shadow_view *sv = &scratch->views[k];
 			float res = (float)scratch->lights[scratch->view_light[k]].resolution;
 			bool persp = sv->params[1] > 0.5f;
+			/* Meshes keep the camera's level (mesh_err 0): see RND_LOD_MESH_TEXEL_ERROR. */
 			need_in_view(sc, (const float *)&sv->view_proj, res, res, persp ? sv->params[2] : 0.0f, RND_LOD_TEXEL_ERROR,
 			             RND_LOD_MESH_TEXEL_ERROR, true, segments);
 		}

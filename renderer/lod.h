@@ -11,7 +11,7 @@
  * Asking for more segments than the output can show costs time and changes nothing visible;
  * asking for fewer is honoured exactly. A mesh with simplified levels (rnd_object.lods, built
  * for imported models by api/model_lod.c) is drawn with the coarsest level whose measured error
- * stays within RND_LOD_MESH_PIXEL_ERROR / RND_LOD_MESH_TEXEL_ERROR. Boxes, planes and other
+ * stays within RND_LOD_MESH_PIXEL_ERROR in every view (the shadow passes draw that level too). Boxes, planes and other
  * meshes are not touched.
  *
  * Usage: render.c calls rnd_lod_choose() before tessellating; the rest are the pure pieces it
@@ -36,7 +36,12 @@
  * STL sphere in a 512-pixel thumbnail (edge error against a 4x4-supersampled full render): full
  * 0.0066, 1/4 pixel 0.0066 (no level fits), 1/2 pixel 0.0087, 1 pixel 0.0107. */
 #define RND_LOD_MESH_PIXEL_ERROR 0.5f
-#define RND_LOD_MESH_TEXEL_ERROR 0.5f
+/* No bound of its own in the shadow maps (0): a mesh casts with the level the cameras chose. A
+ * caster's error moves its shadow's edge by about as much, which the camera sees at its own
+ * pixel scale, and one level in every pass keeps a mesh's shadow on itself consistent. Half a
+ * texel of the 2048^2 map had a 100k-triangle model drawn in full in a 256^2 thumbnail (main
+ * pass 290 ms against 22 with the camera's level). */
+#define RND_LOD_MESH_TEXEL_ERROR 0.0f
 
 /* Fewest segments (even, >= 4) for a circle of radius `radius` whose centred chords deviate at
  * most `max_error` (same units) from it; UINT32_MAX when max_error <= 0 or radius is not finite. */

@@ -88,6 +88,18 @@ static void downsample(const uint8_t *src, uint32_t sw, uint32_t sh, uint8_t *ds
 	}
 }
 
+void rnd_texture_reduce(uint8_t *rgba, uint32_t *w, uint32_t *h, bool srgb, uint32_t levels)
+{
+	if (srgb && levels) pthread_once(&tables_once, tables_once_init);
+	/* in place: a texel is written at or before where its box is read */
+	for (; levels && (*w > 1 || *h > 1); levels--) {
+		uint32_t dw = half(*w), dh = half(*h);
+		downsample(rgba, *w, *h, rgba, dw, dh, srgb ? &tables : NULL);
+		*w = dw;
+		*h = dh;
+	}
+}
+
 void rnd_texture_build_chain(const uint8_t *rgba, uint32_t w, uint32_t h, bool srgb, uint8_t *out)
 {
 	if (srgb) pthread_once(&tables_once, tables_once_init);

@@ -30,6 +30,10 @@ struct job_result {
 	char out[PATH_MAX];
 	char error[640];
 	char warnings[1024];      /* api_scene.warnings of a rendered model, "" = none */
+	/* where an `ok` job's time went (the report's "stages") */
+	struct api_import_times imp;
+	struct rnd_timings tm;
+	double parse_ms, encode_ms;
 };
 
 struct farm {
@@ -235,12 +239,16 @@ static enum job_status run_job(struct farm *f, size_t i)
 {
 	struct job_result *r = &f->res[i];
 	struct api_scene *s = NULL;
+	double t0 = farm_now_ms();
 	enum job_status st = job_scene(f, i, &s);
 	if (st != JOB_OK) return st;
+	r->parse_ms = farm_now_ms() - t0;
+	r->imp = s->import;
 	struct rnd_image img = {0};
 	struct rnd_timings tm;
 	struct rnd_error err;
 	enum rnd_result rr = rnd_render(f->ctx, &s->scene, &img, &tm, &err);
+	r->tm = tm;
 	if (rr != RND_OK) {
 		bool fault = rr == RND_ERR_INVALID || rr == RND_ERR_LIMIT;
 		if (fault) {
@@ -258,7 +266,10 @@ static enum job_status run_job(struct farm *f, size_t i)
 	size_t n = 0;
 	struct api_problem prob;
 	st = JOB_FAILED;
-	if (api_encode(s, &img, &bytes, &n, &prob) != API_OK) api_problem_format(&prob, r->error, sizeof r->error);
+	double t1 = farm_now_ms();
+	enum api_result enc = api_encode(s, &img, &bytes, &n, &prob);
+	r->encode_ms = farm_now_ms() - t1;
+	if (enc != API_OK) api_problem_format(&prob, r->error, sizeof r->error);
 	else if (write_file(r->out, bytes, n, r->error, sizeof r->error) == 0) st = JOB_OK;
 	free(bytes);
 	rnd_image_release(&img);
@@ -320,6 +331,19 @@ static void json_str(FILE *fp, const char *s)
 	free(e);
 }
 
+/* An ok job's stages in ms, named as in umbrad's Server-Timing (parse: what parsing spent
+ * besides the models' stages; writing the file is the rest of "ms"). */
+static void write_stages(FILE *fp, const struct job_result *r)
+{
+	double in_models = 0;
+	for (int k = 0; k < API_IMPORT_STAGES; k++) in_models += r->imp.ms[k];
+	fprintf(fp, ",\"stages\":{\"parse\":%.2f", r->parse_ms > in_models ? r->parse_ms - in_models : 0.0);
+	if (r->imp.imports || r->imp.ms[API_IMPORT_READ] > 0)
+		for (int k = 0; k < API_IMPORT_STAGES; k++) fprintf(fp, ",\"%s\":%.2f", API_IMPORT_STAGE_NAMES[k], (double)r->imp.ms[k]);
+	fprintf(fp, ",\"upload\":%.2f,\"shadow\":%.2f,\"main\":%.2f,\"readback\":%.2f,\"encode\":%.2f}", r->tm.upload_ms,
+	        r->tm.shadow_ms, r->tm.main_ms, r->tm.readback_ms, r->encode_ms);
+}
+
 static int write_report(const struct farm *f, const char *path)
 {
 	FILE *fp = fopen(path, "w");
@@ -340,6 +364,7 @@ static int write_report(const struct farm *f, const char *path)
 		fputs(",\"warnings\":", fp);   /* what of a model's material is not drawn (Umbra-Warnings) */
 		if (r->warnings[0]) json_str(fp, r->warnings);
 		else fputs("null", fp);
+		if (r->status == JOB_OK) write_stages(fp, r);
 		fputs("}\n", fp);
 	}
 	return fclose(fp) == 0 ? 0 : -1;

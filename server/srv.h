@@ -172,7 +172,7 @@ struct srv_request {
 	uint8_t *out;                  /* malloc'd answer body */
 	size_t out_len;
 	const char *content_type;
-	char server_timing[320];
+	char server_timing[640];
 	char warnings[1024];           /* api_scene.warnings, sent as Umbra-Warnings on a 200; "" = none */
 	/* the problem answered (4xx/5xx), for the access log */
 	char problem_pointer[256];

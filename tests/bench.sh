@@ -3,8 +3,10 @@
 # warm-process medians per stage for the bench scenes, the generated 100k / 1M triangle meshes,
 # the cold CLI and the HTTP benchmark, then the ratio table of issue 12 (tests/bench/ratios.py).
 # Env: BUILD, SHARED; BENCH_ONLY=ratios runs only what the ratio table needs, with fewer runs
-# (`make bench-quick`). BENCH_BEFORE=DIR (the build folder of an older checkout) also runs that
-# build's bench and CLI in the same run and prints its ratio table first ("before").
+# (`make bench-quick`); BENCH_ONLY=farm only the farm benchmark on new models (`make bench-farm`:
+# tests/bench/farm_bench.py on the corpus of tests/bench/farm_corpus.py). BENCH_BEFORE=DIR (the
+# build folder of an older checkout) also runs that build's bench and CLI in the same run and
+# prints its ratio table first ("before").
 # Numbers go to stdout; nothing here asserts a time.
 set -eu
 BUILD=${BUILD:-build}
@@ -17,6 +19,27 @@ tmp=$(mktemp -d)
 log=$tmp/log
 mkdir -p "$log"
 trap 'rm -rf "$tmp"' EXIT
+
+# The farm on models it has never seen (issue 28): farm CLI, umbrad at 4 clients, f3d. The corpus
+# (~140 MB, ~10-15 s to write) is kept in $BUILD/bench-corpus/<hash of farm_corpus.py>/, so a
+# changed generator writes a new one and the old one is removed.
+farm_models() {
+	echo "== farm: new models (tests/bench/farm_bench.py: models never imported before, 10k/100k/1M triangles)"
+	key=$(sha256sum tests/bench/farm_corpus.py | cut -c1-12)
+	corpus=$BUILD/bench-corpus/$key
+	if [ ! -s "$corpus/manifest.json" ]; then
+		rm -rf "$BUILD/bench-corpus"
+		mkdir -p "$BUILD/bench-corpus"
+		python3 tests/bench/farm_corpus.py "$corpus.tmp" 2>"$tmp/corpus.log" ||
+			{ cat "$tmp/corpus.log" >&2; exit 1; }
+		mv "$corpus.tmp" "$corpus"
+	fi
+	python3 tests/bench/farm_bench.py "$BUILD" "$corpus"
+}
+if [ "${BENCH_ONLY:-}" = farm ]; then
+	farm_models
+	exit 0
+fi
 python3 tests/bench/variants.py "$SHARED/bench" "$tmp/v"
 
 # Side by side: rounds of the floor, then umbra's thumbnails (and the older build's), so that
@@ -72,6 +95,8 @@ if [ $QUICK = 0 ]; then
 	echo
 	echo "== model import isolation: the same STL imported cold in-process and in the sandbox (api/sandbox.h)"
 	"$BUILD/tests/import_bench" -n "${BENCH_RUNS_SMALL:-7}" 1000 100000
+	echo
+	farm_models
 fi
 echo
 echo "== cold CLI (new process each: device + pipelines + first-use JIT), thumb-512: PNG, and EXR with the shadow AOV"

@@ -103,26 +103,46 @@ static bool write_sphere_stl(const char *path, int seg)
 	return fclose(f) == 0 && ok;
 }
 
-static bool render_model(struct rnd_image *img, const char *root, bool exact)
+static const char *const MODEL_DOC =
+	"{\"width\": 256, \"height\": 256, \"camera\": {\"fit\": \"objects\", \"direction\": [-1, -0.6, -1], \"margin\": 0.1},"
+	" \"objects\": [{\"shape\": \"plane\", \"size\": [20, 20], \"transform\": {\"translation\": [0, -1, 0]}},"
+	" {\"shape\": \"model\", \"path\": \"sphere.stl\"}],"
+	" \"lights\": [{\"type\": \"directional\", \"direction\": [-0.5, -1, -0.3]}]}";
+
+static struct api_scene *parse_model(const char *root)
 {
-	static const char *doc =
-		"{\"width\": 256, \"height\": 256, \"camera\": {\"fit\": \"objects\", \"direction\": [-1, -0.6, -1], \"margin\": 0.1},"
-		" \"objects\": [{\"shape\": \"plane\", \"size\": [20, 20], \"transform\": {\"translation\": [0, -1, 0]}},"
-		" {\"shape\": \"model\", \"path\": \"sphere.stl\"}],"
-		" \"lights\": [{\"type\": \"directional\", \"direction\": [-0.5, -1, -0.3]}]}";
 	struct api_limits lim;
 	api_limits_defaults(&lim);
 	lim.asset_root = root;
 	struct api_scene *s = NULL;
 	struct api_problem p;
+	if (api_scene_parse(MODEL_DOC, strlen(MODEL_DOC), &lim, &s, &p) != API_OK) {
+		CHECK(0, "parse: %s %s", p.pointer, p.detail);
+		return NULL;
+	}
+	return s;
+}
+
+/* A new model's first render already has the one level its size needs (built at import, in
+ * the sandbox: api/model_lod.h). */
+static bool model_has_level(const char *root)
+{
+	struct api_scene *s = parse_model(root);
+	if (!s) return false;
+	CHECK(s->scene.object_count == 2 && s->scene.objects[1].lod_count == 1 && s->scene.objects[1].closed,
+	      "a new 45k-triangle model: the import's one level at its first render, closed");
+	api_scene_free(s);
+	return true;
+}
+
+static bool render_model(struct rnd_image *img, const char *root, bool exact)
+{
 	memset(img, 0, sizeof *img);
 	if (!gpu_ctx()) { CHECK(0, "no context"); return false; }
-	if (api_scene_parse(doc, strlen(doc), &lim, &s, &p) != API_OK) {
-		CHECK(0, "parse: %s %s", p.pointer, p.detail);
-		return false;
-	}
-	CHECK(s->scene.object_count == 2 && s->scene.objects[1].lod_count > 0 && s->scene.objects[1].closed,
-	      "the 45k-triangle sphere has levels and is closed");
+	struct api_scene *s = parse_model(root);
+	if (!s) return false;
+	CHECK(s->scene.object_count == 2 && s->scene.objects[1].lod_count == 1 && s->scene.objects[1].closed,
+	      "the 45k-triangle sphere has its level and is closed");
 	s->scene.exact_segments = exact;
 	struct rnd_timings t;
 	struct rnd_error err = {0};
@@ -144,7 +164,7 @@ TEST(lod_model_level_within_bound_of_full_mesh)
 	snprintf(path, sizeof path, "%s/sphere.stl", dir);
 	REQUIRE(write_sphere_stl(path, 150), "writing %s", path);
 	struct rnd_image lod, full;
-	bool ok = render_model(&lod, dir, false);
+	bool ok = model_has_level(dir) && render_model(&lod, dir, false);
 	if (ok && !render_model(&full, dir, true)) { rnd_image_release(&lod); ok = false; }
 	remove(path);
 	rmdir(dir);

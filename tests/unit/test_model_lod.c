@@ -1,8 +1,8 @@
 /* tests — api/model_lod.c (meshoptimizer levels of imported meshes) and the renderer's choice
  * of a level (renderer/lod.c): a flat-shaded UV sphere (every facet its own vertices, as an STL
- * arrives) gets levels of fewer and fewer triangles whose claimed error bounds how far their
- * surface is from the sphere, with outward unit normals; the level chosen for a pixel size is
- * the coarsest whose error fits. */
+ * arrives) gets, for smaller and smaller images, levels of fewer and fewer triangles whose
+ * claimed error bounds how far their surface is from the sphere, with outward unit normals; the
+ * level chosen for a pixel size is the coarsest whose error fits. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,16 +44,26 @@ static void flat_sphere(int seg, float **pos, float **nrm, uint32_t **idx, uint3
 		}
 }
 
-/* Builds the levels of the one mesh me; returns the arena holding them (the caller destroys
- * it) and the bytes charged for them. */
-static struct api_arena *build_levels(struct api_model_mesh *me, size_t *bytes)
+/* The levels of the one mesh me for images of 1024, 256, 64 and 16 pixels, finest first, as
+ * me->lods (at most 4, in `keep`); returns the arena holding them (the caller destroys it) and
+ * the bytes charged for them. */
+static struct api_arena *build_levels(struct api_model_mesh *me, struct rnd_mesh_lod keep[4], size_t *bytes)
 {
 	struct api_model m = {0};
 	m.meshes = me;
 	m.mesh_count = 1;
 	struct api_arena *a = api_arena_create();
 	*bytes = 0;
-	api_model_build_lods(&m, a, bytes);
+	uint32_t n = 0;
+	static const uint32_t sides[4] = {1024, 256, 64, 16};
+	for (int k = 0; k < 4; k++) {
+		me->lods = NULL;
+		me->lod_count = 0;
+		api_model_build_level(&m, sides[k], a, bytes);
+		if (me->lod_count) keep[n++] = me->lods[0];
+	}
+	me->lods = keep;
+	me->lod_count = n;
 	return a;
 }
 
@@ -64,7 +74,8 @@ TEST(model_lod_levels_of_flat_sphere_keep_their_error)
 	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni); /* 51,200 triangles */
 	struct api_model_mesh me = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
 	size_t bytes;
-	struct api_arena *a = build_levels(&me, &bytes);
+	struct rnd_mesh_lod keep[4];
+	struct api_arena *a = build_levels(&me, keep, &bytes);
 	REQUIRE(me.lod_count >= 3, "levels: %u", me.lod_count);
 	CHECK(bytes > 0, "the cache is charged for the levels");
 	uint32_t prev_tris = ni / 3;
@@ -137,7 +148,8 @@ TEST(model_lod_error_ignores_a_part_close_by)
 	struct api_model_mesh me = {.positions = p, .normals = n, .indices = x, .vertex_count = nv + nv2,
 	                            .index_count = ni + ni2};
 	size_t bytes;
-	struct api_arena *a = build_levels(&me, &bytes);
+	struct rnd_mesh_lod keep[4];
+	struct api_arena *a = build_levels(&me, keep, &bytes);
 	REQUIRE(me.lod_count >= 2, "levels: %u", me.lod_count);
 	/* each level's triangles against the two spheres: its claimed error is not far above that */
 	for (uint32_t l = 0; l < 2; l++) {
@@ -171,7 +183,7 @@ TEST(model_lod_small_meshes_get_no_levels)
 	m.mesh_count = 1;
 	struct api_arena *a = api_arena_create();
 	size_t bytes = 0;
-	api_model_build_lods(&m, a, &bytes);
+	api_model_build_level(&m, 64, a, &bytes);
 	CHECK(me.lod_count == 0 && bytes == 0, "%u levels", me.lod_count);
 	api_arena_destroy(a);
 	free(pos); free(nrm); free(idx);
@@ -228,8 +240,8 @@ TEST(model_mesh_closed_needs_watertight_outward_winding)
 	m.mesh_count = 1;
 	struct api_arena *a = api_arena_create();
 	size_t bytes = 0;
-	api_model_build_lods(&m, a, &bytes);
-	CHECK(me.closed, "welded flat sphere is closed");
+	api_model_finish_import(&m, 0, a, &bytes);
 	api_arena_destroy(a);
+	CHECK(me.closed, "welded flat sphere is closed");
 	free(p); free(n); free(idx);
 }

@@ -3,12 +3,16 @@
  * for STL (it searched a 1M-triangle file for ~1 s and found next to nothing); umbra joins the
  * corners itself, normals compared to within 2^-14: two coplanar facets of a tilted plane get
  * normals that differ in their last bits. */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "api.h"
+#include "arena.h"
 #include "model.h"
+#include "model_import.h"
+#include "models.h"
 #include "test.h"
 
 /* A binary STL of `n` facets (corners tri[t][0..2], normals left zero) into out. */
@@ -81,4 +85,56 @@ TEST(stl_joins_coplanar_facets_of_a_tilted_plane)
 	CHECK(me->vertex_count == 4, "%u vertices for a quad of two facets", me->vertex_count);
 	corners_kept(me, (const float (*)[3][3])tri, 2);
 	api_model_release(m);
+}
+
+/* The reader without Assimp (api/stl_import.c) makes the model the Assimp path made: the same
+ * vertices (positions bit for bit, normals to float rounding), the same indices, one mesh and
+ * instance, the default material. */
+TEST(stl_binary_reader_matches_the_assimp_path)
+{
+	size_t len;
+	uint8_t *d = test_bumpy_stl(48, &len);
+	REQUIRE(d != NULL);
+	struct api_arena *a = api_arena_create(), *b = api_arena_create();
+	struct api_model fast, slow;
+	size_t fb, sb;
+	char err[300];
+	REQUIRE(api_model_import_files(d, len, NULL, 0, API_MODEL_STL, 0, a, &fast, &fb, err, sizeof err) == API_WIRE_OK, "%s", err);
+	REQUIRE(api_model_import_assimp(d, len, NULL, 0, API_MODEL_STL, 0, b, &slow, &sb, err, sizeof err) == API_WIRE_OK, "%s", err);
+	REQUIRE(fast.mesh_count == 1 && slow.mesh_count == 1 && fast.instance_count == 1 && slow.instance_count == 1);
+	const struct api_model_mesh *f = &fast.meshes[0], *s = &slow.meshes[0];
+	CHECK(fast.triangles == slow.triangles && f->vertex_count == s->vertex_count && f->index_count == s->index_count,
+	      "%u/%u vertices, %u/%u indices", f->vertex_count, s->vertex_count, f->index_count, s->index_count);
+	CHECK(!f->uvs && !f->colors && !f->tangents && !s->uvs && !s->colors && !s->tangents);
+	if (f->vertex_count == s->vertex_count && f->index_count == s->index_count) {
+		CHECK(!memcmp(f->positions, s->positions, (size_t)f->vertex_count * 12), "positions");
+		CHECK(!memcmp(f->indices, s->indices, (size_t)f->index_count * 4), "indices");
+		float worst = 0;
+		for (size_t k = 0; k < 3 * (size_t)f->vertex_count; k++) worst = fmaxf(worst, fabsf(f->normals[k] - s->normals[k]));
+		CHECK(worst < 1e-6f, "normals differ by %g", worst);
+	}
+	CHECK(!memcmp(fast.instances[0].model, slow.instances[0].model, 64), "identity instance");
+	CHECK(!memcmp(&fast.materials[0], &slow.materials[0], sizeof fast.materials[0]), "default material");
+	api_arena_destroy(a);
+	api_arena_destroy(b);
+	free(d);
+}
+
+/* Colours stay Assimp's: a facet with bit 15 of its attribute set (VisCAM / SolidView colour)
+ * comes back with vertex colours, through the Assimp path. */
+TEST(stl_binary_reader_leaves_colours_to_assimp)
+{
+	size_t len;
+	uint8_t *d = test_bumpy_stl(8, &len);
+	REQUIRE(d != NULL);
+	uint16_t red = 0x8000 | 31;   /* valid bit, 5 bits of red */
+	memcpy(d + 84 + 48, &red, 2);
+	struct api_arena *a = api_arena_create();
+	struct api_model m;
+	size_t bytes;
+	char err[300];
+	REQUIRE(api_model_import_files(d, len, NULL, 0, API_MODEL_STL, 0, a, &m, &bytes, err, sizeof err) == API_WIRE_OK, "%s", err);
+	CHECK(m.mesh_count == 1 && m.meshes[0].colors != NULL, "the coloured facet's colours are kept");
+	api_arena_destroy(a);
+	free(d);
 }

@@ -1,4 +1,5 @@
 /* tests/util/models.c — see models.h. */
+#include <math.h>
 #include <png.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,3 +64,28 @@ uint8_t *test_glb_pack(const char *json, size_t jn, const uint8_t *bin, size_t b
 	*len = total;
 	return g;
 }
+
+uint8_t *test_bumpy_stl(int seg, size_t *len)
+{
+	uint32_t n = 2u * (uint32_t)seg * (uint32_t)seg;
+	uint8_t *d = calloc(1, 84 + 50 * (size_t)n);
+	if (!d) return NULL;
+	memcpy(d, "solid but binary", 16);
+	memcpy(d + 80, &n, 4);
+	uint32_t t = 0;
+	for (int i = 0; i < seg; i++)
+		for (int j = 0; j < seg; j++) {
+			float q[4][3];
+			for (int c = 0; c < 4; c++) {
+				double th = 3.14159265358979 * (i + (c >> 1)) / seg, ph = 6.28318530717959 * (j + (c & 1)) / seg;
+				double r = 1.0 + 0.05 * sin(5 * th) * cos(3 * ph) + (ph > 3.0 && ph < 6.0 ? 0.1 : 0.0);
+				q[c][0] = (float)(r * sin(th) * cos(ph)); q[c][1] = (float)(r * cos(th)); q[c][2] = (float)(r * sin(th) * sin(ph));
+			}
+			static const int tri[2][3] = {{0, 1, 2}, {1, 3, 2}};   /* wound outward */
+			for (int k = 0; k < 2; k++, t++)
+				for (int c = 0; c < 3; c++) memcpy(d + 84 + 50 * (size_t)t + 12 + 12 * c, q[tri[k][c]], 12);
+		}
+	*len = 84 + 50 * (size_t)n;
+	return d;
+}
+

@@ -17,6 +17,10 @@ uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len);
 /* Binary .stl of the tetrahedron with the given 4 vertices into out (84 + 4*50 = 284 bytes);
  * facet normals 0 (the importer recomputes them). Returns the size. */
 size_t test_tetra_stl(uint8_t *out, const float p[4][3]);
+/* A binary STL of a bumpy, flat-shaded sphere of 2 seg^2 facets (outward winding, degenerate
+ * facets at its poles, a step in its radius: what real files look like to the readers);
+ * NULL when out of memory. */
+uint8_t *test_bumpy_stl(int seg, size_t *len);
 /* A .glb: the JSON chunk (padded with spaces) and the binary chunk (bin[0..binlen), padded with
  * zeros to binpad, which the JSON's buffer byteLength must state). NULL when out of memory. */
 uint8_t *test_glb_pack(const char *json, size_t json_len, const uint8_t *bin, size_t binlen, size_t binpad,

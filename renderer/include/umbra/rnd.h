@@ -107,6 +107,9 @@ uint64_t rnd_texture_chain_bytes(uint32_t w, uint32_t h);
  * folds into its neighbour's box), in linear light when srgb (alpha is always linear). Pure;
  * any thread. */
 void rnd_texture_build_chain(const uint8_t *rgba, uint32_t w, uint32_t h, bool srgb, uint8_t *out);
+/* rgba (*w x *h) replaced, in place, by level `levels` of that chain (the same bytes), its size
+ * in *w x *h: a texture decoded smaller than stored (api/image_decode.c). Pure; any thread. */
+void rnd_texture_reduce(uint8_t *rgba, uint32_t *w, uint32_t *h, bool srgb, uint32_t levels);
 
 struct rnd_material {
 	float base_color[4];  /* linear RGBA, default 0.8 0.8 0.8 1 */
