@@ -38,6 +38,7 @@
 #include "model_io.h"
 #include "model_lod.h"
 #include "ply_strips.h"
+#include "remap.h"
 #include "stl_import.h"
 #include "umbra/rnd_math.h"
 
@@ -219,8 +220,12 @@ uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, ui
 		}
 		if (col) memcpy(key[v].col, col + 4 * (size_t)v, 4);
 	}
-	uint32_t unique = (uint32_t)meshopt_generateVertexRemap(remap, NULL, nv, key, nv, sizeof *key);
+	size_t unique = api_remap_keys(key, nv, sizeof *key, remap);
 	free(key);
+	if (unique == SIZE_MAX) {
+		free(remap);
+		return nv;
+	}
 	/* new ids follow first occurrences: remap[v] <= v, so moving down in order is safe */
 	for (uint32_t v = 0; v < nv; v++)
 		if (remap[v] != v) {
@@ -230,7 +235,7 @@ uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, ui
 		}
 	meshopt_remapIndexBuffer(idx, idx, ni, remap);
 	free(remap);
-	return unique;
+	return (uint32_t)unique;
 }
 
 static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "model_lod.h"
+#include "remap.h"
 #include "umbra/rnd_math.h"
 
 /* A mesh welded by position: what the simplifier works on. meshoptimizer treats vertices at
@@ -31,6 +32,33 @@ struct welded {
 	uint32_t *rep;        /* the first original vertex of each (for uvs, and which side is out) */
 	size_t count;
 };
+
+/* meshopt_generateVertexRemap(remap, idx, ni, keys, nv, 12), through api_remap_keys (its
+ * hashing was most of a 1M-triangle import): the vertices idx refers to, one number for equal
+ * keys, numbered in the order idx first meets them; ~0u for the others. SIZE_MAX without
+ * memory. */
+static size_t index_order_remap(const int32_t *keys, uint32_t nv, const uint32_t *idx, uint32_t ni, unsigned int *remap)
+{
+	uint32_t *group = malloc((size_t)nv * sizeof *group), *first = NULL;
+	size_t groups = group ? api_remap_keys(keys, nv, 12, group) : SIZE_MAX;
+	if (groups != SIZE_MAX && !(first = malloc((groups ? groups : 1) * sizeof *first))) groups = SIZE_MAX;
+	if (groups == SIZE_MAX) {
+		free(group);
+		return SIZE_MAX;
+	}
+	memset(first, 0xff, groups * sizeof *first);
+	memset(remap, 0xff, (size_t)nv * sizeof *remap);
+	size_t count = 0;
+	for (uint32_t i = 0; i < ni; i++) {
+		uint32_t v = idx[i];
+		if (remap[v] != ~0u) continue;
+		if (first[group[v]] == ~0u) first[group[v]] = (uint32_t)count++;
+		remap[v] = first[group[v]];
+	}
+	free(group);
+	free(first);
+	return count;
+}
 
 static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *w)
 {
@@ -48,8 +76,9 @@ static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *
 	for (uint32_t v = 0; v < me->vertex_count; v++)
 		for (int k = 0; k < 3; k++)
 			q[3 * (size_t)v + (size_t)k] = (int32_t)lrintf((me->positions[3 * (size_t)v + (size_t)k] - lo[k]) / unit);
-	w->count = meshopt_generateVertexRemap(remap, me->indices, me->index_count, q, me->vertex_count, 12);
+	w->count = index_order_remap(q, me->vertex_count, me->indices, me->index_count, remap);
 	free(q);
+	if (w->count == SIZE_MAX) { free(remap); w->count = 0; return false; }
 	w->pos = malloc(w->count * 12);
 	w->rep = malloc(w->count * sizeof *w->rep);
 	if (!w->pos || !w->rep) { free(remap); return false; }

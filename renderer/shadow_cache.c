@@ -329,6 +329,15 @@ enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cach
 	return r;
 }
 
+/* Texels of the completed maps the cache keeps. */
+static uint64_t kept_texels(const struct rnd_shadow_cache *c)
+{
+	uint64_t t = 0;
+	for (uint32_t i = 0; i < MAX_ENTRIES; i++)
+		if (c->entries[i].live && c->entries[i].valid) t += (uint64_t)c->entries[i].ntiles * c->entries[i].res * c->entries[i].res;
+	return t;
+}
+
 void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g, uint32_t n, bool ok)
 {
 	struct rnd_shadow_cache *c = ctx->cache;
@@ -346,6 +355,8 @@ void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g,
 		if (!e->key || !ok || dup) { if (!e->refs) entry_free(c, e); }
 		else e->valid = true;
 	}
+	uint64_t cap = ctx->desc.shadow_cache_texels ? ctx->desc.shadow_cache_texels : RND_DEFAULT_SHADOW_CACHE_TEXELS;
+	while (kept_texels(c) > cap && evict_one(c)) {}
 	pthread_cond_broadcast(&c->released);
 	pthread_mutex_unlock(&c->mu);
 }

@@ -39,7 +39,7 @@ static const struct opt_def opts[] = {
 	{ "max-shadow-resolution", OPT_UINT, "N", "largest shadow map side, asked for or chosen by the renderer, 0 = no limit (8192)", LIM(max_shadow_resolution), 0, UINT32_MAX },
 	{ "deadline-ms", OPT_UINT, "MS", "answer 504 past this time from queueing, 0 = none (30000)", CFG(deadline_ms), 0, UINT32_MAX },
 	{ "asset-root", OPT_STR, "DIR", "directory that models' `path` is relative to (none: `path` is a 400)", CFG(asset_root), 0, 0 },
-	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (256M)", CFG(model_cache_bytes), 0, UINT64_MAX },
+	{ "model-cache", OPT_SIZE, "BYTES", "cache of imported models, 0 = off (64M)", CFG(model_cache_bytes), 0, UINT64_MAX },
 	{ "import-timeout-ms", OPT_UINT, "MS", "wall-clock and CPU limit of one sandboxed model import (10000)", LIM(import_timeout_ms), 1, 3600000 },
 	{ "import-memory", OPT_SIZE, "BYTES", "memory limit of one sandboxed model import, 0 = none (2G)", LIM(import_memory), 0, UINT64_MAX },
 	{ "max-textures", OPT_UINT, "N", "distinct textures in one scene, capped by the device's limit (256)", LIM(max_textures), 1, 1000000 },
@@ -211,7 +211,7 @@ static void set_defaults(struct srv_config *cfg)
 	cfg->atlas_size = 8192;
 	cfg->max_body = 64ull << 20;
 	api_limits_defaults(&cfg->limits);
-	cfg->model_cache_bytes = 256u << 20;
+	cfg->model_cache_bytes = 64u << 20;   /* the process stays small (issue 28); more for repeated big models */
 	cfg->deadline_ms = 30000;
 	cfg->log_format = SRV_LOG_TEXT;
 	cfg->max_connections = 1024;

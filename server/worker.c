@@ -364,10 +364,11 @@ static void job_render_stages(struct srv_server *s, const struct rnd_timings *t)
 
 /* Server-Timing: every stage of the request, the models' imports among them (api.h,
  * api_import_stage: only with a model read or imported), `parse` what is left of parsing (the
- * JSON, the checks, the cache look-ups), so that the stages add up to all but the gaps between
+ * JSON, the checks, the cache look-ups), `device-wait` the wait for the device (one render at a
+ * time on a CPU device: server/gate.h), so that the stages add up to all but the gaps between
  * them. */
 static void format_timing(struct srv_request *req, const struct api_scene *sc, const struct rnd_timings *t,
-                          double queue_ms, double parse_ms, double encode_ms, double total_ms)
+                          double queue_ms, double parse_ms, double gate_ms, double encode_ms, double total_ms)
 {
 	char models[400] = "";
 	size_t n = 0;
@@ -380,9 +381,9 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 			if (w > 0) n += (size_t)w;
 		}
 	snprintf(req->server_timing, sizeof req->server_timing,
-	         "queue;dur=%.3f, parse;dur=%.3f%s, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
+	         "queue;dur=%.3f, parse;dur=%.3f%s, device-wait;dur=%.3f, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
 	         "readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
-	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, t->upload_ms, t->shadow_ms,
+	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, gate_ms, t->upload_ms, t->shadow_ms,
 	         t->main_ms, t->readback_ms, encode_ms, total_ms);
 }
 
@@ -427,11 +428,13 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	}
 	/* One render at a time on a CPU device (server/gate.h); parse and encode stay parallel. */
 	struct srv_gate_waiter gw;
+	double t_gate = srv_now();
 	if (!srv_gate_enter(&s->gate, &gw, req->t_queued,
 	                    s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0)) {
 		job_deadline(s, req, "while waiting for the device", srv_now());
 		goto out;
 	}
+	double gate_ms = (srv_now() - t_gate) * 1000.0;
 	enum rnd_result r = srv_render(s, &sc->scene, &img, &t, &err, &lost_gen);
 	srv_gate_leave(&s->gate);
 	if (r != RND_OK) {
@@ -458,7 +461,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	req->out = bytes;
 	req->out_len = len;
 	req->content_type = api_format_mime(sc->format);
-	format_timing(req, sc, &t, (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, encode_s * 1000.0,
+	format_timing(req, sc, &t, (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, gate_ms, encode_s * 1000.0,
 	              (t3 - req->t_queued) * 1000.0);
 out:
 	rnd_image_release(&img);

@@ -396,11 +396,20 @@ struct rnd_context_desc {
 	uint32_t slots;            /* concurrent renders (render slots); 0 = 1 */
 	uint32_t max_width, max_height; /* 0 = 8192 */
 	uint32_t atlas_size;       /* texels per side of the shadow atlases (power of two), 0 = 4096 */
+	/* Texels of cached shadow maps kept between renders; past it the least recently used go
+	 * after each render (tiles are handed out first-fit, so the atlas pages a process touches,
+	 * and its memory, stay near this). 0 = RND_DEFAULT_SHADOW_CACHE_TEXELS. */
+	uint64_t shadow_cache_texels;
 	/* Distinct textures one scene may use; 0 = RND_DEFAULT_MAX_TEXTURES. Capped by the device
 	 * (rnd_info.max_textures says what was granted); each slot holds a descriptor set per texture. */
 	uint32_t max_textures;
 	rnd_log_fn log; void *log_user;
 };
+
+/* Four 2048^2 maps (64 MiB of D32): a thumbnail farm sends new casters every request and kept
+ * every new model's sun map (37 maps, ~160 MB resident after 30 models); a repeated scene keeps
+ * its own (thumb-512 one 2048^2 map, studio-spots 17 smaller ones). */
+#define RND_DEFAULT_SHADOW_CACHE_TEXELS (4ull * 2048 * 2048)
 
 struct rnd_info {
 	char device_name[256];
