@@ -426,7 +426,7 @@ uint64_t api_model_serial(const struct api_model *pub)
 	return ((const struct model_priv *)pub->priv_)->serial;
 }
 
-struct api_model *api_model_cache_take(uint64_t serial, const struct api_limits *lim)
+struct api_model *api_model_cache_take(uint64_t serial)
 {
 	struct model_priv *hit = NULL;
 	pthread_mutex_lock(&cache_mu);
@@ -439,7 +439,6 @@ struct api_model *api_model_cache_take(uint64_t serial, const struct api_limits 
 		atomic_fetch_add(&hit->refs, 1);
 	}
 	pthread_mutex_unlock(&cache_mu);
-	if (hit) api_levels_on_hit(&hit->pub, lim);
 	return hit ? &hit->pub : NULL;
 }
 

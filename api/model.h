@@ -127,7 +127,7 @@ void api_model_release(struct api_model *m);
  * cached (evicted, cleared, or too large to cache): api/model_paths.h finds a model by path
  * this way without the bytes that key the cache. */
 uint64_t api_model_serial(const struct api_model *m);
-struct api_model *api_model_cache_take(uint64_t serial, const struct api_limits *lim);
+struct api_model *api_model_cache_take(uint64_t serial);
 
 /* A file the model refers to (a .gltf's buffer or image, an .obj's .mtl or texture), named as
  * the referring file writes it; found by api/model_refs.h. */

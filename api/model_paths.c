@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "model_levels.h"
 #include "model_paths.h"
 
 struct entry {
@@ -68,7 +69,7 @@ struct api_model *api_model_paths_find(const struct api_model_path_key *k, const
 	struct api_model *m = NULL;
 	pthread_mutex_lock(&mu);
 	struct entry **slot = slot_of(key);
-	if (slot && unchanged(k->root, *slot) && (m = api_model_cache_take((*slot)->serial, lim))) {
+	if (slot && unchanged(k->root, *slot) && (m = api_model_cache_take((*slot)->serial))) {
 		(*slot)->used = ++tick;
 		*files_hash = (*slot)->files_hash;
 		hits++;
@@ -78,6 +79,8 @@ struct api_model *api_model_paths_find(const struct api_model_path_key *k, const
 	}
 	pthread_mutex_unlock(&mu);
 	free(key);
+	/* A hit like the cache's: this size's level, built outside the lock (it may take a while). */
+	if (m) api_levels_on_hit(m, lim);
 	return m;
 }
 

@@ -522,31 +522,41 @@ TEST(model_image_decode)
 	      "%s", err);
 }
 
-TEST(model_image_decode_jpeg)
+/* A w x h JPEG of one colour (quality 100), encoded here; *n its bytes (the caller frees it). */
+static unsigned char *jpeg_of(uint32_t w, uint32_t h, const uint8_t rgb[3], unsigned long *n)
 {
-	/* An 8x4 JPEG of one colour, encoded here. */
 	struct jpeg_compress_struct ci;
 	struct jpeg_error_mgr je;
 	ci.err = jpeg_std_error(&je);
 	jpeg_create_compress(&ci);
 	unsigned char *buf = NULL;
-	unsigned long n = 0;
-	jpeg_mem_dest(&ci, &buf, &n);
-	ci.image_width = 8;
-	ci.image_height = 4;
+	*n = 0;
+	jpeg_mem_dest(&ci, &buf, n);
+	ci.image_width = w;
+	ci.image_height = h;
 	ci.input_components = 3;
 	ci.in_color_space = JCS_RGB;
 	jpeg_set_defaults(&ci);
 	jpeg_set_quality(&ci, 100, TRUE);
 	jpeg_start_compress(&ci, TRUE);
-	uint8_t row[24];
-	for (int i = 0; i < 8; i++) { row[3 * i] = 200; row[3 * i + 1] = 100; row[3 * i + 2] = 50; }
-	while (ci.next_scanline < ci.image_height) {
+	uint8_t *row = malloc((size_t)w * 3);
+	for (uint32_t i = 0; row && i < w; i++) memcpy(row + 3 * i, rgb, 3);
+	while (row && ci.next_scanline < ci.image_height) {
 		JSAMPROW r[1] = {row};
 		jpeg_write_scanlines(&ci, r, 1);
 	}
+	free(row);
 	jpeg_finish_compress(&ci);
 	jpeg_destroy_compress(&ci);
+	return buf;
+}
+
+TEST(model_image_decode_jpeg)
+{
+	/* An 8x4 JPEG of one colour, encoded here. */
+	static const uint8_t rgb[3] = {200, 100, 50};
+	unsigned long n;
+	unsigned char *buf = jpeg_of(8, 4, rgb, &n);
 	uint8_t *px;
 	uint32_t w, h;
 	char err[128];
@@ -565,27 +575,9 @@ TEST(model_image_decode_jpeg)
  * 1/4 (250x150: 1/8 would be 125 < 200), its colour kept; at least 0: as stored. */
 TEST(model_image_decode_jpeg_scaled)
 {
-	struct jpeg_compress_struct ci;
-	struct jpeg_error_mgr je;
-	ci.err = jpeg_std_error(&je);
-	jpeg_create_compress(&ci);
-	unsigned char *buf = NULL;
-	unsigned long n = 0;
-	jpeg_mem_dest(&ci, &buf, &n);
-	ci.image_width = 1000;
-	ci.image_height = 600;
-	ci.input_components = 3;
-	ci.in_color_space = JCS_RGB;
-	jpeg_set_defaults(&ci);
-	jpeg_start_compress(&ci, TRUE);
-	static uint8_t row[3000];
-	for (int i = 0; i < 1000; i++) { row[3 * i] = 30; row[3 * i + 1] = 160; row[3 * i + 2] = 90; }
-	while (ci.next_scanline < ci.image_height) {
-		JSAMPROW r[1] = {row};
-		jpeg_write_scanlines(&ci, r, 1);
-	}
-	jpeg_finish_compress(&ci);
-	jpeg_destroy_compress(&ci);
+	static const uint8_t rgb[3] = {30, 160, 90};
+	unsigned long n;
+	unsigned char *buf = jpeg_of(1000, 600, rgb, &n);
 	uint8_t *px = NULL;
 	uint32_t w, h, stored;
 	char err[128];
