@@ -48,7 +48,7 @@ static int usage(FILE *f, int code)
 	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
 	           "  -j N         batch: threads and render slots (default: one per core)\n"
-	           "  --report F   batch: JSON-lines report (file, output, status, ms, error); default DIR/report.jsonl\n"
+	           "  --report F   batch: JSON-lines report (file, output, status, ms, error, stages); default DIR/report.jsonl\n"
 	           "  --progress, --no-progress  batch: progress bar / plain lines on stderr (default: bar on a tty)\n");
 	return code;
 }
