@@ -171,8 +171,8 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
 		model_free(m);
 		return NULL;
 	}
-	/* The importer marked the meshes closed and built the one level this request can use; the
-	 * rest of the levels come later, for a model drawn again (api/model_levels.h). */
+	/* The importer marked the meshes closed and built the level of this request's image size;
+	 * a cached model drawn at another size gets that size's then (api/model_levels.h). */
 	m->pub.format = format;
 	m->pub.level_side = lim ? lim->output_side : 0;
 	m->pub.priv_ = m;
@@ -224,13 +224,19 @@ uint32_t api_texture_class(uint32_t side)
 	return side ? c : 0;
 }
 
+/* Whether m was imported from these bytes (hash h, the model's first model_len of them). */
+static bool same_source(const struct model_priv *m, uint64_t h, const uint8_t *data, size_t len, size_t model_len,
+                        enum api_model_format f)
+{
+	return m->hash == h && m->src_len == len && m->model_len == model_len && m->pub.format == f &&
+	       !memcmp(m->src, data, len);
+}
+
 static struct model_priv *lru_find(uint64_t h, const uint8_t *data, size_t len, size_t model_len,
                                    enum api_model_format f, uint32_t side)
 {
 	for (struct model_priv *m = lru_head; m; m = m->next)
-		if (m->hash == h && m->src_len == len && m->model_len == model_len && m->pub.format == f &&
-		    textures_cover(m, side) && !memcmp(m->src, data, len))
-			return m;
+		if (textures_cover(m, side) && same_source(m, h, data, len, model_len, f)) return m;
 	return NULL;
 }
 
@@ -242,9 +248,8 @@ static struct model_priv *unlist_covered(const struct model_priv *m)
 	struct model_priv *out = NULL;
 	for (struct model_priv *o = lru_head, *n; o; o = n) {
 		n = o->next;
-		if (o == m || o->hash != m->hash || o->src_len != m->src_len || o->model_len != m->model_len ||
-		    o->pub.format != m->pub.format || !textures_cover(m, o->pub.texture_side) ||
-		    memcmp(o->src, m->src, m->src_len))
+		if (o == m || !textures_cover(m, o->pub.texture_side) ||
+		    !same_source(o, m->hash, m->src, m->src_len, m->model_len, m->pub.format))
 			continue;
 		lru_unlink(o);
 		o->next = out;

@@ -23,7 +23,7 @@
 #include <stdint.h>
 #include "plan.h"
 
-/* Error bounds, measured (README, Performance): with 1/8 pixel the silhouettes of thumb-512
+/* Error bounds, measured (docs/performance.md): with 1/8 pixel the silhouettes of thumb-512
  * were visibly less well anti-aliased than MSAA 4 at full detail against a 4x4-supersampled
  * render (edge error 0.0104 against 0.0088); 1/32 pixel matches it within noise and costs the
  * same on lavapipe (the triangles are no longer what the pass pays for). 1/8 texel is well

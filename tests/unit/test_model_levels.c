@@ -33,6 +33,21 @@ static float extent(const struct api_model_mesh *me)
 	return fmaxf(fmaxf(me->bounds[3] - me->bounds[0], me->bounds[4] - me->bounds[1]), me->bounds[5] - me->bounds[2]);
 }
 
+/* A fresh cache; the 45k-triangle sphere imported for 256^2 images (*a), then hit for images
+ * of `side` under an import limit of timeout_ms (*b, 0: the default); the level counters before
+ * the hit. Returns the file (the caller frees it), NULL when out of memory. */
+static uint8_t *import_then_hit(size_t *len, uint32_t side, uint32_t timeout_ms, struct api_model **a,
+                                struct api_model **b, uint64_t *built0, uint64_t *refused0)
+{
+	api_model_cache_clear();
+	uint8_t *d = test_bumpy_stl(150, len);
+	if (!d) return NULL;
+	api_levels_stats(built0, refused0);
+	*a = get(d, *len, 256, 0);
+	*b = get(d, *len, side, timeout_ms);
+	return d;
+}
+
 /* A new 45k-triangle model imported for 256^2 images comes with one level, within what the
  * renderer allows a mesh that fills 70 % of such an image (api_lod_import_error), and a
  * quarter or more fewer triangles; imported for no known size, with none. */
@@ -80,15 +95,11 @@ static bool same_level(const struct rnd_mesh_lod *a, const struct rnd_mesh_lod *
  * draws the same triangles whatever the cache held. */
 TEST(model_level_for_another_size_equals_a_fresh_imports)
 {
-	api_model_cache_clear();
 	size_t len;
-	uint8_t *d = test_bumpy_stl(150, &len);
-	REQUIRE(d != NULL);
 	uint64_t built0, refused0, built1, refused1;
-	api_levels_stats(&built0, &refused0);
-	struct api_model *a = get(d, len, 256, 0);
-	struct api_model *b = get(d, len, 128, 0);   /* a hit, for 128^2 images */
-	REQUIRE(a && b == a);
+	struct api_model *a, *b;   /* b: a hit, for 128^2 images */
+	uint8_t *d = import_then_hit(&len, 128, 0, &a, &b, &built0, &refused0);
+	REQUIRE(d && a && b == a);
 	api_levels_stats(&built1, &refused1);
 	CHECK(built1 == built0 + 1 && refused1 == refused0, "built %llu, refused %llu", (unsigned long long)(built1 - built0),
 	      (unsigned long long)(refused1 - refused0));
@@ -119,15 +130,11 @@ TEST(model_level_for_another_size_equals_a_fresh_imports)
  * refused, and that size is not tried again; the model renders at full detail there. */
 TEST(model_level_build_is_bounded_by_the_import_limits)
 {
-	api_model_cache_clear();
 	size_t len;
-	uint8_t *d = test_bumpy_stl(150, &len);
-	REQUIRE(d != NULL);
 	uint64_t built0, refused0, built1, refused1;
-	api_levels_stats(&built0, &refused0);
-	struct api_model *a = get(d, len, 256, 0);
-	struct api_model *b = get(d, len, 512, 1);   /* the hit that asks for 512^2, 1 ms */
-	REQUIRE(a && b == a);
+	struct api_model *a, *b;   /* b: the hit that asks for 512^2, 1 ms */
+	uint8_t *d = import_then_hit(&len, 512, 1, &a, &b, &built0, &refused0);
+	REQUIRE(d && a && b == a);
 	struct api_model *c = get(d, len, 512, 0);
 	api_levels_stats(&built1, &refused1);
 	uint32_t n;
