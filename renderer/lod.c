@@ -208,7 +208,7 @@ static void estimate_bounds(const struct rnd_scene *sc, struct rnd_aabb *all, st
 		if (o->shape != RND_SHAPE_PLANE || !o->cast_shadows || catcher) continue;
 		/* as render.c's casters' box, on geometry alone (it also leaves out a ground whose
 		 * shadow no camera sees: that map keeps the whole scene's texel size, all this needs) */
-		bool cast = !rnd_aabb_is_empty(&solid) && rnd_plane_may_shadow(sc, o, &solid);
+		bool cast = !rnd_planes_judged(sc) || (!rnd_aabb_is_empty(&solid) && rnd_plane_may_shadow(sc, o, &solid));
 		for (uint32_t j = 0; j < sc->object_count && !cast; j++) {
 			if (j == i || sc->objects[j].shape != RND_SHAPE_PLANE) continue;
 			rnd_object_bounds(sc, j, NULL, &other);
@@ -390,6 +390,11 @@ static bool plane_shadows(const struct rnd_scene *sc, const struct rnd_object *p
 			if (!quad_hides(plane, inv, n, p0, sgn, x, nx, &cams[v])) return true;
 	}
 	return false;
+}
+
+bool rnd_planes_judged(const struct rnd_scene *sc)
+{
+	return sc->object_count <= RND_PLANES_JUDGED_MAX;
 }
 
 bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b)

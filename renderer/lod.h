@@ -95,6 +95,14 @@ void rnd_lod_proxies(const struct rnd_scene *sc, uint32_t nviews, const uint32_t
  * other objects out of the shadow pass: the ground under a thumbnail costs no depth fill. */
 bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b);
 
+/* Planes are judged one against another (rnd_plane_may_shadow*, each plane against every other
+ * object) only in scenes of at most this many objects: the test is quadratic (16,000 planes
+ * took 107 s of planning before the first submit). In a bigger scene every plane that asks to
+ * cast shadows casts: the estimate (rnd_lod_choose) and render.c's shadow passes both follow
+ * rnd_planes_judged(). */
+#define RND_PLANES_JUDGED_MAX 256u
+bool rnd_planes_judged(const struct rnd_scene *sc);
+
 /* World bounds of object i as asked: an analytic shape's own (a sphere of its radius, not the
  * radius a coarser tessellation raises, rnd_lod_radius), a mesh's `drawn` bounds (its levels
  * keep a subset of its vertices, so they reach no further) or, when drawn is NULL, those of

@@ -330,6 +330,20 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
 	return RND_OK;
 }
 
+double rnd_mesh_area(const struct rnd_vertex *vertices, const uint32_t *indices, uint32_t index_count)
+{
+	double sum = 0.0;
+	for (uint32_t i = 0; i + 2 < index_count; i += 3) {
+		const float *a = vertices[indices[i]].pos, *b = vertices[indices[i + 1]].pos, *c = vertices[indices[i + 2]].pos;
+		float e1[3], e2[3], n[3];
+		rnd_v3_sub(e1, b, a);
+		rnd_v3_sub(e2, c, a);
+		rnd_v3_cross(n, e1, e2);
+		sum += 0.5 * sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+	}
+	return sum;
+}
+
 void rnd_mesh_local_bounds(const struct rnd_object *o, struct rnd_aabb *out)
 {
 	float h[3] = {0, 0, 0};

@@ -1,7 +1,7 @@
 /*
- * renderer/record.c — command recording for one view (see record.h): the shadow passes, the
- * main pass (with its depth pre-pass) and the AOV passes, and the helpers the depth-only passes
- * share with contact.c. The texture and readback copies live with their jobs (upload.c,
+ * renderer/record.c — command recording for one view (see record.h): the main pass (with its
+ * depth pre-pass) and the AOV passes, and the helpers the depth-only passes share with
+ * contact.c and record_shadow.c (the shadow passes). The texture and readback copies live with their jobs (upload.c,
  * readback.c).
  */
 #include <math.h>
@@ -24,13 +24,6 @@ bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_a
 		if (rnd_v3_dot(d, cam->fwd) <= cam->znear * 1.01f) return false;
 	}
 	return true;
-}
-
-static bool point_outside(const float p[3], const struct rnd_aabb *b, float pad)
-{
-	for (int k = 0; k < 3; k++)
-		if (p[k] < b->min[k] - pad || p[k] > b->max[k] + pad) return true;
-	return false;
 }
 
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
@@ -113,128 +106,6 @@ void record_depth_draw(struct rnd_context *ctx, struct rnd_slot *s, const struct
 		                        &s->texture_sets[d->texture_set], 0, NULL);
 	}
 	vkCmdDrawIndexed(cmd, d->index_count, 1, d->first_index, 0, 0);
-}
-
-/* Shadow view v drawn into the slot's scratch depth image, left ready to be copied. */
-static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t v)
-{
-	const struct rnd_scene *sc = rv->sc;
-	const struct rnd_shadow_plan *sp = rv->sp;
-	VkCommandBuffer cmd = s->cmd;
-	const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
-	uint32_t res = (uint32_t)sp->views[v].rect[2];
-	/* Each map is drawn at the origin of the slot's scratch depth image and then copied
-	 * into its tile: rasterisation snaps to a grid relative to the framebuffer, so drawing
-	 * at the tile's own offset would make a map (and the image) depend on where the atlas
-	 * happened to place it. The same request then gives the same bytes whatever the cache
-	 * held before. */
-	record_begin_depth(cmd, s->shadow_scratch.img, s->shadow_scratch.view, res, res, VK_PIPELINE_STAGE_2_COPY_BIT,
-	                   VK_ACCESS_2_TRANSFER_READ_BIT);
-	vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope);
-	/* Masked casters read materials and textures; the set's shadow-map binding is not
-	 * used by the alpha-test shader while the map is a render target. */
-	record_bind_geometry(ctx, s);
-	struct umbra_push push = {0};
-	memcpy(push.view_proj, sp->views[v].view_proj, sizeof push.view_proj);
-	vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-	                   sizeof push, &push);
-	VkPipeline bound = VK_NULL_HANDLE;
-	const struct rnd_light *L = &sc->lights[sp->view_light[v]];
-	for (uint32_t i = 0; i < rv->ndraw; i++) {
-		const struct draw *d = &rv->draws[i];
-		if (!d->cast || !d->index_count) continue;
-		if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) continue;
-		int cull = d->single_sided ||
-		           (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
-		record_depth_draw(ctx, s, d, cull, &push, &bound);
-	}
-	vkCmdEndRendering(cmd);
-	record_image_barrier(cmd, s->shadow_scratch.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1,
-	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-	                     VK_ACCESS_2_TRANSFER_READ_BIT);
-}
-
-/* PCSS: the map as floats for the depth bounds (compute shaders cannot read a depth image on
- * lavapipe without it copying the image on every dispatch). The previous view's compute
- * passes must be done reading the buffer. */
-static void copy_for_bounds(struct rnd_slot *s, uint32_t res)
-{
-	VkCommandBuffer cmd = s->cmd;
-	VkBufferMemoryBarrier2 bb = {
-		.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2,
-		.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-		.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-		.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
-		.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT, .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-		.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .buffer = s->scratch_buf.buf, .size = VK_WHOLE_SIZE,
-	};
-	VkDependencyInfo bdi = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .bufferMemoryBarrierCount = 1, .pBufferMemoryBarriers = &bb};
-	vkCmdPipelineBarrier2(cmd, &bdi);
-	VkBufferImageCopy region = {
-		.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1}, .imageExtent = {res, res, 1},
-	};
-	vkCmdCopyImageToBuffer(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s->scratch_buf.buf, 1,
-	                       &region);
-	bb.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-	bb.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-	bb.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-	bb.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
-	vkCmdPipelineBarrier2(cmd, &bdi);
-}
-
-void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, uint32_t first,
-                    uint32_t end)
-{
-	const struct rnd_scene *sc = rv->sc;
-	const struct rnd_shadow_plan *sp = rv->sp;
-	VkCommandBuffer cmd = s->cmd;
-	/* The atlas stays in GENERAL layout. Earlier submissions (other renders) may still sample
-	 * or write other tiles; this render writes only its own tiles, so an execution and memory
-	 * dependency on what came before is all that is needed. */
-	VkMemoryBarrier2 mb = {
-		.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
-		.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, .srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT,
-		.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
-		                VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-		.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-		                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |
-		                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-	};
-	VkDependencyInfo di = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1, .pMemoryBarriers = &mb};
-	vkCmdPipelineBarrier2(cmd, &di);
-	for (uint32_t v = first; v < end && v < sp->view_count; v++) {
-		if (sp->view_skip[v]) continue;
-		const struct rnd_light_plan *lp = &sp->lights[sp->view_light[v]];
-		uint32_t res = (uint32_t)sp->views[v].rect[2];
-		draw_shadow_map(ctx, s, rv, v);
-		/* Into the depth atlas: a same-format image copy, which lavapipe does as a memcpy. */
-		VkImageCopy copy = {
-			.srcSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
-			.dstSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
-			.dstOffset = {(int32_t)sp->views[v].rect[0], (int32_t)sp->views[v].rect[1], 0}, .extent = {res, res, 1},
-		};
-		vkCmdCopyImage(cmd, s->shadow_scratch.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, ctx->atlas_depth.img,
-		               VK_IMAGE_LAYOUT_GENERAL, 1, &copy);
-		/* PCSS: the tile's depth bounds, drawn with every map drawn, so a cached map has them
-		 * whenever it is reused (the cache key holds the filter and the resolution). */
-		if (rnd_bounds_wanted(ctx, lp, res)) {
-			copy_for_bounds(s, res);
-			rnd_bounds_record_view(ctx, s, sp, v);
-		}
-		/* VSM / EVSM: from the tile just copied into the depth atlas */
-		rnd_moments_record_view(ctx, s, sp, v, sc);
-	}
-	/* The atlas tiles (depth copied in, moments drawn, bounds from compute) are read by the
-	 * main and AOV passes. */
-	mb.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT |
-	                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-	mb.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |
-	                   VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-	mb.dstStageMask = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-	mb.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-	vkCmdPipelineBarrier2(cmd, &di);
 }
 
 uint32_t record_light_type(enum rnd_light_type t)

@@ -169,8 +169,8 @@ static void plane_casters(struct render *rq)
 		ncam++;
 	}
 	bool moments = rnd_moments_need_ground(sc);
-	bool fill_only[256] = {false};
-	for (uint32_t i = 0; i < sc->object_count && sc->object_count <= 256; i++) {
+	bool fill_only[RND_PLANES_JUDGED_MAX] = {false};
+	for (uint32_t i = 0; i < sc->object_count && rnd_planes_judged(sc); i++) {
 		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
 		bool other = false, seen = false;
 		for (uint32_t j = 0; j < sc->object_count && !seen; j++) {
@@ -185,7 +185,7 @@ static void plane_casters(struct render *rq)
 	}
 	rnd_aabb_empty(&rq->casters);
 	for (uint32_t i = 0; i < sc->object_count; i++)
-		if (draws[i].cast && !(i < 256 && fill_only[i])) rnd_aabb_union(&rq->casters, &draws[i].bounds);
+		if (draws[i].cast && !(i < RND_PLANES_JUDGED_MAX && fill_only[i])) rnd_aabb_union(&rq->casters, &draws[i].bounds);
 }
 
 /* What every cached map's key starts from: the casters' world-space geometry, their
@@ -478,6 +478,8 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 
 done:
 	finish(&rq, r, err);
+	rq.tm.submits = rq.pacer.submits;
+	rq.tm.shadow_parts = rq.pacer.shadow_parts;
 	if (timings) *timings = rq.tm;
 	return r;
 }

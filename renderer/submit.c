@@ -8,6 +8,7 @@
 #include "visibility.h"
 #include "submit.h"
 #include "contact.h"
+#include "cost.h"
 
 /* Cost model for the first band and for grouping shadow views, in lavapipe milliseconds (a
  * GPU is faster: the model then only makes the first band smaller than needed, and measured
@@ -25,6 +26,7 @@
 #define EST_MS_PER_TRIANGLE 3e-4     /* main pass: vertex work, repeated in every band */
 #define EST_MS_PER_TEXEL 5e-6        /* shadow map clear, raster, copy into the atlas */
 #define EST_MS_PER_CASTER 1e-4       /* depth-only triangle */
+#define EST_MS_PER_DEPTH_FRAG 2e-6   /* depth-only fragment beyond the map's first layer (cost.h) */
 /* A fence is waited on in slices this long; between slices a long wait is logged. */
 #define WAIT_SLICE_NS (1000ull * 1000 * 1000)
 
@@ -220,18 +222,22 @@ static enum rnd_result cmd_flush(struct rnd_context *ctx, struct rnd_slot *s, st
 
 /* ---- estimates ---- */
 
-static uint64_t caster_triangles(const struct record_view *rv)
+/* Shadow view v: its triangles (*tris) and their fill beyond one layer over the map, in
+ * milliseconds. The first layer is in the per-texel term (clear, raster, copy). */
+static double est_shadow_view_ms(const struct record_view *rv, uint32_t v, uint64_t *tris)
 {
-	uint64_t n = 0;
-	for (uint32_t i = 0; i < rv->ndraw; i++)
-		if (rv->draws[i].cast) n += rv->draws[i].index_count / 3;
-	return n;
-}
-
-static double est_shadow_view_ms(const struct record_view *rv, uint32_t v, uint64_t casters)
-{
-	double res = rv->sp->views[v].rect[2];
-	return res * res * EST_MS_PER_TEXEL + (double)casters * EST_MS_PER_CASTER;
+	const struct umbra_shadow_view *sv = &rv->sp->views[v];
+	double res = sv->rect[2], fill = 0;
+	int cull;
+	*tris = 0;
+	for (uint32_t i = 0; i < rv->ndraw; i++) {
+		if (!record_shadow_draws(rv, v, i, &cull)) continue;
+		const struct draw *d = &rv->draws[i];
+		*tris += d->index_count / 3;
+		fill += rnd_cost_fill(sv->view_proj, res, res, &d->bounds, d->area, d->index_count / 3, d->closed);
+	}
+	double beyond = fill > res * res ? fill - res * res : 0;
+	return res * res * EST_MS_PER_TEXEL + (double)*tris * EST_MS_PER_CASTER + beyond * EST_MS_PER_DEPTH_FRAG;
 }
 
 /* Shading work per pixel, in units of a hard-shadowed light's. */
@@ -259,6 +265,45 @@ static double px_units(const struct record_view *rv)
 
 /* ---- one view ---- */
 
+/* The blur temporary's contents never carry over: take it from UNDEFINED each time. */
+static void moments_tmp_undefined(struct rnd_slot *s)
+{
+	if (s->moments_tmp.img)
+		record_image_barrier(s->cmd, s->moments_tmp.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+}
+
+/* One map estimated past half a slice, in parts of its casters' triangles, a submit each (the
+ * deadline checked between): the first part sized by the estimate, the next ones by the
+ * measured time per triangle (grown at most 2x a part, as the bands). */
+static enum rnd_result submit_shadow_parts(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                                           uint32_t v, double est, uint64_t total, struct rnd_pacer *p,
+                                           struct cmd_state *st, struct rnd_timings *tm, bool *gpu_busy,
+                                           struct rnd_error *err)
+{
+	enum rnd_result r;
+	double target = p->slice_ms / 2;
+	uint32_t fixed = rv->sc->shadow_part_triangles;
+	double per = fixed ? fixed : fmax(1.0, floor((double)total * target / est));
+	for (uint64_t lo = 0; lo < total;) {
+		uint64_t hi = lo + (uint64_t)per < total ? lo + (uint64_t)per : total;
+		if ((r = cmd_open(s, p, st, err)) != RND_OK) return r;
+		if (lo == 0) moments_tmp_undefined(s);
+		record_shadow_part(ctx, s, rv, v, lo, hi, total);
+		cmd_mark(s, st, RND_TS_SHADOW_END);
+		double wall;
+		if ((r = cmd_flush(ctx, s, p, st, tm, &wall, gpu_busy, err)) != RND_OK) return r;
+		double rate = wall / (double)(hi - lo);   /* ms per triangle, measured */
+		double next = rate > 0 ? target / rate : 2 * per;
+		if (!fixed) per = fmax(1.0, fmin(next, 2 * per));
+		lo = hi;
+		p->shadow_parts++;
+	}
+	return RND_OK;
+}
+
 static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
                                       struct rnd_pacer *p, struct cmd_state *st, struct rnd_timings *tm,
                                       bool *gpu_busy, struct rnd_error *err)
@@ -266,25 +311,28 @@ static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *
 	enum rnd_result r;
 	const struct rnd_shadow_plan *sp = rv->sp;
 	bool paced = p->slice_ms > 0;
-	uint64_t casters = caster_triangles(rv);
+	double est[UMBRA_MAX_SHADOW_VIEWS];
+	uint64_t tris[UMBRA_MAX_SHADOW_VIEWS];
+	for (uint32_t v = 0; v < sp->view_count; v++)
+		est[v] = sp->view_skip[v] ? 0 : est_shadow_view_ms(rv, v, &tris[v]);
 	uint32_t v = 0;
 	while (v < sp->view_count) {
 		if (sp->view_skip[v]) { v++; continue; }
+		uint32_t fixed = rv->sc->shadow_part_triangles;
+		if (fixed ? tris[v] > fixed : paced && est[v] > p->slice_ms / 2 && tris[v] > 1) {
+			if ((r = submit_shadow_parts(ctx, s, rv, v, est[v], tris[v], p, st, tm, gpu_busy, err)) != RND_OK) return r;
+			v++;
+			continue;
+		}
 		uint32_t end = v + 1;
-		double est = est_shadow_view_ms(rv, v, casters);
+		double sum = est[v];
 		while (end < sp->view_count) {
-			double e = sp->view_skip[end] ? 0 : est_shadow_view_ms(rv, end, casters);
-			if (paced && est + e > p->slice_ms / 2) break;
-			est += e;
+			if (paced && sum + est[end] > p->slice_ms / 2) break;
+			sum += est[end];
 			end++;
 		}
 		if ((r = cmd_open(s, p, st, err)) != RND_OK) return r;
-		/* The blur temporary's contents never carry over: take it from UNDEFINED each time. */
-		if (s->moments_tmp.img)
-			record_image_barrier(s->cmd, s->moments_tmp.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-			                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-			                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-			                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+		moments_tmp_undefined(s);
 		record_shadows(ctx, s, rv, v, end);
 		cmd_mark(s, st, RND_TS_SHADOW_END);
 		double wall;
@@ -311,7 +359,13 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 	uint64_t tris = 0;
 	for (uint32_t i = 0; i < rv->ndraw; i++) tris += rv->draws[i].cam_index_count / 3;
 	double units = px_units(rv);
-	double est_row = sc->width * units * EST_MS_PER_PIXEL_UNIT;
+	/* Geometry stacked many layers deep costs per layer (cost.h): a band of rows sized as if
+	 * each pixel were covered once had run a 10 s submit past a 3 s deadline. */
+	double fill = 0;
+	for (uint32_t i = 0; i < rv->ndraw; i++)
+		fill += rnd_cost_fill(rv->cam->view_proj, sc->width, sc->height, &rv->draws[i].bounds, rv->draws[i].area,
+		                      rv->draws[i].cam_index_count / 3, rv->draws[i].closed);
+	double est_row = sc->width * units * EST_MS_PER_PIXEL_UNIT * rnd_cost_layer_factor(fill, sc->width, sc->height);
 	/* lavapipe shades each triangle's 4x4 blocks: a triangle costs more where a pixel does */
 	double est_fixed = EST_MS_PER_BAND + (double)tris * EST_MS_PER_TRIANGLE * (1 + units / 4);
 	/* Down to single rows: with many soft-shadowed lights and AOVs one row of a large image

@@ -24,6 +24,7 @@ struct rnd_pacer {
 	const struct rnd_scene *sc;
 	double slice_ms;            /* target wall time of one submit; 0 = as few submits as possible */
 	uint32_t submits;           /* submitted by this render so far */
+	uint32_t shadow_parts;      /* of them, parts of shadow maps (submit.c) */
 	const struct rnd_texture *const *tex; /* staged textures, recorded into the first submit */
 	uint32_t ntex;
 	bool prologue;              /* textures (and the slot's white texture) not yet recorded */

@@ -53,6 +53,7 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 			snprintf(m, sizeof m, "%s", err->msg);
 			return rnd_fail(err, r, "object %u: %s", i, m);
 		}
+		d->area = rnd_mesh_area(vtx, idx + ibase, x);
 		d->first_index = d->cam_first_index = ibase;
 		d->index_count = d->cam_index_count = x;
 		d->first_vertex = vbase;

@@ -298,6 +298,8 @@ struct rnd_scene {
 	bool (*cancel)(void *user); /* polled between submits (any thread-safe check), NULL = none */
 	void *cancel_user;
 	uint32_t band_rows;       /* main-pass rows per submit, 0 = chosen by the renderer (tests) */
+	uint32_t shadow_part_triangles; /* every shadow map in parts of this many casters' triangles, a
+	                                   submit each; 0 = only a costly map, sized by the renderer (tests) */
 	/* false: spheres and cylinders get no more segments, meshes with levels no more triangles,
 	 * than the output can show (renderer/lod.h: within 1/32 pixel and 1/8 shadow texel); true:
 	 * exactly `segments` and every mesh in full (tests, comparisons). */
@@ -379,6 +381,8 @@ struct rnd_timings {
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
 	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
+	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
+	uint32_t shadow_parts;     /* submits of shadow maps drawn in parts (too costly for one) */
 };
 
 /* ---- context ---- */
