@@ -43,6 +43,16 @@ char *api_problem_json(const struct api_problem *p);
 /* One line for CLI stderr: "400 Invalid scene: /lights/0/direction: must not be zero". */
 void api_problem_format(const struct api_problem *p, char *buf, size_t size);
 
+/* Who may start a sandboxed model import now (the daemon's import slots, server/imports.c):
+ * try_enter(user) before each import of a model the cache lacks (levels of a cached model and
+ * texture decodes are not gated: each is bounded by the import limits and happens once per
+ * model and size). false: the parse stops with a 503 problem at the model's member, having
+ * started nothing; the caller, who knows why, parses the request again later. */
+struct api_import_gate {
+	bool (*try_enter)(void *user);
+	void *user;
+};
+
 /* Resource limits; going over one is a 422. 0 = unlimited. */
 struct api_limits {
 	uint64_t max_pixels;             /* width*height (and per sheet when several views), default 16777216 */
@@ -64,6 +74,8 @@ struct api_limits {
 	 * (the largest side of its images, pixels). A model imported for it does no work beyond
 	 * that: one level of detail for that size (api/model_lod.h). 0 = unknown (none). */
 	uint32_t output_side;
+	/* Not a limit either: the caller's gate for imports (NULL = none: every import starts). */
+	const struct api_import_gate *import_gate;
 };
 void api_limits_defaults(struct api_limits *l);
 

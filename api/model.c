@@ -154,6 +154,12 @@ static struct model_priv *import(const uint8_t *data, size_t len, size_t model_l
                                  enum api_model_format format, const struct api_limits *lim, int *status, char *err,
                                  size_t errsize)
 {
+	const struct api_import_gate *g = lim ? lim->import_gate : NULL;
+	if (g && !g->try_enter(g->user)) {
+		*status = 503;
+		api_err_set(err, errsize, "no import slot is free now (--import-slots); retry later");
+		return NULL;
+	}
 	struct model_priv *m = calloc(1, sizeof *m);
 	if (!m || !(m->arena = api_arena_create())) {
 		free(m);

@@ -1,5 +1,5 @@
-/* server/gate — see gate.h. A counting semaphore with a list of its waiters (at most workers - 1
- * of them, so linear scans are fine), admitting them in ticket order. */
+/* server/gate — see gate.h. A counting semaphore with a list of its waiters (at most the threads
+ * less one, so linear scans are fine), admitting them in priority, then ticket order. */
 #include <time.h>
 #include "clock.h"
 #include "gate.h"
@@ -33,7 +33,7 @@ static bool my_turn(const struct srv_gate *g, const struct srv_gate_waiter *w)
 {
 	if (g->running >= g->limit) return false;
 	for (const struct srv_gate_waiter *o = g->waiting; o; o = o->next)
-		if (o->ticket < w->ticket) return false;
+		if (o->priority < w->priority || (o->priority == w->priority && o->ticket < w->ticket)) return false;
 	return true;
 }
 
@@ -48,9 +48,16 @@ static void unlink_waiter(struct srv_gate *g, struct srv_gate_waiter *w)
 
 bool srv_gate_enter(struct srv_gate *g, struct srv_gate_waiter *w, double t_queued, double deadline_s)
 {
+	return srv_gate_enter_prio(g, w, 0, t_queued, deadline_s);
+}
+
+bool srv_gate_enter_prio(struct srv_gate *g, struct srv_gate_waiter *w, unsigned priority, double t_queued,
+                         double deadline_s)
+{
 	struct timespec until = srv_timespec(deadline_s > 0 ? deadline_s : 0);
 	pthread_mutex_lock(&g->mu);
 	w->t_queued = t_queued;
+	w->priority = priority;
 	w->ticket = g->next_ticket++;
 	w->next = g->waiting;
 	g->waiting = w;

@@ -12,7 +12,7 @@
  *   if (srv_gate_enter(&g, &w, req->t_queued, deadline_s)) { render ...; srv_gate_leave(&g); }
  *   else: the deadline passed while waiting (answer 504).
  * srv_gate_oldest(): the queue time of the longest waiter, 0 when none (a long render yields
- * to it as it yields to the queue's oldest request). Waiters are admitted in arrival order, so
+ * to it as it yields to the queue's oldest request). Waiters are admitted by priority, then in arrival order, so
  * the slot a yielding render frees goes to the waiter it yielded to, not to a newcomer.
  * Threading: every function is thread-safe; the waiter struct lives on the caller's stack.
  */
@@ -24,6 +24,7 @@
 
 struct srv_gate_waiter {
 	double t_queued;
+	unsigned priority;            /* enum srv_priority: lower first, before arrival order */
 	unsigned long long ticket;    /* arrival order: the gate admits waiters first come, first served */
 	struct srv_gate_waiter *next;
 };
@@ -39,8 +40,12 @@ struct srv_gate {
 void srv_gate_init(struct srv_gate *g, unsigned limit);
 void srv_gate_destroy(struct srv_gate *g);
 void srv_gate_set_limit(struct srv_gate *g, unsigned limit);
-/* Waits for a turn; false when deadline_s (monotonic seconds, 0 = none) passes first. */
+/* Waits for a turn; false when deadline_s (monotonic seconds, 0 = none) passes first. Waiters
+ * of a lower priority value go first (X-Priority interactive before bulk: more threads than
+ * render slots take requests from the queue, server/imports.h, so its order is kept here too). */
 bool srv_gate_enter(struct srv_gate *g, struct srv_gate_waiter *w, double t_queued, double deadline_s);
+bool srv_gate_enter_prio(struct srv_gate *g, struct srv_gate_waiter *w, unsigned priority, double t_queued,
+                         double deadline_s);
 void srv_gate_leave(struct srv_gate *g);
 double srv_gate_oldest(struct srv_gate *g);
 

@@ -27,6 +27,7 @@
 #include <unistd.h>
 
 #include "conn.h"
+#include "imports.h"
 #include "log.h"
 #include "metrics.h"
 #include "http.h"
@@ -315,6 +316,8 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 		req->srv = s;
 		req->conn = conn;
 		req->t_start = srv_now();
+		const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+		req->client = srv_client_key(ci ? ci->client_addr : NULL);
 		snprintf(req->method, sizeof req->method, "%s", method);
 		snprintf(req->path, sizeof req->path, "%s", url);
 		req->route = route_of(url);

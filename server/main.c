@@ -16,6 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "imports.h"
 #include "log.h"
 #include "metrics.h"
 #include "queue.h"
@@ -86,7 +87,8 @@ int main(int argc, char **argv)
 	s->queue = srv_queue_create(s->cfg.queue);
 	srv_admit_init(&s->admit, s->cfg.max_memory);
 	srv_gate_init(&s->gate, s->cfg.workers);
-	if (!s->metrics || !s->queue) {
+	s->imports = srv_imports_create(s->cfg.import_slots ? s->cfg.import_slots : s->cfg.workers);
+	if (!s->metrics || !s->queue || !s->imports) {
 		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
 		goto out_free;
 	}
@@ -136,6 +138,7 @@ out_http:
 out_free:
 	api_model_cache_clear();
 	srv_queue_destroy(s->queue);
+	srv_imports_destroy(s->imports);
 	srv_metrics_destroy(s->metrics);
 	srv_admit_destroy(&s->admit);
 	pthread_rwlock_destroy(&s->ctx_lock);

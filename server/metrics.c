@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "buf.h"
+#include "imports.h"
 #include "queue.h"
 
 static const double bucket_bounds[] = { 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25,
@@ -240,6 +241,10 @@ static void write_queue(struct srv_buf *b, struct srv_server *s)
 	write_gauge(b, "umbra_ready", "1 when /readyz answers 200.",
 	            atomic_load(&s->ready) && !atomic_load(&s->draining));
 	write_gauge(b, "umbra_draining", "1 after SIGTERM/SIGINT.", atomic_load(&s->draining));
+	unsigned running = 0, parked = 0;
+	if (s->imports) srv_imports_counts(s->imports, &running, &parked);
+	write_gauge(b, "umbra_imports_running", "Sandboxed model imports holding an import slot now (--import-slots).", running);
+	write_gauge(b, "umbra_imports_parked", "Requests waiting for an import slot, holding no thread.", parked);
 
 }
 

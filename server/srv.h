@@ -61,6 +61,7 @@ struct srv_config {
 	unsigned workers;              /* render threads = context slots, default: online CPUs, capped by the CPU quota */
 	const char *warm_up;           /* "defaults" (NULL) or "all": server/warmup.c */
 	unsigned device_renders;       /* renders on the device at once (server/gate.h); 0 = 1 on a CPU device, else workers */
+	unsigned import_slots;         /* import threads: sandboxed model imports at once (server/imports.h); 0 = workers */
 	unsigned queue;                /* queued renders (not counting those rendering), default 64 */
 	uint64_t max_body;             /* bytes, default 64 MiB */
 	struct api_limits limits;      /* 422 limits */
@@ -106,6 +107,7 @@ struct srv_server {
 	struct srv_metrics *metrics;
 	struct srv_admit admit;        /* renders admitted by estimated memory (--max-memory) */
 	struct srv_gate gate;          /* renders on the device at once (--device-renders) */
+	struct srv_imports *imports;   /* requests parked for an import thread (--import-slots) */
 
 	/* The shared renderer. Renders hold ctx_lock for reading; recovery after a lost device
 	 * takes it for writing, destroys and recreates the context (ctx_gen counts recreations). */
@@ -148,6 +150,7 @@ struct srv_request {
 	char path[128];                /* for logs, truncated */
 	char id[80];                   /* X-Request-Id */
 	double t_start, t_queued;      /* monotonic seconds */
+	uint64_t client;               /* srv_client_key() of the peer: its share of import threads */
 
 	/* body of POST /v1/render: the scene document, or for multipart/form-data the `scene` part
 	 * (moved here when the body is complete) and the other named parts */

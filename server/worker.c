@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "imports.h"
 #include "log.h"
 #include "metrics.h"
 #include "negotiate.h"
@@ -283,11 +284,27 @@ static bool render_should_yield(void *user)
 	return true;
 }
 
+/* Whether this parse may import a model the cache lacks (server/imports.h): on an import
+ * thread yes; on a worker no, and the request goes to the import threads (refused). */
+struct import_ticket {
+	struct api_import_gate gate;
+	bool importer, refused;
+};
+
+static bool ticket_enter(void *user)
+{
+	struct import_ticket *t = user;
+	if (!t->importer) t->refused = true;
+	return t->importer;
+}
+
 /* Parses the request's body and parts into *scp and settles what the answer depends on (its
  * warnings, its ETag with any asset files, its format). 0: go on and render; 1: the request is
- * answered already (a problem, or 304 for a matching If-None-Match). *scp, when set, is the
- * caller's to free either way. */
-static int job_parse(struct srv_server *s, struct srv_request *req, struct api_scene **scp, double *parse_s)
+ * answered already (a problem, or 304 for a matching If-None-Match); 2: parked for an import
+ * thread (a worker's parse reached a model to import): not this thread's any more. *scp,
+ * when set, is the caller's to free either way. */
+static int job_parse(struct srv_server *s, struct srv_request *req, bool importer, struct api_scene **scp,
+                     double *parse_s)
 {
 	struct api_problem p = { 0 };
 	double t0 = srv_now();
@@ -295,7 +312,17 @@ static int job_parse(struct srv_server *s, struct srv_request *req, struct api_s
 	size_t nparts = req->part_count < 64 ? req->part_count : 64;
 	for (size_t i = 0; i < nparts; i++)
 		parts[i] = (struct api_part){ req->parts[i].name, req->parts[i].data, req->parts[i].len };
-	enum api_result pr = api_scene_parse_parts(req->body, req->body_len, &s->cfg.limits, parts, nparts, scp, &p);
+	struct import_ticket ticket = { .gate = { ticket_enter, NULL }, .importer = importer };
+	ticket.gate.user = &ticket;
+	struct api_limits lim = s->cfg.limits;
+	lim.import_gate = &ticket.gate;
+	enum api_result pr = api_scene_parse_parts(req->body, req->body_len, &lim, parts, nparts, scp, &p);
+	if (pr != API_OK && ticket.refused) {
+		api_scene_free(*scp);
+		*scp = NULL;
+		srv_imports_park(s->imports, req);
+		return 2;
+	}
 	/* The body and parts are no longer needed: give their memory back before the render. */
 	srv_request_drop_body(req);
 	if (pr != API_OK) {
@@ -390,7 +417,9 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 /* One request from the queue: parse, admit by memory, render, encode, answer. Returns the
  * lost context's generation + 1 when its render lost the device (the caller recovers after
  * answering), else 0. */
-static unsigned job_run(struct srv_server *s, struct srv_request *req)
+/* Answers req (or, on a worker, parks it for an import thread: *parked). Returns the lost
+ * context's generation + 1 after a device loss, else 0. */
+static unsigned job_run(struct srv_server *s, struct srv_request *req, bool importer, bool *parked)
 {
 	unsigned lost_gen = 0;
 	double t_pop = srv_now();
@@ -409,7 +438,9 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	size_t len = 0;
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
 	double parse_s = 0;
-	if (job_parse(s, req, &sc, &parse_s)) goto out;
+	int pr = job_parse(s, req, importer, &sc, &parse_s);
+	*parked = pr == 2;
+	if (pr) goto out;
 
 	double t1 = srv_now();
 	if (past_deadline(s, req, t1)) {
@@ -429,7 +460,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req)
 	/* One render at a time on a CPU device (server/gate.h); parse and encode stay parallel. */
 	struct srv_gate_waiter gw;
 	double t_gate = srv_now();
-	if (!srv_gate_enter(&s->gate, &gw, req->t_queued,
+	if (!srv_gate_enter_prio(&s->gate, &gw, (unsigned)req->priority, req->t_queued,
 	                    s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0)) {
 		job_deadline(s, req, "while waiting for the device", srv_now());
 		goto out;
@@ -491,8 +522,9 @@ static void *worker_main(void *arg)
 	struct srv_server *s = arg;
 	struct srv_request *req;
 	while ((req = srv_queue_pop_idle(s->queue, s->cfg.idle_trim_s, idle_trim, s))) {
-		unsigned lost_gen = job_run(s, req);
-		srv_request_finish(req);
+		bool parked = false;
+		unsigned lost_gen = job_run(s, req, false, &parked);
+		if (!parked) srv_request_finish(req);
 		srv_queue_done(s->queue);
 		/* After the answer: the client learns of the failure at once, /readyz is already 503. */
 		if (lost_gen)
@@ -501,15 +533,38 @@ static void *worker_main(void *arg)
 	return NULL;
 }
 
+/* An import thread (server/imports.h): the requests the workers parked, to the end. */
+static void *importer_main(void *arg)
+{
+	struct srv_server *s = arg;
+	struct srv_request *req;
+	while ((req = srv_imports_take(s->imports))) {
+		bool parked = false;
+		uint64_t client = req->client;
+		unsigned lost_gen = job_run(s, req, true, &parked);
+		srv_request_finish(req);
+		srv_imports_done(s->imports, client);
+		if (lost_gen)
+			context_recover(s, lost_gen - 1);
+	}
+	return NULL;
+}
+
+static unsigned import_threads(const struct srv_server *s)
+{
+	return s->cfg.import_slots ? s->cfg.import_slots : s->cfg.workers;
+}
+
 int srv_workers_start(struct srv_server *s)
 {
-	s->threads = calloc(s->cfg.workers, sizeof *s->threads);
+	unsigned n = s->cfg.workers + import_threads(s);
+	s->threads = calloc(n, sizeof *s->threads);
 	if (!s->threads) {
-		srv_log(SRV_LOG_ERROR, "cannot allocate %u worker threads", s->cfg.workers);
+		srv_log(SRV_LOG_ERROR, "cannot allocate %u worker threads", n);
 		return -1;
 	}
-	for (unsigned i = 0; i < s->cfg.workers; i++) {
-		int e = pthread_create(&s->threads[i], NULL, worker_main, s);
+	for (unsigned i = 0; i < n; i++) {
+		int e = pthread_create(&s->threads[i], NULL, i < s->cfg.workers ? worker_main : importer_main, s);
 		if (e != 0) {
 			srv_log(SRV_LOG_ERROR, "cannot start worker thread %u: %s", i, strerror(e));
 			return -1; /* srv_workers_join() joins those started */
@@ -521,7 +576,13 @@ int srv_workers_start(struct srv_server *s)
 
 void srv_workers_join(struct srv_server *s)
 {
-	for (unsigned i = 0; i < s->thread_count; i++)
+	/* The workers first (the queue is closed): none parks a request after that, and the import
+	 * threads then answer what is parked and end. */
+	unsigned w = s->thread_count < s->cfg.workers ? s->thread_count : s->cfg.workers;
+	for (unsigned i = 0; i < w; i++)
+		pthread_join(s->threads[i], NULL);
+	srv_imports_close(s->imports);
+	for (unsigned i = w; i < s->thread_count; i++)
 		pthread_join(s->threads[i], NULL);
 	free(s->threads);
 	s->threads = NULL;

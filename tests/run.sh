@@ -52,6 +52,7 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -f tests/http/run.sh ] && [ -x "$BUILD/umbrad" ] && run_suite http sh tests/http/run.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-limits sh tests/http/limits.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-sandbox sh tests/http/sandbox.sh
+[ -x "$BUILD/umbrad" ] && run_suite http-imports sh tests/http/imports.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-assets sh tests/http/assets.sh
 [ -z "${ASAN:-}" ] && run_suite deploy sh deploy/check.sh
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
