@@ -25,6 +25,7 @@
 #include "model_lod.h"
 #include "umbra/rnd_math.h"
 #include "sandbox.h"
+#include "sandbox_stats.h"
 
 struct model_priv {
 	struct api_model pub;
@@ -336,11 +337,13 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	uint64_t cache_bytes = cache_limit;
 	pthread_mutex_unlock(&cache_mu);
 	if (!cache_bytes || cost > cache_bytes || !(m->src = malloc(len))) {
+		api_sbx_stats_import_times(&m->pub.times);
 		*out = &m->pub;    /* not cached: the caller's reference is the only one */
 		return API_OK;
 	}
 	texture_chains(&m->pub, m->arena, true);
 	m->pub.times.ms[API_IMPORT_MIPS] = (float)(api_clock_ms() - t0);
+	api_sbx_stats_import_times(&m->pub.times);
 	memcpy(m->src, data, len);
 	m->src_len = len;
 	m->model_len = model_len;

@@ -23,6 +23,7 @@
 #include "model_lod.h"
 #include "model_wire.h"
 #include "sandbox.h"
+#include "sandbox_stats.h"
 #include "umbra/rnd_math.h"
 
 extern char **environ;
@@ -145,6 +146,7 @@ static int start_server(char *err, size_t errsize)
 	}
 	ctl_fd = sv[0];
 	server_pid = pid;
+	api_sbx_stats_server_started();
 	return 0;
 }
 
@@ -253,20 +255,26 @@ static const char *signal_name(int sig)
 	}
 }
 
-/* How the child ended, when it did not end well; 0 when it exited 0 (the reply decides). */
+/* How the child ended, when it did not end well (*how says which way, for the counters); 0 when
+ * it exited 0 (the reply decides). */
 static int classify(const struct api_sbx_status *st, bool got_reply, const struct api_sbx_request *rq, int *status,
-                    char *err, size_t errsize)
+                    enum api_sbx_outcome *how, char *err, size_t errsize)
 {
 	unsigned cpu_s = (rq->timeout_ms + 999) / 1000;
+	*how = API_SBX_OUT_CRASHED;
 	switch (st->how) {
 	case API_SBX_TIMED_OUT:
+		*how = API_SBX_OUT_TIMED_OUT;
 		return fail(status, 422, err, errsize, "took longer than the import time limit of %u ms", rq->timeout_ms), -1;
 	case API_SBX_REFUSED:
+		*how = API_SBX_OUT_ERROR;
 		return fail(status, 500, err, errsize, "the model importer could not start a process (%s)",
 		            strerror(st->code)), -1;
 	case API_SBX_SIGNALED:
-		if (st->code == SIGXCPU || st->code == SIGKILL)
+		if (st->code == SIGXCPU || st->code == SIGKILL) {
+			*how = API_SBX_OUT_TIMED_OUT;
 			return fail(status, 422, err, errsize, "used more than the import CPU time limit of %u s", cpu_s), -1;
+		}
 		if (st->code == SIGSYS)
 			return fail(status, 400, err, errsize, "the importer was stopped by its sandbox (a forbidden system "
 			            "call) while reading it"), -1;
@@ -274,6 +282,8 @@ static int classify(const struct api_sbx_status *st, bool got_reply, const struc
 		            signal_name(st->code), st->code), -1;
 	case API_SBX_EXITED:
 		if (st->code == 0 && got_reply) return 0;
+		*how = st->code == API_SBX_EXIT_OOM ? API_SBX_OUT_OVER_MEMORY
+		     : st->code == API_SBX_EXIT_SETUP ? API_SBX_OUT_ERROR : API_SBX_OUT_CRASHED;
 		if (st->code == API_SBX_EXIT_OOM)
 			return fail(status, 422, err, errsize, "needed more than the import memory limit of %llu MiB",
 			            (unsigned long long)(rq->memory >> 20)), -1;
@@ -281,14 +291,27 @@ static int classify(const struct api_sbx_status *st, bool got_reply, const struc
 			return fail(status, 500, err, errsize, "the model importer could not set up its sandbox"), -1;
 		return fail(status, 400, err, errsize, "the importer failed reading it (exit status %d)", st->code), -1;
 	default:
+		*how = API_SBX_OUT_ERROR;
 		return fail(status, 500, err, errsize, "the model importer sent an unknown status"), -1;
 	}
 }
 
-/* One job: its reply (malloc'd, header checked) or a classified failure. */
+static enum api_sbx_job job_of(uint32_t kind)
+{
+	return kind == API_WIRE_LEVELS ? API_SBX_JOB_LEVELS : kind == API_WIRE_IMAGE ? API_SBX_JOB_IMAGE : API_SBX_JOB_MODEL;
+}
+
+/* The counters' end of a job that started at t0_ms (api_clock_ms). */
+static void job_ended(uint32_t kind, enum api_sbx_outcome how, double t0_ms)
+{
+	api_sbx_stats_ended(job_of(kind), how, (api_clock_ms() - t0_ms) / 1e3);
+}
+
+/* One job: its reply (malloc'd, header checked) or a classified failure, *how the outcome
+ * (API_SBX_OUT_OK with API_OK; the caller's check of the body may still refuse it). */
 static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, const struct api_limits *lim,
-                               uint8_t **reply, const uint8_t **body, size_t *body_len, int *status, char *err,
-                               size_t errsize)
+                               uint8_t **reply, const uint8_t **body, size_t *body_len, enum api_sbx_outcome *how,
+                               int *status, char *err, size_t errsize)
 {
 	struct api_limits def;
 	if (!lim) {
@@ -299,6 +322,8 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 	rq->timeout_ms = lim->import_timeout_ms ? lim->import_timeout_ms : 10000;
 	rq->memory = lim->import_memory;
 	*reply = NULL;
+	*how = API_SBX_OUT_ERROR;
+	api_sbx_stats_started(job_of(rq->kind));
 	int ds[2], ps[2];
 	if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ds) < 0)
 		return fail(status, 500, err, errsize, "cannot create a socket for the importer: %s", strerror(errno));
@@ -326,20 +351,25 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 	if (!got) shutdown(ds[0], SHUT_RDWR);
 	struct api_sbx_status st;
 	if (read_status(ps[0], deadline, &st) < 0) {
-		if (now_ms() >= deadline) fail(status, 422, err, errsize, "took longer than the import time limit of %u ms",
-		                               rq->timeout_ms);
-		else fail(status, 500, err, errsize, "the model importer stopped before reporting");
+		if (now_ms() >= deadline) {
+			*how = API_SBX_OUT_TIMED_OUT;
+			fail(status, 422, err, errsize, "took longer than the import time limit of %u ms", rq->timeout_ms);
+		} else {
+			fail(status, 500, err, errsize, "the model importer stopped before reporting");
+		}
 		goto out;
 	}
-	if (classify(&st, got, rq, status, err, errsize) < 0) goto out;
+	if (classify(&st, got, rq, status, how, err, errsize) < 0) goto out;
 	enum api_wire_kind kind = rq->kind;
 	enum api_wire_status ws;
 	char msg[API_WIRE_MAX_MESSAGE + 1], werr[200];
 	if (api_wire_header(*reply, rlen, &kind, &ws, msg, sizeof msg, body, body_len, werr, sizeof werr) != API_OK ||
 	    kind != rq->kind) {
+		*how = API_SBX_OUT_INVALID;
 		fail(status, 400, err, errsize, "%s", kind != rq->kind ? "the importer's reply is of the wrong kind" : werr);
 		goto out;
 	}
+	*how = ws == API_WIRE_OK ? API_SBX_OUT_OK : ws == API_WIRE_OVER_MEMORY ? API_SBX_OUT_OVER_MEMORY : API_SBX_OUT_INVALID;
 	if (ws == API_WIRE_BAD_INPUT) fail(status, 400, err, errsize, "%s", msg);
 	else if (ws == API_WIRE_OVER_MEMORY)
 		fail(status, 422, err, errsize, "needed more than the import memory limit of %llu MiB (%s)",
@@ -367,11 +397,16 @@ enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_l
 	uint8_t *reply;
 	const uint8_t *body;
 	size_t blen;
+	enum api_sbx_outcome how;
 	double t0 = api_clock_ms();
-	if (run_job(&rq, bundle, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
+	if (run_job(&rq, bundle, lim, &reply, &body, &blen, &how, status, err, errsize) != API_OK) {
+		job_ended(rq.kind, how, t0);
+		return API_ERR;
+	}
 	double t1 = api_clock_ms();
 	enum api_result rc = api_wire_decode_model(body, blen, arena, MAX_TEXTURE_PIXELS, out, bytes, err, errsize);
 	if (rc != API_OK) *status = 400;
+	job_ended(rq.kind, rc == API_OK ? API_SBX_OUT_OK : API_SBX_OUT_INVALID, t0);
 	/* the round trip less what the importer says it spent (its clock is this machine's) */
 	float work = 0;
 	for (int k = API_IMPORT_PARSE; k <= API_IMPORT_LEVEL; k++) work += out->times.ms[k];
@@ -439,8 +474,14 @@ enum api_result api_sandbox_build_levels(const struct api_model *m, uint32_t sid
 	uint8_t *reply;
 	const uint8_t *body;
 	size_t blen;
-	if (run_job(&rq, in.data, lim, &reply, &body, &blen, status, err, errsize) != API_OK) goto out;
+	enum api_sbx_outcome how;
+	double t0 = api_clock_ms();
+	if (run_job(&rq, in.data, lim, &reply, &body, &blen, &how, status, err, errsize) != API_OK) {
+		job_ended(rq.kind, how, t0);
+		goto out;
+	}
 	rc = api_wire_decode_levels(body, blen, sent, n, arena, got, bytes, err, errsize);
+	job_ended(rq.kind, rc == API_OK ? API_SBX_OUT_OK : API_SBX_OUT_INVALID, t0);
 	free(reply);
 	if (rc != API_OK) {
 		*status = 400;
@@ -513,9 +554,15 @@ enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64
 	uint8_t *reply;
 	const uint8_t *body;
 	size_t blen;
-	if (run_job(&rq, data, lim, &reply, &body, &blen, status, err, errsize) != API_OK) return API_ERR;
+	enum api_sbx_outcome how;
+	double t0 = api_clock_ms();
+	if (run_job(&rq, data, lim, &reply, &body, &blen, &how, status, err, errsize) != API_OK) {
+		job_ended(rq.kind, how, t0);
+		return API_ERR;
+	}
 	enum api_result rc = api_wire_decode_image(body, blen, max_pixels, rgba, w, h, err, errsize);
 	if (rc != API_OK) *status = 400;
+	job_ended(rq.kind, rc == API_OK ? API_SBX_OUT_OK : API_SBX_OUT_INVALID, t0);
 	free(reply);
 	return rc;
 }

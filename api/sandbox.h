@@ -36,6 +36,8 @@
  * Outcomes: API_OK; else *status says 400 (the bytes are bad: the parser refused them, crashed,
  * or was stopped by the filter), 422 (over the time or memory limit) or 500 (the helper could
  * not be started), with a sentence in err that names no member (the caller adds the pointer).
+ * Each job is counted by how it ended, with its time and the fork server's restarts, for
+ * /metrics: api/sandbox_stats.h.
  *
  * Threading: every function is thread-safe. The fork server is started on first use and
  * restarted when it died; a mutex guards only that start, never a job.

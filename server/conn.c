@@ -2,10 +2,10 @@
  * umbrad connections: the listen address, the file-descriptor budget, the per-connection
  * header timeout and the HTTP/1.1 framing checks libmicrohttpd 0.9.75 does not make.
  *
- * Called by http.c only, on libmicrohttpd's polling thread (srv_conn_notify,
+ * Called by http.c only, on libmicrohttpd's polling thread (srv_conn_accept, srv_conn_notify,
  * srv_conn_framing_error, srv_conn_request_begins) or before it starts (srv_conn_prepare,
- * srv_conn_listen_addr). Holds no state of its own: the timeouts live in libmicrohttpd's
- * connection, the limits in struct srv_config.
+ * srv_conn_share_start, srv_conn_listen_addr). The timeouts live in libmicrohttpd's
+ * connection, the limits in struct srv_config, the connections per range in s->ranges.
  *
  * What the library answers by itself (HTML, before any callback of ours runs) is listed in the
  * README ("Limits of the HTTP layer"); srv_conn_framing_error covers what it lets through.
@@ -21,6 +21,7 @@
 
 #include "conn.h"
 #include "log.h"
+#include "ranges.h"
 
 /* File descriptors kept for everything that is not a client connection: the listen socket,
  * the epoll and signalling descriptors, the Vulkan driver, the pipeline cache, log output. */
@@ -45,6 +46,32 @@ void srv_conn_prepare(struct srv_config *cfg)
 	srv_log(SRV_LOG_WARN, "--max-connections %u lowered to %u: the open-file limit is %llu", cfg->max_connections,
 	        fit, (unsigned long long)rl.rlim_cur);
 	cfg->max_connections = fit;
+}
+
+int srv_conn_share_start(struct srv_server *s)
+{
+	struct srv_config *cfg = &s->cfg;
+	if (cfg->max_connections_per_range == SRV_SHARE_DEFAULT)
+		cfg->max_connections_per_range = cfg->max_connections / 4 ? cfg->max_connections / 4 : 1;
+	s->ranges = srv_ranges_create(cfg->max_connections_per_range, cfg->max_connections);
+	if (!s->ranges) {
+		srv_log(SRV_LOG_ERROR, "out of memory for the table of %u connections", cfg->max_connections);
+		return -1;
+	}
+	return 0;
+}
+
+void srv_conn_share_stop(struct srv_server *s)
+{
+	srv_ranges_destroy(s->ranges);
+	s->ranges = NULL;
+}
+
+enum MHD_Result srv_conn_accept(void *cls, const struct sockaddr *addr, socklen_t len)
+{
+	struct srv_server *s = cls;
+	(void)len;
+	return srv_ranges_admit(s->ranges, addr) ? MHD_YES : MHD_NO;
 }
 
 int srv_conn_listen_addr(const char *listen, struct sockaddr_storage *ss, socklen_t *len)
@@ -80,11 +107,31 @@ int srv_conn_listen_addr(const char *listen, struct sockaddr_storage *ss, sockle
 	return 0;
 }
 
+/* socket_ctx of a connection that counts for its range (srv_ranges_open said yes). */
+static char counted_mark;
+
+/* Counts the connection for its range at start (the accept policy's check and this count run
+ * one after the other on the polling thread, with no other accept between them), and uncounts
+ * it at close. */
+static void count_connection(struct srv_server *s, struct MHD_Connection *conn, void **socket_ctx,
+                             enum MHD_ConnectionNotificationCode code)
+{
+	const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+	const struct sockaddr *sa = ci ? ci->client_addr : NULL;
+	if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+		*socket_ctx = srv_ranges_open(s->ranges, sa) ? &counted_mark : NULL;
+	} else if (code == MHD_CONNECTION_NOTIFY_CLOSED && *socket_ctx == &counted_mark) {
+		srv_ranges_close(s->ranges, sa);
+		*socket_ctx = NULL;
+	}
+}
+
 void srv_conn_notify(void *cls, struct MHD_Connection *conn, void **socket_ctx,
                      enum MHD_ConnectionNotificationCode code)
 {
-	const struct srv_config *cfg = cls;
-	(void)socket_ctx;
+	struct srv_server *s = cls;
+	const struct srv_config *cfg = &s->cfg;
+	count_connection(s, conn, socket_ctx, code);
 	/* A new connection gets the shorter header timeout until its first request head is
 	 * complete (srv_conn_request_begins): a client that connects and sends nothing, or
 	 * almost nothing, holds a slot for seconds rather than a whole keep-alive period. The

@@ -51,6 +51,7 @@ static const struct opt_def opts[] = {
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
 	{ "max-connections", OPT_UINT, "N", "concurrent connections; more are closed unanswered (1024)", CFG(max_connections), 1, 1000000 },
 	{ "max-connections-per-ip", OPT_UINT, "N", "concurrent connections from one client address, 0 = no limit (256)", CFG(max_connections_per_ip), 0, 1000000 },
+	{ "max-connections-per-range", OPT_UINT, "N", "concurrent connections from one client address range (IPv4 /24, IPv6 /64; loopback too); more are closed unanswered at accept, 0 = no limit (a quarter of --max-connections)", CFG(max_connections_per_range), 0, 1000000 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
 	{ "max-memory", OPT_SIZE, "BYTES", "memory renders in flight may need together; a render estimated over it is a 422, others wait (half the machine's or container's memory)", CFG(max_memory), 0, UINT64_MAX },
 	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
@@ -221,6 +222,7 @@ static void set_defaults(struct srv_config *cfg)
 	 * the connections still leaves room for a balancer's pool (haproxy's per-server maxconn
 	 * is far lower) while one direct client can no longer take them all. */
 	cfg->max_connections_per_ip = 256;
+	cfg->max_connections_per_range = SRV_SHARE_DEFAULT;   /* a quarter of the final max_connections (conn.c) */
 	cfg->header_timeout_s = 10;
 	cfg->drain_timeout_s = 60;
 	cfg->idle_trim_s = 30;

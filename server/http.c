@@ -390,7 +390,7 @@ int srv_http_start(struct srv_server *s)
 	struct sockaddr_storage ss;
 	socklen_t sl;
 	srv_conn_prepare(&s->cfg);
-	if (srv_conn_listen_addr(s->cfg.listen, &ss, &sl) != 0)
+	if (srv_conn_listen_addr(s->cfg.listen, &ss, &sl) != 0 || srv_conn_share_start(s) != 0)
 		return -1;
 	/* poll(), not epoll: libmicrohttpd 0.9.75 registers sockets edge-triggered and takes a
 	 * short recv() as "drained", so the end of a client that closes right after a partial
@@ -401,13 +401,13 @@ int srv_http_start(struct srv_server *s)
 	                 MHD_USE_POLL;
 	if (ss.ss_family == AF_INET6)
 		flags |= MHD_USE_IPv6;
-	s->daemon = MHD_start_daemon(flags, 0, NULL, NULL, access_handler, s,
+	s->daemon = MHD_start_daemon(flags, 0, srv_conn_accept, s, access_handler, s,
 	                             MHD_OPTION_EXTERNAL_LOGGER, mhd_log, s,
 	                             MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&ss,
 	                             MHD_OPTION_CONNECTION_LIMIT, (unsigned)s->cfg.max_connections,
 	                             MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)s->cfg.max_connections_per_ip,
 	                             MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)s->cfg.idle_timeout_s,
-	                             MHD_OPTION_NOTIFY_CONNECTION, srv_conn_notify, &s->cfg,
+	                             MHD_OPTION_NOTIFY_CONNECTION, srv_conn_notify, s,
 	                             /* 0, not 1: at 1 the library answers a missing Host itself
 	                              * (HTML, header block sent twice in 0.9.75); conn.c checks it */
 	                             MHD_OPTION_STRICT_FOR_CLIENT, 0,
@@ -416,6 +416,7 @@ int srv_http_start(struct srv_server *s)
 	                             MHD_OPTION_END);
 	if (!s->daemon) {
 		int e = errno;
+		srv_conn_share_stop(s);
 		srv_log(SRV_LOG_ERROR, "cannot listen on %s: %s%s", s->cfg.listen, strerror(e),
 		        e == EADDRINUSE ? " (another process has that port: choose another --listen port, or port 0 "
 		                          "with --port-file for any free one)" : "");
@@ -464,4 +465,5 @@ void srv_http_stop(struct srv_server *s)
 	if (s->daemon)
 		MHD_stop_daemon(s->daemon);
 	s->daemon = NULL;
+	srv_conn_share_stop(s);
 }

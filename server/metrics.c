@@ -1,5 +1,6 @@
 /*
- * umbrad metrics (see metrics.h). Histograms use fixed latency buckets from 1 ms to 60 s.
+ * umbrad metrics (see metrics.h). Histograms use fixed latency buckets from 1 ms to 60 s, the
+ * same as the import sandbox's (API_STATS_BUCKET_BOUNDS, api/sandbox_stats.h).
  */
 #include "metrics.h"
 
@@ -12,10 +13,11 @@
 #include "buf.h"
 #include "imports.h"
 #include "queue.h"
+#include "ranges.h"
+#include "sandbox_stats.h"
 
-static const double bucket_bounds[] = { 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25,
-	0.5, 1, 2.5, 5, 10, 30, 60 };
-#define BUCKETS (sizeof bucket_bounds / sizeof bucket_bounds[0])
+/* One list of bounds for every histogram on /metrics: api/'s (the sandbox's are filled there). */
+#define BUCKETS API_STATS_BUCKETS
 
 struct srv_histogram {
 	uint64_t bucket[BUCKETS];   /* non-cumulative here, summed when written */
@@ -37,7 +39,7 @@ struct srv_metrics {
 	unsigned series_count;
 	struct srv_histogram duration[SRV_ROUTE_COUNT];
 	struct srv_histogram stage[SRV_STAGE_COUNT];
-	struct srv_histogram queue_wait;
+	struct srv_histogram queue_wait[SRV_PRIO_COUNT];
 	uint64_t counter[SRV_CTR_COUNT];
 };
 
@@ -64,7 +66,7 @@ void srv_metrics_destroy(struct srv_metrics *m)
 static void histogram_observe(struct srv_histogram *h, double v)
 {
 	size_t i = 0;
-	while (i < BUCKETS && v > bucket_bounds[i])
+	while (i < BUCKETS && v > API_STATS_BUCKET_BOUNDS[i])
 		i++;
 	if (i < BUCKETS)
 		h->bucket[i]++;
@@ -98,10 +100,12 @@ void srv_metrics_stage(struct srv_metrics *m, enum srv_stage stage, double secon
 	pthread_mutex_unlock(&m->mu);
 }
 
-void srv_metrics_queue_wait(struct srv_metrics *m, double seconds)
+void srv_metrics_queue_wait(struct srv_metrics *m, enum srv_priority prio, double seconds)
 {
+	if ((unsigned)prio >= SRV_PRIO_COUNT)
+		prio = SRV_PRIO_INTERACTIVE;
 	pthread_mutex_lock(&m->mu);
-	histogram_observe(&m->queue_wait, seconds);
+	histogram_observe(&m->queue_wait[prio], seconds);
 	pthread_mutex_unlock(&m->mu);
 }
 
@@ -112,25 +116,32 @@ void srv_metrics_add(struct srv_metrics *m, enum srv_counter c, uint64_t n)
 	pthread_mutex_unlock(&m->mu);
 }
 
-static void write_histogram(struct srv_buf *b, const char *name, const char *labels,
-                            const struct srv_histogram *h)
+/* One histogram's series from non-cumulative buckets (the server's and api/'s alike). */
+static void write_buckets(struct srv_buf *b, const char *name, const char *labels, const uint64_t *bucket,
+                          uint64_t count, double sum)
 {
 	uint64_t cum = 0;
 	const char *sep = labels[0] ? "," : "";
 	for (size_t i = 0; i < BUCKETS; i++) {
-		cum += h->bucket[i];
-		srv_buf_printf(b, "%s_bucket{%s%sle=\"%g\"} %llu\n", name, labels, sep, bucket_bounds[i],
+		cum += bucket[i];
+		srv_buf_printf(b, "%s_bucket{%s%sle=\"%g\"} %llu\n", name, labels, sep, API_STATS_BUCKET_BOUNDS[i],
 		               (unsigned long long)cum);
 	}
 	srv_buf_printf(b, "%s_bucket{%s%sle=\"+Inf\"} %llu\n", name, labels, sep,
-	               (unsigned long long)h->count);
+	               (unsigned long long)count);
 	if (labels[0]) {
-		srv_buf_printf(b, "%s_sum{%s} %.9g\n", name, labels, h->sum);
-		srv_buf_printf(b, "%s_count{%s} %llu\n", name, labels, (unsigned long long)h->count);
+		srv_buf_printf(b, "%s_sum{%s} %.9g\n", name, labels, sum);
+		srv_buf_printf(b, "%s_count{%s} %llu\n", name, labels, (unsigned long long)count);
 	} else {
-		srv_buf_printf(b, "%s_sum %.9g\n", name, h->sum);
-		srv_buf_printf(b, "%s_count %llu\n", name, (unsigned long long)h->count);
+		srv_buf_printf(b, "%s_sum %.9g\n", name, sum);
+		srv_buf_printf(b, "%s_count %llu\n", name, (unsigned long long)count);
 	}
+}
+
+static void write_histogram(struct srv_buf *b, const char *name, const char *labels,
+                            const struct srv_histogram *h)
+{
+	write_buckets(b, name, labels, h->bucket, h->count, h->sum);
 }
 
 static void write_counter(struct srv_buf *b, const char *name, const char *help, uint64_t v)
@@ -215,10 +226,45 @@ static void write_requests(struct srv_buf *b, const struct srv_metrics *snap)
 		write_histogram(b, "umbra_stage_seconds", labels, &snap->stage[st]);
 	}
 
-	srv_buf_puts(b, "# HELP umbra_queue_wait_seconds Time a render waited in the queue.\n"
+	srv_buf_puts(b, "# HELP umbra_queue_wait_seconds Time a render waited in the queue, by X-Priority.\n"
 	                 "# TYPE umbra_queue_wait_seconds histogram\n");
-	write_histogram(b, "umbra_queue_wait_seconds", "", &snap->queue_wait);
+	write_histogram(b, "umbra_queue_wait_seconds", "priority=\"interactive\"", &snap->queue_wait[SRV_PRIO_INTERACTIVE]);
+	write_histogram(b, "umbra_queue_wait_seconds", "priority=\"bulk\"", &snap->queue_wait[SRV_PRIO_BULK]);
+}
 
+/* The import sandbox (api/sandbox_stats.h): jobs, how they ended, fork-server restarts, times. */
+static void write_sandbox(struct srv_buf *b)
+{
+	struct api_sandbox_stats st;
+	char labels[128];
+	api_sandbox_stats(&st);
+	srv_buf_puts(b, "# HELP umbra_import_jobs_started_total Sandboxed importer jobs started, by job.\n"
+	                 "# TYPE umbra_import_jobs_started_total counter\n");
+	for (int j = 0; j < API_SBX_JOBS; j++)
+		srv_buf_printf(b, "umbra_import_jobs_started_total{job=\"%s\"} %llu\n", API_SBX_JOB_NAMES[j],
+		               (unsigned long long)st.started[j]);
+	srv_buf_puts(b, "# HELP umbra_import_jobs_total Sandboxed importer jobs ended, by job and result.\n"
+	                 "# TYPE umbra_import_jobs_total counter\n");
+	for (int j = 0; j < API_SBX_JOBS; j++)
+		for (int o = 0; o < API_SBX_OUTCOMES; o++)
+			srv_buf_printf(b, "umbra_import_jobs_total{job=\"%s\",result=\"%s\"} %llu\n", API_SBX_JOB_NAMES[j],
+			               API_SBX_OUTCOME_NAMES[o], (unsigned long long)st.ended[j][o]);
+	write_counter(b, "umbra_import_server_restarts_total",
+	              "Importer fork servers started again after one died or stopped answering.", st.server_restarts);
+	srv_buf_puts(b, "# HELP umbra_import_job_seconds Wall time of a sandboxed importer job, by job.\n"
+	                 "# TYPE umbra_import_job_seconds histogram\n");
+	for (int j = 0; j < API_SBX_JOBS; j++) {
+		const struct api_stats_histogram *h = &st.job_seconds[j];
+		snprintf(labels, sizeof labels, "job=\"%s\"", API_SBX_JOB_NAMES[j]);
+		write_buckets(b, "umbra_import_job_seconds", labels, h->bucket, h->count, h->sum);
+	}
+	srv_buf_puts(b, "# HELP umbra_import_seconds Time per stage of a model import (Server-Timing's model-*).\n"
+	                 "# TYPE umbra_import_seconds histogram\n");
+	for (int k = API_IMPORT_READ + 1; k < API_IMPORT_STAGES; k++) {   /* model-read is the request's */
+		const struct api_stats_histogram *h = &st.stage_seconds[k];
+		snprintf(labels, sizeof labels, "stage=\"%s\"", API_IMPORT_STAGE_NAMES[k]);
+		write_buckets(b, "umbra_import_seconds", labels, h->bucket, h->count, h->sum);
+	}
 }
 
 /* The queue and the workers, read live (gauges). */
@@ -246,6 +292,22 @@ static void write_queue(struct srv_buf *b, struct srv_server *s)
 	write_gauge(b, "umbra_imports_running", "Sandboxed model imports holding an import slot now (--import-slots).", running);
 	write_gauge(b, "umbra_imports_parked", "Requests waiting for an import slot, holding no thread.", parked);
 
+}
+
+/* Connections per address range (server/ranges.h), read live. */
+static void write_connections(struct srv_buf *b, struct srv_server *s)
+{
+	struct srv_ranges_stats st;
+	srv_ranges_stats(s->ranges, &st);
+	write_gauge(b, "umbra_connections_open", "Client connections open now (this scrape's own included).",
+	            (double)st.open);
+	write_gauge(b, "umbra_connection_ranges", "Client address ranges (IPv4 /24, IPv6 /64) with a connection open now.",
+	            (double)st.ranges);
+	write_gauge(b, "umbra_connections_per_range_limit", "--max-connections-per-range (0 = no limit).", st.share);
+	srv_buf_printf(b, "# HELP umbra_connections_refused_total Connections closed unanswered at accept, by reason.\n"
+	                  "# TYPE umbra_connections_refused_total counter\n"
+	                  "umbra_connections_refused_total{reason=\"range_share\"} %llu\n",
+	               (unsigned long long)st.refused);
 }
 
 static void write_renders(struct srv_buf *b, const struct srv_metrics *snap)
@@ -335,7 +397,9 @@ char *srv_metrics_text(struct srv_server *s, size_t *len)
 	pthread_mutex_unlock(&m->mu);
 	write_requests(&b, &snap);
 	write_queue(&b, s);
+	write_connections(&b, s);
 	write_renders(&b, &snap);
+	write_sandbox(&b);
 	write_device(&b, s);
 	write_process(&b, s);
 	return srv_buf_detach(&b, len);

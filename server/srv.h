@@ -8,6 +8,7 @@
  *   render_route.c  POST /v1/render: headers, body (JSON or multipart), ETag, queueing
  *   negotiate.c  pure rules: Content-Type, Accept, the ETag (negotiate.h)
  *   conn.c     connection limits and timeouts, HTTP/1.1 framing checks, the listen address
+ *   ranges.c   connections per client address range (--max-connections-per-range), pure
  *   queue.c    the bounded two-level (interactive before bulk) job queue
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
  *   gate.c     how many renders run on the device at once (--device-renders; 1 on lavapipe)
@@ -73,6 +74,9 @@ struct srv_config {
 	unsigned atlas_size;           /* shadow atlas side, 0 = renderer default */
 	unsigned max_connections;      /* concurrent TCP connections, default 1024 */
 	unsigned max_connections_per_ip; /* concurrent connections from one address, 0 = any, default 256 */
+	/* concurrent connections from one address range (IPv4 /24, IPv6 /64: server/ranges.h), 0 = any;
+	 * default SRV_SHARE_DEFAULT = a quarter of max_connections, resolved by srv_conn_share_start() */
+	unsigned max_connections_per_range;
 	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
 	unsigned header_timeout_s;     /* a new connection's first request head, 0 = idle, default 10 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
@@ -83,6 +87,8 @@ struct srv_config {
 	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */
 	const char *test_fault;        /* tests only: "submit:N:lost|oom" armed after warm-up */
 };
+
+#define SRV_SHARE_DEFAULT UINT32_MAX
 
 enum srv_route {
 	SRV_ROUTE_RENDER, SRV_ROUTE_HEALTHZ, SRV_ROUTE_READYZ, SRV_ROUTE_METRICS, SRV_ROUTE_INFO,
@@ -105,6 +111,7 @@ struct srv_server {
 	uint16_t port;
 	struct srv_queue *queue;
 	struct srv_metrics *metrics;
+	struct srv_ranges *ranges;     /* connections per address range (conn.c, server/ranges.h) */
 	struct srv_admit admit;        /* renders admitted by estimated memory (--max-memory) */
 	struct srv_gate gate;          /* renders on the device at once (--device-renders) */
 	struct srv_imports *imports;   /* requests parked for an import thread (--import-slots) */

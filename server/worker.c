@@ -423,7 +423,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 {
 	unsigned lost_gen = 0;
 	double t_pop = srv_now();
-	srv_metrics_queue_wait(s->metrics, t_pop - req->t_queued);
+	srv_metrics_queue_wait(s->metrics, req->priority, t_pop - req->t_queued);
 	if (past_deadline(s, req, t_pop)) {
 		job_deadline(s, req, "while waiting in the queue", t_pop);
 		return 0;

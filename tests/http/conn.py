@@ -3,11 +3,15 @@
 
   conn.py framing PORT SCENE PID   against a daemon with --header-timeout 1 --idle-timeout 8
   conn.py hogs PORT PID            against a daemon with the default limits and timeouts
+  conn.py ranges PORT PID          against a daemon with --max-connections 32
+                                   --max-connections-per-range 4
 
 Run by tests/http/conn.sh. Raw sockets, since curl and http.client cannot send the
-malformed requests. Loopback only: the daemon listens on 127.0.0.1; the "other client" binds
-its socket to 127.0.0.2 (any 127/8 address is local on Linux). Prints "ok - NAME" or
-"FAIL - NAME: why" per check. Every wait is bounded.
+malformed requests. Loopback only: the daemon listens on 127.0.0.1; other clients bind their
+sockets to other 127/8 addresses (all local on Linux): 127.0.0.2 is in 127.0.0.1's address
+range (127.0.0.0/24), 127.0.1.x and 127.0.2.x are other ranges. Prints "ok - NAME" or
+"FAIL - NAME: why" per check. Every wait is bounded, and none is a guess: the daemon's counts
+are read from /metrics.
 """
 import json
 import os
@@ -18,6 +22,7 @@ import sys
 import time
 
 MODE, PORT = sys.argv[1], int(sys.argv[2])
+HEALTHZ = b"GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n"
 SCENE = open(sys.argv[3], "rb").read() if MODE == "framing" else b""
 PID = int(sys.argv[4] if MODE == "framing" else sys.argv[3])
 results = []
@@ -246,19 +251,116 @@ def hogs(pid):
     # The other client must be answered while the 1024 sockets are still open and idle (well
     # within --header-timeout 10).
     try:
-        s = connect("127.0.0.2", timeout=5)
+        s = connect("127.0.1.2", timeout=5)
         s.sendall(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n")
         other = read_all(s, 5.0)
         s.close()
     except OSError as e:
         other = repr(e).encode()
-    check("1024 idle sockets from 127.0.0.1 do not shut out 127.0.0.2", parse(other)[0] == 200, repr(other[:100]))
+    check("1024 idle sockets from 127.0.0.1 do not shut out 127.0.1.2 (another address range)",
+          parse(other)[0] == 200, repr(other[:100]))
+    # 127.0.0.1's 256 are the share of its range, 127.0.0.0/24 (a quarter of 1024).
+    check("... while 127.0.0.2 (the same /24, at its share) is closed at accept, unanswered",
+          refused("127.0.0.2"), "it was answered")
+    for h in held:
+        h.close()
+
+
+def read_answer(s, limit=10.0):
+    """One answer on a kept-alive connection (head and Content-Length body), b"" at EOF."""
+    out = b""
+    end = time.monotonic() + limit
+    while time.monotonic() < end:
+        head, sep, body = out.partition(b"\r\n\r\n")
+        if sep:
+            m = re.search(rb"(?i)\r\ncontent-length: *([0-9]+)", head)
+            if len(body) >= (int(m.group(1)) if m else 0):
+                return out
+        try:
+            d = s.recv(65536)
+        except (socket.timeout, ConnectionResetError):
+            break
+        if not d:
+            break
+        out += d
+    return out
+
+
+def refused(src):
+    """A connection from src is closed at once without an answer."""
+    s = connect(src, timeout=5)
+    try:
+        s.sendall(HEALTHZ)
+        got = s.recv(65536)
+    except ConnectionResetError:
+        got = b""
+    except (socket.timeout, OSError):
+        got = b"(no close)"
+    s.close()
+    return got == b""
+
+
+def metrics(src):
+    """The daemon's /metrics as {series: value}, asked from src."""
+    a = exchange(b"GET /metrics HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", src)
+    out = {}
+    for ln in parse(a)[2].decode("utf-8", "replace").split("\n"):
+        if ln and not ln.startswith("#"):
+            k, _, v = ln.rpartition(" ")
+            out[k] = float(v)
+    return out
+
+
+def ranges():
+    """Share per address range 4 (IPv4 /24) of --max-connections 32: one range at its share is
+    refused at accept while another is served, the refusal is counted, a freed place is reused."""
+    REFUSED = 'umbra_connections_refused_total{reason="range_share"}'
+    held = []
+    answers = []
+    # Two addresses of 127.0.1.0/24, two kept-alive connections each: 4 = the range's share.
+    # Each is answered once, so the daemon has counted it before the next step.
+    for src in ("127.0.1.2", "127.0.1.2", "127.0.1.3", "127.0.1.3"):
+        s = connect(src)
+        s.sendall(HEALTHZ)
+        answers.append(parse(read_answer(s))[0])
+        held.append(s)
+    check("4 kept-alive connections from 127.0.1.2 and 127.0.1.3 answered 200", answers == [200] * 4, repr(answers))
+    m0 = metrics("127.0.3.2")
+    check("/metrics: the share is 4", m0.get("umbra_connections_per_range_limit") == 4,
+          repr(m0.get("umbra_connections_per_range_limit")))
+    check("a fifth connection from the range (127.0.1.4, a third address) is closed at accept, unanswered",
+          refused("127.0.1.4"), "it was answered")
+    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", "127.0.2.2")
+    check("another range (127.0.2.2) is served while 127.0.1.0/24 is at its share", parse(a)[0] == 200, repr(a[:100]))
+    m1 = metrics("127.0.3.2")
+    check("/metrics: exactly that one refusal counted (reason range_share)",
+          m1.get(REFUSED, -1) - m0.get(REFUSED, 0) == 1, "%r -> %r" % (m0.get(REFUSED), m1.get(REFUSED)))
+    check("/metrics: the held connections are open (and counted in ranges)",
+          m1.get("umbra_connections_open", 0) >= 5 and m1.get("umbra_connection_ranges", 0) >= 2,
+          "open %r ranges %r" % (m1.get("umbra_connections_open"), m1.get("umbra_connection_ranges")))
+    # One of the range's connections closes: once the daemon has let it go (3 held + the scrape
+    # itself; a scrape just answered may still be counted for a moment), the range fits again.
+    held.pop().close()
+    m = {}
+    for _ in range(100):
+        m = metrics("127.0.3.2")
+        if m.get("umbra_connections_open", 99) <= len(held) + 1:
+            break
+        time.sleep(0.1)
+    check("the daemon lets the closed connection go (umbra_connections_open %r)" % m.get("umbra_connections_open"),
+          m.get("umbra_connections_open", 99) <= len(held) + 1)
+    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", "127.0.1.4")
+    check("a freed place in the share serves the range again (127.0.1.4)", parse(a)[0] == 200, repr(a[:100]))
+    m2 = metrics("127.0.3.2")
+    check("/metrics: no further refusal", m2.get(REFUSED, -1) == m1.get(REFUSED), repr(m2.get(REFUSED)))
     for h in held:
         h.close()
 
 
 if sys.argv[1] == "hogs":
     hogs(PID)
+elif sys.argv[1] == "ranges":
+    ranges()
 else:
     framing_and_timeouts()
 print("%d passed, %d failed" % (results.count(True), results.count(False)))

@@ -9,12 +9,14 @@ finish() { echo "$pass passed, $fail failed"; [ "$fail" -eq 0 ]; exit $?; }
 
 # ---- flags ----
 "$UMBRAD" --help >"$T/help" 2>&1
-for f in --max-connections --max-connections-per-ip --idle-timeout --header-timeout; do
+for f in --max-connections --max-connections-per-ip --max-connections-per-range --idle-timeout --header-timeout; do
 	if grep -q -- "$f " "$T/help"; then ok "--help lists $f"; else nok "--help lists $f"; fi
 done
 # (bounded, on an ephemeral port: a daemon that accepted the value would otherwise keep running)
 UMBRA_MAX_CONNECTIONS_PER_IP=many timeout 20 "$UMBRAD" --listen 127.0.0.1:0 >/dev/null 2>&1
 [ $? = 2 ] && ok "bad UMBRA_MAX_CONNECTIONS_PER_IP exits 2" || nok "bad UMBRA_MAX_CONNECTIONS_PER_IP exits 2"
+timeout 20 "$UMBRAD" --listen 127.0.0.1:0 --max-connections-per-range -1 >/dev/null 2>&1
+[ $? = 2 ] && ok "bad --max-connections-per-range exits 2" || nok "bad --max-connections-per-range exits 2"
 
 # ---- daemons ----
 cat >"$T/scene.json" <<'EOF'
@@ -85,6 +87,11 @@ if start fdlimit; then
 	stop fdlimit
 fi
 UMBRAD=$UMBRAD_REAL
+# Share per address range: one /24 at its share, another served.
+if start ranges --max-connections 32 --max-connections-per-range 4; then
+	run_py ranges "$PORT" "$PID"
+	stop ranges
+fi
 # One client's idle sockets against the default limits.
 if start hogs; then
 	run_py hogs "$PORT" "$PID"

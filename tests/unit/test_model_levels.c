@@ -13,6 +13,7 @@
 #include "model_lod.h"
 #include "model_wire.h"
 #include "models.h"
+#include "sandbox_stats.h"
 #include "test.h"
 
 static struct api_model *get(const uint8_t *d, size_t len, uint32_t side, uint32_t timeout_ms)
@@ -98,11 +99,20 @@ TEST(model_level_for_another_size_equals_a_fresh_imports)
 	size_t len;
 	uint64_t built0, refused0, built1, refused1;
 	struct api_model *a, *b;   /* b: a hit, for 128^2 images */
+	struct api_sandbox_stats s0, s1;
+	api_sandbox_stats(&s0);
 	uint8_t *d = import_then_hit(&len, 128, 0, &a, &b, &built0, &refused0);
 	REQUIRE(d && a && b == a);
 	api_levels_stats(&built1, &refused1);
 	CHECK(built1 == built0 + 1 && refused1 == refused0, "built %llu, refused %llu", (unsigned long long)(built1 - built0),
 	      (unsigned long long)(refused1 - refused0));
+	/* /metrics' view (api/sandbox_stats.h): one import, then one levels job, both ok and timed. */
+	api_sandbox_stats(&s1);
+	CHECK(s1.ended[API_SBX_JOB_LEVELS][API_SBX_OUT_OK] == s0.ended[API_SBX_JOB_LEVELS][API_SBX_OUT_OK] + 1 &&
+	      s1.job_seconds[API_SBX_JOB_LEVELS].count == s0.job_seconds[API_SBX_JOB_LEVELS].count + 1 &&
+	      s1.ended[API_SBX_JOB_MODEL][API_SBX_OUT_OK] == s0.ended[API_SBX_JOB_MODEL][API_SBX_OUT_OK] + 1,
+	      "levels job counted once, the import once");
+	CHECK(s1.stage_seconds[API_IMPORT_LEVEL].sum > s0.stage_seconds[API_IMPORT_LEVEL].sum, "the import's level timed");
 	uint32_t n128, n256;
 	const struct rnd_mesh_lod *l128 = api_model_mesh_lods(a, 0, 128, &n128), *l256 = api_model_mesh_lods(a, 0, 256, &n256);
 	REQUIRE(n128 == 1 && n256 == 1, "%u and %u levels", n128, n256);
@@ -133,10 +143,15 @@ TEST(model_level_build_is_bounded_by_the_import_limits)
 	size_t len;
 	uint64_t built0, refused0, built1, refused1;
 	struct api_model *a, *b;   /* b: the hit that asks for 512^2, 1 ms */
+	struct api_sandbox_stats s0, s1;
+	api_sandbox_stats(&s0);
 	uint8_t *d = import_then_hit(&len, 512, 1, &a, &b, &built0, &refused0);
 	REQUIRE(d && a && b == a);
 	struct api_model *c = get(d, len, 512, 0);
 	api_levels_stats(&built1, &refused1);
+	api_sandbox_stats(&s1);
+	CHECK(s1.ended[API_SBX_JOB_LEVELS][API_SBX_OUT_TIMED_OUT] == s0.ended[API_SBX_JOB_LEVELS][API_SBX_OUT_TIMED_OUT] + 1,
+	      "the stopped levels job counted as timed out");
 	uint32_t n;
 	api_model_mesh_lods(a, 0, 512, &n);
 	CHECK(n == 0 && built1 == built0 && refused1 == refused0 + 1, "%u levels, built %llu, refused %llu", n,

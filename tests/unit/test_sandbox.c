@@ -17,6 +17,7 @@
 #include "model.h"
 #include "model_wire.h"
 #include "sandbox.h"
+#include "sandbox_stats.h"
 #include "test.h"
 #include "util.h"
 
@@ -76,6 +77,14 @@ static struct api_limits limits(uint32_t timeout_ms)
 
 /* ---- crash, hang, no global lock ---- */
 
+/* ended[model][how] - before (api/sandbox_stats.h); the tests run one at a time. */
+static uint64_t ended_since(const struct api_sandbox_stats *before, enum api_sbx_outcome how)
+{
+	struct api_sandbox_stats now;
+	api_sandbox_stats(&now);
+	return now.ended[API_SBX_JOB_MODEL][how] - before->ended[API_SBX_JOB_MODEL][how];
+}
+
 TEST(sandbox_crashing_ply_is_400)
 {
 	uint8_t buf[1024];
@@ -84,13 +93,21 @@ TEST(sandbox_crashing_ply_is_400)
 	struct api_model *m = NULL;
 	char err[400];
 	int st = 0;
+	struct api_sandbox_stats s0, s1;
+	api_sandbox_stats(&s0);
 	CHECK(api_model_get(buf, n, API_MODEL_PLY, &l, &m, &st, err, sizeof err) == API_ERR && !m);
 	CHECK(st == 400, "status %d: %s", st, err);
+	CHECK(ended_since(&s0, API_SBX_OUT_CRASHED) == 1, "counted as crashed");
 	/* The process that asked is still here, and the next import works. */
 	CHECK(api_model_get((const uint8_t *)OBJ_TRI, strlen(OBJ_TRI), API_MODEL_OBJ, &l, &m, &st, err, sizeof err) ==
 	      API_OK, "%s", err);
 	CHECK(m && m->triangles == 1);
 	api_model_release(m);
+	api_sandbox_stats(&s1);
+	CHECK(ended_since(&s0, API_SBX_OUT_OK) == 1 && s1.started[API_SBX_JOB_MODEL] - s0.started[API_SBX_JOB_MODEL] == 2);
+	CHECK(s1.job_seconds[API_SBX_JOB_MODEL].count - s0.job_seconds[API_SBX_JOB_MODEL].count == 2);
+	CHECK(s1.stage_seconds[API_IMPORT_PARSE].count - s0.stage_seconds[API_IMPORT_PARSE].count == 1,
+	      "the stages of the one import that succeeded");
 }
 
 struct hang_arg {
@@ -149,8 +166,11 @@ TEST(sandbox_memory_limit_is_422)
 	struct api_model *m = NULL;
 	char err[400];
 	int st;
+	struct api_sandbox_stats s0;
+	api_sandbox_stats(&s0);
 	CHECK(api_model_get(stl, n, API_MODEL_STL, &l, &m, &st, err, sizeof err) == API_ERR && !m);
 	CHECK(st == 422 && strstr(err, "memory limit"), "status %d: %s", st, err);
+	CHECK(ended_since(&s0, API_SBX_OUT_OVER_MEMORY) == 1, "counted as over memory");
 	/* The same file under the default limit imports. */
 	l.import_memory = 0;
 	CHECK(api_model_get(stl, n, API_MODEL_STL, &l, &m, &st, err, sizeof err) == API_OK, "%d %s", st, err);
