@@ -17,12 +17,14 @@ static const struct {
 	const char *title;
 } problem_types[] = {
 	{400, "invalid-scene", "Invalid scene"},
+	{403, "origin-not-allowed", "Cross-origin request not allowed"},
 	{404, "not-found", "Not found"},
 	{405, "method-not-allowed", "Method not allowed"},
 	{406, "not-acceptable", "Not acceptable"},
 	{408, "request-timeout", "Request timeout"},
 	{413, "body-too-large", "Request body too large"},
 	{415, "unsupported-media-type", "Unsupported media type"},
+	{421, "host-not-allowed", "Host not allowed"},
 	{422, "limit-exceeded", "Resource limit exceeded"},
 	{500, "internal-error", "Internal error"},
 	{503, "unavailable", "Service unavailable"},

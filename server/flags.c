@@ -52,6 +52,8 @@ static const struct opt_def opts[] = {
 	{ "max-connections", OPT_UINT, "N", "concurrent connections; more are closed unanswered (1024)", CFG(max_connections), 1, 1000000 },
 	{ "max-connections-per-ip", OPT_UINT, "N", "concurrent connections from one client address, 0 = no limit (256)", CFG(max_connections_per_ip), 0, 1000000 },
 	{ "max-connections-per-range", OPT_UINT, "N", "concurrent connections from one client address range (IPv4 /24, IPv6 /64; loopback too); more are closed unanswered at accept, 0 = no limit (a quarter of --max-connections)", CFG(max_connections_per_range), 0, 1000000 },
+	{ "allowed-host", OPT_STR, "LIST", "Host names served, comma-separated, port ignored, * = any; others get 421 (against DNS rebinding; /healthz and /readyz always answer). Default: on a loopback --listen only localhost, 127.0.0.1, ::1 and the listen host; on other addresses any", CFG(allowed_host), 0, 0 },
+	{ "cors-origin", OPT_STR, "LIST", "origins of other sites whose pages may call the daemon (CORS), comma-separated scheme://host[:port], or *; a browser request from any other origin gets 403. Default: none (curl and scripts send no Origin: unaffected)", CFG(cors_origin), 0, 0 },
 	{ "idle-timeout", OPT_UINT, "S", "close connections idle this long (60)", CFG(idle_timeout_s), 1, 86400 },
 	{ "max-memory", OPT_SIZE, "BYTES", "memory renders in flight may need together; a render estimated over it is a 422, others wait (half the machine's or container's memory)", CFG(max_memory), 0, UINT64_MAX },
 	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
@@ -69,7 +71,9 @@ static void usage(FILE *f)
 	           "a flag wins over its variable. UMBRA_VALIDATION=1 enables the Vulkan validation layer.\n"
 	           "Models and textures are parsed in sandboxed child processes of umbra-import (found next to\n"
 	           "umbrad, or UMBRA_IMPORT_HELPER=PATH): over --import-timeout-ms / --import-memory is a 422,\n"
-	           "a crash of the parser a 400, for that request only.\n\n");
+	           "a crash of the parser a 400, for that request only.\n"
+	           "Browsers: a request whose Origin is not the daemon's own is refused (403) unless\n"
+	           "--cors-origin lists it; a Host not in --allowed-host is refused (421).\n\n");
 	for (size_t i = 0; i < OPT_COUNT; i++) {
 		char left[64];
 		snprintf(left, sizeof left, "--%s %s", opts[i].name, opts[i].arg);
@@ -301,6 +305,16 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		fprintf(stderr, "umbrad: --asset-root: cannot open '%s': %s\n", cfg->asset_root, strerror(errno));
 		return -1;
 	}
+	/* The lists are checked here, so that a bad entry exits 2; srv_http_start() builds them
+	 * again with the listen address. */
+	struct srv_origin o;
+	struct srv_origin_error oerr;
+	if (srv_origin_init(&o, &(struct srv_origin_config){ .allowed_hosts = cfg->allowed_host,
+	                                                     .cors_origins = cfg->cors_origin }, &oerr) != SRV_ORIGIN_OK) {
+		fprintf(stderr, "umbrad: %s\n", oerr.msg);
+		return -1;
+	}
+	srv_origin_release(&o);
 	cfg->limits.asset_root = cfg->asset_root;
 	if (!cfg->max_memory) cfg->max_memory = srv_admit_default_budget();
 	return 0;

@@ -2,10 +2,12 @@
  * umbrad HTTP: libmicrohttpd callbacks and the routes of contract §5.
  *
  * The access handler runs on libmicrohttpd's polling thread and never blocks on a render:
- *   1st call   (headers only)  framing (conn.c: Host, Content-Length, Transfer-Encoding), route,
- *                              method, Content-Type, Content-Length, readiness; an error
- *                              is answered at once (libmicrohttpd then skips the body, sends no
- *                              "100 Continue" and closes the connection).
+ *   1st call   (headers only)  framing (conn.c: Host, Content-Length, Transfer-Encoding), the
+ *                              Host and Origin rules (origin_http.c: 421, 403, answered like a
+ *                              GET once the body is dropped), route, method (OPTIONS: 204 on
+ *                              the next call), Content-Type, Content-Length, readiness; any
+ *                              other error is answered at once (libmicrohttpd then skips the
+ *                              body, sends no "100 Continue" and closes the connection).
  *   next calls (body chunks)   appended and hashed (ETag); past --max-body -> 413.
  *   last call  (body complete) If-None-Match -> 304, else suspend + queue (full -> 503).
  *   after resume               the worker's answer is sent.
@@ -89,6 +91,11 @@ static void request_free(struct srv_request *req)
 	free(req);
 }
 
+const char *srv_allow_of(enum srv_route r)
+{
+	return r == SRV_ROUTE_RENDER ? "POST" : "GET, HEAD";
+}
+
 /* Queues an answer. body is malloc'd and becomes libmicrohttpd's (freed with free()), or NULL.
  * Logs the request and counts it. Returns what the access handler returns. */
 enum MHD_Result srv_respond(struct srv_request *req, int status, const char *content_type,
@@ -109,9 +116,9 @@ enum MHD_Result srv_respond(struct srv_request *req, int status, const char *con
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, allow);
 	if (status == 503)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, atomic_load(&s->draining) ? "5" : "1");
+	srv_origin_headers(req, resp, status);
 	if (req->route == SRV_ROUTE_RENDER && (status == 200 || status == 304)) {
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, req->etag);
-		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Accept");
 		if (req->server_timing[0])
 			MHD_add_response_header(resp, MHD_HTTP_HEADER_SERVER_TIMING, req->server_timing);
 		/* What the image leaves out of what the scene asked for (never silent). */
@@ -226,9 +233,11 @@ enum MHD_Result srv_answer_not_ready(struct srv_request *req)
 
 /* ---- dispatch ---- */
 
-static const char *allow_of(enum srv_route r)
+/* OPTIONS on a route: 204 with Allow; to an allowed cross-origin caller (a CORS preflight) with
+ * the Access-Control-Allow-* headers too (srv_origin_headers). */
+static enum MHD_Result answer_options(struct srv_request *req)
 {
-	return r == SRV_ROUTE_RENDER ? "POST" : "GET, HEAD";
+	return srv_respond(req, 204, NULL, NULL, 0, req->route == SRV_ROUTE_RENDER ? "POST, OPTIONS" : "GET, HEAD, OPTIONS");
 }
 
 static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection *conn, const char *version)
@@ -239,11 +248,18 @@ static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection
 	if (framing)
 		return respond_framing(req, status, framing);
 	srv_conn_request_begins(&req->srv->cfg, conn);
+	enum MHD_Result refused;
+	if (srv_origin_refuses(req, conn, &refused))
+		return refused;
 	if (req->route == SRV_ROUTE_OTHER)
 		return srv_respond_problem(req, 404, NULL, "", "no route %s", req->path);
+	if (!strcmp(req->method, "OPTIONS")) {
+		req->state = SRV_REQ_HEADERS; /* answered on the next call, as a GET */
+		return MHD_YES;
+	}
 	if (req->route == SRV_ROUTE_RENDER ? strcmp(req->method, "POST") != 0 : !get)
-		return srv_respond_problem(req, 405, allow_of(req->route), "", "%s is not allowed on %s; allowed: %s",
-		                       req->method, srv_route_name(req->route), allow_of(req->route));
+		return srv_respond_problem(req, 405, srv_allow_of(req->route), "", "%s is not allowed on %s; allowed: %s",
+		                       req->method, srv_route_name(req->route), srv_allow_of(req->route));
 	if (req->route == SRV_ROUTE_RENDER)
 		return srv_render_begin(req, conn);
 	/* GET routes answer on the next call, once libmicrohttpd has the whole request (an
@@ -255,6 +271,10 @@ static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection
 static enum MHD_Result answer_get(struct srv_request *req)
 {
 	struct srv_server *s = req->srv;
+	if (req->refused)
+		return srv_respond_problem(req, req->refused, NULL, "", "%s", req->problem_detail);
+	if (!strcmp(req->method, "OPTIONS"))
+		return answer_options(req);
 	switch (req->route) {
 	case SRV_ROUTE_HEALTHZ:
 		return respond_text(req, 200, "text/plain; charset=utf-8", "ok\n");
@@ -385,6 +405,46 @@ static void mhd_log(void *cls, const char *fmt, va_list ap)
 	srv_log(SRV_LOG_WARN, "libmicrohttpd: %s", msg);
 }
 
+/* The bound port (port 0 = the kernel's pick): logged, and written to --port-file. 0 or -1 (logged). */
+static int publish_port(struct srv_server *s, const char *host)
+{
+	const union MHD_DaemonInfo *di = MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_BIND_PORT);
+	s->port = di ? di->port : 0;
+	if (!s->port) {
+		di = MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_LISTEN_FD);
+		struct sockaddr_storage b;
+		socklen_t bl = sizeof b;
+		if (di && getsockname(di->listen_fd, (struct sockaddr *)&b, &bl) == 0)
+			s->port = ntohs(b.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&b)->sin6_port
+			                                        : ((struct sockaddr_in *)&b)->sin_port);
+	}
+	srv_log(SRV_LOG_INFO, "listening on http://%s:%u (port %u)", host, s->port, s->port);
+	if (s->cfg.port_file) {
+		char tmp[4096];
+		snprintf(tmp, sizeof tmp, "%s.tmp", s->cfg.port_file);
+		FILE *f = fopen(tmp, "w");
+		bool ok = f && fprintf(f, "%u\n", s->port) > 0;
+		if (f && fclose(f) != 0)
+			ok = false;
+		if (!ok || rename(tmp, s->cfg.port_file) != 0) {
+			srv_log(SRV_LOG_ERROR, "cannot write the port file '%s': %s", s->cfg.port_file, strerror(errno));
+			return -1;
+		}
+	}
+	return 0;
+}
+
+/* Whether the listen address is a loopback one: then only loopback names are served by default. */
+static bool loopback_addr(const struct sockaddr_storage *ss)
+{
+	if (ss->ss_family == AF_INET)
+		return ntohl(((const struct sockaddr_in *)ss)->sin_addr.s_addr) >> 24 == 127;
+	if (ss->ss_family != AF_INET6)
+		return false;
+	const struct in6_addr *a = &((const struct sockaddr_in6 *)ss)->sin6_addr;
+	return IN6_IS_ADDR_LOOPBACK(a) || (IN6_IS_ADDR_V4MAPPED(a) && a->s6_addr[12] == 127);
+}
+
 int srv_http_start(struct srv_server *s)
 {
 	struct sockaddr_storage ss;
@@ -392,6 +452,16 @@ int srv_http_start(struct srv_server *s)
 	srv_conn_prepare(&s->cfg);
 	if (srv_conn_listen_addr(s->cfg.listen, &ss, &sl) != 0 || srv_conn_share_start(s) != 0)
 		return -1;
+	char host[128] = "";
+	const char *colon = strrchr(s->cfg.listen, ':');
+	snprintf(host, sizeof host, "%.*s", (int)(colon - s->cfg.listen), s->cfg.listen);
+	struct srv_origin_error oerr;
+	struct srv_origin_config oc = { .allowed_hosts = s->cfg.allowed_host, .cors_origins = s->cfg.cors_origin,
+	                                .listen_host = host, .loopback = loopback_addr(&ss) };
+	if (srv_origin_init(&s->origin, &oc, &oerr) != SRV_ORIGIN_OK) {
+		srv_log(SRV_LOG_ERROR, "%s", oerr.msg);
+		return -1;
+	}
 	/* poll(), not epoll: libmicrohttpd 0.9.75 registers sockets edge-triggered and takes a
 	 * short recv() as "drained", so the end of a client that closes right after a partial
 	 * body (both in one segment) raises no further edge and the connection would sit in
@@ -420,33 +490,12 @@ int srv_http_start(struct srv_server *s)
 		srv_log(SRV_LOG_ERROR, "cannot listen on %s: %s%s", s->cfg.listen, strerror(e),
 		        e == EADDRINUSE ? " (another process has that port: choose another --listen port, or port 0 "
 		                          "with --port-file for any free one)" : "");
+		srv_origin_release(&s->origin);
 		return -1;
 	}
-	const union MHD_DaemonInfo *di = MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_BIND_PORT);
-	s->port = di ? di->port : 0;
-	if (!s->port) {
-		di = MHD_get_daemon_info(s->daemon, MHD_DAEMON_INFO_LISTEN_FD);
-		struct sockaddr_storage b;
-		socklen_t bl = sizeof b;
-		if (di && getsockname(di->listen_fd, (struct sockaddr *)&b, &bl) == 0)
-			s->port = ntohs(b.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&b)->sin6_port
-			                                        : ((struct sockaddr_in *)&b)->sin_port);
-	}
-	char host[128] = "";
-	const char *colon = strrchr(s->cfg.listen, ':');
-	snprintf(host, sizeof host, "%.*s", (int)(colon - s->cfg.listen), s->cfg.listen);
-	srv_log(SRV_LOG_INFO, "listening on http://%s:%u (port %u)", host, s->port, s->port);
-	if (s->cfg.port_file) {
-		char tmp[4096];
-		snprintf(tmp, sizeof tmp, "%s.tmp", s->cfg.port_file);
-		FILE *f = fopen(tmp, "w");
-		bool ok = f && fprintf(f, "%u\n", s->port) > 0;
-		if (f && fclose(f) != 0)
-			ok = false;
-		if (!ok || rename(tmp, s->cfg.port_file) != 0) {
-			srv_log(SRV_LOG_ERROR, "cannot write the port file '%s': %s", s->cfg.port_file, strerror(errno));
-			return -1;
-		}
+	if (publish_port(s, host) != 0) {
+		srv_http_stop(s);
+		return -1;
 	}
 	return 0;
 }
@@ -466,4 +515,5 @@ void srv_http_stop(struct srv_server *s)
 		MHD_stop_daemon(s->daemon);
 	s->daemon = NULL;
 	srv_conn_share_stop(s);
+	srv_origin_release(&s->origin);
 }

@@ -1,12 +1,12 @@
 /*
  * server/http.h — what the HTTP modules share (http.c: dispatch and answers; render_route.c:
- * POST /v1/render). Everything here runs on libmicrohttpd's polling thread, except
+ * POST /v1/render; origin_http.c: Host, Origin, CORS and the browser headers). Everything here runs on libmicrohttpd's polling thread, except
  * srv_request_finish() (srv.h), which a worker calls.
  *
  * Answers: srv_respond() queues one (body: malloc'd, becomes libmicrohttpd's, or NULL), sets
  * the common headers (X-Request-Id, Allow, Retry-After, ETag/Vary/Server-Timing for a render,
- * Cache-Control, Connection), logs and counts the request. It returns what the access handler
- * returns.
+ * Cache-Control, Connection; origin_http.c's browser headers), logs and counts the request. It
+ * returns what the access handler returns.
  */
 #ifndef UMBRA_SRV_HTTP_H
 #define UMBRA_SRV_HTTP_H
@@ -26,6 +26,16 @@ enum MHD_Result srv_respond_problem(struct srv_request *req, int status, const c
 bool srv_is_ready(const struct srv_server *s);
 /* 503 saying why the server is not ready (starting up, or shutting down). */
 enum MHD_Result srv_answer_not_ready(struct srv_request *req);
+
+/* The methods a route allows ("POST", "GET, HEAD"). */
+const char *srv_allow_of(enum srv_route r);
+
+/* origin_http.c: the Host and Origin rules (origin.h) applied to libmicrohttpd's request.
+ * srv_origin_refuses() runs on the first call: true when the request is refused (403/421),
+ * *answer then being what the access handler returns; an allowed cross-origin caller is kept
+ * in req->cors_origin. srv_origin_headers() adds what every answer tells a browser. */
+bool srv_origin_refuses(struct srv_request *req, struct MHD_Connection *conn, enum MHD_Result *answer);
+void srv_origin_headers(struct srv_request *req, struct MHD_Response *resp, int status);
 
 /* render_route.c, in the order the access handler calls them. */
 enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection *conn);

@@ -2,7 +2,9 @@
  * server/playground — the playground page (server/www/), embedded at build time as a C array
  * ($(BUILD)/www/playground_page.h, made by server/www/embed.sh with xxd -i): GET / and
  * GET /playground answer it unless --no-playground / UMBRA_NO_PLAYGROUND=1.
- * The page is static and fetches nothing but this daemon's /v1/render and /v1/info.
+ * The page is static and fetches nothing but this daemon's /v1/render and /v1/info; its
+ * Content-Security-Policy (srv_playground_csp, sent by http.c) is built with it and allows only
+ * its own inline blocks, by hash.
  * Thread-safe: the page is read-only.
  */
 #include <stdlib.h>
@@ -23,4 +25,9 @@ char *srv_playground_page(size_t *len)
 	memcpy(b, playground_html, playground_html_len);
 	*len = playground_html_len;
 	return b;
+}
+
+const char *srv_playground_csp(void)
+{
+	return playground_csp;
 }

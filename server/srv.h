@@ -9,6 +9,8 @@
  *   negotiate.c  pure rules: Content-Type, Accept, the ETag (negotiate.h)
  *   conn.c     connection limits and timeouts, HTTP/1.1 framing checks, the listen address
  *   ranges.c   connections per client address range (--max-connections-per-range), pure
+ *   origin.c   pure rules: the Host allow-list, Origin / Sec-Fetch-Site checks, CORS (origin.h)
+ *   origin_http.c  those rules on libmicrohttpd's requests; the headers every answer carries
  *   queue.c    the bounded two-level (interactive before bulk) job queue
  *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
  *   gate.c     how many renders run on the device at once (--device-renders; 1 on lavapipe)
@@ -41,6 +43,7 @@
 #include "admit.h"
 #include "gate.h"
 #include "api.h"
+#include "origin.h"
 #include "umbra/rnd.h"
 
 #ifndef UMBRA_VERSION
@@ -85,6 +88,8 @@ struct srv_config {
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
 	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */
+	const char *allowed_host;      /* --allowed-host LIST (server/origin.h); NULL = by the listen address */
+	const char *cors_origin;       /* --cors-origin LIST (server/origin.h); NULL = no cross-origin caller */
 	const char *test_fault;        /* tests only: "submit:N:lost|oom" armed after warm-up */
 };
 
@@ -115,6 +120,7 @@ struct srv_server {
 	struct srv_admit admit;        /* renders admitted by estimated memory (--max-memory) */
 	struct srv_gate gate;          /* renders on the device at once (--device-renders) */
 	struct srv_imports *imports;   /* requests parked for an import thread (--import-slots) */
+	struct srv_origin origin;      /* Host and Origin rules, set by srv_http_start() (origin.h) */
 
 	/* The shared renderer. Renders hold ctx_lock for reading; recovery after a lost device
 	 * takes it for writing, destroys and recreates the context (ctx_gen counts recreations). */
@@ -176,6 +182,9 @@ struct srv_request {
 	char if_none_match[256];       /* checked after parsing for scenes that read asset files */
 	bool want_exr;                 /* Accept prefers image/x-exr */
 	bool close_after;              /* answer with Connection: close (framing error) */
+	char cors_origin[SRV_ORIGIN_MAX]; /* an allowed cross-origin caller's Origin, echoed; "" = none */
+	bool cors_private_network;     /* its preflight asked Access-Control-Request-Private-Network */
+	int refused;                   /* 403/421 answered once the body is read (detail in problem_detail) */
 
 	/* result, written by the worker before srv_request_finish() */
 	int status;
@@ -224,6 +233,9 @@ unsigned srv_default_workers(const char *root, const char *self_cgroup, unsigned
  * malloc'd copy (NULL when out of memory). */
 bool srv_playground_path(const char *url);
 char *srv_playground_page(size_t *len);
+/* The page's Content-Security-Policy, made with it at build time (hashes of its inline
+ * script and style: server/www/embed.sh). */
+const char *srv_playground_csp(void);
 
 /* Small shared helpers (main.c). */
 double srv_now(void);                               /* monotonic seconds */

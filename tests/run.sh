@@ -54,6 +54,7 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/umbrad" ] && run_suite http-sandbox sh tests/http/sandbox.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-imports sh tests/http/imports.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-assets sh tests/http/assets.sh
+[ -x "$BUILD/umbrad" ] && run_suite http-origin sh tests/http/origin.sh
 [ -z "${ASAN:-}" ] && run_suite deploy sh deploy/check.sh
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
 [ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh

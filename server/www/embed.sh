@@ -1,30 +1,42 @@
 #!/bin/sh
-# server/www/embed.sh SRC_DIR OUT_DIR [BENCH.json...] — the playground as one page, and that page
-# as a C array (xxd -i) for server/playground.c. The page's markers are replaced in place:
-# /*@css*/ by playground.css, /*@js*/ by playground.js, /*@bench*/ by
+# server/www/embed.sh SRC_DIR OUT_DIR [BENCH.json...] — the playground as one page, that page as
+# a C array (xxd -i) for server/playground.c, and the page's Content-Security-Policy. The page's
+# marker lines are replaced in place: <style>/*@css*/</style> by playground.css,
+# <script>/*@js*/</script> by playground.js, <script>/*@bench*/</script> by
 # `window.UMBRA_BENCH = {"name": scene, ...}` from the bench scenes given (none: an empty
-# object). Runs at build time with no network.
+# object). Each inline block is exactly its file between the tags, so the policy allows it by
+# the SHA-256 of that file ('sha256-...'): no 'unsafe-inline'. Runs at build time with no network.
 set -eu
 src=$1
 out=$2
 shift 2
 page=$out/playground.html
+bench() {
+	printf 'window.UMBRA_BENCH = {'
+	sep=''
+	for f in "$@"; do
+		printf '%s\n"%s": ' "$sep" "$(basename "$f" .json)"
+		cat "$f"
+		sep=','
+	done
+	printf '};\n'
+}
+bench "$@" >"$out/bench.js"
+# 'sha256-BASE64' of a file's bytes.
+hash() { printf "'sha256-%s'" "$(sha256sum <"$1" | cut -d' ' -f1 | xxd -r -p | base64 -w0)"; }
 while IFS= read -r l; do
 	case "$l" in
-	'/*@css*/') cat "$src/playground.css" ;;
-	'/*@js*/') cat "$src/playground.js" ;;
-	'/*@bench*/')
-		printf 'window.UMBRA_BENCH = {'
-		sep=''
-		for f in "$@"; do
-			printf '%s\n"%s": ' "$sep" "$(basename "$f" .json)"
-			cat "$f"
-			sep=','
-		done
-		printf '};\n' ;;
+	'<style>/*@css*/</style>') printf '<style>'; cat "$src/playground.css"; printf '</style>\n' ;;
+	'<script>/*@js*/</script>') printf '<script>'; cat "$src/playground.js"; printf '</script>\n' ;;
+	'<script>/*@bench*/</script>') printf '<script>'; cat "$out/bench.js"; printf '</script>\n' ;;
 	*) printf '%s\n' "$l" ;;
 	esac
 done <"$src/playground.html" >"$page.tmp"
 mv "$page.tmp" "$page"
-(cd "$out" && xxd -i playground.html) >"$out/playground_page.h.tmp"
+# Images are the renders' blob: URLs; fetches go to this daemon only; nothing may frame the page, and no form or <base> may point elsewhere.
+csp="default-src 'self'; script-src $(hash "$out/bench.js") $(hash "$src/playground.js"); style-src $(hash "$src/playground.css"); img-src 'self' blob:; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"
+{
+	(cd "$out" && xxd -i playground.html)
+	printf 'static const char playground_csp[] = "%s";\n' "$csp"
+} >"$out/playground_page.h.tmp"
 mv "$out/playground_page.h.tmp" "$out/playground_page.h"

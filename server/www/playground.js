@@ -269,11 +269,29 @@ function showTiming(header) {
     if (name && d) dur[name] = +d[1];
   });
   const total = STAGES.reduce((a, s) => a + (dur[s] || 0), 0) || 1;
-  $('timing').innerHTML = STAGES.map((s, k) =>
-    '<div data-stage="' + s + '" style="width:' + (100 * (dur[s] || 0) / total) + '%;background:' + COLOURS[k] +
-    '" title="' + s + ' ' + (dur[s] || 0).toFixed(1) + ' ms"></div>').join('');
-  $('timing-legend').innerHTML = STAGES.map((s, k) => '<span><i style="background:' + COLOURS[k] + '"></i>' + s + ' ' +
-    (dur[s] || 0).toFixed(1) + ' ms</span>').join('') + (dur.total ? '<span>total ' + dur.total.toFixed(1) + ' ms</span>' : '');
+  // Elements with styles set through the DOM: the page's Content-Security-Policy refuses
+  // style="" attributes in markup.
+  const bar = $('timing'), legend = $('timing-legend');
+  bar.replaceChildren();
+  legend.replaceChildren();
+  STAGES.forEach((s, k) => {
+    const ms = (dur[s] || 0).toFixed(1) + ' ms';
+    const d = document.createElement('div');
+    d.dataset.stage = s;
+    d.title = s + ' ' + ms;
+    d.style.width = (100 * (dur[s] || 0) / total) + '%';
+    d.style.background = COLOURS[k];
+    bar.append(d);
+    const span = document.createElement('span'), i = document.createElement('i');
+    i.style.background = COLOURS[k];
+    span.append(i, s + ' ' + ms);
+    legend.append(span);
+  });
+  if (dur.total) {
+    const span = document.createElement('span');
+    span.textContent = 'total ' + dur.total.toFixed(1) + ' ms';
+    legend.append(span);
+  }
 }
 // One render at a time: a render asked for while one runs follows it (with the text and controls
 // as they are then), so the page always ends showing what its controls say.

@@ -92,8 +92,19 @@ async function main() {
     page.on('request', (r) => { if (r.url().endsWith('/v1/render')) sent.push(r); });
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
+    // Content-Security-Policy violations: the console's report and the DOM event, both.
+    const violations = [];
+    page.on('console', (m) => { if (/Content Security Policy/i.test(m.text())) violations.push(m.text()); });
+    await page.evaluateOnNewDocument(() => {
+      document.addEventListener('securitypolicyviolation', (e) => {
+        (window.__csp = window.__csp || []).push(e.violatedDirective + ' ' + (e.blockedURI || 'inline'));
+      });
+    });
     const resp = await page.goto(URL + '/', { waitUntil: 'load' });
     check('GET / serves the page', resp.status() === 200 && (await page.title()) === 'umbra playground', 'status ' + resp.status());
+    const csp = resp.headers()['content-security-policy'] || '';
+    check('GET / has a strict Content-Security-Policy', /default-src 'self'/.test(csp) && /frame-ancestors 'none'/.test(csp) &&
+      !/unsafe-inline|unsafe-eval/.test(csp), csp);
     const labels = await page.$$eval('#examples option', (o) => o.map((x) => x.textContent));
     check('examples: every filter, cascades, lights, a model on a shadow catcher',
       ['hard', 'pcf', 'pcss', 'vsm', 'evsm'].every((f) => labels.includes('Filter: ' + f)) &&
@@ -178,6 +189,9 @@ async function main() {
     check('drop: the model renders (512x512, content)', st === 'done' && d.w === 512 && d.h === 512 && d.colours > 5,
       st + ' ' + d.w + 'x' + d.h + ' ' + d.colours);
     check('no script errors', errors.length === 0, errors.join('; '));
+    const domViolations = await page.evaluate(() => window.__csp || []);
+    check('no Content-Security-Policy violations', violations.length === 0 && domViolations.length === 0,
+      (violations.length + domViolations.length) + ': ' + violations.concat(domViolations).slice(0, 2).join('; ').slice(0, 400));
 
     if (process.env.SHOT) {
       await pick(page, 'Filter: pcss');

@@ -1,9 +1,10 @@
 #!/bin/sh
 # tests/browser/run.sh — the playground page in Debian's chromium (headless), driven by
 # puppeteer-core (tests/browser/package.json; `npm ci` here when node_modules is missing).
-# Starts its own umbrad on loopback (ephemeral port) and ends with "N passed, N failed".
-# Without chromium or node the suite says so and counts nothing (tests/run.sh runs it only
-# when chromium is installed). Env: BUILD, SHARED; SHOT=FILE also saves a screenshot.
+# Starts its own umbrad on loopback (ephemeral port); origin.test.js then calls it from pages of
+# other origins. Ends with "N passed, N failed". Without chromium or node the suite says so and
+# counts nothing (tests/run.sh runs it only when chromium is installed). Env: BUILD, SHARED;
+# SHOT=FILE also saves a screenshot.
 BUILD=${BUILD:-build}
 CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
 dir=$(dirname "$0")
@@ -51,10 +52,17 @@ URL="http://127.0.0.1:$(cat "$T/port")"
 BENCH=""
 [ -f "${SHARED:-../shared}/bench/thumb-512.json" ] && BENCH=1
 BENCH=$BENCH UMBRA_URL=$URL CHROMIUM=$CHROMIUM node "$dir/playground.test.js" >"$T/node.out" 2>&1
+# Real cross-origin callers: pages of other local origins posting a form and calling fetch(), to
+# this daemon (refused) and to one the test starts with --cors-origin (origin.test.js).
+UMBRA_URL=$URL UMBRAD="$BUILD/umbrad" DAEMON_PRELOAD="$PRELOAD" T="$T" CHROMIUM=$CHROMIUM \
+	node "$dir/origin.test.js" >>"$T/node.out" 2>&1
 grep -v -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out"
-line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out" | tail -n 1)
-pass=${line%% passed*}; fail=${line#*passed, }; fail=${fail%% failed*}
-[ -n "$line" ] || { echo "FAIL - the browser test gave no result line"; pass=0; fail=1; }
+pass=0; fail=0
+for line in $(grep -E '^[0-9]+ passed, [0-9]+ failed' "$T/node.out" | tr ' ' '_'); do
+	p=${line%%_passed*}; f=${line#*passed,_}; f=${f%%_failed*}
+	pass=$((pass + p)); fail=$((fail + f))
+done
+[ "$(grep -cE '^[0-9]+ passed, [0-9]+ failed' "$T/node.out")" = 2 ] || { echo "FAIL - a browser test gave no result line"; fail=$((fail + 1)); }
 # The playground can be switched off.
 kill "$PID"; wait "$PID" 2>/dev/null; PID=""
 LD_PRELOAD="$PRELOAD" "$BUILD/umbrad" --listen 127.0.0.1:0 --port-file "$T/port2" --workers 1 --no-playground 2>"$T/umbrad2.log" &

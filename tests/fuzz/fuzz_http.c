@@ -98,6 +98,9 @@ static void start_once(void)
 	srv.cfg.max_body = 16 << 10;
 	srv.cfg.max_connections = 64;
 	srv.cfg.idle_timeout_s = 30;
+	/* One allowed cross-origin caller, so that Origin headers reach the CORS answers and the
+	 * deferred 403s (server/origin_http.c); the Host rule is the loopback default. */
+	srv.cfg.cors_origin = "http://a.example";
 	api_limits_defaults(&srv.cfg.limits);
 	pthread_rwlock_init(&srv.ctx_lock, NULL);
 	snprintf(srv.info.device_name, sizeof srv.info.device_name, "fuzz");

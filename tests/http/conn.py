@@ -22,7 +22,7 @@ import sys
 import time
 
 MODE, PORT = sys.argv[1], int(sys.argv[2])
-HEALTHZ = b"GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n"
+HEALTHZ = b"GET /healthz HTTP/1.1\r\nHost: localhost\r\n\r\n"
 SCENE = open(sys.argv[3], "rb").read() if MODE == "framing" else b""
 PID = int(sys.argv[4] if MODE == "framing" else sys.argv[3])
 results = []
@@ -108,15 +108,15 @@ def framing_and_timeouts():
     LEN = b"Content-Length: %d\r\n" % len(SCENE)
 
     # ---- framing ----
-    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n")
+    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n")
     check("control: GET /healthz 200", parse(a)[0] == 200, repr(a[:200]))
-    a = exchange(post(b"Host: t\r\nConnection: close\r\n" + JSON + LEN))
+    a = exchange(post(b"Host: localhost\r\nConnection: close\r\n" + JSON + LEN))
     check("control: a valid render 200", parse(a)[0] == 200, repr(a[:200]))
 
-    a = exchange(post(b"Host: t\r\n" + JSON + LEN + b"Content-Length: %d\r\n" % (len(SCENE) - 1)))
+    a = exchange(post(b"Host: localhost\r\n" + JSON + LEN + b"Content-Length: %d\r\n" % (len(SCENE) - 1)))
     check("two different Content-Length headers: 400 problem+json", *problem_ok(a, 400))
     check("two different Content-Length headers: connection closed", parse(a)[1].get("connection") == "close")
-    a = exchange(post(b"Host: t\r\nConnection: close\r\n" + JSON + LEN + LEN))
+    a = exchange(post(b"Host: localhost\r\nConnection: close\r\n" + JSON + LEN + LEN))
     check("two identical Content-Length headers are one value: 200", parse(a)[0] == 200, repr(a[:200]))
 
     a = exchange(b"GET /healthz HTTP/1.1\r\n\r\n")
@@ -129,31 +129,31 @@ def framing_and_timeouts():
     check("HTTP/1.0 without Host is fine: 200", parse(a)[0] == 200, repr(a[:200]))
 
     chunked = b"%x\r\n" % len(SCENE) + SCENE + b"\r\n0\r\n\r\n"
-    a = exchange(post(b"Host: t\r\n" + JSON + b"Transfer-Encoding: chunked\r\nContent-Length: 5\r\n", chunked))
+    a = exchange(post(b"Host: localhost\r\n" + JSON + b"Transfer-Encoding: chunked\r\nContent-Length: 5\r\n", chunked))
     check("Transfer-Encoding with Content-Length: 400 problem+json", *problem_ok(a, 400))
-    a = exchange(post(b"Host: t\r\nConnection: close\r\n" + JSON + b"Transfer-Encoding: chunked\r\n", chunked))
+    a = exchange(post(b"Host: localhost\r\nConnection: close\r\n" + JSON + b"Transfer-Encoding: chunked\r\n", chunked))
     check("control: a chunked render 200", parse(a)[0] == 200, repr(a[:200]))
-    a = exchange(post(b"Host: t\r\n" + JSON + b"Transfer-Encoding: gzip, chunked\r\n", chunked))
+    a = exchange(post(b"Host: localhost\r\n" + JSON + b"Transfer-Encoding: gzip, chunked\r\n", chunked))
     check("Transfer-Encoding other than chunked: 501 problem+json", *problem_ok(a, 501))
 
     # The answer to an unparsable Content-Length is libmicrohttpd's own (see README, "Limits of
     # the HTTP layer"); what umbrad guarantees is that the connection ends and others are served.
-    a = exchange(post(b"Host: t\r\n" + JSON + b"Content-Length: 12x\r\n", b""))
+    a = exchange(post(b"Host: localhost\r\n" + JSON + b"Content-Length: 12x\r\n", b""))
     st = parse(a)[0]
-    b = exchange(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n")
+    b = exchange(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n")
     check("invalid Content-Length: 400, closed, the next client served",
           st == 400 and parse(b)[0] == 200, "%r / %r" % (a[:120], b[:120]))
 
     # ---- every error umbrad answers is problem+json, one status line ----
     errors = [
-        (b"GET /nowhere HTTP/1.1\r\nHost: t\r\n\r\n", 404),
-        (b"DELETE /v1/render HTTP/1.1\r\nHost: t\r\n\r\n", 405),
-        (b"POST /healthz HTTP/1.1\r\nHost: t\r\nContent-Length: 0\r\n\r\n", 405),
-        (post(b"Host: t\r\nContent-Type: text/plain\r\n" + LEN), 415),
-        (post(b"Host: t\r\n" + JSON + b"Content-Length: 999999999999\r\n", b""), 413),
-        (post(b"Host: t\r\n" + JSON + b"Content-Length: 3\r\n", b"{x}"), 400),
-        (post(b"Host: t\r\n" + JSON + b"X-Priority: urgent\r\n" + LEN), 400),
-        (post(b"Host: t\r\n" + JSON + b"Content-Length: 0\r\n", b""), 400),
+        (b"GET /nowhere HTTP/1.1\r\nHost: localhost\r\n\r\n", 404),
+        (b"DELETE /v1/render HTTP/1.1\r\nHost: localhost\r\n\r\n", 405),
+        (b"POST /healthz HTTP/1.1\r\nHost: localhost\r\nContent-Length: 0\r\n\r\n", 405),
+        (post(b"Host: localhost\r\nContent-Type: text/plain\r\n" + LEN), 415),
+        (post(b"Host: localhost\r\n" + JSON + b"Content-Length: 999999999999\r\n", b""), 413),
+        (post(b"Host: localhost\r\n" + JSON + b"Content-Length: 3\r\n", b"{x}"), 400),
+        (post(b"Host: localhost\r\n" + JSON + b"X-Priority: urgent\r\n" + LEN), 400),
+        (post(b"Host: localhost\r\n" + JSON + b"Content-Length: 0\r\n", b""), 400),
         (b"GET /healthz HTTP/1.1\r\n\r\n", 400),
     ]
     for raw, st in errors:
@@ -174,11 +174,11 @@ def framing_and_timeouts():
     check("a connection that sends nothing is closed by --header-timeout, before --idle-timeout", eof)
 
     s = connect()
-    s.sendall(b"GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n")
+    s.sendall(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\n\r\n")
     first = s.recv(65536)
     time.sleep(3)  # longer than --header-timeout 1, shorter than --idle-timeout 8
     try:
-        s.sendall(b"GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n")
+        s.sendall(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\n\r\n")
         second = s.recv(65536)
     except OSError:
         second = b""
@@ -198,7 +198,7 @@ def framing_and_timeouts():
         # Corked: the head, half the body and the FIN leave in one segment, so the daemon's
         # first read sees all of it (the case epoll mode missed).
         s.setsockopt(socket.IPPROTO_TCP, socket.TCP_CORK, 1)
-        s.sendall(post(b"Host: t\r\n" + JSON + LEN, SCENE[: len(SCENE) // 2]))
+        s.sendall(post(b"Host: localhost\r\n" + JSON + LEN, SCENE[: len(SCENE) // 2]))
         s.close()
     for _ in range(40):
         if fds() <= base:
@@ -239,7 +239,7 @@ def hogs(pid):
     extra = connect("127.0.0.1", timeout=5)
     extra.settimeout(5)
     try:
-        extra.sendall(b"GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n")
+        extra.sendall(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\n\r\n")
         got = extra.recv(65536)
         eof = got == b""
     except ConnectionResetError:
@@ -252,7 +252,7 @@ def hogs(pid):
     # within --header-timeout 10).
     try:
         s = connect("127.0.1.2", timeout=5)
-        s.sendall(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n")
+        s.sendall(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n")
         other = read_all(s, 5.0)
         s.close()
     except OSError as e:
@@ -302,7 +302,7 @@ def refused(src):
 
 def metrics(src):
     """The daemon's /metrics as {series: value}, asked from src."""
-    a = exchange(b"GET /metrics HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", src)
+    a = exchange(b"GET /metrics HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n", src)
     out = {}
     for ln in parse(a)[2].decode("utf-8", "replace").split("\n"):
         if ln and not ln.startswith("#"):
@@ -330,7 +330,7 @@ def ranges():
           repr(m0.get("umbra_connections_per_range_limit")))
     check("a fifth connection from the range (127.0.1.4, a third address) is closed at accept, unanswered",
           refused("127.0.1.4"), "it was answered")
-    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", "127.0.2.2")
+    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n", "127.0.2.2")
     check("another range (127.0.2.2) is served while 127.0.1.0/24 is at its share", parse(a)[0] == 200, repr(a[:100]))
     m1 = metrics("127.0.3.2")
     check("/metrics: exactly that one refusal counted (reason range_share)",
@@ -349,7 +349,7 @@ def ranges():
         time.sleep(0.1)
     check("the daemon lets the closed connection go (umbra_connections_open %r)" % m.get("umbra_connections_open"),
           m.get("umbra_connections_open", 99) <= len(held) + 1)
-    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", "127.0.1.4")
+    a = exchange(b"GET /healthz HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n", "127.0.1.4")
     check("a freed place in the share serves the range again (127.0.1.4)", parse(a)[0] == 200, repr(a[:100]))
     m2 = metrics("127.0.3.2")
     check("/metrics: no further refusal", m2.get(REFUSED, -1) == m1.get(REFUSED), repr(m2.get(REFUSED)))

@@ -183,14 +183,14 @@ def one(cl, i, kind):
     if kind == "abort":
         body = rng.choice(SMALL)
         if rng.random() < 0.5:  # closed mid-body
-            raw(b"POST /v1/render HTTP/1.1\r\nHost: s\r\nContent-Type: application/json\r\n"
+            raw(b"POST /v1/render HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
                 b"Content-Length: %d\r\n\r\n" % len(body) + body[: len(body) // 2], read=False)
         else:  # whole request, closed before the answer
-            raw(b"POST /v1/render HTTP/1.1\r\nHost: s\r\nContent-Type: application/json\r\n"
+            raw(b"POST /v1/render HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
                 b"Content-Length: %d\r\n\r\n" % len(body) + body, read=False)
         return None
     if kind == "framing":
-        a = raw(b"POST /v1/render HTTP/1.1\r\nHost: s\r\nContent-Type: application/json\r\n"
+        a = raw(b"POST /v1/render HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
                 b"Content-Length: 10\r\nContent-Length: 11\r\n\r\n{}")
         head, _, body = a.partition(b"\r\n\r\n")
         ok = head.startswith(b"HTTP/1.1 400 ") and b"application/problem+json" in head and a.count(b"\r\nHTTP/1.") == 0
