@@ -53,6 +53,15 @@ struct api_import_gate {
 	void *user;
 };
 
+/* The caller's admission of memory a parse is about to take (the daemon's --max-memory,
+ * server/admit.h): reserve(user, bytes, p) before a texture is decoded (its header's pixels:
+ * the decode's reply and the copy the scene keeps). false: the parse stops with the problem
+ * the callback wrote (422 over the budget alone, 504 past the deadline while waiting). */
+struct api_memory_gate {
+	bool (*reserve)(void *user, uint64_t bytes, struct api_problem *p);
+	void *user;
+};
+
 /* Resource limits; going over one is a 422. 0 = unlimited. */
 struct api_limits {
 	uint64_t max_pixels;             /* width*height (and per sheet when several views), default 16777216 */
@@ -76,6 +85,7 @@ struct api_limits {
 	uint32_t output_side;
 	/* Not a limit either: the caller's gate for imports (NULL = none: every import starts). */
 	const struct api_import_gate *import_gate;
+	const struct api_memory_gate *memory_gate;   /* NULL = none */
 };
 void api_limits_defaults(struct api_limits *l);
 

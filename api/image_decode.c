@@ -185,3 +185,35 @@ enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_p
 {
 	return api_image_decode_fit(data, len, max_pixels, 0, false, rgba, width, height, NULL, err, errsize);
 }
+
+static uint32_t be32(const uint8_t *p) { return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3]; }
+
+bool api_image_header_size(const uint8_t *d, size_t len, uint32_t *w, uint32_t *h)
+{
+	if (len >= 24 && !memcmp(d, "\x89PNG\r\n\x1a\n", 8) && !memcmp(d + 12, "IHDR", 4)) {
+		*w = be32(d + 16);
+		*h = be32(d + 20);
+		return *w && *h;
+	}
+	if (len < 4 || d[0] != 0xff || d[1] != 0xd8) return false;
+	/* Markers after SOI: each FF xx with a 16-bit length, up to the first frame header. */
+	size_t at = 2;
+	while (at + 4 <= len) {
+		if (d[at] != 0xff) return false;
+		uint8_t m = d[at + 1];
+		if (m == 0xff) { at++; continue; }                      /* fill byte */
+		if (m == 0xd8 || m == 0x01 || (m >= 0xd0 && m <= 0xd7)) { at += 2; continue; }
+		size_t seg = (size_t)d[at + 2] << 8 | d[at + 3];
+		if (seg < 2) return false;
+		bool sof = m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc;
+		if (sof) {
+			if (at + 9 > len) return false;
+			*h = (uint32_t)d[at + 5] << 8 | d[at + 6];
+			*w = (uint32_t)d[at + 7] << 8 | d[at + 8];
+			return *w && *h;
+		}
+		if (m == 0xda || m == 0xd9) return false;              /* scan or end before a frame */
+		at += 2 + seg;
+	}
+	return false;
+}

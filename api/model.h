@@ -174,6 +174,10 @@ enum api_result api_image_decode(const uint8_t *data, size_t len, uint64_t max_p
 enum api_result api_image_decode_fit(const uint8_t *data, size_t len, uint64_t max_pixels, uint32_t min_side,
                                      bool srgb, uint8_t **rgba, uint32_t *width, uint32_t *height,
                                      uint32_t *stored_side, char *err, size_t errsize);
+/* The size a PNG (IHDR) or JPEG (its first SOFn marker) says it has, read from the header
+ * alone (no library: the daemon calls it on request bytes before a decode). false when the
+ * bytes say nothing usable. */
+bool api_image_header_size(const uint8_t *data, size_t len, uint32_t *width, uint32_t *height);
 /* The class of image sizes textures are decoded for: side rounded up to a power of two (0 for
  * 0: as stored). A texture of larger side L is halved while L / 2 >= API_TEXTURE_SIDE_PER_PIXEL
  * times the class, so requests of one class decode every texture alike. */

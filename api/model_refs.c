@@ -21,6 +21,7 @@ static const char *const KIND_NAMES[] = {"buffer", "image", "material library", 
 struct ctx {
 	const struct api_ref_source *src;
 	struct api_model_refs *out;
+	char *resolved[API_MODEL_REFS_MAX];   /* each file's name as resolved (api_asset_resolve) */
 	uint64_t total;
 	int *status;
 	char *err;
@@ -117,6 +118,17 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 		*c->status = 400;
 		return api_err_set(c->err, c->errsize, "its %s \"%.128s\" cannot be used: %s", KIND_NAMES[kind], ref, why), -1;
 	}
+	/* The same file under another spelling ("a.bin", "./a.bin", "a%2Ebin"): one copy of its
+	 * bytes, counted once; the importer sees both names (a 40 MB part named 24 ways had been
+	 * sent to it 24 times: +1 GB). */
+	for (size_t i = 0; i < c->out->count; i++)
+		if (c->resolved[i] && !strcmp(c->resolved[i], full)) {
+			const struct api_model_file *f = &c->out->files[i];
+			if (push(c, ref, f->data, f->len, false) < 0) return -1;
+			c->out->bytes -= f->len;
+			c->resolved[c->out->count - 1] = strdup(full);
+			return (long)c->out->count - 1;
+		}
 	const uint8_t *data = NULL;
 	uint8_t *owned = NULL;
 	size_t len = 0;
@@ -159,6 +171,7 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 	}
 	c->total += len;
 	if (push(c, ref, data, len, owned != NULL) < 0) return -1;
+	c->resolved[c->out->count - 1] = strdup(full);   /* NULL when out of memory: not shared */
 	return (long)c->out->count - 1;
 }
 
@@ -303,6 +316,7 @@ enum api_result api_model_refs_collect(const uint8_t *data, size_t len, enum api
 	int rc = 0;
 	if (format == API_MODEL_GLTF || format == API_MODEL_GLB) rc = gltf_refs(&c, data, len, format == API_MODEL_GLB);
 	else if (format == API_MODEL_OBJ) rc = obj_refs(&c, data, len);
+	for (size_t i = 0; i < API_MODEL_REFS_MAX; i++) free(c.resolved[i]);
 	return rc < 0 ? API_ERR : API_OK;
 }
 

@@ -106,11 +106,11 @@ void api_problem_format(const struct api_problem *p, char *buf, size_t size)
 void api_limits_defaults(struct api_limits *l)
 {
 	if (!l) return;
+	memset(l, 0, sizeof *l);   /* output_side, the gates: none */
 	l->max_pixels = 16777216;
 	l->max_triangles = 20000000;
 	l->max_lights = 64;
 	l->max_shadow_resolution = 8192;
-	l->asset_root = NULL;
 	l->import_timeout_ms = 10000;
 	l->import_memory = 2ull << 30;
 	l->max_textures = RND_DEFAULT_MAX_TEXTURES;

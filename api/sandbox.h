@@ -113,8 +113,10 @@ struct api_sbx_request {
 
 /* A model's input with the files it refers to: the model's bytes, then per file
  * {uint32 name_len (with its NUL), uint64 data_len, name, NUL, data}, host byte order (both
- * ends run on one machine). Encode: malloc'd, NULL when out of memory or too large. Decode (the
+ * ends run on one machine). A file whose bytes are an earlier file's (the same data pointer and
+ * length: two spellings of one name) has data_len API_SBX_ALIAS | that file's index, no data. Encode: malloc'd, NULL when out of memory or too large. Decode (the
  * child): files[] point into `in`; -1 when the layout is inconsistent. */
+#define API_SBX_ALIAS (1ull << 63)
 uint8_t *api_sbx_bundle_encode(const uint8_t *model, size_t len, const struct api_model_file *files, size_t n,
                                size_t *out_len);
 int api_sbx_bundle_decode(const uint8_t *in, size_t len, size_t model_len, uint32_t count,

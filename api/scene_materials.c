@@ -4,6 +4,7 @@
  * (decoded in the sandbox, copied into the arena) and the count of distinct textures.
  * See scene_internal.h for the conventions.
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "sandbox.h"
@@ -63,6 +64,16 @@ int api_parse_material(struct pctx *c, json_t *j, struct rnd_material *m, const 
 		uint32_t w = 0, h = 0;
 		char err[300];
 		int status;
+		/* What the decode will take, admitted first: its reply and the arena's copy. A JPEG of
+		 * 141 bytes may claim 8192^2 texels (+512 MB here, uncounted before). */
+		const struct api_memory_gate *mg = c->lim->memory_gate;
+		uint32_t hw, hh;
+		if (mg && api_image_header_size(b, len, &hw, &hh) && (uint64_t)hw * hh <= MAX_TEXTURE_PIXELS &&
+		    !mg->reserve(mg->user, (uint64_t)hw * hh * 8, c->p)) {
+			if (!c->p->pointer[0]) snprintf(c->p->pointer, sizeof c->p->pointer, "%s", c->ptr);
+			api_ptr_pop(c, old);
+			return -1;
+		}
 		/* In a sandboxed helper process (api/sandbox.h): libpng/libjpeg never see request bytes here. */
 		if (api_sandbox_decode_image(b, len, MAX_TEXTURE_PIXELS, c->lim, &rgba, &w, &h, &status, err, sizeof err) !=
 		    API_OK) {

@@ -61,14 +61,22 @@ static const char *big_member(const struct api_scene *sc)
 int srv_admit_request(struct srv_admit *a, const struct api_scene *sc, uint64_t need, double deadline,
                       struct api_problem *p)
 {
-	if (a->budget && need > a->budget) {
-		api_problem_set(p, 422, big_member(sc), "this render needs about %.0f MB of memory, over this server's "
-		                "--max-memory of %.0f MB", need / 1e6, a->budget / 1e6);
+	return srv_admit_grow(a, sc, 0, need, deadline, p);
+}
+
+int srv_admit_grow(struct srv_admit *a, const struct api_scene *sc, uint64_t held, uint64_t need, double deadline,
+                   struct api_problem *p)
+{
+	if (a->budget && held + need > a->budget) {
+		api_problem_set(p, 422, sc ? big_member(sc) : "", "this request needs about %.0f MB of memory, over this "
+		                "server's --max-memory of %.0f MB", (held + need) / 1e6, a->budget / 1e6);
 		return -1;
 	}
 	pthread_mutex_lock(&a->mu);
-	/* Wait while others hold the room; alone, a render within the budget always runs. */
-	while (a->budget && a->in_use && a->in_use + need > a->budget) {
+	/* What it holds is given back while it waits: two requests that each hold some and wait for
+	 * more would otherwise wait for each other. Alone, a request within the budget always runs. */
+	a->in_use -= held;
+	while (a->budget && a->in_use && a->in_use + held + need > a->budget) {
 		int e;
 		if (deadline > 0) {
 			struct timespec ts = srv_timespec(deadline);
@@ -77,13 +85,14 @@ int srv_admit_request(struct srv_admit *a, const struct api_scene *sc, uint64_t 
 			e = pthread_cond_wait(&a->cv, &a->mu);
 		}
 		if (e == ETIMEDOUT) {
+			a->in_use += held;
 			pthread_mutex_unlock(&a->mu);
-			api_problem_set(p, 504, "", "the render passed its deadline waiting for %.0f MB of memory (%.0f of %.0f MB "
-			                "held by renders in flight)", need / 1e6, a->in_use / 1e6, a->budget / 1e6);
+			api_problem_set(p, 504, "", "the request passed its deadline waiting for %.0f MB of memory (%.0f of %.0f MB "
+			                "held by requests in flight)", need / 1e6, a->in_use / 1e6, a->budget / 1e6);
 			return -1;
 		}
 	}
-	a->in_use += need;
+	a->in_use += held + need;
 	if (a->in_use > a->peak) a->peak = a->in_use;
 	pthread_mutex_unlock(&a->mu);
 	return 0;

@@ -38,6 +38,11 @@ uint64_t srv_admit_default_budget(void);
  * 504 when `deadline` (monotonic seconds, 0 = none) passed while waiting. */
 int srv_admit_request(struct srv_admit *a, const struct api_scene *sc, uint64_t need, double deadline,
                       struct api_problem *p);
+/* The same for a request that holds `held` bytes admitted already (its parse's, api.h
+ * api_memory_gate): on success it holds held + need, on failure still held. sc may be NULL
+ * (the 422's pointer is then ""). */
+int srv_admit_grow(struct srv_admit *a, const struct api_scene *sc, uint64_t held, uint64_t need, double deadline,
+                   struct api_problem *p);
 void srv_admit_release(struct srv_admit *a, uint64_t need);
 /* Bytes admitted now and the budget, for /metrics. */
 void srv_admit_stats(struct srv_admit *a, uint64_t *in_use, uint64_t *budget, uint64_t *peak);

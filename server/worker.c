@@ -223,11 +223,14 @@ static void job_deadline(struct srv_server *s, struct srv_request *req, const ch
 	job_problem(req, &p);
 }
 
+#define BIG_REQUEST_BYTES (64ull << 20)
+
 /* Admission by memory: the renderer's estimate of what the scene allocates, against
  * --max-memory (admit.h). Limits no retry can cure (one allocation over the device's limit)
- * answer 422 here, before the render. 0 admitted (*need to release), else p is filled. */
-static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t *need,
-                 struct api_problem *p)
+ * answer 422 here, before the render. held: what its parse holds already (api_memory_gate).
+ * 0 admitted (*need, held included, to release), else p is filled (held still to release). */
+static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t held,
+                 uint64_t *need, struct api_problem *p)
 {
 	struct rnd_estimate est;
 	struct rnd_error err = {0};
@@ -242,11 +245,11 @@ static int admit(struct srv_server *s, const struct srv_request *req, const stru
 	}
 	uint64_t n = est.device_bytes + est.host_bytes;
 	double deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0;
-	if (srv_admit_request(&s->admit, sc, n, deadline, p) != 0) {
+	if (srv_admit_grow(&s->admit, sc, held, n, deadline, p) != 0) {
 		if (p->status == 504) srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
 		return -1;
 	}
-	*need = n;
+	*need = held + n;
 	return 0;
 }
 
@@ -284,18 +287,34 @@ static bool render_should_yield(void *user)
 	return true;
 }
 
-/* Whether this parse may import a model the cache lacks (server/imports.h): on an import
- * thread yes; on a worker no, and the request goes to the import threads (refused). */
-struct import_ticket {
-	struct api_import_gate gate;
+/* What a parse may take (api.h's gates): the import of a model the cache lacks, on an import
+ * thread only (server/imports.h; on a worker the request goes to them: refused), and memory,
+ * admitted against --max-memory as it goes (reserved: what it holds, released with the render's). */
+struct parse_ticket {
+	struct api_import_gate imports;
+	struct api_memory_gate memory;
+	struct srv_server *s;
+	double deadline;
 	bool importer, refused;
+	uint64_t reserved;
 };
 
-static bool ticket_enter(void *user)
+static bool ticket_import(void *user)
 {
-	struct import_ticket *t = user;
+	struct parse_ticket *t = user;
 	if (!t->importer) t->refused = true;
 	return t->importer;
+}
+
+static bool ticket_memory(void *user, uint64_t bytes, struct api_problem *p)
+{
+	struct parse_ticket *t = user;
+	if (srv_admit_grow(&t->s->admit, NULL, t->reserved, bytes, t->deadline, p) != 0) {
+		if (p->status == 504) srv_metrics_add(t->s->metrics, SRV_CTR_DEADLINE, 1);
+		return false;
+	}
+	t->reserved += bytes;
+	return true;
 }
 
 /* Parses the request's body and parts into *scp and settles what the answer depends on (its
@@ -303,7 +322,7 @@ static bool ticket_enter(void *user)
  * answered already (a problem, or 304 for a matching If-None-Match); 2: parked for an import
  * thread (a worker's parse reached a model to import): not this thread's any more. *scp,
  * when set, is the caller's to free either way. */
-static int job_parse(struct srv_server *s, struct srv_request *req, bool importer, struct api_scene **scp,
+static int job_parse(struct srv_server *s, struct srv_request *req, struct parse_ticket *t, struct api_scene **scp,
                      double *parse_s)
 {
 	struct api_problem p = { 0 };
@@ -312,14 +331,15 @@ static int job_parse(struct srv_server *s, struct srv_request *req, bool importe
 	size_t nparts = req->part_count < 64 ? req->part_count : 64;
 	for (size_t i = 0; i < nparts; i++)
 		parts[i] = (struct api_part){ req->parts[i].name, req->parts[i].data, req->parts[i].len };
-	struct import_ticket ticket = { .gate = { ticket_enter, NULL }, .importer = importer };
-	ticket.gate.user = &ticket;
 	struct api_limits lim = s->cfg.limits;
-	lim.import_gate = &ticket.gate;
+	lim.import_gate = &t->imports;
+	lim.memory_gate = &t->memory;
 	enum api_result pr = api_scene_parse_parts(req->body, req->body_len, &lim, parts, nparts, scp, &p);
-	if (pr != API_OK && ticket.refused) {
+	if (pr != API_OK && t->refused) {
 		api_scene_free(*scp);
 		*scp = NULL;
+		srv_admit_release(&s->admit, t->reserved);   /* its import thread parses it again */
+		t->reserved = 0;
 		srv_imports_park(s->imports, req);
 		return 2;
 	}
@@ -438,7 +458,12 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	size_t len = 0;
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
 	double parse_s = 0;
-	int pr = job_parse(s, req, importer, &sc, &parse_s);
+	struct parse_ticket ticket = { .imports = { ticket_import, NULL }, .memory = { ticket_memory, NULL }, .s = s,
+	                               .deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0,
+	                               .importer = importer };
+	ticket.imports.user = ticket.memory.user = &ticket;
+	int pr = job_parse(s, req, &ticket, &sc, &parse_s);
+	admitted = ticket.reserved;
 	*parked = pr == 2;
 	if (pr) goto out;
 
@@ -447,7 +472,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 		job_deadline(s, req, "before rendering", t1);
 		goto out;
 	}
-	if (admit(s, req, sc, &admitted, &p) != 0) {
+	if (admit(s, req, sc, admitted, &admitted, &p) != 0) {
 		job_problem(req, &p);
 		goto out;
 	}
@@ -498,6 +523,8 @@ out:
 	rnd_image_release(&img);
 	api_scene_free(sc);
 	srv_admit_release(&s->admit, admitted);
+	/* After an enormous request, its freed heap back to the system now, not at the idle trim. */
+	if (admitted > BIG_REQUEST_BYTES) malloc_trim(0);
 	return lost_gen;
 }
 

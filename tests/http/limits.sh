@@ -103,5 +103,25 @@ check "renders in flight never held more than the budget (peak $peak > 0, budget
 get info /v1/info >/dev/null
 check "/v1/info lists max_memory and the device's largest allocation" \
 	grep -q '"max_memory":268435456,"device_max_allocation":[1-9]' "$T/info.body"
+# Parse-time memory is admitted too (issue 29): a texture of a few bytes claiming 8192^2 texels
+# would take ~540 MB decoded (the decode's reply and the scene's copy); it is refused by its
+# header, before any decode starts, at the texture's member and naming the flag.
+python3 - "$T/bigtex.json" <<'PY'
+import base64, json, struct, sys, zlib
+def chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 8192, 8192, 8, 6, 0, 0, 0)) + chunk(b"IEND", b"")
+s = {"width": 64, "height": 64, "camera": {"position": [3, 2, 3], "target": [0, 0, 0]},
+     "materials": {"t": {"base_color_texture": base64.b64encode(png).decode()}},
+     "objects": [{"shape": "box", "material": "t"}], "lights": []}
+json.dump(s, open(sys.argv[1], "w"))
+PY
+get metrics /metrics >/dev/null
+jobs0=$(metric 'umbra_import_jobs_started_total{job="image"}')
+code=$(post bigtex "$T/bigtex.json")
+check "a 57-byte PNG claiming 8192² texels under --max-memory 256M: 422 at its member, naming --max-memory" \
+	eval '[ "$code" = 422 ] && problem bigtex 422 /materials/t/base_color_texture && grep -q -- "--max-memory" "$T/bigtex.body"'
+get metrics /metrics >/dev/null
+check "... refused before any decode started" [ "$(metric 'umbra_import_jobs_started_total{job="image"}')" = "$jobs0" ]
 stop budget "$PID"
 finish
