@@ -17,6 +17,19 @@
 static const char *const MATERIAL_MEMBERS[] = {"base_color", "base_color_texture", "alpha_mode", "alpha_cutoff",
                                                "roughness", "metallic", "emissive", "shadow_catcher", NULL};
 
+/* What a texture's decode will take, admitted first (api_memory_gate): its reply and the
+ * arena's copy, by the header's size. A JPEG of 141 bytes may claim 8192^2 texels (+512 MB
+ * here, uncounted before). False: c->p says why (at the texture's member). */
+static bool reserve_decode(struct pctx *c, const uint8_t *b, size_t len)
+{
+	const struct api_memory_gate *mg = c->lim->memory_gate;
+	uint32_t w, h;
+	if (!mg || !api_image_header_size(b, len, &w, &h) || (uint64_t)w * h > MAX_TEXTURE_PIXELS) return true;
+	if (mg->reserve(mg->user, (uint64_t)w * h * 8, c->p)) return true;
+	if (!c->p->pointer[0]) snprintf(c->p->pointer, sizeof c->p->pointer, "%s", c->ptr);
+	return false;
+}
+
 int api_parse_material(struct pctx *c, json_t *j, struct rnd_material *m, const char *what)
 {
 	if (api_require_object(c, j, what) < 0 || api_check_members(c, j, MATERIAL_MEMBERS, NULL, "a material") < 0)
@@ -64,16 +77,7 @@ int api_parse_material(struct pctx *c, json_t *j, struct rnd_material *m, const 
 		uint32_t w = 0, h = 0;
 		char err[300];
 		int status;
-		/* What the decode will take, admitted first: its reply and the arena's copy. A JPEG of
-		 * 141 bytes may claim 8192^2 texels (+512 MB here, uncounted before). */
-		const struct api_memory_gate *mg = c->lim->memory_gate;
-		uint32_t hw, hh;
-		if (mg && api_image_header_size(b, len, &hw, &hh) && (uint64_t)hw * hh <= MAX_TEXTURE_PIXELS &&
-		    !mg->reserve(mg->user, (uint64_t)hw * hh * 8, c->p)) {
-			if (!c->p->pointer[0]) snprintf(c->p->pointer, sizeof c->p->pointer, "%s", c->ptr);
-			api_ptr_pop(c, old);
-			return -1;
-		}
+		if (!reserve_decode(c, b, len)) { api_ptr_pop(c, old); return -1; }
 		/* In a sandboxed helper process (api/sandbox.h): libpng/libjpeg never see request bytes here. */
 		if (api_sandbox_decode_image(b, len, MAX_TEXTURE_PIXELS, c->lim, &rgba, &w, &h, &status, err, sizeof err) !=
 		    API_OK) {

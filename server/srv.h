@@ -12,7 +12,8 @@
  *   origin.c   pure rules: the Host allow-list, Origin / Sec-Fetch-Site checks, CORS (origin.h)
  *   origin_http.c  those rules on libmicrohttpd's requests; the headers every answer carries
  *   queue.c    the bounded two-level (interactive before bulk) job queue
- *   worker.c   worker threads: parse -> render -> encode; the shared rnd_context; warm-up
+ *   worker.c   worker threads: parse -> render -> encode (imports.c: the import threads)
+ *   context.c  the shared rnd_context: create, recovery after a lost device, srv_render()
  *   gate.c     how many renders run on the device at once (--device-renders; 1 on lavapipe)
  *   clock.c    monotonic condition variables and deadlines for the queue, admission and gate
  *   metrics.c  Prometheus counters, gauges and histograms
@@ -211,17 +212,20 @@ int srv_http_start(struct srv_server *s);           /* 0 or -1 (logged) */
 void srv_http_quiesce(struct srv_server *s);        /* stops accepting connections */
 void srv_http_stop(struct srv_server *s);
 
-/* worker.c */
+/* context.c */
 int srv_context_open(struct srv_server *s);         /* create + info; 0 or -1 (logged) */
+/* After RND_ERR_DEVICE_LOST from the context of generation gen: recreates and warms it up once. */
+void srv_context_recover(struct srv_server *s, unsigned gen);
 int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged); server/warmup.c */
-/* Renders on the shared context (worker.c). On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the
+/* Renders on the shared context (context.c). On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the
  * lost context's generation + 1, and the daemon is marked not ready. */
 enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
                            struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
-int srv_workers_start(struct srv_server *s);
-void srv_workers_join(struct srv_server *s);        /* after srv_queue_close() */
 int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */
 int srv_fault_arm(struct srv_server *s);            /* --test-fault; 0 or -1 (logged) */
+/* worker.c */
+int srv_workers_start(struct srv_server *s);
+void srv_workers_join(struct srv_server *s);        /* after srv_queue_close() */
 
 /* flags.c: 0 ok, 1 --help printed (exit 0), -1 error printed (exit 2). The strings in cfg
  * point into argv or the environment: nothing to free. */

@@ -1,6 +1,6 @@
 /*
- * umbrad workers: the shared rnd_context (create, recovery after a lost device, cache save;
- * the warm-up is server/warmup.c) and the threads that turn a queued request into an answer:
+ * umbrad workers: the threads that turn a queued request into an answer (the shared
+ * rnd_context they render on is server/context.c, its warm-up server/warmup.c):
  *   deadline check -> api_scene_parse -> Accept -> deadline check -> rnd_render -> api_encode
  *   -> deadline check -> srv_request_finish().
  * A worker never touches the request after srv_request_finish().
@@ -11,8 +11,8 @@
  * request cannot make every request behind it miss its deadline; one render yields per waiter.
  *
  * Device loss: the render that saw it marks the daemon not ready (/readyz 503) before its own
- * 503 answer goes out; its worker then recreates the context and runs the warm-up again, and
- * only then is the daemon ready again.
+ * 503 answer goes out; its worker then recreates the context (srv_context_recover) and runs
+ * the warm-up again, and only then is the daemon ready again.
  */
 #include <malloc.h>
 #include <stdio.h>
@@ -25,177 +25,6 @@
 #include "negotiate.h"
 #include "queue.h"
 #include "srv.h"
-
-/* ---- context ---- */
-
-static void rnd_log_cb(void *user, int level, const char *msg)
-{
-	(void)user;
-	srv_log(level <= 0 ? SRV_LOG_ERROR : level == 1 ? SRV_LOG_WARN : SRV_LOG_INFO, "renderer: %s", msg);
-}
-
-static int context_create(struct srv_server *s, struct rnd_context **out)
-{
-	struct rnd_context_desc cd = { 0 };
-	struct rnd_error err = { 0 };
-	cd.device_name = s->cfg.device;
-	cd.validation = s->cfg.validation;
-	cd.pipeline_cache_path = s->cfg.pipeline_cache;
-	cd.slots = s->cfg.workers;
-	cd.atlas_size = s->cfg.atlas_size;
-	cd.max_textures = s->cfg.limits.max_textures;
-	cd.log = rnd_log_cb;
-	enum rnd_result r = rnd_context_create(&cd, out, &err);
-	if (r != RND_OK) {
-		srv_log(SRV_LOG_ERROR, "cannot create the renderer context: %s (%s)", err.msg, rnd_result_str(r));
-		*out = NULL;
-		return -1;
-	}
-	return 0;
-}
-
-int srv_context_open(struct srv_server *s)
-{
-	struct rnd_context *ctx;
-	if (context_create(s, &ctx) != 0)
-		return -1;
-	pthread_rwlock_wrlock(&s->ctx_lock);
-	s->ctx = ctx;
-	rnd_context_info(ctx, &s->info);
-	/* --max-textures as the device grants it: the parser's 422 then comes before the renderer's. */
-	if (s->cfg.limits.max_textures != s->info.max_textures) s->cfg.limits.max_textures = s->info.max_textures;
-	pthread_rwlock_unlock(&s->ctx_lock);
-	unsigned renders = s->cfg.device_renders ? s->cfg.device_renders : s->info.is_cpu ? 1 : s->cfg.workers;
-	if (renders > s->cfg.workers) renders = s->cfg.workers;
-	srv_gate_set_limit(&s->gate, renders);
-	srv_log(SRV_LOG_INFO, "device \"%s\", driver \"%s\" %s%s, %u render slots, %u on the device at once%s",
-	        s->info.device_name, s->info.driver_name, s->info.driver_info, s->info.is_cpu ? " (CPU)" : "",
-	        s->cfg.workers, renders, s->cfg.validation ? ", validation on" : "");
-	return 0;
-}
-
-/* After RND_ERR_DEVICE_LOST from the context of generation `gen`: the first worker to get
- * here waits for the other renders to leave, then destroys and recreates the context and warms
- * it up again; the others see a newer generation and do nothing. /readyz answers 503 from the
- * moment the loss was seen until the new context is warm. */
-static bool context_recover_once(struct srv_server *s, unsigned gen, unsigned *new_gen)
-{
-	pthread_rwlock_wrlock(&s->ctx_lock);
-	if (s->ctx_gen != gen) {
-		pthread_rwlock_unlock(&s->ctx_lock);
-		return true;
-	}
-	atomic_store(&s->ready, false);
-	srv_metrics_add(s->metrics, SRV_CTR_DEVICE_LOST, 1);
-	srv_log(SRV_LOG_ERROR, "device lost: recreating the renderer context");
-	if (s->ctx)
-		s->validation_lost += rnd_context_validation_messages(s->ctx);
-	rnd_context_destroy(s->ctx);
-	s->ctx = NULL;
-	s->ctx_gen++;
-	unsigned my_gen = *new_gen = s->ctx_gen;
-	struct rnd_context *ctx;
-	bool created = context_create(s, &ctx) == 0;
-	if (created) {
-		s->ctx = ctx;
-		rnd_context_info(ctx, &s->info);
-	}
-	pthread_rwlock_unlock(&s->ctx_lock);
-	if (!created)
-		return true;   /* renders answer 503 "could not be recreated"; nothing more to try */
-	srv_log(SRV_LOG_INFO, "renderer context recreated on \"%s\"; warming up again", s->info.device_name);
-	/* The warm-up renders take the lock for reading like any render; requests that reach a
-	 * worker meanwhile render on the new context (compiling what they need). */
-	bool warm = srv_warmup(s) == 0;
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	bool mine = s->ctx_gen == my_gen;   /* else lost again and recovered by another worker */
-	if (warm && mine && s->ctx && !atomic_load(&s->draining))
-		atomic_store(&s->ready, true);
-	pthread_rwlock_unlock(&s->ctx_lock);
-	if (!warm)
-		srv_log(SRV_LOG_ERROR, "warm-up after the device loss failed");
-	return warm || !mine;
-}
-
-/* A loss during the new warm-up would leave the daemon not ready with no request reaching a
- * worker to notice: try again a few times. */
-static void context_recover(struct srv_server *s, unsigned gen)
-{
-	for (int attempt = 0; attempt < 3; attempt++) {
-		unsigned new_gen = gen;
-		if (context_recover_once(s, gen, &new_gen) || new_gen == gen)
-			return;
-		gen = new_gen;
-	}
-	srv_log(SRV_LOG_ERROR, "the renderer could not be brought back after a device loss: staying not ready");
-}
-
-/* Renders on the shared context. On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the lost
- * context's generation + 1 for context_recover(), and the daemon is marked not ready before
- * the lock is let go (so a recovery cannot finish before this mark). */
-enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
-                           struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen)
-{
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	unsigned gen = s->ctx_gen;
-	enum rnd_result r;
-	if (!s->ctx) {
-		memset(err, 0, sizeof *err);
-		err->code = r = RND_ERR_DEVICE_LOST;
-		snprintf(err->msg, sizeof err->msg, "the renderer context could not be recreated after a lost device");
-	} else {
-		atomic_fetch_add(&s->in_flight, 1);
-		r = rnd_render(s->ctx, scene, img, t, err);
-		atomic_fetch_sub(&s->in_flight, 1);
-		if (r == RND_ERR_DEVICE_LOST) {
-			atomic_store(&s->ready, false);
-			if (lost_gen)
-				*lost_gen = gen + 1;
-		}
-	}
-	pthread_rwlock_unlock(&s->ctx_lock);
-	return r;
-}
-
-int srv_fault_arm(struct srv_server *s)
-{
-	const char *f = s->cfg.test_fault;
-	if (!f)
-		return 0;
-	unsigned n = 0;
-	char kind[8] = "";
-	if (sscanf(f, "submit:%u:%7s", &n, kind) != 2 || n == 0 || (strcmp(kind, "lost") && strcmp(kind, "oom"))) {
-		srv_log(SRV_LOG_ERROR, "--test-fault '%s': want submit:N:lost or submit:N:oom (N >= 1)", f);
-		return -1;
-	}
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	if (s->ctx)
-		rnd_context_inject_fault(s->ctx, strcmp(kind, "lost") ? RND_FAULT_OUT_OF_MEMORY : RND_FAULT_DEVICE_LOST, n);
-	pthread_rwlock_unlock(&s->ctx_lock);
-	srv_log(SRV_LOG_WARN, "test fault armed: queue submit %u from now returns %s", n,
-	        strcmp(kind, "lost") ? "out of device memory" : "device lost");
-	return 0;
-}
-
-int srv_context_close(struct srv_server *s)
-{
-	pthread_rwlock_wrlock(&s->ctx_lock);
-	uint32_t msgs = s->validation_lost;
-	if (s->ctx) {
-		struct rnd_error err = { 0 };
-		if (s->cfg.pipeline_cache) {
-			if (rnd_context_save_cache(s->ctx, &err) != RND_OK)
-				srv_log(SRV_LOG_WARN, "cannot save the pipeline cache '%s': %s", s->cfg.pipeline_cache, err.msg);
-			else
-				srv_log(SRV_LOG_INFO, "pipeline cache saved to '%s'", s->cfg.pipeline_cache);
-		}
-		msgs += rnd_context_validation_messages(s->ctx);
-		rnd_context_destroy(s->ctx);
-		s->ctx = NULL;
-	}
-	pthread_rwlock_unlock(&s->ctx_lock);
-	return (int)msgs;
-}
 
 /* ---- jobs ---- */
 
@@ -315,6 +144,13 @@ static bool ticket_memory(void *user, uint64_t bytes, struct api_problem *p)
 	}
 	t->reserved += bytes;
 	return true;
+}
+
+static void ticket_init(struct parse_ticket *t, struct srv_server *s, const struct srv_request *req, bool importer)
+{
+	*t = (struct parse_ticket){ .imports = { ticket_import, t }, .memory = { ticket_memory, t }, .s = s,
+	                            .deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0,
+	                            .importer = importer };
 }
 
 /* Parses the request's body and parts into *scp and settles what the answer depends on (its
@@ -458,10 +294,8 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	size_t len = 0;
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
 	double parse_s = 0;
-	struct parse_ticket ticket = { .imports = { ticket_import, NULL }, .memory = { ticket_memory, NULL }, .s = s,
-	                               .deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0,
-	                               .importer = importer };
-	ticket.imports.user = ticket.memory.user = &ticket;
+	struct parse_ticket ticket;
+	ticket_init(&ticket, s, req, importer);
 	int pr = job_parse(s, req, &ticket, &sc, &parse_s);
 	admitted = ticket.reserved;
 	*parked = pr == 2;
@@ -555,7 +389,7 @@ static void *worker_main(void *arg)
 		srv_queue_done(s->queue);
 		/* After the answer: the client learns of the failure at once, /readyz is already 503. */
 		if (lost_gen)
-			context_recover(s, lost_gen - 1);
+			srv_context_recover(s, lost_gen - 1);
 	}
 	return NULL;
 }
@@ -572,7 +406,7 @@ static void *importer_main(void *arg)
 		srv_request_finish(req);
 		srv_imports_done(s->imports, client);
 		if (lost_gen)
-			context_recover(s, lost_gen - 1);
+			srv_context_recover(s, lost_gen - 1);
 	}
 	return NULL;
 }
