@@ -73,6 +73,20 @@ enum rnd_result rnd_pacer_check(const struct rnd_pacer *p, struct rnd_error *err
 	return RND_OK;
 }
 
+enum rnd_result rnd_pacer_hopeless(const struct rnd_pacer *p, uint32_t rows_left, struct rnd_error *err)
+{
+	const struct rnd_scene *sc = p->sc;
+	if (!sc->deadline_ns || !p->measured || !p->rows[1]) return RND_OK;
+	/* The rows left at the last band's measured cost: a low bound (the rows below are rarely
+	 * cheaper than the sky above), so a render stopped here would not have made it. */
+	double left_ms = (double)rows_left * p->ms[1] / p->rows[1];
+	uint64_t now = now_ns();
+	double time_ms = sc->deadline_ns > now ? (double)(sc->deadline_ns - now) / 1e6 : 0;
+	if (left_ms <= time_ms) return RND_OK;
+	return rnd_fail(err, RND_ERR_TIMEOUT, "stopped after %u submits: its %u rows left need ~%.0f ms at the rate measured, "
+	                "%.0f ms before its deadline", p->submits, rows_left, left_ms, time_ms);
+}
+
 uint32_t rnd_pacer_band_rows(const struct rnd_pacer *p, uint32_t left, uint32_t min_rows, double est_row_ms,
                              double est_fixed_ms)
 {
@@ -391,6 +405,7 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 		p->rows[1] = rows; p->ms[1] = wall;
 		p->measured++;
 		y += rows;
+		if (y < sc->height && (r = rnd_pacer_hopeless(p, sc->height - y, err)) != RND_OK) return r;
 	}
 	return RND_OK;
 fail:

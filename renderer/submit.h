@@ -36,6 +36,10 @@ struct rnd_pacer {
 
 /* Sets the slice from the deadline left (a quarter of it, 50..1000 ms) or 0 without one. */
 void rnd_pacer_init(struct rnd_pacer *p, const struct rnd_scene *sc);
+/* RND_ERR_TIMEOUT when the rows_left of the main pass cannot be drawn before the deadline at
+ * the last band's measured cost: stopped now, not at the deadline (the worker goes to the
+ * requests behind it a whole render's time earlier; under load, when the machine is slowest). */
+enum rnd_result rnd_pacer_hopeless(const struct rnd_pacer *p, uint32_t rows_left, struct rnd_error *err);
 /* RND_ERR_TIMEOUT (message says how far past) when the deadline has passed or cancel says so. */
 enum rnd_result rnd_pacer_check(const struct rnd_pacer *p, struct rnd_error *err);
 /* Height of the next band: from the estimate before any band ran, else from the last two

@@ -2,6 +2,8 @@
  * no GPU. The numbers are the ones a lavapipe run of 16 soft-shadowed spot lights produced:
  * cheap sky rows above, rows ~40x dearer below. */
 #include "test.h"
+#include <string.h>
+#include <time.h>
 #include "submit.h"
 
 static struct rnd_pacer pacer(double slice_ms)
@@ -68,4 +70,28 @@ TEST(pacer_no_sliver_at_the_bottom)
 {
 	struct rnd_pacer p = pacer(1000);
 	CHECK(rnd_pacer_band_rows(&p, 11, 4, 100, 0) == 11, "a last band of 1 row left over");
+}
+
+/* A render that cannot finish stops at once (rnd_pacer_hopeless): its worker goes to the
+ * requests behind it a render's time before the deadline (issue 29, fairness under load). */
+TEST(pacer_stops_a_render_that_cannot_make_its_deadline)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	uint64_t now = (uint64_t)t.tv_sec * 1000000000ull + (uint64_t)t.tv_nsec;
+	struct rnd_scene sc = {0};
+	struct rnd_error err = {0};
+	struct rnd_pacer p = pacer(500);
+	p.sc = &sc;
+	measured(&p, 10, 50);   /* 5 ms a row */
+	CHECK(rnd_pacer_hopeless(&p, 1000, &err) == RND_OK, "no deadline: never hopeless");
+	sc.deadline_ns = now + 60ull * 1000000000ull;
+	CHECK(rnd_pacer_hopeless(&p, 1000, &err) == RND_OK, "5 s of rows, a minute left");
+	sc.deadline_ns = now + 2ull * 1000000000ull;
+	CHECK(rnd_pacer_hopeless(&p, 1000, &err) == RND_ERR_TIMEOUT && strstr(err.msg, "1000 rows left"),
+	      "5 s of rows, 2 s left: %s", err.msg);
+	CHECK(rnd_pacer_hopeless(&p, 100, &err) == RND_OK, "0.5 s of rows, 2 s left");
+	struct rnd_pacer fresh = pacer(500);
+	fresh.sc = &sc;
+	CHECK(rnd_pacer_hopeless(&fresh, 1000, &err) == RND_OK, "nothing measured yet: no judgement");
 }
