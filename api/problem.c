@@ -106,6 +106,7 @@ void api_problem_format(const struct api_problem *p, char *buf, size_t size)
 void api_limits_defaults(struct api_limits *l)
 {
 	if (!l) return;
+	memset(l, 0, sizeof *l);   /* every member not named here (the gate, output_side, ...): none */
 	l->max_pixels = 16777216;
 	l->max_triangles = 20000000;
 	l->max_lights = 64;
