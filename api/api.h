@@ -76,6 +76,10 @@ struct api_limits {
 	 * Over either is a 422 at the member that carried the bytes. */
 	uint32_t import_timeout_ms;      /* default 10000; 0 = the default */
 	uint64_t import_memory;          /* bytes, default 2147483648 (2 GiB); 0 = no memory limit */
+	/* Not a limit: the two above are the caller's --import-timeout-ms and --import-memory
+	 * (umbrad), and their 422s say so; false: the caller has no option for them (umbra-render),
+	 * and the 422s say that. */
+	bool import_flags;               /* default false */
 	/* Distinct textures in one scene (the renderer's rnd_info.max_textures: its desc's value
 	 * capped by the device); over it is a 422 at the object that brought one too many. */
 	uint32_t max_textures;           /* default RND_DEFAULT_MAX_TEXTURES (256); 0 = the default */

@@ -171,8 +171,10 @@ static enum api_result check_file(int fd, const char *path, struct stat *st, cha
 {
 	if (fstat(fd, st) < 0 || !S_ISREG(st->st_mode))
 		return api_err_set(err, errsize, "path \"%.128s\" is not a regular file", path);
-	if ((uint64_t)st->st_size > API_ASSET_MAX_FILE || !st->st_size)
-		return api_err_set(err, errsize, "path \"%.128s\" is empty or larger than %llu bytes", path,
+	if (!st->st_size) return api_err_set(err, errsize, "path \"%.128s\" is an empty file (0 bytes)", path);
+	if ((uint64_t)st->st_size > API_ASSET_MAX_FILE)
+		return api_err_set(err, errsize, "path \"%.128s\" is %llu bytes, larger than the limit of %llu bytes (1 GiB) "
+		                   "for one file", path, (unsigned long long)st->st_size,
 		                   (unsigned long long)API_ASSET_MAX_FILE);
 	return API_OK;
 }

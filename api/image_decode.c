@@ -1,10 +1,11 @@
 /*
- * api/image_decode — PNG (libpng's simplified API) and JPEG (libjpeg-turbo) to RGBA8, for the
+ * api/image_decode — PNG (libpng) and JPEG (libjpeg-turbo) to RGBA8, for the
  * base-colour textures of imported models (and of materials). See model.h.
  *
  * Both decoders check the header's size against max_pixels before allocating, so a small file
- * that claims to be 100000x100000 costs nothing. libjpeg reports errors through longjmp; the
- * error manager below turns that into an API_ERR with the library's message.
+ * that claims to be 100000x100000 costs nothing. Both libraries report errors through longjmp;
+ * the error handlers below turn that into an API_ERR with the library's message. Colour values
+ * come out as stored: no gamma or colour-space conversion (glTF's rule, see decode_png).
  */
 #include <setjmp.h>
 #include <stdbool.h>
@@ -23,35 +24,90 @@ static enum api_result err_set(char *err, size_t n, const char *fmt, const char 
 	return API_ERR;
 }
 
+/* libpng's low-level reader over a memory buffer. Its simplified API (png_image) converts to
+ * sRGB by the file's gAMA / cHRM / iCCP chunks, and there is no way to ask it not to; glTF
+ * says a texture's values are used as stored ("any colorspace information (such as ICC
+ * profiles, intents, gamma values, etc.) from PNG images MUST be ignored"), and so does a
+ * material's base_color_texture here: no gamma transform is ever set up below. */
+struct png_src {
+	const uint8_t *data;
+	size_t len, at;
+	char msg[160];
+};
+
+static void png_read_mem(png_structp png, png_bytep out, size_t n)
+{
+	struct png_src *s = png_get_io_ptr(png);
+	if (s->len - s->at < n) png_error(png, "the file is cut short");
+	memcpy(out, s->data + s->at, n);
+	s->at += n;
+}
+
+static void png_on_error(png_structp png, png_const_charp msg)
+{
+	struct png_src *s = png_get_error_ptr(png);
+	snprintf(s->msg, sizeof s->msg, "%s", msg);
+	png_longjmp(png, 1);
+}
+
+/* Warnings (a bad ancillary chunk, skipped) are not fatal and not printed on stderr. */
+static void png_quiet(png_structp png, png_const_charp msg)
+{
+	(void)png;
+	(void)msg;
+}
+
+/* Any PNG to 8-bit RGBA, values as stored: palette and low bit depths expanded, tRNS to alpha,
+ * 16 bits scaled to 8, grey to RGB, alpha 255 where the file has none. */
+static void png_to_rgba8(png_structp png, png_infop info)
+{
+	png_byte type = png_get_color_type(png, info);
+	png_set_expand(png);
+	png_set_scale_16(png);
+	if (!(type & PNG_COLOR_MASK_COLOR)) png_set_gray_to_rgb(png);
+	if (!(type & PNG_COLOR_MASK_ALPHA) && !png_get_valid(png, info, PNG_INFO_tRNS))
+		png_set_add_alpha(png, 0xff, PNG_FILLER_AFTER);
+	png_set_interlace_handling(png);
+	png_read_update_info(png, info);
+}
+
 static enum api_result decode_png(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
                                   uint32_t *w, uint32_t *h, char *err, size_t errsize)
 {
-	png_image img;
-	memset(&img, 0, sizeof img);
-	img.version = PNG_IMAGE_VERSION;
-	if (!png_image_begin_read_from_memory(&img, data, len))
-		return err_set(err, errsize, "PNG: %s", img.message);
-	if (!img.width || !img.height || (uint64_t)img.width * img.height > max_pixels) {
-		png_image_free(&img);
-		return err_set(err, errsize, "PNG: %s", "the image is empty or over the texture size limit");
-	}
-	img.format = PNG_FORMAT_RGBA;
-	size_t size = PNG_IMAGE_SIZE(img);
-	uint8_t *px = malloc(size);
-	if (!px) {
-		png_image_free(&img);
+	struct png_src src = {data, len, 0, ""};
+	png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, png_on_error, png_quiet);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	/* volatile: written after setjmp and read after a longjmp back to it. */
+	uint8_t *volatile px = NULL;
+	png_bytep *volatile rows = NULL;
+	if (!info) {
+		png_destroy_read_struct(&png, NULL, NULL);
 		return err_set(err, errsize, "PNG: %s", "out of memory");
 	}
-	/* A NULL background: alpha is kept, not composited. */
-	if (!png_image_finish_read(&img, NULL, px, 0, NULL)) {
+	if (setjmp(png_jmpbuf(png))) {
+		png_destroy_read_struct(&png, &info, NULL);
 		free(px);
-		png_image_free(&img);
-		return err_set(err, errsize, "PNG: %s", img.message);
+		free(rows);
+		return err_set(err, errsize, "PNG: %s", src.msg[0] ? src.msg : "cannot be read");
 	}
-	*w = img.width;
-	*h = img.height;
+	png_set_read_fn(png, &src, png_read_mem);
+	png_read_info(png, info);
+	uint32_t width = png_get_image_width(png, info), height = png_get_image_height(png, info);
+	if (!width || !height || (uint64_t)width * height > max_pixels)
+		png_error(png, "the image is empty or over the texture size limit");
+	png_to_rgba8(png, info);
+	if (png_get_rowbytes(png, info) != (size_t)width * 4) png_error(png, "unexpected pixel layout");
+	px = malloc((size_t)width * height * 4);
+	rows = malloc((size_t)height * sizeof *rows);
+	if (!px || !rows) png_error(png, "out of memory");
+	for (uint32_t y = 0; y < height; y++) rows[y] = px + (size_t)y * width * 4;
+	png_read_image(png, rows);
+	/* The chunks after the pixels (and a missing IEND) do not matter: not read. */
+	png_destroy_read_struct(&png, &info, NULL);
+	free(rows);
+	*w = width;
+	*h = height;
 	*rgba = px;
-	png_image_free(&img);
 	return API_OK;
 }
 

@@ -108,6 +108,19 @@ enum api_model_format api_model_sniff(const uint8_t *d, size_t len)
 	return API_MODEL_SNIFF;
 }
 
+enum api_model_format api_model_settle_format(const uint8_t *data, size_t len, enum api_model_format stated,
+                                              char *warning, size_t size)
+{
+	if (warning && size) warning[0] = 0;
+	enum api_model_format seen = api_model_sniff(data, len);
+	/* OBJ is told by its statements (a heuristic): it never overrides what was stated. */
+	if (stated == API_MODEL_SNIFF || seen == API_MODEL_SNIFF || seen == API_MODEL_OBJ) return stated;
+	if (seen != stated && warning && size)
+		snprintf(warning, size, "the file is a %s file by its bytes, not %s as its format or file name says: read as "
+		         "%s", FORMAT_NAMES[seen], api_model_format_name(stated), FORMAT_NAMES[seen]);
+	return seen;
+}
+
 static void model_free(struct model_priv *m)
 {
 	if (!m) return;

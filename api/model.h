@@ -154,6 +154,12 @@ enum api_result api_model_get_timed(const uint8_t *data, size_t len, const struc
 
 /* Tells the format from the bytes; API_MODEL_SNIFF when it cannot. */
 enum api_model_format api_model_sniff(const uint8_t *data, size_t len);
+/* The format to read data as when `stated` was given (a `format` member, a file's extension):
+ * the bytes' own where they say it unambiguously (glb and ply magic, a binary STL's size, an
+ * ASCII STL's "solid", glTF JSON), else `stated` (an OBJ is never overridden). When the two
+ * differ, warning (may be NULL) gets a sentence naming both, else "". SNIFF stays SNIFF. */
+enum api_model_format api_model_settle_format(const uint8_t *data, size_t len, enum api_model_format stated,
+                                              char *warning, size_t size);
 const char *api_model_format_name(enum api_model_format f);
 
 /* ---- image decoding (api/image_decode.c) ---- */

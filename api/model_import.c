@@ -37,6 +37,7 @@
 #include "model_import.h"
 #include "model_io.h"
 #include "model_lod.h"
+#include "ply_colors.h"
 #include "ply_strips.h"
 #include "remap.h"
 #include "stl_import.h"
@@ -355,6 +356,22 @@ static int convert(struct api_conv *c)
 }
 
 
+/* A PLY before Assimp reads it: a point cloud is refused saying what it is; triangle strips
+ * (Assimp 5.2 reads a strip as one polygon: a flat sliver) and face colours (which it drops)
+ * are rewritten into *out (malloc'd, or NULL: read the original; *face_colors for the second).
+ * 0, or -1 with err set. */
+static int ply_prepare(const uint8_t *data, size_t len, uint8_t **out, size_t *out_len, bool *face_colors, char *err,
+                       size_t errsize)
+{
+	uint64_t points = api_ply_point_cloud(data, len);
+	if (points)
+		return api_err_set(err, errsize, "the ply has %llu vertices and no faces: it is a point cloud, and point clouds "
+		                   "are not drawn (only surfaces are)", (unsigned long long)points), -1;
+	*out = api_ply_strips_to_faces(data, len, out_len);
+	if (!*out) *face_colors = (*out = api_ply_face_colors_to_vertices(data, len, out_len)) != NULL;
+	return 0;
+}
+
 enum api_wire_status api_model_import_local(const uint8_t *data, size_t len, enum api_model_format format,
                                             struct api_arena *arena, struct api_model *out, size_t *bytes,
                                             char *err, size_t errsize)
@@ -407,9 +424,11 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		}
 	}
 	json_decref(root);
-	/* PLY triangle strips: Assimp 5.2 reads a strip as one polygon (a flat sliver). */
 	size_t strips_len = 0;
-	uint8_t *strips = format == API_MODEL_PLY ? api_ply_strips_to_faces(data, len, &strips_len) : NULL;
+	uint8_t *strips = NULL;
+	bool face_colors = false;
+	if (format == API_MODEL_PLY && ply_prepare(data, len, &strips, &strips_len, &face_colors, err, errsize) < 0)
+		return API_WIRE_BAD_INPUT;
 	if (strips) {
 		data = strips;
 		len = strips_len;
@@ -432,6 +451,12 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	if (format == API_MODEL_STL)
 		flags = (flags & ~(unsigned)(aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)) |
 		        aiProcess_DropNormals | aiProcess_GenNormals;
+	/* Assimp 5.2's join of identical vertices ignores their colours: the corners of a red and a
+	 * green face became one vertex. convert_mesh joins them by position, normal and colour. */
+	if (face_colors) {
+		flags &= ~(unsigned)aiProcess_JoinIdenticalVertices;
+		c.join = true;
+	}
 	/* Normal maps need tangents: the file's, or made from the uvs where it has none. */
 	if (gltf) flags |= aiProcess_CalcTangentSpace;
 	enum api_wire_status st = API_WIRE_OK;
@@ -439,7 +464,10 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, flags, &io, props);
 	if (!sc) {
 		const char *msg = aiGetErrorString();
-		api_err_set(err, errsize, "%s", msg && msg[0] ? msg : "Assimp could not read it");
+		if (msg && strstr(msg, "contains no faces"))   /* ValidateDataStructure's "Mesh  contains no faces" */
+			api_err_set(err, errsize, "the %s file has a mesh with no faces (points or lines only): only surfaces are "
+			            "drawn, point clouds are not", FORMAT_NAMES[format]);
+		else api_err_set(err, errsize, "%s", msg && msg[0] ? msg : "Assimp could not read it");
 		/* Assimp turns std::bad_alloc into its error string. */
 		st = msg && strstr(msg, "bad_alloc") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 	}

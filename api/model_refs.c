@@ -26,6 +26,7 @@ struct ctx {
 	int *status;
 	char *err;
 	size_t errsize;
+	char missing[200];        /* why the last optional file (fetch's -2) was left out */
 };
 
 static int hex(char ch)
@@ -136,7 +137,12 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 		int st;
 		struct api_asset_stamp stamp;
 		if (api_asset_read_stamped(s->root, full, &owned, &len, &stamp, &st, why, sizeof why) != API_OK) {
-			if (s->optional_obj_files && (kind == REF_MTL || kind == REF_TEXTURE)) return -2;
+			/* As for a request that does not carry it (and the farm): the model is drawn
+			 * without it, and the answer says why. */
+			if (kind == REF_MTL || kind == REF_TEXTURE) {
+				snprintf(c->missing, sizeof c->missing, "cannot be read under the asset root (%.150s)", why);
+				return -2;
+			}
 			*c->status = st;
 			return api_err_set(c->err, c->errsize, "its %s \"%.128s\" cannot be read: %s", KIND_NAMES[kind], ref,
 			                   why), -1;
@@ -150,7 +156,10 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 			i++;
 		/* An .obj's .mtl and textures are optional to Assimp: sent without them (inline, or as
 		 * the only part, as the farm does) the model renders with what it has, and says so. */
-		if (i == s->nparts && (!s->nparts || kind == REF_MTL || kind == REF_TEXTURE)) return -2;
+		if (i == s->nparts && (!s->nparts || kind == REF_MTL || kind == REF_TEXTURE)) {
+			snprintf(c->missing, sizeof c->missing, "is not in the request");
+			return -2;
+		}
 		if (i == s->nparts) {
 			*c->status = 400;
 			return api_err_set(c->err, c->errsize, "its %s \"%.128s\" is not a part of this request (send it as a "
@@ -270,7 +279,7 @@ static int mtl_refs(struct ctx *c, const char *mtl_path, const uint8_t *d, size_
 			texture_name(after, eol, name, sizeof name);
 			long r = name[0] ? fetch(c, REF_TEXTURE, mtl_path, name) : 0;
 			if (r == -1) return -1;
-			if (r == -2) warn(c, "the obj's texture \"%.64s\" is not in the request: drawn without it", name);
+			if (r == -2) warn(c, "the obj's texture \"%.64s\" %s: drawn without it", name, c->missing);
 			break;
 		}
 		p = eol + 1;
@@ -291,8 +300,8 @@ static int obj_refs(struct ctx *c, const uint8_t *d, size_t len)
 			long r = name[0] ? fetch(c, REF_MTL, c->src->path, name) : 0;
 			if (r == -1) return -1;
 			if (r == -2) {
-				warn(c, "the obj's material library \"%.64s\" is not in the request: drawn with the default "
-				     "material", name);
+				warn(c, "the obj's material library \"%.64s\" %s: drawn with the default material", name,
+				     c->missing);
 			} else if (name[0]) {
 				/* The .mtl's textures resolve against the .mtl's own directory. */
 				char mpath[PATH_MAX] = "", why[8];

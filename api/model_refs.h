@@ -11,8 +11,9 @@
  *     named by the reference ("Avocado.bin", "textures/wood.png"); a "../" reference is a 400;
  *   - inline `data` without parts: nothing can be found; a glTF that needs a file is a 400.
  * An .obj's .mtl or texture missing from the request (inline data, or parts without it: the
- * farm sends the model alone) is left out and said in `warning`; by `path` it is a 400 unless
- * the source says optional_obj_files (then it too is left out and said).
+ * farm sends the model alone) or that cannot be read beside a model by `path` is left out and
+ * said in `warning` (Assimp draws an .obj without them): the same answer, 200 with a warning,
+ * whichever way the model came. A reference that escapes the root is still a 400.
  * A reference that cannot be found or read is a 400 whose sentence names it; more than
  * API_MODEL_REFS_MAX files or API_ASSET_MAX_FILE bytes with the model is a 422.
  *
@@ -44,10 +45,6 @@ struct api_ref_source {
 	const char *path;                 /* ... and the model's path under it (NULL: not by path) */
 	const struct api_part *parts;     /* the request's parts (multipart), or NULL */
 	size_t nparts;
-	/* By path: an .obj's .mtl or texture that cannot be read is left out with a `warning`, as
-	 * for a request without it, instead of a 400 (umbra-render thumb: a thumbnail of what the
-	 * directory has). A name that escapes the root is still a 400. */
-	bool optional_obj_files;
 };
 
 struct api_model_refs {
@@ -55,7 +52,7 @@ struct api_model_refs {
 	size_t count;
 	uint64_t bytes;                   /* of every file */
 	uint64_t asset_hash;              /* files read under the root (api_asset_hash), 0 = none */
-	char warning[256];                /* "" or what was left out (an .obj's missing .mtl, "; " between) */
+	char warning[512];                /* "" or what was left out (an .obj's missing .mtl, "; " between) */
 	/* By path: every file read under the root, with its stamp (api/model_paths.h) */
 	struct api_asset_origin *origins;
 	size_t norigins;

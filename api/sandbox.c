@@ -296,6 +296,19 @@ static int classify(const struct api_sbx_status *st, bool got_reply, const struc
 	}
 }
 
+/* Appends to a 422 over an import limit what changes that limit: umbrad's flag, or (a caller
+ * without them: umbra-render) that nothing here does. */
+static void limit_hint(const struct api_limits *lim, enum api_sbx_outcome how, char *err, size_t errsize)
+{
+	if (how != API_SBX_OUT_TIMED_OUT && how != API_SBX_OUT_OVER_MEMORY) return;
+	const char *flag = how == API_SBX_OUT_TIMED_OUT ? "--import-timeout-ms" : "--import-memory";
+	size_t n = err ? strlen(err) : 0;
+	if (!err || n + 1 >= errsize) return;
+	if (lim->import_flags) snprintf(err + n, errsize - n, " (this server's %s)", flag);
+	else snprintf(err + n, errsize - n, " (a fixed limit in umbra-render, which has no option for it; umbrad sets it "
+	              "with %s)", flag);
+}
+
 static enum api_sbx_job job_of(uint32_t kind)
 {
 	return kind == API_WIRE_LEVELS ? API_SBX_JOB_LEVELS : kind == API_WIRE_IMAGE ? API_SBX_JOB_IMAGE : API_SBX_JOB_MODEL;
@@ -381,6 +394,7 @@ out:
 	if (rc != API_OK) {
 		free(*reply);
 		*reply = NULL;
+		limit_hint(lim, *how, err, errsize);
 	}
 	return rc;
 }

@@ -1,8 +1,8 @@
 /*
  * api/scene_objects.c — the scene's `objects`: shapes (plane, box, sphere, cylinder), mesh
  * arrays, transforms, materials by name or inline, ground placement; model objects (whose
- * source scene_parse.c reads) are expanded into one mesh object per instance, and the
- * triangle limits are checked. See scene_internal.h for the conventions.
+ * source scene_parse.c reads, and whose `up` turns them upright) are expanded into one mesh
+ * object per instance, and the triangle limits are checked. See scene_internal.h for the conventions.
  */
 #include <math.h>
 #include <stdio.h>
@@ -51,19 +51,46 @@ static int parse_transform(struct pctx *c, json_t *j, float model[16])
 	return 0;
 }
 
+/* ---- a model's orientation ---- */
+
+/* `up`: the file's axis that points up. Its rotation to +Y, applied before the object's own
+ * transform, keeps the frame right-handed, as Blender's glTF exporter turns Z-up into Y-up:
+ *   "+y" identity; "-y" 180° about X: (x, y, z) -> (x, -y, -z);
+ *   "+z" -90° about X: (x, y, z) -> (x, z, -y) (a Z-up file's front, -Y, faces +Z);
+ *   "-z" +90° about X: (x, y, z) -> (x, -z, y);
+ *   "+x" +90° about Z: (x, y, z) -> (-y, x, z); "-x" -90° about Z: (x, y, z) -> (y, -x, z). */
+static const char *const UP_AXES[] = {"+y", "-y", "+z", "-z", "+x", "-x", NULL};
+static const signed char UP_COLUMNS[][3][3] = {   /* the images of the file's x, y, z axes */
+	{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
+	{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+	{{0, 1, 0}, {-1, 0, 0}, {0, 0, 1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+};
+
+/* model = model · the rotation of UP_AXES[up]. */
+static void apply_up(int up, float model[16])
+{
+	if (!up) return;
+	float r[16], out[16];
+	rnd_mat4_identity(r);
+	for (int col = 0; col < 3; col++)
+		for (int row = 0; row < 3; row++) r[col * 4 + row] = UP_COLUMNS[up][col][row];
+	rnd_mat4_mul(out, model, r);
+	memcpy(model, out, sizeof out);
+}
+
 /* ---- objects ---- */
 
 static const char *const OBJECT_COMMON[] = {"shape", "name", "transform", "material", "cast_shadows",
                                             "receive_shadows", "double_sided", NULL};
 static const char *const SHAPES[] = {"plane", "box", "sphere", "cylinder", "mesh", "model", NULL};
 enum { SHAPE_MODEL = 5 };
-static const char *const SHAPE_MEMBERS[][5] = {
+static const char *const SHAPE_MEMBERS[][6] = {
 	{"size", "placement", "margin", NULL},
 	{"size", NULL},
 	{"radius", "segments", NULL},
 	{"radius", "height", "segments", NULL},
 	{"positions", "indices", "normals", "uvs", NULL},
-	{"data", "format", "path", "part", NULL},
+	{"data", "format", "path", "part", "up", NULL},
 };
 #define MAX_SEGMENTS 1000000
 
@@ -162,7 +189,7 @@ static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 	json_t *sv = json_object_get(j, "shape");
 	if (!sv) return api_fail_at(c, "shape", "shape is required (one of \"plane\", \"box\", \"sphere\", \"cylinder\", "
 	                        "\"mesh\", \"model\")");
-	int shape;
+	int shape, up = 0;
 	if (api_get_enum(c, j, "shape", SHAPES, &shape) < 0) return -1;
 	char what[32];
 	snprintf(what, sizeof what, "a %s object", SHAPES[shape]);
@@ -198,9 +225,10 @@ static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 		if (parse_mesh(c, j, o) < 0) return -1;
 		break;
 	default:
-		/* An empty mesh until parse_root expands it into one object per mesh instance. */
+		/* An empty mesh until parse_root expands it into one object per mesh instance;
+		 * `up` is checked before the import, which may take a while. */
 		o->shape = RND_SHAPE_MESH;
-		if (api_parse_model(c, j) < 0) return -1;
+		if (api_get_enum(c, j, "up", UP_AXES, &up) < 0 || api_parse_model(c, j) < 0) return -1;
 		break;
 	}
 	json_t *t = json_object_get(j, "transform");
@@ -210,6 +238,7 @@ static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 		api_ptr_pop(c, old);
 		if (rc < 0) return -1;
 	}
+	apply_up(up, o->model);   /* under the object's transform */
 	if (object_material(c, j, o) < 0) return -1;
 	if (api_get_bool(c, j, "cast_shadows", &o->cast_shadows) < 0 ||
 	    api_get_bool(c, j, "receive_shadows", &o->receive_shadows) < 0 ||

@@ -181,7 +181,11 @@ int api_parse_model(struct pctx *c, json_t *j)
 	struct api_asset_stamp stamp;
 	double t0 = api_clock_ms();
 	rc = model_bytes(c, first, v, formats, &f, &given, &b, &len, &stamp);
-	enum api_model_format fmt = given ? (enum api_model_format)f : API_MODEL_SNIFF;
+	/* The format or extension is a hint: the bytes decide where they can (a .glb renamed .stl). */
+	char said[300];
+	enum api_model_format fmt = api_model_settle_format(b, len, given ? (enum api_model_format)f : API_MODEL_SNIFF,
+	                                                    said, sizeof said);
+	if (rc == 0 && said[0]) api_warn(c, "%s: %s", c->ptr, said);
 	struct api_model_refs refs = {0};
 	if (rc == 0) rc = model_refs(c, j, first, v, b, len, fmt, &refs);
 	c->import.ms[API_IMPORT_READ] += (float)(api_clock_ms() - t0);   /* the model and the files it names */
@@ -203,7 +207,8 @@ int api_parse_model(struct pctx *c, json_t *j)
 		api_asset_hash(&h, key.path, b, len);
 		if (refs.asset_hash) api_asset_hash(&h, NULL, (const uint8_t *)&refs.asset_hash, 8);
 		api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
-		if (!refs.warning[0]) api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
+		/* A model remembered is attached without its bytes: only one with nothing to say is. */
+		if (!refs.warning[0] && !said[0]) api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
 	}
 	if (rc == 0) rc = attach_model(c, m);
 	api_model_refs_release(&refs);

@@ -4,7 +4,7 @@
  *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr] [--timings] [--device NAME]
  *   umbra-render SCENE.json... -o DIR/ [batch options]            many scenes, one process
  *   umbra-render --manifest LIST.jsonl -o DIR/ [batch options]    {"scene": ..., "output": ...} per line
- *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [batch options]
+ *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [batch options]
  *   batch options: -j N (threads and render slots, default one per core), --report FILE (JSON lines,
  *                  default DIR/report.jsonl), --progress | --no-progress (default: bar on a tty)
  *
@@ -35,7 +35,7 @@ static int usage(FILE *f, int code)
 	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr] [--timings] [--device NAME]\n"
 	           "       umbra-render SCENE.json... -o DIR/ [batch options]\n"
 	           "       umbra-render --manifest LIST.jsonl -o DIR/ [batch options]\n"
-	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [batch options]\n"
+	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [batch options]\n"
 	           "  Renders scenes (contract: scene-v1). Exit 0 ok, 2 invalid input, 1 other failure, 130 interrupted.\n"
 	           "  -o FILE      output file; .png or .exr picks the format (default: stdout, output.format)\n"
 	           "  -o DIR/      batch: one image per input in DIR (name of the input, extension of the format)\n"
@@ -46,6 +46,8 @@ static int usage(FILE *f, int code)
 	           "               (framed, soft sun and sky light, a ground shadow catcher under the model)\n"
 	           "  --size N     thumbnail width and height (default 512)\n"
 	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
+	           "  --up AXIS    thumbnails: the models' up axis, z y x -z -y -x (default y; z for most STL and\n"
+	           "               CAD/3D-printing OBJ files): the model object's \"up\"\n"
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
 	           "  -j N         batch: threads and render slots (default: one per core)\n"
 	           "  --report F   batch: JSON-lines report (file, output, status, ms, error, stages); default DIR/report.jsonl\n"
@@ -196,18 +198,27 @@ static unsigned uint_arg(const char *s, unsigned max)
 	return *s && !*end && v > 0 && v <= max ? (unsigned)v : 0;
 }
 
+/* --up's value: "z", "+z", "-z", ... as the scene's "+z" etc.; NULL when it is none. */
+static const char *up_arg(const char *s)
+{
+	static const char *const axes[] = {"+y", "-y", "+z", "-z", "+x", "-x"};
+	for (int i = 0; i < 6; i++)
+		if (!strcasecmp(s, axes[i]) || (axes[i][0] == '+' && !strcasecmp(s, axes[i] + 1))) return axes[i];
+	return NULL;
+}
+
 /* getopt_long, as umbrad's flags.c: options and inputs in any order ("-" is an input: stdin). */
 static int parse_args(int argc, char **argv, struct args *a)
 {
 	enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
-	       O_REPORT, O_SIZE };
+	       O_REPORT, O_SIZE, O_UP };
 	static const struct option lopts[] = {
 		{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
 		{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
 		{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
 		{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
 		{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
-		{0},
+		{"up", required_argument, NULL, O_UP}, {0},
 	};
 	a->farm.progress = -1;
 	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
@@ -225,6 +236,10 @@ static int parse_args(int argc, char **argv, struct args *a)
 		case O_ASSET_ROOT: a->farm.asset_root = optarg; break;
 		case O_MANIFEST: a->manifest = optarg; break;
 		case O_REPORT: a->report = optarg; break;
+		case O_UP:
+			if ((a->farm.up = up_arg(optarg))) break;
+			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x)\n", optarg);
+			return usage(stderr, 1);
 		case 'j': case O_SIZE:
 			if ((c == 'j' ? (a->farm.threads = uint_arg(optarg, 64)) : (a->farm.size = uint_arg(optarg, 8192))))
 				break;
@@ -235,6 +250,10 @@ static int parse_args(int argc, char **argv, struct args *a)
 	}
 	for (int i = optind; i < argc; i++) a->inputs[a->ninputs++] = argv[i];
 	if (!a->ninputs && !a->manifest) return usage(stderr, 1);
+	if (a->farm.up && !a->thumb) {   /* a scene says its models' "up" itself */
+		fprintf(stderr, "umbra-render: --up is for thumb (in a scene, give the model object \"up\")\n");
+		return usage(stderr, 1);
+	}
 	return 0;
 }
 

@@ -106,10 +106,11 @@ static int thumb_doc(const struct farm_job *j, const struct farm_opts *o, char *
 		snprintf(err, esize, "not a model file name (.glb, .gltf, .obj, .stl or .ply): %s", j->input);
 		return -1;
 	}
-	char dims[64] = "";
+	char dims[64] = "", up[32] = "";
 	if (o->size) snprintf(dims, sizeof dims, "\"width\":%u,\"height\":%u,", o->size, o->size);
+	if (o->up) snprintf(up, sizeof up, ",\"up\":\"%.4s\"", o->up);
 	snprintf(doc, size, "{\"preset\":\"thumbnail\",%s%s\"objects\":[{\"shape\":\"model\",\"part\":\"model\","
-	         "\"format\":\"%s\"}]}", dims, o->transparent ? "\"output\":{\"transparent\":true}," : "", fmt);
+	         "\"format\":\"%s\"%s}]}", dims, o->transparent ? "\"output\":{\"transparent\":true}," : "", fmt, up);
 	return 0;
 }
 
@@ -128,10 +129,11 @@ static int model_parts(const char *input, const uint8_t *bytes, size_t len, stru
 	enum api_model_format fmt = API_MODEL_STL;
 	for (int i = 0; dot && MODEL_EXT[i]; i++)
 		if (!strcasecmp(dot + 1, MODEL_EXT[i])) fmt = FMT[i];
+	fmt = api_model_settle_format(bytes, len, fmt, NULL, 0);   /* the parse says so when they differ */
 	char root[PATH_MAX];
 	if (!slash) snprintf(root, sizeof root, ".");
 	else snprintf(root, sizeof root, "%.*s", slash == input ? 1 : (int)(slash - input), input);
-	struct api_ref_source src = {.root = root, .path = slash ? slash + 1 : input, .optional_obj_files = true};
+	struct api_ref_source src = {.root = root, .path = slash ? slash + 1 : input};
 	int status;
 	char why[400];
 	memset(refs, 0, sizeof *refs);
@@ -152,6 +154,23 @@ static int model_parts(const char *input, const uint8_t *bytes, size_t len, stru
 	return 0;
 }
 
+/* An input that is no file to render (a directory, an empty model) is the caller's mistake,
+ * `invalid` (exit 2) like a bad scene, not a failure: true with r->error set. */
+static bool input_refused(const struct farm_job *j, struct job_result *r)
+{
+	struct stat st;
+	if (j->json || !strcmp(j->input, "-") || stat(j->input, &st) != 0) return false;
+	const char *what = j->model ? "model" : "scene";
+	if (S_ISDIR(st.st_mode))
+		snprintf(r->error, sizeof r->error, "'%s' is a directory, not a %s file (name the files in it: %s/*.%s)",
+		         j->input, what, j->input, j->model ? "glb" : "json");
+	else if (j->model && !st.st_size)
+		snprintf(r->error, sizeof r->error, "'%s' is an empty %s file (0 bytes)", j->input, what);
+	else
+		return false;
+	return true;
+}
+
 /* Parses the job's document into *s and settles its output path. JOB_OK or the failure. */
 static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 {
@@ -164,6 +183,7 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 	char doc[512];
 	size_t len = 0;
 	char *bytes = NULL;
+	if (input_refused(j, r)) return JOB_INVALID;
 	if (!j->json && !(bytes = farm_read_file(j->input, &len))) {
 		snprintf(r->error, sizeof r->error, "cannot read '%s': %s", j->input, strerror(errno));
 		return JOB_FAILED;

@@ -15,7 +15,8 @@
  * stderr: a bar (done/total, images/s, ETA) on a terminal, one line per finished job otherwise.
  * SIGINT / SIGTERM: no new job starts; the renders in flight finish and are written; the rest
  * are reported "skipped". The report (JSON lines, input order) has file, output, status (ok,
- * invalid, failed, skipped), ms, error.
+ * invalid: a bad scene or model, or an input that is a directory or an empty model file;
+ * failed, skipped), ms, error. opts.up gives every model object that `up` (Z-up STL files).
  *
  * Ownership: jobs and their strings belong to the caller. farm_run() is not reentrant (signal
  * handlers); call it once per process.
@@ -42,6 +43,7 @@ struct farm_opts {
 	unsigned threads;         /* 0: one per core */
 	unsigned size;            /* thumbnails: width = height (0: the preset's 512) */
 	bool transparent;         /* thumbnails: transparent background */
+	const char *up;           /* thumbnails: every model's `up` ("+z", ...), NULL: the file's own (+y) */
 	int progress;             /* -1 auto (bar on a tty), 0 plain lines, 1 bar */
 };
 

@@ -217,6 +217,7 @@ static void set_defaults(struct srv_config *cfg)
 	cfg->atlas_size = 8192;
 	cfg->max_body = 64ull << 20;
 	api_limits_defaults(&cfg->limits);
+	cfg->limits.import_flags = true;   /* --import-timeout-ms, --import-memory: named in their 422s */
 	cfg->model_cache_bytes = 64u << 20;   /* the process stays small (issue 28); more for repeated big models */
 	cfg->deadline_ms = 30000;
 	cfg->log_format = SRV_LOG_TEXT;

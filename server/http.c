@@ -358,8 +358,7 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 			if (!srv_render_body(req, upload_data, n)) {
 				/* Over the limit: answer now if libmicrohttpd lets us, else after the body;
 				 * a client that keeps sending far past the limit is cut off. */
-				if (srv_respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
-				                    (unsigned long long)s->cfg.max_body) == MHD_YES)
+				if (srv_respond_too_large(req, 0, req->post != NULL) == MHD_YES)
 					return MHD_YES;
 				if (req->body_discarded > 2 * s->cfg.max_body + (16u << 20))
 					return MHD_NO;

@@ -41,6 +41,9 @@ void srv_origin_headers(struct srv_request *req, struct MHD_Response *resp, int 
 enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection *conn);
 bool srv_render_body(struct srv_request *req, const char *data, size_t size);   /* false: over --max-body */
 enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connection *conn);
+/* The 413 for a body over --max-body (n: its Content-Length, 0 = not known), saying how a
+ * large model fits: a multipart part instead of base64, or `path` where there is an asset root. */
+enum MHD_Result srv_respond_too_large(struct srv_request *req, unsigned long long n, bool multipart);
 enum MHD_Result srv_render_answer(struct srv_request *req);
 
 #endif

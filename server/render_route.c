@@ -109,9 +109,7 @@ enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection 
 		char *end;
 		errno = 0;
 		unsigned long long n = strtoull(cl, &end, 10);
-		if (!errno && end != cl && n > s->cfg.max_body)
-			return srv_respond_problem(req, 413, NULL, "", "the body of %llu bytes is over the limit of %llu bytes",
-			                       n, (unsigned long long)s->cfg.max_body);
+		if (!errno && end != cl && n > s->cfg.max_body) return srv_respond_too_large(req, n, multipart);
 		if (!errno && end != cl && n > 0 && !multipart) {
 			req->body = malloc((size_t)n + 1);
 			if (!req->body)
@@ -133,6 +131,24 @@ enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection 
 	req->body_hash = srv_etag_start();
 	req->state = SRV_REQ_BODY;
 	return MHD_YES;
+}
+
+enum MHD_Result srv_respond_too_large(struct srv_request *req, unsigned long long n, bool multipart)
+{
+	const struct srv_server *s = req->srv;
+	char size[64] = "";
+	if (n) snprintf(size, sizeof size, " of %llu bytes", n);
+	/* What makes a big model fit: its raw bytes as a part (base64 in JSON is 4/3 of them), or
+	 * no upload at all by path. */
+	const char *how = multipart ? (s->cfg.asset_root ? "; a large model can be named by \"path\" under this server's "
+	                                                   "asset root instead of uploaded" : "")
+	                  : s->cfg.asset_root ? "; send a large model as a multipart/form-data part (its raw bytes, "
+	                                        "not base64: 3/4 of the size) or name it by \"path\" under this server's "
+	                                        "asset root"
+	                  : "; send a large model as a multipart/form-data part (its raw bytes, not base64: 3/4 of the "
+	                    "size)";
+	return srv_respond_problem(req, 413, NULL, "", "the body%s is over this server's limit of %llu bytes "
+	                       "(--max-body)%s", size, (unsigned long long)s->cfg.max_body, how);
 }
 
 /* A chunk of body. Returns false when over the limit. */
@@ -178,9 +194,7 @@ bool srv_render_body(struct srv_request *req, const char *data, size_t size)
 enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connection *conn)
 {
 	struct srv_server *s = req->srv;
-	if (req->body_discarded)
-		return srv_respond_problem(req, 413, NULL, "", "the body is over the limit of %llu bytes",
-		                       (unsigned long long)s->cfg.max_body);
+	if (req->body_discarded) return srv_respond_too_large(req, 0, req->post != NULL);
 	if (req->body_oom)
 		return srv_respond_problem(req, 503, NULL, "", "out of memory while reading the body");
 	if (req->post) {

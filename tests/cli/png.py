@@ -6,6 +6,8 @@ the standard library only, for the shell suites.
   png.py px FILE X Y           -> "R G B A" of pixel (X, Y) (A = 255 without alpha)
   png.py distinct FILE         -> number of distinct colours
   png.py tint FILE             -> "RED BLUE": pixels whose red (blue) beats both other channels by 40
+  png.py opaque FILE           -> "W H" of the box around the pixels of alpha 255 (a transparent
+                                  thumbnail's model: not its background, not its ground shadow)
 """
 import struct, sys, zlib
 
@@ -59,6 +61,15 @@ def main():
         px = [r[i:i + 3] for r in rows for i in range(0, w * bpp, bpp)]
         print(sum(1 for p in px if p[0] > p[1] + 40 and p[0] > p[2] + 40),
               sum(1 for p in px if p[2] > p[0] + 40 and p[2] > p[1] + 40))
+    elif cmd == 'opaque':
+        if bpp != 4:
+            raise SystemExit('opaque needs an RGBA PNG')
+        pts = [(i // 4, y) for y, r in enumerate(rows) for i in range(3, w * 4, 4) if r[i] == 255]
+        if not pts:
+            print(0, 0)
+        else:
+            xs, ys = [p[0] for p in pts], [p[1] for p in pts]
+            print(max(xs) - min(xs) + 1, max(ys) - min(ys) + 1)
 
 
 if __name__ == '__main__':

@@ -209,6 +209,48 @@ check "thumb --transparent: exit 0" [ $rc = 0 ]
 a=$($PNG px "$T/tr/cube.png" 0 0 2>/dev/null | cut -d' ' -f4)
 check "thumb --transparent: corner alpha 0" [ "$a" = 0 ]
 
+# ---- thumb --up: a Z-up model (a post 0.3 x 0.3 x 2 along Z, as CAD and 3D-printing STLs lie)
+# stands up: its opaque pixels are taller than wide; without --up it lies on its side.
+python3 - "$T/zup/post.stl" <<'PY'
+import sys, os
+os.makedirs(os.path.dirname(sys.argv[1]), exist_ok=True)
+x, y, z = (-0.15, 0.15), (-0.15, 0.15), (0.0, 2.0)
+c = [(x[i & 1], y[i >> 1 & 1], z[i >> 2]) for i in range(8)]
+quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+out = ['solid post']
+for a, b, cc, d in quads:
+    for t in ((a, b, cc), (a, cc, d)):
+        out += ['facet normal 0 0 0', ' outer loop'] + ['  vertex %g %g %g' % c[k] for k in t] + [' endloop', 'endfacet']
+open(sys.argv[1], 'w').write('\n'.join(out + ['endsolid post', '']))
+PY
+cli thumb "$T/zup/post.stl" -o "$T/zup/up/" --up z --size 96 --transparent --no-progress 2>"$T/zup/up.err"
+check "thumb --up z: exit 0" [ $? = 0 ]
+wh=$($PNG opaque "$T/zup/up/post.png" 2>/dev/null || echo 0 0)
+w=${wh% *} h=${wh#* }
+check "thumb --up z: the Z-up post stands up (${w}x${h} px: height > 2 x width)" [ "$h" -gt $((2 * w)) ]
+cli thumb "$T/zup/post.stl" -o "$T/zup/flat/" --size 96 --transparent --no-progress 2>/dev/null
+wh=$($PNG opaque "$T/zup/flat/post.png" 2>/dev/null || echo 0 0)
+w=${wh% *} h=${wh#* }
+check "thumb without --up: the same post lies on its side (${w}x${h} px: wider than tall)" [ "$w" -gt "$h" ]
+cli thumb "$T/zup/post.stl" -o "$T/zup/bad/" --up w 2>"$T/zup/bad.err"
+rc=$?
+check "thumb --up w: refused (exit 1), naming the axes" eval '[ $rc = 1 ] && grep -q "z y x -z -y -x" "$T/zup/bad.err"'
+cli "$T/ground.json" -o "$T/zup/scene.png" --up z 2>"$T/zup/scene.err"
+rc=$?
+check "--up without thumb: refused, pointing to the model object's \"up\"" eval '[ $rc = 1 ] && grep -q "model object" "$T/zup/scene.err"'
+
+# ---- farm inputs that are no model file: invalid (exit 2), not failed ----
+mkdir -p "$T/notfiles/adir"
+: >"$T/notfiles/empty.stl"
+cli thumb "$T/notfiles/adir" "$T/notfiles/empty.stl" "$T/models/cube.obj" -o "$T/notfiles/out/" --size 32 \
+	--no-progress 2>"$T/notfiles.err"
+rc=$?
+check "thumb with a directory and an empty file among the models: exit 2 (invalid input), not 1" [ $rc = 2 ]
+check "thumb: the directory is reported invalid, saying it is a directory" \
+	grep -q '"file":"[^"]*adir","output":null,"status":"invalid".*is a directory' "$T/notfiles/out/report.jsonl"
+check "thumb: the empty file is reported invalid, saying it is empty" \
+	grep -q '"file":"[^"]*empty.stl","output":null,"status":"invalid".*empty model file (0 bytes)' "$T/notfiles/out/report.jsonl"
+
 # ---- the self-placing ground: its shadow appears under a floating box ----
 # Orthographic view straight down (+x right, -z up) over x, z in [-3, 3] at 96 px: 16 px per
 # unit. A unit box floats at y 3; the ground places itself at the box's base (y 2.5); the light

@@ -2,7 +2,9 @@
 # tests/http/assets.sh — models made of several files, and the texture limit, against a live
 # umbrad: a .gltf with its .bin and PNG by `path` under --asset-root and as multipart parts
 # named by their URI, an .obj with its .mtl and map_Kd texture, an inline .obj whose .mtl is
-# missing (Umbra-Warnings, also as a lone part), an inline .gltf needing its .bin (400), a missing .bin and a "../" URI (400 at the model's member), 20
+# missing (Umbra-Warnings, also as a lone part), an .obj whose texture is missing (200 and the
+# same warning by path and by multipart), a .glb misnamed .stl (read as glb, warned), an inline
+# .gltf needing its .bin (400), a missing .bin and a "../" URI (400 at the model's member), 20
 # textures under the default limit (200) and over --max-textures 4 (422 at /objects/N).
 # The quad's texture is red on its left half, blue on its right: the image must be too.
 . tests/http/lib.sh
@@ -73,6 +75,27 @@ check "obj without its .mtl part: Umbra-Warnings names box.mtl" warned objalone 
 code=$(multipart objnotex "$T/mp.json" -F "model=@$A/box.obj" -F "box.mtl=@$A/box.mtl")
 check "obj + mtl parts without the texture part: 200" [ "$code" = 200 ]
 check "obj without its texture part: Umbra-Warnings names halves.png" warned objnotex halves.png
+# An .obj whose .mtl names a missing texture: the same answer by path and by multipart (and in
+# the farm): 200, drawn without it, Umbra-Warnings naming it (by path it was a 400).
+scene "$T/notex.json" '"path": "notex.obj"'
+code=$(post notexpath "$T/notex.json")
+check "obj by path whose .mtl names a missing texture: 200 (was 400)" [ "$code" = 200 ]
+check "obj by path, missing texture: Umbra-Warnings names gone.png and says it cannot be read" \
+	sh -c "grep -i '^Umbra-Warnings:' '$T/notexpath.hdr' | grep -q 'texture \"gone.png\" cannot be read'"
+code=$(multipart notexmp "$T/mp.json" -F "model=@$A/notex.obj" -F "notex.mtl=@$A/notex.mtl")
+check "the same obj by multipart without the texture: 200" [ "$code" = 200 ]
+check "the same obj by multipart: Umbra-Warnings names gone.png" warned notexmp 'texture "gone.png"'
+# The bytes decide the format: a .glb named .stl is read as glb, and the answer says so.
+scene "$T/misnamed.json" '"path": "quadglb.stl"'
+code=$(post misnamed "$T/misnamed.json")
+check "a .glb named .stl by path: 200 (was read as STL: 400)" [ "$code" = 200 ]
+check "a .glb named .stl: drawn as the glb (the texture's halves)" halves misnamed
+check "a .glb named .stl: Umbra-Warnings names both formats" warned misnamed 'glb file by its bytes, not stl'
+scene "$T/misnamedf.json" '"path": "quad.gltf", "format": "glb"'
+code=$(post misnamedf "$T/misnamedf.json")
+check "a .gltf sent with format glb: 200, read as gltf, warned" sh -c "[ '$code' = 200 ] && grep -i '^Umbra-Warnings:' \
+	'$T/misnamedf.hdr' | grep -q 'gltf file by its bytes, not glb'"
+
 scene "$T/gltfinline.json" "\"data\": \"$(base64 -w0 "$A/quad.gltf")\", \"format\": \"gltf\""
 code=$(post gltfinline "$T/gltfinline.json")
 check "inline gltf whose .bin is a separate file: 400 at /objects/0/data" answered "$code" 400 gltfinline /objects/0/data

@@ -11,6 +11,9 @@ library only, deterministic):
   escape.gltf                         refers to ../outside.bin (above the root)
   many.gltf + many.bin + t0..t19.png  one mesh with 20 primitives, each its own material and
                                       texture (20 distinct textures)
+  notex.obj + notex.mtl               the OBJ quad whose .mtl names gone.png, which does not exist
+  quadglb.stl                         the quad as a .glb (its .bin inside, halves.png beside it),
+                                      misnamed .stl
 """
 import json, os, struct, sys, zlib
 
@@ -74,6 +77,17 @@ def main():
         png(os.path.join(d, n), 2, 2, lambda x, y, i=i: (10 * i, 255 - 10 * i, 128))
     open(os.path.join(d, 'many.bin'), 'wb').write(quad_bin())
     json.dump(gltf('many.bin', names, 20), open(os.path.join(d, 'many.gltf'), 'w'))
+    open(os.path.join(d, 'notex.obj'), 'w').write(obj.replace('mtllib box.mtl', 'mtllib notex.mtl'))
+    open(os.path.join(d, 'notex.mtl'), 'w').write('newmtl halves\nKd 1 1 1\nmap_Kd gone.png\n')
+    doc = gltf(None, ['halves.png'])
+    binary = quad_bin()
+    doc['buffers'][0].pop('uri', None)
+    js = json.dumps(doc).encode()
+    js += b' ' * (-len(js) % 4)
+    binary += b'\0' * (-len(binary) % 4)
+    glb = struct.pack('<4sII', b'glTF', 2, 12 + 8 + len(js) + 8 + len(binary))
+    glb += struct.pack('<I4s', len(js), b'JSON') + js + struct.pack('<I4s', len(binary), b'BIN\0') + binary
+    open(os.path.join(d, 'quadglb.stl'), 'wb').write(glb)
 
 
 if __name__ == '__main__':

@@ -106,6 +106,10 @@ c=$(curl -s -o /dev/null -w '%{http_code}' --max-time 30 --data-binary "@$T/smal
 check "missing Content-Type 415" [ "$c" = 415 ]
 c=$(post e413 "$T/huge.json"); check "2 MiB body over --max-body 1M: 413" [ "$c" = 413 ]
 check "413 is problem+json" problem e413 413 -
+check "413 says how a large model fits: a multipart part, or path under the asset root" python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))["detail"]
+sys.exit(0 if "--max-body" in d and "multipart/form-data part" in d and "\"path\"" in d else 1)' "$T/e413.body"
 c=$(post e413c "$T/huge.json" -H 'Transfer-Encoding: chunked'); check "chunked body over --max-body: 413" [ "$c" = 413 ]
 
 # -- scene errors (400 with the member's pointer; 422 over the limits)

@@ -124,6 +124,8 @@ ready=$(curl -s -o /dev/null -w '%{http_code}' --max-time 5 "$URL/readyz")
 wait $p1 $p2 $p3
 check "hanging PLY: 422 at its time limit" [ "$(code hang)" = 422 ]
 check "hanging PLY: problem at /objects/0/data" problem hang 422 /objects/0/data
+check "hanging PLY: the 422 names the flag that raises the limit (--import-timeout-ms)" \
+	grep -q "this server's --import-timeout-ms" "$T/hang.body"
 check "model request sent behind the hanging one: 200" [ "$(code good)" = 200 ]
 check "plain render sent with the hanging one: 200" [ "$(code plain)" = 200 ]
 check "/readyz 200 while a model import hangs" [ "$ready" = 200 ]

@@ -180,30 +180,28 @@ TEST(model_files_served_and_keyed)
 	api_model_release(mb);
 }
 
-/* An .obj by path whose .mtl is missing: a 400 naming it for the daemon; with
- * optional_obj_files (umbra-render thumb) it is left out with a warning, and a present .mtl and
- * its texture are read from the model's directory. */
-TEST(model_refs_optional_obj_files)
+/* An .obj by path whose .mtl is missing: left out with a warning naming it and why (as for a
+ * multipart request without it, and umbra-render thumb), and a present .mtl and its texture
+ * are read from the model's directory. */
+TEST(model_refs_missing_obj_files_by_path)
 {
 	char base[] = "/tmp/umbra-refs-XXXXXX", root[300];
 	REQUIRE(mkdtemp(base));
 	make_tree(base, root, sizeof root);
-	test_put_file(root, "blue.mtl", "newmtl b\nKd 0 0 1\nmap_Kd sub/a.txt\n");
+	test_put_file(root, "blue.mtl", "newmtl b\nKd 0 0 1\nmap_Kd sub/a.txt\nmap_Ks sub/gone.png\n");
 	static const char lost[] = "mtllib gone.mtl\nv 0 0 0\n", found[] = "mtllib blue.mtl\nv 0 0 0\n";
 	struct api_model_refs r;
 	int st;
 	char err[400];
 	struct api_ref_source src = {.root = root, .path = "m.obj"};
 	CHECK(api_model_refs_collect((const uint8_t *)lost, strlen(lost), API_MODEL_OBJ, &src, &r, &st, err, sizeof err) ==
-	      API_ERR && st == 400 && strstr(err, "gone.mtl"), "%d %s", st, err);
-	api_model_refs_release(&r);
-	src.optional_obj_files = true;
-	CHECK(api_model_refs_collect((const uint8_t *)lost, strlen(lost), API_MODEL_OBJ, &src, &r, &st, err, sizeof err) ==
-	      API_OK && r.count == 0 && strstr(r.warning, "gone.mtl"), "%d %s / %s", st, err, r.warning);
+	      API_OK && r.count == 0 && strstr(r.warning, "\"gone.mtl\" cannot be read") &&
+	      strstr(r.warning, "No such file"), "%d %s / %s", st, err, r.warning);
 	api_model_refs_release(&r);
 	CHECK(api_model_refs_collect((const uint8_t *)found, strlen(found), API_MODEL_OBJ, &src, &r, &st, err,
-	                             sizeof err) == API_OK && r.count == 2 && !strcmp(r.files[1].name, "sub/a.txt"),
-	      "%d %s: %zu files", st, err, r.count);
+	                             sizeof err) == API_OK && r.count == 2 && !strcmp(r.files[1].name, "sub/a.txt") &&
+	      strstr(r.warning, "texture \"sub/gone.png\" cannot be read"), "%d %s: %zu files / %s", st, err, r.count,
+	      r.warning);
 	api_model_refs_release(&r);
 	/* Still no escape: a .mtl above the root is a 400 either way. */
 	static const char up[] = "mtllib ../outside/secret.txt\n";

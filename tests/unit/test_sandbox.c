@@ -154,6 +154,9 @@ TEST(sandbox_hanging_ply_is_422_and_others_go_on)
 	api_model_release(m);
 	pthread_join(t, NULL);
 	CHECK(a.rc == API_ERR && a.status == 422 && strstr(a.err, "time limit"), "status %d: %s", a.status, a.err);
+	/* The CLI's limits (no import_flags): it says that umbra-render has no option, and umbrad's. */
+	CHECK(strstr(a.err, "umbra-render, which has no option for it; umbrad sets it with --import-timeout-ms"), "%s",
+	      a.err);
 }
 
 TEST(sandbox_memory_limit_is_422)
@@ -170,7 +173,11 @@ TEST(sandbox_memory_limit_is_422)
 	api_sandbox_stats(&s0);
 	CHECK(api_model_get(stl, n, API_MODEL_STL, &l, &m, &st, err, sizeof err) == API_ERR && !m);
 	CHECK(st == 422 && strstr(err, "memory limit"), "status %d: %s", st, err);
+	CHECK(strstr(err, "umbrad sets it with --import-memory"), "%s", err);
 	CHECK(ended_since(&s0, API_SBX_OUT_OVER_MEMORY) == 1, "counted as over memory");
+	l.import_flags = true;   /* umbrad's: its own flag named */
+	CHECK(api_model_get(stl, n, API_MODEL_STL, &l, &m, &st, err, sizeof err) == API_ERR && st == 422 &&
+	      strstr(err, "(this server's --import-memory)"), "%d %s", st, err);
 	/* The same file under the default limit imports. */
 	l.import_memory = 0;
 	CHECK(api_model_get(stl, n, API_MODEL_STL, &l, &m, &st, err, sizeof err) == API_OK, "%d %s", st, err);

@@ -28,6 +28,54 @@ uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len)
 	return buf;
 }
 
+struct png_out {
+	uint8_t *d;
+	size_t n, cap;
+	int bad;
+};
+
+static void png_out_write(png_structp png, png_bytep b, size_t n)
+{
+	struct png_out *o = png_get_io_ptr(png);
+	if (o->n + n > o->cap) {
+		size_t cap = (o->cap ? o->cap * 2 : 4096) + n;
+		uint8_t *d = realloc(o->d, cap);
+		if (!d) { o->bad = 1; return; }
+		o->d = d;
+		o->cap = cap;
+	}
+	memcpy(o->d + o->n, b, n);
+	o->n += n;
+}
+
+static void png_out_flush(png_structp png)
+{
+	(void)png;
+}
+
+uint8_t *test_png_rgb_gamma(const uint8_t *rgb, int w, int h, double file_gamma, size_t *len)
+{
+	struct png_out o = {0};
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	if (!info || setjmp(png_jmpbuf(png))) {
+		png_destroy_write_struct(&png, &info);
+		free(o.d);
+		return NULL;
+	}
+	png_set_write_fn(png, &o, png_out_write, png_out_flush);
+	png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+	             PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+	png_set_gAMA(png, info, file_gamma);
+	png_write_info(png, info);
+	for (int y = 0; y < h; y++) png_write_row(png, (png_const_bytep)(rgb + (size_t)y * (size_t)w * 3));
+	png_write_end(png, info);
+	png_destroy_write_struct(&png, &info);
+	if (o.bad) { free(o.d); return NULL; }
+	*len = o.n;
+	return o.d;
+}
+
 size_t test_tetra_stl(uint8_t *out, const float p[4][3])
 {
 	static const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};

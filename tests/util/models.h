@@ -14,6 +14,9 @@
 void test_put32(uint8_t *p, uint32_t v);
 /* A straight-alpha RGBA8 PNG of w x h texels; NULL on failure. */
 uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len);
+/* An RGB8 PNG of w x h texels (rgb: 3 bytes each, rows top to bottom) with a gAMA chunk of
+ * file_gamma (1/2.2 = 0.45455 is what most tools write); NULL on failure. */
+uint8_t *test_png_rgb_gamma(const uint8_t *rgb, int w, int h, double file_gamma, size_t *len);
 /* Binary .stl of the tetrahedron with the given 4 vertices into out (84 + 4*50 = 284 bytes);
  * facet normals 0 (the importer recomputes them). Returns the size. */
 size_t test_tetra_stl(uint8_t *out, const float p[4][3]);
