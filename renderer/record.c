@@ -55,19 +55,12 @@ static float srgb_encode(float c)
 	return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
-/* Makes img a depth attachment (after src_stage / src_access of its previous use) and begins a
- * depth-only pass over (0, 0, w, h) of its view, cleared to 1 (the shadow pipelines' far),
- * with that viewport and scissor. */
-void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint32_t w, uint32_t h,
-                        VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access)
+void record_depth_rendering(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h, bool load)
 {
-	record_image_barrier(cmd, img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, src_stage, src_access,
-	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 	VkRenderingAttachmentInfo da = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = view,
-		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+		.loadOp = load ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
 		.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {1.0f, 0},
 	};
 	VkRenderingInfo ri = {
@@ -79,6 +72,19 @@ void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint
 	VkRect2D scissor = {{0, 0}, {w, h}};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
 	vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+/* Makes img a depth attachment (after src_stage / src_access of its previous use) and begins a
+ * depth-only pass over (0, 0, w, h) of its view, cleared to 1 (the shadow pipelines' far),
+ * with that viewport and scissor. */
+void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint32_t w, uint32_t h,
+                        VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access)
+{
+	record_image_barrier(cmd, img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, src_stage, src_access,
+	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+	record_depth_rendering(cmd, view, w, h, false);
 }
 
 void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s)

@@ -64,6 +64,9 @@ void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags a
  * view over (0, 0, w, h), cleared to 1, with that viewport and scissor. */
 void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint32_t w, uint32_t h,
                         VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access);
+/* The rendering begun by record_begin_depth (view already a depth attachment): cleared to 1, or
+ * with load what an earlier submit drew kept (a shadow map in parts, record_shadow.c). */
+void record_depth_rendering(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h, bool load);
 /* Binds the slot's vertex and index buffers and its set 0 (frame constants, atlases). */
 void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s);
 /* One draw with the shadow (depth-only) pipelines, culling back faces when cull is set; masked

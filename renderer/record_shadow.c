@@ -43,20 +43,7 @@ static void begin_depth_load(VkCommandBuffer cmd, VkImage img, VkImageView view,
 	record_image_barrier(cmd, img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
 	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, tests, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
 	                     tests, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-	VkRenderingAttachmentInfo da = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = view,
-		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD,
-		.storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-	};
-	VkRenderingInfo ri = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = {{0, 0}, {w, h}}, .layerCount = 1,
-		.pDepthAttachment = &da,
-	};
-	vkCmdBeginRendering(cmd, &ri);
-	VkViewport vp = {0, 0, (float)w, (float)h, 0, 1};
-	VkRect2D scissor = {{0, 0}, {w, h}};
-	vkCmdSetViewport(cmd, 0, 1, &vp);
-	vkCmdSetScissor(cmd, 0, 1, &scissor);
+	record_depth_rendering(cmd, view, w, h, true);
 }
 
 /* Triangles [lo, hi) of shadow view v's casters (in draw order, as record_shadow_triangles

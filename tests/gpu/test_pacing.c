@@ -47,13 +47,19 @@ static char *stacked_scene(int n, int w, int res)
 	return j;
 }
 
+static struct api_scene *stacked(int n, int w, int res)
+{
+	char *json = stacked_scene(n, w, res);
+	struct api_scene *s = json ? gpu_parse(json) : NULL;
+	free(json);
+	return s;
+}
+
 TEST(pacing_shadow_map_parts_give_the_same_bytes)
 {
 	struct rnd_context *ctx = gpu_ctx();
 	REQUIRE(ctx);
-	char *json = stacked_scene(6, 64, 512);
-	struct api_scene *s = json ? gpu_parse(json) : NULL;
-	free(json);
+	struct api_scene *s = stacked(6, 64, 512);
 	REQUIRE(s);
 	uint32_t before = rnd_context_validation_messages(ctx);
 	struct rnd_image whole = {0}, parts = {0};
@@ -79,9 +85,7 @@ TEST(pacing_stacked_layers_are_cut_into_submits)
 {
 	struct rnd_context *ctx = gpu_ctx();
 	REQUIRE(ctx);
-	char *json = stacked_scene(400, 224, 2048);
-	struct api_scene *s = json ? gpu_parse(json) : NULL;
-	free(json);
+	struct api_scene *s = stacked(400, 224, 2048);
 	REQUIRE(s);
 	uint32_t before = rnd_context_validation_messages(ctx);
 	struct rnd_image whole = {0}, paced = {0};
