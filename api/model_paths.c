@@ -10,7 +10,7 @@
 #include "model_paths.h"
 
 struct entry {
-	char *key;                       /* "root\npath\nformat\noptional" */
+	char *key;                       /* "root\npath\nformat" */
 	size_t nfiles;                   /* the model file, then the files it referred to */
 	char **paths;
 	struct api_asset_stamp *stamps;
@@ -25,7 +25,7 @@ static char *key_of(const struct api_model_path_key *k)
 {
 	size_t n = strlen(k->root) + strlen(k->path) + 32;
 	char *s = malloc(n);
-	if (s) snprintf(s, n, "%s\n%s\n%d\n%d", k->root, k->path, k->format, (int)k->optional);
+	if (s) snprintf(s, n, "%s\n%s\n%d", k->root, k->path, k->format);
 	return s;
 }
 

@@ -4,7 +4,7 @@
  *
  * The model cache (api/model.h) is keyed by the bytes: a 50 MB model by path was read, hashed
  * and compared on every request (~100 ms of a 1M-triangle thumbnail's ~150 ms). This remembers,
- * per (asset root, path, format asked for, optional_obj_files), the stamps (api/asset.h) of the
+ * per (asset root, path, format asked for), the stamps (api/asset.h) of the
  * model file and of every file it referred to when it was imported, the serial of the cached
  * model and the hash the files' bytes added to the scene's asset hash (the ETag). A later
  * request stats the same files; when every stamp is equal it takes the cached model by its
@@ -17,7 +17,7 @@
  * remembered, as the missing file may appear.
  *
  * Usage (api/scene_parse.c):
- *   struct api_model_path_key k = {root, path, format_or_minus_1, optional};
+ *   struct api_model_path_key k = {root, path, format_or_minus_1};
  *   struct api_model *m = api_model_paths_find(&k, lim, &hash);   // NULL: read and import, then
  *   api_model_paths_remember(&k, &stamp, refs.origins, refs.norigins, m, hash);
  *
@@ -41,7 +41,6 @@ struct api_model_path_key {
 	const char *root;
 	const char *path;
 	int format;            /* the request's `format` (enum api_model_format), -1 when not given */
-	bool optional;         /* api_ref_source.optional_obj_files */
 };
 
 /* A reference to the model remembered for k whose files are unchanged, and the hash its files

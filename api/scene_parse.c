@@ -170,7 +170,7 @@ int api_parse_model(struct pctx *c, json_t *j)
 	json_t *v = json_object_get(j, first);
 	size_t old = api_ptr_push(c, first);
 	bool by_path = !strcmp(first, "path");
-	struct api_model_path_key key = {c->lim->asset_root, json_string_value(v), given ? f : -1, false};
+	struct api_model_path_key key = {c->lim->asset_root, json_string_value(v), given ? f : -1};
 	int rc = by_path ? model_remembered(c, v, &key) : 0;
 	if (rc != 0) {
 		api_ptr_pop(c, old);

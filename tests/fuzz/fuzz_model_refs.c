@@ -7,7 +7,7 @@
  *   - inline: no path, no parts (every separate file must be refused or left out);
  *   - by path "models/m.*" under a root made once in a temporary directory: models/a.bin,
  *     models/t.png, models/m.mtl (whose textures include escapes), models/sub/, and a file
- *     beside the root that no reference may reach; optional_obj_files from byte 0;
+ *     beside the root that no reference may reach;
  *   - multipart: parts a.bin, t.png and m.mtl, where m.mtl's bytes are the input itself, so
  *     the .mtl scanner reads fuzzed text too.
  * Properties: no sanitizer report; on success every file is named, at most API_MODEL_REFS_MAX
@@ -92,7 +92,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (mode == 1) {
 		src.root = g_root;
 		src.path = PATH[f];
-		src.optional_obj_files = (sel & 0x80) != 0;
 	} else if (mode == 2) {
 		src.parts = parts;
 		src.nparts = 3;
