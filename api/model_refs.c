@@ -80,9 +80,11 @@ static int push(struct ctx *c, const char *name, const uint8_t *data, size_t len
 		*c->status = 500;
 		return api_err_set(c->err, c->errsize, "out of memory reading the model's files"), -1;
 	}
+	bool again = false;   /* the bytes of a file already here (another spelling of its name) */
+	for (size_t i = 0; i < r->count && !again; i++) again = r->files[i].data == data && r->files[i].len == len;
 	r->files[r->count] = (struct api_model_file){nm, data, len};
 	r->owned_[r->count++] = owned;
-	r->bytes += len;
+	if (!again) r->bytes += len;
 	return 0;
 }
 
@@ -126,7 +128,6 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 		if (c->resolved[i] && !strcmp(c->resolved[i], full)) {
 			const struct api_model_file *f = &c->out->files[i];
 			if (push(c, ref, f->data, f->len, false) < 0) return -1;
-			c->out->bytes -= f->len;
 			c->resolved[c->out->count - 1] = strdup(full);
 			return (long)c->out->count - 1;
 		}

@@ -50,7 +50,7 @@ struct api_ref_source {
 struct api_model_refs {
 	struct api_model_file *files;
 	size_t count;
-	uint64_t bytes;                   /* of every file */
+	uint64_t bytes;                   /* of every file, counted once whatever its names */
 	uint64_t asset_hash;              /* files read under the root (api_asset_hash), 0 = none */
 	char warning[512];                /* "" or what was left out (an .obj's missing .mtl, "; " between) */
 	/* By path: every file read under the root, with its stamp (api/model_paths.h) */
