@@ -92,9 +92,12 @@ void api_ground_place(struct rnd_object *objs, uint32_t n, const struct rnd_mate
 			centre[k] = 0.5 * (lo[k] + hi[k]);
 			extent = fmax(extent, hi[k] - lo[k]);
 		}
-		centre[1] = lo[1];
 		/* A flat object (a quad lying down) still gets a ground the size of its footprint. */
 		if (!(extent > 0)) extent = 1;
+		/* Just below the lowest point, not at it: a model's own bottom face (a quad lying down,
+		 * TwoSidedPlane) coplanar with the ground z-fought with it, and the shadow catcher's
+		 * background showed through it in stripes. */
+		centre[1] = lo[1] - API_GROUND_GAP * extent;
 	}
 	for (uint32_t i = 0; i < n; i++) {
 		if (!(margin[i] > 0)) continue;

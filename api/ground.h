@@ -5,8 +5,10 @@
  *   float margin[n];   // > 0 for each plane object with "placement": "ground", else 0
  *   api_ground_place(objects, n, materials, margin);
  *
- * A ground plane is centred under the other objects' world bounds (x, z), sits at their lowest
- * point (min y) and is a square of side margin × the largest extent of those bounds. "Other
+ * A ground plane is centred under the other objects' world bounds (x, z), sits just below their
+ * lowest point (min y less API_GROUND_GAP × the largest extent of those bounds: resolvable in
+ * depth, so a model's own flat bottom is drawn, not the ground through it) and is a square of
+ * side margin × that extent. "Other
  * objects" are those the camera's `fit: "objects"` frames: every object except planes and shadow
  * catchers; when none is left (only planes), the ground sits at y = 0 under the origin with
  * side = margin. The bounds are exact per shape under any transform (a box by its corners, a
@@ -20,6 +22,8 @@
 
 #include <stdint.h>
 #include "umbra/rnd.h"
+
+#define API_GROUND_GAP 1e-4
 
 /* Grows [lo, hi] by the object's exact world-space bounds (its model matrix applied). */
 void api_object_bounds(const struct rnd_object *o, double lo[3], double hi[3]);

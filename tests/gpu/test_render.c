@@ -473,3 +473,34 @@ TEST(sixteen_shadowed_lights)
 	CHECK(v > 191, "debug light 16: open ground reads %d", v);
 	rnd_image_release(&img);
 }
+
+/* A flat model at its lowest point (glTF TwoSidedPlane: a quad lying down) under the thumbnail
+ * preset: its self-placing ground (a shadow catcher) had sat exactly in the quad's plane and
+ * z-fought with it, the white background showing through the quad in stripes. The ground now
+ * sits just below (api/ground.h API_GROUND_GAP): every pixel well inside the quad is the quad. */
+TEST(render_flat_model_is_not_cut_by_its_ground)
+{
+	static const char *doc = "{'preset': 'thumbnail', 'width': 256, 'height': 256, 'objects': [{'shape': 'mesh',"
+	                         " 'positions': [-1,0,-1, 1,0,-1, 1,0,1, -1,0,1], 'indices': [0,2,1, 0,3,2]}]}";
+	struct rnd_image img;
+	if (!gpu_render(&img, doc, 0)) return;
+	int x0 = 256, x1 = -1, y0 = 256, y1 = -1;
+	for (int j = 0; j < 256; j++)
+		for (int i = 0; i < 256; i++)
+			if (gpu_px8(&img, i, j)[0] < 250) {
+				if (i < x0) x0 = i;
+				if (i > x1) x1 = i;
+				if (j < y0) y0 = j;
+				if (j > y1) y1 = j;
+			}
+	REQUIRE(x1 - x0 > 100 && y1 - y0 > 30, "the quad covers %dx%d pixels", x1 - x0, y1 - y0);
+	/* The middle third of its outline's box lies inside the quad (a convex trapezoid from here). */
+	int holes = 0, n = 0;
+	for (int j = y0 + (y1 - y0) / 3; j <= y1 - (y1 - y0) / 3; j++)
+		for (int i = x0 + (x1 - x0) / 3; i <= x1 - (x1 - x0) / 3; i++, n++) {
+			const uint8_t *p = gpu_px8(&img, i, j);
+			holes += p[0] >= 254 && p[1] >= 254 && p[2] >= 254;
+		}
+	CHECK(holes == 0, "%d of %d pixels inside the quad show the background", holes, n);
+	rnd_image_release(&img);
+}

@@ -18,6 +18,12 @@ static bool near_d(double a, double b)
 	return fabs(a - b) <= 1e-4 * (1.0 + fabs(b));
 }
 
+/* The ground's height y for objects whose lowest point is lo and largest extent e: just below. */
+static bool ground_at(double y, double lo, double e)
+{
+	return near_d(y + API_GROUND_GAP * e, lo) && y < lo;
+}
+
 /* Column-major T * R(angle about unit axis) * S. */
 static void trs(float m[16], const float t[3], const float axis[3], float angle, const float s[3])
 {
@@ -62,7 +68,8 @@ TEST(ground_sits_at_min_y_of_rotated_scaled_box)
 	}
 	float margin[2] = {0, 2};
 	api_ground_place(o, 2, NULL, margin);
-	CHECK(near_d(o[1].model[13], lo), "ground at y=%g, the box's lowest corner is at %g", o[1].model[13], lo);
+	CHECK(o[1].model[13] < lo && near_d(o[1].model[13], lo), "ground at y=%g, just under the box's lowest corner at %g",
+	      o[1].model[13], lo);
 	CHECK(near_d(o[1].model[12], 0.5 * (xlo + xhi)), "centred under the box in x: %g vs %g", o[1].model[12],
 	      0.5 * (xlo + xhi));
 	CHECK(o[1].size[0] >= 2 * (xhi - xlo) - 1e-4 && o[1].size[0] == o[1].size[2],
@@ -89,7 +96,7 @@ TEST(ground_sits_at_lowest_vertex_of_rotated_mesh)
 	o[2].model[13] = -50;
 	float margin[3] = {0, 3, 0};
 	api_ground_place(o, 3, NULL, margin);
-	CHECK(near_d(o[1].model[13], -1.0), "ground at y=%g, expected 1 - 2 = -1", o[1].model[13]);
+	CHECK(ground_at(o[1].model[13], -1.0, 2.0), "ground at y=%g, expected just under 1 - 2 = -1", o[1].model[13]);
 	CHECK(near_d(o[2].model[13], -50), "the ordinary plane is left alone");
 	/* Extent: x 0..1, y -1..1, z 0..1 -> largest 2, side 3 x 2. */
 	CHECK(near_d(o[1].size[0], 6), "side %g, expected margin 3 x extent 2", o[1].size[0]);
@@ -118,7 +125,8 @@ TEST(ground_under_scaled_sphere_and_rotated_mesh_through_the_parser)
 		"{\"shape\":\"mesh\",\"positions\":[0,0,0, 1,0,0, 0,1,0, 0,0,2],\"indices\":[0,1,2, 0,1,3, 0,2,3, 1,2,3],"
 		"\"transform\":{\"translation\":[0,1,0],\"rotation\":[0.70710678,0,0,0.70710678]}}]}";
 	REQUIRE(api_scene_parse(doc2, strlen(doc2), NULL, &s, &p) == API_OK, "%s: %s", p.pointer, p.detail);
-	CHECK(near_d(s->scene.objects[0].model[13], -1.0), "ground at %g, expected -1", s->scene.objects[0].model[13]);
+	CHECK(ground_at(s->scene.objects[0].model[13], -1.0, 2.0), "ground at %g, expected just under -1",
+	      s->scene.objects[0].model[13]);
 	CHECK(near_d(s->scene.objects[0].size[0], 6), "default margin 3 x extent 2 = 6, got %g",
 	      s->scene.objects[0].size[0]);
 	api_scene_free(s);
@@ -228,7 +236,7 @@ TEST(ground_under_an_imported_model_with_two_meshes)
 	REQUIRE(sc->object_count >= 3, "two meshes and the ground, got %u objects", sc->object_count);
 	const struct rnd_object *g = &sc->objects[sc->object_count - 1];
 	CHECK(g->shape == RND_SHAPE_PLANE, "the ground is last");
-	CHECK(near_d(g->model[13], 0.0), "ground at %g, expected 2 x -0.5 + 1 = 0", g->model[13]);
+	CHECK(ground_at(g->model[13], 0.0, 6.0), "ground at %g, expected just under 2 x -0.5 + 1 = 0", g->model[13]);
 	/* x spans 0..6 after the scale: centre 3, largest extent 6 (y: 0..5). */
 	CHECK(near_d(g->model[12], 3.0) && near_d(g->size[0], 6.0), "centre x %g (3), side %g (6)", g->model[12],
 	      g->size[0]);
@@ -287,4 +295,25 @@ TEST(object_bounds_of_a_mesh_with_known_bounds)
 	CHECK(near_d(lo[1], 2.0 - 3.0) && near_d(hi[1], 2.0 + 1.5), "y %g..%g, expected -1..3.5", lo[1], hi[1]);
 	trs(a.model, t, axis, (float)M_PI / 4, sc);
 	CHECK(same_with_known(&a, wrong, lo, hi), "rotated: wrong given bounds were used");
+}
+
+/* A flat model lying at its lowest point (TwoSidedPlane: a quad at y = 0) coplanar with the
+ * ground z-fought with it: the ground now sits API_GROUND_GAP x the extent below it. */
+TEST(ground_sits_just_below_a_flat_model)
+{
+	static const float pos[] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
+	static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+	struct rnd_object o[2];
+	memset(o, 0, sizeof o);
+	o[0].shape = RND_SHAPE_MESH;
+	o[0].positions = pos;
+	o[0].vertex_count = 4;
+	o[0].indices = idx;
+	o[0].index_count = 6;
+	for (int k = 0; k < 16; k++) o[0].model[k] = (k % 5 == 0) ? 1.0f : 0.0f;
+	plane_object(&o[1]);
+	float margin[2] = {0, 3};
+	api_ground_place(o, 2, NULL, margin);
+	CHECK(o[1].model[13] < 0.0f && fabs(o[1].model[13] + API_GROUND_GAP * 2) < 1e-7, "ground at %g, want %g",
+	      o[1].model[13], -API_GROUND_GAP * 2);
 }
