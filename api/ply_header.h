@@ -1,7 +1,7 @@
 /*
  * api/ply_header — the header of a PLY file, and its values read one at a time (ASCII tokens,
  * or binary in either byte order), for the few rewrites umbra does before Assimp reads a PLY
- * (api/ply_strips.h, api/ply_colors.h). Pure functions of the bytes; every read is bounded by
+ * (api/ply_strips.h, api/ply_colors.h share it). Pure functions of the bytes; every read is bounded by
  * the input (untrusted: they run inside the import sandbox). Thread-safe.
  *
  * Usage:

@@ -12,37 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "ply_strips.h"
-
-enum { MAX_PROPS = 32, MAX_ELEMS = 16 };
-
-struct ply_prop {
-	int list;                 /* 1: list property */
-	int count_size, item_size; /* bytes (binary); count_size unused for scalars */
-	int item_signed;
-};
-
-struct ply_elem {
-	char name[32];
-	uint64_t count;
-	int nprops;
-	struct ply_prop props[MAX_PROPS];
-	size_t start, end;        /* byte range of its data */
-};
-
-static int type_size(const char *t, int *is_signed)
-{
-	static const struct { const char *name; int size, sgn; } types[] = {
-		{"char", 1, 1}, {"int8", 1, 1}, {"uchar", 1, 0}, {"uint8", 1, 0}, {"short", 2, 1}, {"int16", 2, 1},
-		{"ushort", 2, 0}, {"uint16", 2, 0}, {"int", 4, 1}, {"int32", 4, 1}, {"uint", 4, 0}, {"uint32", 4, 0},
-		{"float", 4, 1}, {"float32", 4, 1}, {"double", 8, 1}, {"float64", 8, 1},
-	};
-	for (size_t i = 0; i < sizeof types / sizeof types[0]; i++)
-		if (!strcmp(t, types[i].name)) {
-			*is_signed = types[i].sgn;
-			return types[i].size;
-		}
-	return 0;
-}
+#include "ply_header.h"
 
 /* Reads one header line into buf (without the newline); the offset after it, or 0. */
 static size_t header_line(const uint8_t *d, size_t len, size_t at, char *buf, size_t size)
@@ -56,115 +26,28 @@ static size_t header_line(const uint8_t *d, size_t len, size_t at, char *buf, si
 	return at < len ? at + 1 : 0;
 }
 
-/* Parses the header; the offset of the data, or 0. */
-static size_t parse_header(const uint8_t *d, size_t len, int *binary, struct ply_elem *el, int *nel)
-{
-	char line[256];
-	size_t at = header_line(d, len, 0, line, sizeof line);
-	if (!at || strcmp(line, "ply")) return 0;
-	*nel = 0;
-	*binary = -1;
-	while ((at = header_line(d, len, at, line, sizeof line))) {
-		char a[32], b[32], c[32], e[32];
-		unsigned long long n;
-		if (!strcmp(line, "end_header")) return *binary >= 0 && *nel ? at : 0;
-		if (sscanf(line, "format %31s", a) == 1) {
-			*binary = !strcmp(a, "ascii") ? 0 : !strcmp(a, "binary_little_endian") ? 1 : -2;
-			if (*binary == -2) return 0; /* big endian: left to Assimp */
-		} else if (sscanf(line, "element %31s %llu", a, &n) == 2) {
-			if (*nel == MAX_ELEMS) return 0;
-			struct ply_elem *x = &el[(*nel)++];
-			memset(x, 0, sizeof *x);
-			snprintf(x->name, sizeof x->name, "%s", a);
-			x->count = n;
-		} else if (sscanf(line, "property list %31s %31s %31s", a, b, c) == 3) {
-			if (!*nel || el[*nel - 1].nprops == MAX_PROPS) return 0;
-			struct ply_prop *p = &el[*nel - 1].props[el[*nel - 1].nprops++];
-			int s;
-			p->list = 1;
-			p->count_size = type_size(a, &s);
-			p->item_size = type_size(b, &p->item_signed);
-			if (!p->count_size || !p->item_size) return 0;
-		} else if (sscanf(line, "property %31s %31s", a, e) == 2) {
-			if (!*nel || el[*nel - 1].nprops == MAX_PROPS) return 0;
-			struct ply_prop *p = &el[*nel - 1].props[el[*nel - 1].nprops++];
-			p->item_size = type_size(a, &p->item_signed);
-			if (!p->item_size) return 0;
-		}
-		/* comment / obj_info lines are skipped */
-	}
-	return 0;
-}
-
-static uint64_t read_uint(const uint8_t *p, int size)
-{
-	uint64_t v = 0;
-	for (int i = size - 1; i >= 0; i--) v = v << 8 | p[i];
-	return v;
-}
-
-static int64_t read_int(const uint8_t *p, int size, int is_signed)
-{
-	uint64_t v = read_uint(p, size);
-	if (is_signed && size < 8 && (v >> (8 * size - 1)) & 1) v |= ~(uint64_t)0 << (8 * size);
-	return (int64_t)v;
-}
-
-/* ASCII: the next whitespace-separated token from *at; its value in *v. 0 at the end. */
-static int ascii_token(const uint8_t *d, size_t len, size_t *at, int64_t *v)
-{
-	while (*at < len && (d[*at] == ' ' || d[*at] == '\t' || d[*at] == '\r' || d[*at] == '\n')) (*at)++;
-	if (*at >= len) return 0;
-	char buf[40];
-	size_t n = 0;
-	while (*at < len && !(d[*at] == ' ' || d[*at] == '\t' || d[*at] == '\r' || d[*at] == '\n')) {
-		if (n + 1 < sizeof buf) buf[n++] = (char)d[*at];
-		(*at)++;
-	}
-	buf[n] = 0;
-	*v = strtoll(buf, NULL, 10);
-	return 1;
-}
-
-/* Walks one element's data from *at (binary or ASCII), calling on_list for the first list
- * property of each instance when given. 0 when the data is cut short. */
+/* Walks one element's data (binary or ASCII, api/ply_header.h), calling on_list for the first
+ * list property of each instance when given. 0 when the data is cut short. */
 typedef int (*list_fn)(void *user, const int64_t *items, uint64_t n);
 
-static int walk(const uint8_t *d, size_t len, int binary, const struct ply_elem *x, size_t *at, list_fn fn,
-                void *user, int64_t *scratch, uint64_t scratch_cap)
+static int walk(struct api_ply_reader *r, const struct api_ply_elem *x, list_fn fn, void *user, int64_t *scratch,
+                uint64_t scratch_cap)
 {
 	for (uint64_t i = 0; i < x->count; i++) {
 		for (int k = 0; k < x->nprops; k++) {
-			const struct ply_prop *p = &x->props[k];
-			int64_t v;
+			const struct api_ply_prop *p = &x->props[k];
+			double v;
 			if (!p->list) {
-				if (binary) {
-					if (len - *at < (size_t)p->item_size) return 0;
-					*at += (size_t)p->item_size;
-				} else if (!ascii_token(d, len, at, &v)) {
-					return 0;
-				}
+				if (!api_ply_read(r, p->type, &v)) return 0;
 				continue;
 			}
-			uint64_t n;
-			if (binary) {
-				if (len - *at < (size_t)p->count_size) return 0;
-				n = read_uint(d + *at, p->count_size);
-				*at += (size_t)p->count_size;
-				if (n > (len - *at) / (size_t)p->item_size) return 0;
-			} else {
-				if (!ascii_token(d, len, at, &v) || v < 0 || (uint64_t)v > len) return 0;
-				n = (uint64_t)v;
-			}
+			if (!api_ply_read(r, p->count_type, &v) || !(v >= 0) || v > (double)r->len) return 0;
+			uint64_t n = (uint64_t)v;
+			if (r->format != API_PLY_ASCII && n > (r->len - r->at) / (size_t)api_ply_type_size(p->type)) return 0;
 			if (fn && n > scratch_cap) return 0;
 			for (uint64_t m = 0; m < n; m++) {
-				if (binary) {
-					v = read_int(d + *at, p->item_size, p->item_signed);
-					*at += (size_t)p->item_size;
-				} else if (!ascii_token(d, len, at, &v)) {
-					return 0;
-				}
-				if (fn) scratch[m] = v;
+				if (!api_ply_read(r, p->type, &v) || !(v > -4e18 && v < 4e18)) return 0;
+				if (fn) scratch[m] = (int64_t)v;
 			}
 			if (fn && k == 0 && !fn(user, scratch, n)) return 0;
 		}
@@ -227,17 +110,15 @@ static size_t write_header(const uint8_t *d, size_t hdr_end, uint64_t ntris, uin
 
 uint8_t *api_ply_strips_to_faces(const uint8_t *d, size_t len, size_t *out_len)
 {
-	struct ply_elem el[MAX_ELEMS];
-	int nel, binary;
-	size_t data = parse_header(d, len, &binary, el, &nel);
-	if (!data) return NULL;
-	int strips = -1;
-	uint64_t vertices = 0;
-	for (int i = 0; i < nel; i++) {
-		if (!strcmp(el[i].name, "face")) return NULL;
-		if (!strcmp(el[i].name, "tristrips")) strips = i;
-		if (!strcmp(el[i].name, "vertex")) vertices = el[i].count;
-	}
+	struct api_ply_header h;
+	/* big endian: left to Assimp (the faces are written little endian) */
+	if (!api_ply_header_parse(d, len, &h) || h.format == API_PLY_BE || !h.nelems) return NULL;
+	const struct api_ply_elem *el = h.elems;
+	int nel = h.nelems, binary = h.format != API_PLY_ASCII;
+	size_t data = h.data, start[API_PLY_MAX_ELEMS], end[API_PLY_MAX_ELEMS];
+	int strips = api_ply_elem_index(&h, "tristrips"), vi = api_ply_elem_index(&h, "vertex");
+	uint64_t vertices = vi >= 0 ? el[vi].count : 0;
+	if (api_ply_elem_index(&h, "face") >= 0) return NULL;
 	if (strips < 0 || el[strips].nprops != 1 || !el[strips].props[0].list || !vertices || vertices > INT32_MAX)
 		return NULL;
 	/* Each strip index yields at most one triangle; an index takes at least one input byte. */
@@ -246,11 +127,11 @@ uint8_t *api_ply_strips_to_faces(const uint8_t *d, size_t len, size_t *out_len)
 	int64_t *scratch = malloc((size_t)cap * sizeof *scratch);
 	uint8_t *out = NULL;
 	if (!t.idx || !scratch) goto done;
-	size_t at = data;
+	struct api_ply_reader r = {d, len, data, h.format};
 	for (int i = 0; i < nel; i++) {
-		el[i].start = at;
-		if (!walk(d, len, binary, &el[i], &at, i == strips ? strip_to_tris : NULL, &t, scratch, cap)) goto done;
-		el[i].end = at;
+		start[i] = r.at;
+		if (!walk(&r, &el[i], i == strips ? strip_to_tris : NULL, &t, scratch, cap)) goto done;
+		end[i] = r.at;
 	}
 	if (!t.n) goto done;
 	/* header + other elements' bytes + faces (13 bytes binary, at most 36 characters ASCII) */
@@ -260,8 +141,8 @@ uint8_t *api_ply_strips_to_faces(const uint8_t *d, size_t len, size_t *out_len)
 	size_t o = write_header(d, data, t.n, out);
 	for (int i = 0; i < nel; i++) {
 		if (i != strips) {
-			memcpy(out + o, d + el[i].start, el[i].end - el[i].start);
-			o += el[i].end - el[i].start;
+			memcpy(out + o, d + start[i], end[i] - start[i]);
+			o += end[i] - start[i];
 			continue;
 		}
 		for (uint64_t k = 0; k < t.n; k++) {
