@@ -55,6 +55,14 @@ static struct api_scene *stacked(int n, int w, int res)
 	return s;
 }
 
+/* A render with no cached map: every map drawn (rnd_context_trim drops them). */
+static enum rnd_result render_uncached(struct rnd_context *ctx, struct api_scene *s, struct rnd_image *img,
+                                       struct rnd_timings *t, struct rnd_error *err)
+{
+	rnd_context_trim(ctx, 0);
+	return rnd_render(ctx, &s->scene, img, t, err);
+}
+
 TEST(pacing_shadow_map_parts_give_the_same_bytes)
 {
 	struct rnd_context *ctx = gpu_ctx();
@@ -65,12 +73,10 @@ TEST(pacing_shadow_map_parts_give_the_same_bytes)
 	struct rnd_image whole = {0}, parts = {0};
 	struct rnd_timings t1 = {0}, t2 = {0};
 	struct rnd_error err = {0};
-	rnd_context_trim(ctx, 0);   /* no cached map: every map drawn */
-	CHECK(rnd_render(ctx, &s->scene, &whole, &t1, &err) == RND_OK, "one submit: %s", err.msg);
-	rnd_context_trim(ctx, 0);
+	CHECK(render_uncached(ctx, s, &whole, &t1, &err) == RND_OK, "one submit: %s", err.msg);
 	/* 6 boxes and a plane: 74 caster triangles in parts of 5, across box boundaries. */
 	s->scene.shadow_part_triangles = 5;
-	CHECK(rnd_render(ctx, &s->scene, &parts, &t2, &err) == RND_OK, "in parts: %s", err.msg);
+	CHECK(render_uncached(ctx, s, &parts, &t2, &err) == RND_OK, "in parts: %s", err.msg);
 	CHECK(t1.shadow_parts == 0, "unasked parts: %u", t1.shadow_parts);
 	CHECK(t2.shadow_parts > t2.shadow_maps_rendered, "maps in parts of 5 triangles: %u submits for %u maps",
 	      t2.shadow_parts, t2.shadow_maps_rendered);
@@ -91,14 +97,12 @@ TEST(pacing_stacked_layers_are_cut_into_submits)
 	struct rnd_image whole = {0}, paced = {0};
 	struct rnd_timings t = {0};
 	struct rnd_error err = {0};
-	rnd_context_trim(ctx, 0);   /* no cached map: every map drawn */
-	CHECK(rnd_render(ctx, &s->scene, &whole, NULL, &err) == RND_OK, "unpaced: %s", err.msg);
-	rnd_context_trim(ctx, 0);
+	CHECK(render_uncached(ctx, s, &whole, NULL, &err) == RND_OK, "unpaced: %s", err.msg);
 	/* A deadline ten minutes away: slices of 1 s. The cost model counts ~750 layers over the
 	 * image and ~400 over the spot light's 2048^2 map, each estimated past half a slice (~2 s
 	 * each on lavapipe): the map in parts and the main pass in bands (before, one submit each). */
 	s->scene.deadline_ns = mono_ns() + 600ull * 1000000000ull;
-	CHECK(rnd_render(ctx, &s->scene, &paced, &t, &err) == RND_OK, "paced: %s", err.msg);
+	CHECK(render_uncached(ctx, s, &paced, &t, &err) == RND_OK, "paced: %s", err.msg);
 	CHECK(t.shadow_parts >= 2, "the spot light's map in %u parts", t.shadow_parts);
 	CHECK(t.submits >= t.shadow_parts + 2, "%u submits (%u of them shadow parts): the main pass in bands", t.submits,
 	      t.shadow_parts);
