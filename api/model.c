@@ -384,8 +384,12 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	pthread_mutex_unlock(&cache_mu);
 	release_list(evicted);
 	if (dup) {
+		/* Imported for another image size of the same texture class, maybe: this request's
+		 * level as on any hit, or it would render at full detail here and with its level
+		 * the next time (the same request, other bytes). */
 		api_model_release(&m->pub);
 		m = dup;
+		api_levels_on_hit(&m->pub, lim);
 	}
 	*out = &m->pub;
 	return API_OK;
