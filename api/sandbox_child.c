@@ -129,8 +129,7 @@ static void do_job(const struct api_sbx_request *rq, const uint8_t *in, struct a
 		if (!arena) st = API_WIRE_OVER_MEMORY, snprintf(err, sizeof err, "out of memory");
 		else if (api_wire_decode_model(in, rq->input_len, arena, 1, &m, &bytes, err, sizeof err) == API_OK)
 			st = API_WIRE_OK;
-		for (uint32_t i = 0; st == API_WIRE_OK && i < m.mesh_count; i++)
-			api_mesh_bounds((struct api_model_mesh *)&m.meshes[i]);
+		/* (api_wire_decode_model has set every mesh's bounds) */
 		if (st == API_WIRE_OK) api_model_build_level(&m, rq->output_side, arena, &bytes);
 		api_wire_put_header(out, API_WIRE_LEVELS, st, err);
 		if (st == API_WIRE_OK) api_wire_put_levels(out, &m);

@@ -43,7 +43,9 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
                                uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err);
 
 /* The world-space area of the index_count / 3 triangles at indices (as rnd_mesh_write leaves
- * them: offset by base_vertex) over vertices (the buffer's start, vertex 0 = base 0). */
+ * them: offset by base_vertex) over vertices (the buffer's start, vertex 0 = base 0): exact up
+ * to RND_MESH_AREA_SAMPLES triangles, past it estimated from that many, evenly strided. */
+#define RND_MESH_AREA_SAMPLES 16384u
 double rnd_mesh_area(const struct rnd_vertex *vertices, const uint32_t *indices, uint32_t index_count);
 
 /* Object-space bounds before any tessellation (cheap; for culling and camera derivation). */

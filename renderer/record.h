@@ -82,15 +82,14 @@ void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, u
 void record_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v, uint32_t first,
                     uint32_t end);
 /* One map in parts, each its own submit (record_shadow.c): triangles [lo, hi) of the `total`
- * that shadow view v draws (record_shadow_triangles); the part from 0 begins the map, the one
+ * that shadow view v draws (those of the draws record_shadow_draws says it draws); the part from 0 begins the map, the one
  * reaching total copies it into its tile. Between parts the slot's scratch depth image holds
  * the map so far: nothing else may draw into it. */
 void record_shadow_part(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v, uint32_t view,
                         uint64_t lo, uint64_t hi, uint64_t total);
 /* Whether shadow view v draws draw i (a caster inside its frustum) and, if so, with back faces
- * culled (*cull); how many triangles it draws in all. */
+ * culled (*cull). */
 bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, int *cull);
-uint64_t record_shadow_triangles(const struct record_view *rv, uint32_t v);
 /* The specialization key of this scene's main pass (see mesh.frag). */
 void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
                      uint32_t ndraw, struct rnd_main_key *k);

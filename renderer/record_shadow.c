@@ -27,15 +27,6 @@ bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, i
 	return true;
 }
 
-uint64_t record_shadow_triangles(const struct record_view *rv, uint32_t v)
-{
-	uint64_t n = 0;
-	int cull;
-	for (uint32_t i = 0; i < rv->ndraw; i++)
-		if (record_shadow_draws(rv, v, i, &cull)) n += rv->draws[i].index_count / 3;
-	return n;
-}
-
 /* Begins a later part of a map: the earlier part's depth (an earlier submit) loaded. */
 static void begin_depth_load(VkCommandBuffer cmd, VkImage img, VkImageView view, uint32_t w, uint32_t h)
 {
@@ -46,8 +37,8 @@ static void begin_depth_load(VkCommandBuffer cmd, VkImage img, VkImageView view,
 	record_depth_rendering(cmd, view, w, h, true);
 }
 
-/* Triangles [lo, hi) of shadow view v's casters (in draw order, as record_shadow_triangles
- * counts them) drawn into the slot's scratch depth image, at its origin: rasterisation snaps
+/* Triangles [lo, hi) of shadow view v's casters (in draw order, those record_shadow_draws
+ * says it draws) drawn into the slot's scratch depth image, at its origin: rasterisation snaps
  * to a grid relative to the framebuffer, so drawing at the tile's own offset would make a map
  * (and the image) depend on where the atlas happened to place it; the same request then gives
  * the same bytes whatever the cache held before. lo 0 clears the map; a part that ends the

@@ -144,7 +144,16 @@ static void entry_free(struct rnd_shadow_cache *c, struct rnd_cache_entry *e)
 }
 
 /* Evicts the least recently used entry nobody is using. False when there is none. */
+static bool evict_one_counted(struct rnd_shadow_cache *c, uint64_t *texels);
+
 static bool evict_one(struct rnd_shadow_cache *c)
+{
+	uint64_t texels;
+	return evict_one_counted(c, &texels);
+}
+
+/* The least recently used unreferenced map freed; *texels: what it held. */
+static bool evict_one_counted(struct rnd_shadow_cache *c, uint64_t *texels)
 {
 	struct rnd_cache_entry *lru = NULL;
 	for (uint32_t i = 0; i < MAX_ENTRIES; i++) {
@@ -152,6 +161,7 @@ static bool evict_one(struct rnd_shadow_cache *c)
 		if (e->live && e->valid && !e->refs && (!lru || e->last_use < lru->last_use)) lru = e;
 	}
 	if (!lru) return false;
+	*texels = (uint64_t)lru->ntiles * lru->res * lru->res;
 	entry_free(c, lru);
 	return true;
 }
@@ -356,7 +366,9 @@ void rnd_cache_release(struct rnd_context *ctx, const struct rnd_cache_grant *g,
 		else e->valid = true;
 	}
 	uint64_t cap = ctx->desc.shadow_cache_texels ? ctx->desc.shadow_cache_texels : RND_DEFAULT_SHADOW_CACHE_TEXELS;
-	while (kept_texels(c) > cap && evict_one(c)) {}
+	/* one scan for the total, then each eviction subtracts what it freed */
+	uint64_t kept = kept_texels(c), freed;
+	while (kept > cap && evict_one_counted(c, &freed)) kept -= freed;
 	pthread_cond_broadcast(&c->released);
 	pthread_mutex_unlock(&c->mu);
 }
