@@ -72,8 +72,10 @@ void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 
 /* What a slot keeps for the next render: each group of targets or buffer over this is freed
  * when its render ends, so one enormous request does not hold its memory for the life of the
- * process, while the targets of ordinary renders (a 1024² MSAA target is 16 MiB) stay. */
-#define RND_SLOT_KEEP_BYTES (64ull << 20)
+ * process, while the targets of ordinary renders stay (a 1024² output with MSAA 4: colour,
+ * depth and resolve 36 MiB; a 2048² shadow scratch map 16 MiB). 64 MiB kept two slots' buffers
+ * of 48,000 planes (~40 MB) after the request. */
+#define RND_SLOT_KEEP_BYTES (40ull << 20)
 /* Frees what is over RND_SLOT_KEEP_BYTES. Only after the slot's work has completed. */
 void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s);
 

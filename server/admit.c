@@ -2,7 +2,6 @@
  * server/admit.c — admission of renders by their estimated memory (see admit.h).
  */
 #include <errno.h>
-#include <malloc.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -13,7 +12,6 @@
 
 /* After a render that held this much, freed heap memory goes back to the system at once
  * (glibc keeps it otherwise, and RSS would stay at the size of the largest request seen). */
-#define TRIM_AFTER_BYTES (64ull << 20)
 
 void srv_admit_init(struct srv_admit *a, uint64_t budget)
 {
@@ -105,7 +103,6 @@ void srv_admit_release(struct srv_admit *a, uint64_t need)
 	a->in_use = a->in_use > need ? a->in_use - need : 0;
 	pthread_cond_broadcast(&a->cv);
 	pthread_mutex_unlock(&a->mu);
-	if (need >= TRIM_AFTER_BYTES) malloc_trim(0);
 }
 
 void srv_admit_stats(struct srv_admit *a, uint64_t *in_use, uint64_t *budget, uint64_t *peak)

@@ -2,6 +2,13 @@
 #include <math.h>
 #include "clock.h"
 
+double srv_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
 int srv_cond_init_monotonic(pthread_cond_t *cv)
 {
 	pthread_condattr_t ca;

@@ -10,6 +10,8 @@
 #include <pthread.h>
 #include <time.h>
 
+/* Monotonic seconds: every time the daemon measures or waits on. */
+double srv_now(void);
 /* pthread_cond_init on CLOCK_MONOTONIC; its result (0 = done). */
 int srv_cond_init_monotonic(pthread_cond_t *cv);
 /* Monotonic seconds (as srv_now()) as an absolute timespec. */

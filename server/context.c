@@ -4,6 +4,7 @@
  * again, server/warmup.c), its pipeline cache saved at exit — and srv_render(), the one way a
  * worker renders on it.
  */
+#include <malloc.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -138,6 +139,17 @@ enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, 
 	}
 	pthread_rwlock_unlock(&s->ctx_lock);
 	return r;
+}
+
+uint64_t srv_context_trim(struct srv_server *s, double idle_s)
+{
+	uint64_t released = 0;
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	if (s->ctx)
+		released = rnd_context_trim(s->ctx, idle_s);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	malloc_trim(0);
+	return released;
 }
 
 int srv_fault_arm(struct srv_server *s)

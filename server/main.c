@@ -22,13 +22,6 @@
 #include "queue.h"
 #include "srv.h"
 
-double srv_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
 /* Waits until every begun request has been answered and completed, or the timeout. */
 static void wait_pending(struct srv_server *s, double timeout_s)
 {

@@ -5,7 +5,6 @@
 #include "clock.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdlib.h>
 #include <time.h>
 
@@ -22,6 +21,7 @@ struct srv_queue {
 	bool closed;
 	unsigned busy;      /* requests handed out and not yet srv_queue_done */
 	bool idle_due;      /* a request was handed out since on_idle last ran (srv_queue_pop_idle) */
+	double active_at;   /* srv_now() of the last hand-out or srv_queue_done (or the creation) */
 };
 
 struct srv_queue *srv_queue_create(unsigned capacity)
@@ -35,6 +35,7 @@ struct srv_queue *srv_queue_create(unsigned capacity)
 		goto err_mutex;
 	q->capacity = capacity;
 	q->idle_due = true;
+	q->active_at = srv_now();
 	return q;
 
 err_mutex:
@@ -97,6 +98,7 @@ static struct srv_request *take(struct srv_queue *q)
 		req->next = NULL;
 		q->busy++;
 		q->idle_due = true;
+		q->active_at = srv_now();
 		return req;
 	}
 	return NULL;
@@ -111,28 +113,25 @@ struct srv_request *srv_queue_pop_idle(struct srv_queue *q, double idle_s, void 
 {
 	pthread_mutex_lock(&q->mu);
 	while (q->count == 0 && !q->closed) {
-		if (idle_s <= 0 || !on_idle || !q->idle_due) {
+		/* While a request is in work, its thread starts the idle period when it is done (it
+		 * comes back here): the others just wait. */
+		if (idle_s <= 0 || !on_idle || !q->idle_due || q->busy) {
 			pthread_cond_wait(&q->nonempty, &q->mu);
 			continue;
 		}
-		struct timespec ts;
-		clock_gettime(CLOCK_MONOTONIC, &ts);
-		double whole, frac = modf(idle_s, &whole);
-		ts.tv_sec += (time_t)whole;
-		ts.tv_nsec += (long)(frac * 1e9);
-		if (ts.tv_nsec >= 1000000000L) {
-			ts.tv_sec++;
-			ts.tv_nsec -= 1000000000L;
-		}
-		/* Several threads may wait out the same idle time: the first to time out runs it, once
-		 * no request is being worked on either (the last to finish waits out its own). */
-		if (pthread_cond_timedwait(&q->nonempty, &q->mu, &ts) == ETIMEDOUT && q->count == 0 && !q->closed &&
-		    q->idle_due && q->busy == 0) {
+		/* The period counts from the last request handed out or done, whichever thread did
+		 * it: a thread that began waiting earlier must not cut another's period short (the
+		 * idle trim would find the last request's shadow maps used too recently to go). */
+		double due = q->active_at + idle_s;
+		if (srv_now() >= due) {
 			q->idle_due = false;
 			pthread_mutex_unlock(&q->mu);
 			on_idle(arg);
 			pthread_mutex_lock(&q->mu);
+			continue;
 		}
+		struct timespec ts = srv_timespec(due);
+		pthread_cond_timedwait(&q->nonempty, &q->mu, &ts);
 	}
 	struct srv_request *req = take(q);
 	pthread_mutex_unlock(&q->mu);
@@ -144,6 +143,10 @@ void srv_queue_done(struct srv_queue *q)
 	pthread_mutex_lock(&q->mu);
 	if (q->busy)
 		q->busy--;
+	q->active_at = srv_now();
+	/* A waiting thread starts the idle period when the done one is not coming back. */
+	if (q->busy == 0)
+		pthread_cond_signal(&q->nonempty);
 	pthread_mutex_unlock(&q->mu);
 }
 

@@ -24,10 +24,10 @@ void srv_queue_destroy(struct srv_queue *q);          /* NULL-safe; the queue mu
 enum srv_push_result srv_queue_push(struct srv_queue *q, struct srv_request *req,
                                     void (*before_push)(struct srv_request *req));
 struct srv_request *srv_queue_pop(struct srv_queue *q);
-/* srv_queue_pop that, once the queue has stayed empty and no request has been in work
- * (srv_queue_done) for idle_s seconds after a request was handed out (or since the queue was
- * created), calls on_idle(arg) once, without the lock, on one of the waiting threads, and goes
- * on waiting. idle_s 0: plain srv_queue_pop. */
+/* srv_queue_pop that, once the queue has stayed empty with no request in work for idle_s
+ * seconds — counted from the last hand-out or srv_queue_done on any thread (or the creation) —
+ * and a request was handed out since the last time, calls on_idle(arg) once, without the
+ * lock, on one of the waiting threads, and goes on waiting. idle_s 0: plain srv_queue_pop. */
 struct srv_request *srv_queue_pop_idle(struct srv_queue *q, double idle_s, void (*on_idle)(void *arg), void *arg);
 /* A request handed out by a pop is finished: idle time counts only while none is in work. */
 void srv_queue_done(struct srv_queue *q);

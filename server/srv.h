@@ -42,6 +42,7 @@
 #include <stdint.h>
 
 #include "admit.h"
+#include "clock.h"
 #include "gate.h"
 #include "api.h"
 #include "origin.h"
@@ -221,6 +222,9 @@ int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged); server/
  * lost context's generation + 1, and the daemon is marked not ready. */
 enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
                            struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
+/* Memory back to the system: shadow maps unused for idle_s seconds, the atlases' pages once no
+ * map is left (rnd_context_trim), then malloc's free pages. Returns the atlas bytes released. */
+uint64_t srv_context_trim(struct srv_server *s, double idle_s);
 int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */
 int srv_fault_arm(struct srv_server *s);            /* --test-fault; 0 or -1 (logged) */
 /* worker.c */
@@ -242,6 +246,5 @@ char *srv_playground_page(size_t *len);
 const char *srv_playground_csp(void);
 
 /* Small shared helpers (main.c). */
-double srv_now(void);                               /* monotonic seconds */
 
 #endif
