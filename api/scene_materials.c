@@ -175,7 +175,7 @@ int api_check_textures(struct pctx *c, const struct rnd_scene *sc)
 				size_t old = api_ptr_push(c, "objects");
 				api_ptr_index(c, c->object_source ? c->object_source[o] : o);
 				api_defer(c, false, NULL, "this object brings the scene over %u distinct textures (this server's "
-				          "limit: --max-textures, capped by the device)", max);
+				          "limit: --max-textures)", max);
 				api_ptr_pop(c, old);
 				return 0;
 			}

@@ -252,14 +252,13 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 	vkGetPhysicalDeviceProperties2(ctx->phys, &lim2);
 	ctx->max_allocation = m3.maxMemoryAllocationSize;
 	if (m4.maxBufferSize && m4.maxBufferSize < ctx->max_allocation) ctx->max_allocation = m4.maxBufferSize;
-	/* Textures per scene. Today each texture is its own descriptor set (set 1, one sampler) and
-	 * a draw binds one; the bound taken from the device is the stricter one of a layout that
-	 * would hold all of a scene's textures at once beside set 0's two samplers (sampled images
-	 * per set and per stage), so the number stays valid if textures move into one array. */
-	const VkPhysicalDeviceLimits *dl = &ctx->props.limits;
-	uint32_t dev = dl->maxDescriptorSetSampledImages < dl->maxPerStageDescriptorSampledImages
-	               ? dl->maxDescriptorSetSampledImages : dl->maxPerStageDescriptorSampledImages;
-	ctx->device_max_textures = dev > 2 ? dev - 2 : 1;
+	/* Textures per scene. A draw binds one material's set (UMBRA_TEX_SLOTS images) beside set
+	 * 0's two samplers, so the device's per-stage bound limits a material, not a scene: a
+	 * scene's distinct textures are bounded by memory (the estimate and admission count
+	 * their texels) and by the descriptor sets each slot preallocates for them, which
+	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. (Vulkan guarantees 16 sampled images per
+	 * stage, more than the 7 a draw binds.) */
+	ctx->device_max_textures = RND_MAX_TEXTURES_CEILING;
 
 	VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
 	VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &drv};

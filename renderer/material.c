@@ -59,10 +59,11 @@ void rnd_material_write(const struct rnd_material *in, struct umbra_material *ou
 	}
 }
 
-/* Arrays sized by ctx->max_textures (the device's, capped by the caller): that many distinct
- * images and that many textured materials (each has at least one image). */
+/* Distinct images up to ctx->max_textures; descriptor sets (one per distinct combination of
+ * images and samplers a textured material binds, however many materials share it) up to
+ * rnd_texture_sets(ctx->max_textures). */
 struct tex_plan {
-	uint32_t max;
+	uint32_t max, max_sets;
 	uint32_t n;                                /* distinct images */
 	const struct rnd_texture **tex;
 	bool *srgb;
@@ -83,7 +84,9 @@ static int image_of(struct tex_plan *p, const struct rnd_texture *t, bool srgb)
 }
 
 /* Gives material mi, first met on object o, its set (its images and samplers); 0 when it has
- * no texture. The limit's error names o: the object that brought one too many. */
+ * no texture. Materials that bind the same images with the same samplers share one set (their
+ * factors are in the material buffer, not in the set): VC.glb's 147 materials use 20 images.
+ * The limit's error names o: the object that brought one too many. */
 static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene *sc, uint32_t mi, uint32_t o,
                                      uint32_t *set, struct rnd_error *err)
 {
@@ -92,24 +95,35 @@ static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene 
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) any = any || m->textures[k];
 	*set = 0;
 	if (!any) return RND_OK;
-	if (p->nsets == p->max)
-		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u textured materials in one scene "
-		                   "(this renderer's limit)", p->max);
-	uint32_t si = p->nsets++;
+	int16_t img[UMBRA_TEX_SLOTS];
+	uint8_t smp[UMBRA_TEX_SLOTS];
+	for (uint32_t k = 0; k < UMBRA_TEX_SLOTS; k++) {
+		img[k] = -1;
+		smp[k] = 0;
+	}
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
 		const struct rnd_texture *t = m->textures[k];
-		p->img[si][k] = -1;
-		p->smp[si][k] = (uint8_t)rnd_texture_sampler_index(&m->sampling[k]);
 		if (!t) continue;
 		if (!t->rgba || !t->width || !t->height || t->width > RND_MAX_TEXTURE_SIDE || t->height > RND_MAX_TEXTURE_SIDE)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", mi, t->width, t->height);
 		int ii = image_of(p, t, rnd_texture_slot_srgb((enum rnd_texture_slot)k));
 		if (ii < 0)
 			return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u distinct textures in one scene "
-			                   "(this renderer's limit)", p->max);
-		p->img[si][k] = (int16_t)ii;
+			                   "(the limit: --max-textures)", p->max);
+		img[k] = (int16_t)ii;
+		smp[k] = (uint8_t)rnd_texture_sampler_index(&m->sampling[k]);
 	}
-	*set = 1 + si;
+	for (uint32_t si = 0; si < p->nsets; si++)
+		if (!memcmp(p->img[si], img, sizeof img) && !memcmp(p->smp[si], smp, sizeof smp)) {
+			*set = 1 + si;
+			return RND_OK;
+		}
+	if (p->nsets == p->max_sets)
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECT, o, "more than %u different combinations of textures "
+		                   "and samplers in one scene (the limit: twice --max-textures)", p->max_sets);
+	memcpy(p->img[p->nsets], img, sizeof img);
+	memcpy(p->smp[p->nsets], smp, sizeof smp);
+	*set = 1 + p->nsets++;
 	return RND_OK;
 }
 
@@ -139,13 +153,14 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 	enum rnd_result r = RND_OK;
 	rnd_slot_drop_textures(ctx, s);
 	*ntex = 0;
-	uint32_t max = ctx->max_textures;
+	uint32_t max = ctx->max_textures, max_sets = rnd_texture_sets(max);
 	struct tex_plan *p = calloc(1, sizeof *p);
 	if (p) {
 		p->max = max;
+		p->max_sets = max_sets;
 		p->srgb = calloc(max, sizeof *p->srgb);
-		p->img = calloc(max, sizeof *p->img);
-		p->smp = calloc(max, sizeof *p->smp);
+		p->img = calloc(max_sets, sizeof *p->img);
+		p->smp = calloc(max_sets, sizeof *p->smp);
 	}
 	/* material -> its set + 1 (0 = not planned yet) */
 	uint32_t *set_of = calloc(sc->material_count ? sc->material_count : 1, sizeof *set_of);

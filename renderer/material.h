@@ -22,9 +22,13 @@ void rnd_material_record(const struct rnd_scene *sc, uint32_t index, struct umbr
 
 /* Creates the scene's distinct textures (per colour space: base colour and emissive read
  * sRGB, the others linear) in the slot, stages their texels (tex[] in staging order,
- * *ntex of them), writes one set-1 descriptor set per textured material that a draw uses
- * and points draws at it. RND_ERR_LIMIT at the object that brought one too many, past
- * ctx->max_textures images or textured materials. */
+ * *ntex of them), writes one set-1 descriptor set per distinct combination of images and
+ * samplers that a draw uses and points draws at it. RND_ERR_LIMIT at the object that brought
+ * one too many, past ctx->max_textures images or rnd_texture_sets() combinations. */
+/* Descriptor sets of textured materials a slot holds for max_textures distinct images (besides
+ * the white set 0): twice as many, since materials combine the same images differently. */
+static inline uint32_t rnd_texture_sets(uint32_t max_textures) { return 2 * max_textures; }
+
 enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                       struct draw *draws, const struct rnd_texture **tex, uint32_t *ntex,
                                       struct rnd_error *err);

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "slot.h"
+#include "material.h"
 
 /* A descriptor pool (named "slot N <what> descriptor pool") holding exactly `count` sets, one
  * per layouts[i], all allocated into sets[]. On failure nothing is left. Descriptor sets stay
@@ -44,10 +45,10 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	struct rnd_slot *s = calloc(1, sizeof *s);
 	if (!s) return rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
 	s->index = index;
-	uint32_t ntex = ctx->max_textures;
+	uint32_t ntex = ctx->max_textures, nsets = rnd_texture_sets(ntex);
 	s->textures = calloc(ntex, sizeof *s->textures);
-	s->texture_sets = calloc(1 + ntex, sizeof *s->texture_sets);
-	VkDescriptorSetLayout *layouts = calloc(1 + ntex, sizeof *layouts);
+	s->texture_sets = calloc(1 + nsets, sizeof *s->texture_sets);
+	VkDescriptorSetLayout *layouts = calloc(1 + nsets, sizeof *layouts);
 	if (!s->textures || !s->texture_sets || !layouts) {
 		r = rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
 		goto fail_pool;
@@ -94,9 +95,9 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	};
 	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
 		goto fail_desc_pool;
-	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (1 + ntex) * UMBRA_TEX_SLOTS};
-	for (uint32_t i = 0; i < 1 + ntex; i++) layouts[i] = ctx->pipes.texture_layout;
-	if ((r = pool_with_sets(ctx, &tsize, 1, 1 + ntex, layouts, "texture", index, &s->texture_pool, s->texture_sets,
+	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (1 + nsets) * UMBRA_TEX_SLOTS};
+	for (uint32_t i = 0; i < 1 + nsets; i++) layouts[i] = ctx->pipes.texture_layout;
+	if ((r = pool_with_sets(ctx, &tsize, 1, 1 + nsets, layouts, "texture", index, &s->texture_pool, s->texture_sets,
 	                        err)) != RND_OK)
 		goto fail_set;
 	char name[48];

@@ -30,7 +30,7 @@ struct rnd_slot {
 	/* set 1: [0] the white 1x1 in every slot (untextured draws), [1 + i] the i-th textured
 	 * material's textures (render.c textures()) */
 	VkDescriptorPool texture_pool;
-	VkDescriptorSet *texture_sets;    /* 1 + ctx->max_textures */
+	VkDescriptorSet *texture_sets;    /* 1 + rnd_texture_sets(ctx->max_textures) */
 	struct rnd_image_res white;
 	bool white_ready;             /* cleared to white and in SHADER_READ_ONLY layout */
 	/* AOV pass targets: UMBRA_AOV_ATTACHMENTS x RGBA32F + a single-sample depth */

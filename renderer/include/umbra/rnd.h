@@ -392,6 +392,9 @@ struct rnd_context; /* opaque */
 typedef void (*rnd_log_fn)(void *user, int level /* 0 error 1 warn 2 info */, const char *msg);
 
 #define RND_DEFAULT_MAX_TEXTURES 256u
+/* The most a context grants (rnd_info.device_max_textures): each render slot preallocates
+ * descriptor sets for its textures, ~1 KB each on lavapipe. */
+#define RND_MAX_TEXTURES_CEILING 4096u
 
 struct rnd_context_desc {
 	const char *device_name;   /* substring of the device name to pick; NULL = $UMBRA_DEVICE, else a GPU, else lavapipe */
@@ -404,8 +407,9 @@ struct rnd_context_desc {
 	 * after each render (tiles are handed out first-fit, so the atlas pages a process touches,
 	 * and its memory, stay near this). 0 = RND_DEFAULT_SHADOW_CACHE_TEXELS. */
 	uint64_t shadow_cache_texels;
-	/* Distinct textures one scene may use; 0 = RND_DEFAULT_MAX_TEXTURES. Capped by the device
-	 * (rnd_info.max_textures says what was granted); each slot holds a descriptor set per texture. */
+	/* Distinct textures one scene may use; 0 = RND_DEFAULT_MAX_TEXTURES. Capped at
+	 * RND_MAX_TEXTURES_CEILING (rnd_info.max_textures says what was granted); each slot holds
+	 * two descriptor sets per texture (rnd_texture_sets). Materials sharing textures share a set. */
 	uint32_t max_textures;
 	rnd_log_fn log; void *log_user;
 };
@@ -424,8 +428,8 @@ struct rnd_info {
 	uint32_t max_image_dimension;
 	uint32_t max_shadow_resolution;
 	uint64_t max_allocation;   /* largest single buffer/allocation (an image with its AOVs must fit) */
-	uint32_t max_textures;     /* distinct textures per scene: the desc's, capped by the device */
-	uint32_t device_max_textures; /* the device's own bound on that (see device.c) */
+	uint32_t max_textures;     /* distinct textures per scene: the desc's, capped by the one below */
+	uint32_t device_max_textures; /* the renderer's bound on that on this device (see device.c) */
 	bool moments_fp32_filterable;
 };
 
