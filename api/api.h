@@ -1,6 +1,6 @@
 /*
  * umbra api — scene documents (JSON, contract v1) to renderer scenes, problems (RFC 9457),
- * and image encoders (PNG via libpng, EXR via OpenEXR's C core).
+ * and image encoders (PNG via libpng, EXR via OpenEXR's C core, WebP via libwebp).
  *
  * Usage:
  *   struct api_limits lim; api_limits_defaults(&lim);
@@ -93,7 +93,9 @@ struct api_limits {
 };
 void api_limits_defaults(struct api_limits *l);
 
-enum api_format { API_FORMAT_PNG, API_FORMAT_EXR };
+enum api_format { API_FORMAT_PNG, API_FORMAT_EXR, API_FORMAT_WEBP };
+/* WebP's own bound on each side of an image (its 14-bit dimensions). */
+#define API_WEBP_MAX_SIDE 16383u
 
 /* Where the time of a request's model imports went, ms (Server-Timing's model-* stages; the
  * importer measures its own in the sandbox, api/model.c the daemon's). */
@@ -121,6 +123,7 @@ struct api_scene {
 	int format_explicit;        /* output.format was given (else the Accept header may choose) */
 	uint32_t bit_depth;         /* 8 or 16 (png) */
 	int png_level;              /* zlib level for PNG, -1 = chosen by image size */
+	float quality;              /* output.quality: lossy WebP 0..100; -1 = not given (lossless WebP) */
 	uint64_t triangles;         /* total after tessellation */
 	uint64_t asset_hash;        /* hash of files read under the asset root (`path` models), 0 = none:
 	                               the answer depends on them, so caches and ETags must too */
@@ -197,8 +200,8 @@ enum api_result api_scene_check_output(const struct api_scene *s, struct api_pro
 enum api_result api_problem_from_render(struct api_problem *p, const struct api_scene *s, const struct rnd_error *e,
                                         int status);
 
-/* Encodes a rendered image as the scene asks (PNG 8/16-bit or EXR with AOVs). Several views:
- * the PNG is the sheet as rendered; the EXR is multi-part (see api_exr_encode). */
+/* Encodes a rendered image as the scene asks (PNG 8/16-bit, EXR with AOVs, or WebP). Several
+ * views: the PNG and the WebP are the sheet as rendered; the EXR is multi-part (api_exr_encode). */
 enum api_result api_encode(const struct api_scene *s, const struct rnd_image *img, uint8_t **out, size_t *len,
                            struct api_problem *p);
 /* PNG of an RGBA8 or RGBA16 image; level -1 = chosen by size. */
@@ -210,7 +213,19 @@ enum api_result api_png_encode(const struct rnd_image *img, int level, uint8_t *
  * view's cell of the sheet and of every AOV plane. One view: a single part with no name. */
 enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_t *len, struct api_problem *p);
 
+/* WebP of an RGBA8 image (api/encode_webp.c): lossless when quality < 0 (every sample, alpha
+ * included, decodes exactly), else lossy at quality 0..100 with a lossless alpha plane. Fully
+ * opaque images carry no alpha. A side over API_WEBP_MAX_SIDE is a 422; the bytes are malloc'd. */
+enum api_result api_webp_encode(const struct rnd_image *img, float quality, uint8_t **out, size_t *len,
+                                struct api_problem *p);
+
+/* "image/png", "image/x-exr", "image/webp". */
 const char *api_format_mime(enum api_format f);
+/* "png", "exr", "webp": output.format's name, and the extension of the format's files. */
+const char *api_format_name(enum api_format f);
+/* The format an output file name's extension names (.png, .exr, .webp, in any case): true with
+ * *f set; false (*f untouched) for any other name. */
+bool api_format_from_name(const char *name, enum api_format *f);
 
 /* What umbrad says of itself in GET /v1/info (the strings are only read). */
 struct api_info {

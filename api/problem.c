@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <jansson.h>
 #include "api.h"
 
@@ -118,7 +119,24 @@ void api_limits_defaults(struct api_limits *l)
 
 const char *api_format_mime(enum api_format f)
 {
-	return f == API_FORMAT_EXR ? "image/x-exr" : "image/png";
+	return f == API_FORMAT_EXR ? "image/x-exr" : f == API_FORMAT_WEBP ? "image/webp" : "image/png";
+}
+
+const char *api_format_name(enum api_format f)
+{
+	return f == API_FORMAT_EXR ? "exr" : f == API_FORMAT_WEBP ? "webp" : "png";
+}
+
+bool api_format_from_name(const char *name, enum api_format *f)
+{
+	const char *dot = name ? strrchr(name, '.') : NULL;
+	if (!dot || strchr(dot, '/')) return false;
+	for (int k = API_FORMAT_PNG; k <= API_FORMAT_WEBP; k++)
+		if (!strcasecmp(dot + 1, api_format_name((enum api_format)k))) {
+			*f = (enum api_format)k;
+			return true;
+		}
+	return false;
 }
 
 enum api_result api_problem_from_render(struct api_problem *p, const struct api_scene *s, const struct rnd_error *e,

@@ -317,6 +317,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->format = API_FORMAT_PNG;
 	s->bit_depth = 8;
 	s->png_level = -1;
+	s->quality = -1;
 
 	int rc = parse_root(&c, root, s);
 	json_decref(c.mat_index);
@@ -354,10 +355,26 @@ enum api_result api_scene_check_output(const struct api_scene *s, struct api_pro
 {
 	struct api_problem scratch;
 	if (!p) p = &scratch;
-	if (s && s->format == API_FORMAT_PNG && s->scene.output.aovs)
+	if (!s) return API_OK;
+	bool webp = s->format == API_FORMAT_WEBP;
+	if (s->format != API_FORMAT_EXR && s->scene.output.aovs)
 		return api_problem_set(p, 400, "/output/aovs", "aovs need an EXR answer (output.format \"exr\", "
-		                       "Accept: image/x-exr, or an .exr output file): the default format PNG has no room "
-		                       "for AOV channels");
+		                       "Accept: image/x-exr, or an .exr output file): %s has no room for AOV channels",
+		                       webp ? "a WebP" : "the default format PNG");
+	if (!webp && s->quality >= 0)
+		return api_problem_set(p, 400, "/output/quality", "quality (lossy WebP, 0..100) needs a WebP answer "
+		                       "(output.format \"webp\", Accept: image/webp, or a .webp output file), not %s",
+		                       s->format == API_FORMAT_EXR ? "an EXR" : "a PNG");
+	/* A sheet of views may pass WebP's bound (one view cannot: 8192 a side at most). */
+	uint32_t cols = 1, rows = 1;
+	if (s->scene.view_count > 1) rnd_sheet_layout(s->scene.view_count, &cols, &rows);
+	char at[16];
+	snprintf(at, sizeof at, "/%s", s->views_key_ ? s->views_key_ : "width");
+	if (webp && ((uint64_t)s->scene.width * cols > API_WEBP_MAX_SIDE ||
+	             (uint64_t)s->scene.height * rows > API_WEBP_MAX_SIDE))
+		return api_problem_set(p, 422, at, "a WebP is at most %u pixels a side; this image is %llux%llu (a sheet of %u x %u "
+		                       "views)", API_WEBP_MAX_SIDE, (unsigned long long)s->scene.width * cols,
+		                       (unsigned long long)s->scene.height * rows, cols, rows);
 	return API_OK;
 }
 
@@ -366,9 +383,9 @@ enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, str
 	struct api_problem scratch;
 	if (!p) p = &scratch;
 	if (!s) return api_problem_set(p, 500, "", "api_scene_set_format: no scene");
-	if (f == API_FORMAT_PNG && s->scene.output.aovs)
-		return api_problem_set(p, 400, "/output/aovs", "aovs need format \"exr\": a PNG has no room for AOV "
-		                       "channels");
+	if (f != API_FORMAT_EXR && s->scene.output.aovs)
+		return api_problem_set(p, 400, "/output/aovs", "aovs need format \"exr\": a %s has no room for AOV "
+		                       "channels", f == API_FORMAT_WEBP ? "WebP" : "PNG");
 	s->format = f;
 	s->format_explicit = 1;
 	api_set_pixels(s);

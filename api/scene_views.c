@@ -1,7 +1,7 @@
 /*
  * api/scene_views.c — several views (`views`: cameras over the root camera's members;
- * `turntable`: cameras around the objects), `output` (format, depth, tonemap, AOVs, debug
- * views), and the size of the image or of the sheet of views against the limits.
+ * `turntable`: cameras around the objects), `output` (format, depth, WebP quality, tonemap,
+ * AOVs, debug views), and the size of the image or of the sheet of views against the limits.
  * See scene_internal.h for the conventions.
  */
 #include <math.h>
@@ -11,11 +11,14 @@
 #include "scene_internal.h"
 
 static const char *const OUTPUT_MEMBERS[] = {"format", "bit_depth", "transparent", "tonemap", "msaa", "aovs",
-                                             "debug", "debug_light", "png_level", NULL};
-/* Output members that only a PNG answer uses, and why an EXR has no use for them. */
+                                             "debug", "debug_light", "png_level", "quality", NULL};
+/* Output members that only a PNG answer uses, and why an EXR (or a WebP: NULL where it does
+ * use the member) has no use for them. */
 static const char *const PNG_ONLY[] = {"bit_depth", "tonemap", "png_level", NULL};
 static const char *const PNG_ONLY_WHY[] = {"a half-float image; bit_depth 16 is for PNG",
                                            "linear scene-referred; tonemap is for PNG", "zlib level of a PNG"};
+static const char *const PNG_ONLY_WEBP_WHY[] = {"8 bits per channel; bit_depth 16 is for PNG", NULL,
+                                                "zlib level of a PNG"};
 static const char *const TURNTABLE_MEMBERS[] = {"frames", "elevation", "distance", NULL};
 
 static int parse_views(struct pctx *c, json_t *views, struct rnd_scene *sc)
@@ -139,7 +142,8 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 	struct rnd_output *o = &s->scene.output;
 	if (api_require_object(c, j, "output") < 0 || api_check_members(c, j, OUTPUT_MEMBERS, NULL, "output") < 0)
 		return -1;
-	static const char *const formats[] = {"png", "exr", NULL};
+	static const char *const formats[] = {"png", "exr", "webp", NULL};
+	static const enum api_format format_values[] = {API_FORMAT_PNG, API_FORMAT_EXR, API_FORMAT_WEBP};
 	static const char *const tonemaps[] = {"neutral", "aces", "none", NULL};
 	static const enum rnd_tonemap tonemap_values[] = {RND_TONEMAP_NEUTRAL, RND_TONEMAP_ACES, RND_TONEMAP_NONE};
 	static const char *const debugs[] = {"none", "shadow", "cascades", "normals", "depth", "atlas", NULL};
@@ -148,9 +152,15 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 	int e, rc;
 	if ((rc = api_get_enum(c, j, "format", formats, &e)) < 0) return -1;
 	if (rc) {
-		s->format = e ? API_FORMAT_EXR : API_FORMAT_PNG;
+		s->format = format_values[e];
 		s->format_explicit = 1;
 	}
+	/* quality makes the WebP lossy; without it the WebP is lossless. */
+	static const struct range percent = {0, 100, false, false};
+	if ((rc = api_get_float(c, j, "quality", &percent, &s->quality)) < 0) return -1;
+	if (rc && s->format_explicit && s->format != API_FORMAT_WEBP)
+		return api_fail_at(c, "quality", "quality (lossy WebP, 0..100) needs format \"webp\", not \"%s\"",
+		                   formats[s->format]);
 	if ((rc = api_get_u32(c, j, "bit_depth", 8, 16, &s->bit_depth)) < 0) return -1;
 	if (rc && s->bit_depth != 8 && s->bit_depth != 16)
 		return api_fail_at(c, "bit_depth", "bit_depth must be 8 or 16 (got %u)", s->bit_depth);
@@ -190,35 +200,45 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 		/* The default format is PNG, which has no room for AOVs. Without an explicit format the
 		 * request may still choose EXR (Accept, the CLI's -o name): api_scene_check_output()
 		 * decides once that choice is made. */
-		if (!rc && o->aovs && s->format_explicit && s->format == API_FORMAT_PNG)
-			rc = api_fail(c, "aovs need format \"exr\": a PNG has no room for AOV channels");
+		if (!rc && o->aovs && s->format_explicit && s->format != API_FORMAT_EXR)
+			rc = api_fail(c, "aovs need format \"exr\": a %s has no room for AOV channels",
+			              s->format == API_FORMAT_WEBP ? "WebP" : "PNG");
 		api_ptr_pop(c, old);
 		if (rc) return -1;
 	}
 	return 0;
 }
 
-/* Says, in s->warnings, which PNG-only output members an EXR answer leaves unused, and takes
- * the sentence back when the answer becomes a PNG again (the format is chosen last: by
+/* Adds the sentence "/output/MEMBER: not used, the answer is FORMAT (WHY)" to s->warnings
+ * (on), or cuts it out with the separator next to it (off). */
+static void sync_warning(struct api_scene *s, const char *member, const char *format, const char *why, bool on)
+{
+	char line[160];
+	snprintf(line, sizeof line, "/output/%s: not used, the answer is %s (%s)", member, format, why);
+	char *at = strstr(s->warnings, line);
+	size_t n = strlen(s->warnings), len = strlen(line);
+	if (on && !at && n + 2 + len < sizeof s->warnings) {
+		snprintf(s->warnings + n, sizeof s->warnings - n, "%s%s", n ? "; " : "", line);
+	} else if (!on && at) {
+		/* "; " before the sentence, or after it when it is the first. */
+		char *from = at, *to = at + len;
+		if (from > s->warnings) from -= 2;
+		else if (!strncmp(to, "; ", 2)) to += 2;
+		memmove(from, to, strlen(to) + 1);
+	}
+}
+
+/* Says, in s->warnings, which PNG-only output members an EXR or WebP answer leaves unused, and
+ * takes the sentence back when the answer becomes another format (the format is chosen last: by
  * output.format, or by Accept / the CLI's -o name through api_scene_set_format). A warning,
- * not an error: the same document may be answered in either format. */
+ * not an error: the same document may be answered in any format. */
 static void sync_png_only(struct api_scene *s)
 {
 	for (int k = 0; PNG_ONLY[k]; k++) {
 		if (!(s->png_only_ & (1u << k))) continue;
-		char line[160];
-		snprintf(line, sizeof line, "/output/%s: not used, the answer is EXR (%s)", PNG_ONLY[k], PNG_ONLY_WHY[k]);
-		char *at = strstr(s->warnings, line);
-		size_t n = strlen(s->warnings), len = strlen(line);
-		if (s->format == API_FORMAT_EXR && !at && n + 2 + len < sizeof s->warnings) {
-			snprintf(s->warnings + n, sizeof s->warnings - n, "%s%s", n ? "; " : "", line);
-		} else if (s->format != API_FORMAT_EXR && at) {
-			/* Cut the sentence with the separator next to it ("; " before, or after when first). */
-			char *from = at, *to = at + len;
-			if (from > s->warnings) from -= 2;
-			else if (!strncmp(to, "; ", 2)) to += 2;
-			memmove(from, to, strlen(to) + 1);
-		}
+		sync_warning(s, PNG_ONLY[k], "EXR", PNG_ONLY_WHY[k], s->format == API_FORMAT_EXR);
+		if (PNG_ONLY_WEBP_WHY[k])
+			sync_warning(s, PNG_ONLY[k], "WebP", PNG_ONLY_WEBP_WHY[k], s->format == API_FORMAT_WEBP);
 	}
 }
 
@@ -226,6 +246,7 @@ void api_set_pixels(struct api_scene *s)
 {
 	sync_png_only(s);
 	if (s->format == API_FORMAT_EXR) s->scene.output.pixels = RND_PIXELS_RGBA32F;
+	else if (s->format == API_FORMAT_WEBP) s->scene.output.pixels = RND_PIXELS_RGBA8;
 	else s->scene.output.pixels = s->bit_depth == 16 ? RND_PIXELS_RGBA16 : RND_PIXELS_RGBA8;
 }
 

@@ -1,10 +1,11 @@
 /*
  * server/cli.c — umbra-render: renders scenes with the renderer library, no server.
  *
- *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr] [--timings] [--device NAME]
+ *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp] [--timings] [--device NAME]
  *   umbra-render SCENE.json... -o DIR/ [batch options]            many scenes, one process
  *   umbra-render --manifest LIST.jsonl -o DIR/ [batch options]    {"scene": ..., "output": ...} per line
- *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [batch options]
+ *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]
+ *                [batch options]
  *   batch options: -j N (threads and render slots, default one per core), --report FILE (JSON lines,
  *                  default DIR/report.jsonl), --progress | --no-progress (default: bar on a tty)
  *
@@ -32,12 +33,13 @@
 
 static int usage(FILE *f, int code)
 {
-	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr] [--timings] [--device NAME]\n"
+	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp] [--timings] [--device NAME]\n"
 	           "       umbra-render SCENE.json... -o DIR/ [batch options]\n"
 	           "       umbra-render --manifest LIST.jsonl -o DIR/ [batch options]\n"
-	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [batch options]\n"
+	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]\n"
+	           "                    [batch options]\n"
 	           "  Renders scenes (contract: scene-v1). Exit 0 ok, 2 invalid input, 1 other failure, 130 interrupted.\n"
-	           "  -o FILE      output file; .png or .exr picks the format (default: stdout, output.format)\n"
+	           "  -o FILE      output file; .png, .exr or .webp picks the format (default: stdout, output.format)\n"
 	           "  -o DIR/      batch: one image per input in DIR (name of the input, extension of the format)\n"
 	           "  --timings    print per-stage milliseconds to stderr (one scene)\n"
 	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n"
@@ -48,6 +50,8 @@ static int usage(FILE *f, int code)
 	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
 	           "  --up AXIS    thumbnails: the models' up axis, z y x -z -y -x (default y; z for most STL and\n"
 	           "               CAD/3D-printing OBJ files): the model object's \"up\"\n"
+	           "  --format F   thumbnails: png (default), webp (lossless) or exr: output.format\n"
+	           "  --quality Q  thumbnails with --format webp: lossy WebP at quality 0..100: output.quality\n"
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
 	           "  -j N         batch: threads and render slots (default: one per core)\n"
 	           "  --report F   batch: JSON-lines report (file, output, status, ms, error, stages); default DIR/report.jsonl\n"
@@ -81,11 +85,9 @@ static int load_scene(const char *in, const char *out, const char *asset_root, s
 	if (r == API_OK && out) {
 		const char *dot = strrchr(out, '.');
 		enum api_format f = (*scene)->format;
-		if (dot && !strcasecmp(dot, ".png")) f = API_FORMAT_PNG;
-		else if (dot && !strcasecmp(dot, ".exr")) f = API_FORMAT_EXR;
-		else if (dot && !strchr(dot, '/'))
-			r = api_problem_set(&prob, 400, "", "cannot write '%s': umbra-render writes PNG (.png) or EXR (.exr)",
-			                    out);
+		if (!api_format_from_name(out, &f) && dot && !strchr(dot, '/'))
+			r = api_problem_set(&prob, 400, "", "cannot write '%s': umbra-render writes PNG (.png), EXR (.exr) or "
+			                    "WebP (.webp)", out);
 		if (r == API_OK) r = api_scene_set_format(*scene, f, &prob);
 	}
 	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
@@ -187,6 +189,7 @@ struct args {
 	size_t ninputs;
 	bool thumb;
 	int timings;
+	enum api_format format;   /* thumb --format (PNG by default) */
 	struct farm_opts farm;
 };
 
@@ -207,18 +210,37 @@ static const char *up_arg(const char *s)
 	return NULL;
 }
 
+/* --format's value: png, webp or exr (any case) as output.format names it; NULL when it is none. */
+static const char *format_arg(const char *s, enum api_format *f)
+{
+	for (int k = API_FORMAT_PNG; k <= API_FORMAT_WEBP; k++)
+		if (!strcasecmp(s, api_format_name((enum api_format)k))) return api_format_name(*f = (enum api_format)k);
+	return NULL;
+}
+
+/* --quality's value: a number 0..100 (output.quality). */
+static bool quality_arg(const char *s, float *q)
+{
+	char *end;
+	double v = strtod(s, &end);
+	if (!*s || *end || !(v >= 0 && v <= 100)) return false;
+	*q = (float)v;
+	return true;
+}
+
 /* getopt_long, as umbrad's flags.c: options and inputs in any order ("-" is an input: stdin). */
 static int parse_args(int argc, char **argv, struct args *a)
 {
 	enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
-	       O_REPORT, O_SIZE, O_UP };
+	       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY };
 	static const struct option lopts[] = {
 		{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
 		{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
 		{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
 		{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
 		{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
-		{"up", required_argument, NULL, O_UP}, {0},
+		{"up", required_argument, NULL, O_UP}, {"format", required_argument, NULL, O_FORMAT},
+		{"quality", required_argument, NULL, O_QUALITY}, {0},
 	};
 	a->farm.progress = -1;
 	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
@@ -240,6 +262,14 @@ static int parse_args(int argc, char **argv, struct args *a)
 			if ((a->farm.up = up_arg(optarg))) break;
 			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x)\n", optarg);
 			return usage(stderr, 1);
+		case O_FORMAT:
+			if ((a->farm.format = format_arg(optarg, &a->format))) break;
+			fprintf(stderr, "umbra-render: bad option --format %s (png, webp or exr)\n", optarg);
+			return usage(stderr, 1);
+		case O_QUALITY:
+			if ((a->farm.lossy = quality_arg(optarg, &a->farm.quality))) break;
+			fprintf(stderr, "umbra-render: bad option --quality %s (0..100)\n", optarg);
+			return usage(stderr, 1);
 		case 'j': case O_SIZE:
 			if ((c == 'j' ? (a->farm.threads = uint_arg(optarg, 64)) : (a->farm.size = uint_arg(optarg, 8192))))
 				break;
@@ -252,6 +282,14 @@ static int parse_args(int argc, char **argv, struct args *a)
 	if (!a->ninputs && !a->manifest) return usage(stderr, 1);
 	if (a->farm.up && !a->thumb) {   /* a scene says its models' "up" itself */
 		fprintf(stderr, "umbra-render: --up is for thumb (in a scene, give the model object \"up\")\n");
+		return usage(stderr, 1);
+	}
+	if (a->farm.format && !a->thumb) {   /* a scene's format: its output.format or the -o name */
+		fprintf(stderr, "umbra-render: --format is for thumb (a scene says output.format, or -o names it)\n");
+		return usage(stderr, 1);
+	}
+	if (a->farm.lossy && a->format != API_FORMAT_WEBP) {
+		fprintf(stderr, "umbra-render: --quality is for thumb --format webp (lossy WebP)\n");
 		return usage(stderr, 1);
 	}
 	return 0;

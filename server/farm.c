@@ -106,11 +106,17 @@ static int thumb_doc(const struct farm_job *j, const struct farm_opts *o, char *
 		snprintf(err, esize, "not a model file name (.glb, .gltf, .obj, .stl or .ply): %s", j->input);
 		return -1;
 	}
-	char dims[64] = "", up[32] = "";
+	char dims[64] = "", up[32] = "", out[96] = "";
 	if (o->size) snprintf(dims, sizeof dims, "\"width\":%u,\"height\":%u,", o->size, o->size);
 	if (o->up) snprintf(up, sizeof up, ",\"up\":\"%.4s\"", o->up);
+	if (o->transparent || o->format) {
+		int n = snprintf(out, sizeof out, "\"output\":{\"transparent\":%s", o->transparent ? "true" : "false");
+		if (o->format) n += snprintf(out + n, sizeof out - (size_t)n, ",\"format\":\"%.4s\"", o->format);
+		if (o->lossy) n += snprintf(out + n, sizeof out - (size_t)n, ",\"quality\":%g", o->quality);
+		snprintf(out + n, sizeof out - (size_t)n, "},");
+	}
 	snprintf(doc, size, "{\"preset\":\"thumbnail\",%s%s\"objects\":[{\"shape\":\"model\",\"part\":\"model\","
-	         "\"format\":\"%s\"%s}]}", dims, o->transparent ? "\"output\":{\"transparent\":true}," : "", fmt, up);
+	         "\"format\":\"%s\"%s}]}", dims, out, fmt, up);
 	return 0;
 }
 
@@ -211,20 +217,17 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 	free(bytes);
 	if (ar != API_OK) goto invalid;
 	/* An explicit output name picks the format by extension; else the scene's format names it. */
-	const char *dot = j->out ? strrchr(j->out, '.') : NULL;
 	enum api_format fmt = (*s)->format;
 	if (j->out) {
-		if (dot && !strcasecmp(dot, ".png")) fmt = API_FORMAT_PNG;
-		else if (dot && !strcasecmp(dot, ".exr")) fmt = API_FORMAT_EXR;
-		else {
-			snprintf(r->error, sizeof r->error, "output '%s' must end in .png or .exr", j->out);
+		if (!api_format_from_name(j->out, &fmt)) {
+			snprintf(r->error, sizeof r->error, "output '%s' must end in .png, .exr or .webp", j->out);
 			api_scene_free(*s);
 			*s = NULL;
 			return JOB_INVALID;
 		}
 		snprintf(r->out, sizeof r->out, "%s", j->out);
 	} else {
-		snprintf(r->out, sizeof r->out, "%s.%s", r->stem, fmt == API_FORMAT_EXR ? "exr" : "png");
+		snprintf(r->out, sizeof r->out, "%s.%s", r->stem, api_format_name(fmt));
 	}
 	if (api_scene_set_format(*s, fmt, &prob) != API_OK || api_scene_check_output(*s, &prob) != API_OK)
 		goto invalid;

@@ -16,7 +16,8 @@
  * SIGINT / SIGTERM: no new job starts; the renders in flight finish and are written; the rest
  * are reported "skipped". The report (JSON lines, input order) has file, output, status (ok,
  * invalid: a bad scene or model, or an input that is a directory or an empty model file;
- * failed, skipped), ms, error. opts.up gives every model object that `up` (Z-up STL files).
+ * failed, skipped), ms, error. opts.up gives every model object that `up` (Z-up STL files);
+ * opts.format and opts.quality every thumbnail that output.format and output.quality.
  *
  * Ownership: jobs and their strings belong to the caller. farm_run() is not reentrant (signal
  * handlers); call it once per process.
@@ -44,6 +45,9 @@ struct farm_opts {
 	unsigned size;            /* thumbnails: width = height (0: the preset's 512) */
 	bool transparent;         /* thumbnails: transparent background */
 	const char *up;           /* thumbnails: every model's `up` ("+z", ...), NULL: the file's own (+y) */
+	const char *format;       /* thumbnails: output.format ("png", "webp", "exr"), NULL: the preset's (png) */
+	bool lossy;               /* thumbnails: output.quality = quality (lossy WebP); false: none (lossless) */
+	float quality;            /* 0..100, with lossy */
 	int progress;             /* -1 auto (bar on a tty), 0 plain lines, 1 bar */
 };
 

@@ -39,8 +39,8 @@ enum srv_accept srv_accept_choice(const char *accept)
 {
 	if (!accept || !*accept)
 		return SRV_ACCEPT_PNG;
-	double q_png = -1, q_exr = -1, q_wild = -1;
-	bool spec_png = false, spec_exr = false;
+	double q_png = -1, q_exr = -1, q_webp = -1, q_wild = -1;
+	bool spec_png = false, spec_exr = false, spec_webp = false;
 	const char *p = accept;
 	while (*p) {
 		while (*p == ' ' || *p == ',')
@@ -70,6 +70,9 @@ enum srv_accept srv_accept_choice(const char *accept)
 		} else if (!strcasecmp(buf, "image/x-exr")) {
 			q_exr = q;
 			spec_exr = true;
+		} else if (!strcasecmp(buf, "image/webp")) {
+			q_webp = q;
+			spec_webp = true;
 		} else if (!strcasecmp(buf, "image/*") || !strcasecmp(buf, "*/*")) {
 			if (q > q_wild)
 				q_wild = q;
@@ -79,9 +82,13 @@ enum srv_accept srv_accept_choice(const char *accept)
 		q_png = q_wild;
 	if (!spec_exr)
 		q_exr = q_wild;
-	if (q_png <= 0 && q_exr <= 0)
+	if (!spec_webp)
+		q_webp = q_wild;
+	if (q_png <= 0 && q_exr <= 0 && q_webp <= 0)
 		return SRV_ACCEPT_NONE;
-	return q_exr > 0 && q_exr > q_png ? SRV_ACCEPT_EXR : SRV_ACCEPT_PNG;
+	if (q_png >= q_webp && q_png >= q_exr)
+		return SRV_ACCEPT_PNG;
+	return q_webp >= q_exr ? SRV_ACCEPT_WEBP : SRV_ACCEPT_EXR;
 }
 
 /* ---- ETag ---- */
@@ -96,9 +103,9 @@ uint64_t srv_etag_body(uint64_t h, const void *data, size_t len)
 	return rnd_fnv1a(h, data, len);
 }
 
-uint64_t srv_etag_finish(uint64_t h, bool exr, const char *device_name, const char *driver_info)
+uint64_t srv_etag_finish(uint64_t h, enum srv_accept format, const char *device_name, const char *driver_info)
 {
-	h = rnd_fnv1a(h, exr ? "\0exr" : "\0png", 4);
+	h = rnd_fnv1a(h, format == SRV_ACCEPT_EXR ? "\0exr" : format == SRV_ACCEPT_WEBP ? "\0wbp" : "\0png", 4);
 	h = rnd_fnv1a(h, UMBRA_VERSION, strlen(UMBRA_VERSION));
 	h = rnd_fnv1a(h, device_name, strlen(device_name));
 	return rnd_fnv1a(h, driver_info, strlen(driver_info));

@@ -125,9 +125,9 @@ enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection 
 	const char *accept = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
 	enum srv_accept choice = srv_accept_choice(accept);
 	if (choice == SRV_ACCEPT_NONE)
-		return srv_respond_problem(req, 406, NULL, "", "this server answers image/png or image/x-exr (or a problem+json "
-		                       "document); Accept: %.200s names neither", accept);
-	req->want_exr = choice == SRV_ACCEPT_EXR;
+		return srv_respond_problem(req, 406, NULL, "", "this server answers image/png, image/webp or image/x-exr (or a "
+		                       "problem+json document); Accept: %.200s names none of them", accept);
+	req->want = choice;
 	req->body_hash = srv_etag_start();
 	req->state = SRV_REQ_BODY;
 	return MHD_YES;
@@ -223,7 +223,7 @@ enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connect
 
 	/* ETag: the body, the format negotiation, the build and the device. */
 	pthread_rwlock_rdlock(&s->ctx_lock);
-	req->etag_hash = srv_etag_finish(req->body_hash, req->want_exr, s->info.device_name, s->info.driver_info);
+	req->etag_hash = srv_etag_finish(req->body_hash, req->want, s->info.device_name, s->info.driver_info);
 	pthread_rwlock_unlock(&s->ctx_lock);
 	srv_etag_format(req->etag, sizeof req->etag, req->etag_hash);
 	/* A scene that reads models from --asset-root may change without its body changing: its

@@ -182,7 +182,7 @@ struct srv_request {
 	uint64_t etag_hash;            /* the ETag's value (srv_etag_finish(), then srv_etag_assets()) */
 	char etag[40];
 	char if_none_match[256];       /* checked after parsing for scenes that read asset files */
-	bool want_exr;                 /* Accept prefers image/x-exr */
+	int want;                      /* Accept's choice (enum srv_accept: PNG, EXR or WebP) */
 	bool close_after;              /* answer with Connection: close (framing error) */
 	char cors_origin[SRV_ORIGIN_MAX]; /* an allowed cross-origin caller's Origin, echoed; "" = none */
 	bool cors_private_network;     /* its preflight asked Access-Control-Request-Private-Network */

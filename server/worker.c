@@ -207,7 +207,8 @@ static int job_parse(struct srv_server *s, struct srv_request *req, struct parse
 			return 1;
 		}
 	}
-	if ((req->want_exr && !sc->format_explicit && api_scene_set_format(sc, API_FORMAT_EXR, &p) != API_OK) ||
+	enum api_format accepted = req->want == SRV_ACCEPT_EXR ? API_FORMAT_EXR : API_FORMAT_WEBP;
+	if ((req->want != SRV_ACCEPT_PNG && !sc->format_explicit && api_scene_set_format(sc, accepted, &p) != API_OK) ||
 	    api_scene_check_output(sc, &p) != API_OK) {
 		job_problem(req, &p);
 		return 1;

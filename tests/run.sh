@@ -59,6 +59,8 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
 [ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
+# api/scene.schema.json against the daemon (ajv from tests/browser's tooling; skipped without node).
+[ -x "$BUILD/umbrad" ] && run_suite schema sh tests/schema/run.sh
 # The playground in a real browser, when Debian's chromium is installed (install-deps does).
 [ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh
 # libFuzzer targets, a few seconds each (make test builds them into FUZZ_BUILD).

@@ -208,6 +208,18 @@ rc=$?
 check "thumb --transparent: exit 0" [ $rc = 0 ]
 a=$($PNG px "$T/tr/cube.png" 0 0 2>/dev/null | cut -d' ' -f4)
 check "thumb --transparent: corner alpha 0" [ "$a" = 0 ]
+cli thumb "$T/models/cube.obj" -o "$T/trw" --size 64 --transparent --format webp --no-progress 2>/dev/null
+check "thumb --format webp: DIR/NAME.webp, lossless with alpha, the PNG thumbnail's pixels" sh -c \
+	"[ \"\$(python3 tests/util/webp.py info '$T/trw/cube.webp' 2>&1)\" = '64 64 lossless alpha' ] &&
+	 [ \"\$(python3 tests/util/webp.py compare '$T/trw/cube.webp' '$T/tr/cube.png' 2>&1)\" = 'inf 0' ]"
+cli thumb "$T/models/cube.obj" -o "$T/trq" --size 64 --format WebP --quality 80 --no-progress 2>/dev/null
+check "thumb --format webp --quality 80: lossy" [ "$(python3 tests/util/webp.py info "$T/trq/cube.webp" 2>&1)" = "64 64 lossy opaque" ]
+cli thumb "$T/models/cube.obj" -o "$T/trq2" --quality 80 2>"$T/trq2.err"
+rc=$?
+check "thumb --quality without --format webp: refused (exit 1)" eval '[ $rc = 1 ] && grep -q "format webp" "$T/trq2.err"'
+cli thumb "$T/models/cube.obj" -o "$T/trq3" --format jpeg 2>"$T/trq3.err"
+rc=$?
+check "thumb --format jpeg: refused (exit 1), naming the formats" eval '[ $rc = 1 ] && grep -q "png, webp or exr" "$T/trq3.err"'
 
 # ---- thumb --up: a Z-up model (a post 0.3 x 0.3 x 2 along Z, as CAD and 3D-printing STLs lie)
 # stands up: its opaque pixels are taller than wide; without --up it lies on its side.
@@ -280,6 +292,18 @@ cli "$T/ground-t.json" -o "$T/ground-t.png" 2>/dev/null
 sa=$($PNG px "$T/ground-t.png" 64 48 2>/dev/null | cut -d' ' -f4)
 ba=$($PNG px "$T/ground-t.png" 16 48 2>/dev/null | cut -d' ' -f4)
 check "ground, transparent: shadow has alpha ($sa), background none ($ba)" sh -c "[ '${sa:-0}' -gt 60 ] && [ '$ba' = 0 ]"
+# -o NAME.webp: a lossless WebP (decoded by the system's libwebp: tests/util/webp.py) with the
+# PNG's pixels, alpha included (other extensions: -o x.jpg below).
+WEBP="python3 tests/util/webp.py"
+cli "$T/ground-t.json" -o "$T/ground-t.webp" 2>/dev/null
+check "-o .webp: a lossless WebP with alpha" [ "$($WEBP info "$T/ground-t.webp" 2>&1)" = "96 96 lossless alpha" ]
+check "-o .webp: the transparent PNG's pixels exactly" [ "$($WEBP compare "$T/ground-t.webp" "$T/ground-t.png" 2>&1)" = "inf 0" ]
+sed 's/"msaa": 1/"msaa": 1, "quality": 80/' "$T/ground.json" >"$T/ground-q.json"
+cli "$T/ground-q.json" -o "$T/ground-q.png" 2>"$T/q.err"
+rc=$?
+check "quality with -o .png: exit 2 at /output/quality" eval '[ $rc = 2 ] && grep -q "/output/quality" "$T/q.err"'
+cli "$T/ground-q.json" -o "$T/ground-q.webp" 2>/dev/null
+check "quality with -o .webp: a lossy WebP" [ "$($WEBP info "$T/ground-q.webp" 2>&1)" = "96 96 lossy opaque" ]
 # A model by `path`: only under --asset-root, never outside it.
 mkdir -p "$T/assets"
 printf 'v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
@@ -295,7 +319,7 @@ check "--asset-root: a path leaving it is exit 2" [ $? = 2 ]
 cli "$T/ground.json" -o "$T/ground.jpg" 2>"$T/jpg.err"
 rc=$?
 check "-o x.jpg: exit 2, nothing written, the reason on stderr" \
-	eval '[ $rc = 2 ] && [ ! -e "$T/ground.jpg" ] && grep -q "writes PNG (.png) or EXR (.exr)" "$T/jpg.err"'
+	eval '[ $rc = 2 ] && [ ! -e "$T/ground.jpg" ] && grep -q "writes PNG (.png), EXR (.exr) or WebP (.webp)" "$T/jpg.err"'
 
 # ---- several scenes and a manifest in one process ----
 mkdir -p "$T/scenes"

@@ -41,6 +41,10 @@ sed 's/"intensity": 3,/"intensity": 3, "colour": [1, 1, 1],/' "$T/small.json" >"
 sed 's/"width": 64/"width": "64"/' "$T/small.json" >"$T/wrongtype.json"
 sed 's/"width": 64/"width": 0/' "$T/small.json" >"$T/range.json"
 sed 's/"msaa": 1/"msaa": 1, "format": "exr"/' "$T/small.json" >"$T/exr.json"
+for o in 'webp:"format": "webp"' 'webp-q80:"format": "webp", "quality": 80' 'webp-q101:"format": "webp", "quality": 101' \
+	'q80:"quality": 80' 'webp-alpha:"format": "webp", "transparent": true' 'png-alpha:"transparent": true'; do
+	sed "s/\"msaa\": 1/\"msaa\": 1, ${o#*:}/" "$T/small.json" >"$T/${o%%:*}.json"
+done
 mkdir -p "$T/assets"
 printf 'v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
 sed 's/"objects": \[/"objects": [{"shape": "model", "path": "tri.obj"},/' "$T/small.json" >"$T/model-path.json"
@@ -81,7 +85,7 @@ check "/v1/info has version, device, driver, limits, filters, formats" python3 -
 import json, sys
 d = json.load(open(sys.argv[1]))
 ok = all(k in d for k in ("version", "device", "driver", "limits", "filters", "formats"))
-ok = ok and set(["hard", "pcf", "pcss", "vsm", "evsm"]) <= set(d["filters"]) and "png" in d["formats"] and "exr" in d["formats"]
+ok = ok and set(["hard", "pcf", "pcss", "vsm", "evsm"]) <= set(d["filters"]) and {"png", "exr", "webp"} <= set(d["formats"])
 ok = ok and d["limits"].get("max_pixels") == 1000000
 print("# info:", json.dumps(d)[:300])
 sys.exit(0 if ok else 1)
@@ -156,6 +160,29 @@ c=$(post rexr2 "$T/exr.json"); check "output.format exr: image/x-exr" sh -c "[ $
 c=$(post rpng "$T/small.json" -H 'Accept: image/png, image/x-exr;q=0.5'); check "Accept preferring PNG: image/png" [ "$(hdr rpng Content-Type)" = image/png ]
 c=$(post rjpg "$T/small.json" -H 'Accept: image/jpeg'); check "Accept: image/jpeg (neither format): 406 problem+json" eval '[ "$c" = 406 ] && problem rjpg 406 ""'
 c=$(post rjpg2 "$T/small.json" -H 'Accept: image/jpeg, */*;q=0.1'); check "Accept: image/jpeg, */*;q=0.1: 200 PNG" eval '[ "$c" = 200 ] && [ "$(hdr rjpg2 Content-Type)" = image/png ]'
+# -- WebP: output.format, Accept, quality; decoded by the system's libwebp (tests/util/webp.py)
+webp() { python3 tests/util/webp.py "$@"; }
+c=$(post rwebp "$T/webp.json"); check "output.format webp: 200 image/webp" sh -c "[ $c = 200 ] && [ '$(hdr rwebp Content-Type)' = image/webp ]"
+check "WebP: RIFF/WEBP magic, lossless, 64x64, opaque" [ "$(webp info "$T/rwebp.body")" = "64 64 lossless opaque" ]
+check "lossless WebP decodes to the PNG's pixels exactly" [ "$(webp compare "$T/rwebp.body" "$T/r1.body")" = "inf 0" ]
+c=$(post rwebp2 "$T/small.json" -H 'Accept: image/webp'); check "Accept: image/webp gives image/webp" sh -c "[ $c = 200 ] && [ '$(hdr rwebp2 Content-Type)' = image/webp ]"
+check "Accept: image/webp: the same bytes as output.format webp" cmp -s "$T/rwebp.body" "$T/rwebp2.body"
+check "Accept: image/webp: its own ETag" sh -c "[ '$(hdr rwebp2 ETag)' != '$etag' ] && [ '$(hdr rwebp2 ETag)' != '$(hdr rexr ETag)' ]"
+c=$(post rwebp3 "$T/small.json" -H 'Accept: image/webp;q=0.5, image/png'); check "Accept preferring PNG over WebP: image/png" [ "$(hdr rwebp3 Content-Type)" = image/png ]
+c=$(post rwebp4 "$T/small.json" -H 'Accept: image/avif, image/webp, */*;q=0.8'); check "a browser's image Accept: image/webp" [ "$(hdr rwebp4 Content-Type)" = image/webp ]
+c=$(post rwebp5 "$T/exr.json" -H 'Accept: image/webp'); check "output.format exr wins over Accept: image/webp" [ "$(hdr rwebp5 Content-Type)" = image/x-exr ]
+c=$(post rq80 "$T/webp-q80.json"); cmp80=$(webp compare "$T/rq80.body" "$T/r1.body")
+check "quality 80: lossy WebP, PSNR ${cmp80% *} dB against the PNG (> 30), alpha exact" \
+	sh -c "[ $c = 200 ] && [ '$(webp info "$T/rq80.body")' = '64 64 lossy opaque' ] && [ '${cmp80#* }' = 0 ] && \
+	python3 -c 'import sys; sys.exit(not float(\"${cmp80% *}\") > 30)'"
+check "quality 80: smaller than lossless" [ "$(wc -c <"$T/rq80.body")" -lt "$(wc -c <"$T/rwebp.body")" ]
+c=$(post rq101 "$T/webp-q101.json"); check "quality 101: 400 at /output/quality" eval '[ "$c" = 400 ] && problem rq101 400 /output/quality'
+c=$(post rq80p "$T/q80.json"); check "quality without format, answer PNG: 400 at /output/quality" eval '[ "$c" = 400 ] && problem rq80p 400 /output/quality'
+c=$(post rq80w "$T/q80.json" -H 'Accept: image/webp'); check "quality without format, Accept: image/webp: lossy WebP" \
+	sh -c "[ $c = 200 ] && [ '$(webp info "$T/rq80w.body")' = '64 64 lossy opaque' ]"
+c=$(post ralpha "$T/webp-alpha.json"); c2=$(post palpha "$T/png-alpha.json")
+check "transparent WebP keeps alpha, pixels equal to the transparent PNG's" \
+	sh -c "[ $c = 200 ] && [ $c2 = 200 ] && [ '$(webp info "$T/ralpha.body")' = '64 64 lossless alpha' ] && [ '$(webp compare "$T/ralpha.body" "$T/palpha.body")' = 'inf 0' ]"
 c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
 c=$(post mpath "$T/model-path.json"); check "model by path under --asset-root 200" [ "$c" = 200 ]
 # The answer depends on the file under --asset-root: when it changes, so must the ETag, and the

@@ -37,6 +37,13 @@ TEST(negotiate_accept)
 	CHECK(srv_accept_choice("text/html") == SRV_ACCEPT_NONE);
 	CHECK(srv_accept_choice("image/png;q=0, image/x-exr;q=0") == SRV_ACCEPT_NONE);
 	CHECK(srv_accept_choice("IMAGE/X-EXR ") == SRV_ACCEPT_EXR);
+	CHECK(srv_accept_choice("image/webp") == SRV_ACCEPT_WEBP);
+	CHECK(srv_accept_choice("image/webp, image/png") == SRV_ACCEPT_PNG, "a tie keeps the default");
+	CHECK(srv_accept_choice("image/webp, image/x-exr") == SRV_ACCEPT_WEBP, "a tie: WebP before EXR");
+	CHECK(srv_accept_choice("image/avif,image/webp,*/*;q=0.8") == SRV_ACCEPT_WEBP, "a browser's image Accept");
+	CHECK(srv_accept_choice("image/webp;q=0.5, image/x-exr;q=0.9") == SRV_ACCEPT_EXR);
+	CHECK(srv_accept_choice("image/webp, image/*;q=0") == SRV_ACCEPT_WEBP);
+	CHECK(srv_accept_choice("image/webp;q=0, image/png;q=0, image/x-exr;q=0") == SRV_ACCEPT_NONE);
 }
 
 TEST(negotiate_etag_streams_and_formats)
@@ -50,9 +57,11 @@ TEST(negotiate_etag_streams_and_formats)
 		h = srv_etag_body(h, body + cut, n - cut);
 		CHECK(h == whole, "cut at %zu", cut);
 	}
-	uint64_t png = srv_etag_finish(whole, false, "dev", "drv"), exr = srv_etag_finish(whole, true, "dev", "drv");
-	CHECK(png != exr, "the format is part of the ETag");
-	CHECK(srv_etag_finish(whole, false, "dev2", "drv") != png, "the device is part of the ETag");
+	uint64_t png = srv_etag_finish(whole, SRV_ACCEPT_PNG, "dev", "drv");
+	uint64_t exr = srv_etag_finish(whole, SRV_ACCEPT_EXR, "dev", "drv");
+	uint64_t webp = srv_etag_finish(whole, SRV_ACCEPT_WEBP, "dev", "drv");
+	CHECK(png != exr && webp != png && webp != exr, "the format is part of the ETag");
+	CHECK(srv_etag_finish(whole, SRV_ACCEPT_PNG, "dev2", "drv") != png, "the device is part of the ETag");
 	CHECK(srv_etag_assets(png, 1) != png && srv_etag_assets(png, 1) != srv_etag_assets(png, 2));
 	char etag[40];
 	srv_etag_format(etag, sizeof etag, 0x0123456789abcdefull);
