@@ -19,7 +19,8 @@
 
 static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
                                                        "occlusionTexture", "emissiveTexture"};
-static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform", NULL};
+static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform",
+                                             "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness", NULL};
 
 void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...)
 {
@@ -105,6 +106,29 @@ static void read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, co
 	if (slot == RND_TEX_OCCLUSION) gm->occlusion_strength = fminf(fmaxf(num(info, "strength", 1), 0), 1);
 }
 
+/* The specular-glossiness model has no exact metallic-roughness equal; what is kept is what
+ * shows most in a picture (the diffuse colour and how glossy), what is not is warned. */
+static void read_spec_gloss(struct api_gltf_info *gi, uint32_t mi, const char *mname, json_t *sg,
+                            struct api_gltf_material *gm)
+{
+	gm->spec_gloss = true;
+	json_t *d = json_object_get(sg, "diffuseFactor"), *sp = json_object_get(sg, "specularFactor");
+	for (int k = 0; k < 4; k++) {
+		json_t *e = json_array_get(d, (size_t)k);
+		double x = json_is_number(e) ? json_number_value(e) : 1;
+		gm->diffuse[k] = isfinite(x) ? fminf(fmaxf((float)x, 0), 1) : 1;
+	}
+	gm->glossiness = fminf(fmaxf(num(sg, "glossinessFactor", 1), 0), 1);
+	bool white = true;
+	for (int k = 0; k < 3; k++) {
+		json_t *e = json_array_get(sp, (size_t)k);
+		white = white && (!json_is_number(e) || json_number_value(e) == 1);
+	}
+	if (json_object_get(sg, "specularGlossinessTexture") || !white)
+		api_gltf_warn(gi, "material %u (\"%.40s\"): specular-glossiness drawn as metallic-roughness (diffuse as base "
+		              "colour, glossinessFactor as roughness; the specular colour and texture are not used)", mi, mname);
+}
+
 static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, json_t *mat, struct api_gltf_material *gm)
 {
 	memset(gm, 0, sizeof *gm);
@@ -127,6 +151,8 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 			float s = num(v, "emissiveStrength", 1);
 			gm->emissive_strength = s >= 0 ? s : 1;
 		}
+		if (!strcmp(key, "KHR_materials_unlit")) gm->unlit = true;
+		if (!strcmp(key, "KHR_materials_pbrSpecularGlossiness") && !pbr) read_spec_gloss(gi, mi, name, v, gm);
 	}
 }
 
@@ -177,6 +203,29 @@ void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, str
 	m->normal_scale = fminf(fmaxf(gm->normal_scale, -1e3f), 1e3f);
 	m->occlusion_strength = gm->occlusion_strength;   /* clamped to 0..1 when read */
 	*single_sided = !gm->double_sided;
+}
+
+void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m)
+{
+	if (index >= gi->material_count) return;
+	const struct api_gltf_material *gm = &gi->materials[index];
+	if (gm->spec_gloss) {
+		memcpy(m->base_color, gm->diffuse, sizeof gm->diffuse);
+		m->metallic = 0;
+		m->roughness = 1 - gm->glossiness;
+		m->metal_rough_texture = NULL;
+	}
+	if (gm->unlit) {
+		for (int k = 0; k < 3; k++) {
+			m->emissive[k] = m->base_color[k];
+			m->base_color[k] = 0;
+		}
+		m->emissive_texture = m->base_color_texture;
+		m->sampling[RND_TEX_EMISSIVE] = m->sampling[RND_TEX_BASE];
+		m->metallic = 0;
+		m->roughness = 1;
+		m->metal_rough_texture = m->normal_texture = m->occlusion_texture = NULL;
+	}
 }
 
 void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out)

@@ -29,6 +29,12 @@
 
 struct api_gltf_material {
 	float emissive_strength;           /* 1 */
+	bool unlit;                        /* KHR_materials_unlit */
+	/* KHR_materials_pbrSpecularGlossiness on a material without pbrMetallicRoughness: drawn as
+	 * a dielectric of base colour diffuseFactor (x diffuseTexture, which Assimp hands over as
+	 * the base colour's DIFFUSE texture) and roughness 1 - glossinessFactor. */
+	bool spec_gloss;
+	float diffuse[4], glossiness;
 	bool double_sided;                 /* false (glTF's default) */
 	float normal_scale, occlusion_strength;    /* 1, 1 */
 	struct rnd_texture_sampling sampling[RND_TEX_SLOTS];
@@ -54,6 +60,11 @@ int api_gltf_material_of(const char *name);
  * when index is past the document's materials. */
 void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m,
                              bool *single_sided);
+/* What material `index` changes once its textures are known: KHR_materials_unlit drawn as its
+ * base colour alone (moved to the emissive term, which no light or shadow changes: base
+ * colour black, alpha kept; normal and occlusion maps dropped); the specular-glossiness
+ * stand-in (metallic 0, base colour diffuseFactor, roughness 1 - glossiness). */
+void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m);
 /* Vertex data: n RGBA float colours -> linear RGBA8 (clamped); n tangents, bitangents and
  * normals (xyz floats) -> xyzw tangents, w = the side of the bitangent (+1 / -1). */
 void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out);

@@ -156,5 +156,7 @@ int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t 
 			m->alpha_cutoff = clampf(f, 0, 1);
 	}
 	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
-	return material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m);
+	if (material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m) != 0) return -1;
+	if (gi >= 0) api_gltf_material_shading(&c->gi, (uint32_t)gi, m);
+	return 0;
 }

@@ -201,6 +201,66 @@ TEST(materials_emissive_texture_and_strength)
 	}
 }
 
+/* ---- KHR_materials_unlit, KHR_materials_pbrSpecularGlossiness ---- */
+
+/* Unlit: the pixels are base colour factor x texture whatever the light (a light of intensity
+ * pi straight down leaves only the dielectric's F0 0.04 x 1/4 = 0.01 over the no-light
+ * picture). Before, the extension was ignored: the quad was shaded, the texel x Lambert. */
+TEST(materials_unlit_is_its_base_colour)
+{
+	static const uint8_t tex[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 128, 128, 128, 255};
+	static const double factor[3] = {0.5, 0.25, 1};
+	struct mglb g = {.material = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.25,1,1],"
+	                             "\"baseColorTexture\":{\"index\":0}},\"extensions\":{\"KHR_materials_unlit\":{}}}",
+	                 .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+	                 .extensions_used = "[\"KHR_materials_unlit\"]"};
+	add_png(&g, tex, 2, 2);
+	struct rnd_image lit, dark;
+	bool ok = render_quad(__LINE__, &lit, &g, true, false);
+	ok = ok && render_quad(__LINE__, &dark, &g, false, false);
+	free_pngs(&g);
+	if (!ok) return;
+	for (int t = 0; t < 4; t++) {
+		double x = -0.5 + (t & 1), z = -0.5 + (t >> 1);
+		for (int c = 0; c < 3; c++) {
+			double want = factor[c] * gpu_srgb_decode(tex[4 * t + c] / 255.0);
+			double got = lin_at(&dark, false, x, z, c), got_lit = lin_at(&lit, false, x, z, c);
+			CHECK(fabs(got - want) < 0.02, "no light: texel %d channel %d: %.3f, want %.3f", t, c, got, want);
+			CHECK(fabs(got_lit - want) < 0.03, "lit: texel %d channel %d: %.3f, want %.3f", t, c, got_lit, want);
+		}
+	}
+	rnd_image_release(&lit);
+	rnd_image_release(&dark);
+}
+
+/* Specular-glossiness only (no pbrMetallicRoughness): a dielectric of base colour
+ * diffuseFactor x diffuseTexture, roughness 1 - glossiness. Glossiness 0 under the light of
+ * intensity pi: Lambert radiance = the albedo, + 0.01 of F0 in every channel. Before, the
+ * extension was ignored and glTF's default metallic 1 made it near black. */
+TEST(materials_specular_glossiness_drawn_as_its_diffuse)
+{
+	static const uint8_t tex[16] = {255, 255, 255, 255, 255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255};
+	struct mglb g = {.material = "{\"extensions\":{\"KHR_materials_pbrSpecularGlossiness\":{"
+	                             "\"diffuseFactor\":[1,1,0.5,1],\"glossinessFactor\":0,"
+	                             "\"diffuseTexture\":{\"index\":0}}}}",
+	                 .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+	                 .extensions_used = "[\"KHR_materials_pbrSpecularGlossiness\"]"};
+	add_png(&g, tex, 2, 2);
+	struct rnd_image img;
+	bool ok = render_quad(__LINE__, &img, &g, true, false);
+	free_pngs(&g);
+	if (!ok) return;
+	static const double factor[3] = {1, 1, 0.5};
+	for (int t = 0; t < 4; t++) {
+		double x = -0.5 + (t & 1), z = -0.5 + (t >> 1);
+		for (int c = 0; c < 3; c++) {
+			double want = factor[c] * gpu_srgb_decode(tex[4 * t + c] / 255.0) + 0.01, got = lin_at(&img, false, x, z, c);
+			CHECK(fabs(got - want) < 0.03, "texel %d channel %d: %.3f, want %.3f", t, c, got, want);
+		}
+	}
+	rnd_image_release(&img);
+}
+
 /* ---- vertex colour ---- */
 
 /* COLOR_0 multiplies the base colour: white x red vertices = red (Lambert radiance 1 under
