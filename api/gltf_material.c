@@ -20,7 +20,8 @@
 static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
                                                        "occlusionTexture", "emissiveTexture"};
 static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform",
-                                             "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness", NULL};
+                                             "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
+                                             "EXT_mesh_gpu_instancing", NULL};
 
 void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...)
 {
@@ -259,11 +260,12 @@ void api_gltf_info_free(struct api_gltf_info *gi)
 
 #define TAG "umbra-gltf-material-"
 
-uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len)
+uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, bool changed,
+                                size_t *out_len)
 {
 	json_t *mats = json_object_get(root, "materials"), *m;
 	size_t i;
-	if (!json_array_size(mats)) return NULL;
+	if (!json_array_size(mats) && !changed) return NULL;
 	json_array_foreach(mats, i, m) {
 		char tag[48];
 		snprintf(tag, sizeof tag, TAG "%zu", i);

@@ -14,7 +14,7 @@
  *
  * Usage (api/model_import.c, inside the sandboxed importer):
  *   struct api_gltf_info gi; api_gltf_info_read(root, &gi);   // root: the parsed JSON
- *   uint8_t *t = api_gltf_tag_materials(root, data, len, glb, &tlen);  // import t (or data if NULL)
+ *   uint8_t *t = api_gltf_tag_materials(root, data, len, glb, changed, &tlen);  // import t (or data if NULL)
  *   ... i = api_gltf_material_of(assimp material name): gi.materials[i] when i >= 0 ...
  *   free(t); api_gltf_info_free(&gi);
  * Ownership: gi owns its materials array (malloc). Threading: no shared state.
@@ -51,8 +51,10 @@ struct api_gltf_info {
 void api_gltf_info_read(json_t *root, struct api_gltf_info *out);
 void api_gltf_info_free(struct api_gltf_info *gi);
 /* The file's bytes with every material's name replaced by its index tag (malloc'd, you free
- * it), or NULL (no materials, or out of memory: import the original then). root is changed. */
-uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, size_t *out_len);
+ * it), or NULL (no materials and root not `changed` otherwise, or out of memory: import the
+ * original then). root is changed. */
+uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, bool glb, bool changed,
+                                size_t *out_len);
 /* The glTF material index an Assimp material name tags, or -1. */
 int api_gltf_material_of(const char *name);
 /* What material `index` of the document adds to m as Assimp read it: emissive x strength,

@@ -32,6 +32,7 @@
 #include <jansson.h>
 #include <meshoptimizer.h>
 #include "errmsg.h"
+#include "gltf_instancing.h"
 #include "gltf_material.h"
 #include "model_conv.h"
 #include "model_import.h"
@@ -415,10 +416,17 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	                     .join = format == API_MODEL_STL, .texture_side = api_texture_class(output_side)};
 	uint8_t *tagged = NULL;
 	if (gltf) {
+		int inst = api_gltf_expand_instancing(root, data, len, format == API_MODEL_GLB, files, nfiles,
+		                                      API_GLTF_MAX_INSTANCES, err, errsize);
+		if (inst < 0) {
+			json_decref(root);
+			return API_WIRE_BAD_INPUT;
+		}
 		api_gltf_info_read(root, &c.gi);
 		size_t tagged_len = 0;
-		/* Materials renamed to their glTF index, to find them again (see gltf_material.h). */
-		if ((tagged = api_gltf_tag_materials(root, data, len, format == API_MODEL_GLB, &tagged_len))) {
+		/* Materials renamed to their glTF index, to find them again (see gltf_material.h); the
+		 * document handed to Assimp also when the instancing changed it. */
+		if ((tagged = api_gltf_tag_materials(root, data, len, format == API_MODEL_GLB, inst > 0, &tagged_len))) {
 			data = tagged;
 			len = tagged_len;
 		}
