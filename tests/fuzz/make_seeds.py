@@ -57,6 +57,22 @@ j += b" " * (-len(j) % 4)
 glb = b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(buf)) + struct.pack("<I", len(j)) + b"JSON" + j + \
       struct.pack("<I", len(buf)) + b"BIN\0" + buf
 put("fuzz_model_glb", "tri.glb", glb)
+# EXT_mesh_gpu_instancing (api/gltf_instancing.c): the triangle at three instances, TRANSLATION
+# floats in the BIN chunk, ROTATION normalized shorts in a data: URI buffer
+ibuf = buf + struct.pack("<9f", 0, 0, 0, 2, 0, 0, 0, 2, 0)
+rot = struct.pack("<12h", 0, 0, 0, 32767, 0, 0, 0, 32767, 0, 0, 0, 32767)
+g = gltf(None)
+g["extensionsUsed"] = ["EXT_mesh_gpu_instancing"]
+g["buffers"] = [{"byteLength": len(ibuf)}, {"byteLength": len(rot), "uri": "data:application/octet-stream;base64," +
+                                           base64.b64encode(rot).decode()}]
+g["bufferViews"] += [{"buffer": 0, "byteOffset": 44, "byteLength": 36}, {"buffer": 1, "byteOffset": 0, "byteLength": 24}]
+g["accessors"] += [{"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3"},
+                   {"bufferView": 3, "componentType": 5122, "normalized": True, "count": 3, "type": "VEC4"}]
+g["nodes"][0]["extensions"] = {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 2, "ROTATION": 3}}}
+j = json.dumps(g).encode()
+j += b" " * (-len(j) % 4)
+put("fuzz_model_glb", "instanced.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(ibuf)) +
+    struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(ibuf)) + b"BIN\0" + ibuf)
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
     return b"UMBRAIMP" + struct.pack("<IIII", 2, kind, status, len(msg)) + msg
