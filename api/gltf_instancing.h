@@ -7,7 +7,7 @@
  * serialises it: api_gltf_tag_materials).
  *
  * Usage (api/model_import.c, inside the sandboxed importer):
- *   int n = api_gltf_expand_instancing(root, data, len, glb, files, nfiles, API_GLTF_MAX_INSTANCES, err, errsize);
+ *   int n = api_gltf_expand_instancing(&bufs, API_GLTF_MAX_INSTANCES, err, errsize);   // api/gltf_buffers.h
  *   n < 0: the file is refused (err says why); n > 0: root changed (n instances made)
  * Ownership: nothing kept; root stays the caller's. Threading: no shared state.
  */
@@ -18,18 +18,15 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <jansson.h>
-#include "model.h"
+#include "gltf_buffers.h"
 
 /* Instances one model may make: each is an object the renderer draws (and ~100 bytes of JSON
  * here before that). */
 #define API_GLTF_MAX_INSTANCES 65536
 
-/* data/len: the file (a glb's BIN chunk is buffer 0 without a uri); files: the files the
- * model refers to (external buffers); data: URIs are decoded. Returns the instances made
- * (0: no node has the extension), or -1 with err filled: an accessor out of its buffer, of
- * a type the extension does not allow, counts that disagree, or over max instances. */
-int api_gltf_expand_instancing(json_t *root, const uint8_t *data, size_t len, bool glb,
-                               const struct api_model_file *files, size_t nfiles, size_t max, char *err,
-                               size_t errsize);
+/* Returns the instances made (0: no node has the extension), or -1 with err filled: an
+ * accessor out of its buffer, of a type the extension does not allow, counts that disagree,
+ * or over max instances. */
+int api_gltf_expand_instancing(struct api_gltf_bufs *b, size_t max, char *err, size_t errsize);
 
 #endif

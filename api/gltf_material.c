@@ -21,7 +21,8 @@ static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {"baseColorTexture", "metal
                                                        "occlusionTexture", "emissiveTexture"};
 static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform",
                                              "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
-                                             "EXT_mesh_gpu_instancing", NULL};
+                                             "EXT_mesh_gpu_instancing", "EXT_meshopt_compression",
+                                             "KHR_mesh_quantization", NULL};
 
 void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...)
 {

@@ -32,6 +32,8 @@
 #include <jansson.h>
 #include <meshoptimizer.h>
 #include "errmsg.h"
+#include "gltf_buffers.h"
+#include "gltf_decode.h"
 #include "gltf_instancing.h"
 #include "gltf_material.h"
 #include "model_conv.h"
@@ -399,6 +401,28 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	return (enum api_wire_status)st;
 }
 
+/* A glTF document made readable for Assimp 5.2 (api/gltf_decode.h, api/gltf_instancing.h) and
+ * its materials tagged (api/gltf_material.h): *tagged the bytes to import (NULL: the file as
+ * it is), b the buffers with what was made. 0, or -1 with err. */
+static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb, const struct api_model_file *files,
+                        size_t nfiles, struct api_conv *c, struct api_gltf_bufs *b, uint8_t **tagged,
+                        size_t *tagged_len, char *err, size_t errsize)
+{
+	api_gltf_bufs_init(b, root, data, len, glb, files, nfiles);
+	int dec = api_gltf_decode(b, err, errsize);
+	int inst = dec < 0 ? -1 : api_gltf_expand_instancing(b, API_GLTF_MAX_INSTANCES, err, errsize);
+	if (inst < 0) return -1;
+	if (api_gltf_bufs_finish(b) != 0) return api_err_set(err, errsize, "out of memory"), -1;
+	api_gltf_drop_fallbacks(root);
+	api_gltf_info_read(root, &c->gi);
+	bool changed = dec > 0 || inst > 0;
+	/* Materials renamed to their glTF index, to find them again (see gltf_material.h); the
+	 * document handed to Assimp also when it was changed here. */
+	*tagged = api_gltf_tag_materials(root, data, len, glb, changed, tagged_len);
+	if (!*tagged && changed) return api_err_set(err, errsize, "out of memory"), -1;
+	return 0;
+}
+
 enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, const struct api_model_file *files,
                                              size_t nfiles, enum api_model_format format, uint32_t output_side,
                                              struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
@@ -415,21 +439,30 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	struct api_conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf,
 	                     .join = format == API_MODEL_STL, .texture_side = api_texture_class(output_side)};
 	uint8_t *tagged = NULL;
+	struct api_gltf_bufs bufs;
+	memset(&bufs, 0, sizeof bufs);
+	const struct api_model_file *io_files = files;
+	size_t io_nfiles = nfiles;
 	if (gltf) {
-		int inst = api_gltf_expand_instancing(root, data, len, format == API_MODEL_GLB, files, nfiles,
-		                                      API_GLTF_MAX_INSTANCES, err, errsize);
-		if (inst < 0) {
-			json_decref(root);
+		size_t tagged_len = 0;
+		int rc = prepare_gltf(root, data, len, format == API_MODEL_GLB, files, nfiles, &c, &bufs, &tagged, &tagged_len,
+		                      err, errsize);
+		if (rc == 0 && api_gltf_bufs_files(&bufs, &io_files, &io_nfiles) != 0) {
+			api_err_set(err, errsize, "out of memory");
+			rc = -1;
+		}
+		json_decref(root);
+		if (rc != 0) {
+			free(tagged);
+			api_gltf_bufs_release(&bufs);
+			api_gltf_info_free(&c.gi);
 			return API_WIRE_BAD_INPUT;
 		}
-		api_gltf_info_read(root, &c.gi);
-		size_t tagged_len = 0;
-		/* Materials renamed to their glTF index, to find them again (see gltf_material.h); the
-		 * document handed to Assimp also when the instancing changed it. */
-		if ((tagged = api_gltf_tag_materials(root, data, len, format == API_MODEL_GLB, inst > 0, &tagged_len))) {
+		if (tagged) {
 			data = tagged;
 			len = tagged_len;
 		}
+		root = NULL;
 	}
 	json_decref(root);
 	size_t strips_len = 0;
@@ -441,7 +474,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		data = strips;
 		len = strips_len;
 	}
-	struct api_mem_io mi = {.data = data, .len = len, .files = files, .nfiles = nfiles};
+	struct api_mem_io mi = {.data = data, .len = len, .files = io_files, .nfiles = io_nfiles};
 	snprintf(mi.name, sizeof mi.name, MEM_NAME ".%s", FORMAT_NAMES[format]);
 	struct aiFileIO io;
 	api_mem_io_init(&mi, &io);
@@ -483,6 +516,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	aiReleasePropertyStore(props);
 	free(strips);   /* Assimp copied what it needed */
 	free(tagged);
+	api_gltf_bufs_release(&bufs);
 	if (!sc) {
 		api_gltf_info_free(&c.gi);
 		return st;

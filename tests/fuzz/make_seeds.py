@@ -73,6 +73,25 @@ j = json.dumps(g).encode()
 j += b" " * (-len(j) % 4)
 put("fuzz_model_glb", "instanced.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(ibuf)) +
     struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(ibuf)) + b"BIN\0" + ibuf)
+# KHR_mesh_quantization (api/gltf_decode.c): positions as shorts under a node scale, normals
+# as normalized bytes
+qbuf = b"".join(struct.pack("<4h", x, y, 0, 0) for x, y in [(0, 0), (1000, 0), (1000, 1000), (0, 1000)]) + \
+       b"".join(struct.pack("<4b", 0, 0, 127, 0) for _ in range(4)) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+q = {"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"],
+     "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "scale": [0.001, 0.001, 0.001]}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
+     "buffers": [{"byteLength": len(qbuf)}],
+     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 32, "byteStride": 8},
+                     {"buffer": 0, "byteOffset": 32, "byteLength": 16, "byteStride": 4},
+                     {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+     "accessors": [{"bufferView": 0, "componentType": 5122, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1000, 1000, 0]},
+                   {"bufferView": 1, "componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"},
+                   {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}]}
+j = json.dumps(q).encode()
+j += b" " * (-len(j) % 4)
+qbuf += b"\0" * (-len(qbuf) % 4)
+put("fuzz_model_glb", "quantized.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(qbuf)) +
+    struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(qbuf)) + b"BIN\0" + qbuf)
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
     return b"UMBRAIMP" + struct.pack("<IIII", 2, kind, status, len(msg)) + msg

@@ -1,0 +1,33 @@
+/*
+ * api/gltf_decode — what Assimp 5.2 cannot read of a glTF document's data, made readable
+ * before it reads it (inside the sandboxed importer):
+ *   - EXT_meshopt_compression: every compressed bufferView decoded with meshoptimizer
+ *     (ATTRIBUTES, TRIANGLES, INDICES; filters OCTAHEDRAL, QUATERNION, EXPONENTIAL) into the
+ *     made buffer (api/gltf_buffers.h), the view pointed at it; the fallback buffers the
+ *     extension leaves without data are then dropped (api_gltf_drop_fallbacks);
+ *   - KHR_mesh_quantization, and any vertex attribute stored as integers (glTF core allows
+ *     normalized TEXCOORD_n and COLOR_n): the accessor rewritten as floats (Assimp 5.2 read a
+ *     quantized POSITION as garbage, "triangles have no area").
+ * Both extensions are then removed from extensionsUsed / extensionsRequired. A file that
+ * requires KHR_draco_mesh_compression is refused with what to do (Draco is not decoded).
+ *
+ * Usage: n = api_gltf_decode(&bufs, err, errsize): n < 0 refused (err says why), n > 0 the
+ * document changed. After api_gltf_bufs_finish: api_gltf_drop_fallbacks(root).
+ * Threading: no shared state.
+ */
+#ifndef UMBRA_API_GLTF_DECODE_H
+#define UMBRA_API_GLTF_DECODE_H
+
+#include <stddef.h>
+#include <jansson.h>
+#include "gltf_buffers.h"
+
+/* The most bytes one decoded bufferView may take (count x byteStride). */
+#define API_GLTF_MAX_DECODED_VIEW ((size_t)1 << 30)
+
+int api_gltf_decode(struct api_gltf_bufs *b, char *err, size_t errsize);
+/* Removes the buffers no bufferView names any more and that have no uri (meshopt's
+ * fallbacks), renumbering the views' buffer indices. */
+void api_gltf_drop_fallbacks(json_t *root);
+
+#endif
