@@ -23,6 +23,23 @@ static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "
                                              "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
                                              "EXT_mesh_gpu_instancing", "EXT_meshopt_compression",
                                              "KHR_mesh_quantization", NULL};
+/* Extensions known and not drawn (or drawn in part): what the picture lacks. */
+static const char *const LACKS[][2] = {
+	{"KHR_materials_transmission", "transmission drawn as see-through coverage (dithered), not refraction"},
+	{"KHR_materials_volume", "volume (thickness, attenuation) not drawn: thin surfaces"},
+	{"KHR_materials_clearcoat", "the clear coat layer not drawn (the base layer only)"},
+	{"KHR_materials_sheen", "sheen not drawn"},
+	{"KHR_materials_specular", "specular strength and colour not used (F0 0.04)"},
+	{"KHR_materials_ior", "ior not used (1.5)"},
+	{"KHR_materials_iridescence", "iridescence not drawn"},
+	{"KHR_materials_anisotropy", "anisotropy not drawn (isotropic highlights)"},
+	{"KHR_materials_variants", "variants: the default materials drawn"},
+	{"KHR_texture_basisu", "KTX2/Basis textures not decoded: those materials drawn without their textures"},
+	{"EXT_texture_webp", "WebP textures not decoded: those materials drawn without their textures (or with a PNG/JPEG fallback)"},
+	{"KHR_lights_punctual", "the file's lights not used (the scene's lights are)"},
+	{"KHR_draco_mesh_compression", "Draco meshes not decoded: the uncompressed fallback drawn"},
+	{NULL, NULL},
+};
 
 void api_gltf_warn(struct api_gltf_info *gi, const char *fmt, ...)
 {
@@ -154,6 +171,8 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 			gm->emissive_strength = s >= 0 ? s : 1;
 		}
 		if (!strcmp(key, "KHR_materials_unlit")) gm->unlit = true;
+		if (!strcmp(key, "KHR_materials_transmission"))
+			gm->transmission = fminf(fmaxf(num(v, "transmissionFactor", 0), 0), 1);
 		if (!strcmp(key, "KHR_materials_pbrSpecularGlossiness") && !pbr) read_spec_gloss(gi, mi, name, v, gm);
 	}
 }
@@ -167,6 +186,11 @@ static void scene_warnings(struct api_gltf_info *gi, json_t *root)
 		const char *s = json_string_value(e);
 		bool known = false;
 		for (int k = 0; s && SUPPORTED_EXT[k]; k++) known = known || !strcmp(s, SUPPORTED_EXT[k]);
+		for (int k = 0; s && !known && LACKS[k][0]; k++)
+			if (!strcmp(s, LACKS[k][0])) {
+				api_gltf_warn(gi, "%s: %s", s, LACKS[k][1]);
+				known = true;
+			}
 		if (s && !known) api_gltf_warn(gi, "extension %.60s is not supported (ignored)", s);
 	}
 	if (json_array_size(json_object_get(root, "skins"))) api_gltf_warn(gi, "skins are not applied (drawn in the bind pose)");
@@ -216,6 +240,10 @@ void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, s
 		m->metallic = 0;
 		m->roughness = 1 - gm->glossiness;
 		m->metal_rough_texture = NULL;
+	}
+	if (gm->transmission > 0 && m->alpha_mode != RND_ALPHA_MASK) {
+		m->alpha_mode = RND_ALPHA_BLEND;
+		m->base_color[3] *= 1 - 0.8f * gm->transmission;
 	}
 	if (gm->unlit) {
 		for (int k = 0; k < 3; k++) {

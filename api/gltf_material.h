@@ -35,6 +35,8 @@ struct api_gltf_material {
 	 * the base colour's DIFFUSE texture) and roughness 1 - glossinessFactor. */
 	bool spec_gloss;
 	float diffuse[4], glossiness;
+	/* KHR_materials_transmission's factor (0): drawn as partial coverage, see shading. */
+	float transmission;
 	bool double_sided;                 /* false (glTF's default) */
 	float normal_scale, occlusion_strength;    /* 1, 1 */
 	struct rnd_texture_sampling sampling[RND_TEX_SLOTS];
@@ -65,7 +67,10 @@ void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, str
 /* What material `index` changes once its textures are known: KHR_materials_unlit drawn as its
  * base colour alone (moved to the emissive term, which no light or shadow changes: base
  * colour black, alpha kept; normal and occlusion maps dropped); the specular-glossiness
- * stand-in (metallic 0, base colour diffuseFactor, roughness 1 - glossiness). */
+ * stand-in (metallic 0, base colour diffuseFactor, roughness 1 - glossiness);
+ * KHR_materials_transmission as dithered coverage (alpha mode BLEND, alpha x (1 - 0.8 x
+ * transmission): clear glass shows a fifth of its surface and lets four fifths of the light
+ * through to its shadow), not refraction. */
 void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m);
 /* Vertex data: n RGBA float colours -> linear RGBA8 (clamped); n tangents, bitangents and
  * normals (xyz floats) -> xyzw tangents, w = the side of the bitangent (+1 / -1). */

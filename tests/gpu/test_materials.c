@@ -510,13 +510,9 @@ TEST(materials_single_sided_hides_back_face)
 /* A red quad at y = 1 (alpha 0.5 BLEND, or OPAQUE) over a blue ground, sun along (0.8, -1, 0):
  * its shadow is the quad moved 0.8 along +x. Seen from above (orthographic), the quad itself
  * covers about half its pixels (dithered) and its shadow takes about half the light. */
-static bool blend_render(int line, struct rnd_image *img, bool blend)
+static bool material_render(int line, struct rnd_image *img, const char *material, const char *extensions_used)
 {
-	struct mglb g = {.material = blend ? "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,0.5],"
-	                                     "\"metallicFactor\":0,\"roughnessFactor\":1},\"alphaMode\":\"BLEND\"}"
-	                                   : "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],"
-	                                     "\"metallicFactor\":0,\"roughnessFactor\":1}}",
-	                 .y = 1};
+	struct mglb g = {.material = material, .extensions_used = extensions_used, .y = 1};
 	size_t n;
 	uint8_t *glb = glb_of(&g, &n);
 	char *enc = test_b64(glb, n);
@@ -533,6 +529,16 @@ static bool blend_render(int line, struct rnd_image *img, bool blend)
 	                        BW, BH, enc);
 	free(enc);
 	return ok;
+}
+
+static bool blend_render(int line, struct rnd_image *img, bool blend)
+{
+	return material_render(line, img,
+	                       blend ? "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,0.5],"
+	                               "\"metallicFactor\":0,\"roughnessFactor\":1},\"alphaMode\":\"BLEND\"}"
+	                             : "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],"
+	                               "\"metallicFactor\":0,\"roughnessFactor\":1}}",
+	                       NULL);
 }
 
 /* Mean of channel c over the world rectangle [x0, x1] x [z0, z1] at height y. */
@@ -573,6 +579,31 @@ TEST(materials_blend_dithered_half_coverage_half_shadow)
 	rnd_image_release(&op);
 	rnd_image_release(&bl);
 	rnd_image_release(&bl2);
+}
+
+/* KHR_materials_transmission 1 on an opaque red quad: drawn as coverage 0.2 (dithered) that
+ * lets 0.8 of the light through to its shadow; before, the glass was drawn opaque (coverage
+ * 1, a full shadow). */
+TEST(materials_transmission_as_partial_coverage)
+{
+	struct rnd_image op, tr;
+	if (!blend_render(__LINE__, &op, false)) return;
+	if (!material_render(__LINE__, &tr,
+	                     "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],\"metallicFactor\":0,"
+	                     "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1}}}",
+	                     "[\"KHR_materials_transmission\"]")) {
+		rnd_image_release(&op);
+		return;
+	}
+	double lit = mean_rect(&op, 2.0, 2.35, -0.6, 0.6, 0, 2);
+	double sh_op = mean_rect(&op, 1.1, 1.7, -0.6, 0.6, 0, 2), sh_tr = mean_rect(&tr, 1.1, 1.7, -0.6, 0.6, 0, 2);
+	double share = (lit - sh_tr) / (lit - sh_op);
+	double red_op = mean_rect(&op, -0.8, 0.8, -0.8, 0.8, 1, 0), red_tr = mean_rect(&tr, -0.8, 0.8, -0.8, 0.8, 1, 0);
+	printf("    transmission 1: coverage %.2f, shadow share %.2f\n", red_tr / red_op, share);
+	CHECK(red_tr / red_op > 0.1 && red_tr / red_op < 0.3, "transmission 1 coverage %.2f, want ~0.2", red_tr / red_op);
+	CHECK(share > 0.1 && share < 0.3, "transmission 1 takes %.2f of the light, want ~0.2", share);
+	rnd_image_release(&op);
+	rnd_image_release(&tr);
 }
 
 /* ---- mipmaps ---- */
