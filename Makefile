@@ -59,7 +59,8 @@ LIBS := $(PKG_LIBS) -lmeshoptimizer -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
-SRV_SRC := $(filter-out server/cli.c server/farm.c,$(wildcard server/*.c))
+FARM_SRC := server/cli.c server/farm.c server/farm_remote.c server/farm_report.c server/http_client.c
+SRV_SRC := $(filter-out $(FARM_SRC),$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)
 # tests/util/: the harness (test.h, test_main.c) and helpers both test binaries share.
@@ -124,7 +125,7 @@ $(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
-$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/umbra-render: $(FARM_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 # The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
 # them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).

@@ -238,4 +238,21 @@ struct api_manifest_entry {
 enum api_result api_manifest_line(const char *line, size_t len, struct api_manifest_entry *e, struct api_problem *p);
 void api_manifest_entry_release(struct api_manifest_entry *e);
 
+/* One line of a farm report (umbra-render's report.jsonl, read back by --resume), api/manifest.c:
+ * file, output (or NULL), status and hash (or NULL) of the line, malloc'd; release with
+ * api_report_entry_release() (NULL-safe). API_ERR: not such a line (p says why). */
+struct api_report_entry {
+	char *file;
+	char *output;
+	char *status;
+	char *hash;
+};
+enum api_result api_report_line(const char *line, size_t len, struct api_report_entry *e, struct api_problem *p);
+void api_report_entry_release(struct api_report_entry *e);
+
+/* An application/problem+json document (a daemon's answer with HTTP status `status`) back into
+ * p, as api_problem_json() wrote it. A body that is no such document still fills p: its status,
+ * and as detail the start of the body. api/problem.c. */
+void api_problem_parse(const char *body, size_t len, int status, struct api_problem *p);
+
 #endif
