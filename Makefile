@@ -9,6 +9,7 @@
 #   make bench-farm   only the farm benchmark on new models: farm CLI, umbrad c=4, f3d (BENCH_ONLY=farm)
 #   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
+#   make test-farm      umbra-render --server on three daemons behind HAProxy (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
 #   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
 #   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
@@ -83,7 +84,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster test-farm bench-cluster check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -203,6 +204,10 @@ cluster: deps
 test-cluster: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) UMBRA_VALIDATION=1 python3 tests/cluster/test_cluster.py
+
+test-farm: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) UMBRA_VALIDATION=1 python3 tests/cluster/test_farm.py
 
 bench-cluster: deps
 	@$(MAKE) --no-print-directory all
