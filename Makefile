@@ -11,6 +11,7 @@
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
 #   make test-farm      umbra-render --server on three daemons behind HAProxy (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
+#   make bench-farm-remote  the local farm against --server on 3 daemons, 300 models
 #   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
 #   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
 BUILD ?= build
@@ -84,7 +85,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster test-farm bench-cluster check-deploy print-version
+.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster test-farm bench-cluster bench-farm-remote check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -212,6 +213,10 @@ test-farm: deps
 bench-cluster: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) python3 tests/cluster/bench_cluster.py
+
+bench-farm-remote: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) python3 tests/cluster/bench_farm.py 300 256
 
 check-deploy:
 	@sh deploy/check.sh
