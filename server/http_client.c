@@ -152,9 +152,9 @@ static ssize_t dechunk(uint8_t *b, size_t len)
 	}
 }
 
-/* Splits the answer in raw[0, n) into r (taking raw over). false: not a whole HTTP answer. */
-static bool parse_answer(uint8_t *raw, size_t n, struct srv_http_response *r)
+bool srv_http_response_parse(uint8_t *raw, size_t n, struct srv_http_response *r)
 {
+	memset(r, 0, sizeof *r);
 	char *text = (char *)raw, *eoh = strstr(text, "\r\n\r\n");
 	int status;
 	if (!eoh || sscanf(text, "HTTP/1.%*d %3d", &status) != 1) return false;
@@ -211,7 +211,7 @@ enum srv_http_result srv_http_post(const struct srv_http_url *u, const char *pat
 		snprintf(e->msg, sizeof e->msg, "out of memory for the answer");
 		return SRV_HTTP_ERR_MEMORY;
 	}
-	if (n <= 0 || !parse_answer(raw, (size_t)n, r)) {
+	if (n <= 0 || !srv_http_response_parse(raw, (size_t)n, r)) {
 		free(raw);
 		memset(r, 0, sizeof *r);
 		snprintf(e->msg, sizeof e->msg, "connection to %s:%s lost: %s", u->host, u->port,

@@ -20,6 +20,7 @@
 #ifndef UMBRA_HTTP_CLIENT_H
 #define UMBRA_HTTP_CLIENT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -57,5 +58,9 @@ enum srv_http_result srv_http_post(const struct srv_http_url *u, const char *pat
                                    const struct srv_http_chunk *body, size_t nchunks, unsigned timeout_s,
                                    struct srv_http_response *r, struct srv_http_error *e);
 void srv_http_response_release(struct srv_http_response *r);
+/* An answer as read from the socket, raw[0, n) with raw[n] writable (malloc'd, n + 1 bytes),
+ * split into r, which then owns raw (as body). false: not a whole HTTP/1.x answer (no end of
+ * headers, a body shorter than Content-Length, a cut chunked body); raw is still the caller's. */
+bool srv_http_response_parse(uint8_t *raw, size_t n, struct srv_http_response *r);
 
 #endif
