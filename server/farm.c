@@ -342,6 +342,7 @@ static void *worker(void *arg)
 		f->done++;
 		f->resumed += f->res[i].resumed;
 		if (st != JOB_OK) f->failed++;
+		farm_journal_line(f, i);   /* before the progress line: a line seen means it is in the report */
 		progress(f, i);
 		pthread_mutex_unlock(&f->mu);
 	}
@@ -442,6 +443,13 @@ static int farm_open(struct farm *f, unsigned threads)
 		fprintf(stderr, "umbra-render: out of memory reading '%s'\n", o->report);
 		return -1;
 	}
+	/* The report is rewritten in input order at the end; until then a line is added per
+	 * finished job, in the order they finish, after the earlier report's lines when resuming
+	 * (so a run killed before it reached them keeps them too; the last line of a file wins). */
+	if (o->report && !(f->journal = fopen(o->report, o->resume ? "a" : "w"))) {
+		fprintf(stderr, "umbra-render: cannot write report '%s': %s\n", o->report, strerror(errno));
+		return -1;
+	}
 	return 0;
 }
 
@@ -481,12 +489,15 @@ int farm_run(struct farm_job *jobs, size_t n, const struct farm_opts *o)
 	for (size_t i = 0; i < f.n; i++)
 		if (f.res[i].status == JOB_PENDING) f.res[i].status = JOB_SKIPPED;
 	rc = summary(&f, threads);
+	if (f.journal) fclose(f.journal);
+	f.journal = NULL;
 	if (o->report && farm_write_report(&f, o->report) < 0 && rc == 0) rc = 1;
 	if (f.ctx && rnd_context_validation_messages(f.ctx)) {
 		fprintf(stderr, "umbra-render: %u Vulkan validation messages\n", rnd_context_validation_messages(f.ctx));
 		if (rc == 0) rc = 1;
 	}
 out_open:
+	if (f.journal) fclose(f.journal);
 	farm_resume_free(f.resume);
 	rnd_context_destroy(f.ctx);
 	pthread_mutex_destroy(&f.mu);

@@ -16,7 +16,9 @@
  * opts.server: no renderer here; each job is POSTed to umbrad (or a balancer) with the same
  * document and parts, `threads` requests in flight, retried when the connection was lost or a
  * balancer said 502/503/504 (server/farm_remote.c). opts.resume: a job whose earlier report
- * line says ok for the same content hash, and whose output is there, is not rendered again.
+ * line says ok for the same content hash, and whose output is there, is not rendered again;
+ * while the run goes the report holds a line per finished job (flushed), so a farm killed by
+ * SIGKILL resumes too, and it is rewritten in input order at the end.
  * SIGINT / SIGTERM: no new job starts; the renders in flight finish and are written; the rest
  * are reported "skipped". The report (JSON lines, input order) has file, output, status (ok,
  * invalid: a bad scene or model, or an input that is a directory or an empty model file;

@@ -10,6 +10,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include "api.h"
 #include "farm.h"
 #include "http_client.h"
@@ -58,6 +59,7 @@ struct farm {
 	struct rnd_context *ctx;  /* local farm only */
 	struct srv_http_url url;  /* remote farm only */
 	struct farm_resume *resume;
+	FILE *journal;            /* the report while the run goes: a line per finished job */
 	atomic_size_t next;
 	pthread_mutex_t mu;       /* guards done, failed and the progress output */
 	size_t done, failed, resumed;
@@ -77,6 +79,9 @@ enum job_status farm_remote_job(struct farm *f, size_t i, const struct job_input
 
 /* farm_report.c */
 int farm_write_report(const struct farm *f, const char *path);
+/* Job i's line to the journal (opened by farm_run at the report's path, so a farm killed with
+ * SIGKILL leaves the lines of what it finished for --resume); called with f->mu held. */
+void farm_journal_line(struct farm *f, size_t i);
 /* Reads the earlier report at path (absent: an empty one). NULL only when out of memory. */
 struct farm_resume *farm_resume_load(const char *path);
 void farm_resume_free(struct farm_resume *r);

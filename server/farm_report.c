@@ -1,7 +1,8 @@
 /*
  * server/farm_report — the farm's JSON-lines report (one line per input, input order) and its
  * reading back for --resume: an input whose earlier line says ok with the same content hash,
- * and whose output file is still there, is not rendered again.
+ * and whose output file is still there, is not rendered again. While a run goes the report is
+ * a journal (a line per finished job, flushed), so even a farm killed by SIGKILL can resume.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -75,6 +76,13 @@ static void write_line(FILE *fp, const struct farm *f, size_t i)
 	fputs("}\n", fp);
 }
 
+void farm_journal_line(struct farm *f, size_t i)
+{
+	if (!f->journal) return;
+	write_line(f->journal, f, i);
+	fflush(f->journal);
+}
+
 int farm_write_report(const struct farm *f, const char *path)
 {
 	/* Through a temporary name: a report being replaced (--resume) is never left half written. */
@@ -96,21 +104,47 @@ int farm_write_report(const struct farm *f, const char *path)
 
 /* ---- --resume ---- */
 
+struct resume_entry {
+	struct api_report_entry e;
+	size_t order;                  /* line number: a later line for the same file wins */
+};
+
 struct farm_resume {
-	struct api_report_entry *e;   /* the earlier report's ok lines with a hash, sorted by file */
+	struct resume_entry *e;        /* the earlier report's ok lines with a hash, by file */
 	size_t n;
 };
 
 static int by_file(const void *a, const void *b)
 {
-	return strcmp(((const struct api_report_entry *)a)->file, ((const struct api_report_entry *)b)->file);
+	const struct resume_entry *x = a, *y = b;
+	int c = strcmp(x->e.file, y->e.file);
+	return c ? c : (x->order > y->order) - (x->order < y->order);
+}
+
+static int by_file_only(const void *key, const void *b)
+{
+	return strcmp(key, ((const struct resume_entry *)b)->e.file);
+}
+
+/* Keeps the last line of each file (sorted by file, then line). */
+static void keep_last(struct farm_resume *rs)
+{
+	size_t m = 0;
+	for (size_t k = 0; k < rs->n; k++) {
+		if (k + 1 < rs->n && !strcmp(rs->e[k].e.file, rs->e[k + 1].e.file)) {
+			api_report_entry_release(&rs->e[k].e);
+			continue;
+		}
+		rs->e[m++] = rs->e[k];
+	}
+	rs->n = m;
 }
 
 struct farm_resume *farm_resume_load(const char *path)
 {
 	struct farm_resume *rs = calloc(1, sizeof *rs);
 	if (!rs) return NULL;
-	size_t len = 0, cap = 0;
+	size_t len = 0, cap = 0, order = 0;
 	char *text = farm_read_file(path, &len);
 	if (!text) {
 		if (errno != ENOENT) fprintf(stderr, "umbra-render: --resume: cannot read '%s': %s (rendering all)\n", path,
@@ -122,30 +156,28 @@ struct farm_resume *farm_resume_load(const char *path)
 		if (next) *next++ = 0;
 		struct api_report_entry e;
 		struct api_problem p;
+		order++;
 		if (api_report_line(line, strlen(line), &e, &p) != API_OK) continue;   /* a line cut short */
-		if (strcmp(e.status, "ok") || !e.hash || !e.output) {
-			api_report_entry_release(&e);
-			continue;
-		}
 		if (rs->n == cap) {
-			struct api_report_entry *ne = realloc(rs->e, (cap = cap ? 2 * cap : 64) * sizeof *ne);
+			struct resume_entry *ne = realloc(rs->e, (cap = cap ? 2 * cap : 64) * sizeof *ne);
 			if (!ne) {
 				api_report_entry_release(&e);
 				break;
 			}
 			rs->e = ne;
 		}
-		rs->e[rs->n++] = e;
+		rs->e[rs->n++] = (struct resume_entry){e, order};
 	}
 	free(text);
 	if (rs->n) qsort(rs->e, rs->n, sizeof *rs->e, by_file);
+	keep_last(rs);
 	return rs;
 }
 
 void farm_resume_free(struct farm_resume *rs)
 {
 	if (!rs) return;
-	for (size_t k = 0; k < rs->n; k++) api_report_entry_release(&rs->e[k]);
+	for (size_t k = 0; k < rs->n; k++) api_report_entry_release(&rs->e[k].e);
 	free(rs->e);
 	free(rs);
 }
@@ -154,9 +186,10 @@ bool farm_resume_hit(const struct farm_resume *rs, const struct farm *f, size_t 
 {
 	struct job_result *r = &f->res[i];
 	const struct farm_job *j = &f->jobs[i];
-	struct api_report_entry key = {.file = (char *)farm_label(j)};
-	const struct api_report_entry *e = rs->n ? bsearch(&key, rs->e, rs->n, sizeof *rs->e, by_file) : NULL;
-	if (!e || strcmp(e->hash, r->hash)) return false;
+	const struct resume_entry *re = rs->n ? bsearch(farm_label(j), rs->e, rs->n, sizeof *rs->e, by_file_only) : NULL;
+	const struct api_report_entry *e = re ? &re->e : NULL;
+	/* The file's last line: ok, for these bytes. */
+	if (!e || strcmp(e->status, "ok") || !e->hash || !e->output || strcmp(e->hash, r->hash)) return false;
 	/* The same output this run would write: the explicit name, or the default stem + extension. */
 	size_t sl = strlen(r->stem);
 	if (j->out ? strcmp(e->output, j->out) : strncmp(e->output, r->stem, sl) || e->output[sl] != '.' ||

@@ -7,7 +7,7 @@ Models are generated here (tests/cli/gen_models.py, plus an .obj with its .mtl a
 its .bin, so the files a model refers to travel as parts). Checked:
   - the remote farm (three umbrad behind HAProxy, deploy/cluster.py) gives the local farm's
     bytes, statuses and content hashes for every input;
-  - SIGINT mid-run then --resume: every input ok, nothing rendered in both runs; a local
+  - SIGINT (and SIGKILL) mid-run then --resume: every input ok, nothing rendered in both runs; a local
     --resume renders nothing, and a changed model (new hash) is rendered again;
   - --shard K/3: the three shards cover every input exactly once;
   - a bad scene is `invalid` with the same problem text (status, pointer, detail) as locally;
@@ -89,9 +89,9 @@ def models(tmp):
     return sorted(os.path.join(d, f) for f in os.listdir(d) if f.rsplit(".", 1)[-1] in ("obj", "stl", "ply", "gltf"))
 
 
-def farm(inputs, out, *extra, stop_after=None, on_line=None, timeout=600):
-    """Runs umbra-render thumb; stop_after=k sends SIGINT after k progress lines; on_line(n) is
-    called after each. Returns (exit code, stderr text, report lines by file)."""
+def farm(inputs, out, *extra, stop_after=None, on_line=None, timeout=600, sig=signal.SIGINT):
+    """Runs umbra-render thumb; stop_after=k sends sig (SIGINT) after k progress lines; on_line(n)
+    is called after each. Returns (exit code, stderr text, report lines)."""
     cmd = [CLI, "thumb"] + inputs + ["-o", out, "--size", SIZE, "--no-progress"] + list(extra)
     p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                          env=ENV, text=True)
@@ -101,7 +101,7 @@ def farm(inputs, out, *extra, stop_after=None, on_line=None, timeout=600):
         if line.startswith("umbra-render: ["):
             n += 1
             if stop_after is not None and n == stop_after:
-                p.send_signal(signal.SIGINT)
+                p.send_signal(sig)
             if on_line:
                 on_line(n)
     code = p.wait(timeout)
@@ -117,9 +117,16 @@ def report(out, extra=()):
         path = os.path.join(out, "report-%s-of-%s.jsonl" % (k, n))
     try:
         with open(path) as f:
-            return [json.loads(l) for l in f if l.strip()]
+            text = f.read()
     except OSError:
         return []
+    lines = []
+    for l in text.splitlines():
+        try:
+            lines.append(json.loads(l))
+        except ValueError:
+            lines.append({"file": None, "status": "cut line"})
+    return lines
 
 
 def read(path):
@@ -219,6 +226,23 @@ def interrupt_resume(c, tmp, inputs, ref):
     ok("resumed and rendered outputs are the local bytes", not same_images(second, ref))
 
 
+def killed_resume(c, tmp, inputs, ref):
+    """SIGKILL, not Ctrl-C: the report is then the journal of what finished; --resume uses it."""
+    out = os.path.join(tmp, "killed")
+    code, err, first = farm(inputs, out, "--server", c.url, "-j", "2", stop_after=5, sig=signal.SIGKILL)
+    done1 = {l["file"] for l in first if l["status"] == "ok"}
+    ok("a SIGKILLed farm leaves a line per finished input", code == -signal.SIGKILL and len(done1) >= 5 and
+       len(done1) < len(inputs) and all(l["status"] == "ok" for l in first), (code, len(done1), first[-2:]))
+    code, err, second = farm(inputs, out, "--server", c.url, "-j", "2", "--resume")
+    resumed = {l["file"] for l in second if l.get("resumed")}
+    rendered = {l["file"] for l in second if l["status"] == "ok" and not l.get("resumed")}
+    ok("--resume after SIGKILL: what was done kept, the rest rendered once, all ok",
+       code == 0 and resumed == done1 and not (rendered & done1) and (resumed | rendered) == set(inputs) and
+       len(second) == len(inputs), "%d resumed, %d rendered, %d first, exit %d" %
+       (len(resumed), len(rendered), len(done1), code))
+    ok("... the local bytes", not same_images(second, ref))
+
+
 def local_resume(tmp, inputs, ref):
     out = os.path.join(tmp, "local")
     code, err, lines = farm(inputs, out, "-j", "2", "--resume")
@@ -304,6 +328,7 @@ def main():
         remote_equals_local(c, tmp, inputs, ref, local)
         invalid_same_as_local(c, tmp)
         interrupt_resume(c, tmp, inputs, ref)
+        killed_resume(c, tmp, inputs, ref)
         local_resume(tmp, inputs, ref)
         shards(c, tmp, inputs, ref)
         daemons_die(c, tmp, inputs, ref)
