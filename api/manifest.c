@@ -90,3 +90,23 @@ enum api_result api_report_line(const char *line, size_t len, struct api_report_
 	json_decref(j);
 	return r;
 }
+
+char *api_scene_doc_set_format(const char *doc, size_t len, enum api_format f, size_t *out_len)
+{
+	json_t *j = json_loadb(doc, len, 0, NULL);
+	if (!json_is_object(j)) {
+		json_decref(j);
+		return NULL;
+	}
+	json_t *out = json_object_get(j, "output");
+	if (out && !json_is_object(out)) {   /* the daemon's 400 at /output says what is wrong */
+		json_decref(j);
+		return NULL;
+	}
+	if (!out) json_object_set_new(j, "output", out = json_object());
+	json_object_set_new(out, "format", json_string(f == API_FORMAT_EXR ? "exr" : "png"));
+	char *s = json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER);
+	json_decref(j);
+	if (s) *out_len = strlen(s);
+	return s;
+}

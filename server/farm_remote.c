@@ -115,6 +115,11 @@ static enum job_status take_image(struct farm *f, size_t i, const struct srv_htt
 		snprintf(r->error, sizeof r->error, "the server answered 200 with '%.100s', not an image", resp->content_type);
 		return JOB_FAILED;
 	}
+	const char *dot = j->out ? strrchr(j->out, '.') : NULL;
+	if (dot && !strcasecmp(dot, exr ? ".png" : ".exr")) {
+		snprintf(r->error, sizeof r->error, "the server answered %s for '%s'", exr ? "EXR" : "PNG", j->out);
+		return JOB_FAILED;
+	}
 	if (j->out) snprintf(r->out, sizeof r->out, "%s", j->out);
 	else snprintf(r->out, sizeof r->out, "%s.%s", r->stem, exr ? "exr" : "png");
 	snprintf(r->warnings, sizeof r->warnings, "%s", resp->warnings);
@@ -157,7 +162,13 @@ enum job_status farm_remote_job(struct farm *f, size_t i, const struct job_input
 		multipart_release(&m);
 		return JOB_INVALID;
 	}
-	struct srv_http_chunk json = {in->doc, in->doc_len};
+	/* A scene whose output name picks the format says so in its document (umbrad lets an
+	 * explicit output.format win over Accept, where the local farm lets the name win). */
+	const char *dot = f->jobs[i].out ? strrchr(f->jobs[i].out, '.') : NULL;
+	size_t fixed_len = 0;
+	char *fixed = dot && !in->nparts ? api_scene_doc_set_format(in->doc, in->doc_len, strcasecmp(dot, ".exr") ?
+	                                                            API_FORMAT_PNG : API_FORMAT_EXR, &fixed_len) : NULL;
+	struct srv_http_chunk json = {fixed ? fixed : in->doc, fixed ? fixed_len : in->doc_len};
 	unsigned lost = 0, busy = 0;
 	enum job_status st = JOB_FAILED;
 	for (;;) {
@@ -198,5 +209,6 @@ enum job_status farm_remote_job(struct farm *f, size_t i, const struct job_input
 		snprintf(r->error + l, sizeof r->error - l, " (after %u tries)", r->attempts);
 	}
 	multipart_release(&m);
+	free(fixed);
 	return st;
 }

@@ -191,8 +191,10 @@ enum srv_http_result srv_http_post(const struct srv_http_url *u, const char *pat
 	size_t total = 0;
 	for (size_t k = 0; k < nchunks; k++) total += body[k].len;
 	char head[2048];
-	int hl = snprintf(head, sizeof head, "POST %s%s HTTP/1.1\r\nHost: %s:%s\r\nConnection: close\r\n"
-	                  "Content-Length: %zu\r\n%s\r\n", u->base, path, u->host, u->port, total, headers);
+	bool v6 = strchr(u->host, ':');   /* an IPv6 address goes in brackets */
+	int hl = snprintf(head, sizeof head, "POST %s%s HTTP/1.1\r\nHost: %s%s%s:%s\r\nConnection: close\r\n"
+	                  "Content-Length: %zu\r\n%s\r\n", u->base, path, v6 ? "[" : "", u->host, v6 ? "]" : "", u->port,
+	                  total, headers);
 	if (hl < 0 || (size_t)hl >= sizeof head) {
 		snprintf(e->msg, sizeof e->msg, "request headers too long");
 		return SRV_HTTP_ERR_URL;

@@ -208,6 +208,29 @@ def remote_equals_local(c, tmp, inputs, ref, local):
     ok("report has the daemons' stages", all("main" in (l.get("stages") or {}) for l in lines), lines[:1])
 
 
+def scenes_same(c, tmp):
+    """Scenes through a manifest: an EXR scene by its own format and named .png (the name wins)."""
+    scene = {"width": 48, "height": 48, "objects": [{"shape": "plane", "size": [8, 8]}, {"shape": "sphere", "radius": 1,
+             "transform": {"translation": [0, 1, 0]}}], "lights": [{"type": "directional", "direction": [-0.5, -1, -0.3],
+             "color": [1, 1, 1], "intensity": 3}], "output": {"format": "exr"},
+             "camera": {"type": "perspective", "position": [4, 3, 4], "target": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 40}}
+    with open(os.path.join(tmp, "exr.json"), "w") as f:
+        json.dump(scene, f)
+    with open(os.path.join(tmp, "jobs.jsonl"), "w") as f:
+        f.write('{"scene": "exr.json"}\n{"scene": "exr.json", "output": "named.png"}\n')
+    outs = []
+    for extra in ([], ["--server", c.url]):
+        out = os.path.join(tmp, "scenes-%d" % len(outs))
+        p = subprocess.run([CLI, "--manifest", os.path.join(tmp, "jobs.jsonl"), "-o", out, "--no-progress"] + extra,
+                           capture_output=True, text=True, env=ENV, timeout=300)
+        outs.append((p.returncode, [(os.path.basename(l["output"] or ""), read(l["output"]) if l["output"] else b"")
+                                    for l in report(out)]))
+    names = [n for n, _ in outs[0][1]]
+    ok("scenes by --server: an EXR scene, and named .png, are the local farm's files and bytes",
+       outs[0] == outs[1] and outs[0][0] == 0 and names == ["exr.exr", "named.png"] and
+       outs[0][1][1][1][:4] == b"\x89PNG", (outs[0][0], outs[1][0], names, [n for n, _ in outs[1][1]]))
+
+
 def interrupt_resume(c, tmp, inputs, ref):
     out = os.path.join(tmp, "resume")
     code, err, first = farm(inputs, out, "--server", c.url, "-j", "2", stop_after=4)
@@ -327,6 +350,7 @@ def main():
         ok("three daemons UP behind haproxy", True)
         remote_equals_local(c, tmp, inputs, ref, local)
         invalid_same_as_local(c, tmp)
+        scenes_same(c, tmp)
         interrupt_resume(c, tmp, inputs, ref)
         killed_resume(c, tmp, inputs, ref)
         local_resume(tmp, inputs, ref)

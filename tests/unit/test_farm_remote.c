@@ -93,3 +93,20 @@ TEST(report_line_parse)
 	CHECK(api_report_line("{\"status\":\"ok\"}", 15, &e, &p) == API_ERR && !e.file);
 	api_report_entry_release(NULL);
 }
+
+TEST(scene_doc_set_format)
+{
+	size_t n = 0;
+	const char *d = "{\"width\":8,\"output\":{\"format\":\"exr\",\"transparent\":true}}";
+	char *s = api_scene_doc_set_format(d, strlen(d), API_FORMAT_PNG, &n);
+	REQUIRE(s);
+	CHECK(n == strlen(s) && strstr(s, "\"format\":\"png\"") && strstr(s, "\"transparent\":true") &&
+	      strstr(s, "\"width\":8"), "%s", s);
+	free(s);
+	s = api_scene_doc_set_format("{}", 2, API_FORMAT_EXR, &n);
+	CHECK(s && !strcmp(s, "{\"output\":{\"format\":\"exr\"}}"), "%s", s ? s : "(null)");
+	free(s);
+	CHECK(!api_scene_doc_set_format("{\"output\":5}", 12, API_FORMAT_PNG, &n), "a bad output stays the daemon's 400");
+	CHECK(!api_scene_doc_set_format("[1]", 3, API_FORMAT_PNG, &n));
+	CHECK(!api_scene_doc_set_format("{", 1, API_FORMAT_PNG, &n));
+}
