@@ -5,6 +5,7 @@
  */
 #include <errno.h>
 #include <netdb.h>
+#include <poll.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +54,22 @@ bad:
 	return SRV_HTTP_ERR_URL;
 }
 
+/* A connect() a signal interrupted goes on in the background: wait for it (a Ctrl-C that lets
+ * the requests in flight finish must not fail the one being connected). 0, or -1 with errno. */
+static int finish_connect(int fd, unsigned timeout_s)
+{
+	struct pollfd p = {.fd = fd, .events = POLLOUT};
+	int rc;
+	while ((rc = poll(&p, 1, (int)timeout_s * 1000)) < 0 && errno == EINTR) {}
+	if (rc == 0) errno = ETIMEDOUT;
+	if (rc <= 0) return -1;
+	int err = 0;
+	socklen_t len = sizeof err;
+	if (getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &len) < 0) return -1;
+	if (err) { errno = err; return -1; }
+	return 0;
+}
+
 static int dial(const struct srv_http_url *u, unsigned timeout_s, struct srv_http_error *e)
 {
 	struct addrinfo hints = {.ai_family = AF_UNSPEC, .ai_socktype = SOCK_STREAM}, *ai, *a;
@@ -69,7 +86,8 @@ static int dial(const struct srv_http_url *u, unsigned timeout_s, struct srv_htt
 		/* SO_SNDTIMEO also bounds connect() on Linux. */
 		setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
 		setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-		while ((rc = connect(fd, a->ai_addr, a->ai_addrlen)) < 0 && errno == EINTR) {}
+		rc = connect(fd, a->ai_addr, a->ai_addrlen);
+		if (rc < 0 && errno == EINTR) rc = finish_connect(fd, timeout_s);
 		if (rc < 0) { err = errno; close(fd); fd = -1; }
 	}
 	freeaddrinfo(ai);

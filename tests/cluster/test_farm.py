@@ -206,6 +206,9 @@ def remote_equals_local(c, tmp, inputs, ref, local):
     ok("remote and local reports carry the same content hashes",
        all(lh.get(l["file"]) == l.get("hash") for l in lines))
     ok("report has the daemons' stages", all("main" in (l.get("stages") or {}) for l in lines), lines[:1])
+    rows = {r["pxname"]: int(r.get("stot") or 0) for r in c.stats_rows() if r.get("svname") == "BACKEND"}
+    ok("every request went by X-Umbra-Affinity (HAProxy's consistent-hash backend)",
+       rows.get("umbrad_affinity", 0) >= len(inputs) and rows.get("umbrad", -1) == 0, rows)
 
 
 def scenes_same(c, tmp):
