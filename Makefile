@@ -9,7 +9,9 @@
 #   make bench-farm   only the farm benchmark on new models: farm CLI, umbrad c=4, f3d (BENCH_ONLY=farm)
 #   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
+#   make test-farm      umbra-render --server on three daemons behind HAProxy (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
+#   make bench-farm-remote  the local farm against --server on 3 daemons, 300 models
 #   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
 #   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
 BUILD ?= build
@@ -59,7 +61,8 @@ LIBS := $(PKG_LIBS) -lmeshoptimizer -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
-SRV_SRC := $(filter-out server/cli.c server/farm.c,$(wildcard server/*.c))
+FARM_SRC := server/cli.c server/farm.c server/farm_remote.c server/farm_report.c server/http_client.c
+SRV_SRC := $(filter-out $(FARM_SRC),$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)
 # tests/util/: the harness (test.h, test_main.c) and helpers both test binaries share.
@@ -82,7 +85,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster bench-cluster check-deploy print-version
+.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster test-farm bench-cluster bench-farm-remote check-deploy print-version
 all: $(BINS)
 
 deps:
@@ -124,7 +127,7 @@ $(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^
 
-$(BUILD)/umbra-render: $(BUILD)/obj/server/cli.o $(BUILD)/obj/server/farm.o $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/umbra-render: $(FARM_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/server/buf.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 # The sandboxed model importer (api/sandbox.h), started by umbrad and umbra-render; found next to
 # them. --as-needed: it maps only the libraries it uses (no Vulkan, no HTTP).
@@ -137,7 +140,7 @@ $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 # negotiate.o and buf.o: Accept, Content-Type, ETag and the JSON escaper (test_negotiate.c);
 # queue.o: srv_queue_pop_idle; gate.o: the device gate; clock.o: what queue, admit and gate wait with;
 # ranges.o: connections per address range (test_ranges.c).
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/clock.o $(BUILD)/obj/server/gate.o $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/origin.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/obj/server/queue.o $(BUILD)/obj/server/ranges.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/http_client.o $(BUILD)/obj/server/clock.o $(BUILD)/obj/server/gate.o $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/origin.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/obj/server/queue.o $(BUILD)/obj/server/ranges.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
@@ -203,9 +206,17 @@ test-cluster: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) UMBRA_VALIDATION=1 python3 tests/cluster/test_cluster.py
 
+test-farm: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) UMBRA_VALIDATION=1 python3 tests/cluster/test_farm.py
+
 bench-cluster: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) python3 tests/cluster/bench_cluster.py
+
+bench-farm-remote: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) python3 tests/cluster/bench_farm.py 300 256
 
 check-deploy:
 	@sh deploy/check.sh

@@ -253,4 +253,27 @@ struct api_manifest_entry {
 enum api_result api_manifest_line(const char *line, size_t len, struct api_manifest_entry *e, struct api_problem *p);
 void api_manifest_entry_release(struct api_manifest_entry *e);
 
+/* A copy of the scene document doc with "output": {"format": "png" | "exr"} set (compact
+ * JSON, malloc'd, *out_len its length), for a manifest line's output name that picks the
+ * format: umbrad lets an explicit output.format win over Accept. NULL when doc is not a JSON
+ * object (send it as it is: the daemon's 400 says why) or out of memory. api/manifest.c. */
+char *api_scene_doc_set_format(const char *doc, size_t len, enum api_format f, size_t *out_len);
+
+/* One line of a farm report (umbra-render's report.jsonl, read back by --resume), api/manifest.c:
+ * file, output (or NULL), status and hash (or NULL) of the line, malloc'd; release with
+ * api_report_entry_release() (NULL-safe). API_ERR: not such a line (p says why). */
+struct api_report_entry {
+	char *file;
+	char *output;
+	char *status;
+	char *hash;
+};
+enum api_result api_report_line(const char *line, size_t len, struct api_report_entry *e, struct api_problem *p);
+void api_report_entry_release(struct api_report_entry *e);
+
+/* An application/problem+json document (a daemon's answer with HTTP status `status`) back into
+ * p, as api_problem_json() wrote it. A body that is no such document still fills p: its status,
+ * and as detail the start of the body. api/problem.c. */
+void api_problem_parse(const char *body, size_t len, int status, struct api_problem *p);
+
 #endif

@@ -55,3 +55,58 @@ out:
 	json_decref(j);
 	return r;
 }
+
+void api_report_entry_release(struct api_report_entry *e)
+{
+	if (!e) return;
+	free(e->file);
+	free(e->output);
+	free(e->status);
+	free(e->hash);
+	memset(e, 0, sizeof *e);
+}
+
+static char *dup_member(json_t *o, const char *key)
+{
+	json_t *v = json_object_get(o, key);
+	return json_is_string(v) ? strdup(json_string_value(v)) : NULL;
+}
+
+enum api_result api_report_line(const char *line, size_t len, struct api_report_entry *e, struct api_problem *p)
+{
+	memset(e, 0, sizeof *e);
+	json_error_t je;
+	json_t *j = json_loadb(line, len, 0, &je);
+	if (!j) return api_problem_set(p, 400, "", "malformed JSON at column %d: %s", je.column, je.text);
+	enum api_result r = API_OK;
+	e->file = dup_member(j, "file");
+	e->status = dup_member(j, "status");
+	e->output = dup_member(j, "output");
+	e->hash = dup_member(j, "hash");
+	if (!e->file || !e->status) {
+		r = api_problem_set(p, 400, "", "a report line has file and status");
+		api_report_entry_release(e);
+	}
+	json_decref(j);
+	return r;
+}
+
+char *api_scene_doc_set_format(const char *doc, size_t len, enum api_format f, size_t *out_len)
+{
+	json_t *j = json_loadb(doc, len, 0, NULL);
+	if (!json_is_object(j)) {
+		json_decref(j);
+		return NULL;
+	}
+	json_t *out = json_object_get(j, "output");
+	if (out && !json_is_object(out)) {   /* the daemon's 400 at /output says what is wrong */
+		json_decref(j);
+		return NULL;
+	}
+	if (!out) json_object_set_new(j, "output", out = json_object());
+	json_object_set_new(out, "format", json_string(f == API_FORMAT_EXR ? "exr" : "png"));
+	char *s = json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER);
+	json_decref(j);
+	if (s) *out_len = strlen(s);
+	return s;
+}

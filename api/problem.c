@@ -162,3 +162,25 @@ enum api_result api_problem_from_render(struct api_problem *p, const struct api_
 	}
 	return api_problem_set(p, status, ptr, "%s", e->msg[0] ? e->msg : rnd_result_str(e->code));
 }
+
+void api_problem_parse(const char *body, size_t len, int status, struct api_problem *p)
+{
+	memset(p, 0, sizeof *p);
+	json_t *j = body && len ? json_loadb(body, len, 0, NULL) : NULL;
+	const char *detail = j ? json_string_value(json_object_get(j, "detail")) : NULL;
+	if (!detail) {   /* not a problem document (a balancer's HTML page, ...): its first line */
+		size_t n = body ? strcspn(body, "\r\n") : 0;
+		api_problem_set(p, status, "", "%.*s", (int)(n < 200 ? n : 200), body ? body : "");
+		if (!n) snprintf(p->detail, sizeof p->detail, "HTTP status %d without a problem document", status);
+		json_decref(j);
+		return;
+	}
+	api_problem_set(p, status, "", "%s", detail);
+	const char *ptr = json_string_value(json_object_get(j, "pointer"));
+	const char *title = json_string_value(json_object_get(j, "title"));
+	const char *type = json_string_value(json_object_get(j, "type"));
+	if (ptr) snprintf(p->pointer, sizeof p->pointer, "%s", ptr);
+	if (title) snprintf(p->title, sizeof p->title, "%s", title);
+	if (type) snprintf(p->type, sizeof p->type, "%s", type);
+	json_decref(j);
+}

@@ -7,7 +7,9 @@
  *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]
  *                [batch options]
  *   batch options: -j N (threads and render slots, default one per core), --report FILE (JSON lines,
- *                  default DIR/report.jsonl), --progress | --no-progress (default: bar on a tty)
+ *                  default DIR/report.jsonl), --progress | --no-progress (default: bar on a tty),
+ *                  --server URL (render by umbrad / a balancer: -j N requests in flight, default 8),
+ *                  --resume (skip inputs the report has as ok for the same bytes), --shard K/N
  *
  * One scene: exit 0 on success; 2 on an invalid scene (the problem text on stderr, as the
  * server's problem+json would say it); 1 otherwise. The extension of -o picks the format,
@@ -17,6 +19,7 @@
  * another failure happened; 130 when stopped by Ctrl-C (the renders in flight are finished).
  * UMBRA_VALIDATION=1 turns the Vulkan validation layer on; any message then fails the run.
  */
+#include <ctype.h>
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -55,7 +58,14 @@ static int usage(FILE *f, int code)
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
 	           "  -j N         batch: threads and render slots (default: one per core)\n"
 	           "  --report F   batch: JSON-lines report (file, output, status, ms, error, stages); default DIR/report.jsonl\n"
-	           "  --progress, --no-progress  batch: progress bar / plain lines on stderr (default: bar on a tty)\n");
+	           "  --progress, --no-progress  batch: progress bar / plain lines on stderr (default: bar on a tty)\n"
+	           "  --server URL batch: render by umbrad or a cluster at http://HOST:PORT (-j N requests in flight,\n"
+	           "               default 8); same inputs, outputs, report and exit status; retries lost connections,\n"
+	           "               502/504 (4 times) and 503 after Retry-After; a 4xx is `invalid`\n"
+	           "  --resume     batch: skip inputs whose report line says ok for the same bytes (\"hash\") and whose\n"
+	           "               output is there: after Ctrl-C, the same command with --resume renders the rest\n"
+	           "  --shard K/N  batch: only inputs K, K+N, K+2N... (0-based, input order; default report\n"
+	           "               DIR/report-K-of-N.jsonl), e.g. --shard $JOB_COMPLETION_INDEX/4\n");
 	return code;
 }
 
@@ -228,11 +238,24 @@ static bool quality_arg(const char *s, float *q)
 	return true;
 }
 
+/* --shard K/N (0 <= K < N <= 100000); false when it is not that. */
+static bool shard_arg(const char *s, struct farm_opts *o)
+{
+	char *end, *end2;
+	unsigned long k = strtoul(s, &end, 10), n;
+	if (end == s || *end != '/' || !isdigit((unsigned char)s[0])) return false;
+	n = strtoul(end + 1, &end2, 10);
+	if (end2 == end + 1 || *end2 || n == 0 || n > 100000 || k >= n) return false;
+	o->shard_k = (unsigned)k;
+	o->shard_n = (unsigned)n;
+	return true;
+}
+
 /* getopt_long, as umbrad's flags.c: options and inputs in any order ("-" is an input: stdin). */
 static int parse_args(int argc, char **argv, struct args *a)
 {
 	enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
-	       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY };
+	       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY, O_SERVER, O_RESUME, O_SHARD };
 	static const struct option lopts[] = {
 		{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
 		{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
@@ -240,7 +263,8 @@ static int parse_args(int argc, char **argv, struct args *a)
 		{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
 		{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
 		{"up", required_argument, NULL, O_UP}, {"format", required_argument, NULL, O_FORMAT},
-		{"quality", required_argument, NULL, O_QUALITY}, {0},
+		{"quality", required_argument, NULL, O_QUALITY}, {"server", required_argument, NULL, O_SERVER},
+		{"resume", no_argument, NULL, O_RESUME}, {"shard", required_argument, NULL, O_SHARD}, {0},
 	};
 	a->farm.progress = -1;
 	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
@@ -258,6 +282,12 @@ static int parse_args(int argc, char **argv, struct args *a)
 		case O_ASSET_ROOT: a->farm.asset_root = optarg; break;
 		case O_MANIFEST: a->manifest = optarg; break;
 		case O_REPORT: a->report = optarg; break;
+		case O_SERVER: a->farm.server = optarg; break;
+		case O_RESUME: a->farm.resume = true; break;
+		case O_SHARD:
+			if (shard_arg(optarg, &a->farm)) break;
+			fprintf(stderr, "umbra-render: bad option --shard %s (K/N with 0 <= K < N, e.g. 0/4)\n", optarg);
+			return usage(stderr, 1);
 		case O_UP:
 			if ((a->farm.up = up_arg(optarg))) break;
 			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x)\n", optarg);
@@ -280,6 +310,10 @@ static int parse_args(int argc, char **argv, struct args *a)
 	}
 	for (int i = optind; i < argc; i++) a->inputs[a->ninputs++] = argv[i];
 	if (!a->ninputs && !a->manifest) return usage(stderr, 1);
+	if (a->farm.server && a->farm.asset_root) {   /* a scene's "path" is the daemon's to resolve */
+		fprintf(stderr, "umbra-render: --asset-root is the daemon's with --server (umbrad --asset-root)\n");
+		return usage(stderr, 1);
+	}
 	if (a->farm.up && !a->thumb) {   /* a scene says its models' "up" itself */
 		fprintf(stderr, "umbra-render: --up is for thumb (in a scene, give the model object \"up\")\n");
 		return usage(stderr, 1);
@@ -362,6 +396,12 @@ int main(int argc, char **argv)
 		return rc < 0 ? 0 : rc;
 	}
 	bool batch = a.thumb || a.manifest || a.ninputs > 1 || (a.out && is_dir(a.out));
+	if (!batch && (a.farm.server || a.farm.resume || a.farm.shard_n)) {
+		fprintf(stderr, "umbra-render: --server, --resume and --shard are for batches (thumb, several scenes, "
+		        "--manifest, -o DIR/)\n");
+		free(a.inputs);
+		return 1;
+	}
 	if (!batch) {
 		rc = render_one(a.inputs[0], a.out, a.device, a.farm.asset_root, a.timings);
 		free(a.inputs);
@@ -376,8 +416,12 @@ int main(int argc, char **argv)
 	char dir[PATH_MAX];
 	snprintf(dir, sizeof dir, "%s", a.out);
 	for (size_t l = strlen(dir); l > 1 && dir[l - 1] == '/'; l--) dir[l - 1] = 0;
-	char report[PATH_MAX + 16];
-	snprintf(report, sizeof report, "%s/report.jsonl", dir);
+	char report[PATH_MAX + 32];
+	if (a.farm.shard_n > 1)   /* shards writing into one directory each keep their own report */
+		snprintf(report, sizeof report, "%s/report-%u-of-%u.jsonl", dir, a.farm.shard_k, a.farm.shard_n);
+	else
+		snprintf(report, sizeof report, "%s/report.jsonl", dir);
+	if (a.farm.server && !a.farm.threads) a.farm.threads = 8;
 	a.farm.dir = dir;
 	a.farm.report = a.report ? a.report : report;
 	a.farm.device = a.device;

@@ -16,46 +16,20 @@
 #include <unistd.h>
 #include "api.h"
 #include "buf.h"
-#include "farm.h"
+#include "farm_internal.h"
 #include "model_refs.h"
 #include "umbra/rnd.h"
+#include "umbra/rnd_math.h"
 
-enum job_status { JOB_PENDING, JOB_OK, JOB_INVALID, JOB_FAILED, JOB_SKIPPED };
-static const char *const STATUS[] = {"pending", "ok", "invalid", "failed", "skipped"};
+const char *const FARM_STATUS[] = {"pending", "ok", "invalid", "failed", "skipped"};
+#define STATUS FARM_STATUS
 
-struct job_result {
-	enum job_status status;
-	double ms;
-	char stem[PATH_MAX - 8];  /* output path without extension (default names) */
-	char out[PATH_MAX];
-	char error[640];
-	char warnings[1024];      /* api_scene.warnings of a rendered model, "" = none */
-	/* where an `ok` job's time went (the report's "stages") */
-	struct api_import_times imp;
-	struct rnd_timings tm;
-	double parse_ms, encode_ms;
-};
-
-struct farm {
-	struct farm_job *jobs;
-	struct job_result *res;
-	size_t n;
-	const struct farm_opts *o;
-	struct rnd_context *ctx;
-	atomic_size_t next;
-	pthread_mutex_t mu;       /* guards done, failed and the progress output */
-	size_t done, failed;
-	double t0;
-	bool bar;
-};
-
-/* Set by SIGINT/SIGTERM: workers take no new job. */
-static volatile sig_atomic_t g_stop;
+volatile sig_atomic_t farm_stop;
 
 static void on_signal(int sig)
 {
 	(void)sig;
-	g_stop = 1;
+	farm_stop = 1;
 }
 
 double farm_now_ms(void)
@@ -86,7 +60,7 @@ char *farm_read_file(const char *path, size_t *len)
 	return buf;
 }
 
-static const char *label(const struct farm_job *j)
+const char *farm_label(const struct farm_job *j)
 {
 	return j->label ? j->label : j->input ? j->input : "(inline)";
 }
@@ -177,8 +151,53 @@ static bool input_refused(const struct farm_job *j, struct job_result *r)
 	return true;
 }
 
+static void job_input_release(struct job_input *in)
+{
+	free(in->bytes);
+	free(in->parts);
+	api_model_refs_release(&in->refs);
+	memset(in, 0, sizeof *in);
+}
+
+/* Reads job i's bytes once: the scene (or the model, its thumbnail document and the files it
+ * refers to) into *in, and the content hash of them all into r->hash. JOB_OK or the failure. */
+static enum job_status job_read(struct farm *f, size_t i, struct job_input *in)
+{
+	const struct farm_job *j = &f->jobs[i];
+	struct job_result *r = &f->res[i];
+	memset(in, 0, sizeof *in);
+	if (input_refused(j, r)) return JOB_INVALID;
+	if (j->json) {
+		in->doc = j->json;
+		in->doc_len = strlen(j->json);
+	} else if (!(in->bytes = farm_read_file(j->input, &in->len))) {
+		snprintf(r->error, sizeof r->error, "cannot read '%s': %s", j->input, strerror(errno));
+		return JOB_FAILED;
+	} else {
+		in->doc = in->bytes;
+		in->doc_len = in->len;
+	}
+	uint64_t h = rnd_fnv1a(RND_FNV_SEED, in->doc, in->doc_len);
+	if (j->model) {
+		if (thumb_doc(j, f->o, in->thumb, sizeof in->thumb, r->error, sizeof r->error) < 0 ||
+		    model_parts(j->input, (const uint8_t *)in->bytes, in->len, &in->refs, &in->parts, &in->nparts, r->error,
+		                sizeof r->error) < 0) {
+			job_input_release(in);
+			return JOB_INVALID;
+		}
+		for (size_t k = 1; k < in->nparts; k++) {   /* the files it refers to, by name and bytes */
+			h = rnd_fnv1a(h, in->parts[k].name, strlen(in->parts[k].name) + 1);
+			h = rnd_fnv1a(h, in->parts[k].data, in->parts[k].len);
+		}
+		in->doc = in->thumb;
+		in->doc_len = strlen(in->thumb);
+	}
+	snprintf(r->hash, sizeof r->hash, "%016llx", (unsigned long long)h);
+	return JOB_OK;
+}
+
 /* Parses the job's document into *s and settles its output path. JOB_OK or the failure. */
-static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
+static enum job_status job_scene(struct farm *f, size_t i, const struct job_input *in, struct api_scene **s)
 {
 	const struct farm_job *j = &f->jobs[i];
 	struct job_result *r = &f->res[i];
@@ -186,35 +205,8 @@ static enum job_status job_scene(struct farm *f, size_t i, struct api_scene **s)
 	api_limits_defaults(&lim);
 	lim.asset_root = f->o->asset_root;
 	struct api_problem prob;
-	char doc[512];
-	size_t len = 0;
-	char *bytes = NULL;
-	if (input_refused(j, r)) return JOB_INVALID;
-	if (!j->json && !(bytes = farm_read_file(j->input, &len))) {
-		snprintf(r->error, sizeof r->error, "cannot read '%s': %s", j->input, strerror(errno));
-		return JOB_FAILED;
-	}
-	enum api_result ar;
-	if (j->model) {
-		if (thumb_doc(j, f->o, doc, sizeof doc, r->error, sizeof r->error) < 0) {
-			free(bytes);
-			return JOB_INVALID;
-		}
-		struct api_model_refs refs;
-		struct api_part *parts;
-		size_t nparts;
-		if (model_parts(j->input, (const uint8_t *)bytes, len, &refs, &parts, &nparts, r->error, sizeof r->error) < 0) {
-			free(bytes);
-			return JOB_INVALID;
-		}
-		ar = api_scene_parse_parts(doc, strlen(doc), &lim, parts, nparts, s, &prob);
-		free(parts);
-		api_model_refs_release(&refs);
-	} else {
-		const char *text = j->json ? j->json : bytes;
-		ar = api_scene_parse(text, j->json ? strlen(j->json) : len, &lim, s, &prob);
-	}
-	free(bytes);
+	enum api_result ar = in->nparts ? api_scene_parse_parts(in->doc, in->doc_len, &lim, in->parts, in->nparts, s, &prob)
+	                                : api_scene_parse(in->doc, in->doc_len, &lim, s, &prob);
 	if (ar != API_OK) goto invalid;
 	/* An explicit output name picks the format by extension; else the scene's format names it. */
 	enum api_format fmt = (*s)->format;
@@ -239,11 +231,10 @@ invalid:
 	return JOB_INVALID;
 }
 
-/* Writes bytes to path through a temporary name, so a stopped run never leaves half a file. */
-static int write_file(const char *path, const uint8_t *b, size_t n, char *err, size_t esize)
+int farm_write_file(const char *path, const uint8_t *b, size_t n, char *err, size_t esize)
 {
 	char tmp[PATH_MAX + 32];
-	snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+	snprintf(tmp, sizeof tmp, "%s.tmp%ld.%lx", path, (long)getpid(), (unsigned long)pthread_self());
 	FILE *fp = fopen(tmp, "wb");
 	if (!fp) {
 		snprintf(err, esize, "cannot write '%.400s': %s", tmp, strerror(errno));
@@ -258,12 +249,13 @@ static int write_file(const char *path, const uint8_t *b, size_t n, char *err, s
 	return 0;
 }
 
-static enum job_status run_job(struct farm *f, size_t i)
+/* Renders job i here, on the farm's context, and writes its file. */
+static enum job_status local_job(struct farm *f, size_t i, const struct job_input *in)
 {
 	struct job_result *r = &f->res[i];
 	struct api_scene *s = NULL;
 	double t0 = farm_now_ms();
-	enum job_status st = job_scene(f, i, &s);
+	enum job_status st = job_scene(f, i, in, &s);
 	if (st != JOB_OK) return st;
 	r->parse_ms = farm_now_ms() - t0;
 	r->imp = s->import;
@@ -293,10 +285,23 @@ static enum job_status run_job(struct farm *f, size_t i)
 	enum api_result enc = api_encode(s, &img, &bytes, &n, &prob);
 	r->encode_ms = farm_now_ms() - t1;
 	if (enc != API_OK) api_problem_format(&prob, r->error, sizeof r->error);
-	else if (write_file(r->out, bytes, n, r->error, sizeof r->error) == 0) st = JOB_OK;
+	else if (farm_write_file(r->out, bytes, n, r->error, sizeof r->error) == 0) st = JOB_OK;
 	free(bytes);
 	rnd_image_release(&img);
 	api_scene_free(s);
+	return st;
+}
+
+/* Job i: its bytes read and hashed, then skipped (--resume: an earlier run made it), rendered
+ * by the server (--server) or here. */
+static enum job_status run_job(struct farm *f, size_t i)
+{
+	struct job_input in;
+	enum job_status st = job_read(f, i, &in);
+	if (st != JOB_OK) return st;
+	if (f->resume && farm_resume_hit(f->resume, f, i)) f->res[i].resumed = true;
+	else st = f->o->server ? farm_remote_job(f, i, &in) : local_job(f, i, &in);
+	job_input_release(&in);
 	return st;
 }
 
@@ -305,15 +310,17 @@ static enum job_status run_job(struct farm *f, size_t i)
 /* Called with f->mu held after job i finished. */
 static void progress(struct farm *f, size_t i)
 {
-	double el = (farm_now_ms() - f->t0) / 1e3, rate = el > 0 ? f->done / el : 0;
+	/* images/s counts what was rendered now, not what an earlier run made (--resume) */
+	double el = (farm_now_ms() - f->t0) / 1e3, rate = el > 0 ? (f->done - f->resumed) / el : 0;
 	double eta = rate > 0 ? (f->n - f->done) / rate : 0;
 	if (!f->bar) {
-		fprintf(stderr, "umbra-render: [%zu/%zu] %s %s (%.0f ms)%s%s\n", f->done, f->n, label(&f->jobs[i]),
-		        STATUS[f->res[i].status], f->res[i].ms, f->res[i].error[0] ? ": " : "", f->res[i].error);
+		fprintf(stderr, "umbra-render: [%zu/%zu] %s %s%s (%.0f ms)%s%s\n", f->done, f->n, farm_label(&f->jobs[i]),
+		        STATUS[f->res[i].status], f->res[i].resumed ? " (resumed)" : "", f->res[i].ms,
+		        f->res[i].error[0] ? ": " : "", f->res[i].error);
 		return;
 	}
 	if (f->res[i].status != JOB_OK)  /* failures stay on screen above the bar */
-		fprintf(stderr, "\r\033[K%s: %s: %s\n", label(&f->jobs[i]), STATUS[f->res[i].status], f->res[i].error);
+		fprintf(stderr, "\r\033[K%s: %s: %s\n", farm_label(&f->jobs[i]), STATUS[f->res[i].status], f->res[i].error);
 	char bar[31];
 	size_t fill = f->n ? f->done * 30 / f->n : 30;
 	for (size_t k = 0; k < 30; k++) bar[k] = k < fill ? '#' : '.';
@@ -327,7 +334,7 @@ static void *worker(void *arg)
 {
 	struct farm *f = arg;
 	for (;;) {
-		if (g_stop) break;
+		if (farm_stop) break;
 		size_t i = atomic_fetch_add(&f->next, 1);
 		if (i >= f->n) break;
 		double t = farm_now_ms();
@@ -336,61 +343,13 @@ static void *worker(void *arg)
 		f->res[i].status = st;
 		f->res[i].ms = farm_now_ms() - t;
 		f->done++;
+		f->resumed += f->res[i].resumed;
 		if (st != JOB_OK) f->failed++;
+		farm_journal_line(f, i);   /* before the progress line: a line seen means it is in the report */
 		progress(f, i);
 		pthread_mutex_unlock(&f->mu);
 	}
 	return NULL;
-}
-
-/* ---- report ---- */
-
-static void json_str(FILE *fp, const char *s)
-{
-	size_t n = strlen(s) * 6 + 1;   /* every byte may become \u00XX */
-	char *e = malloc(n);
-	if (e) srv_json_escape(e, n, s);
-	fprintf(fp, "\"%s\"", e ? e : "");
-	free(e);
-}
-
-/* An ok job's stages in ms, named as in umbrad's Server-Timing (parse: what parsing spent
- * besides the models' stages; writing the file is the rest of "ms"). */
-static void write_stages(FILE *fp, const struct job_result *r)
-{
-	double in_models = 0;
-	for (int k = 0; k < API_IMPORT_STAGES; k++) in_models += r->imp.ms[k];
-	fprintf(fp, ",\"stages\":{\"parse\":%.2f", r->parse_ms > in_models ? r->parse_ms - in_models : 0.0);
-	if (r->imp.imports || r->imp.ms[API_IMPORT_READ] > 0)
-		for (int k = 0; k < API_IMPORT_STAGES; k++) fprintf(fp, ",\"%s\":%.2f", API_IMPORT_STAGE_NAMES[k], (double)r->imp.ms[k]);
-	fprintf(fp, ",\"upload\":%.2f,\"shadow\":%.2f,\"main\":%.2f,\"readback\":%.2f,\"encode\":%.2f}", r->tm.upload_ms,
-	        r->tm.shadow_ms, r->tm.main_ms, r->tm.readback_ms, r->encode_ms);
-}
-
-static int write_report(const struct farm *f, const char *path)
-{
-	FILE *fp = fopen(path, "w");
-	if (!fp) {
-		fprintf(stderr, "umbra-render: cannot write report '%s': %s\n", path, strerror(errno));
-		return -1;
-	}
-	for (size_t i = 0; i < f->n; i++) {
-		const struct job_result *r = &f->res[i];
-		fputs("{\"file\":", fp);
-		json_str(fp, label(&f->jobs[i]));
-		fputs(",\"output\":", fp);
-		if (r->status == JOB_OK) json_str(fp, r->out);
-		else fputs("null", fp);
-		fprintf(fp, ",\"status\":\"%s\",\"ms\":%.1f,\"error\":", STATUS[r->status], r->ms);
-		if (r->error[0]) json_str(fp, r->error);
-		else fputs("null", fp);
-		fputs(",\"warnings\":", fp);   /* what of a model's material is not drawn (Umbra-Warnings) */
-		if (r->warnings[0]) json_str(fp, r->warnings);
-		else fputs("null", fp);
-		if (r->status == JOB_OK) write_stages(fp, r);
-		fputs("}\n", fp);
-	}
-	return fclose(fp) == 0 ? 0 : -1;
 }
 
 /* ---- the run ---- */
@@ -435,12 +394,81 @@ static int summary(const struct farm *f, unsigned threads)
 	for (size_t i = 0; i < f->n; i++) cnt[f->res[i].status]++;
 	cnt[JOB_SKIPPED] += cnt[JOB_PENDING];
 	double s = (farm_now_ms() - f->t0) / 1e3;
-	fprintf(stderr, "umbra-render: %zu ok, %zu invalid, %zu failed, %zu skipped of %zu in %.1f s (%.2f images/s, "
-	        "%u threads)%s\n", cnt[JOB_OK], cnt[JOB_INVALID], cnt[JOB_FAILED], cnt[JOB_SKIPPED], f->n, s,
-	        s > 0 ? cnt[JOB_OK] / s : 0.0, threads, g_stop ? ", interrupted" : "");
-	if (g_stop) return 130;
+	char resumed[48] = "";
+	if (f->resumed) snprintf(resumed, sizeof resumed, " (%zu from the earlier run)", f->resumed);
+	fprintf(stderr, "umbra-render: %zu ok%s, %zu invalid, %zu failed, %zu skipped of %zu in %.1f s (%.2f images/s, "
+	        "%u %s)%s\n", cnt[JOB_OK], resumed, cnt[JOB_INVALID], cnt[JOB_FAILED], cnt[JOB_SKIPPED], f->n, s,
+	        s > 0 ? (cnt[JOB_OK] - f->resumed) / s : 0.0, threads, f->o->server ? "requests in flight" : "threads",
+	        farm_stop ? ", interrupted" : "");
+	if (farm_stop) return 130;
 	if (cnt[JOB_FAILED]) return 1;
 	return cnt[JOB_INVALID] ? 2 : 0;
+}
+
+/* --shard K/N: keeps inputs K, K+N, ... (their output names were settled over all inputs, so a
+ * shard names a file as the whole run would). f->jobs becomes a malloc'd copy. */
+static int take_shard(struct farm *f)
+{
+	unsigned k = f->o->shard_k, n = f->o->shard_n;
+	struct farm_job *jobs = malloc((f->n / n + 1) * sizeof *jobs);
+	if (!jobs) return -1;
+	size_t m = 0;
+	for (size_t i = k; i < f->n; i += n) {
+		jobs[m] = f->jobs[i];
+		f->res[m++] = f->res[i];
+	}
+	f->jobs = jobs;
+	f->n = m;
+	return 0;
+}
+
+/* The device (local) or the server's URL (remote), and the earlier report (--resume). */
+static int farm_open(struct farm *f, unsigned threads)
+{
+	const struct farm_opts *o = f->o;
+	if (o->server) {
+		struct srv_http_error he;
+		if (srv_http_url_parse(o->server, &f->url, &he) != SRV_HTTP_OK) {
+			fprintf(stderr, "umbra-render: --server: %s\n", he.msg);
+			return -1;
+		}
+	} else {
+		const char *v = getenv("UMBRA_VALIDATION");
+		struct rnd_context_desc cd = {.device_name = o->device, .validation = v && *v == '1', .slots = threads,
+		                              .log = log_cb};
+		struct rnd_error err;
+		if (rnd_context_create(&cd, &f->ctx, &err) != RND_OK) {
+			fprintf(stderr, "umbra-render: %s\n", err.msg);
+			return -1;
+		}
+	}
+	if (o->resume && o->report && !(f->resume = farm_resume_load(o->report))) {
+		fprintf(stderr, "umbra-render: out of memory reading '%s'\n", o->report);
+		return -1;
+	}
+	/* The report is rewritten in input order at the end; until then a line is added per
+	 * finished job, in the order they finish, after the earlier report's lines when resuming
+	 * (so a run killed before it reached them keeps them too; the last line of a file wins). */
+	if (o->report && !(f->journal = fopen(o->report, o->resume ? "a" : "w"))) {
+		fprintf(stderr, "umbra-render: cannot write report '%s': %s\n", o->report, strerror(errno));
+		return -1;
+	}
+	return 0;
+}
+
+static void run_workers(struct farm *f, unsigned threads)
+{
+	struct sigaction sa = {.sa_handler = on_signal}, old_int, old_term;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGINT, &sa, &old_int);
+	sigaction(SIGTERM, &sa, &old_term);
+	pthread_t tids[64];
+	unsigned started = 0;
+	while (started < threads && pthread_create(&tids[started], NULL, worker, f) == 0) started++;
+	if (!started) worker(f);   /* no thread could start: work on this one */
+	for (unsigned k = 0; k < started; k++) pthread_join(tids[k], NULL);
+	sigaction(SIGINT, &old_int, NULL);
+	sigaction(SIGTERM, &old_term, NULL);
 }
 
 int farm_run(struct farm_job *jobs, size_t n, const struct farm_opts *o)
@@ -454,39 +482,29 @@ int farm_run(struct farm_job *jobs, size_t n, const struct farm_opts *o)
 	if (!f.res) return 1;
 	f.bar = o->progress > 0 || (o->progress < 0 && isatty(2));
 	name_outputs(&f);
-	unsigned threads = thread_count(o, n);
-	const char *v = getenv("UMBRA_VALIDATION");
-	struct rnd_context_desc cd = {.device_name = o->device, .validation = v && *v == '1', .slots = threads,
-	                              .log = log_cb};
-	struct rnd_error err;
 	int rc = 1;
-	if (rnd_context_create(&cd, &f.ctx, &err) != RND_OK) {
-		fprintf(stderr, "umbra-render: %s\n", err.msg);
-		goto out_res;
-	}
+	if (o->shard_n > 1 && take_shard(&f) < 0) goto out_res;
+	unsigned threads = thread_count(o, f.n);
 	pthread_mutex_init(&f.mu, NULL);
-	struct sigaction sa = {.sa_handler = on_signal}, old_int, old_term;
-	sigemptyset(&sa.sa_mask);
-	sigaction(SIGINT, &sa, &old_int);
-	sigaction(SIGTERM, &sa, &old_term);
-	pthread_t tids[64];
-	unsigned started = 0;
-	while (started < threads && pthread_create(&tids[started], NULL, worker, &f) == 0) started++;
-	if (!started) worker(&f);   /* no thread could start: work on this one */
-	for (unsigned k = 0; k < started; k++) pthread_join(tids[k], NULL);
-	sigaction(SIGINT, &old_int, NULL);
-	sigaction(SIGTERM, &old_term, NULL);
+	if (farm_open(&f, threads) < 0) goto out_open;
+	run_workers(&f, threads);
 	if (f.bar && f.done < f.n) fputc('\n', stderr);
-	for (size_t i = 0; i < n; i++)
+	for (size_t i = 0; i < f.n; i++)
 		if (f.res[i].status == JOB_PENDING) f.res[i].status = JOB_SKIPPED;
 	rc = summary(&f, threads);
-	if (o->report && write_report(&f, o->report) < 0 && rc == 0) rc = 1;
-	if (rnd_context_validation_messages(f.ctx)) {
+	if (f.journal) fclose(f.journal);
+	f.journal = NULL;
+	if (o->report && farm_write_report(&f, o->report) < 0 && rc == 0) rc = 1;
+	if (f.ctx && rnd_context_validation_messages(f.ctx)) {
 		fprintf(stderr, "umbra-render: %u Vulkan validation messages\n", rnd_context_validation_messages(f.ctx));
 		if (rc == 0) rc = 1;
 	}
+out_open:
+	if (f.journal) fclose(f.journal);
+	farm_resume_free(f.resume);
 	rnd_context_destroy(f.ctx);
 	pthread_mutex_destroy(&f.mu);
+	if (f.jobs != jobs) free(f.jobs);
 out_res:
 	free(f.res);
 	return rc;

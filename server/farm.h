@@ -13,11 +13,18 @@
  * to (a .gltf's .bin and images, an .obj's .mtl and textures) read from the model's own
  * directory as further parts (api/model_refs.h's rules, that directory as the root). Progress goes to
  * stderr: a bar (done/total, images/s, ETA) on a terminal, one line per finished job otherwise.
+ * opts.server: no renderer here; each job is POSTed to umbrad (or a balancer) with the same
+ * document and parts, `threads` requests in flight, retried when the connection was lost or a
+ * balancer said 502/503/504 (server/farm_remote.c). opts.resume: a job whose earlier report
+ * line says ok for the same content hash, and whose output is there, is not rendered again;
+ * while the run goes the report holds a line per finished job (flushed), so a farm killed by
+ * SIGKILL resumes too, and it is rewritten in input order at the end.
  * SIGINT / SIGTERM: no new job starts; the renders in flight finish and are written; the rest
  * are reported "skipped". The report (JSON lines, input order) has file, output, status (ok,
  * invalid: a bad scene or model, or an input that is a directory or an empty model file;
- * failed, skipped), ms, error. opts.up gives every model object that `up` (Z-up STL files);
- * opts.format and opts.quality every thumbnail that output.format and output.quality.
+ * failed, skipped), ms, error, hash (of the input's files). opts.up gives every model object
+ * that `up` (Z-up STL files); opts.format and opts.quality every thumbnail that output.format
+ * and output.quality.
  *
  * Ownership: jobs and their strings belong to the caller. farm_run() is not reentrant (signal
  * handlers); call it once per process.
@@ -49,6 +56,9 @@ struct farm_opts {
 	bool lossy;               /* thumbnails: output.quality = quality (lossy WebP); false: none (lossless) */
 	float quality;            /* 0..100, with lossy */
 	int progress;             /* -1 auto (bar on a tty), 0 plain lines, 1 bar */
+	const char *server;       /* http://HOST:PORT of umbrad or a balancer: render there, not here */
+	bool resume;              /* skip inputs the report already has as ok, same hash, output there */
+	unsigned shard_k, shard_n; /* shard_n > 1: only inputs k, k+N, k+2N, ... (0-based input order) */
 };
 
 int farm_run(struct farm_job *jobs, size_t n, const struct farm_opts *o);

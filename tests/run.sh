@@ -57,6 +57,9 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/umbrad" ] && run_suite http-origin sh tests/http/origin.sh
 [ -z "${ASAN:-}" ] && run_suite deploy sh deploy/check.sh
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
+# umbra-render thumb --server: the farm on three daemons behind HAProxy (and a fake server).
+command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && [ -x "$BUILD/umbra-render" ] &&
+	run_suite farm-remote env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_farm.py
 [ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
 # api/scene.schema.json against the daemon (ajv from tests/browser's tooling; skipped without node).

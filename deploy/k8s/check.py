@@ -16,6 +16,9 @@ its kind requires, and that the pieces agree with each other and with umbrad:
     variable the container needs; values are strings;
   - Service and PodDisruptionBudget selectors match the pods; Service targetPort names a
     container port; HPAs target the Deployment and have min <= max;
+  - Job (the farm, farm-job.yaml): Indexed, its completions = the N of `--shard
+    $JOB_COMPLETION_INDEX/N`, --resume, --server naming a Service here on its port, the same
+    security settings as the Deployment, every mounted volume declared;
   - kustomization.yaml lists files that exist.
 Prints "ok - x" / "FAIL - x" and "N passed, N failed"; exit 1 on a failure.
 """
@@ -110,6 +113,36 @@ def check_deployment(f, d, cms):
     return labels, ports
 
 
+def check_job(f, d, services):
+    """The farm's Indexed Job: shards, resume, a Service it can reach, a locked-down pod."""
+    name = "%s Job/%s" % (f, get(d, "metadata.name"))
+    spec, pod = d.get("spec", {}), get(d, "spec.template.spec", {})
+    c = (pod.get("containers") or [{}])[0]
+    cmd = " ".join(str(x) for x in (c.get("command") or []) + (c.get("args") or []))
+    check(name + ": completionMode Indexed", spec.get("completionMode") == "Indexed")
+    m = re.search(r"--shard \"?\$\(?JOB_COMPLETION_INDEX\)?/(\d+)", cmd)
+    check(name + ": --shard $JOB_COMPLETION_INDEX/N with N = completions %s" % spec.get("completions"),
+          m and int(m.group(1)) == spec.get("completions"), m and m.group(0))
+    check(name + ": parallelism <= completions", spec.get("parallelism", 1) <= spec.get("completions", 0))
+    check(name + ": runs umbra-render thumb --resume", "umbra-render thumb" in cmd and "--resume" in cmd, cmd)
+    srv = re.search(r"--server http://([a-z0-9-]+)(?::(\d+))?", cmd)
+    port = int(srv.group(2) or 80) if srv else None
+    ok_srv = srv and srv.group(1) in services and port in services[srv.group(1)]
+    check(name + ": --server names a Service here on one of its ports", ok_srv, srv and srv.group(0))
+    check(name + ": restartPolicy Never or OnFailure", pod.get("restartPolicy") in ("Never", "OnFailure"))
+    sc, psc = c.get("securityContext", {}), pod.get("securityContext", {})
+    check(name + ": readOnlyRootFilesystem, no privilege escalation, capabilities drop ALL",
+          sc.get("readOnlyRootFilesystem") is True and sc.get("allowPrivilegeEscalation") is False and
+          "ALL" in (get(sc, "capabilities.drop") or []))
+    check(name + ": non-root user", bool(psc.get("runAsNonRoot")) and int(psc.get("runAsUser", 0)) != 0)
+    for kind in ("requests", "limits"):
+        r = get(c, "resources." + kind, {})
+        check("%s: resources.%s cpu and memory" % (name, kind), "cpu" in r and "memory" in r, r)
+    vols = {v.get("name") for v in pod.get("volumes", [])}
+    mounts = [mt.get("name") for mt in c.get("volumeMounts", [])]
+    check(name + ": every mount has a volume", all(mt in vols for mt in mounts), mounts)
+
+
 def main(argv):
     root = argv[0] if argv else os.path.dirname(os.path.abspath(__file__))
     build = os.environ.get("BUILD", "build")
@@ -126,7 +159,7 @@ def main(argv):
     required = {"ConfigMap": ["data"], "Deployment": ["spec.selector", "spec.template.spec.containers"],
                 "Service": ["spec.ports", "spec.selector"], "PodDisruptionBudget": ["spec.selector"],
                 "HorizontalPodAutoscaler": ["spec.scaleTargetRef", "spec.maxReplicas", "spec.metrics"],
-                "Kustomization": ["resources"]}
+                "Kustomization": ["resources"], "Job": ["spec.completions", "spec.template.spec.containers"]}
     for f, d in docs:
         kind = d.get("kind")
         fields = ["apiVersion", "kind"] + ([] if kind == "Kustomization" else ["metadata.name"])
@@ -144,6 +177,12 @@ def main(argv):
     for f, d in docs:
         if d.get("kind") == "Deployment":
             deps[get(d, "metadata.name")] = check_deployment(f, d, cms)
+    services = {get(d, "metadata.name"): {p.get("port") for p in get(d, "spec.ports", [])}
+                for f, d in docs if d.get("kind") == "Service"}
+    jobs = [(f, d) for f, d in docs if d.get("kind") == "Job"]
+    check("a farm Job is here (farm-job.yaml)", bool(jobs))
+    for f, d in jobs:
+        check_job(f, d, services)
     for f, d in docs:
         kind, name = d.get("kind"), "%s %s/%s" % (f, d.get("kind"), get(d, "metadata.name"))
         if kind == "Service":

@@ -17,7 +17,8 @@ const { Service } = await load('kubernetes-models/v1/Service.js');
 const { Deployment } = await load('kubernetes-models/apps/v1/Deployment.js');
 const { HorizontalPodAutoscaler } = await load('kubernetes-models/autoscaling/v2/HorizontalPodAutoscaler.js');
 const { PodDisruptionBudget } = await load('kubernetes-models/policy/v1/PodDisruptionBudget.js');
-const kinds = { ConfigMap, Service, Deployment, HorizontalPodAutoscaler, PodDisruptionBudget };
+const { Job } = await load('kubernetes-models/batch/v1/Job.js');
+const kinds = { ConfigMap, Service, Deployment, HorizontalPodAutoscaler, PodDisruptionBudget, Job };
 
 let pass = 0, fail = 0;
 for (const f of process.argv.slice(2)) {
