@@ -104,7 +104,7 @@ char *api_scene_doc_set_format(const char *doc, size_t len, enum api_format f, s
 		return NULL;
 	}
 	if (!out) json_object_set_new(j, "output", out = json_object());
-	json_object_set_new(out, "format", json_string(f == API_FORMAT_EXR ? "exr" : "png"));
+	json_object_set_new(out, "format", json_string(api_format_name(f)));
 	char *s = json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER);
 	json_decref(j);
 	if (s) *out_len = strlen(s);

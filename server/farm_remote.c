@@ -110,18 +110,23 @@ static enum job_status take_image(struct farm *f, size_t i, const struct srv_htt
 {
 	const struct farm_job *j = &f->jobs[i];
 	struct job_result *r = &f->res[i];
-	bool exr = !strncasecmp(resp->content_type, "image/x-exr", 11);
-	if (!exr && strncasecmp(resp->content_type, "image/png", 9)) {
+	int got = -1;
+	for (int k = API_FORMAT_PNG; k <= API_FORMAT_WEBP; k++) {
+		const char *mime = api_format_mime((enum api_format)k);
+		if (!strncasecmp(resp->content_type, mime, strlen(mime))) got = k;
+	}
+	if (got < 0) {
 		snprintf(r->error, sizeof r->error, "the server answered 200 with '%.100s', not an image", resp->content_type);
 		return JOB_FAILED;
 	}
-	const char *dot = j->out ? strrchr(j->out, '.') : NULL;
-	if (dot && !strcasecmp(dot, exr ? ".png" : ".exr")) {
-		snprintf(r->error, sizeof r->error, "the server answered %s for '%s'", exr ? "EXR" : "PNG", j->out);
+	enum api_format want;
+	if (j->out && api_format_from_name(j->out, &want) && want != (enum api_format)got) {
+		snprintf(r->error, sizeof r->error, "the server answered %s for '%s'", api_format_mime((enum api_format)got),
+		         j->out);
 		return JOB_FAILED;
 	}
 	if (j->out) snprintf(r->out, sizeof r->out, "%s", j->out);
-	else snprintf(r->out, sizeof r->out, "%s.%s", r->stem, exr ? "exr" : "png");
+	else snprintf(r->out, sizeof r->out, "%s.%s", r->stem, api_format_name((enum api_format)got));
 	snprintf(r->warnings, sizeof r->warnings, "%s", resp->warnings);
 	snprintf(r->timing, sizeof r->timing, "%s", resp->server_timing);
 	return farm_write_file(r->out, resp->body, resp->len, r->error, sizeof r->error) == 0 ? JOB_OK : JOB_FAILED;
@@ -132,11 +137,11 @@ static int request_headers(const struct farm *f, size_t i, const struct multipar
 {
 	const struct farm_job *j = &f->jobs[i];
 	const struct job_result *r = &f->res[i];
-	const char *dot = j->out ? strrchr(j->out, '.') : NULL, *accept = "";
+	char accept[64] = "";
+	enum api_format want;
 	if (j->out) {
-		if (dot && !strcasecmp(dot, ".png")) accept = "Accept: image/png\r\n";
-		else if (dot && !strcasecmp(dot, ".exr")) accept = "Accept: image/x-exr\r\n";
-		else return -1;
+		if (!api_format_from_name(j->out, &want)) return -1;
+		snprintf(accept, sizeof accept, "Accept: %s\r\n", api_format_mime(want));
 	}
 	if (m->boundary[0])
 		snprintf(h, size, "Content-Type: multipart/form-data; boundary=%s\r\n%sX-Umbra-Affinity: %s\r\n"
@@ -158,16 +163,16 @@ enum job_status farm_remote_job(struct farm *f, size_t i, const struct job_input
 	}
 	char headers[512];
 	if (request_headers(f, i, &m, headers, sizeof headers) < 0) {
-		snprintf(r->error, sizeof r->error, "output '%s' must end in .png or .exr", f->jobs[i].out);
+		snprintf(r->error, sizeof r->error, "output '%s' must end in .png, .exr or .webp", f->jobs[i].out);
 		multipart_release(&m);
 		return JOB_INVALID;
 	}
 	/* A scene whose output name picks the format says so in its document (umbrad lets an
 	 * explicit output.format win over Accept, where the local farm lets the name win). */
-	const char *dot = f->jobs[i].out ? strrchr(f->jobs[i].out, '.') : NULL;
+	enum api_format want;
+	bool named = f->jobs[i].out && api_format_from_name(f->jobs[i].out, &want);
 	size_t fixed_len = 0;
-	char *fixed = dot && !in->nparts ? api_scene_doc_set_format(in->doc, in->doc_len, strcasecmp(dot, ".exr") ?
-	                                                            API_FORMAT_PNG : API_FORMAT_EXR, &fixed_len) : NULL;
+	char *fixed = named && !in->nparts ? api_scene_doc_set_format(in->doc, in->doc_len, want, &fixed_len) : NULL;
 	struct srv_http_chunk json = {fixed ? fixed : in->doc, fixed ? fixed_len : in->doc_len};
 	unsigned lost = 0, busy = 0;
 	enum job_status st = JOB_FAILED;
