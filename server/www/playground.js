@@ -235,7 +235,7 @@ function pretty(v) {
   return JSON.stringify(v, null, 2).replace(/\[\s+(-?[\d.eE+-]+(?:,\s+-?[\d.eE+-]+)*)\s+\]/g,
     (m, g) => '[' + g.split(/,\s+/).join(', ') + ']');
 }
-function setText(t) { ed.value = t; ed.scrollTop = 0; closeSuggest(); clearError(); }
+function setText(t) { ed.value = t; ed.scrollTop = 0; closeSuggest(); clearError(); helpLine(null); }
 
 // ---- the schema: completion and help ----
 // The scene schema (api/scene.schema.json, spliced in by embed.sh) walked along the JSON path at
@@ -550,6 +550,7 @@ async function renderNow() {
     if (e.line === undefined) throw e;
     showError(e.line, 'JSON syntax: ' + e.message, e.col);
     $('status').textContent = 'not sent: the JSON does not parse';
+    $('images').classList.add('stale');
     return;
   }
   clearError();

@@ -160,6 +160,7 @@ async function main() {
       await page.keyboard.type('"f');
       await page.waitForSelector('#suggest:not([hidden]) li', { timeout: TIMEOUT });
       let sg = await suggestions(page);
+      if (process.env.SHOT) await page.screenshot({ path: process.env.SHOT.replace(/\.png$/, '-completion.png') });
       const fov = sg.find((x) => x.name === 'fov_y');
       check('completion: camera members starting with f, described', fov && /Vertical field of view/.test(fov.help) &&
         ['far', 'fit'].every((n) => sg.some((x) => x.name === n)) && !sg.some((x) => x.name === 'width'), JSON.stringify(sg).slice(0, 300));
