@@ -729,6 +729,9 @@ $('examples').addEventListener('change', () => {
   if (k === 'other') return;
   const o = $('examples').querySelector('option[value="other"]');
   if (o) o.remove();
+  // An example is not the dropped model's scene: the model goes with it.
+  model = null;
+  $('model').textContent = '';
   source = { file: slug(EXAMPLES[+k][0].replace(/^Filter: /, 'filter ')) };
   setText(pretty(EXAMPLES[+k][1]()));
   lightsChanged();

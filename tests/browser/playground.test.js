@@ -357,7 +357,11 @@ async function main() {
     check('no Content-Security-Policy violations', violations.length === 0 && domViolations.length === 0,
       (violations.length + domViolations.length) + ': ' + violations.concat(domViolations).slice(0, 2).join('; ').slice(0, 400));
 
+    await pick(page, 'Filter: hard');
+    const modelLabel = await page.$eval('#model', (e) => e.textContent);
+    check('an example picked after a drop: the model is let go', modelLabel === '', modelLabel);
     if (process.env.SHOT) {
+      await page.waitForFunction(() => [...document.querySelectorAll('header button')].every((b) => !/copied/i.test(b.textContent)), { timeout: TIMEOUT });
       await pick(page, 'Filter: pcss');
       await rendered(page, () => page.click('#compare'));
       await page.screenshot({ path: process.env.SHOT });
