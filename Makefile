@@ -118,11 +118,11 @@ $(RND_OBJ): | $(SHADER_HDRS)
 $(BUILD)/librenderer.a: $(RND_OBJ)
 	@rm -f $@; ar rcs $@ $^
 # The playground page (server/www/) inlined into one HTML document, with the bench scenes of
-# $(SHARED)/bench when present, and embedded in umbrad as a C array (xxd -i).
+# $(SHARED)/bench when present and the scene schema (for the editor's help), and embedded in umbrad as a C array (xxd -i).
 BENCH_JSON := $(wildcard $(SHARED)/bench/*.json)
-$(BUILD)/www/playground_page.h: $(wildcard server/www/*) $(BENCH_JSON)
+$(BUILD)/www/playground_page.h: $(wildcard server/www/*) api/scene.schema.json $(BENCH_JSON)
 	@mkdir -p $(dir $@)
-	sh server/www/embed.sh server/www $(BUILD)/www $(BENCH_JSON)
+	sh server/www/embed.sh server/www $(BUILD)/www api/scene.schema.json $(BENCH_JSON)
 $(BUILD)/obj/server/playground.o: $(BUILD)/www/playground_page.h
 $(BUILD)/libapi.a: $(API_OBJ)
 	@rm -f $@; ar rcs $@ $^

@@ -14,7 +14,7 @@ const $ = (id) => document.getElementById(id);
 function parseJsonLines(text) {
   let i = 0, line = 1, col0 = 0;
   const lines = new Map();
-  const fail = (msg) => { throw { message: msg, line, col: i - col0 + 1 }; };
+  const fail = (msg) => { throw { message: (i >= text.length ? 'the document ends early: ' : '') + msg, line, col: i - col0 + 1 }; };
   const ws = () => {
     for (;;) {
       const c = text[i];
@@ -70,7 +70,7 @@ function parseJsonLines(text) {
     }
     if (c === '"') return str();
     const m = /^(-?(0|[1-9]\d*)(\.\d+)?([eE][+-]?\d+)?|true|false|null)/.exec(text.slice(i, i + 400));
-    if (!m) fail(c === undefined ? 'unexpected end of the document' : 'unexpected "' + c + '"');
+    if (!m) fail(c === undefined ? 'a value expected' : 'unexpected "' + c + '"');
     i += m[0].length;
     return JSON.parse(m[0]);
   }
@@ -185,16 +185,19 @@ function gutter(bad) {
   $('gutter').scrollTop = ed.scrollTop;
 }
 let errLine = 0;
+// The message goes under its line, or above it where under would leave the editor (the last lines).
 function place() {
-  const y = 6 + (errLine - 1) * LINE - ed.scrollTop;
+  const y = 6 + (errLine - 1) * LINE - ed.scrollTop, err = $('error');
   $('hl').style.top = y + 'px';
   $('hl').style.display = errLine ? 'block' : 'none';
-  $('error').style.top = (y + LINE + 2) + 'px';
+  let top = y + LINE + 2;
+  if (!err.hidden && top + err.offsetHeight > ed.clientHeight - 2) top = Math.max(2, y - err.offsetHeight - 2);
+  err.style.top = top + 'px';
   $('gutter').scrollTop = ed.scrollTop;
 }
-function showError(line, msg) {
+function showError(line, msg, col) {
   errLine = line;
-  $('error').textContent = 'line ' + line + ': ' + msg;
+  $('error').textContent = 'line ' + line + (col ? ', column ' + col : '') + ': ' + msg;
   $('error').hidden = false;
   $('error').dataset.line = line;
   gutter(line);
@@ -210,10 +213,21 @@ function clearError() {
   gutter(0);
   place();
 }
-ed.addEventListener('input', () => { if (errLine) clearError(); else gutter(0); });
-ed.addEventListener('scroll', place);
+ed.addEventListener('input', (e) => {
+  if (errLine) clearError(); else gutter(0);
+  lightsChanged();
+  if (e.inputType && (e.inputType.startsWith('insert') || sugg)) showSuggest(false);
+});
+ed.addEventListener('scroll', () => { closeSuggest(); place(); });
 ed.addEventListener('keydown', (e) => {
-  if (e.key === 'Enter' && (e.ctrlKey || e.metaKey)) { e.preventDefault(); render(); }
+  if (e.key === 'Enter' && (e.ctrlKey || e.metaKey)) { e.preventDefault(); closeSuggest(); render(); return; }
+  if (e.key === ' ' && e.ctrlKey) { e.preventDefault(); showSuggest(true); return; }
+  if (sugg) {
+    const n = sugg.items.length;
+    if (e.key === 'ArrowDown' || e.key === 'ArrowUp') { e.preventDefault(); sugg.on = (sugg.on + (e.key === 'ArrowDown' ? 1 : n - 1)) % n; markSuggest(); return; }
+    if (e.key === 'Tab' || e.key === 'Enter') { e.preventDefault(); acceptSuggest(sugg.on); return; }
+    if (e.key === 'Escape') { e.preventDefault(); closeSuggest(); return; }
+  }
   if (e.key === 'Tab') { e.preventDefault(); document.execCommand('insertText', false, '  '); }
 });
 // JSON.stringify with two-space indents, but arrays of numbers on one line ([0, 1, 0]).
@@ -221,7 +235,233 @@ function pretty(v) {
   return JSON.stringify(v, null, 2).replace(/\[\s+(-?[\d.eE+-]+(?:,\s+-?[\d.eE+-]+)*)\s+\]/g,
     (m, g) => '[' + g.split(/,\s+/).join(', ') + ']');
 }
-function setText(t) { ed.value = t; ed.scrollTop = 0; clearError(); }
+function setText(t) { ed.value = t; ed.scrollTop = 0; closeSuggest(); clearError(); helpLine(null); }
+
+// ---- the schema: completion and help ----
+// The scene schema (api/scene.schema.json, spliced in by embed.sh) walked along the JSON path at
+// the caret. scanAt() reads the editor's text as it is, broken or half typed: a stack of the open
+// objects and arrays, each with the members seen so far (values only when they are strings,
+// numbers or booleans: enough for the schema's if/then on "shape" and "type").
+const SCHEMA = window.UMBRA_SCHEMA || {};
+function scanAt(text, cur) {
+  const stack = [];
+  let snap = null, i = 0;
+  const top = () => stack[stack.length - 1];
+  // The path to the innermost container: its frames, each with its key or index then.
+  const frames = () => stack.map((f) => ({ kind: f.kind, members: f.members, seg: f.kind === 'obj' ? f.key : f.index }));
+  const inKey = () => { const f = top(); return !!f && f.kind === 'obj' && f.expectKey; };
+  const at = (extra) => { snap = Object.assign({ frames: frames(), where: stack.length ? (inKey() ? 'key' : 'value') : 'root', from: cur, to: cur, prefix: '' }, extra); };
+  while (i < text.length) {
+    const c = text[i];
+    if (c === ' ' || c === '\n' || c === '\t' || c === '\r') { i++; continue; }
+    if (!snap && i >= cur) at({});
+    const start = i, f = top();
+    if (c === '"') {
+      for (i++; i < text.length && text[i] !== '"' && text[i] !== '\n'; i++) if (text[i] === '\\') i++;
+      const closed = text[i] === '"';
+      if (closed) i++;
+      let s;
+      try { s = JSON.parse(closed ? text.slice(start, i) : text.slice(start, i) + '"'); } catch (e) { s = text.slice(start + 1, closed ? i - 1 : i); }
+      if (!snap && cur > start && (cur < i || !closed)) at({ inString: true, from: start, to: i, prefix: text.slice(start + 1, cur), token: s });
+      if (inKey()) { f.key = s; f.expectKey = false; f.members[s] = undefined; } else if (f && f.kind === 'obj') f.members[f.key] = s;
+      continue;
+    }
+    i++;
+    if (c === '{' || c === '[') stack.push({ kind: c === '{' ? 'obj' : 'arr', key: null, index: 0, members: {}, expectKey: c === '{' });
+    else if (c === '}' || c === ']') stack.pop();
+    else if (c === ',' && f) { if (f.kind === 'obj') { f.expectKey = true; f.key = null; } else f.index++; }
+    else if (c !== ':') {
+      while (i < text.length && !/[\s,:{}[\]"]/.test(text[i])) i++;
+      const w = text.slice(start, i);
+      if (!snap && cur > start && cur <= i) at({ from: start, to: i, prefix: text.slice(start, cur), token: w });
+      if (f && f.kind === 'obj' && !f.expectKey) { try { f.members[f.key] = JSON.parse(w); } catch (e) { /* half typed */ } }
+    }
+  }
+  if (!snap) at({});
+  return snap;
+}
+function schemaRef(ref) {
+  return ref.replace(/^#\/?/, '').split('/').filter(Boolean)
+    .reduce((o, k) => o && o[k.replace(/~1/g, '/').replace(/~0/g, '~')], SCHEMA);
+}
+// Does an `if` hold for an object whose members are known as far as scanAt saw them?
+function holds(cond, members) {
+  if (!members) return false;
+  if ((cond.required || []).some((k) => !(k in members))) return false;
+  return Object.entries(cond.properties || {}).every(([k, p]) => {
+    if (!(k in members) || members[k] === undefined) return !(cond.required || []).includes(k);
+    if ('const' in p) return members[k] === p.const;
+    if (p.enum) return p.enum.includes(members[k]);
+    return true;
+  }) && !cond.not;
+}
+// Every schema node that applies to a value: $ref, allOf/anyOf/oneOf and if/then expanded.
+function applying(s, members, out = [], depth = 0) {
+  if (!s || typeof s !== 'object' || depth > 24) return out;
+  out.push(s);
+  if (s.$ref) applying(schemaRef(s.$ref), members, out, depth + 1);
+  ['allOf', 'anyOf', 'oneOf'].forEach((k) => (s[k] || []).forEach((b) => applying(b, members, out, depth + 1)));
+  if (s.if && s.then && holds(s.if, members)) applying(s.then, members, out, depth + 1);
+  return out;
+}
+function childOf(nodes, seg) {
+  const hit = [];
+  if (typeof seg === 'number') nodes.forEach((n) => { if (n.items && typeof n.items === 'object') hit.push(n.items); });
+  else {
+    nodes.forEach((n) => { if (n.properties && n.properties[seg]) hit.push(n.properties[seg]); });
+    if (!hit.length) nodes.forEach((n) => Object.entries(n.patternProperties || {}).forEach(([re, p]) => { if (new RegExp(re).test(seg)) hit.push(p); }));
+    if (!hit.length) nodes.forEach((n) => { if (n.additionalProperties && typeof n.additionalProperties === 'object') hit.push(n.additionalProperties); });
+  }
+  return hit;
+}
+// The schema nodes of the container scanAt found (frames[n-1]): walked from the root.
+function containerNodes(fr) {
+  let nodes = applying(SCHEMA, fr.length ? fr[0].members : {});
+  for (let k = 0; k + 1 < fr.length; k++) {
+    const next = [];
+    childOf(nodes, fr[k].seg).forEach((c) => applying(c, fr[k + 1].members, next));
+    nodes = next;
+  }
+  return nodes;
+}
+// One line about a member: its type, enum, range and default, then its description.
+function describe(schemas) {
+  const nodes = [];
+  schemas.forEach((s) => applying(s, {}, nodes));
+  const real = nodes.filter((n) => n.type !== 'null');
+  const types = [...new Set(real.map((n) => n.type).filter(Boolean).flat())];
+  const en = [...new Set(real.flatMap((n) => n.enum || []))];
+  const d = real.find((n) => n.description), def = real.find((n) => 'default' in n);
+  const lo = real.find((n) => 'minimum' in n || 'exclusiveMinimum' in n), hi = real.find((n) => 'maximum' in n || 'exclusiveMaximum' in n);
+  let facts = en.length ? en.map((x) => JSON.stringify(x)).join(' | ') : types.join(' or ');
+  if (lo || hi) facts += ' ' + (lo ? ('minimum' in lo ? lo.minimum + ' ≤ ' : lo.exclusiveMinimum + ' < ') : '') + 'x' +
+    (hi ? ('maximum' in hi ? ' ≤ ' + hi.maximum : ' < ' + hi.exclusiveMaximum) : '');
+  if (def) facts += ', default ' + JSON.stringify(def.default);
+  return { facts: facts.trim(), text: d ? d.description : '' };
+}
+// The members (or, in a value, the enum values) the schema allows at the caret.
+function completions(text, cur) {
+  const s = scanAt(text, cur), fr = s.frames;
+  if (!fr.length || s.where === 'root') return { s, items: [] };
+  const nodes = containerNodes(fr), f = fr[fr.length - 1];
+  const items = [];
+  if (s.where === 'key') {
+    const seen = new Set();
+    nodes.forEach((n) => Object.keys(n.properties || {}).forEach((k) => {
+      if (seen.has(k) || (k in f.members && k !== s.token)) return;
+      seen.add(k);
+      const d = describe(childOf(nodes, k));
+      items.push({ label: k, insert: JSON.stringify(k) + ': ', key: true, help: d.text || d.facts });
+    }));
+  } else {
+    const vals = new Set();
+    const inner = [];
+    childOf(nodes, f.seg).forEach((c) => applying(c, {}, inner));
+    inner.forEach((n) => { (n.enum || []).forEach((v) => vals.add(JSON.stringify(v))); if ('const' in n) vals.add(JSON.stringify(n.const)); if (n.type === 'boolean') { vals.add('true'); vals.add('false'); } });
+    vals.forEach((v) => items.push({ label: v, insert: v, key: false, help: '' }));
+  }
+  const p = s.prefix.toLowerCase().replace(/^"/, '');
+  const match = (x) => x.label.replace(/^"/, '').toLowerCase();
+  return { s, items: items.filter((x) => match(x).startsWith(p)).concat(items.filter((x) => !match(x).startsWith(p) && match(x).includes(p))) };
+}
+// The member at a text offset, explained: its JSON Pointer, facts and description.
+function helpAt(text, cur) {
+  const s = scanAt(text, cur), fr = s.frames;
+  if (!fr.length) return null;
+  const f = fr[fr.length - 1];
+  const seg = s.where === 'key' ? (s.inString ? s.token : null) : f.seg;
+  if (seg === null || seg === undefined) return null;
+  const ptr = fr.slice(0, -1).map((x) => x.seg).concat([seg]).map((k) => '/' + String(k).replace(/~/g, '~0').replace(/\//g, '~1')).join('');
+  const schemas = childOf(containerNodes(fr), seg);
+  if (!schemas.length) return { ptr, facts: 'not in the schema', text: '' };
+  return Object.assign({ ptr }, describe(schemas));
+}
+
+// The suggestion list under the caret: Tab or Enter takes one, Escape closes it.
+let sugg = null;   // {items, on, from, to, key}
+let charW = 0;
+function charWidth() {
+  if (!charW) {
+    const g = document.createElement('canvas').getContext('2d');
+    g.font = getComputedStyle(ed).font;
+    charW = g.measureText('0'.repeat(40)).width / 40 || 7.8;
+  }
+  return charW;
+}
+function closeSuggest() { sugg = null; $('suggest').hidden = true; }
+function showSuggest(force) {
+  const cur = ed.selectionStart;
+  if (cur !== ed.selectionEnd) return closeSuggest();
+  const { s, items } = completions(ed.value, cur);
+  const typing = s.where === 'key' ? (s.inString || s.prefix) : s.inString;
+  if (!items.length || (!force && !typing) || (items.length === 1 && items[0].label.replace(/"/g, '') === s.prefix.replace(/"/g, '') && !force)) return closeSuggest();
+  sugg = { items: items.slice(0, 60), on: 0, from: s.from, to: s.to };
+  const ul = $('suggest');
+  ul.replaceChildren(...sugg.items.map((x, k) => {
+    const li = document.createElement('li'), b = document.createElement('b'), sp = document.createElement('span');
+    li.setAttribute('role', 'option');
+    li.dataset.k = k;
+    b.textContent = x.label;
+    sp.textContent = x.help;
+    li.title = x.help;
+    li.append(b, sp);
+    return li;
+  }));
+  const before = ed.value.slice(0, cur), line = before.split('\n').length, col = cur - before.lastIndexOf('\n') - 1;
+  ul.style.left = Math.max(0, Math.min(8 + col * charWidth() - ed.scrollLeft, ed.clientWidth - 260)) + 'px';
+  const y = 6 + line * LINE - ed.scrollTop;
+  ul.hidden = false;
+  ul.style.top = (y + ul.offsetHeight > ed.clientHeight ? Math.max(0, y - LINE - ul.offsetHeight) : y) + 'px';
+  markSuggest();
+}
+function markSuggest() {
+  [...$('suggest').children].forEach((li, k) => { li.classList.toggle('on', k === sugg.on); li.setAttribute('aria-selected', k === sugg.on); });
+  const on = $('suggest').children[sugg.on];
+  if (on) on.scrollIntoView({ block: 'nearest' });
+}
+function acceptSuggest(k) {
+  const x = sugg.items[k];
+  let to = sugg.to;
+  let ins = x.insert;
+  // A key that already has its colon keeps it.
+  if (x.key && /^\s*:/.test(ed.value.slice(to))) ins = JSON.stringify(x.label);
+  ed.focus();
+  ed.setSelectionRange(sugg.from, to);
+  closeSuggest();
+  if (!document.execCommand('insertText', false, ins)) {
+    ed.setRangeText(ins, ed.selectionStart, ed.selectionEnd, 'end');
+    ed.dispatchEvent(new Event('input'));
+  }
+  cursorHelp();
+}
+$('suggest').addEventListener('mousedown', (e) => {
+  const li = e.target.closest('li');
+  if (li && sugg) { e.preventDefault(); acceptSuggest(+li.dataset.k); }
+});
+function helpLine(h) {
+  const el = $('help');
+  el.replaceChildren();
+  if (!h) { el.textContent = 'Ctrl+Space: the members allowed here (Tab or Enter takes one); the caret\'s member is explained here.'; return; }
+  const c = document.createElement('code');
+  c.textContent = h.ptr;
+  el.append(c, ' — ' + h.facts + (h.text ? '. ' + h.text : ''));
+}
+function cursorHelp() { helpLine(helpAt(ed.value, ed.selectionStart)); }
+ed.addEventListener('keyup', (e) => { if (!['Tab', 'Enter', 'Escape'].includes(e.key)) cursorHelp(); });
+ed.addEventListener('click', () => { closeSuggest(); cursorHelp(); });
+ed.addEventListener('blur', closeSuggest);
+// Hover: the member under the mouse, as the editor's tooltip.
+ed.addEventListener('mousemove', (e) => {
+  const r = ed.getBoundingClientRect();
+  const line = Math.floor((e.clientY - r.top - 6 + ed.scrollTop) / LINE), col = Math.floor((e.clientX - r.left - 8 + ed.scrollLeft) / charWidth());
+  const lines = ed.value.split('\n');
+  let h = null;
+  if (line >= 0 && line < lines.length && col >= 0 && col < lines[line].length && lines[line][col] !== ' ') {
+    const off = lines.slice(0, line).reduce((a, l) => a + l.length + 1, 0) + col + 1;
+    h = helpAt(ed.value, off);
+  }
+  ed.title = h ? h.ptr + ' — ' + h.facts + (h.text ? '. ' + h.text : '') : '';
+});
 
 // ---- the request ----
 let model = null;   // {name, file, format}: a dropped model, sent as the multipart part "model"
@@ -308,8 +548,9 @@ async function renderNow() {
   let parsed;
   try { parsed = parseJsonLines(ed.value); } catch (e) {
     if (e.line === undefined) throw e;
-    showError(e.line, 'JSON syntax: ' + e.message + ' (column ' + e.col + ')');
+    showError(e.line, 'JSON syntax: ' + e.message, e.col);
     $('status').textContent = 'not sent: the JSON does not parse';
+    $('images').classList.add('stale');
     return;
   }
   clearError();
@@ -333,6 +574,7 @@ async function renderNow() {
       $('images').classList.add('stale');
       $('size').textContent = $('etag').textContent = '—';
       $('timing').innerHTML = $('timing-legend').innerHTML = '';
+      $('download').hidden = true;
       $('status').textContent = again ? 'rendering…' : 'error ' + bad.status;
       return;
     }
@@ -344,6 +586,11 @@ async function renderNow() {
     $('size').textContent = res.map((x) => x.size.toLocaleString('en') + ' bytes').join(', ');
     $('etag').textContent = res.map((x) => x.etag || '').join(', ');
     showTiming(a.timing);
+    const dl = $('download');
+    dl.href = $('image').src;
+    dl.download = imageName(compare, $('image').naturalWidth, $('image').naturalHeight);
+    dl.title = 'Save ' + dl.download;
+    dl.hidden = false;
     $('status').textContent = again ? 'rendering…' : 'done';
   } catch (e) {
     $('status').textContent = 'request failed: ' + e.message;
@@ -352,14 +599,107 @@ async function renderNow() {
   }
 }
 
+// The download's file name: the scene, the view and the size ("filter-pcss-512x384.png").
+function imageName(compare, w, h) {
+  const view = $('debug').value;
+  return source.file + (view ? '-' + view + (view === 'shadow' ? '-light' + ($('debug-light').value || 0) : '') : '') +
+    (compare ? '-' + $('filter-a').value : '') + '-' + w + 'x' + h + '.png';
+}
+
+// ---- sharing: a link with the scene, the request as curl ----
+const b64url = (bytes) => {
+  let t = '';
+  for (let k = 0; k < bytes.length; k += 0x8000) t += String.fromCharCode.apply(null, bytes.subarray(k, k + 0x8000));
+  return btoa(t).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
+};
+const unb64url = (t) => Uint8Array.from(atob(t.replace(/-/g, '+').replace(/_/g, '/')), (c) => c.charCodeAt(0));
+async function through(bytes, stream) {
+  return new Uint8Array(await new Response(new Blob([bytes]).stream().pipeThrough(stream)).arrayBuffer());
+}
+// #scene=<base64url of the editor's text>, raw-deflated (&enc=deflate-raw) where the browser can.
+async function shareLink() {
+  const raw = new TextEncoder().encode(ed.value);
+  const frag = window.CompressionStream
+    ? 'scene=' + b64url(await through(raw, new CompressionStream('deflate-raw'))) + '&enc=deflate-raw'
+    : 'scene=' + b64url(raw);
+  return location.origin + location.pathname + '#' + frag;
+}
+// The scene of the page's link, into the editor; false when the link has none.
+async function fromLink() {
+  const p = new URLSearchParams(location.hash.slice(1)), t = p.get('scene');
+  if (!t) return false;
+  try {
+    let bytes = unb64url(t);
+    if (p.get('enc') === 'deflate-raw') bytes = await through(bytes, new DecompressionStream('deflate-raw'));
+    setText(new TextDecoder('utf-8', { fatal: true }).decode(bytes));
+  } catch (e) {
+    $('status').textContent = 'the link\'s scene cannot be read: ' + (e.message || e);
+    return false;
+  }
+  setSource('Scene from the link', 'shared-scene');
+  lightsChanged();
+  return true;
+}
+// POSIX shell single quotes: nothing inside is expanded; a ' becomes '\''.
+const shq = (t) => "'" + String(t).replace(/'/g, "'\\''") + "'";
+// The curl command for the request the page makes (the first, when comparing): the exact JSON
+// body, or with a dropped model the same multipart parts (the model by its file name, the scene
+// from the here-document).
+function curlCommand() {
+  const doc = JSON.parse(ed.value);
+  const json = JSON.stringify(withView(doc, $('compare').checked ? $('filter-a').value : null));
+  const head = ['curl', '-sS', '--fail-with-body', '-H', shq('Accept: image/png')];
+  const tail = ['-o', shq(imageName($('compare').checked, 'W', 'H').replace('-WxH', '')), shq(location.origin + '/v1/render')];
+  if (model && json.includes('"part":"model"')) {
+    // JSON.stringify writes no raw newline, so no line of the document can end the here-document.
+    return head.concat(['-F', shq('scene=<-;type=application/json'), '-F', shq('model=@' + model.name)], tail).join(' ') +
+      " <<'EOF'\n" + json + '\nEOF\n';
+  }
+  return head.concat(['-H', shq('Content-Type: application/json'), '--data-binary', shq(json)], tail).join(' ') + '\n';
+}
+// The clipboard, or where it is refused (an insecure origin) a selected textarea and copy.
+async function copy(text) {
+  try { await navigator.clipboard.writeText(text); return true; } catch (e) {
+    const t = document.createElement('textarea');
+    t.value = text;
+    document.body.append(t);
+    t.select();
+    const ok = document.execCommand('copy');
+    t.remove();
+    return ok;
+  }
+}
+function said(button, text) {
+  const was = button.dataset.label || (button.dataset.label = button.textContent);
+  button.textContent = text;
+  setTimeout(() => { button.textContent = was; }, 2000);
+}
+$('share').addEventListener('click', async () => {
+  const link = await shareLink();
+  history.replaceState(null, '', link);
+  const ok = await copy(link);
+  said($('share'), ok ? (model ? 'Copied (not the model file)' : 'Link copied') : 'Copy refused: see the address bar');
+});
+$('curl').addEventListener('click', async () => {
+  let cmd;
+  try { cmd = curlCommand(); } catch (e) { said($('curl'), 'The JSON does not parse'); return; }
+  said($('curl'), (await copy(cmd)) ? 'curl copied' : 'Copy refused');
+});
+
 // ---- controls ----
+// The shadow view's light list: "0: directional", ... from the text (kept while it does not
+// parse); by default the first light that casts shadows.
 function lightsChanged() {
-  let n = 0;
-  try { n = (JSON.parse(ed.value).lights || []).length; } catch (e) { n = 0; }
+  let doc;
+  try { doc = JSON.parse(ed.value); } catch (e) { return; }
+  const lights = doc && Array.isArray(doc.lights) ? doc.lights : [];
   const sel = $('debug-light'), old = sel.value;
-  sel.innerHTML = '';
-  for (let k = 0; k < Math.max(n, 1); k++) sel.add(new Option(String(k), String(k)));
-  if (+old < n) sel.value = old;
+  const names = lights.map((l, k) => k + ': ' + (l && l.name ? l.name + ' (' + l.type + ')' : (l && l.type) || '?'));
+  if (!names.length) names.push(doc && doc.preset ? '0: the preset\'s light' : '0: (no lights)');
+  if (names.join('\n') === [...sel.options].map((o) => o.text).join('\n') && sel.selectedIndex >= 0) return;
+  sel.replaceChildren(...names.map((t, k) => new Option(t, String(k))));
+  const first = Math.max(0, lights.findIndex((l) => l && l.shadow !== false));
+  sel.value = old !== '' && +old < names.length ? old : String(first);
 }
 $('debug').addEventListener('change', () => { lightsChanged(); $('light-label').hidden = $('debug').value !== 'shadow'; render(); });
 $('debug-light').addEventListener('change', render);
@@ -371,9 +711,29 @@ FILTERS.forEach((f) => { $('filter-a').add(new Option(f, f)); $('filter-b').add(
 $('filter-a').value = 'pcf'; $('filter-b').value = 'pcss';
 $('filter-a').addEventListener('change', render);
 $('filter-b').addEventListener('change', render);
+// What the editor holds: an example, or a scene that is none of them (a dropped model's, a link's)
+// named by an extra entry in the list. `source.file` names downloads.
+let source = { file: 'filter-hard' };
+function setSource(label, file) {
+  const sel = $('examples');
+  let o = sel.querySelector('option[value="other"]');
+  if (!o) { o = new Option('', 'other'); sel.add(o); }
+  o.text = label;
+  sel.value = 'other';
+  source = { file };
+}
+const slug = (t) => t.toLowerCase().replace(/[^a-z0-9]+/g, '-').replace(/^-|-$/g, '') || 'scene';
 EXAMPLES.forEach((e, k) => $('examples').add(new Option(e[0], String(k))));
 $('examples').addEventListener('change', () => {
-  setText(pretty(EXAMPLES[+$('examples').value][1]()));
+  const k = $('examples').value;
+  if (k === 'other') return;
+  const o = $('examples').querySelector('option[value="other"]');
+  if (o) o.remove();
+  // An example is not the dropped model's scene: the model goes with it.
+  model = null;
+  $('model').textContent = '';
+  source = { file: slug(EXAMPLES[+k][0].replace(/^Filter: /, 'filter ')) };
+  setText(pretty(EXAMPLES[+k][1]()));
   lightsChanged();
 });
 $('render').addEventListener('click', render);
@@ -386,6 +746,7 @@ function useModel(file) {
   model = { name: file.name, file, format: ext };
   $('model').textContent = 'model: ' + file.name + ' (' + file.size.toLocaleString('en') + ' bytes)';
   setText(pretty({ preset: 'thumbnail', objects: [{ shape: 'model', part: 'model', format: ext }] }));
+  setSource('Dropped model: ' + file.name, slug(file.name.replace(/\.[^.]*$/, '')));
   lightsChanged();
   render();
 }
@@ -403,7 +764,10 @@ window.addEventListener('drop', (e) => {
 fetch('/v1/info').then((r) => r.ok ? r.json() : null).then((i) => {
   if (i) $('device').textContent = (i.device || '') + (i.version ? ' · ' + i.version : '');
 }).catch(() => {});
+// On open: the link's scene, else the first example; rendered at once.
 $('examples').value = '0';
 setText(pretty(EXAMPLES[0][1]()));
 lightsChanged();
-window.umbraPlayground = { parseJsonLines, lineOf, render, useModel };
+fromLink().finally(render);
+window.addEventListener('hashchange', () => fromLink().then((ok) => ok && render()));
+window.umbraPlayground = { parseJsonLines, lineOf, render, useModel, scanAt, completions, helpAt, curlCommand, shareLink };

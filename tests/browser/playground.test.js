@@ -4,6 +4,10 @@
 // Prints "ok - x" / "FAIL - x" and, last, "N passed, N failed".
 'use strict';
 const puppeteer = require('puppeteer-core');
+const fs = require('fs');
+const os = require('os');
+const path = require('path');
+const { execFileSync } = require('child_process');
 
 const URL = process.env.UMBRA_URL;
 const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
@@ -80,12 +84,42 @@ async function rendered(page, act) {
   return page.$eval('#status', (e) => e.textContent);
 }
 
+// Runs a part of the test; an exception in it (a wait that timed out) is one failure, and the
+// rest still runs.
+async function section(name, fn) {
+  try { await fn(); } catch (e) { fail++; console.log('FAIL - ' + name + ': ' + String(e && e.message || e).split('\n')[0]); }
+}
+
+// Sets the editor's text and puts the caret where `mark` (a string in it, removed) was.
+async function caretAt(page, text, mark) {
+  await page.$eval('#editor', (e, text, mark) => {
+    const at = text.indexOf(mark);
+    e.value = text.replace(mark, '');
+    e.dispatchEvent(new Event('input'));
+    e.focus();
+    e.setSelectionRange(at, at);
+  }, text, mark);
+}
+const suggestions = (page) => page.$$eval('#suggest:not([hidden]) li', (l) => l.map((x) => ({ name: x.querySelector('b').textContent, help: x.title })));
+
+// The clipboard's text once a click has changed it (the page writes it asynchronously).
+async function copied(page, button) {
+  await page.evaluate(() => navigator.clipboard.writeText(''));
+  await page.click(button);
+  await page.waitForFunction(async () => (await navigator.clipboard.readText()) !== '', { timeout: TIMEOUT, polling: 100 });
+  return page.evaluate(() => navigator.clipboard.readText());
+}
+
+const pngSize = (buf) => buf.length > 24 && buf.toString('latin1', 1, 4) === 'PNG' ? buf.readUInt32BE(16) + 'x' + buf.readUInt32BE(20) : 'not a PNG';
+
 async function main() {
+  const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'umbra-page-'));
   const browser = await puppeteer.launch({
     executablePath: CHROMIUM, headless: true,
     args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--no-first-run'],
   });
   try {
+    await browser.defaultBrowserContext().overridePermissions(URL, ['clipboard-read', 'clipboard-write', 'clipboard-sanitized-write']);
     const page = await browser.newPage();
     await page.setViewport({ width: 1280, height: 820 });
     const sent = [];
@@ -112,10 +146,63 @@ async function main() {
       labels.includes('Model on a shadow catcher, transparent'), labels.join(' | '));
     if (process.env.BENCH) check('examples: the bench scenes are embedded', labels.includes('Bench: thumb-512'), labels.join(' | '));
 
+    await section('on open', async () => {
+      // On open the first example is rendered, with no click.
+      await page.waitForFunction(() => /^(done|error|request failed)/.test(document.getElementById('status').textContent), { timeout: TIMEOUT });
+      const opened = await imageFacts(page, 'image');
+      check('on open: the first example is rendered', sent.length === 1 && opened.w === 512 && opened.h === 384 && opened.colours > 100,
+        sent.length + ' requests, ' + opened.w + 'x' + opened.h + ', ' + opened.colours + ' colours');
+    });
+
+    await section('completion and help', async () => {
+      // Completion from api/scene.schema.json: the members allowed at the caret, with descriptions.
+      await caretAt(page, '{\n  "camera": {\n    @\n  }\n}\n', '@');
+      await page.keyboard.type('"f');
+      await page.waitForSelector('#suggest:not([hidden]) li', { timeout: TIMEOUT });
+      let sg = await suggestions(page);
+      if (process.env.SHOT) await page.screenshot({ path: process.env.SHOT.replace(/\.png$/, '-completion.png') });
+      const fov = sg.find((x) => x.name === 'fov_y');
+      check('completion: camera members starting with f, described', fov && /Vertical field of view/.test(fov.help) &&
+        ['far', 'fit'].every((n) => sg.some((x) => x.name === n)) && !sg.some((x) => x.name === 'width'), JSON.stringify(sg).slice(0, 300));
+      await page.keyboard.press('ArrowDown');
+      const second = sg[1].name;
+      await page.keyboard.press('Tab');
+      let edText = await page.$eval('#editor', (e) => e.value);
+      check('completion: Tab takes the chosen member', edText.includes('    "' + second + '": \n') && await page.$eval('#suggest', (e) => e.hidden),
+        JSON.stringify(edText));
+      // The schema's if/then on "shape": a sphere's members, not a box's.
+      await caretAt(page, '{\n  "objects": [\n    {"shape": "sphere", @}\n  ]\n}\n', '@');
+      await page.keyboard.type('"');
+      await page.waitForSelector('#suggest:not([hidden]) li', { timeout: TIMEOUT });
+      sg = await suggestions(page);
+      check('completion: follows "shape" (a sphere: radius, segments; no size)', ['radius', 'segments', 'material', 'transform'].every((n) => sg.some((x) => x.name === n)) &&
+        !sg.some((x) => x.name === 'size' || x.name === 'shape'), sg.map((x) => x.name).join(','));
+      await page.keyboard.press('Escape');
+      await caretAt(page, '{\n  "lights": [{"type": "@"}]\n}\n', '@');
+      await page.keyboard.press('Backspace');
+      await page.keyboard.type('"s');
+      await page.waitForSelector('#suggest:not([hidden]) li', { timeout: TIMEOUT });
+      sg = await suggestions(page);
+      await page.keyboard.press('Enter');
+      edText = await page.$eval('#editor', (e) => e.value);
+      check('completion: enum values ("type": "spot")', sg.length === 1 && sg[0].name === '"spot"' && edText.includes('"type": "spot"'), JSON.stringify(sg) + ' ' + JSON.stringify(edText));
+      // Help for the member at the caret, and on hover.
+      await caretAt(page, '{\n  "camera": {"position": [1, 2, 3], "fo@v_y": 30}\n}\n', '@');
+      await page.keyboard.press('ArrowRight');
+      const help = await page.$eval('#help', (e) => e.textContent);
+      check('help: the caret\'s member, from the schema', /^\/camera\/fov_y — number.*default 45.*Vertical field of view/.test(help), help);
+      const box = await page.$eval('#editor', (e) => { const r = e.getBoundingClientRect(); return { x: r.left, y: r.top }; });
+      const cw = await page.evaluate(() => { const g = document.createElement('canvas').getContext('2d'); g.font = getComputedStyle(document.getElementById('editor')).font; return g.measureText('0000000000').width / 10; });
+      await page.mouse.move(box.x + 8 + cw * 6.5, box.y + 6 + 18 * 1.5);
+      const tip = await page.$eval('#editor', (e) => e.title);
+      check('hover help: the member under the mouse', /^\/camera — object/.test(tip), tip);
+    });
+
     // Pick an example, render: the image has the example's size and real content.
     await pick(page, 'Filter: pcss');
     let st = await rendered(page);
     let a = await imageFacts(page, 'image');
+    const pcssText = await page.$eval('#editor', (e) => e.value);
     check('render: status done', st === 'done', st);
     check('render: image is 512x384', a.w === 512 && a.h === 384, a.w + 'x' + a.h);
     check('render: non-trivial content', a.colours > 100, a.colours + ' colours');
@@ -125,6 +212,46 @@ async function main() {
     const bars = await page.$$eval('#timing div', (d) => d.map((x) => parseFloat(x.style.width)));
     check('render: Server-Timing bar has its stages', bars.length === 7 && bars.some((w) => w > 10), bars.join(','));
     check('line numbers in the gutter', (await page.$eval('#gutter', (g) => g.textContent.split('\n').length)) > 20);
+
+    let dl = Buffer.alloc(0);
+    await section('download', async () => {
+      // The image downloads under a name that says what it is.
+      const dlName = await page.$eval('#download', (e) => e.download);
+      const cdp = await browser.target().createCDPSession();
+      await cdp.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: tmp, eventsEnabled: true });
+      const done = new Promise((res) => cdp.on('Browser.downloadProgress', (e) => { if (e.state !== 'inProgress') res(e.state); }));
+      await page.click('#download');
+      const dlState = await done;
+      dl = fs.existsSync(path.join(tmp, dlName)) ? fs.readFileSync(path.join(tmp, dlName)) : Buffer.alloc(0);
+      check('download: the PNG saved as ' + dlName, dlState === 'completed' && dlName === 'filter-pcss-512x384.png' && pngSize(dl) === '512x384' &&
+        dl.length + ' bytes' === size.replace(/,/g, ''), dlState + ' ' + pngSize(dl) + ' ' + dl.length);
+    });
+
+    await section('copy as curl', async () => {
+      // Copy as curl: the command makes the same request; its PNG is the page's (the download), byte for byte.
+      const cmd = await copied(page, '#curl');
+      let out = '';
+      try { out = execFileSync('sh', ['-c', cmd], { cwd: tmp, timeout: TIMEOUT, encoding: 'utf8' }); } catch (e) { out = String(e.stderr || e); }
+      const curlPng = fs.existsSync(path.join(tmp, 'filter-pcss.png')) ? fs.readFileSync(path.join(tmp, 'filter-pcss.png')) : Buffer.alloc(0);
+      check('copy as curl: JSON body, the same image', /^curl .*--data-binary '\{/.test(cmd) && dl.length > 0 && curlPng.equals(dl),
+        cmd.slice(0, 160) + ' → ' + pngSize(curlPng) + ' ' + out.slice(0, 200));
+    });
+
+    await section('copy link', async () => {
+      // Copy link: the scene in the fragment; the link opens that scene and renders it.
+      const link = await copied(page, '#share');
+      check('copy link: the scene in the fragment', link.startsWith(URL + '/#scene=') && /&enc=deflate-raw$/.test(link) && (await page.evaluate(() => location.href)) === link, link.slice(0, 100));
+      const page2 = await browser.newPage();
+      const sent2 = [];
+      page2.on('request', (r) => { if (r.url().endsWith('/v1/render')) sent2.push(r.postData() || ''); });
+      page2.on('pageerror', (e) => errors.push(e.message));
+      await page2.goto(link, { waitUntil: 'load' });
+      await page2.waitForFunction(() => /^(done|error|request failed)/.test(document.getElementById('status').textContent), { timeout: TIMEOUT });
+      const linked = await page2.evaluate(() => ({ text: document.getElementById('editor').value, label: document.querySelector('#examples option:checked').textContent }));
+      check('link: opens with the scene, rendered', linked.text === pcssText && linked.label === 'Scene from the link' && sent2.length === 1 &&
+        sent2[0] === JSON.stringify(JSON.parse(pcssText)), linked.label + ', ' + sent2.length + ' requests, ' + (linked.text === pcssText ? 'same text' : 'other text'));
+      await page2.close();
+    });
 
     // The cascades debug view of the street.
     await pick(page, 'Cascades: a street at dusk');
@@ -161,6 +288,31 @@ async function main() {
     const serr = await page.$eval('#error', (e) => ({ hidden: e.hidden, line: +e.dataset.line, text: e.textContent }));
     check('syntax error: nothing sent', sent.length === n0 && st.startsWith('not sent'), st);
     check('syntax error: at line 4', !serr.hidden && serr.line === 4, serr.line + ' ' + serr.text);
+    await section('syntax error on the last line', async () => {
+      // On the last line of a long document: the message fully inside the editor, with line and column.
+      await pick(page, 'Cascades: a street at dusk');
+      await page.$eval('#editor', (e) => { e.value = e.value.replace(/\}\s*$/, ''); e.dispatchEvent(new Event('input')); });
+      st = await rendered(page);
+      const last = await page.$eval('#error', (e) => {
+        const ed = document.getElementById('editor'), r = e.getBoundingClientRect(), q = ed.getBoundingClientRect();
+        return { text: e.textContent, line: +e.dataset.line, lines: ed.value.split('\n').length, inside: r.top >= q.top && r.bottom <= q.top + ed.clientHeight && r.height > 0 };
+      });
+      check('syntax error on the last line: fully shown, with its column', st.startsWith('not sent') && last.inside && last.line === last.lines &&
+        /^line \d+, column \d+: JSON syntax: the document ends early/.test(last.text), JSON.stringify(last));
+      if (process.env.SHOT) await page.screenshot({ path: process.env.SHOT.replace(/\.png$/, '-syntax.png') });
+    });
+
+    await section('shadow view lights', async () => {
+      // The shadow view's light list names the lights and selects one.
+      await pick(page, 'Spot and point lights');
+      const nl = sent.length;
+      st = await rendered(page, () => page.select('#debug', 'shadow'));
+      const ls = await page.$eval('#debug-light', (s) => ({ texts: [...s.options].map((o) => o.text), shown: s.selectedIndex >= 0 ? s.options[s.selectedIndex].text : '' }));
+      const lbody = sent.length > nl ? sent[sent.length - 1].postData() || '' : '';
+      check('shadow view: the lights listed, the first selected', ls.texts.join('|') === '0: spot|1: point' && ls.shown === '0: spot' &&
+        /"debug":"shadow","debug_light":0/.test(lbody) && st === 'done', JSON.stringify(ls) + ' ' + st);
+      await rendered(page, () => page.select('#debug', ''));
+    });
 
     // Compare two filters side by side.
     await pick(page, 'Filter: pcf');
@@ -188,18 +340,35 @@ async function main() {
     // anti-aliased edges make a handful of colours (an empty image has 1).
     check('drop: the model renders (512x512, content)', st === 'done' && d.w === 512 && d.h === 512 && d.colours > 5,
       st + ' ' + d.w + 'x' + d.h + ' ' + d.colours);
+    const exLabel = await page.$eval('#examples option:checked', (o) => o.textContent);
+    check('drop: the example list says the scene is the model\'s', exLabel === 'Dropped model: tetra.glb', exLabel);
+    await section('copy as curl with a model', async () => {
+      // Copy as curl with a model: multipart, the model by its file name.
+      fs.writeFileSync(path.join(tmp, 'tetra.glb'), tetraGlb());
+      const mcmd = await copied(page, '#curl');
+      let mout = '';
+      try { mout = execFileSync('sh', ['-c', mcmd], { cwd: tmp, timeout: TIMEOUT, encoding: 'utf8' }); } catch (e) { mout = String(e.stderr || e); }
+      const mpng = fs.existsSync(path.join(tmp, 'tetra.png')) ? fs.readFileSync(path.join(tmp, 'tetra.png')) : Buffer.alloc(0);
+      check('copy as curl: multipart, -F model=@tetra.glb, renders 512x512', / -F 'model=@tetra\.glb' /.test(mcmd) && pngSize(mpng) === '512x512',
+        mcmd.slice(0, 200) + ' → ' + pngSize(mpng) + ' ' + mout.slice(0, 200));
+    });
     check('no script errors', errors.length === 0, errors.join('; '));
     const domViolations = await page.evaluate(() => window.__csp || []);
     check('no Content-Security-Policy violations', violations.length === 0 && domViolations.length === 0,
       (violations.length + domViolations.length) + ': ' + violations.concat(domViolations).slice(0, 2).join('; ').slice(0, 400));
 
+    await pick(page, 'Filter: hard');
+    const modelLabel = await page.$eval('#model', (e) => e.textContent);
+    check('an example picked after a drop: the model is let go', modelLabel === '', modelLabel);
     if (process.env.SHOT) {
+      await page.waitForFunction(() => [...document.querySelectorAll('header button')].every((b) => !/copied/i.test(b.textContent)), { timeout: TIMEOUT });
       await pick(page, 'Filter: pcss');
       await rendered(page, () => page.click('#compare'));
       await page.screenshot({ path: process.env.SHOT });
     }
   } finally {
     await browser.close();
+    fs.rmSync(tmp, { recursive: true, force: true });
   }
 }
 
