@@ -221,6 +221,17 @@ int api_gltf_bufs_finish(struct api_gltf_bufs *b)
 	return json_array_append_new(bufs, e) == 0 ? 0 : -1;
 }
 
+void api_gltf_drop_extension_name(json_t *root, const char *key, const char *name)
+{
+	json_t *list = json_object_get(root, key), *e;
+	size_t i;
+	json_array_foreach(list, i, e)
+		if (json_is_string(e) && !strcmp(json_string_value(e), name)) {
+			json_array_remove(list, i);
+			return;
+		}
+}
+
 int api_gltf_bufs_files(struct api_gltf_bufs *b, const struct api_model_file **files, size_t *nfiles)
 {
 	*files = b->files;

@@ -75,6 +75,8 @@ long api_gltf_made_bytes(struct api_gltf_bufs *b, const void *bytes, size_t n);
 long api_gltf_made_view(struct api_gltf_bufs *b, const void *bytes, size_t n);
 /* Adds the made buffer to root's buffers (uri API_GLTF_MADE_FILE) if there is one. */
 int api_gltf_bufs_finish(struct api_gltf_bufs *b);
+/* Removes `name` from root's list `key` ("extensionsUsed", "extensionsRequired") if there. */
+void api_gltf_drop_extension_name(json_t *root, const char *key, const char *name);
 /* The files to import with: the caller's, and the made buffer when there is one (b owns the
  * array). 0, or -1 (out of memory). */
 int api_gltf_bufs_files(struct api_gltf_bufs *b, const struct api_model_file **files, size_t *nfiles);

@@ -13,17 +13,6 @@
 #define MESHOPT "EXT_meshopt_compression"
 #define QUANT "KHR_mesh_quantization"
 
-static void drop_ext_name(json_t *root, const char *key, const char *name)
-{
-	json_t *list = json_object_get(root, key), *e;
-	size_t i;
-	json_array_foreach(list, i, e)
-		if (json_is_string(e) && !strcmp(json_string_value(e), name)) {
-			json_array_remove(list, i);
-			return;
-		}
-}
-
 /* meshopt's decoders by mode and filter, into dst (count x stride bytes). 0, or -1 with err. */
 static int meshopt_decode(uint8_t *dst, size_t count, size_t stride, const char *mode, const char *filter,
                           const uint8_t *src, size_t n, size_t vi, char *err, size_t errsize)
@@ -199,10 +188,10 @@ int api_gltf_decode(struct api_gltf_bufs *b, char *err, size_t errsize)
 	long a = decode_meshopt(b, err, errsize);
 	long q = a < 0 ? -1 : dequantize(b, err, errsize);
 	if (a < 0 || q < 0) return -1;
-	drop_ext_name(b->root, "extensionsUsed", MESHOPT);
-	drop_ext_name(b->root, "extensionsRequired", MESHOPT);
-	drop_ext_name(b->root, "extensionsUsed", QUANT);
-	drop_ext_name(b->root, "extensionsRequired", QUANT);
+	api_gltf_drop_extension_name(b->root, "extensionsUsed", MESHOPT);
+	api_gltf_drop_extension_name(b->root, "extensionsRequired", MESHOPT);
+	api_gltf_drop_extension_name(b->root, "extensionsUsed", QUANT);
+	api_gltf_drop_extension_name(b->root, "extensionsRequired", QUANT);
 	return a + q > 0;
 }
 

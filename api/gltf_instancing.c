@@ -89,17 +89,6 @@ out:
 	return made;
 }
 
-static void drop_from(json_t *root, const char *key)
-{
-	json_t *list = json_object_get(root, key), *e;
-	size_t i;
-	json_array_foreach(list, i, e)
-		if (json_is_string(e) && !strcmp(json_string_value(e), EXT)) {
-			json_array_remove(list, i);
-			return;
-		}
-}
-
 int api_gltf_expand_instancing(struct api_gltf_bufs *b, size_t max, char *err, size_t errsize)
 {
 	json_t *nodes = json_object_get(b->root, "nodes");
@@ -113,8 +102,8 @@ int api_gltf_expand_instancing(struct api_gltf_bufs *b, size_t max, char *err, s
 		made += (size_t)k;
 	}
 	if (made) {
-		drop_from(b->root, "extensionsUsed");
-		drop_from(b->root, "extensionsRequired");
+		api_gltf_drop_extension_name(b->root, "extensionsUsed", EXT);
+		api_gltf_drop_extension_name(b->root, "extensionsRequired", EXT);
 	}
 	return (int)made;
 }

@@ -19,15 +19,10 @@
 
 static struct api_scene *parse_glb(const uint8_t *g, size_t n, struct api_problem *p)
 {
-	char *enc = test_b64(g, n);
-	size_t cap = strlen(enc) + 256;
-	char *doc = malloc(cap);
-	snprintf(doc, cap, "{\"camera\":{\"position\":[0,0,30]},\"objects\":[{\"shape\":\"model\",\"format\":\"glb\","
-	         "\"data\":\"%s\"}]}", enc);
-	free(enc);
+	char *doc = test_model_doc(g, n, "glb");
 	struct api_scene *s = NULL;
 	memset(p, 0, sizeof *p);
-	if (api_scene_parse(doc, strlen(doc), NULL, &s, p) != API_OK) s = NULL;
+	if (!doc || api_scene_parse(doc, strlen(doc), NULL, &s, p) != API_OK) s = NULL;
 	free(doc);
 	return s;
 }

@@ -1,6 +1,7 @@
 /* tests/util/util.c — see util.h. */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "util.h"
 
@@ -42,4 +43,16 @@ void test_put_file(const char *dir, const char *name, const char *text)
 		fputs(text, f);
 		fclose(f);
 	}
+}
+
+char *test_model_doc(const uint8_t *d, size_t n, const char *format)
+{
+	char *enc = test_b64(d, n);
+	size_t cap = (enc ? strlen(enc) : 0) + 256;
+	char *doc = enc ? malloc(cap) : NULL;
+	if (doc)
+		snprintf(doc, cap, "{\"camera\":{\"position\":[0,0,30]},\"objects\":[{\"shape\":\"model\",\"format\":\"%s\","
+		         "\"data\":\"%s\"}]}", format, enc);
+	free(enc);
+	return doc;
 }

@@ -19,4 +19,8 @@ void test_put_file(const char *dir, const char *name, const char *text);
  * "{'width': %d}"). NULL when out of memory. */
 char *test_vdoc(const char *fmt, va_list ap);
 
+/* A scene of one model object: the file d[0..n) inline as `data`, of `format` ("glb", ...),
+ * seen by a camera at (0, 0, 30). NULL when out of memory. */
+char *test_model_doc(const uint8_t *d, size_t n, const char *format);
+
 #endif
