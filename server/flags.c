@@ -59,6 +59,8 @@ static const struct opt_def opts[] = {
 	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
 	{ "idle-trim", OPT_UINT, "S", "after S s without a request, drop shadow maps unused for S s and give the atlas pages and freed heap back to the system, 0 = never (30)", CFG(idle_trim_s), 0, 86400 },
+	{ "result-cache-mb", OPT_UINT, "MB", "images POST /v1/renders keeps for GET /v1/renders/{hash}.{ext} (LRU), and up to an eighth as much (1 MB at least) of their scenes, each up to 1 MB, to render an evicted image again; 0 = off: both routes 404 (64)", CFG(result_cache_mb), 0, 1048576 },
+	{ "cache-control", OPT_STR, "VALUE", "Cache-Control of POST /v1/render and /v1/renders answers (no-cache: a cache must revalidate; the ETag is in the answer); GET /v1/renders/{hash}.{ext} always says public, max-age=31536000, immutable", CFG(cache_control), 0, 0 },
 	{ "test-fault", OPT_STR, "submit:N:lost|oom", "tests only: the Nth queue submit after warm-up fails", CFG(test_fault), 0, 0 },
 };
 #define OPT_COUNT (sizeof opts / sizeof opts[0])
@@ -66,8 +68,8 @@ static const struct opt_def opts[] = {
 static void usage(FILE *f)
 {
 	fprintf(f, "usage: umbrad [FLAGS]\n"
-	           "HTTP render daemon: POST /v1/render (scene JSON -> PNG/EXR), GET /healthz, /readyz,\n"
-	           "/metrics, /v1/info. Every flag can also be set as UMBRA_<FLAG> (e.g. UMBRA_MAX_BODY);\n"
+	           "HTTP render daemon: POST /v1/render (scene JSON -> PNG/EXR), POST /v1/renders (-> 303 to\n"
+	           "a cacheable GET /v1/renders/{hash}.png), GET /healthz, /readyz, /metrics, /v1/info. Every flag can also be set as UMBRA_<FLAG> (e.g. UMBRA_MAX_BODY);\n"
 	           "a flag wins over its variable. UMBRA_VALIDATION=1 enables the Vulkan validation layer.\n"
 	           "Models and textures are parsed in sandboxed child processes of umbra-import (found next to\n"
 	           "umbrad, or UMBRA_IMPORT_HELPER=PATH): over --import-timeout-ms / --import-memory is a 422,\n"
@@ -231,6 +233,7 @@ static void set_defaults(struct srv_config *cfg)
 	cfg->header_timeout_s = 10;
 	cfg->drain_timeout_s = 60;
 	cfg->idle_trim_s = 30;
+	cfg->result_cache_mb = 64;
 	const char *v = getenv("UMBRA_VALIDATION");
 	cfg->validation = v && *v && strcmp(v, "0") != 0;
 	v = getenv("UMBRA_NO_PLAYGROUND");
@@ -316,6 +319,11 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		return -1;
 	}
 	srv_origin_release(&o);
+	for (const char *p = cfg->cache_control; p && *p; p++)
+		if ((unsigned char)*p < 0x20 || (unsigned char)*p > 0x7e) {
+			fprintf(stderr, "umbrad: --cache-control: not one line of printable ASCII\n");
+			return -1;
+		}
 	cfg->limits.asset_root = cfg->asset_root;
 	if (!cfg->max_memory) cfg->max_memory = srv_admit_default_budget();
 	return 0;

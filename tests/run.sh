@@ -58,6 +58,8 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -z "${ASAN:-}" ] && run_suite deploy sh deploy/check.sh
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
 [ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
+# Cacheable renders (POST /v1/renders, GET /v1/renders/{hash}), and nginx in front when installed.
+[ -x "$BUILD/umbrad" ] && run_suite http-cache sh tests/http/cache.sh
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
 # The playground in a real browser, when Debian's chromium is installed (install-deps does).
 [ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh

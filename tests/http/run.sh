@@ -147,7 +147,14 @@ check "same body, same bytes" cmp -s "$T/r1.body" "$T/r2.body"
 check "same body, same ETag" [ "$(hdr r2 ETag)" = "$etag" ]
 c=$(post r3 "$T/small-64x48.json"); check "other body 200, 64x48" [ "$(png_size "$T/r3.body")" = 64x48 ]
 check "other body, other ETag" [ "$(hdr r3 ETag)" != "$etag" ]
-c=$(post r304 "$T/small.json" -H "If-None-Match: $etag"); check "If-None-Match with the ETag: 304" [ "$c" = 304 ]
+# RFC 9110 §13.1.2: a POST whose If-None-Match lists its ETag is a 412 (304 is for GET and HEAD).
+c=$(post r412 "$T/small.json" -H "If-None-Match: $etag"); check "If-None-Match with the ETag on a POST: 412 problem+json" eval '[ "$c" = 412 ] && problem r412 412 ""'
+check "the 412 carries the ETag" [ "$(hdr r412 ETag)" = "$etag" ]
+# The ETag is the parsed scene's: the same scene spelled otherwise (members reordered, other
+# whitespace, 1.0 for 1) has the same one.
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(json.dumps(dict(reversed(list(d.items()))), indent=3))' "$T/small.json" >"$T/small-reordered.json"
+c=$(post rre "$T/small-reordered.json"); check "re-serialized scene: 200, the same ETag" eval '[ "$c" = 200 ] && [ "$(hdr rre ETag)" = "$etag" ]'
+check "POST answers say Cache-Control: no-cache" [ "$(hdr r1 Cache-Control)" = no-cache ]
 c=$(post rexr "$T/small.json" -H 'Accept: image/x-exr'); check "Accept: image/x-exr 200" [ "$c" = 200 ]
 check "Accept: image/x-exr gives image/x-exr" [ "$(hdr rexr Content-Type)" = image/x-exr ]
 check "EXR magic" is_exr "$T/rexr.body"
@@ -159,12 +166,12 @@ c=$(post rjpg2 "$T/small.json" -H 'Accept: image/jpeg, */*;q=0.1'); check "Accep
 c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
 c=$(post mpath "$T/model-path.json"); check "model by path under --asset-root 200" [ "$c" = 200 ]
 # The answer depends on the file under --asset-root: when it changes, so must the ETag, and the
-# old ETag must not earn a 304.
+# old ETag must not earn a 412.
 mtag=$(hdr mpath ETag)
-c=$(post mpath304 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model, same file: 304" [ "$c" = 304 ]
+c=$(post mpath412 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model, same file: 412" [ "$c" = 412 ]
 cp "$T/assets/tri.obj" "$T/tri.obj.orig"
 printf 'v -1 0 -1\nv 1 0 -1\nv 0 0.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
-c=$(post mpath2 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model file changed: 200, not 304" [ "$c" = 200 ]
+c=$(post mpath2 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model file changed: 200, not 412" [ "$c" = 200 ]
 check "asset model file changed: other ETag" [ "$(hdr mpath2 ETag)" != "$mtag" ]
 cp "$T/tri.obj.orig" "$T/assets/tri.obj"
 c=$(post mesc "$T/model-escape.json"); check "model path escaping --asset-root 400" [ "$c" = 400 ]
