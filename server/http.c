@@ -157,8 +157,11 @@ enum MHD_Result srv_respond(struct srv_request *req, int status, const char *con
 	req->state = SRV_REQ_ANSWERED;
 	double secs = srv_now() - req->t_start;
 	srv_metrics_request(s->metrics, req->route, status, secs, len);
-	srv_log_request(req->method, req->path, srv_route_name(req->route), status, len, secs * 1000.0, req->id,
-	                status >= 400 ? req->problem_detail : NULL, status >= 400 ? req->problem_pointer : NULL);
+	srv_log_request(&(struct srv_access){ .method = req->method, .path = req->path, .route = srv_route_name(req->route),
+	                                      .request_id = req->id, .client = req->client_addr,
+	                                      .detail = status >= 400 ? req->problem_detail : NULL,
+	                                      .pointer = status >= 400 ? req->problem_pointer : NULL,
+	                                      .status = status, .bytes = len, .ms = secs * 1000.0 });
 	return r;
 }
 
@@ -350,6 +353,24 @@ static void request_id(struct srv_request *req, struct MHD_Connection *conn)
 	snprintf(req->id, sizeof req->id, "%016llx-%06llx", (unsigned long long)s->id_seed, (unsigned long long)n);
 }
 
+/* The peer's address for the access log: "192.0.2.7", "2001:db8::1" (an IPv4-mapped IPv6
+ * address as its IPv4 form), "" when unknown. */
+static void client_address(char *out, size_t n, const struct sockaddr *sa)
+{
+	out[0] = 0;
+	if (!sa)
+		return;
+	if (sa->sa_family == AF_INET) {
+		inet_ntop(AF_INET, &((const struct sockaddr_in *)sa)->sin_addr, out, (socklen_t)n);
+	} else if (sa->sa_family == AF_INET6) {
+		const struct in6_addr *a = &((const struct sockaddr_in6 *)sa)->sin6_addr;
+		if (IN6_IS_ADDR_V4MAPPED(a))
+			inet_ntop(AF_INET, &a->s6_addr[12], out, (socklen_t)n);
+		else
+			inet_ntop(AF_INET6, a, out, (socklen_t)n);
+	}
+}
+
 static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, const char *url,
                                       const char *method, const char *version, const char *upload_data,
                                       size_t *upload_data_size, void **con_cls)
@@ -367,6 +388,7 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 		req->t_start = srv_now();
 		const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
 		req->client = srv_client_key(ci ? ci->client_addr : NULL);
+		client_address(req->client_addr, sizeof req->client_addr, ci ? ci->client_addr : NULL);
 		snprintf(req->method, sizeof req->method, "%s", method);
 		snprintf(req->path, sizeof req->path, "%s", url);
 		req->route = route_of(url);

@@ -182,6 +182,7 @@ struct srv_request {
 	char id[80];                   /* X-Request-Id */
 	double t_start, t_queued;      /* monotonic seconds */
 	uint64_t client;               /* srv_client_key() of the peer: its share of import threads */
+	char client_addr[48];          /* the peer's address, for the access log ("" = unknown) */
 
 	/* body of POST /v1/render: the scene document, or for multipart/form-data the `scene` part
 	 * (moved here when the body is complete) and the other named parts */

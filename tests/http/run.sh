@@ -230,7 +230,7 @@ check "metrics have queue depth and in-flight gauges" sh -c "grep -q '^umbra_que
 check "metrics have shadow-map reuse" grep -q '^umbra_shadow_maps_reused_total ' "$T/metrics.body"
 check "metrics have atlas occupancy" grep -q '^umbra_atlas_occupancy_ratio ' "$T/metrics.body"
 check "metrics count 413/415/422" sh -c "grep -q 'status=\"413\"' '$T/metrics.body' && grep -q 'status=\"415\"' '$T/metrics.body' && grep -q 'status=\"422\"' '$T/metrics.body'"
-check "access log line per request" grep -q 'POST /v1/render 200 .*id=test-id-42' "$T/main.log"
+check "access log line per request, with the client's address" grep -q 'info  POST /v1/render 200 .*id=test-id-42 client=127.0.0.1' "$T/main.log"
 
 # -- resources over $REPS sequential small renders (keep-alive batches of 25); the growth is
 # measured after the first fifth, once caches and allocator pools have settled.
@@ -323,18 +323,30 @@ echo "# starting the deadline daemon"
 if start deadline --workers 1 --deadline-ms 1 --log-format json; then
 	c=$(post d1 "$T/small.json" -H 'X-Request-Id: deadline-1'); check "render past --deadline-ms: 504" [ "$c" = 504 ]
 	check "504 is problem+json" problem d1 504 -
-	check "--log-format json: every line is a JSON object; the access line has the fields and the problem's detail" python3 - "$T/deadline.log" <<'PY'
+	check "--log-format json: every line is a JSON object; the access line has the fields, the client, the problem's detail, and a 5xx at level warn" python3 - "$T/deadline.log" <<'PY'
 import json, sys
 ok = False
 for line in open(sys.argv[1]):
     d = json.loads(line)
     if d.get("request_id") == "deadline-1":
         ok = d["status"] == 504 and d["method"] == "POST" and d["route"] == "/v1/render" and "ms" in d and "bytes" in d \
-             and "deadline" in d.get("detail", "") and d.get("pointer") == ""
+             and "deadline" in d.get("detail", "") and d.get("pointer") == "" and d.get("level") == "warn" \
+             and d.get("client") == "127.0.0.1"
 sys.exit(0 if ok else 1)
 PY
 	stop deadline $PID
 fi
+
+# A configuration error with UMBRA_LOG_FORMAT=json is a JSON log line too, and exit 2.
+UMBRA_LOG_FORMAT=json "$UMBRAD" --atlas-size 3 2>"$T/badflag.log"; rc=$?
+check "UMBRA_LOG_FORMAT=json: a bad flag is exit 2 and one JSON error line" python3 - "$T/badflag.log" "$rc" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().splitlines()
+d = json.loads(lines[0]) if len(lines) == 1 else {}
+sys.exit(0 if sys.argv[2] == "2" and d.get("level") == "error" and "--atlas-size" in d.get("msg", "") else 1)
+PY
+"$UMBRAD" --atlas-size 3 2>"$T/badflag.txt"
+check "text log format: the bad flag says 'umbrad: --atlas-size ...'" grep -q '^umbrad: --atlas-size: 3 is not a power of two' "$T/badflag.txt"
 
 # ==== SIGTERM under load (main daemon) ====
 URL=$MAIN_URL
