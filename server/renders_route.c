@@ -44,13 +44,10 @@ enum MHD_Result srv_result_get(struct srv_request *req, struct MHD_Connection *c
 	req->etag_hash = hash;
 	srv_etag_format(req->etag, sizeof req->etag, hash);
 	const char *inm = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-	uint8_t *img = NULL;
-	size_t len = 0;
-	const char *mime = NULL;
+	struct srv_result_image img = { 0 };
 	struct srv_kept_scene scene = { 0 };
 	bool conditional = srv_etag_matches(inm, req->etag);
-	enum srv_result_found f = srv_results_get(s->results, hash, req->result_ext, conditional ? NULL : &img, &len,
-	                                          &mime, &scene);
+	enum srv_result_found f = srv_results_get(s->results, hash, req->result_ext, conditional ? NULL : &img, &scene);
 	if (f != SRV_RESULT_NONE && conditional) {
 		srv_metrics_add(s->metrics, SRV_CTR_NOT_MODIFIED, 1);
 		return srv_respond(req, 304, NULL, NULL, 0, NULL);
@@ -58,7 +55,9 @@ enum MHD_Result srv_result_get(struct srv_request *req, struct MHD_Connection *c
 	switch (f) {
 	case SRV_RESULT_IMAGE:
 		srv_metrics_add(s->metrics, SRV_CTR_RESULT_HIT, 1);
-		return srv_respond(req, 200, mime, img, len, NULL);
+		snprintf(req->warnings, sizeof req->warnings, "%s", img.warnings ? img.warnings : "");
+		free((char *)img.warnings);
+		return srv_respond(req, 200, img.mime, img.data, img.len, NULL);
 	case SRV_RESULT_SCENE:
 		srv_metrics_add(s->metrics, SRV_CTR_RESULT_MISS, 1);
 		return render_again(req, &scene);

@@ -18,6 +18,7 @@ struct result {
 	const char *mime;          /* a static string (api_format_mime) */
 	uint8_t *image;            /* NULL: evicted (or never stored) */
 	size_t image_len;
+	char *warnings;            /* the image's Umbra-Warnings, NULL = none (dropped with it) */
 	struct srv_kept_scene scene;   /* empty: not kept */
 };
 
@@ -61,6 +62,7 @@ void srv_results_destroy(struct srv_results *r)
 	for (struct result *e = r->head, *next; e; e = next) {
 		next = e->next;
 		free(e->image);
+		free(e->warnings);
 		srv_kept_release(&e->scene);
 		free(e);
 	}
@@ -148,7 +150,9 @@ static void drop_image(struct srv_results *r, struct result *e)
 	r->image_bytes -= e->image_len;
 	r->images--;
 	free(e->image);
+	free(e->warnings);
 	e->image = NULL;
+	e->warnings = NULL;
 	e->image_len = 0;
 }
 
@@ -187,15 +191,20 @@ static struct result *find(struct srv_results *r, uint64_t hash, const char *ext
 	return NULL;
 }
 
-bool srv_results_put(struct srv_results *r, uint64_t hash, const char *ext, const char *mime, const uint8_t *img,
-                     size_t len, struct srv_kept_scene *kept)
+bool srv_results_put(struct srv_results *r, uint64_t hash, const char *ext, const struct srv_result_image *img,
+                     struct srv_kept_scene *kept)
 {
-	if (!r || len > r->image_budget || strlen(ext) >= sizeof ((struct result *)0)->ext)
+	if (!r || img->len > r->image_budget || strlen(ext) >= sizeof ((struct result *)0)->ext)
 		goto refuse;
+	size_t len = img->len;
 	uint8_t *copy = malloc(len ? len : 1);
-	if (!copy)
+	char *warnings = img->warnings && *img->warnings ? strdup(img->warnings) : NULL;
+	if (!copy || (img->warnings && *img->warnings && !warnings)) {
+		free(copy);
+		free(warnings);
 		goto refuse;
-	memcpy(copy, img, len);
+	}
+	memcpy(copy, img->data, len);
 	pthread_mutex_lock(&r->lock);
 	struct result *e = find(r, hash, ext);
 	if (!e && (e = calloc(1, sizeof *e))) {
@@ -206,12 +215,14 @@ bool srv_results_put(struct srv_results *r, uint64_t hash, const char *ext, cons
 	if (!e) {
 		pthread_mutex_unlock(&r->lock);
 		free(copy);
+		free(warnings);
 		goto refuse;
 	}
 	drop_image(r, e);
 	e->image = copy;
 	e->image_len = len;
-	e->mime = mime;
+	e->warnings = warnings;
+	e->mime = img->mime;
 	r->image_bytes += len;
 	r->images++;
 	if (kept && kept->body && !e->scene.body) {
@@ -231,8 +242,24 @@ refuse:
 	return false;
 }
 
-enum srv_result_found srv_results_get(struct srv_results *r, uint64_t hash, const char *ext, uint8_t **img,
-                                      size_t *len, const char **mime, struct srv_kept_scene *scene)
+/* The entry's image as malloc'd copies; false when out of memory (nothing to free). */
+static bool image_copy(const struct result *e, struct srv_result_image *out)
+{
+	*out = (struct srv_result_image){ .len = e->image_len, .mime = e->mime };
+	out->data = malloc(e->image_len ? e->image_len : 1);
+	out->warnings = e->warnings ? strdup(e->warnings) : NULL;
+	if (!out->data || (e->warnings && !out->warnings)) {
+		free(out->data);
+		free((char *)out->warnings);
+		*out = (struct srv_result_image){ 0 };
+		return false;
+	}
+	memcpy(out->data, e->image, e->image_len);
+	return true;
+}
+
+enum srv_result_found srv_results_get(struct srv_results *r, uint64_t hash, const char *ext,
+                                      struct srv_result_image *img, struct srv_kept_scene *scene)
 {
 	enum srv_result_found found = SRV_RESULT_NONE;
 	if (!r)
@@ -245,14 +272,8 @@ enum srv_result_found srv_results_get(struct srv_results *r, uint64_t hash, cons
 		found = e->image ? SRV_RESULT_IMAGE : SRV_RESULT_SCENE;
 	}
 	if (e && img && e->image) {
-		*img = malloc(e->image_len ? e->image_len : 1);
-		if (*img) {
-			memcpy(*img, e->image, e->image_len);
-			*len = e->image_len;
-			*mime = e->mime;
-		} else {
+		if (!image_copy(e, img))
 			found = SRV_RESULT_NONE;
-		}
 	} else if (e && img && !scene_copy(&e->scene, scene)) {
 		found = SRV_RESULT_NONE;
 	}

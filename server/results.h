@@ -12,8 +12,9 @@
  *
  * Usage:
  *   worker (POST /v1/renders): srv_scene_keep(&req->kept, req) before the body is dropped;
- *     after the encode: srv_results_put(r, hash, "png", mime, bytes, len, &req->kept)
- *   polling thread (GET): switch (srv_results_get(r, hash, "png", &img, &n, &mime, &scene)) ...
+ *     after the encode: srv_results_put(r, hash, "png", &(struct srv_result_image){ bytes, len,
+ *     mime, req->warnings }, &req->kept)
+ *   polling thread (GET): switch (srv_results_get(r, hash, "png", &img, &scene)) ...
  *
  * Ownership: put copies the image and takes the kept scene (leaving *kept empty); get hands
  * out malloc'd copies (the image, or a scene to render: srv_kept_release it or move it into a
@@ -42,17 +43,28 @@ bool srv_scene_keep(struct srv_kept_scene *kept, struct srv_request *req);
 void srv_scene_give(struct srv_kept_scene *kept, struct srv_request *req);
 void srv_kept_release(struct srv_kept_scene *kept);   /* NULL-safe, leaves it empty */
 
-/* Stores a copy of the image under (hash, ext), and takes *kept (may be empty). False when the
- * image alone is over the cache's size or out of memory: nothing stored, *kept released. */
-bool srv_results_put(struct srv_results *r, uint64_t hash, const char *ext, const char *mime, const uint8_t *img,
-                     size_t len, struct srv_kept_scene *kept);
+/* A stored image: its bytes, its media type (a static string: api_format_mime) and the
+ * Umbra-Warnings its render had ("" or NULL = none), sent again with every GET. */
+struct srv_result_image {
+	uint8_t *data;
+	size_t len;
+	const char *mime;
+	const char *warnings;
+};
+
+/* Stores a copy of the image under (hash, ext), and takes *kept (may be NULL or empty). False
+ * when the image alone is over the cache's size or out of memory: nothing stored, *kept
+ * released. */
+bool srv_results_put(struct srv_results *r, uint64_t hash, const char *ext, const struct srv_result_image *img,
+                     struct srv_kept_scene *kept);
 
 enum srv_result_found { SRV_RESULT_NONE, SRV_RESULT_IMAGE, SRV_RESULT_SCENE };
-/* What the cache has for (hash, ext): the image (a malloc'd copy in *img, *len, its media type
- * in *mime), or only its scene (a copy in *scene), or nothing. With img NULL, only whether it
- * knows the hash (IMAGE or SCENE), nothing copied. Out of memory for a copy: NONE. */
-enum srv_result_found srv_results_get(struct srv_results *r, uint64_t hash, const char *ext, uint8_t **img,
-                                      size_t *len, const char **mime, struct srv_kept_scene *scene);
+/* What the cache has for (hash, ext): the image (malloc'd copies in *img: data, and warnings
+ * unless NULL; free both), or only its scene (a copy in *scene), or nothing. With img NULL,
+ * only whether it knows the hash (IMAGE or SCENE), nothing copied. Out of memory for a copy:
+ * NONE. */
+enum srv_result_found srv_results_get(struct srv_results *r, uint64_t hash, const char *ext,
+                                      struct srv_result_image *img, struct srv_kept_scene *scene);
 
 struct srv_results_stats {
 	uint64_t image_bytes, scene_bytes, images, scenes, capacity;

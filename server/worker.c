@@ -182,7 +182,7 @@ static int job_identity(struct srv_server *s, struct srv_request *req, const str
 		return 1;
 	}
 	if (req->route == SRV_ROUTE_RENDERS &&
-	    srv_results_get(s->results, req->etag_hash, srv_format_ext(mime), NULL, NULL, NULL, NULL) == SRV_RESULT_IMAGE) {
+	    srv_results_get(s->results, req->etag_hash, srv_format_ext(mime), NULL, NULL) == SRV_RESULT_IMAGE) {
 		srv_metrics_add(s->metrics, SRV_CTR_RESULT_HIT, 1);
 		snprintf(req->location, sizeof req->location, "/v1/renders/%016llx.%s", (unsigned long long)req->etag_hash,
 		         srv_format_ext(mime));
@@ -257,7 +257,8 @@ static void job_answer(struct srv_server *s, struct srv_request *req, const stru
 	req->content_type = mime;
 	if (req->route == SRV_ROUTE_RENDER)
 		return;
-	bool stored = srv_results_put(s->results, req->etag_hash, ext, mime, bytes, len, &req->kept);
+	bool stored = srv_results_put(s->results, req->etag_hash, ext,
+	                              &(struct srv_result_image){ bytes, len, mime, req->warnings }, &req->kept);
 	if (!stored || req->route != SRV_ROUTE_RENDERS)
 		return;
 	snprintf(req->location, sizeof req->location, "/v1/renders/%016llx.%s", (unsigned long long)req->etag_hash, ext);

@@ -85,7 +85,8 @@ static void *worker_main(void *arg)
 			/* What worker.c does after a render: store the image (and the scene), 303. */
 			uint64_t h = rnd_fnv1a(RND_FNV_SEED, req->body, req->body_len);
 			srv_scene_keep(&req->kept, req);
-			CHECK(srv_results_put(srv.results, h, "png", "image/png", (const uint8_t *)"png", 3, &req->kept));
+			CHECK(srv_results_put(srv.results, h, "png", &(struct srv_result_image){ (uint8_t *)"png", 3, "image/png", "w" },
+			                      &req->kept));
 			srv_request_drop_body(req);
 			snprintf(req->location, sizeof req->location, "/v1/renders/%016llx.png", (unsigned long long)h);
 			srv_etag_format(req->etag, sizeof req->etag, h);
@@ -137,10 +138,11 @@ static void start_once(void)
 	fake.body_len = strlen(fake.body);
 	CHECK(fake.body && srv_scene_keep(&kept, &fake));
 	static uint8_t big[600 << 10];
-	CHECK(srv_results_put(srv.results, 0xaa, "png", "image/png", big, sizeof big, &kept));
-	CHECK(srv_results_put(srv.results, 0xbb, "png", "image/png", big, sizeof big, NULL));
-	CHECK(srv_results_get(srv.results, 0xaa, "png", NULL, NULL, NULL, NULL) == SRV_RESULT_SCENE);
-	CHECK(srv_results_put(srv.results, 0x0123456789abcdefull, "png", "image/png", (const uint8_t *)"png", 3, NULL));
+	CHECK(srv_results_put(srv.results, 0xaa, "png", &(struct srv_result_image){ big, sizeof big, "image/png", NULL }, &kept));
+	CHECK(srv_results_put(srv.results, 0xbb, "png", &(struct srv_result_image){ big, sizeof big, "image/png", NULL }, NULL));
+	CHECK(srv_results_get(srv.results, 0xaa, "png", NULL, NULL) == SRV_RESULT_SCENE);
+	CHECK(srv_results_put(srv.results, 0x0123456789abcdefull, "png",
+	                      &(struct srv_result_image){ (uint8_t *)"png", 3, "image/png", NULL }, NULL));
 	atomic_store(&srv.ready, true);
 	CHECK(srv_http_start(&srv) == 0);
 	CHECK(pthread_create(&worker, NULL, worker_main, NULL) == 0);

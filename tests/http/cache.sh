@@ -60,6 +60,11 @@ check "GET of an unknown hash: 404 problem+json saying to POST again" sh -c "[ '
 c=$(fetch gbad "$URL/v1/renders/xyz.png"); check "GET of a malformed name: 404" [ "$c" = 404 ]
 c=$(fetch gext "$URL$(dirname "$loc")/$(basename "$loc" .png).exr"); check "GET with another format's extension: 404" [ "$c" = 404 ]
 c=$(fetch gpost "$URL$loc" -X POST); check "POST on the GET form: 405" [ "$c" = 405 ]
+# What the image leaves out is never silent: the GET form repeats the render's Umbra-Warnings.
+printf '{"preset": "thumbnail", "width": 64, "height": 64, "objects": [{"shape": "box"}], "shadows": {"pcf_radius": 2}}' >"$T/warn.json"
+curl -s --max-time 120 -o /dev/null -D "$T/w1.hdr" -H 'Content-Type: application/json' --data-binary "@$T/warn.json" "$URL/v1/renders" >/dev/null
+c=$(fetch w2 "$URL$(hdr w1 Location)")
+check "GET form: the render's Umbra-Warnings ($(hdr w2 Umbra-Warnings))" sh -c "[ '$c' = 200 ] && [ -n \"\$1\" ] && [ \"\$1\" = \"\$2\" ]" - "$(hdr w1 Umbra-Warnings)" "$(hdr w2 Umbra-Warnings)"
 check "hits counted (umbra_result_cache_hits_total >= 3)" [ "$(metric umbra_result_cache_hits_total)" -ge 3 ]
 check "misses counted" [ "$(metric umbra_result_cache_misses_total)" -ge 1 ]
 
