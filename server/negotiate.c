@@ -106,6 +106,11 @@ const char *srv_format_ext(const char *mime)
 	return strncmp(ext, "x-", 2) ? ext : ext + 2;
 }
 
+void srv_result_name(char *out, size_t n, uint64_t hash, const char *mime)
+{
+	snprintf(out, n, "/v1/renders/%016llx.%s", (unsigned long long)hash, srv_format_ext(mime));
+}
+
 bool srv_result_path(const char *url, uint64_t *hash, char *ext, size_t extsize)
 {
 	static const char prefix[] = "/v1/renders/";

@@ -41,7 +41,10 @@ uint64_t srv_etag_of(uint64_t scene_hash, uint64_t asset_hash, const char *forma
 /* The file extension of a format's media type in GET /v1/renders/{hash}.{ext}: its subtype
  * without "x-" ("image/png" -> "png", "image/x-exr" -> "exr"); points into mime. */
 const char *srv_format_ext(const char *mime);
-/* Reads "/v1/renders/{16 lower-case hex digits}.{ext}" (ext: a-z, shorter than extsize). */
+/* Writes the GET form's path of a render, "/v1/renders/{hash as 16 hex digits}.{ext of mime}"
+ * (the Location of POST /v1/renders; n >= 64 holds any), and reads one back: true for
+ * "/v1/renders/{16 lower-case hex digits}.{ext}" (ext: a-z, shorter than extsize). */
+void srv_result_name(char *out, size_t n, uint64_t hash, const char *mime);
 bool srv_result_path(const char *url, uint64_t *hash, char *ext, size_t extsize);
 /* Writes the strong ETag header value ("0123456789abcdef", quotes included); n >= 19. */
 void srv_etag_format(char *out, size_t n, uint64_t h);

@@ -184,8 +184,7 @@ static int job_identity(struct srv_server *s, struct srv_request *req, const str
 	if (req->route == SRV_ROUTE_RENDERS &&
 	    srv_results_get(s->results, req->etag_hash, srv_format_ext(mime), NULL, NULL) == SRV_RESULT_IMAGE) {
 		srv_metrics_add(s->metrics, SRV_CTR_RESULT_HIT, 1);
-		snprintf(req->location, sizeof req->location, "/v1/renders/%016llx.%s", (unsigned long long)req->etag_hash,
-		         srv_format_ext(mime));
+		srv_result_name(req->location, sizeof req->location, req->etag_hash, mime);
 		req->status = 303;
 		return 1;
 	}
@@ -261,7 +260,7 @@ static void job_answer(struct srv_server *s, struct srv_request *req, const stru
 	                              &(struct srv_result_image){ bytes, len, mime, req->warnings }, &req->kept);
 	if (!stored || req->route != SRV_ROUTE_RENDERS)
 		return;
-	snprintf(req->location, sizeof req->location, "/v1/renders/%016llx.%s", (unsigned long long)req->etag_hash, ext);
+	srv_result_name(req->location, sizeof req->location, req->etag_hash, mime);
 	req->status = 303;
 	req->out = NULL;
 	req->out_len = 0;

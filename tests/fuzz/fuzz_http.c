@@ -88,7 +88,7 @@ static void *worker_main(void *arg)
 			CHECK(srv_results_put(srv.results, h, "png", &(struct srv_result_image){ (uint8_t *)"png", 3, "image/png", "w" },
 			                      &req->kept));
 			srv_request_drop_body(req);
-			snprintf(req->location, sizeof req->location, "/v1/renders/%016llx.png", (unsigned long long)h);
+			srv_result_name(req->location, sizeof req->location, h, "image/png");
 			srv_etag_format(req->etag, sizeof req->etag, h);
 			req->status = 303;
 			srv_request_finish(req);

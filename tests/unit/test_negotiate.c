@@ -54,6 +54,10 @@ TEST(negotiate_etag_of_decides_identity)
 	char ext[8];
 	CHECK(srv_result_path("/v1/renders/0123456789abcdef.png", &h, ext, sizeof ext) && h == 0x0123456789abcdefull &&
 	      !strcmp(ext, "png"));
+	char name[64];
+	srv_result_name(name, sizeof name, 0xabcull, "image/x-exr");
+	CHECK(!strcmp(name, "/v1/renders/0000000000000abc.exr"), "got %s", name);
+	CHECK(srv_result_path(name, &h, ext, sizeof ext) && h == 0xabc && !strcmp(ext, "exr"), "the name reads back");
 	CHECK(!srv_result_path("/v1/renders/0123456789abcdef", &h, ext, sizeof ext), "no extension");
 	CHECK(!srv_result_path("/v1/renders/0123456789ABCDEF.png", &h, ext, sizeof ext), "upper-case hex");
 	CHECK(!srv_result_path("/v1/renders/0123456789abcde.png", &h, ext, sizeof ext), "15 digits");
