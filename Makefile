@@ -140,7 +140,7 @@ $(BUILD)/umbrad: $(SRV_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 # negotiate.o and buf.o: Accept, Content-Type, ETag and the JSON escaper (test_negotiate.c);
 # queue.o: srv_queue_pop_idle; gate.o: the device gate; clock.o: what queue, admit and gate wait with;
 # ranges.o: connections per address range (test_ranges.c).
-$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/http_client.o $(BUILD)/obj/server/clock.o $(BUILD)/obj/server/gate.o $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/origin.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/obj/server/queue.o $(BUILD)/obj/server/ranges.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/unit_tests: $(UNIT_OBJ) $(BUILD)/obj/server/http_client.o $(BUILD)/obj/server/clock.o $(BUILD)/obj/server/gate.o $(BUILD)/obj/server/flags.o $(BUILD)/obj/server/log.o $(BUILD)/obj/server/admit.o $(BUILD)/obj/server/origin.o $(BUILD)/obj/server/negotiate.o $(BUILD)/obj/server/buf.o $(BUILD)/obj/server/queue.o $(BUILD)/obj/server/ranges.o $(BUILD)/obj/server/results.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a

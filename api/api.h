@@ -127,6 +127,9 @@ struct api_scene {
 	uint64_t triangles;         /* total after tessellation */
 	uint64_t asset_hash;        /* hash of files read under the asset root (`path` models), 0 = none:
 	                               the answer depends on them, so caches and ETags must too */
+	uint64_t scene_hash;        /* canonical hash of the document after its preset, and of the
+	                               parts (api/scene_hash.h): key order, whitespace, escapes and
+	                               number spellings do not change it */
 	/* What the image leaves out of what the scene asked for ("" = nothing), as sentences joined
 	 * by "; " that start with the member's JSON Pointer: an .obj sent inline whose .mtl is not in
 	 * the request, material data of a model that is not drawn as its file says. The server sends

@@ -23,6 +23,7 @@ static const struct {
 	{405, "method-not-allowed", "Method not allowed"},
 	{406, "not-acceptable", "Not acceptable"},
 	{408, "request-timeout", "Request timeout"},
+	{412, "precondition-failed", "Precondition failed"},
 	{413, "body-too-large", "Request body too large"},
 	{415, "unsupported-media-type", "Unsupported media type"},
 	{421, "host-not-allowed", "Host not allowed"},

@@ -26,6 +26,7 @@
 #include "model_paths.h"
 #include "model_refs.h"
 #include "preset.h"
+#include "scene_hash.h"
 #include "scene_internal.h"
 
 /* A reference to an imported model, released in api_scene_free() (the node is in the arena). */
@@ -302,6 +303,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 		api_big_strings_free(&big);
 		return API_ERR;
 	}
+	uint64_t scene_hash = api_scene_hash(root, &big, parts, nparts);   /* the merged document, before the walk */
 	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts, .big = &big};
 	c.arena = api_arena_create();
 	struct api_scene *s = c.arena ? api_arena_alloc(c.arena, sizeof *s) : NULL;
@@ -336,6 +338,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
+	s->scene_hash = scene_hash;
 	s->import = c.import;
 	memcpy(s->warnings, c.warnings, sizeof s->warnings);
 	api_set_pixels(s);   /* again: the format's own warnings follow the document's */

@@ -6,7 +6,9 @@
 #   3. the Dockerfile's runtime stage installs, directly or as dependencies, the package of
 #      every shared library build/umbrad links, and every package it names exists in Debian;
 #   4. the version is baked in without .git (make with UMBRA_VERSION= and with a VERSION file);
-#   5. deploy/k8s/check.py (python3-yaml), and deploy/k8s/validate.mjs when
+#   5. nginx -t accepts deploy/nginx/umbra-cache.conf inside a minimal nginx.conf (when nginx
+#      is installed: nginx-light);
+#   6. deploy/k8s/check.py (python3-yaml), and deploy/k8s/validate.mjs when
 #      KUBERNETES_MODELS_DIR names a node_modules holding kubernetes-models and js-yaml.
 BUILD=${BUILD:-build}
 pass=0; fail=0
@@ -85,7 +87,21 @@ echo 8.8.8-file > "$T/src/VERSION"
 v=$(cd "$T/src" && make -s print-version 2>/dev/null)
 case "$v" in *8.8.8-file*) ok "version from a VERSION file without .git" ;; *) nok "version from VERSION" "$v" ;; esac
 
-# 5. Kubernetes manifests
+# 5. nginx: the shared cache's config, in a prefix of its own (runs as any user).
+NGINX=$(command -v nginx 2>/dev/null || { [ -x /usr/sbin/nginx ] && echo /usr/sbin/nginx; })
+if [ -n "$NGINX" ]; then
+	mkdir -p "$T/nginx/cache"
+	sed "s|/var/cache/nginx/umbra|$T/nginx/cache|" deploy/nginx/umbra-cache.conf >"$T/nginx/umbra-cache.conf"
+	printf 'error_log %s/nginx/error.log;\npid %s/nginx/pid;\nevents {}\nhttp {\n    client_body_temp_path %s/nginx/b;\n    proxy_temp_path %s/nginx/p;\n    fastcgi_temp_path %s/nginx/f;\n    uwsgi_temp_path %s/nginx/u;\n    scgi_temp_path %s/nginx/s;\n    include %s/nginx/umbra-cache.conf;\n}\n' \
+		"$T" "$T" "$T" "$T" "$T" "$T" "$T" "$T" >"$T/nginx/nginx.conf"
+	if out=$("$NGINX" -t -p "$T/nginx" -c "$T/nginx/nginx.conf" -e "$T/nginx/error.log" 2>&1); then
+		ok "nginx -t accepts deploy/nginx/umbra-cache.conf"
+	else nok "nginx -t accepts deploy/nginx/umbra-cache.conf" "$out"; fi
+else
+	echo "# nginx not installed (nginx-light): deploy/nginx/umbra-cache.conf not checked"
+fi
+
+# 6. Kubernetes manifests
 # Debian's python3 has python3-yaml (install-deps.sh); another python3 first on PATH may not.
 PY=""
 for py in python3 /usr/bin/python3; do

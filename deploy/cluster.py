@@ -31,6 +31,9 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TEMPLATE = os.path.join(HERE, "haproxy.cfg.in")
+# The backends of haproxy.cfg.in over the same daemons: round robin, X-Umbra-Affinity, and the
+# GET form of renders (/v1/renders, by client address).
+BACKENDS = ("umbrad", "umbrad_affinity", "umbrad_renders")
 
 
 class ClusterError(Exception):
@@ -209,17 +212,17 @@ class Cluster:
                 if r.get("pxname") == backend and r.get("svname") not in ("FRONTEND", "BACKEND")}
 
     def sessions(self):
-        """{server name: requests sent to it by either backend} (stats `stot`)."""
+        """{server name: requests sent to it by any backend} (stats `stot`)."""
         out = {d.name: 0 for d in self.daemons}
         for r in self.stats_rows():
-            if r.get("pxname") in ("umbrad", "umbrad_affinity") and r.get("svname") in out:
+            if r.get("pxname") in BACKENDS and r.get("svname") in out:
                 out[r["svname"]] += int(r.get("stot") or 0)
         return out
 
     def backend_total(self, field):
-        """A counter (wretr, wredis, ...) summed over both backends' BACKEND rows."""
+        """A counter (wretr, wredis, ...) summed over the backends' BACKEND rows."""
         return sum(int(r.get(field) or 0) for r in self.stats_rows()
-                   if r.get("pxname") in ("umbrad", "umbrad_affinity") and r.get("svname") == "BACKEND")
+                   if r.get("pxname") in BACKENDS and r.get("svname") == "BACKEND")
 
     @staticmethod
     def row_is(row, state):

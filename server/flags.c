@@ -5,12 +5,14 @@
  */
 #include <errno.h>
 #include <getopt.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include <unistd.h>
 
+#include "log.h"
 #include "srv.h"
 
 enum opt_kind { OPT_STR, OPT_UINT, OPT_SIZE, OPT_LOGFMT };
@@ -49,7 +51,7 @@ static const struct opt_def opts[] = {
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
 	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (8192)", CFG(atlas_size), 0, 16384 },
 	{ "device", OPT_STR, "NAME", "substring of the Vulkan device name to use", CFG(device), 0, 0 },
-	{ "max-connections", OPT_UINT, "N", "concurrent connections; more are closed unanswered (1024)", CFG(max_connections), 1, 1000000 },
+	{ "max-connections", OPT_UINT, "N", "concurrent connections; more wait in the listen queue until one closes (1024)", CFG(max_connections), 1, 1000000 },
 	{ "max-connections-per-ip", OPT_UINT, "N", "concurrent connections from one client address, 0 = no limit (256)", CFG(max_connections_per_ip), 0, 1000000 },
 	{ "max-connections-per-range", OPT_UINT, "N", "concurrent connections from one client address range (IPv4 /24, IPv6 /64; loopback too); more are closed unanswered at accept, 0 = no limit (a quarter of --max-connections)", CFG(max_connections_per_range), 0, 1000000 },
 	{ "allowed-host", OPT_STR, "LIST", "Host names served, comma-separated, port ignored, * = any; others get 421 (against DNS rebinding; /healthz and /readyz always answer). Default: on a loopback --listen only localhost, 127.0.0.1, ::1 and the listen host; on other addresses any", CFG(allowed_host), 0, 0 },
@@ -59,15 +61,49 @@ static const struct opt_def opts[] = {
 	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
 	{ "idle-trim", OPT_UINT, "S", "after S s without a request, drop shadow maps unused for S s and give the atlas pages and freed heap back to the system, 0 = never (30)", CFG(idle_trim_s), 0, 86400 },
+	{ "result-cache-mb", OPT_UINT, "MB", "images POST /v1/renders keeps for GET /v1/renders/{hash}.{ext} (LRU), and up to an eighth as much (1 MB at least) of their scenes, each up to 1 MB, to render an evicted image again; 0 = off: both routes 404 (64)", CFG(result_cache_mb), 0, 1048576 },
+	{ "cache-control", OPT_STR, "VALUE", "Cache-Control of POST /v1/render and /v1/renders answers (no-cache: a cache must revalidate; the ETag is in the answer); GET /v1/renders/{hash}.{ext} always says public, max-age=31536000, immutable", CFG(cache_control), 0, 0 },
 	{ "test-fault", OPT_STR, "submit:N:lost|oom", "tests only: the Nth queue submit after warm-up fails", CFG(test_fault), 0, 0 },
 };
 #define OPT_COUNT (sizeof opts / sizeof opts[0])
 
+static enum srv_log_format early_format = SRV_LOG_TEXT;
+
+/* A configuration error on stderr: "umbrad: MESSAGE", or with --log-format json (flag or
+ * UMBRA_LOG_FORMAT, read before anything else) a JSON log line like every other. */
+static void config_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void config_error(const char *fmt, ...)
+{
+	char msg[600];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(msg, sizeof msg, fmt, ap);
+	va_end(ap);
+	if (early_format == SRV_LOG_JSON)
+		srv_log(SRV_LOG_ERROR, "%s", msg);
+	else
+		fprintf(stderr, "umbrad: %s\n", msg);
+}
+
+/* The log format the flags and environment ask for, before they are parsed (the last
+ * --log-format wins, as getopt will have it). */
+static enum srv_log_format peek_log_format(int argc, char **argv)
+{
+	const char *v = getenv("UMBRA_LOG_FORMAT");
+	for (int i = 1; i < argc; i++) {
+		if (!strcmp(argv[i], "--log-format") && i + 1 < argc)
+			v = argv[++i];
+		else if (!strncmp(argv[i], "--log-format=", 13))
+			v = argv[i] + 13;
+	}
+	return v && !strcasecmp(v, "json") ? SRV_LOG_JSON : SRV_LOG_TEXT;
+}
+
 static void usage(FILE *f)
 {
 	fprintf(f, "usage: umbrad [FLAGS]\n"
-	           "HTTP render daemon: POST /v1/render (scene JSON -> PNG/EXR), GET /healthz, /readyz,\n"
-	           "/metrics, /v1/info. Every flag can also be set as UMBRA_<FLAG> (e.g. UMBRA_MAX_BODY);\n"
+	           "HTTP render daemon: POST /v1/render (scene JSON -> PNG/EXR), POST /v1/renders (-> 303 to\n"
+	           "a cacheable GET /v1/renders/{hash}.png), GET /healthz, /readyz, /metrics, /v1/info. Every flag can also be set as UMBRA_<FLAG> (e.g. UMBRA_MAX_BODY);\n"
 	           "a flag wins over its variable. UMBRA_VALIDATION=1 enables the Vulkan validation layer.\n"
 	           "Models and textures are parsed in sandboxed child processes of umbra-import (found next to\n"
 	           "umbrad, or UMBRA_IMPORT_HELPER=PATH): over --import-timeout-ms / --import-memory is a 422,\n"
@@ -122,7 +158,7 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 	switch (o->kind) {
 	case OPT_STR:
 		if (!val || !*val) {
-			fprintf(stderr, "umbrad: %s: empty value\n", from);
+			config_error("%s: empty value", from);
 			return -1;
 		}
 		*(const char **)(base + o->offset) = val;
@@ -133,14 +169,14 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 		else if (val && !strcasecmp(val, "json"))
 			cfg->log_format = SRV_LOG_JSON;
 		else {
-			fprintf(stderr, "umbrad: %s: '%s' is not text or json\n", from, val ? val : "");
+			config_error("%s: '%s' is not text or json", from, val ? val : "");
 			return -1;
 		}
 		return 0;
 	case OPT_UINT:
 	case OPT_SIZE:
 		if (parse_u64(val, o->kind == OPT_SIZE, &v) != 0 || v < o->min || v > o->max) {
-			fprintf(stderr, "umbrad: %s: '%s' is not a number in %llu..%llu\n", from, val ? val : "",
+			config_error("%s: '%s' is not a number in %llu..%llu", from, val ? val : "",
 			        (unsigned long long)o->min, (unsigned long long)o->max);
 			return -1;
 		}
@@ -231,6 +267,7 @@ static void set_defaults(struct srv_config *cfg)
 	cfg->header_timeout_s = 10;
 	cfg->drain_timeout_s = 60;
 	cfg->idle_trim_s = 30;
+	cfg->result_cache_mb = 64;
 	const char *v = getenv("UMBRA_VALIDATION");
 	cfg->validation = v && *v && strcmp(v, "0") != 0;
 	v = getenv("UMBRA_NO_PLAYGROUND");
@@ -241,6 +278,8 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 {
 	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
 	set_defaults(cfg);
+	early_format = peek_log_format(argc, argv);
+	srv_log_init(early_format);
 
 	/* Environment first. */
 	for (size_t i = 0; i < OPT_COUNT; i++) {
@@ -285,25 +324,25 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 			return -1;
 	}
 	if (optind < argc) {
-		fprintf(stderr, "umbrad: unexpected argument '%s'\n", argv[optind]);
+		config_error("unexpected argument '%s'", argv[optind]);
 		usage(stderr);
 		return -1;
 	}
 	if (cfg->limits.max_shadow_resolution && cfg->limits.max_shadow_resolution < RND_MIN_SHADOW_RESOLUTION) {
-		fprintf(stderr, "umbrad: --max-shadow-resolution: %u is under the smallest map, %u (0: no limit)\n",
+		config_error("--max-shadow-resolution: %u is under the smallest map, %u (0: no limit)",
 		        cfg->limits.max_shadow_resolution, RND_MIN_SHADOW_RESOLUTION);
 		return -1;
 	}
 	if (cfg->atlas_size & (cfg->atlas_size - 1)) {
-		fprintf(stderr, "umbrad: --atlas-size: %u is not a power of two\n", cfg->atlas_size);
+		config_error("--atlas-size: %u is not a power of two", cfg->atlas_size);
 		return -1;
 	}
 	if (cfg->warm_up && strcmp(cfg->warm_up, "defaults") && strcmp(cfg->warm_up, "all")) {
-		fprintf(stderr, "umbrad: --warm-up: '%s' is not defaults or all\n", cfg->warm_up);
+		config_error("--warm-up: '%s' is not defaults or all", cfg->warm_up);
 		return -1;
 	}
 	if (cfg->asset_root && access(cfg->asset_root, R_OK | X_OK) != 0) {
-		fprintf(stderr, "umbrad: --asset-root: cannot open '%s': %s\n", cfg->asset_root, strerror(errno));
+		config_error("--asset-root: cannot open '%s': %s", cfg->asset_root, strerror(errno));
 		return -1;
 	}
 	/* The lists are checked here, so that a bad entry exits 2; srv_http_start() builds them
@@ -312,10 +351,15 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 	struct srv_origin_error oerr;
 	if (srv_origin_init(&o, &(struct srv_origin_config){ .allowed_hosts = cfg->allowed_host,
 	                                                     .cors_origins = cfg->cors_origin }, &oerr) != SRV_ORIGIN_OK) {
-		fprintf(stderr, "umbrad: %s\n", oerr.msg);
+		config_error("%s", oerr.msg);
 		return -1;
 	}
 	srv_origin_release(&o);
+	for (const char *p = cfg->cache_control; p && *p; p++)
+		if ((unsigned char)*p < 0x20 || (unsigned char)*p > 0x7e) {
+			config_error("--cache-control: not one line of printable ASCII");
+			return -1;
+		}
 	cfg->limits.asset_root = cfg->asset_root;
 	if (!cfg->max_memory) cfg->max_memory = srv_admit_default_budget();
 	return 0;

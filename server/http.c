@@ -9,10 +9,12 @@
  *                              other error is answered at once (libmicrohttpd then skips the
  *                              body, sends no "100 Continue" and closes the connection).
  *   next calls (body chunks)   appended and hashed (ETag); past --max-body -> 413.
- *   last call  (body complete) If-None-Match -> 304, else suspend + queue (full -> 503).
+ *   last call  (body complete) suspend + queue (full -> 503); the worker parses, and answers
+ *                              412 to a POST whose If-None-Match lists the scene's ETag.
  *   after resume               the worker's answer is sent.
- * This file dispatches (routes, methods, the GET routes) and answers; POST /v1/render's headers
- * and body are render_route.c's, the negotiation rules negotiate.c's.
+ * This file dispatches (routes, methods, the GET routes) and answers; POST /v1/render's (and
+ * /v1/renders') headers and body are render_route.c's, GET /v1/renders/{hash} renders_route.c's,
+ * the negotiation rules negotiate.c's.
  * The request struct is freed in the completion callback, which also ends the pending count
  * that the drain at exit waits for.
  */
@@ -34,11 +36,12 @@
 #include "metrics.h"
 #include "http.h"
 #include "queue.h"
+#include "results.h"
 
 const char *srv_route_name(enum srv_route r)
 {
 	static const char *const names[SRV_ROUTE_COUNT] = { "/v1/render", "/healthz", "/readyz",
-		"/metrics", "/v1/info", "/playground", "other" };
+		"/metrics", "/v1/info", "/playground", "/v1/renders", "/v1/renders/{hash}", "other" };
 	return (unsigned)r < SRV_ROUTE_COUNT ? names[r] : "other";
 }
 
@@ -54,13 +57,15 @@ static enum srv_route route_of(const char *url)
 	static const struct { const char *path; enum srv_route r; } routes[] = {
 		{ "/v1/render", SRV_ROUTE_RENDER }, { "/healthz", SRV_ROUTE_HEALTHZ },
 		{ "/readyz", SRV_ROUTE_READYZ }, { "/metrics", SRV_ROUTE_METRICS },
-		{ "/v1/info", SRV_ROUTE_INFO },
+		{ "/v1/info", SRV_ROUTE_INFO }, { "/v1/renders", SRV_ROUTE_RENDERS },
 	};
 	for (size_t i = 0; i < sizeof routes / sizeof routes[0]; i++)
 		if (!strcmp(url, routes[i].path))
 			return routes[i].r;
 	if (srv_playground_path(url))
 		return SRV_ROUTE_PLAYGROUND;
+	if (!strncmp(url, "/v1/renders/", 12))
+		return SRV_ROUTE_RESULT;
 	return SRV_ROUTE_OTHER;
 }
 
@@ -87,13 +92,38 @@ static void request_free(struct srv_request *req)
 	if (req->post)
 		MHD_destroy_post_processor(req->post);
 	srv_request_drop_body(req);
+	srv_kept_release(&req->kept);
 	free(req->out);
 	free(req);
 }
 
 const char *srv_allow_of(enum srv_route r)
 {
-	return r == SRV_ROUTE_RENDER ? "POST" : "GET, HEAD";
+	return r == SRV_ROUTE_RENDER || r == SRV_ROUTE_RENDERS ? "POST" : "GET, HEAD";
+}
+
+/* The headers of a render answer (POST /v1/render, POST /v1/renders, GET /v1/renders/{hash}):
+ * ETag, Location, Server-Timing, Umbra-Warnings and Cache-Control; no-store for the rest. */
+static void render_headers(struct srv_request *req, struct MHD_Response *resp, int status)
+{
+	const struct srv_server *s = req->srv;
+	bool render = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS || req->route == SRV_ROUTE_RESULT;
+	bool fresh = status == 200 || status == 303 || status == 304;
+	if (render && (fresh || status == 412) && req->etag[0])
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, req->etag);
+	if (render && status == 303)
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_LOCATION, req->location);
+	if (render && fresh && req->server_timing[0])
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_SERVER_TIMING, req->server_timing);
+	/* What the image leaves out of what the scene asked for (never silent). */
+	if (render && (status == 200 || status == 303) && req->warnings[0])
+		MHD_add_response_header(resp, "Umbra-Warnings", req->warnings);
+	const char *cc = "no-store";
+	if (req->route == SRV_ROUTE_RESULT && (status == 200 || status == 304))
+		cc = SRV_RESULT_CACHE_CONTROL;
+	else if (render && (status == 200 || status == 303))
+		cc = s->cfg.cache_control ? s->cfg.cache_control : SRV_RENDER_CACHE_CONTROL;
+	MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, cc);
 }
 
 /* Queues an answer. body is malloc'd and becomes libmicrohttpd's (freed with free()), or NULL.
@@ -117,15 +147,7 @@ enum MHD_Result srv_respond(struct srv_request *req, int status, const char *con
 	if (status == 503)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, atomic_load(&s->draining) ? "5" : "1");
 	srv_origin_headers(req, resp, status);
-	if (req->route == SRV_ROUTE_RENDER && (status == 200 || status == 304)) {
-		MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, req->etag);
-		if (req->server_timing[0])
-			MHD_add_response_header(resp, MHD_HTTP_HEADER_SERVER_TIMING, req->server_timing);
-		/* What the image leaves out of what the scene asked for (never silent). */
-		if (status == 200 && req->warnings[0]) MHD_add_response_header(resp, "Umbra-Warnings", req->warnings);
-	}
-	if (req->route != SRV_ROUTE_RENDER || status != 200)
-		MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+	render_headers(req, resp, status);
 	if (atomic_load(&s->draining) || req->close_after)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
 	enum MHD_Result r = MHD_queue_response(req->conn, (unsigned)status, resp);
@@ -135,8 +157,11 @@ enum MHD_Result srv_respond(struct srv_request *req, int status, const char *con
 	req->state = SRV_REQ_ANSWERED;
 	double secs = srv_now() - req->t_start;
 	srv_metrics_request(s->metrics, req->route, status, secs, len);
-	srv_log_request(req->method, req->path, srv_route_name(req->route), status, len, secs * 1000.0, req->id,
-	                status >= 400 ? req->problem_detail : NULL, status >= 400 ? req->problem_pointer : NULL);
+	srv_log_request(&(struct srv_access){ .method = req->method, .path = req->path, .route = srv_route_name(req->route),
+	                                      .request_id = req->id, .client = req->client_addr,
+	                                      .detail = status >= 400 ? req->problem_detail : NULL,
+	                                      .pointer = status >= 400 ? req->problem_pointer : NULL,
+	                                      .status = status, .bytes = len, .ms = secs * 1000.0 });
 	return r;
 }
 
@@ -237,7 +262,8 @@ enum MHD_Result srv_answer_not_ready(struct srv_request *req)
  * the Access-Control-Allow-* headers too (srv_origin_headers). */
 static enum MHD_Result answer_options(struct srv_request *req)
 {
-	return srv_respond(req, 204, NULL, NULL, 0, req->route == SRV_ROUTE_RENDER ? "POST, OPTIONS" : "GET, HEAD, OPTIONS");
+	bool post = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS;
+	return srv_respond(req, 204, NULL, NULL, 0, post ? "POST, OPTIONS" : "GET, HEAD, OPTIONS");
 }
 
 static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection *conn, const char *version)
@@ -257,10 +283,14 @@ static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection
 		req->state = SRV_REQ_HEADERS; /* answered on the next call, as a GET */
 		return MHD_YES;
 	}
-	if (req->route == SRV_ROUTE_RENDER ? strcmp(req->method, "POST") != 0 : !get)
+	bool post = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS;
+	if (post ? strcmp(req->method, "POST") != 0 : !get)
 		return srv_respond_problem(req, 405, srv_allow_of(req->route), "", "%s is not allowed on %s; allowed: %s",
 		                       req->method, srv_route_name(req->route), srv_allow_of(req->route));
-	if (req->route == SRV_ROUTE_RENDER)
+	if ((req->route == SRV_ROUTE_RENDERS || req->route == SRV_ROUTE_RESULT) && !req->srv->results)
+		return srv_respond_problem(req, 404, NULL, "", "no route %s: this server keeps no results "
+		                           "(--result-cache-mb 0); POST /v1/render answers the image itself", req->path);
+	if (post)
 		return srv_render_begin(req, conn);
 	/* GET routes answer on the next call, once libmicrohttpd has the whole request (an
 	 * answer queued on the first call makes it close the connection). */
@@ -288,6 +318,8 @@ static enum MHD_Result answer_get(struct srv_request *req)
 		if (!atomic_load(&s->ready))
 			return srv_answer_not_ready(req);
 		return answer_info(req);
+	case SRV_ROUTE_RESULT:
+		return srv_result_get(req, req->conn);
 	case SRV_ROUTE_PLAYGROUND: {
 		size_t len = 0;
 		if (s->cfg.no_playground)
@@ -321,6 +353,24 @@ static void request_id(struct srv_request *req, struct MHD_Connection *conn)
 	snprintf(req->id, sizeof req->id, "%016llx-%06llx", (unsigned long long)s->id_seed, (unsigned long long)n);
 }
 
+/* The peer's address for the access log: "192.0.2.7", "2001:db8::1" (an IPv4-mapped IPv6
+ * address as its IPv4 form), "" when unknown. */
+static void client_address(char *out, size_t n, const struct sockaddr *sa)
+{
+	out[0] = 0;
+	if (!sa)
+		return;
+	if (sa->sa_family == AF_INET) {
+		inet_ntop(AF_INET, &((const struct sockaddr_in *)sa)->sin_addr, out, (socklen_t)n);
+	} else if (sa->sa_family == AF_INET6) {
+		const struct in6_addr *a = &((const struct sockaddr_in6 *)sa)->sin6_addr;
+		if (IN6_IS_ADDR_V4MAPPED(a))
+			inet_ntop(AF_INET, &a->s6_addr[12], out, (socklen_t)n);
+		else
+			inet_ntop(AF_INET6, a, out, (socklen_t)n);
+	}
+}
+
 static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, const char *url,
                                       const char *method, const char *version, const char *upload_data,
                                       size_t *upload_data_size, void **con_cls)
@@ -338,6 +388,7 @@ static enum MHD_Result access_handler(void *cls, struct MHD_Connection *conn, co
 		req->t_start = srv_now();
 		const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
 		req->client = srv_client_key(ci ? ci->client_addr : NULL);
+		client_address(req->client_addr, sizeof req->client_addr, ci ? ci->client_addr : NULL);
 		snprintf(req->method, sizeof req->method, "%s", method);
 		snprintf(req->path, sizeof req->path, "%s", url);
 		req->route = route_of(url);

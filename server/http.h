@@ -17,6 +17,11 @@
 
 #include "srv.h"
 
+/* Cache-Control of render answers: POST answers (--cache-control overrides it), and the
+ * content-addressed GET form (its name changes with the scene, the build and the device). */
+#define SRV_RENDER_CACHE_CONTROL "no-cache"
+#define SRV_RESULT_CACHE_CONTROL "public, max-age=31536000, immutable"
+
 enum MHD_Result srv_respond(struct srv_request *req, int status, const char *content_type, void *body, size_t len,
                             const char *allow);
 /* A problem+json answer with a printf-style detail at `pointer`. */
@@ -45,5 +50,11 @@ enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connect
  * large model fits: a multipart part instead of base64, or `path` where there is an asset root. */
 enum MHD_Result srv_respond_too_large(struct srv_request *req, unsigned long long n, bool multipart);
 enum MHD_Result srv_render_answer(struct srv_request *req);
+/* Hands a request with its body (req->body, parts) to the queue: MHD_YES once queued (the
+ * connection suspended), else the 503 answered. */
+enum MHD_Result srv_render_enqueue(struct srv_request *req);
+
+/* renders_route.c: GET/HEAD /v1/renders/{hash}.{ext}, on the request's last call. */
+enum MHD_Result srv_result_get(struct srv_request *req, struct MHD_Connection *conn);
 
 #endif

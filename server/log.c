@@ -74,33 +74,38 @@ void srv_log(enum srv_log_level level, const char *fmt, ...)
 		log_write(line, (size_t)n, sizeof line);
 }
 
-void srv_log_request(const char *method, const char *path, const char *route, int status,
-                     uint64_t bytes, double ms, const char *request_id, const char *detail,
-                     const char *pointer)
+static enum srv_log_level access_level(int status)
 {
-	char ts[40], line[1536], epath[400], eid[200], emethod[40], edetail[520] = "", eptr[260] = "";
+	return status == 500 ? SRV_LOG_ERROR : status >= 500 ? SRV_LOG_WARN : SRV_LOG_INFO;
+}
+
+void srv_log_request(const struct srv_access *a)
+{
+	char ts[40], line[1700], epath[400], eid[200], emethod[40], eclient[80], edetail[520] = "", eptr[260] = "";
 	log_timestamp(ts, sizeof ts);
-	srv_json_escape(epath, sizeof epath, path);
-	srv_json_escape(eid, sizeof eid, request_id);
-	srv_json_escape(emethod, sizeof emethod, method);
-	bool problem = detail && *detail;
+	srv_json_escape(epath, sizeof epath, a->path);
+	srv_json_escape(eid, sizeof eid, a->request_id);
+	srv_json_escape(emethod, sizeof emethod, a->method);
+	srv_json_escape(eclient, sizeof eclient, a->client && *a->client ? a->client : "-");
+	const char *level = level_names[access_level(a->status)];
+	bool problem = a->detail && *a->detail;
 	if (problem) {
-		srv_json_escape(edetail, sizeof edetail, detail);
-		srv_json_escape(eptr, sizeof eptr, pointer ? pointer : "");
+		srv_json_escape(edetail, sizeof edetail, a->detail);
+		srv_json_escape(eptr, sizeof eptr, a->pointer ? a->pointer : "");
 	}
 	int n;
 	if (log_format == SRV_LOG_JSON)
 		n = snprintf(line, sizeof line,
-		             "{\"ts\":\"%s\",\"level\":\"info\",\"msg\":\"request\",\"method\":\"%s\","
+		             "{\"ts\":\"%s\",\"level\":\"%s\",\"msg\":\"request\",\"method\":\"%s\","
 		             "\"path\":\"%s\",\"route\":\"%s\",\"status\":%d,\"bytes\":%llu,\"ms\":%.3f,"
-		             "\"request_id\":\"%s\"%s%s%s%s%s}",
-		             ts, emethod, epath, route, status, (unsigned long long)bytes, ms, eid,
-		             problem ? ",\"pointer\":\"" : "", eptr, problem ? "\",\"detail\":\"" : "", edetail,
+		             "\"request_id\":\"%s\",\"client\":\"%s\"%s%s%s%s%s}",
+		             ts, level, emethod, epath, a->route, a->status, (unsigned long long)a->bytes, a->ms, eid,
+		             eclient, problem ? ",\"pointer\":\"" : "", eptr, problem ? "\",\"detail\":\"" : "", edetail,
 		             problem ? "\"" : "");
 	else
-		n = snprintf(line, sizeof line, "%s info  %s %s %d %lluB %.1fms route=%s id=%s%s%s%s%s%s", ts,
-		             emethod, epath, status, (unsigned long long)bytes, ms, route, eid,
-		             problem ? " pointer=" : "", problem ? (pointer && *pointer ? eptr : "\"\"") : "",
+		n = snprintf(line, sizeof line, "%s %-5s %s %s %d %lluB %.1fms route=%s id=%s client=%s%s%s%s%s%s", ts,
+		             level, emethod, epath, a->status, (unsigned long long)a->bytes, a->ms, a->route, eid, eclient,
+		             problem ? " pointer=" : "", problem ? (a->pointer && *a->pointer ? eptr : "\"\"") : "",
 		             problem ? " detail=\"" : "", edetail, problem ? "\"" : "");
 	if (n > 0)
 		log_write(line, (size_t)n, sizeof line);

@@ -20,6 +20,7 @@
 #include "log.h"
 #include "metrics.h"
 #include "queue.h"
+#include "results.h"
 #include "srv.h"
 
 /* Waits until every begun request has been answered and completed, or the timeout. */
@@ -81,7 +82,8 @@ int main(int argc, char **argv)
 	srv_admit_init(&s->admit, s->cfg.max_memory);
 	srv_gate_init(&s->gate, s->cfg.workers);
 	s->imports = srv_imports_create(s->cfg.import_slots ? s->cfg.import_slots : s->cfg.workers);
-	if (!s->metrics || !s->queue || !s->imports) {
+	s->results = srv_results_create((uint64_t)s->cfg.result_cache_mb << 20);
+	if (!s->metrics || !s->queue || !s->imports || (s->cfg.result_cache_mb && !s->results)) {
 		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
 		goto out_free;
 	}
@@ -132,6 +134,7 @@ out_free:
 	api_model_cache_clear();
 	srv_queue_destroy(s->queue);
 	srv_imports_destroy(s->imports);
+	srv_results_destroy(s->results);
 	srv_metrics_destroy(s->metrics);
 	srv_admit_destroy(&s->admit);
 	pthread_rwlock_destroy(&s->ctx_lock);

@@ -3,6 +3,7 @@
  * same as the import sandbox's (API_STATS_BUCKET_BOUNDS, api/sandbox_stats.h).
  */
 #include "metrics.h"
+#include "results.h"
 
 #include <dirent.h>
 #include <stdio.h>
@@ -322,7 +323,8 @@ static void write_renders(struct srv_buf *b, const struct srv_metrics *snap)
 	              snap->counter[SRV_CTR_SHADOW_RENDERED]);
 	write_counter(b, "umbra_shadow_maps_reused_total", "Shadow maps reused from the renderer's cache.",
 	              snap->counter[SRV_CTR_SHADOW_REUSED]);
-	write_counter(b, "umbra_not_modified_total", "Renders answered 304 from If-None-Match (ETag hits).",
+	write_counter(b, "umbra_not_modified_total", "Renders whose If-None-Match listed their ETag: POST answered 412, "
+	              "GET /v1/renders/{hash} 304; nothing rendered.",
 	              snap->counter[SRV_CTR_NOT_MODIFIED]);
 	write_counter(b, "umbra_queue_rejected_total", "Renders refused with 503 because the queue was full.",
 	              snap->counter[SRV_CTR_QUEUE_REJECTED]);
@@ -333,6 +335,25 @@ static void write_renders(struct srv_buf *b, const struct srv_metrics *snap)
 	write_counter(b, "umbra_response_bytes_total", "Bytes of answer bodies.",
 	              snap->counter[SRV_CTR_BYTES_OUT]);
 
+}
+
+/* The result cache of the GET form of renders (server/results.h). */
+static void write_results(struct srv_buf *b, struct srv_server *s, const struct srv_metrics *snap)
+{
+	struct srv_results_stats st;
+	srv_results_stats(s->results, &st);
+	write_counter(b, "umbra_result_cache_hits_total", "GET /v1/renders/{hash} answered from the result cache, and "
+	              "POST /v1/renders that found its image stored.", snap->counter[SRV_CTR_RESULT_HIT]);
+	write_counter(b, "umbra_result_cache_misses_total", "GET /v1/renders/{hash} without its image stored (rendered "
+	              "again from its kept scene, or 404).", snap->counter[SRV_CTR_RESULT_MISS]);
+	write_counter(b, "umbra_result_cache_rendered_again_total", "Evicted images rendered again from their kept scene.",
+	              snap->counter[SRV_CTR_RESULT_RENDERED_AGAIN]);
+	write_gauge(b, "umbra_result_cache_bytes", "Bytes of images held by the result cache (--result-cache-mb).",
+	            (double)st.image_bytes);
+	write_gauge(b, "umbra_result_cache_scene_bytes", "Bytes of scenes kept to render evicted images again.",
+	            (double)st.scene_bytes);
+	write_gauge(b, "umbra_result_cache_images", "Images held by the result cache.", (double)st.images);
+	write_gauge(b, "umbra_result_cache_capacity_bytes", "--result-cache-mb in bytes (0 = off).", (double)st.capacity);
 }
 
 /* The model cache, the renderer's atlas and shadow cache, validation messages, the build. */
@@ -400,6 +421,7 @@ char *srv_metrics_text(struct srv_server *s, size_t *len)
 	write_connections(&b, s);
 	write_renders(&b, &snap);
 	write_sandbox(&b);
+	write_results(&b, s, &snap);
 	write_device(&b, s);
 	write_process(&b, s);
 	return srv_buf_detach(&b, len);

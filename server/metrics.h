@@ -12,6 +12,8 @@
  *   (ETag hits), umbra_queue_rejected_total, umbra_deadline_exceeded_total,
  *   umbra_device_lost_total, umbra_response_bytes_total, umbra_model_cache_hits_total,
  *   umbra_model_cache_misses_total    counters; umbra_model_cache_bytes gauge
+ *   umbra_result_cache_hits_total, _misses_total, _rendered_again_total counters;
+ *   umbra_result_cache_bytes, _scene_bytes, _images, _capacity_bytes gauges (server/results.h)
  *   umbra_atlas_size_texels, umbra_atlas_occupancy_ratio, umbra_atlas_tiles, umbra_shadow_cache_maps
  *   gauges and umbra_shadow_cache_hits_total / _misses_total counters (rnd_context_stats)
  *   umbra_validation_messages, umbra_build_info{version,device,driver}, process_resident_memory_bytes,
@@ -33,7 +35,7 @@
 enum srv_counter {
 	SRV_CTR_RENDER_OK, SRV_CTR_RENDER_FAILED, SRV_CTR_NOT_MODIFIED, SRV_CTR_QUEUE_REJECTED,
 	SRV_CTR_DEADLINE, SRV_CTR_DEVICE_LOST, SRV_CTR_SHADOW_RENDERED, SRV_CTR_SHADOW_REUSED,
-	SRV_CTR_BYTES_OUT,
+	SRV_CTR_BYTES_OUT, SRV_CTR_RESULT_HIT, SRV_CTR_RESULT_MISS, SRV_CTR_RESULT_RENDERED_AGAIN,
 	SRV_CTR_COUNT
 };
 

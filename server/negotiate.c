@@ -1,5 +1,5 @@
 /*
- * server/negotiate — Content-Type, Accept and ETag rules of POST /v1/render (see negotiate.h).
+ * server/negotiate — Content-Type, Accept and ETag rules of the render routes (see negotiate.h).
  * Pure string work; the hash is the project's byte-stream hash, rnd_fnv1a() (umbra/rnd_math.h).
  */
 #include <stdlib.h>
@@ -93,28 +93,45 @@ enum srv_accept srv_accept_choice(const char *accept)
 
 /* ---- ETag ---- */
 
-uint64_t srv_etag_start(void)
+uint64_t srv_etag_of(uint64_t scene_hash, uint64_t asset_hash, const char *format, const char *device_name,
+                     const char *driver_info)
 {
-	return RND_FNV_SEED;
+	/* The canonical scene (api/scene_hash.h: document after its preset, and the parts), the
+	 * files it read under --asset-root, the negotiated format, the build and the device. */
+	uint64_t h = rnd_fnv1a(RND_FNV_SEED, &scene_hash, sizeof scene_hash);
+	h = rnd_fnv1a(h, &asset_hash, sizeof asset_hash);
+	h = rnd_fnv1a(h, format, strlen(format) + 1);
+	h = rnd_fnv1a(h, UMBRA_VERSION, strlen(UMBRA_VERSION) + 1);
+	h = rnd_fnv1a(h, device_name, strlen(device_name) + 1);
+	return rnd_fnv1a(h, driver_info, strlen(driver_info) + 1);
 }
 
-uint64_t srv_etag_body(uint64_t h, const void *data, size_t len)
+const char *srv_format_ext(const char *mime)
 {
-	return rnd_fnv1a(h, data, len);
+	const char *slash = strchr(mime, '/');
+	const char *ext = slash ? slash + 1 : mime;
+	return strncmp(ext, "x-", 2) ? ext : ext + 2;
 }
 
-uint64_t srv_etag_finish(uint64_t h, enum srv_accept format, const char *device_name, const char *driver_info)
+void srv_result_name(char *out, size_t n, uint64_t hash, const char *mime)
 {
-	h = rnd_fnv1a(h, format == SRV_ACCEPT_EXR ? "\0exr" : format == SRV_ACCEPT_WEBP ? "\0wbp" : "\0png", 4);
-	h = rnd_fnv1a(h, UMBRA_VERSION, strlen(UMBRA_VERSION));
-	h = rnd_fnv1a(h, device_name, strlen(device_name));
-	return rnd_fnv1a(h, driver_info, strlen(driver_info));
+	snprintf(out, n, "/v1/renders/%016llx.%s", (unsigned long long)hash, srv_format_ext(mime));
 }
 
-uint64_t srv_etag_assets(uint64_t h, uint64_t asset_hash)
+bool srv_result_path(const char *url, uint64_t *hash, char *ext, size_t extsize)
 {
-	/* One FNV step with the asset hash as the "byte": the ETag changes when a file does. */
-	return (h ^ asset_hash) * 0x100000001b3ull;
+	static const char prefix[] = "/v1/renders/";
+	if (strncmp(url, prefix, sizeof prefix - 1) != 0)
+		return false;
+	const char *h = url + sizeof prefix - 1, *dot = strchr(h, '.');
+	if (!dot || dot - h != 16 || strspn(h, "0123456789abcdef") != 16)
+		return false;
+	size_t n = strlen(dot + 1);
+	if (n == 0 || n >= extsize || strspn(dot + 1, "abcdefghijklmnopqrstuvwxyz") != n)
+		return false;
+	*hash = strtoull(h, NULL, 16);
+	memcpy(ext, dot + 1, n + 1);
+	return true;
 }
 
 void srv_etag_format(char *out, size_t n, uint64_t h)
@@ -134,7 +151,7 @@ bool srv_etag_matches(const char *inm, const char *etag)
 		if (!*p)
 			break;
 		/* "*" is not a match: a render always has a representation to make, and an
-		 * unconditional 304 would hide it. */
+		 * unconditional 412 or 304 would hide it. */
 		if (!strncmp(p, "W/", 2))
 			p += 2;
 		size_t n = strcspn(p, ", \t");

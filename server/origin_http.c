@@ -78,7 +78,8 @@ bool srv_origin_refuses(struct srv_request *req, struct MHD_Connection *conn, en
 void srv_origin_headers(struct srv_request *req, struct MHD_Response *resp, int status)
 {
 	bool page = req->route == SRV_ROUTE_PLAYGROUND && status == 200;
-	bool by_accept = req->route == SRV_ROUTE_RENDER && (status == 200 || status == 304);
+	bool by_accept = (req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS) &&
+	                 (status == 200 || status == 303 || status == 412);
 	bool cors = req->srv->origin.cors;
 	MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
 	MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");

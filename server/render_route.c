@@ -1,9 +1,10 @@
 /*
- * server/render_route — POST /v1/render on the polling thread (see http.c for the call order):
- * the checks on its headers (readiness, Content-Type, Content-Encoding, X-Priority,
- * Content-Length, Accept), the body in chunks (a JSON document, or multipart/form-data whose
- * `scene` part is the document and whose other parts are named model files), the ETag and the
- * early 304, the hand-over to the queue, and the answer once a worker has finished.
+ * server/render_route — POST /v1/render and POST /v1/renders on the polling thread (see http.c
+ * for the call order): the checks on its headers (readiness, Content-Type, Content-Encoding,
+ * X-Priority, Content-Length, Accept), the body in chunks (a JSON document, or
+ * multipart/form-data whose `scene` part is the document and whose other parts are named model
+ * files), the hand-over to the queue, and the answer once a worker has finished. The ETag and
+ * If-None-Match (412) are the worker's: they depend on the parsed scene (worker.c).
  * Negotiation rules live in negotiate.c; this file only applies them to libmicrohttpd's request.
  */
 #include <errno.h>
@@ -128,7 +129,6 @@ enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection 
 		return srv_respond_problem(req, 406, NULL, "", "this server answers image/png, image/webp or image/x-exr (or a "
 		                       "problem+json document); Accept: %.200s names none of them", accept);
 	req->want = choice;
-	req->body_hash = srv_etag_start();
 	req->state = SRV_REQ_BODY;
 	return MHD_YES;
 }
@@ -163,7 +163,6 @@ bool srv_render_body(struct srv_request *req, const char *data, size_t size)
 		return false;
 	}
 	req->body_received += size;
-	req->body_hash = srv_etag_body(req->body_hash, data, size);
 	if (req->body_oom)
 		return true; /* the rest is read and dropped; answered 503 at the end */
 	if (req->post) {
@@ -193,7 +192,6 @@ bool srv_render_body(struct srv_request *req, const char *data, size_t size)
 
 enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connection *conn)
 {
-	struct srv_server *s = req->srv;
 	if (req->body_discarded) return srv_respond_too_large(req, 0, req->post != NULL);
 	if (req->body_oom)
 		return srv_respond_problem(req, 503, NULL, "", "out of memory while reading the body");
@@ -221,21 +219,15 @@ enum MHD_Result srv_render_body_done(struct srv_request *req, struct MHD_Connect
 		return srv_respond_problem(req, 400, NULL, "", "the request has no body: a scene document is required");
 	req->body[req->body_len] = 0;
 
-	/* ETag: the body, the format negotiation, the build and the device. */
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	req->etag_hash = srv_etag_finish(req->body_hash, req->want, s->info.device_name, s->info.driver_info);
-	pthread_rwlock_unlock(&s->ctx_lock);
-	srv_etag_format(req->etag, sizeof req->etag, req->etag_hash);
-	/* A scene that reads models from --asset-root may change without its body changing: its
-	 * ETag is only known after parsing, so it never gets an early 304. */
-	bool reads_assets = memmem(req->body, req->body_len, "\"path\"", 6) != NULL;
+	/* The ETag is the parsed scene's (worker.c): If-None-Match is checked there. */
 	const char *inm = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-	if (reads_assets && inm) snprintf(req->if_none_match, sizeof req->if_none_match, "%s", inm);
-	if (!reads_assets && srv_etag_matches(inm, req->etag)) {
-		srv_metrics_add(s->metrics, SRV_CTR_NOT_MODIFIED, 1);
-		return srv_respond(req, 304, NULL, NULL, 0, NULL);
-	}
+	if (inm) snprintf(req->if_none_match, sizeof req->if_none_match, "%s", inm);
+	return srv_render_enqueue(req);
+}
 
+enum MHD_Result srv_render_enqueue(struct srv_request *req)
+{
+	struct srv_server *s = req->srv;
 	switch (srv_queue_push(s->queue, req, suspend_before_push)) {
 	case SRV_PUSH_OK:
 		return MHD_YES;

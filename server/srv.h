@@ -5,7 +5,9 @@
  *   flags.c    srv_config: defaults, UMBRA_* environment, command-line flags, --help
  *   main.c     startup (listen, context, warm-up, workers), signals, graceful drain, exit code
  *   http.c     libmicrohttpd callbacks: dispatch, GET routes, answers (http.h)
- *   render_route.c  POST /v1/render: headers, body (JSON or multipart), ETag, queueing
+ *   render_route.c  POST /v1/render and /v1/renders: headers, body (JSON or multipart), queueing
+ *   renders_route.c GET /v1/renders/{hash}.{ext}: the stored result, or its scene rendered again
+ *   results.c  the bounded result cache behind the GET form (--result-cache-mb, results.h)
  *   negotiate.c  pure rules: Content-Type, Accept, the ETag (negotiate.h)
  *   conn.c     connection limits and timeouts, HTTP/1.1 framing checks, the listen address
  *   ranges.c   connections per client address range (--max-connections-per-range), pure
@@ -93,6 +95,8 @@ struct srv_config {
 	const char *allowed_host;      /* --allowed-host LIST (server/origin.h); NULL = by the listen address */
 	const char *cors_origin;       /* --cors-origin LIST (server/origin.h); NULL = no cross-origin caller */
 	const char *test_fault;        /* tests only: "submit:N:lost|oom" armed after warm-up */
+	unsigned result_cache_mb;      /* --result-cache-mb: the GET form's images (results.h); 0 = off, default 64 */
+	const char *cache_control;     /* --cache-control: of POST render answers, default "no-cache" */
 };
 
 #define SRV_SHARE_DEFAULT UINT32_MAX
@@ -100,6 +104,8 @@ struct srv_config {
 enum srv_route {
 	SRV_ROUTE_RENDER, SRV_ROUTE_HEALTHZ, SRV_ROUTE_READYZ, SRV_ROUTE_METRICS, SRV_ROUTE_INFO,
 	SRV_ROUTE_PLAYGROUND,          /* GET / and /playground (server/playground.c) */
+	SRV_ROUTE_RENDERS,             /* POST /v1/renders: render, store, 303 to the GET form */
+	SRV_ROUTE_RESULT,              /* GET /v1/renders/{hash}.{ext} (server/renders_route.c) */
 	SRV_ROUTE_OTHER,
 	SRV_ROUTE_COUNT
 };
@@ -123,6 +129,7 @@ struct srv_server {
 	struct srv_gate gate;          /* renders on the device at once (--device-renders) */
 	struct srv_imports *imports;   /* requests parked for an import thread (--import-slots) */
 	struct srv_origin origin;      /* Host and Origin rules, set by srv_http_start() (origin.h) */
+	struct srv_results *results;   /* the GET form's result cache (results.h); NULL = off */
 
 	/* The shared renderer. Renders hold ctx_lock for reading; recovery after a lost device
 	 * takes it for writing, destroys and recreates the context (ctx_gen counts recreations). */
@@ -151,6 +158,16 @@ struct srv_part {
 	size_t len, cap;
 };
 
+/* A scene kept to render again (server/results.h): a request's body and parts as sent. */
+struct srv_kept_scene {
+	char *body;
+	size_t body_len;
+	struct srv_part *parts;
+	size_t part_count;
+	int want;                      /* the request's Accept choice (enum srv_accept) */
+	size_t bytes;                  /* what it holds, for the cache's bound */
+};
+
 /* One HTTP request (see the ownership note at the top). */
 enum srv_req_state { SRV_REQ_HEADERS, SRV_REQ_BODY, SRV_REQ_QUEUED, SRV_REQ_FINISHED, SRV_REQ_ANSWERED };
 
@@ -166,6 +183,7 @@ struct srv_request {
 	char id[80];                   /* X-Request-Id */
 	double t_start, t_queued;      /* monotonic seconds */
 	uint64_t client;               /* srv_client_key() of the peer: its share of import threads */
+	char client_addr[48];          /* the peer's address, for the access log ("" = unknown) */
 
 	/* body of POST /v1/render: the scene document, or for multipart/form-data the `scene` part
 	 * (moved here when the body is complete) and the other named parts */
@@ -178,10 +196,13 @@ struct srv_request {
 	uint64_t body_received;        /* raw body bytes so far (multipart included) */
 	bool body_oom;                 /* a body buffer could not grow: answer 503 */
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
-	uint64_t body_hash;            /* srv_etag_body() of the raw body so far */
-	uint64_t etag_hash;            /* the ETag's value (srv_etag_finish(), then srv_etag_assets()) */
+	uint64_t etag_hash;            /* the ETag's value, known after parsing (negotiate.h srv_etag_of) */
 	char etag[40];
-	char if_none_match[256];       /* checked after parsing for scenes that read asset files */
+	char if_none_match[512];       /* checked after parsing: 412 on a POST */
+	uint64_t result_hash;          /* GET /v1/renders/{hash}: the hash asked for (rendered again) */
+	char result_ext[8];            /* its extension */
+	struct srv_kept_scene kept;    /* POST /v1/renders: the scene for the result cache (results.h) */
+	char location[64];             /* the Location of a 303 */
 	int want;                      /* Accept's choice (enum srv_accept: PNG, EXR or WebP) */
 	bool close_after;              /* answer with Connection: close (framing error) */
 	char cors_origin[SRV_ORIGIN_MAX]; /* an allowed cross-origin caller's Origin, echoed; "" = none */

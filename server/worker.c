@@ -23,6 +23,7 @@
 #include "metrics.h"
 #include "negotiate.h"
 #include "queue.h"
+#include "results.h"
 #include "srv.h"
 
 /* ---- jobs ---- */
@@ -163,11 +164,48 @@ static void ticket_init(struct parse_ticket *t, struct srv_server *s, const stru
 	                            .importer = importer };
 }
 
+/* The render's identity once its scene is parsed and its format settled: the ETag (negotiate.h
+ * srv_etag_of), and what follows from it before anything is rendered. 0: go on; 1: answered
+ * (412 for a POST whose If-None-Match lists it; for POST /v1/renders a 303 when its image is
+ * stored already; for GET /v1/renders/{hash} a 404 when the scene no longer makes that hash). */
+static int job_identity(struct srv_server *s, struct srv_request *req, const struct api_scene *sc)
+{
+	struct api_problem p = { 0 };
+	const char *mime = api_format_mime(sc->format);
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	req->etag_hash = srv_etag_of(sc->scene_hash, sc->asset_hash, mime, s->info.device_name, s->info.driver_info);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	srv_etag_format(req->etag, sizeof req->etag, req->etag_hash);
+	if (req->route == SRV_ROUTE_RESULT && req->etag_hash != req->result_hash) {
+		api_problem_set(&p, 404, "", "no stored render %s: its scene now makes another image (a file it reads "
+		                "under --asset-root changed); POST the scene to /v1/renders again", req->path);
+		req->etag[0] = 0;
+		job_problem(req, &p);
+		return 1;
+	}
+	if (req->route != SRV_ROUTE_RESULT && srv_etag_matches(req->if_none_match, req->etag)) {
+		/* RFC 9110 §13.1.2: a POST whose condition fails is a 412, not a 304. */
+		srv_metrics_add(s->metrics, SRV_CTR_NOT_MODIFIED, 1);
+		api_problem_set(&p, 412, "", "If-None-Match lists %s, this scene's ETag: the image the caller holds is "
+		                "this render's, so nothing was rendered", req->etag);
+		job_problem(req, &p);
+		return 1;
+	}
+	if (req->route == SRV_ROUTE_RENDERS &&
+	    srv_results_get(s->results, req->etag_hash, srv_format_ext(mime), NULL, NULL) == SRV_RESULT_IMAGE) {
+		srv_metrics_add(s->metrics, SRV_CTR_RESULT_HIT, 1);
+		srv_result_name(req->location, sizeof req->location, req->etag_hash, mime);
+		req->status = 303;
+		return 1;
+	}
+	return 0;
+}
+
 /* Parses the request's body and parts into *scp and settles what the answer depends on (its
- * warnings, its ETag with any asset files, its format). 0: go on and render; 1: the request is
- * answered already (a problem, or 304 for a matching If-None-Match); 2: parked for an import
- * thread (a worker's parse reached a model to import): not this thread's any more. *scp,
- * when set, is the caller's to free either way. */
+ * warnings, its format, its ETag: job_identity). 0: go on and render; 1: the request is
+ * answered already (a problem, 412, 303); 2: parked for an import thread (a worker's parse
+ * reached a model to import): not this thread's any more. *scp, when set, is the caller's to
+ * free either way. */
 static int job_parse(struct srv_server *s, struct srv_request *req, struct parse_ticket *t, struct api_scene **scp,
                      double *parse_s)
 {
@@ -189,7 +227,10 @@ static int job_parse(struct srv_server *s, struct srv_request *req, struct parse
 		srv_imports_park(s->imports, req);
 		return 2;
 	}
-	/* The body and parts are no longer needed: give their memory back before the render. */
+	/* The body and parts are no longer needed (but for the result cache, which keeps a small
+	 * scene to render its image again): give their memory back before the render. */
+	if (pr == API_OK && req->route != SRV_ROUTE_RENDER && s->results && !req->kept.body)
+		srv_scene_keep(&req->kept, req);
 	srv_request_drop_body(req);
 	if (pr != API_OK) {
 		job_problem(req, &p);
@@ -199,23 +240,43 @@ static int job_parse(struct srv_server *s, struct srv_request *req, struct parse
 	/* A header value is one line of printable ASCII: file names from a model may hold anything. */
 	for (size_t i = 0; i + 1 < sizeof req->warnings && (req->warnings[i] = sc->warnings[i]); i++)
 		if ((unsigned char)req->warnings[i] < 0x20 || (unsigned char)req->warnings[i] > 0x7e) req->warnings[i] = '?';
-	if (sc->asset_hash) {
-		/* The image depends on files under --asset-root as well as on the body. */
-		srv_etag_format(req->etag, sizeof req->etag, srv_etag_assets(req->etag_hash, sc->asset_hash));
-		if (req->if_none_match[0] && srv_etag_matches(req->if_none_match, req->etag)) {
-			req->status = 304;
-			return 1;
-		}
-	}
 	enum api_format accepted = req->want == SRV_ACCEPT_EXR ? API_FORMAT_EXR : API_FORMAT_WEBP;
 	if ((req->want != SRV_ACCEPT_PNG && !sc->format_explicit && api_scene_set_format(sc, accepted, &p) != API_OK) ||
 	    api_scene_check_output(sc, &p) != API_OK) {
 		job_problem(req, &p);
 		return 1;
 	}
+	if (job_identity(s, req, sc))
+		return 1;
 	*parse_s = srv_now() - t0;
 	srv_metrics_stage(s->metrics, SRV_STAGE_PARSE, *parse_s);
 	return 0;
+}
+
+/* The encoded image of a render route: POST /v1/render answers it; POST /v1/renders stores it
+ * (with its kept scene) and answers 303 to its GET form, or the image itself (200) when it
+ * cannot be stored (larger than --result-cache-mb); GET /v1/renders/{hash} stores and answers it.
+ * Takes bytes. */
+static void job_answer(struct srv_server *s, struct srv_request *req, const struct api_scene *sc, uint8_t *bytes,
+                       size_t len)
+{
+	const char *mime = api_format_mime(sc->format), *ext = srv_format_ext(mime);
+	req->status = 200;
+	req->out = bytes;
+	req->out_len = len;
+	req->content_type = mime;
+	if (req->route == SRV_ROUTE_RENDER)
+		return;
+	bool stored = srv_results_put(s->results, req->etag_hash, ext,
+	                              &(struct srv_result_image){ bytes, len, mime, req->warnings }, &req->kept);
+	if (!stored || req->route != SRV_ROUTE_RENDERS)
+		return;
+	srv_result_name(req->location, sizeof req->location, req->etag_hash, mime);
+	req->status = 303;
+	req->out = NULL;
+	req->out_len = 0;
+	req->content_type = NULL;
+	free(bytes);
 }
 
 /* The problem a failed render answers: 504 past the deadline (said differently when the render
@@ -359,10 +420,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 		job_deadline(s, req, "while rendering", t3);
 		goto out;
 	}
-	req->status = 200;
-	req->out = bytes;
-	req->out_len = len;
-	req->content_type = api_format_mime(sc->format);
+	job_answer(s, req, sc, bytes, len);
 	format_timing(req, sc, &t, (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, gate_ms, encode_s * 1000.0,
 	              (t3 - req->t_queued) * 1000.0);
 out:

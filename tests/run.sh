@@ -62,6 +62,8 @@ command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && [ -x "$BUILD/umbra-render" ] &&
 	run_suite farm-remote env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_farm.py
 [ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
+# Cacheable renders (POST /v1/renders, GET /v1/renders/{hash}), and nginx in front when installed.
+[ -x "$BUILD/umbrad" ] && run_suite http-cache sh tests/http/cache.sh
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
 # api/scene.schema.json against the daemon (ajv from tests/browser's tooling; skipped without node).
 [ -x "$BUILD/umbrad" ] && run_suite schema sh tests/schema/run.sh

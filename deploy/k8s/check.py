@@ -7,7 +7,8 @@ Python 3 with Debian's python3-yaml only. Not a schema validation (that is valid
 the npm package kubernetes-models): this checks that every document parses, carries the fields
 its kind requires, and that the pieces agree with each other and with umbrad:
   - apiVersion/kind/metadata.name on every document; kinds are the ones expected here;
-  - Deployment: selector matches the pod labels; readiness on /readyz, liveness on /healthz, on
+  - Deployment: selector matches the pod labels; a versioned image; readiness and start-up on
+    /readyz, liveness on /healthz, on
     the container's named port; preStop present; terminationGracePeriodSeconds longer than
     preStop + UMBRA_DRAIN_TIMEOUT (from the ConfigMap) and than the deadline; CPU/memory
     requests and limits; read-only root filesystem, non-root user, no privilege escalation;
@@ -78,7 +79,10 @@ def check_deployment(f, d, cms):
     check(name + ": has containers with name and image", cs and all(c.get("name") and c.get("image") for c in cs))
     c = cs[0] if cs else {}
     ports = {p.get("name"): p.get("containerPort") for p in c.get("ports", [])}
-    for probe, path in (("readinessProbe", "/readyz"), ("livenessProbe", "/healthz")):
+    img = c.get("image", "")
+    check(name + ": image has a version tag, not :latest", ":" in img.rsplit("/", 1)[-1] and not img.endswith(":latest"), img)
+    # The startup probe waits for the warm-up: /readyz (a /healthz one passes before it).
+    for probe, path in (("readinessProbe", "/readyz"), ("livenessProbe", "/healthz"), ("startupProbe", "/readyz")):
         hg = get(c, probe + ".httpGet", {})
         check("%s: %s on %s" % (name, probe, path), hg.get("path") == path and hg.get("port") in ports, hg)
     pre = get(c, "lifecycle.preStop.exec.command") or []

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""tests/cluster/bench_cluster.py — HAProxy + umbrad numbers for README "Running many".
+"""tests/cluster/bench_cluster.py — HAProxy + umbrad numbers for "Running many" (docs/running-many.md).
 
     BUILD=build python3 tests/cluster/bench_cluster.py        (make bench-cluster)
 

@@ -12,7 +12,11 @@
  * answer is read until the daemon closes. A stub worker thread stands in for
  * server/worker.c: it takes each queued request off the real queue (server/queue.c), checks
  * what http.c handed over (a NUL-terminated scene body, named parts), and answers 200 without
- * parsing or rendering. No change to server/http.c is needed for this.
+ * parsing or rendering (POST /v1/renders: stores a fake image and answers 303, as worker.c
+ * does). The result cache (server/results.c) is real and holds, from the start, an image under
+ * 0123456789abcdef.png and only a scene under 00000000000000aa.png, so that GET and HEAD
+ * /v1/renders/{hash} reach the 200, 304 and render-again paths. No change to server/http.c is
+ * needed for this.
  *
  * Everything linked is umbrad's own code: server/main.c comes in with main() renamed (see the
  * Makefile) for srv_now(), and server/log.c writes the access log to stderr, which
@@ -46,8 +50,11 @@
 
 #include "log.h"
 #include "metrics.h"
+#include "negotiate.h"
 #include "queue.h"
+#include "results.h"
 #include "srv.h"
+#include "umbra/rnd_math.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -64,7 +71,8 @@ static void *worker_main(void *arg)
 	(void)arg;
 	struct srv_request *req;
 	while ((req = srv_queue_pop(srv.queue)) != NULL) {
-		CHECK(req->state == SRV_REQ_QUEUED && req->route == SRV_ROUTE_RENDER);
+		CHECK(req->state == SRV_REQ_QUEUED && (req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS ||
+		                                       req->route == SRV_ROUTE_RESULT));
 		CHECK(req->body && req->body_len > 0 && req->body_len < req->body_cap && !req->body[req->body_len]);
 		CHECK(req->body_len <= srv.cfg.max_body);
 		for (size_t i = 0; i < req->part_count; i++) {
@@ -72,6 +80,19 @@ static void *worker_main(void *arg)
 			CHECK(p->name && strcmp(p->name, "scene") != 0);
 			CHECK(p->data && p->len < p->cap && !p->data[p->len]);
 			for (size_t j = 0; j < i; j++) CHECK(strcmp(p->name, req->parts[j].name) != 0);
+		}
+		if (req->route == SRV_ROUTE_RENDERS) {
+			/* What worker.c does after a render: store the image (and the scene), 303. */
+			uint64_t h = rnd_fnv1a(RND_FNV_SEED, req->body, req->body_len);
+			srv_scene_keep(&req->kept, req);
+			CHECK(srv_results_put(srv.results, h, "png", &(struct srv_result_image){ (uint8_t *)"png", 3, "image/png", "w" },
+			                      &req->kept));
+			srv_request_drop_body(req);
+			srv_result_name(req->location, sizeof req->location, h, "image/png");
+			srv_etag_format(req->etag, sizeof req->etag, h);
+			req->status = 303;
+			srv_request_finish(req);
+			continue;
 		}
 		srv_request_drop_body(req);
 		static const char ok[] = "{\"fuzz\":true}";
@@ -107,7 +128,21 @@ static void start_once(void)
 	srv.id_seed = 1;
 	srv.metrics = srv_metrics_create();
 	srv.queue = srv_queue_create(srv.cfg.queue);
-	CHECK(srv.metrics && srv.queue);
+	srv.results = srv_results_create(1 << 20);
+	CHECK(srv.metrics && srv.queue && srv.results);
+	/* A scene whose image is gone: stored with a 600 KB image that the next one pushes out of
+	 * the 1 MB cache, while the scene stays (the scenes' bound is its own). */
+	struct srv_request fake = { 0 };
+	struct srv_kept_scene kept = { 0 };
+	fake.body = strdup("{\"objects\": []}");
+	fake.body_len = strlen(fake.body);
+	CHECK(fake.body && srv_scene_keep(&kept, &fake));
+	static uint8_t big[600 << 10];
+	CHECK(srv_results_put(srv.results, 0xaa, "png", &(struct srv_result_image){ big, sizeof big, "image/png", NULL }, &kept));
+	CHECK(srv_results_put(srv.results, 0xbb, "png", &(struct srv_result_image){ big, sizeof big, "image/png", NULL }, NULL));
+	CHECK(srv_results_get(srv.results, 0xaa, "png", NULL, NULL) == SRV_RESULT_SCENE);
+	CHECK(srv_results_put(srv.results, 0x0123456789abcdefull, "png",
+	                      &(struct srv_result_image){ (uint8_t *)"png", 3, "image/png", NULL }, NULL));
 	atomic_store(&srv.ready, true);
 	CHECK(srv_http_start(&srv) == 0);
 	CHECK(pthread_create(&worker, NULL, worker_main, NULL) == 0);

@@ -151,7 +151,14 @@ check "same body, same bytes" cmp -s "$T/r1.body" "$T/r2.body"
 check "same body, same ETag" [ "$(hdr r2 ETag)" = "$etag" ]
 c=$(post r3 "$T/small-64x48.json"); check "other body 200, 64x48" [ "$(png_size "$T/r3.body")" = 64x48 ]
 check "other body, other ETag" [ "$(hdr r3 ETag)" != "$etag" ]
-c=$(post r304 "$T/small.json" -H "If-None-Match: $etag"); check "If-None-Match with the ETag: 304" [ "$c" = 304 ]
+# RFC 9110 §13.1.2: a POST whose If-None-Match lists its ETag is a 412 (304 is for GET and HEAD).
+c=$(post r412 "$T/small.json" -H "If-None-Match: $etag"); check "If-None-Match with the ETag on a POST: 412 problem+json" eval '[ "$c" = 412 ] && problem r412 412 ""'
+check "the 412 carries the ETag" [ "$(hdr r412 ETag)" = "$etag" ]
+# The ETag is the parsed scene's: the same scene spelled otherwise (members reordered, other
+# whitespace, 1.0 for 1) has the same one.
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(json.dumps(dict(reversed(list(d.items()))), indent=3))' "$T/small.json" >"$T/small-reordered.json"
+c=$(post rre "$T/small-reordered.json"); check "re-serialized scene: 200, the same ETag" eval '[ "$c" = 200 ] && [ "$(hdr rre ETag)" = "$etag" ]'
+check "POST answers say Cache-Control: no-cache" [ "$(hdr r1 Cache-Control)" = no-cache ]
 c=$(post rexr "$T/small.json" -H 'Accept: image/x-exr'); check "Accept: image/x-exr 200" [ "$c" = 200 ]
 check "Accept: image/x-exr gives image/x-exr" [ "$(hdr rexr Content-Type)" = image/x-exr ]
 check "EXR magic" is_exr "$T/rexr.body"
@@ -186,12 +193,12 @@ check "transparent WebP keeps alpha, pixels equal to the transparent PNG's" \
 c=$(post bulk "$T/small.json" -H 'X-Priority: bulk'); check "X-Priority: bulk 200" [ "$c" = 200 ]
 c=$(post mpath "$T/model-path.json"); check "model by path under --asset-root 200" [ "$c" = 200 ]
 # The answer depends on the file under --asset-root: when it changes, so must the ETag, and the
-# old ETag must not earn a 304.
+# old ETag must not earn a 412.
 mtag=$(hdr mpath ETag)
-c=$(post mpath304 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model, same file: 304" [ "$c" = 304 ]
+c=$(post mpath412 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model, same file: 412" [ "$c" = 412 ]
 cp "$T/assets/tri.obj" "$T/tri.obj.orig"
 printf 'v -1 0 -1\nv 1 0 -1\nv 0 0.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
-c=$(post mpath2 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model file changed: 200, not 304" [ "$c" = 200 ]
+c=$(post mpath2 "$T/model-path.json" -H "If-None-Match: $mtag"); check "asset model file changed: 200, not 412" [ "$c" = 200 ]
 check "asset model file changed: other ETag" [ "$(hdr mpath2 ETag)" != "$mtag" ]
 cp "$T/tri.obj.orig" "$T/assets/tri.obj"
 c=$(post mesc "$T/model-escape.json"); check "model path escaping --asset-root 400" [ "$c" = 400 ]
@@ -250,7 +257,7 @@ check "metrics have queue depth and in-flight gauges" sh -c "grep -q '^umbra_que
 check "metrics have shadow-map reuse" grep -q '^umbra_shadow_maps_reused_total ' "$T/metrics.body"
 check "metrics have atlas occupancy" grep -q '^umbra_atlas_occupancy_ratio ' "$T/metrics.body"
 check "metrics count 413/415/422" sh -c "grep -q 'status=\"413\"' '$T/metrics.body' && grep -q 'status=\"415\"' '$T/metrics.body' && grep -q 'status=\"422\"' '$T/metrics.body'"
-check "access log line per request" grep -q 'POST /v1/render 200 .*id=test-id-42' "$T/main.log"
+check "access log line per request, with the client's address" grep -q 'info  POST /v1/render 200 .*id=test-id-42 client=127.0.0.1' "$T/main.log"
 
 # -- resources over $REPS sequential small renders (keep-alive batches of 25); the growth is
 # measured after the first fifth, once caches and allocator pools have settled.
@@ -343,18 +350,30 @@ echo "# starting the deadline daemon"
 if start deadline --workers 1 --deadline-ms 1 --log-format json; then
 	c=$(post d1 "$T/small.json" -H 'X-Request-Id: deadline-1'); check "render past --deadline-ms: 504" [ "$c" = 504 ]
 	check "504 is problem+json" problem d1 504 -
-	check "--log-format json: every line is a JSON object; the access line has the fields and the problem's detail" python3 - "$T/deadline.log" <<'PY'
+	check "--log-format json: every line is a JSON object; the access line has the fields, the client, the problem's detail, and a 5xx at level warn" python3 - "$T/deadline.log" <<'PY'
 import json, sys
 ok = False
 for line in open(sys.argv[1]):
     d = json.loads(line)
     if d.get("request_id") == "deadline-1":
         ok = d["status"] == 504 and d["method"] == "POST" and d["route"] == "/v1/render" and "ms" in d and "bytes" in d \
-             and "deadline" in d.get("detail", "") and d.get("pointer") == ""
+             and "deadline" in d.get("detail", "") and d.get("pointer") == "" and d.get("level") == "warn" \
+             and d.get("client") == "127.0.0.1"
 sys.exit(0 if ok else 1)
 PY
 	stop deadline $PID
 fi
+
+# A configuration error with UMBRA_LOG_FORMAT=json is a JSON log line too, and exit 2.
+UMBRA_LOG_FORMAT=json "$UMBRAD" --atlas-size 3 2>"$T/badflag.log"; rc=$?
+check "UMBRA_LOG_FORMAT=json: a bad flag is exit 2 and one JSON error line" python3 - "$T/badflag.log" "$rc" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().splitlines()
+d = json.loads(lines[0]) if len(lines) == 1 else {}
+sys.exit(0 if sys.argv[2] == "2" and d.get("level") == "error" and "--atlas-size" in d.get("msg", "") else 1)
+PY
+"$UMBRAD" --atlas-size 3 2>"$T/badflag.txt"
+check "text log format: the bad flag says 'umbrad: --atlas-size ...'" grep -q '^umbrad: --atlas-size: 3 is not a power of two' "$T/badflag.txt"
 
 # ==== SIGTERM under load (main daemon) ====
 URL=$MAIN_URL

@@ -1,5 +1,6 @@
 /* tests — server/negotiate.c (Content-Type, Accept, ETag), the server's JSON string escaper
  * (server/buf.c) and the /v1/info document (api/info.c): pure functions, no daemon. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -46,23 +47,32 @@ TEST(negotiate_accept)
 	CHECK(srv_accept_choice("image/webp;q=0, image/png;q=0, image/x-exr;q=0") == SRV_ACCEPT_NONE);
 }
 
-TEST(negotiate_etag_streams_and_formats)
+TEST(negotiate_etag_of_decides_identity)
 {
-	const char body[] = "{\"width\":64,\"height\":64,\"objects\":[]}";
-	size_t n = strlen(body);
-	uint64_t whole = srv_etag_body(srv_etag_start(), body, n);
-	/* However the body is cut into chunks, the hash is the same. */
-	for (size_t cut = 0; cut <= n; cut += 5) {
-		uint64_t h = srv_etag_body(srv_etag_start(), body, cut);
-		h = srv_etag_body(h, body + cut, n - cut);
-		CHECK(h == whole, "cut at %zu", cut);
-	}
-	uint64_t png = srv_etag_finish(whole, SRV_ACCEPT_PNG, "dev", "drv");
-	uint64_t exr = srv_etag_finish(whole, SRV_ACCEPT_EXR, "dev", "drv");
-	uint64_t webp = srv_etag_finish(whole, SRV_ACCEPT_WEBP, "dev", "drv");
-	CHECK(png != exr && webp != png && webp != exr, "the format is part of the ETag");
-	CHECK(srv_etag_finish(whole, SRV_ACCEPT_PNG, "dev2", "drv") != png, "the device is part of the ETag");
-	CHECK(srv_etag_assets(png, 1) != png && srv_etag_assets(png, 1) != srv_etag_assets(png, 2));
+	uint64_t png = srv_etag_of(1, 0, "image/png", "dev", "drv");
+	CHECK(png == srv_etag_of(1, 0, "image/png", "dev", "drv"), "the same inputs give the same ETag");
+	CHECK(png != srv_etag_of(2, 0, "image/png", "dev", "drv"), "the scene is part of the ETag");
+	CHECK(png != srv_etag_of(1, 1, "image/png", "dev", "drv"), "the asset files are part of the ETag");
+	CHECK(png != srv_etag_of(1, 0, "image/x-exr", "dev", "drv"), "the format is part of the ETag");
+	CHECK(png != srv_etag_of(1, 0, "image/webp", "dev", "drv") &&
+	      srv_etag_of(1, 0, "image/webp", "dev", "drv") != srv_etag_of(1, 0, "image/x-exr", "dev", "drv"),
+	      "WebP is a format of its own in the ETag");
+	CHECK(png != srv_etag_of(1, 0, "image/png", "dev2", "drv"), "the device is part of the ETag");
+	CHECK(png != srv_etag_of(1, 0, "image/png", "dev", "drv2"), "the driver is part of the ETag");
+	CHECK(!strcmp(srv_format_ext("image/png"), "png") && !strcmp(srv_format_ext("image/x-exr"), "exr") &&
+	      !strcmp(srv_format_ext("image/webp"), "webp"));
+	uint64_t h = 0;
+	char ext[8];
+	CHECK(srv_result_path("/v1/renders/0123456789abcdef.png", &h, ext, sizeof ext) && h == 0x0123456789abcdefull &&
+	      !strcmp(ext, "png"));
+	char name[64];
+	srv_result_name(name, sizeof name, 0xabcull, "image/x-exr");
+	CHECK(!strcmp(name, "/v1/renders/0000000000000abc.exr"), "got %s", name);
+	CHECK(srv_result_path(name, &h, ext, sizeof ext) && h == 0xabc && !strcmp(ext, "exr"), "the name reads back");
+	CHECK(!srv_result_path("/v1/renders/0123456789abcdef", &h, ext, sizeof ext), "no extension");
+	CHECK(!srv_result_path("/v1/renders/0123456789ABCDEF.png", &h, ext, sizeof ext), "upper-case hex");
+	CHECK(!srv_result_path("/v1/renders/0123456789abcde.png", &h, ext, sizeof ext), "15 digits");
+	CHECK(!srv_result_path("/v1/renders/0123456789abcdef.p/g", &h, ext, sizeof ext));
 	char etag[40];
 	srv_etag_format(etag, sizeof etag, 0x0123456789abcdefull);
 	CHECK(!strcmp(etag, "\"0123456789abcdef\""), "got %s", etag);
@@ -100,4 +110,36 @@ TEST(info_document_is_json)
 	CHECK(strstr(s, "\"max_body\":67108864") != NULL && strstr(s, "\"max_dimension\":8192") != NULL);
 	CHECK(strstr(s, "\"priorities\":[\"interactive\",\"bulk\"]}") != NULL, "got %s", s);
 	free(s);
+}
+
+/* api/scene_hash.h: the canonical scene hash behind the ETag. */
+static uint64_t scene_hash_of(const char *doc, const struct api_part *parts, size_t nparts)
+{
+	struct api_scene *s = NULL;
+	struct api_problem p;
+	if (api_scene_parse_parts(doc, strlen(doc), NULL, parts, nparts, &s, &p) != API_OK) {
+		fprintf(stderr, "# parse failed: %s\n", p.detail);
+		return 0;
+	}
+	uint64_t h = s->scene_hash;
+	api_scene_free(s);
+	return h;
+}
+
+TEST(scene_hash_is_canonical)
+{
+	const char *a = "{\"width\":64,\"height\":32,\"objects\":[{\"shape\":\"sphere\",\"radius\":1}],"
+	                "\"camera\":{\"position\":[0,0,5],\"target\":[0,0,0]}}";
+	const char *b = "{ \"camera\" : { \"target\":[0.0,0,0], \"position\":[0, 0, 5e0] },\n"
+	                "  \"objects\":[{\"radius\":1.0,\"shape\":\"sph\\u0065re\"}], \"height\":32, \"width\":64 }";
+	const char *c = "{\"width\":64,\"height\":32,\"objects\":[{\"shape\":\"sphere\",\"radius\":2}],"
+	                "\"camera\":{\"position\":[0,0,5],\"target\":[0,0,0]}}";
+	uint64_t ha = scene_hash_of(a, NULL, 0), hb = scene_hash_of(b, NULL, 0), hc = scene_hash_of(c, NULL, 0);
+	CHECK(ha != 0 && ha == hb, "key order, whitespace, escapes and number spellings: %016llx vs %016llx",
+	      (unsigned long long)ha, (unsigned long long)hb);
+	CHECK(hc != ha, "a changed value changes the hash");
+	/* The preset's defaults are merged before hashing: naming the preset's own value changes nothing. */
+	const char *t1 = "{\"preset\":\"thumbnail\",\"objects\":[{\"shape\":\"box\"}]}";
+	const char *t2 = "{\"objects\":[{\"shape\":\"box\"}],\"preset\":\"thumbnail\"}";
+	CHECK(scene_hash_of(t1, NULL, 0) == scene_hash_of(t2, NULL, 0) && scene_hash_of(t1, NULL, 0) != 0);
 }
