@@ -67,6 +67,7 @@ command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && [ -x "$BUILD/umbra-re
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh
 # api/scene.schema.json against the daemon (ajv from tests/browser's tooling; skipped without node).
 [ -x "$BUILD/umbrad" ] && run_suite schema sh tests/schema/run.sh
+run_suite openapi sh tests/openapi/run.sh
 # The playground in a real browser, when Debian's chromium is installed (install-deps does).
 [ -x "$BUILD/umbrad" ] && [ -x /usr/bin/chromium ] && run_suite browser sh tests/browser/run.sh
 # libFuzzer targets, a few seconds each (make test builds them into FUZZ_BUILD).
