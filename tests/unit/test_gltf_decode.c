@@ -17,15 +17,6 @@
 #include "util.h"
 #include "umbra/rnd_math.h"
 
-static struct api_scene *parse_glb(const uint8_t *g, size_t n, struct api_problem *p)
-{
-	char *doc = test_model_doc(g, n, "glb");
-	struct api_scene *s = NULL;
-	memset(p, 0, sizeof *p);
-	if (!doc || api_scene_parse(doc, strlen(doc), NULL, &s, p) != API_OK) s = NULL;
-	free(doc);
-	return s;
-}
 
 /* One object: a quad from (0,0,0) to (1,1,0) in world space, two triangles, normals +z. */
 static void check_quad(const struct api_scene *s)
@@ -92,7 +83,7 @@ TEST(gltf_quantized_attributes_read_as_floats)
 	                 bin, sizeof bin, &n, "", "");
 	REQUIRE(g);
 	struct api_problem p;
-	struct api_scene *s = parse_glb(g, n, &p);
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
 	REQUIRE(s, "%d %s: %s", p.status, p.pointer, p.detail);
 	check_quad(s);
@@ -137,7 +128,7 @@ TEST(gltf_meshopt_compressed_views_decoded)
 	uint8_t *g = meshopt_glb(false, &n);
 	REQUIRE(g);
 	struct api_problem p;
-	struct api_scene *s = parse_glb(g, n, &p);
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
 	REQUIRE(s, "%d %s: %s", p.status, p.pointer, p.detail);
 	check_quad(s);
@@ -150,7 +141,7 @@ TEST(gltf_meshopt_corrupt_stream_is_refused)
 	uint8_t *g = meshopt_glb(true, &n);
 	REQUIRE(g);
 	struct api_problem p;
-	struct api_scene *s = parse_glb(g, n, &p);
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
 	CHECK(!s, "a corrupt meshopt stream was accepted");
 	if (s) api_scene_free(s);
@@ -167,7 +158,7 @@ TEST(gltf_draco_required_is_refused_with_what_to_do)
 	                 bin, sizeof bin, &n, ",\"KHR_draco_mesh_compression\"", ",\"KHR_draco_mesh_compression\"");
 	REQUIRE(g);
 	struct api_problem p;
-	struct api_scene *s = parse_glb(g, n, &p);
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
 	CHECK(!s, "a file requiring Draco was accepted");
 	if (s) api_scene_free(s);

@@ -49,15 +49,6 @@ static uint8_t *instanced_glb(int translation_count, size_t *len)
 	return test_glb_pack(json, (size_t)jn, bin, sizeof bin, sizeof bin, len);
 }
 
-static struct api_scene *parse_glb(const uint8_t *g, size_t n, struct api_problem *p)
-{
-	char *doc = test_model_doc(g, n, "glb");
-	struct api_scene *s = NULL;
-	memset(p, 0, sizeof *p);
-	if (!doc || api_scene_parse(doc, strlen(doc), NULL, &s, p) != API_OK) s = NULL;
-	free(doc);
-	return s;
-}
 
 TEST(gltf_instancing_draws_every_instance)
 {
@@ -65,7 +56,7 @@ TEST(gltf_instancing_draws_every_instance)
 	uint8_t *g = instanced_glb(3, &n);
 	REQUIRE(g);
 	struct api_problem p;
-	struct api_scene *s = parse_glb(g, n, &p);
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
 	REQUIRE(s, "%d %s: %s", p.status, p.pointer, p.detail);
 	const struct rnd_scene *sc = &s->scene;
@@ -106,7 +97,7 @@ TEST(gltf_instancing_accessor_outside_its_buffer_is_refused)
 	uint8_t *g = instanced_glb(4, &n);   /* 4 VEC3 in a 36-byte view */
 	REQUIRE(g);
 	struct api_problem p;
-	struct api_scene *s = parse_glb(g, n, &p);
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
 	CHECK(!s, "a TRANSLATION accessor past its view was accepted");
 	if (s) api_scene_free(s);

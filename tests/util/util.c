@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api.h"
 #include "util.h"
 
 char *test_b64(const void *data, size_t n)
@@ -55,4 +56,14 @@ char *test_model_doc(const uint8_t *d, size_t n, const char *format)
 		         "\"data\":\"%s\"}]}", format, enc);
 	free(enc);
 	return doc;
+}
+
+struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *format, struct api_problem *p)
+{
+	char *doc = test_model_doc(d, n, format);
+	struct api_scene *s = NULL;
+	memset(p, 0, sizeof *p);
+	if (!doc || api_scene_parse(doc, strlen(doc), NULL, &s, p) != API_OK) s = NULL;
+	free(doc);
+	return s;
 }

@@ -22,5 +22,10 @@ char *test_vdoc(const char *fmt, va_list ap);
 /* A scene of one model object: the file d[0..n) inline as `data`, of `format` ("glb", ...),
  * seen by a camera at (0, 0, 30). NULL when out of memory. */
 char *test_model_doc(const uint8_t *d, size_t n, const char *format);
+/* That scene parsed (api_scene_parse, default limits): the scene, or NULL with *p its
+ * problem. p: a struct api_problem (api.h). */
+struct api_scene;
+struct api_problem;
+struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *format, struct api_problem *p);
 
 #endif
