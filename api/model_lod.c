@@ -592,5 +592,5 @@ float api_lod_import_error(uint32_t output_side)
 
 bool api_mesh_wants_levels(const struct api_model_mesh *me)
 {
-	return me->index_count / 3 >= API_LOD_MIN_TRIANGLES && me->normals && !me->colors && !me->tangents;
+	return me->index_count / 3 >= API_LOD_MIN_TRIANGLES && me->normals && !me->colors && !me->tangents && !me->uvs1;
 }

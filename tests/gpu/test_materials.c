@@ -33,6 +33,8 @@ struct mglb {
 	const float *color;          /* COLOR_0 RGBA float per vertex, or NULL */
 	const float *tangent;        /* TANGENT xyzw per vertex, or NULL */
 	const char *output;          /* the scene's output members, or NULL: no tone map, no MSAA */
+	const float *uv0;            /* TEXCOORD_0 uv per vertex instead of the one above, or NULL */
+	const float *uv1;            /* TEXCOORD_1 uv per vertex, or NULL: none */
 };
 
 static uint8_t *glb_of(const struct mglb *in, size_t *len)
@@ -44,7 +46,8 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 		uv[2 * v] = (pos[3 * v] + 1) / 2 * us;
 		uv[2 * v + 1] = (pos[3 * v + 2] + 1) / 2;
 	}
-	/* bin: pos 48, nrm 48, uv 32, [color 64], [tangent 64], idx 24, pngs (4-aligned) */
+	if (in->uv0) memcpy(uv, in->uv0, sizeof uv);
+	/* bin: pos 48, nrm 48, uv 32, [color 64], [tangent 64], [uv1 32], idx 24, pngs (4-aligned) */
 	size_t off[16], n = 0, k = 0;
 	const void *src[16];
 	size_t sz[16];
@@ -53,6 +56,7 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 	src[k] = uv; sz[k++] = 32;
 	if (in->color) { src[k] = in->color; sz[k++] = 64; }
 	if (in->tangent) { src[k] = in->tangent; sz[k++] = 64; }
+	if (in->uv1) { src[k] = in->uv1; sz[k++] = 32; }
 	src[k] = QIDX; sz[k++] = 24;
 	for (int i = 0; i < in->npng; i++) { src[k] = in->png[i]; sz[k++] = in->png_len[i]; }
 	for (size_t i = 0; i < k; i++) { off[i] = n; n += (sz[i] + 3) & ~(size_t)3; }
@@ -76,6 +80,11 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 		al += snprintf(accs + al, sizeof accs - (size_t)al,
 		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"}", view++);
 		tl += snprintf(attrs + tl, sizeof attrs - (size_t)tl, ",\"TANGENT\":%d", acc++);
+	}
+	if (in->uv1) {
+		al += snprintf(accs + al, sizeof accs - (size_t)al,
+		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"}", view++);
+		tl += snprintf(attrs + tl, sizeof attrs - (size_t)tl, ",\"TEXCOORD_1\":%d", acc++);
 	}
 	al += snprintf(accs + al, sizeof accs - (size_t)al,
 	               ",{\"bufferView\":%d,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}", view++);
@@ -476,6 +485,55 @@ TEST(materials_texture_transform_offset_and_scale)
 		printf("    %s at x %.1f: r %.3f b %.3f\n", tt[k], x[k], r, b);
 		if (k == 0) CHECK(b > 0.8 && r < 0.1, "offset: want blue, got r %.3f b %.3f", r, b);
 		else CHECK(r > 0.8 && b < 0.1, "scale: want red, got r %.3f b %.3f", r, b);
+		rnd_image_release(&img);
+	}
+}
+
+/* ---- a second uv set (TEXCOORD_1) ---- */
+
+/* A 2x2 texture (red green / blue white, nearest, clamped) on a quad whose TEXCOORD_0 puts
+ * every vertex on the red texel and whose TEXCOORD_1 spans the whole texture. A slot that
+ * reads set 1 (textureInfo.texCoord, or KHR_texture_transform's texCoord over it) shows the
+ * four texels in the four quarters; set 0 shows red everywhere, and so does set 1 on a quad
+ * without TEXCOORD_1 (drawn with TEXCOORD_0). Base colour (light straight down: a white
+ * Lambert surface gives the texel) and emissive (no light). */
+TEST(materials_second_uv_set)
+{
+	static const uint8_t tex[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+	static const float uv0[8] = {0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
+	static const float uv1[8] = {0, 0, 1, 0, 1, 1, 0, 1};   /* u = (x + 1) / 2, v = (z + 1) / 2 */
+	static const char *const mats[5] = {
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1},\"metallicFactor\":0,"
+		"\"roughnessFactor\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":"
+		"{\"texCoord\":1}}},\"metallicFactor\":0,\"roughnessFactor\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0},\"emissiveFactor\":[1,1,1],"
+		"\"emissiveTexture\":{\"index\":0,\"texCoord\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0,\"roughnessFactor\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1},\"metallicFactor\":0,"
+		"\"roughnessFactor\":1}}",
+	};
+	static const char *const what[5] = {"base texCoord 1", "base KHR_texture_transform texCoord 1",
+	                                    "emissive texCoord 1", "base texCoord 0", "base texCoord 1, no TEXCOORD_1"};
+	static const double qx[4] = {-0.5, 0.5, -0.5, 0.5}, qz[4] = {-0.5, -0.5, 0.5, 0.5};
+	for (int m = 0; m < 5; m++) {
+		struct mglb g = {.material = mats[m], .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+		                 .uv0 = uv0, .uv1 = m == 4 ? NULL : uv1,
+		                 .extensions_used = m == 1 ? "[\"KHR_texture_transform\"]" : NULL};
+		add_png(&g, tex, 2, 2);
+		struct rnd_image img;
+		bool ok = render_quad(__LINE__, &img, &g, m != 2, false);
+		free_pngs(&g);
+		if (!ok) return;
+		for (int q = 0; q < 4; q++) {
+			const uint8_t *t = m >= 3 ? tex : tex + 4 * q;   /* set 0: the red texel everywhere */
+			double got[3];
+			for (int c = 0; c < 3; c++) got[c] = lin_at(&img, false, qx[q], qz[q], c);
+			printf("    %s, quarter %d: %.3f %.3f %.3f\n", what[m], q, got[0], got[1], got[2]);
+			for (int c = 0; c < 3; c++)
+				CHECK(fabs(got[c] - t[c] / 255.0) < 0.05, "%s: quarter %d channel %d is %.3f, want %.3f", what[m], q, c,
+				      got[c], t[c] / 255.0);
+		}
 		rnd_image_release(&img);
 	}
 }
