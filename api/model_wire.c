@@ -93,11 +93,12 @@ static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh 
 		const struct rnd_mesh_lod *lv = &me->lods[l];
 		put_u32(b, lv->vertex_count);
 		put_u32(b, lv->index_count);
-		put_u32(b, lv->uvs ? 1u : 0u);
+		put_u32(b, (lv->uvs ? 1u : 0u) | (lv->uvs1 ? 2u : 0u));
 		put(b, &lv->error, 4);
 		put(b, lv->positions, (size_t)lv->vertex_count * 12);
 		put(b, lv->normals, (size_t)lv->vertex_count * 12);
 		if (lv->uvs) put(b, lv->uvs, (size_t)lv->vertex_count * 8);
+		if (lv->uvs1) put(b, lv->uvs1, (size_t)lv->vertex_count * 8);
 		put(b, lv->indices, (size_t)lv->index_count * 4);
 	}
 }
@@ -459,8 +460,8 @@ void api_wire_put_levels(struct api_wire_buf *b, const struct api_model *m)
 }
 
 /* One level of mesh `me` (the one it simplifies): coarser than what it follows (fewer indices),
- * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs only where
- * the mesh has them, and an error no finer than the previous level's. */
+ * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs (each set)
+ * only where the mesh has them, and an error no finer than the previous level's. */
 static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const struct api_model_mesh *me,
                                     uint32_t max_indices, float min_error, struct rnd_mesh_lod *out)
 {
@@ -468,20 +469,24 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 	float error;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &flags) || !take(&d->r, &error, 4))
 		return bad(&d->r, "mesh %u level %u is cut short", i, l);
-	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 1 || ((flags & 1) && !me->uvs) ||
+	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 3 || ((flags & 1) && !me->uvs) ||
+	    ((flags & 2) && !me->uvs1) ||
 	    !isfinite(error) || error < min_error)
 		return bad(&d->r, "mesh %u level %u: %u vertices, %u indices, flags %u, error %g", i, l, nv, ni, flags,
 		           (double)error);
-	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0);
+	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0) + (flags & 2 ? 8 : 0);
 	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u level %u is cut short", i, l);
 	float *pos = dec_alloc(d, nv, 12), *nrm = dec_alloc(d, nv, 12), *uv = flags & 1 ? dec_alloc(d, nv, 8) : NULL;
+	float *uv1 = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
 	uint32_t *idx = dec_alloc(d, ni, 4);
-	if (!pos || !nrm || ((flags & 1) && !uv) || !idx) return bad(&d->r, "out of memory");
+	if (!pos || !nrm || ((flags & 1) && !uv) || ((flags & 2) && !uv1) || !idx) return bad(&d->r, "out of memory");
 	take(&d->r, pos, (size_t)nv * 12);
 	take(&d->r, nrm, (size_t)nv * 12);
 	if (uv) take(&d->r, uv, (size_t)nv * 8);
+	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
 	take(&d->r, idx, (size_t)ni * 4);
-	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)))
+	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)) ||
+	    (uv1 && !finite_all(uv1, (size_t)nv * 2)))
 		return bad(&d->r, "mesh %u level %u has a value that is not finite", i, l);
 	for (uint32_t v = 0; v < nv; v++)
 		for (int k = 0; k < 3; k++)
@@ -489,7 +494,7 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 				return bad(&d->r, "mesh %u level %u: vertex %u lies outside the mesh", i, l, v);
 	for (uint32_t k = 0; k < ni; k++)
 		if (idx[k] >= nv) return bad(&d->r, "mesh %u level %u: index %u refers to vertex %u of %u", i, l, k, idx[k], nv);
-	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error};
+	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error, uv1};
 	return API_OK;
 }
 

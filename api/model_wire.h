@@ -35,7 +35,8 @@
  *   Nothing may follow the last instance.
  *   levels   (a levels-of-detail job: its input is a model, its reply this) mesh_count, then per
  *            mesh level_count (at most API_LOD_LEVELS), per level vertex_count index_count
- *            flags(1 uvs) error(f32), positions f32[3v], normals f32[3v], uvs f32[2v], indices u32[i]
+ *            flags(1 uvs, 2 second uv set) error(f32), positions f32[3v], normals f32[3v], uvs
+ *            f32[2v], uvs1 f32[2v], indices u32[i]
  *
  * Usage (parent): api_wire_header(); then api_wire_decode_model() / _image() on the body.
  * Usage (child):  struct api_wire_buf b = {0}; api_wire_put_model(&b, model); write b.data.

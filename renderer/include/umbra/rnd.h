@@ -152,6 +152,8 @@ struct rnd_mesh_lod {
 	const uint32_t *indices;
 	uint32_t vertex_count, index_count;
 	float error;          /* largest deviation from the full mesh, object-space units */
+	const float *uvs1;    /* the second uv set, where the mesh has one (a level without it is
+	                         not used for an object with uvs1) */
 };
 
 struct rnd_object {
@@ -169,8 +171,7 @@ struct rnd_object {
 	const float *normals;
 	const float *uvs;
 	/* optional second uv set (glTF TEXCOORD_1), uv per vertex, for the material slots whose
-	 * sampling says uv_set 1; NULL: those slots read uvs. A mesh with it is drawn at full
-	 * detail (its lods, which carry one uv set, are not used). */
+	 * sampling says uv_set 1; NULL: those slots read uvs. Its lods need their uvs1 too. */
 	const float *uvs1;
 	const uint8_t *colors;  /* optional linear RGBA8 per vertex (glTF COLOR_0): multiplies base colour */
 	const float *tangents;  /* optional xyzw per vertex (w = bitangent sign), for normal maps */
