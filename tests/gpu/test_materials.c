@@ -2,8 +2,9 @@
  * quad, its material and textures given as JSON text), rendered through api_scene_parse and
  * the renderer, and their pixels compared with the material maths done here: emissive texture
  * and strength, COLOR_0, metallic-roughness texture, normal map (file and generated tangents,
- * scale), sampler wrap modes, KHR_texture_transform, doubleSided culling, alpha BLEND coverage
- * and shadow. Camera straight down (orthographic), light straight down: N·V = N·L = 1 on the
+ * scale), sampler wrap modes, KHR_texture_transform, a second uv set (TEXCOORD_1, in the
+ * camera and the alpha-tested shadow passes), doubleSided culling, alpha BLEND coverage and
+ * shadow. Camera straight down (orthographic), light straight down: N·V = N·L = 1 on the
  * flat quad, so Lambert + GGX reduce to numbers written out in each test. */
 #include <math.h>
 #include <stdio.h>
@@ -568,11 +569,10 @@ TEST(materials_single_sided_hides_back_face)
 /* A red quad at y = 1 (alpha 0.5 BLEND, or OPAQUE) over a blue ground, sun along (0.8, -1, 0):
  * its shadow is the quad moved 0.8 along +x. Seen from above (orthographic), the quad itself
  * covers about half its pixels (dithered) and its shadow takes about half the light. */
-static bool material_render(int line, struct rnd_image *img, const char *material, const char *extensions_used)
+static bool quad_over_ground(int line, struct rnd_image *img, const struct mglb *g)
 {
-	struct mglb g = {.material = material, .extensions_used = extensions_used, .y = 1};
 	size_t n;
-	uint8_t *glb = glb_of(&g, &n);
+	uint8_t *glb = glb_of(g, &n);
 	char *enc = test_b64(glb, n);
 	free(glb);
 	bool ok = gpu_render_at(__FILE__, line, img,
@@ -587,6 +587,12 @@ static bool material_render(int line, struct rnd_image *img, const char *materia
 	                        BW, BH, enc);
 	free(enc);
 	return ok;
+}
+
+static bool material_render(int line, struct rnd_image *img, const char *material, const char *extensions_used)
+{
+	struct mglb g = {.material = material, .extensions_used = extensions_used, .y = 1};
+	return quad_over_ground(line, img, &g);
 }
 
 static bool blend_render(int line, struct rnd_image *img, bool blend)
@@ -637,6 +643,42 @@ TEST(materials_blend_dithered_half_coverage_half_shadow)
 	rnd_image_release(&op);
 	rnd_image_release(&bl);
 	rnd_image_release(&bl2);
+}
+
+/* alphaMode MASK with the base colour's alpha on TEXCOORD_1: a 2x1 texture, opaque | clear
+ * (red), TEXCOORD_0 on the opaque texel everywhere, TEXCOORD_1 across (u = (x + 1) / 2). On
+ * set 1 the quad's right half is cut in the camera pass (the blue ground shows) and in the
+ * shadow pass (its shadow, x in [1.1, 1.7], is lit); on set 0 both are whole. */
+TEST(materials_mask_alpha_on_the_second_uv_set)
+{
+	static const uint8_t tex[8] = {255, 0, 0, 255, 255, 0, 0, 0};
+	static const float uv0[8] = {0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f};
+	static const float uv1[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+	for (int set = 0; set < 2; set++) {
+		char mat[300];
+		snprintf(mat, sizeof mat, "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":%d},"
+		         "\"metallicFactor\":0,\"roughnessFactor\":1},\"alphaMode\":\"MASK\"}", set);
+		struct mglb g = {.material = mat, .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+		                 .uv0 = uv0, .uv1 = uv1, .y = 1};
+		add_png(&g, tex, 2, 1);
+		struct rnd_image img;
+		bool ok = quad_over_ground(__LINE__, &img, &g);
+		free_pngs(&g);
+		if (!ok) return;
+		double left = mean_rect(&img, -0.8, -0.2, -0.6, 0.6, 1, 0), right = mean_rect(&img, 0.2, 0.8, -0.6, 0.6, 1, 0);
+		double lit = mean_rect(&img, 2.0, 2.35, -0.6, 0.6, 0, 2), shadow = mean_rect(&img, 1.1, 1.7, -0.6, 0.6, 0, 2);
+		printf("    texCoord %d: red left %.3f right %.3f; ground lit %.3f, under the right half %.3f\n", set, left,
+		       right, lit, shadow);
+		CHECK(left > 0.5, "texCoord %d: the left half is drawn (red %.3f)", set, left);
+		if (set == 1) {
+			CHECK(right < 0.05 && shadow > 0.9 * lit, "texCoord 1: right half red %.3f, its shadow %.3f of %.3f lit",
+			      right, shadow, lit);
+		} else {
+			CHECK(right > 0.5 && shadow < 0.1 * lit, "texCoord 0: right half red %.3f, its shadow %.3f of %.3f lit",
+			      right, shadow, lit);
+		}
+		rnd_image_release(&img);
+	}
 }
 
 /* KHR_materials_transmission 1 on an opaque red quad: drawn as coverage 0.2 (dithered) that
