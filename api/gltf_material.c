@@ -118,7 +118,10 @@ static void read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, co
 		transform_of(tt, ts);
 		if (json_is_integer(json_object_get(tt, "texCoord"))) tc = json_integer_value(json_object_get(tt, "texCoord"));
 	}
-	if (tc != 0)
+	/* Sets 0 and 1 are drawn (a mesh without set 1 draws it with set 0: api/model_import.c
+	 * says so per mesh); the renderer has no third. */
+	ts->uv_set = tc == 1 ? 1 : 0;
+	if (tc != 0 && tc != 1)
 		api_gltf_warn(gi, "material %u (\"%.40s\"): %s reads TEXCOORD_%lld, drawn with TEXCOORD_0", mi, mname, SLOT_NAMES[slot],
 		     (long long)tc);
 	if (slot == RND_TEX_NORMAL) gm->normal_scale = num(info, "scale", 1);

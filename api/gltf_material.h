@@ -3,8 +3,8 @@
  * read from the document's JSON itself: per texture slot the sampler (wrap and filter modes),
  * KHR_texture_transform, texCoord, normalTexture.scale and occlusionTexture.strength;
  * KHR_materials_emissive_strength; doubleSided. Also the list of what the renderer does not
- * do of the file (unknown extensions, a second uv set, skins, animations, morph targets,
- * points and lines), as warnings that travel with the model (api_model.warnings).
+ * do of the file (unknown extensions, a uv set past the second, skins, animations, morph
+ * targets, points and lines), as warnings that travel with the model (api_model.warnings).
  *
  * Assimp 5.2's glTF importer numbers materials in the order it first meets them walking the
  * node tree (children before a node's own mesh), not the document's order. So the document is

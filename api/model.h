@@ -55,6 +55,8 @@ struct api_model_mesh {
 	const float *positions;   /* xyz per vertex */
 	const float *normals;     /* xyz per vertex, always present (generated when the file has none) */
 	const float *uvs;         /* uv per vertex (glTF convention: v = 0 at the image's top row), or NULL */
+	const float *uvs1;        /* the second uv set (glTF TEXCOORD_1), the same convention, or NULL
+	                             (its levels carry it too) */
 	const uint8_t *colors;    /* linear RGBA8 per vertex (glTF COLOR_0), or NULL */
 	const float *tangents;    /* xyzw per vertex (w = bitangent sign), or NULL (kept only when the
 	                             mesh's material has a normal map) */

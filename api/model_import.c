@@ -159,11 +159,23 @@ static int convert_extras(struct api_conv *c, const struct aiMesh *am, struct ap
 }
 
 /* Fills convert_mesh's arrays; sets out->index_count (and its colours and tangents). */
+/* Assimp's uv set `set` of am into uv (glTF's v, finite), when it has one. */
+static void convert_uvs(const struct aiMesh *am, int set, float *uv)
+{
+	if (!uv) return;
+	for (uint32_t v = 0; v < am->mNumVertices; v++) {
+		/* Assimp puts v = 0 at the bottom (OpenGL); glTF and our textures at the top. */
+		const struct aiVector3D *t = &am->mTextureCoords[set][v];
+		uv[2 * v] = isfinite(t->x) ? t->x : 0;
+		uv[2 * v + 1] = isfinite(t->y) ? 1.0f - t->y : 0;
+	}
+}
+
 static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out, float *pos, float *nrm,
-                        float *uv, uint32_t *idx)
+                        float *uv, float *uv1, uint32_t *idx)
 {
 	uint32_t nv = am->mNumVertices;
-	if (!pos || (am->mNormals && !nrm) || (am->mTextureCoords[0] && !uv) || !idx)
+	if (!pos || (am->mNormals && !nrm) || (am->mTextureCoords[0] && !uv) || (am->mTextureCoords[1] && !uv1) || !idx)
 		return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	if (convert_extras(c, am, out) < 0) return -1;
 	for (uint32_t v = 0; v < nv; v++) {
@@ -178,13 +190,9 @@ static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_
 			/* Degenerate faces leave NaN normals behind; any direction will do for them. */
 			nrm[3 * v] = ok ? n->x : 0; nrm[3 * v + 1] = ok ? n->y : 1; nrm[3 * v + 2] = ok ? n->z : 0;
 		}
-		if (uv) {
-			/* Assimp puts v = 0 at the bottom (OpenGL); glTF and our textures at the top. */
-			const struct aiVector3D *t = &am->mTextureCoords[0][v];
-			uv[2 * v] = isfinite(t->x) ? t->x : 0;
-			uv[2 * v + 1] = isfinite(t->y) ? 1.0f - t->y : 0;
-		}
 	}
+	convert_uvs(am, 0, uv);
+	convert_uvs(am, 1, uv1);
 	uint32_t k = 0;
 	for (unsigned f = 0; f < am->mNumFaces; f++) {
 		const struct aiFace *face = &am->mFaces[f];
@@ -242,6 +250,20 @@ uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, ui
 	return (uint32_t)unique;
 }
 
+/* A material slot on TEXCOORD_1 of a mesh without that set: the renderer draws it with
+ * TEXCOORD_0 (rnd.h uvs1), and the model says so. */
+static void warn_missing_uv1(struct api_conv *c, const struct aiMesh *am, const struct api_model_mesh *me,
+                             const struct rnd_material *m)
+{
+	static const char *const slot[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
+	                                                 "occlusionTexture", "emissiveTexture"};
+	if (me->uvs1) return;
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++)
+		if (m->textures[k] && m->sampling[k].uv_set == 1)
+			api_gltf_warn(&c->gi, "mesh \"%.40s\": its material's %s reads TEXCOORD_1, which the mesh lacks: drawn "
+			              "with TEXCOORD_0", am->mName.data, slot[k]);
+}
+
 static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
 {
 	uint32_t nv = am->mNumVertices, ntri = 0;
@@ -249,17 +271,19 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 	float *pos = api_conv_alloc(c, nv, 3 * sizeof(float));
 	float *nrm = am->mNormals ? api_conv_alloc(c, nv, 3 * sizeof(float)) : NULL;
 	float *uv = am->mTextureCoords[0] ? api_conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
+	float *uv1 = am->mTextureCoords[1] ? api_conv_alloc(c, nv, 2 * sizeof(float)) : NULL;
 	uint32_t *idx = (uint64_t)ntri * 3 <= UINT32_MAX ? api_conv_alloc(c, (size_t)ntri * 3, sizeof(uint32_t)) : NULL;
-	if (convert_data(c, am, out, pos, nrm, uv, idx) < 0) return -1;
+	if (convert_data(c, am, out, pos, nrm, uv, uv1, idx) < 0) return -1;
 	out->positions = pos;
 	out->normals = nrm;
 	out->uvs = uv;
+	out->uvs1 = uv1;
 	out->single_sided = c->single_sided[am->mMaterialIndex < c->sc->mNumMaterials ? am->mMaterialIndex : 0];
 	out->indices = idx;
 	out->vertex_count = nv;
 	out->material = am->mMaterialIndex;
 	/* the colours are ours (the arena) until the model is shared */
-	if (c->join && nrm && !uv && !out->tangents && nv)
+	if (c->join && nrm && !uv && !uv1 && !out->tangents && nv)
 		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
 	return 0;
 }
@@ -324,6 +348,7 @@ static int convert(struct api_conv *c)
 		if (convert_mesh(c, am, &meshes[nmesh]) < 0) return -1;
 		if (!meshes[nmesh].index_count) continue;
 		if (meshes[nmesh].material >= nmat) meshes[nmesh].material = 0;
+		warn_missing_uv1(c, am, &meshes[nmesh], &mats[meshes[nmesh].material]);
 		c->mesh_map[i] = (int32_t)nmesh++;
 	}
 	if (!nmesh) return api_err_set(c->err, c->errsize, "the model has no triangles"), -1;

@@ -12,7 +12,7 @@
  * met walking its surface (another part close by or a crease misled the first). Every level
  * gets its own vertex arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
  * position (weld), so a level's normals are computed from its own triangles with a crease angle
- * (write_level) and its uvs are those of each position's first vertex: a texture seam of a
+ * (write_level) and its uvs (both sets) those of each position's first vertex: a texture seam of a
  * coarse level can show the wrong side's uvs (a thumbnail rarely can tell).
  */
 #include <math.h>
@@ -423,36 +423,43 @@ static bool corner_normals(const struct api_model_mesh *me, const struct welded 
 	return ok;
 }
 
-/* Writes one level into the arena: corners with equal position, normal and uv (the uv of the
- * position's first vertex) become one vertex again. */
+/* Writes one level into the arena: corners with equal position, normal and uvs (both sets:
+ * those of the position's first vertex) become one vertex again. */
 static bool write_level(struct api_arena *arena, const struct api_model_mesh *me, const struct welded *w,
                         const uint32_t *idx, size_t ni, struct rnd_mesh_lod *out, size_t *bytes)
 {
 	float *cp = malloc(ni * 12), *cn = malloc(ni * 12), *cu = me->uvs ? malloc(ni * 8) : NULL;
+	float *cu1 = me->uvs1 ? malloc(ni * 8) : NULL;
 	unsigned int *remap = malloc(ni * sizeof *remap);
 	bool ok = false;
-	if (!cp || !cn || (me->uvs && !cu) || !remap || !corner_normals(me, w, idx, ni, cn)) goto done;
+	if (!cp || !cn || (me->uvs && !cu) || (me->uvs1 && !cu1) || !remap || !corner_normals(me, w, idx, ni, cn)) goto done;
 	for (size_t i = 0; i < ni; i++) {
 		memcpy(cp + 3 * i, w->pos + 3 * (size_t)idx[i], 12);
 		if (cu) memcpy(cu + 2 * i, me->uvs + 2 * (size_t)w->rep[idx[i]], 8);
+		if (cu1) memcpy(cu1 + 2 * i, me->uvs1 + 2 * (size_t)w->rep[idx[i]], 8);
 	}
-	struct meshopt_Stream st[3] = {{cp, 12, 12}, {cn, 12, 12}, {cu, 8, 8}};
-	size_t nv = meshopt_generateVertexRemapMulti(remap, NULL, ni, ni, st, cu ? 3 : 2);
+	struct meshopt_Stream st[4] = {{cp, 12, 12}, {cn, 12, 12}};
+	size_t ns = 2;
+	if (cu) st[ns++] = (struct meshopt_Stream){cu, 8, 8};
+	if (cu1) st[ns++] = (struct meshopt_Stream){cu1, 8, 8};
+	size_t nv = meshopt_generateVertexRemapMulti(remap, NULL, ni, ni, st, ns);
 	float *pos = api_arena_alloc(arena, nv * 12), *nrm = api_arena_alloc(arena, nv * 12);
-	float *uv = cu ? api_arena_alloc(arena, nv * 8) : NULL;
+	float *uv = cu ? api_arena_alloc(arena, nv * 8) : NULL, *uv1 = cu1 ? api_arena_alloc(arena, nv * 8) : NULL;
 	uint32_t *ix = api_arena_alloc(arena, ni * 4);
-	if (!pos || !nrm || (cu && !uv) || !ix) goto done;
+	if (!pos || !nrm || (cu && !uv) || (cu1 && !uv1) || !ix) goto done;
 	meshopt_remapVertexBuffer(pos, cp, ni, 12, remap);
 	meshopt_remapVertexBuffer(nrm, cn, ni, 12, remap);
 	if (cu) meshopt_remapVertexBuffer(uv, cu, ni, 8, remap);
+	if (cu1) meshopt_remapVertexBuffer(uv1, cu1, ni, 8, remap);
 	meshopt_remapIndexBuffer(ix, NULL, ni, remap);
-	*out = (struct rnd_mesh_lod){pos, nrm, uv, ix, (uint32_t)nv, (uint32_t)ni, 0.0f};
-	*bytes += nv * (cu ? 32 : 24) + ni * 4;
+	*out = (struct rnd_mesh_lod){pos, nrm, uv, ix, (uint32_t)nv, (uint32_t)ni, 0.0f, uv1};
+	*bytes += nv * (24 + (cu ? 8 : 0) + (cu1 ? 8 : 0)) + ni * 4;
 	ok = true;
 done:
 	free(cp);
 	free(cn);
 	free(cu);
+	free(cu1);
 	free(remap);
 	return ok;
 }

@@ -80,7 +80,8 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
 		const struct rnd_texture_sampling *ts = &mt->sampling[s];
 		put_u32(b, (uint32_t)ts->wrap_s | (uint32_t)ts->wrap_t << 2 | (uint32_t)ts->mag_nearest << 4 |
-		           (uint32_t)ts->min_nearest << 5 | (uint32_t)ts->transformed << 6 | (uint32_t)(ts->mip % 3u) << 7);
+		           (uint32_t)ts->min_nearest << 5 | (uint32_t)ts->transformed << 6 | (uint32_t)(ts->mip % 3u) << 7 |
+		           (uint32_t)(ts->uv_set == 1) << 9);
 		put(b, ts->transform, sizeof ts->transform);
 	}
 }
@@ -92,11 +93,12 @@ static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh 
 		const struct rnd_mesh_lod *lv = &me->lods[l];
 		put_u32(b, lv->vertex_count);
 		put_u32(b, lv->index_count);
-		put_u32(b, lv->uvs ? 1u : 0u);
+		put_u32(b, (lv->uvs ? 1u : 0u) | (lv->uvs1 ? 2u : 0u));
 		put(b, &lv->error, 4);
 		put(b, lv->positions, (size_t)lv->vertex_count * 12);
 		put(b, lv->normals, (size_t)lv->vertex_count * 12);
 		if (lv->uvs) put(b, lv->uvs, (size_t)lv->vertex_count * 8);
+		if (lv->uvs1) put(b, lv->uvs1, (size_t)lv->vertex_count * 8);
 		put(b, lv->indices, (size_t)lv->index_count * 4);
 	}
 }
@@ -136,10 +138,12 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 		put_u32(b, me->index_count);
 		put_u32(b, me->material);
 		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u) | (me->colors ? 4u : 0u) | (me->tangents ? 8u : 0u) |
-		           (me->single_sided ? 16u : 0u) | (me->closed ? 32u : 0u) | (me->lod_count ? 64u : 0u));
+		           (me->single_sided ? 16u : 0u) | (me->closed ? 32u : 0u) | (me->lod_count ? 64u : 0u) |
+		           (me->uvs1 ? 128u : 0u));
 		put(b, me->positions, (size_t)me->vertex_count * 12);
 		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
 		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
+		if (me->uvs1) put(b, me->uvs1, (size_t)me->vertex_count * 8);
 		if (me->colors) put(b, me->colors, (size_t)me->vertex_count * 4);
 		if (me->tangents) put(b, me->tangents, (size_t)me->vertex_count * 16);
 		put(b, me->indices, (size_t)me->index_count * 4);
@@ -274,7 +278,9 @@ static void *dec_alloc(struct dec *d, size_t n, size_t size)
 
 static bool sampling_ok(uint32_t packed, const float *t)
 {
-	if (packed > 0x1ff || (packed & 3) > RND_WRAP_MIRROR || (packed >> 2 & 3) > RND_WRAP_MIRROR || (packed >> 7) > RND_MIP_NEAREST)
+	/* bit 9: the uv set (0 or 1) */
+	if (packed > 0x3ff || (packed & 3) > RND_WRAP_MIRROR || (packed >> 2 & 3) > RND_WRAP_MIRROR ||
+	    (packed >> 7 & 3) > RND_MIP_NEAREST)
 		return false;
 	for (int k = 0; k < 6; k++)
 		if (!isfinite(t[k]) || fabsf(t[k]) > 1e6f) return false;
@@ -313,6 +319,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 			ts->min_nearest = packed[s] >> 5 & 1;
 			ts->transformed = packed[s] >> 6 & 1;
 			ts->mip = (uint8_t)(packed[s] >> 7 & 3);
+			ts->uv_set = (uint8_t)(packed[s] >> 9 & 1);
 			memcpy(ts->transform, tf[s], sizeof tf[s]);
 		}
 		memcpy(m->base_color, f, 4 * sizeof(float));
@@ -335,29 +342,31 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 	uint32_t nv, ni, mat, flags;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &mat) || !take_u32(&d->r, &flags))
 		return bad(&d->r, "mesh %u is cut short", i);
-	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 127)
+	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 255)
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
-	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
+	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 128 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
 	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u is cut short", i);
 	float *pos = dec_alloc(d, nv, 12), *nrm = flags & 1 ? dec_alloc(d, nv, 12) : NULL;
-	float *uv = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
+	float *uv = flags & 2 ? dec_alloc(d, nv, 8) : NULL, *uv1 = flags & 128 ? dec_alloc(d, nv, 8) : NULL;
 	uint8_t *col = flags & 4 ? dec_alloc(d, nv, 4) : NULL;
 	float *tan = flags & 8 ? dec_alloc(d, nv, 16) : NULL;
 	uint32_t *idx = dec_alloc(d, ni, 4);
-	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || ((flags & 4) && !col) || ((flags & 8) && !tan) || !idx)
+	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || ((flags & 128) && !uv1) || ((flags & 4) && !col) || ((flags & 8) && !tan) || !idx)
 		return bad(&d->r, "out of memory");
 	take(&d->r, pos, (size_t)nv * 12);
 	if (nrm) take(&d->r, nrm, (size_t)nv * 12);
 	if (uv) take(&d->r, uv, (size_t)nv * 8);
+	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
 	if (col) take(&d->r, col, (size_t)nv * 4);
 	if (tan) take(&d->r, tan, (size_t)nv * 16);
 	if (!take(&d->r, idx, (size_t)ni * 4)) return bad(&d->r, "mesh %u is cut short", i);
 	if (!finite_all(pos, (size_t)nv * 3) || (nrm && !finite_all(nrm, (size_t)nv * 3)) ||
-	    (uv && !finite_all(uv, (size_t)nv * 2)) || (tan && !finite_all(tan, (size_t)nv * 4)))
+	    (uv && !finite_all(uv, (size_t)nv * 2)) || (uv1 && !finite_all(uv1, (size_t)nv * 2)) ||
+	    (tan && !finite_all(tan, (size_t)nv * 4)))
 		return bad(&d->r, "mesh %u has a value that is not finite", i);
 	for (uint32_t k = 0; k < ni; k++)
 		if (idx[k] >= nv) return bad(&d->r, "mesh %u: index %u refers to vertex %u of %u", i, k, idx[k], nv);
-	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .uvs = uv, .colors = col, .tangents = tan,
+	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .uvs = uv, .uvs1 = uv1, .colors = col, .tangents = tan,
 	                              .indices = idx, .vertex_count = nv, .index_count = ni, .material = mat,
 	                              .single_sided = (flags & 16) != 0, .closed = (flags & 32) != 0};
 	api_mesh_bounds(me);
@@ -451,8 +460,8 @@ void api_wire_put_levels(struct api_wire_buf *b, const struct api_model *m)
 }
 
 /* One level of mesh `me` (the one it simplifies): coarser than what it follows (fewer indices),
- * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs only where
- * the mesh has them, and an error no finer than the previous level's. */
+ * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs (each set)
+ * only where the mesh has them, and an error no finer than the previous level's. */
 static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const struct api_model_mesh *me,
                                     uint32_t max_indices, float min_error, struct rnd_mesh_lod *out)
 {
@@ -460,20 +469,24 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 	float error;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &flags) || !take(&d->r, &error, 4))
 		return bad(&d->r, "mesh %u level %u is cut short", i, l);
-	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 1 || ((flags & 1) && !me->uvs) ||
+	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 3 || ((flags & 1) && !me->uvs) ||
+	    ((flags & 2) && !me->uvs1) ||
 	    !isfinite(error) || error < min_error)
 		return bad(&d->r, "mesh %u level %u: %u vertices, %u indices, flags %u, error %g", i, l, nv, ni, flags,
 		           (double)error);
-	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0);
+	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0) + (flags & 2 ? 8 : 0);
 	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u level %u is cut short", i, l);
 	float *pos = dec_alloc(d, nv, 12), *nrm = dec_alloc(d, nv, 12), *uv = flags & 1 ? dec_alloc(d, nv, 8) : NULL;
+	float *uv1 = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
 	uint32_t *idx = dec_alloc(d, ni, 4);
-	if (!pos || !nrm || ((flags & 1) && !uv) || !idx) return bad(&d->r, "out of memory");
+	if (!pos || !nrm || ((flags & 1) && !uv) || ((flags & 2) && !uv1) || !idx) return bad(&d->r, "out of memory");
 	take(&d->r, pos, (size_t)nv * 12);
 	take(&d->r, nrm, (size_t)nv * 12);
 	if (uv) take(&d->r, uv, (size_t)nv * 8);
+	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
 	take(&d->r, idx, (size_t)ni * 4);
-	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)))
+	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)) ||
+	    (uv1 && !finite_all(uv1, (size_t)nv * 2)))
 		return bad(&d->r, "mesh %u level %u has a value that is not finite", i, l);
 	for (uint32_t v = 0; v < nv; v++)
 		for (int k = 0; k < 3; k++)
@@ -481,7 +494,7 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 				return bad(&d->r, "mesh %u level %u: vertex %u lies outside the mesh", i, l, v);
 	for (uint32_t k = 0; k < ni; k++)
 		if (idx[k] >= nv) return bad(&d->r, "mesh %u level %u: index %u refers to vertex %u of %u", i, l, k, idx[k], nv);
-	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error};
+	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error, uv1};
 	return API_OK;
 }
 

@@ -24,16 +24,19 @@
  *                       occlusion_strength reserved (f32, reserved = 0), alpha_mode (u32),
  *                       texture[5] (i32 per rnd_texture_slot, -1 = none), then per slot the
  *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
- *                       transformed << 6 | mip << 7 (u32, enum rnd_mip), transform f32[6]
+ *                       transformed << 6 | mip << 7 (u32, enum rnd_mip) | uv_set << 9 (0 or 1),
+ *                       transform f32[6]
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
- *                       8 tangents, 16 single-sided, 32 closed, 64 levels), positions f32[3v],
- *                       normals f32[3v], uvs f32[2v], colours u8[4v], tangents f32[4v], indices
+ *                       8 tangents, 16 single-sided, 32 closed, 64 levels, 128 second uv set),
+ *                       positions f32[3v], normals f32[3v], uvs f32[2v], uvs1 f32[2v], colours
+ *                       u8[4v], tangents f32[4v], indices
  *                       u32[i], then with flag 64 the mesh's levels as below (level_count ...)
  *            instances: mesh (u32), model matrix f32[16] (column-major)
  *   Nothing may follow the last instance.
  *   levels   (a levels-of-detail job: its input is a model, its reply this) mesh_count, then per
  *            mesh level_count (at most API_LOD_LEVELS), per level vertex_count index_count
- *            flags(1 uvs) error(f32), positions f32[3v], normals f32[3v], uvs f32[2v], indices u32[i]
+ *            flags(1 uvs, 2 second uv set) error(f32), positions f32[3v], normals f32[3v], uvs
+ *            f32[2v], uvs1 f32[2v], indices u32[i]
  *
  * Usage (parent): api_wire_header(); then api_wire_decode_model() / _image() on the body.
  * Usage (child):  struct api_wire_buf b = {0}; api_wire_put_model(&b, model); write b.data.
@@ -49,7 +52,7 @@
 #include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 3u
+#define API_WIRE_VERSION 4u
 #define API_WIRE_MAX_MESSAGE 1024u
 
 enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2, API_WIRE_LEVELS = 3 };

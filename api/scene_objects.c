@@ -303,11 +303,12 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->index_count = me->index_count;
 			o->normals = me->normals;
 			o->uvs = me->uvs;
+			o->uvs1 = me->uvs1;
 			o->colors = me->colors;
 			o->tangents = me->tangents;
 			/* The level for this request's size (api/model_levels.h). Levels carry
-			 * positions, normals and uvs only: a mesh with vertex colours or tangents is
-			 * always drawn whole. */
+			 * positions, normals and uvs (both sets) only: a mesh with vertex colours or
+			 * tangents is always drawn whole. */
 			if (!me->colors && !me->tangents) o->lods = api_model_mesh_lods(m, in->mesh, c->lim->output_side, &o->lod_count);
 			o->closed = me->closed;
 			o->mesh_bounds = me->vertex_count ? me->bounds : NULL;

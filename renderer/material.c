@@ -7,7 +7,9 @@
  * the slot's white 1x1, which is the neutral value of every multiply (base, metal-rough,
  * occlusion, emissive); the normal map's bit gates its use. Every image carries its full mip
  * chain (renderer/texture.c), so a texture far smaller on screen than in the file is averaged,
- * not aliased; the sampler's rnd_mip decides whether the chain is read.
+ * not aliased; the sampler's rnd_mip decides whether the chain is read. A slot whose sampling
+ * says uv_set 1 has its bit (1 << (UMBRA_TEX_UV1_SHIFT + slot)) in tex.x, and the scene's
+ * UMBRA_TEXBIT_UV1 turns on the shaders' second-uv path only where the slot has that set.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,8 +48,9 @@ void rnd_material_write(const struct rnd_material *in, struct umbra_material *ou
 	out->tex[1] = in->alpha_mode == RND_ALPHA_MASK ? UMBRA_ALPHA_MASK
 	            : in->alpha_mode == RND_ALPHA_BLEND ? UMBRA_ALPHA_BLEND : UMBRA_ALPHA_OPAQUE;
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
-		if (in->textures[k]) out->tex[0] |= 1u << k;
 		const struct rnd_texture_sampling *ts = &in->sampling[k];
+		if (in->textures[k]) out->tex[0] |= 1u << k;
+		if (in->textures[k] && ts->uv_set == 1) out->tex[0] |= 1u << (UMBRA_TEX_UV1_SHIFT + k);
 		float *r0 = out->uvx[2 * k], *r1 = out->uvx[2 * k + 1];
 		if (ts->transformed) {
 			memcpy(r0, ts->transform, 3 * sizeof(float));
@@ -180,7 +183,11 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 		}
 		draws[i].texture_set = set_of[mi] - 1;
 		for (uint32_t k = 0; k < RND_TEX_SLOTS; k++)
-			if (sc->materials[mi].textures[k]) draws[i].tex_bits |= 1u << k;
+			if (sc->materials[mi].textures[k]) {
+				draws[i].tex_bits |= 1u << k;
+				/* the uv1 path only where the scene has the set (else binding 1 is uv0) */
+				if (sc->materials[mi].sampling[k].uv_set == 1 && s->has_uv1) draws[i].tex_bits |= UMBRA_TEXBIT_UV1;
+			}
 		if (sc->objects[i].shape == RND_SHAPE_MESH && sc->objects[i].colors)
 			draws[i].tex_bits |= UMBRA_TEXBIT_VERTEX_COLOR;
 	}

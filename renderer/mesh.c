@@ -275,6 +275,20 @@ static void gen_mesh(const struct rnd_object *o, struct rnd_vertex *vt, uint32_t
 	}
 }
 
+void rnd_mesh_write_uv1(const struct rnd_object *o, const struct rnd_vertex *vertices, uint32_t count, float *out)
+{
+	if (o->shape != RND_SHAPE_MESH || !o->uvs1) {
+		for (uint32_t i = 0; i < count; i++) memcpy(out + 2 * (size_t)i, vertices[i].uv, 8);
+		return;
+	}
+	/* gen_mesh's order: the vertices as given (indexed, with normals), else one per corner */
+	bool shared = o->normals && o->indices;
+	for (uint32_t i = 0; i < count; i++) {
+		uint32_t src = shared ? i : o->indices ? o->indices[i] : i;
+		memcpy(out + 2 * (size_t)i, o->uvs1 + 2 * (size_t)src, 8);
+	}
+}
+
 enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
                                uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err)
 {

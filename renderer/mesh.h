@@ -42,6 +42,11 @@ void rnd_mesh_counts(const struct rnd_object *o, uint32_t *vertex_count, uint32_
 enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
                                uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err);
 
+/* The second uv set of the count vertices rnd_mesh_write() wrote for o at vertices (the same
+ * order), into out (2 floats each): o->uvs1 where it has them, else each vertex's own uv, so
+ * a slot that asks for set 1 on an object without it reads set 0. */
+void rnd_mesh_write_uv1(const struct rnd_object *o, const struct rnd_vertex *vertices, uint32_t count, float *out);
+
 /* The world-space area of the index_count / 3 triangles at indices (as rnd_mesh_write leaves
  * them: offset by base_vertex) over vertices (the buffer's start, vertex 0 = base 0): exact up
  * to RND_MESH_AREA_SAMPLES triangles, past it estimated from that many, evenly strided. */

@@ -130,7 +130,7 @@ struct pipe_desc {
 	bool cull_back;
 	bool shadow;                /* depth bias + clamp, LESS compare; else reversed-Z */
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
-	bool uv_only;               /* vertex input: position (0), uv (2), colour (3) */
+	bool uv_only;               /* vertex input: position (0), uv (2), colour (3), uv1 (UMBRA_LOCATION_UV1) */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	VkFormat color_rest;        /* when set: the format of attachments 1.. */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
@@ -150,16 +150,19 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = d->fs, .pName = "main",
 		 .pSpecializationInfo = d->spec},
 	};
-	VkVertexInputBindingDescription vb = {0, sizeof(struct rnd_vertex), VK_VERTEX_INPUT_RATE_VERTEX};
-	VkVertexInputAttributeDescription va[5] = {
+	/* binding 1: the second uv set (umbra_shared.h); both strides are dynamic (record.c) */
+	VkVertexInputBindingDescription vb[2] = {{0, sizeof(struct rnd_vertex), VK_VERTEX_INPUT_RATE_VERTEX},
+	                                         {UMBRA_VERTEX_BINDING_UV1, 8, VK_VERTEX_INPUT_RATE_VERTEX}};
+	VkVertexInputAttributeDescription va[6] = {
 		{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, pos)},
 		{1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, nrm)},
 		{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
 		{3, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(struct rnd_vertex, color)},
 		{4, 0, VK_FORMAT_R8G8B8A8_SNORM, offsetof(struct rnd_vertex, tangent)},
+		{UMBRA_LOCATION_UV1, UMBRA_VERTEX_BINDING_UV1, VK_FORMAT_R32G32_SFLOAT, 0},
 	};
-	/* alpha-tested depth passes: position, uv and colour (its alpha scales coverage) */
-	VkVertexInputAttributeDescription va_uv[3] = {va[0], va[2], va[3]};
+	/* alpha-tested depth passes: position, uvs and colour (its alpha scales coverage) */
+	VkVertexInputAttributeDescription va_uv[4] = {va[0], va[2], va[3], va[5]};
 	uint32_t ncolor = d->color == VK_FORMAT_UNDEFINED ? 0 : d->color_count ? d->color_count : 1;
 	VkFormat formats[UMBRA_AOV_ATTACHMENTS];
 	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
@@ -169,9 +172,9 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	}
 	VkPipelineVertexInputStateCreateInfo vi = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-		.pVertexBindingDescriptions = &vb,
-		.vertexBindingDescriptionCount = d->no_vertices ? 0 : 1,
-		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 3 : d->shadow ? 1 : 5,
+		.pVertexBindingDescriptions = vb,
+		.vertexBindingDescriptionCount = d->no_vertices ? 0 : 2,
+		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 4 : d->shadow ? 1 : 6,
 		.pVertexAttributeDescriptions = d->uv_only ? va_uv : va,
 	};
 	VkPipelineInputAssemblyStateCreateInfo ia = {
@@ -207,9 +210,12 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
 		.attachmentCount = ncolor, .pAttachments = cbas,
 	};
-	VkDynamicState dyn[3] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_DEPTH_BIAS};
+	VkDynamicState dyn[4] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_DEPTH_BIAS,
+	                         VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE};
+	if (!d->shadow) dyn[2] = dyn[3];
 	VkPipelineDynamicStateCreateInfo dy = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, .dynamicStateCount = d->shadow ? 3 : 2, .pDynamicStates = dyn,
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+		.dynamicStateCount = (d->shadow ? 3u : 2u) + (d->no_vertices ? 0u : 1u), .pDynamicStates = dyn,
 	};
 	VkPipelineRenderingCreateInfo rci = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,

@@ -5,11 +5,13 @@
  * readback.c).
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "moments.h"
 #include "contact.h"
 #include "material.h"
+#include "mesh.h"
 #include "record.h"
 
 /* Culling back faces of a closed primitive changes nothing in the picture as long as the
@@ -89,8 +91,13 @@ void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint
 
 void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s)
 {
-	VkDeviceSize zero = 0;
-	vkCmdBindVertexBuffers(s->cmd, 0, 1, &s->vertices.buf, &zero);
+	/* Binding 1, the second uv set: its own buffer, or (a scene without one) the vertices'
+	 * own uvs at their stride, so a slot that asks for set 1 reads set 0 (the strides are
+	 * dynamic state, renderer/pipelines.c). */
+	VkBuffer bufs[2] = {s->vertices.buf, s->has_uv1 ? s->uvs1.buf : s->vertices.buf};
+	VkDeviceSize offs[2] = {0, s->has_uv1 ? 0 : offsetof(struct rnd_vertex, uv)};
+	VkDeviceSize strides[2] = {sizeof(struct rnd_vertex), s->has_uv1 ? 8 : sizeof(struct rnd_vertex)};
+	vkCmdBindVertexBuffers2(s->cmd, 0, 2, bufs, offs, NULL, strides);
 	vkCmdBindIndexBuffer(s->cmd, s->indices.buf, 0, VK_INDEX_TYPE_UINT32);
 	vkCmdBindDescriptorSets(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
 }

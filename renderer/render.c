@@ -208,6 +208,8 @@ static uint64_t caster_key(const struct render *rq)
 			geo = rnd_hash(geo, &m->alpha_cutoff, sizeof m->alpha_cutoff);
 			geo = rnd_hash(geo, &m->alpha_mode, sizeof m->alpha_mode);
 			geo = rnd_hash(geo, &m->sampling[RND_TEX_BASE], sizeof m->sampling[RND_TEX_BASE]);
+			if (s->has_uv1 && m->sampling[RND_TEX_BASE].uv_set == 1)   /* the alpha test reads uv1 */
+				geo = rnd_hash(geo, (const float *)s->uvs1.map + 2 * (size_t)d->first_vertex, (size_t)d->vertex_count * 8);
 			geo = rnd_hash(geo, m->base_color, sizeof m->base_color);
 			if (m->base_color_texture)
 				geo = rnd_hash(geo, m->base_color_texture->rgba,

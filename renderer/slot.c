@@ -171,6 +171,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_buffer_destroy(ctx, &s->readback);
 	rnd_buffer_destroy(ctx, &s->params);
 	rnd_buffer_destroy(ctx, &s->indices);
+	rnd_buffer_destroy(ctx, &s->uvs1);
 	rnd_buffer_destroy(ctx, &s->vertices);
 	vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
 	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
@@ -366,7 +367,7 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 		rnd_image_destroy(ctx, &s->moments_tmp);
 		s->moments_initialised = false;
 	}
-	struct rnd_buffer *bufs[] = {&s->readback, &s->vertices, &s->indices, &s->staging};
+	struct rnd_buffer *bufs[] = {&s->readback, &s->vertices, &s->uvs1, &s->indices, &s->staging};
 	for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
 		if (bufs[i]->size > keep) rnd_buffer_destroy(ctx, bufs[i]);
 }

@@ -24,6 +24,10 @@ struct rnd_slot {
 	VkDescriptorSet set;
 
 	struct rnd_buffer vertices, indices, params, readback, staging;
+	/* the second uv set (float2 per vertex of `vertices`), reserved only for a scene with an
+	 * object that has one (upload.c); has_uv1 says whether this render's scene filled it */
+	struct rnd_buffer uvs1;
+	bool has_uv1;
 	/* this render's material textures (destroyed when the next render starts) */
 	struct rnd_image_res *textures;   /* ctx->max_textures */
 	uint32_t texture_count;

@@ -5,11 +5,24 @@
  * the staged textures into their images (record_textures).
  */
 #include <stdio.h>
+#include <string.h>
 #include "lod.h"
 #include "mesh.h"
 #include "proxy.h"
 #include "texture.h"
 #include "upload.h"
+
+/* The slot's second-uv-set buffer, reserved (nv float2) only when an object of the scene has
+ * one: a scene without keeps its memory and binds the vertices there (record.c). */
+static enum rnd_result reserve_uv1(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc, uint64_t nv,
+                                   struct rnd_error *err)
+{
+	s->has_uv1 = false;
+	for (uint32_t i = 0; i < sc->object_count && !s->has_uv1; i++)
+		s->has_uv1 = sc->objects[i].shape == RND_SHAPE_MESH && sc->objects[i].uvs1;
+	if (!s->has_uv1) return RND_OK;
+	return rnd_buffer_reserve(ctx, &s->uvs1, (nv ? nv : 1) * 8, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "slot uvs1", err);
+}
 
 enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                  const struct rnd_pacer *pacer, const uint32_t *lod, const struct rnd_proxy *proxies,
@@ -34,6 +47,8 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		return r;
 	if ((r = rnd_buffer_reserve(ctx, &s->indices, ibytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "slot indices", err)) != RND_OK)
 		return r;
+	if ((r = reserve_uv1(ctx, s, sc, nv, err)) != RND_OK) return r;
+	float *uv1 = s->has_uv1 ? s->uvs1.map : NULL;
 	struct rnd_vertex *vtx = s->vertices.map;
 	uint32_t *idx = s->indices.map;
 	uint32_t vbase = 0, ibase = 0;
@@ -53,6 +68,7 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 			snprintf(m, sizeof m, "%s", err->msg);
 			return rnd_fail(err, r, "object %u: %s", i, m);
 		}
+		if (uv1) rnd_mesh_write_uv1(o, vtx + vbase, v, uv1 + 2 * (size_t)vbase);
 		d->area = rnd_mesh_area(vtx, idx + ibase, x);
 		d->first_index = d->cam_first_index = ibase;
 		d->index_count = d->cam_index_count = x;
@@ -82,6 +98,7 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		rnd_proxy_counts(&proxies[i], &v, &x);
 		if (!x) continue;
 		rnd_proxy_write(&proxies[i], vtx + vbase, idx + ibase, vbase);
+		if (uv1) memset(uv1 + 2 * (size_t)vbase, 0, (size_t)v * 8);   /* a sphere's proxy: no texture uvs */
 		draws[i].cam_first_index = ibase;
 		draws[i].cam_index_count = x;
 		draws[i].cam_first_vertex = vbase;

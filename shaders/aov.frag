@@ -28,7 +28,7 @@ float visibility(uint i, vec3 p_shadow, vec3 n_shadow, bool receive)
 
 void main()
 {
-	material_derivatives(v_uv);
+	material_derivatives(v_uv, v_uv1);
 	umbra_material m = materials[pc.info.x];
 	vec3 n_geo, p_shadow, n_shadow;   // before base_color's discard
 	surface_at(in_pos, v_nrm, v_uv, pc.info.y, 1u, v_pos, n_geo, p_shadow, n_shadow);

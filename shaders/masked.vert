@@ -8,12 +8,15 @@ layout(push_constant) uniform PushBlock { umbra_push pc; };
 layout(location = 0) in vec3 a_pos;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in vec4 a_color;
+layout(location = UMBRA_LOCATION_UV1) in vec2 a_uv1;
 layout(location = 2) out vec2 v_uv;
 layout(location = 3) out float v_alpha;
+layout(location = UMBRA_LOCATION_UV1) out vec2 v_uv1;
 void main()
 {
 	v_uv = a_uv;
 	v_alpha = a_color.a;
+	v_uv1 = a_uv1;
 	precise vec4 clip = pc.view_proj * vec4(a_pos, 1.0);
 	gl_Position = clip;
 }

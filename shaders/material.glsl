@@ -18,21 +18,37 @@ vec2 material_uv(umbra_material m, uint slot, vec2 uv)
 // material has this texture)` are undefined where a 2x2 quad's helper lanes do not take the
 // branch, and on lavapipe a helper lane reads the material buffer as zeros, which put a
 // coarse level on every pixel along a triangle edge. Zero (never taken): level 0.
+// The second uv set's (uv1) only where the scene's materials read it (UMBRA_TEXBIT_UV1).
 vec2 material_dx = vec2(0.0), material_dy = vec2(0.0);
+vec2 material_dx1 = vec2(0.0), material_dy1 = vec2(0.0);
 
-void material_derivatives(vec2 uv)
+void material_derivatives(vec2 uv, vec2 uv1)
 {
 	material_dx = dFdx(uv);
 	material_dy = dFdy(uv);
+	if ((SC_TEXTURES & UMBRA_TEXBIT_UV1) != 0u) {
+		material_dx1 = dFdx(uv1);
+		material_dy1 = dFdy(uv1);
+	}
 }
 
-// Texture slot `slot` at uv (through the slot's transform), its gradients carried through
-// the same (affine) transform.
-vec4 material_texture(sampler2D s, umbra_material m, uint slot, vec2 uv)
+// Whether slot `slot` of m samples the second uv set: one bit of the draw's material (the
+// same for the whole draw: a select, not a divergent branch), folded away in scenes that
+// have none.
+bool material_reads_uv1(umbra_material m, uint slot)
 {
+	return (SC_TEXTURES & UMBRA_TEXBIT_UV1) != 0u && (m.tex.x & (1u << (UMBRA_TEX_UV1_SHIFT + slot))) != 0u;
+}
+
+// Texture slot `slot` at its uv set's coordinate (uv or uv1, through the slot's transform),
+// its gradients carried through the same (affine) transform.
+vec4 material_texture(sampler2D s, umbra_material m, uint slot, vec2 uv, vec2 uv1)
+{
+	bool one = material_reads_uv1(m, slot);
 	vec4 r0 = m.uvx[2u * slot], r1 = m.uvx[2u * slot + 1u];
 	mat2 t = mat2(r0.x, r1.x, r0.y, r1.y);
-	return textureGrad(s, material_uv(m, slot, uv), t * material_dx, t * material_dy);
+	return textureGrad(s, material_uv(m, slot, one ? uv1 : uv), t * (one ? material_dx1 : material_dx),
+	                   t * (one ? material_dy1 : material_dy));
 }
 
 // Alpha mode BLEND, dithered: an ordered 4x4 (Bayer) threshold per pixel, so a surface of
@@ -67,7 +83,7 @@ vec3 material_normal(umbra_material m, vec3 n_geo, bool mapped)
 	if (tl < 1e-4) return n_geo;   // no usable tangent here (degenerate uvs)
 	t /= tl;
 	vec3 b = cross(n_geo, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-	vec3 tn = material_texture(normal_texture, m, UMBRA_TEX_NORMAL, v_uv).xyz * 2.0 - 1.0;
+	vec3 tn = material_texture(normal_texture, m, UMBRA_TEX_NORMAL, v_uv, v_uv1).xyz * 2.0 - 1.0;
 	tn.xy *= m.params.z;
 	vec3 n = t * tn.x + b * tn.y + n_geo * tn.z;
 	float nl = length(n);

@@ -14,13 +14,13 @@ umbra_material draw_material()
 	m.emissive = pc.emissive;
 	m.params = pc.params;
 	m.tex = pc.tex;
-	if ((SC_TEXTURES & ~UMBRA_TEXBIT_VERTEX_COLOR) != 0u) m.uvx = materials[pc.info.x].uvx;
+	if ((SC_TEXTURES & ~(UMBRA_TEXBIT_VERTEX_COLOR | UMBRA_TEXBIT_UV1)) != 0u) m.uvx = materials[pc.info.x].uvx;
 	return m;
 }
 
 void main()
 {
-	material_derivatives(v_uv);
+	material_derivatives(v_uv, v_uv1);
 	umbra_material m = draw_material();
 	uint flags = pc.info.y;
 	vec3 n_geo, p_shadow, n_shadow;   // before base_color's discard
@@ -31,7 +31,7 @@ void main()
 	vec3 base = bc.rgb;
 	float rough = m.emissive.a, metal = m.params.x;
 	if (has_tex(m, UMBRA_TEX_METAL_ROUGH)) {
-		vec4 mr = material_texture(metal_rough_texture, m, UMBRA_TEX_METAL_ROUGH, v_uv);
+		vec4 mr = material_texture(metal_rough_texture, m, UMBRA_TEX_METAL_ROUGH, v_uv, v_uv1);
 		rough *= mr.g;   // glTF: G roughness, B metalness (linear)
 		metal *= mr.b;
 	}
@@ -48,11 +48,11 @@ void main()
 	// Occlusion darkens the ambient (indirect) light only: direct light has its shadows.
 	float ao = 1.0;
 	if (has_tex(m, UMBRA_TEX_OCCLUSION))
-		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv).r - 1.0);
+		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv, v_uv1).r - 1.0);
 	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * metal) * ao;
 	vec3 emissive = m.emissive.rgb;
 	if (has_tex(m, UMBRA_TEX_EMISSIVE))
-		emissive *= material_texture(emissive_texture, m, UMBRA_TEX_EMISSIVE, v_uv).rgb;
+		emissive *= material_texture(emissive_texture, m, UMBRA_TEX_EMISSIVE, v_uv, v_uv1).rgb;
 	vec3 radiance = (ambient + lit + emissive) * frame.params.x;
 
 	const uint debug = SC_DEBUG;

@@ -54,7 +54,7 @@ layout(constant_id = UMBRA_SC_TONEMAP) const uint SC_TONEMAP = 0u;     // UMBRA_
 layout(constant_id = UMBRA_SC_CATCHER) const uint SC_CATCHER = 0u;     // scene has shadow catchers
 layout(constant_id = UMBRA_SC_LIGHT_TYPES) const uint SC_LIGHT_TYPES = 7u; // bit (1 << UMBRA_LIGHT_*)
 layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any directional light has cascades
-layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 63u;  // bit (1 << UMBRA_TEX_*) | vertex colour
+layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 127u; // bit (1 << UMBRA_TEX_*) | vertex colour | uv1
 layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1 << UMBRA_ALPHA_*)
 layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any light marches contact shadows
 layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
@@ -65,6 +65,7 @@ layout(constant_id = UMBRA_SC_SAMPLES) const uint SC_SAMPLES = 1u;      // sampl
 vec3 v_pos;
 vec3 v_nrm;
 vec2 v_uv;
+vec2 v_uv1;
 vec4 v_color;
 vec4 v_tangent;
 vec2 vis_frag_xy;        // the pixel (centre) this invocation computes, in the view
@@ -76,6 +77,7 @@ layout(location = 1) in vec3 v_nrm;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_color;
 layout(location = 4) in vec4 v_tangent;
+layout(location = UMBRA_LOCATION_UV1) in vec2 v_uv1;
 vec2 frag_xy() { return gl_FragCoord.xy; }
 
 #include "facet.glsl"
@@ -473,7 +475,7 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 vec4 base_color(umbra_material m)
 {
 	vec4 c = m.base_color;
-	if (has_tex(m, UMBRA_TEX_BASE)) c *= material_texture(base_texture, m, UMBRA_TEX_BASE, v_uv);
+	if (has_tex(m, UMBRA_TEX_BASE)) c *= material_texture(base_texture, m, UMBRA_TEX_BASE, v_uv, v_uv1);
 	if ((SC_TEXTURES & UMBRA_TEXBIT_VERTEX_COLOR) != 0u) c *= v_color;
 	if (SC_MASKED != 0u && m.tex.y != UMBRA_ALPHA_OPAQUE && !alpha_keep(m, c.a, gl_FragCoord.xy)) discard;
 	return c;

@@ -66,6 +66,17 @@
 /* umbra_material.tex.x: bit (1 << UMBRA_TEX_*) per texture the material samples; the same
  * bits, ORed over a scene, make UMBRA_SC_TEXTURES, plus this one for vertex colours. */
 #define UMBRA_TEXBIT_VERTEX_COLOR    (1u << UMBRA_TEX_SLOTS)
+/* ... and this one when a textured slot of a drawn material reads the second uv set (the
+ * scene then has a uv1 vertex buffer; without it the shaders never read location UV1). */
+#define UMBRA_TEXBIT_UV1             (1u << (UMBRA_TEX_SLOTS + 1))
+/* umbra_material.tex.x, bit (1 << (UMBRA_TEX_UV1_SHIFT + UMBRA_TEX_*)): that slot samples
+ * the second uv set (glTF TEXCOORD_1) instead of the first. */
+#define UMBRA_TEX_UV1_SHIFT          8
+/* Vertex input: binding 0 the interleaved vertices (locations 0..4: position, normal, uv,
+ * colour, tangent), binding 1 the second uv set, a float2 per vertex at this location (the
+ * vertices' own buffer bound there when the scene has no second uv set: never read then). */
+#define UMBRA_LOCATION_UV1           5
+#define UMBRA_VERTEX_BINDING_UV1     1
 /* umbra_material.tex.y: alpha mode */
 #define UMBRA_ALPHA_OPAQUE 0u
 #define UMBRA_ALPHA_MASK   1u
@@ -130,7 +141,7 @@
 #define UMBRA_SC_CATCHER     4
 #define UMBRA_SC_LIGHT_TYPES 5
 #define UMBRA_SC_CASCADES    6
-#define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR */
+#define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR | UMBRA_TEXBIT_UV1 */
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
 #define UMBRA_SC_PCF_RADIUS  10   /* 2 when every PCF-filtered light has the default radius 1; 0: read per light */
@@ -176,7 +187,8 @@ struct umbra_material {
 	U_VEC4 base_color;       /* linear rgba */
 	U_VEC4 emissive;         /* rgb (x KHR_materials_emissive_strength), a roughness */
 	U_VEC4 params;           /* x metallic, y alpha cutoff, z normal scale, w occlusion strength */
-	U_UVEC4 tex;             /* x texture bits (1 << UMBRA_TEX_*), y UMBRA_ALPHA_* */
+	U_UVEC4 tex;             /* x texture bits (1 << UMBRA_TEX_*) and uv-set-1 bits
+	                            (1 << (UMBRA_TEX_UV1_SHIFT + UMBRA_TEX_*)), y UMBRA_ALPHA_* */
 	/* per texture slot, the uv transform (KHR_texture_transform) as two rows:
 	 * uv' = (dot(uvx[2s].xy, uv) + uvx[2s].z, dot(uvx[2s+1].xy, uv) + uvx[2s+1].z) */
 	U_VEC4 uvx[2 * UMBRA_TEX_SLOTS];

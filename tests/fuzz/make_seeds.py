@@ -94,17 +94,22 @@ put("fuzz_model_glb", "quantized.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + 
     struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(qbuf)) + b"BIN\0" + qbuf)
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
-    return b"UMBRAIMP" + struct.pack("<IIII", 2, kind, status, len(msg)) + msg
+    return b"UMBRAIMP" + struct.pack("<IIII", 4, kind, status, len(msg)) + msg
 tex = struct.pack("<II", 2, 1) + bytes([255, 0, 0, 255, 0, 255, 0, 255])
 # material: 13 floats, alpha mode, a texture per slot (base, metal-rough, normal, occlusion,
-# emissive), per slot the sampling (packed modes + a 2x3 uv transform)
+# emissive), per slot the sampling (packed modes + a 2x3 uv transform; bit 9: the second uv
+# set, here on the occlusion slot)
 mat = struct.pack("<13f", 1, 1, 1, 1, 0.5, 0, 1, 1, 1, 0.5, 1, 1, 0) + struct.pack("<I5i", 2, 0, -1, 0, -1, 0) + \
-      b"".join(struct.pack("<I6f", 0x45, 1, 0, 0.5, 0, 1, 0) for _ in range(5))
-# mesh: normals, uvs, colours, tangents, single-sided
-mesh = struct.pack("<4I", 3, 3, 0, 31) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0, 0, 1, 0, 0, 1) + \
+      b"".join(struct.pack("<I6f", 0x45 | (0x200 if s == 3 else 0), 1, 0, 0.5, 0, 1, 0) for s in range(5))
+# mesh: normals, uvs, colours, tangents, single-sided, a second uv set (flag 128, after the uvs)
+mesh = struct.pack("<4I", 3, 3, 0, 31 | 128) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + \
+       struct.pack("<6f", 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0.5, 0.5, 1, 0.5, 0.5, 1) + \
        bytes([255, 0, 0, 255] * 3) + struct.pack("<12f", 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, -1) + struct.pack("<3I", 0, 1, 2)
 inst = struct.pack("<I", 0) + struct.pack("<16f", 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1)
 warn = b"skins are not applied (drawn in the bind pose)"
-put("fuzz_import_reply", "model.bin", header(1, 0) + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn + tex + mat + mesh + inst)
+# the importer's stage times f32[4], texture_side texture_max, then the counts
+times = struct.pack("<4f", 1, 2, 0, 0) + struct.pack("<II", 0, 2)
+put("fuzz_import_reply", "model.bin", header(1, 0) + times + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn + tex + mat + mesh +
+    inst)
 put("fuzz_import_reply", "image.bin", header(2, 0) + tex)
 put("fuzz_import_reply", "error.bin", header(1, 1, b"PLY: bad header"))

@@ -2,8 +2,9 @@
  * quad, its material and textures given as JSON text), rendered through api_scene_parse and
  * the renderer, and their pixels compared with the material maths done here: emissive texture
  * and strength, COLOR_0, metallic-roughness texture, normal map (file and generated tangents,
- * scale), sampler wrap modes, KHR_texture_transform, doubleSided culling, alpha BLEND coverage
- * and shadow. Camera straight down (orthographic), light straight down: N·V = N·L = 1 on the
+ * scale), sampler wrap modes, KHR_texture_transform, a second uv set (TEXCOORD_1, in the
+ * camera and the alpha-tested shadow passes), doubleSided culling, alpha BLEND coverage and
+ * shadow. Camera straight down (orthographic), light straight down: N·V = N·L = 1 on the
  * flat quad, so Lambert + GGX reduce to numbers written out in each test. */
 #include <math.h>
 #include <stdio.h>
@@ -33,6 +34,8 @@ struct mglb {
 	const float *color;          /* COLOR_0 RGBA float per vertex, or NULL */
 	const float *tangent;        /* TANGENT xyzw per vertex, or NULL */
 	const char *output;          /* the scene's output members, or NULL: no tone map, no MSAA */
+	const float *uv0;            /* TEXCOORD_0 uv per vertex instead of the one above, or NULL */
+	const float *uv1;            /* TEXCOORD_1 uv per vertex, or NULL: none */
 };
 
 static uint8_t *glb_of(const struct mglb *in, size_t *len)
@@ -44,7 +47,8 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 		uv[2 * v] = (pos[3 * v] + 1) / 2 * us;
 		uv[2 * v + 1] = (pos[3 * v + 2] + 1) / 2;
 	}
-	/* bin: pos 48, nrm 48, uv 32, [color 64], [tangent 64], idx 24, pngs (4-aligned) */
+	if (in->uv0) memcpy(uv, in->uv0, sizeof uv);
+	/* bin: pos 48, nrm 48, uv 32, [color 64], [tangent 64], [uv1 32], idx 24, pngs (4-aligned) */
 	size_t off[16], n = 0, k = 0;
 	const void *src[16];
 	size_t sz[16];
@@ -53,6 +57,7 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 	src[k] = uv; sz[k++] = 32;
 	if (in->color) { src[k] = in->color; sz[k++] = 64; }
 	if (in->tangent) { src[k] = in->tangent; sz[k++] = 64; }
+	if (in->uv1) { src[k] = in->uv1; sz[k++] = 32; }
 	src[k] = QIDX; sz[k++] = 24;
 	for (int i = 0; i < in->npng; i++) { src[k] = in->png[i]; sz[k++] = in->png_len[i]; }
 	for (size_t i = 0; i < k; i++) { off[i] = n; n += (sz[i] + 3) & ~(size_t)3; }
@@ -76,6 +81,11 @@ static uint8_t *glb_of(const struct mglb *in, size_t *len)
 		al += snprintf(accs + al, sizeof accs - (size_t)al,
 		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"}", view++);
 		tl += snprintf(attrs + tl, sizeof attrs - (size_t)tl, ",\"TANGENT\":%d", acc++);
+	}
+	if (in->uv1) {
+		al += snprintf(accs + al, sizeof accs - (size_t)al,
+		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"}", view++);
+		tl += snprintf(attrs + tl, sizeof attrs - (size_t)tl, ",\"TEXCOORD_1\":%d", acc++);
 	}
 	al += snprintf(accs + al, sizeof accs - (size_t)al,
 	               ",{\"bufferView\":%d,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}", view++);
@@ -480,6 +490,55 @@ TEST(materials_texture_transform_offset_and_scale)
 	}
 }
 
+/* ---- a second uv set (TEXCOORD_1) ---- */
+
+/* A 2x2 texture (red green / blue white, nearest, clamped) on a quad whose TEXCOORD_0 puts
+ * every vertex on the red texel and whose TEXCOORD_1 spans the whole texture. A slot that
+ * reads set 1 (textureInfo.texCoord, or KHR_texture_transform's texCoord over it) shows the
+ * four texels in the four quarters; set 0 shows red everywhere, and so does set 1 on a quad
+ * without TEXCOORD_1 (drawn with TEXCOORD_0). Base colour (light straight down: a white
+ * Lambert surface gives the texel) and emissive (no light). */
+TEST(materials_second_uv_set)
+{
+	static const uint8_t tex[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+	static const float uv0[8] = {0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
+	static const float uv1[8] = {0, 0, 1, 0, 1, 1, 0, 1};   /* u = (x + 1) / 2, v = (z + 1) / 2 */
+	static const char *const mats[5] = {
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1},\"metallicFactor\":0,"
+		"\"roughnessFactor\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":"
+		"{\"texCoord\":1}}},\"metallicFactor\":0,\"roughnessFactor\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0},\"emissiveFactor\":[1,1,1],"
+		"\"emissiveTexture\":{\"index\":0,\"texCoord\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0,\"roughnessFactor\":1}}",
+		"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1},\"metallicFactor\":0,"
+		"\"roughnessFactor\":1}}",
+	};
+	static const char *const what[5] = {"base texCoord 1", "base KHR_texture_transform texCoord 1",
+	                                    "emissive texCoord 1", "base texCoord 0", "base texCoord 1, no TEXCOORD_1"};
+	static const double qx[4] = {-0.5, 0.5, -0.5, 0.5}, qz[4] = {-0.5, -0.5, 0.5, 0.5};
+	for (int m = 0; m < 5; m++) {
+		struct mglb g = {.material = mats[m], .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+		                 .uv0 = uv0, .uv1 = m == 4 ? NULL : uv1,
+		                 .extensions_used = m == 1 ? "[\"KHR_texture_transform\"]" : NULL};
+		add_png(&g, tex, 2, 2);
+		struct rnd_image img;
+		bool ok = render_quad(__LINE__, &img, &g, m != 2, false);
+		free_pngs(&g);
+		if (!ok) return;
+		for (int q = 0; q < 4; q++) {
+			const uint8_t *t = m >= 3 ? tex : tex + 4 * q;   /* set 0: the red texel everywhere */
+			double got[3];
+			for (int c = 0; c < 3; c++) got[c] = lin_at(&img, false, qx[q], qz[q], c);
+			printf("    %s, quarter %d: %.3f %.3f %.3f\n", what[m], q, got[0], got[1], got[2]);
+			for (int c = 0; c < 3; c++)
+				CHECK(fabs(got[c] - t[c] / 255.0) < 0.05, "%s: quarter %d channel %d is %.3f, want %.3f", what[m], q, c,
+				      got[c], t[c] / 255.0);
+		}
+		rnd_image_release(&img);
+	}
+}
+
 /* ---- doubleSided ---- */
 
 /* Seen from below (its back), the quad is hidden when doubleSided is false (glTF's default)
@@ -510,11 +569,10 @@ TEST(materials_single_sided_hides_back_face)
 /* A red quad at y = 1 (alpha 0.5 BLEND, or OPAQUE) over a blue ground, sun along (0.8, -1, 0):
  * its shadow is the quad moved 0.8 along +x. Seen from above (orthographic), the quad itself
  * covers about half its pixels (dithered) and its shadow takes about half the light. */
-static bool material_render(int line, struct rnd_image *img, const char *material, const char *extensions_used)
+static bool quad_over_ground(int line, struct rnd_image *img, const struct mglb *g)
 {
-	struct mglb g = {.material = material, .extensions_used = extensions_used, .y = 1};
 	size_t n;
-	uint8_t *glb = glb_of(&g, &n);
+	uint8_t *glb = glb_of(g, &n);
 	char *enc = test_b64(glb, n);
 	free(glb);
 	bool ok = gpu_render_at(__FILE__, line, img,
@@ -529,6 +587,12 @@ static bool material_render(int line, struct rnd_image *img, const char *materia
 	                        BW, BH, enc);
 	free(enc);
 	return ok;
+}
+
+static bool material_render(int line, struct rnd_image *img, const char *material, const char *extensions_used)
+{
+	struct mglb g = {.material = material, .extensions_used = extensions_used, .y = 1};
+	return quad_over_ground(line, img, &g);
 }
 
 static bool blend_render(int line, struct rnd_image *img, bool blend)
@@ -579,6 +643,42 @@ TEST(materials_blend_dithered_half_coverage_half_shadow)
 	rnd_image_release(&op);
 	rnd_image_release(&bl);
 	rnd_image_release(&bl2);
+}
+
+/* alphaMode MASK with the base colour's alpha on TEXCOORD_1: a 2x1 texture, opaque | clear
+ * (red), TEXCOORD_0 on the opaque texel everywhere, TEXCOORD_1 across (u = (x + 1) / 2). On
+ * set 1 the quad's right half is cut in the camera pass (the blue ground shows) and in the
+ * shadow pass (its shadow, x in [1.1, 1.7], is lit); on set 0 both are whole. */
+TEST(materials_mask_alpha_on_the_second_uv_set)
+{
+	static const uint8_t tex[8] = {255, 0, 0, 255, 255, 0, 0, 0};
+	static const float uv0[8] = {0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f};
+	static const float uv1[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+	for (int set = 0; set < 2; set++) {
+		char mat[300];
+		snprintf(mat, sizeof mat, "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":%d},"
+		         "\"metallicFactor\":0,\"roughnessFactor\":1},\"alphaMode\":\"MASK\"}", set);
+		struct mglb g = {.material = mat, .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+		                 .uv0 = uv0, .uv1 = uv1, .y = 1};
+		add_png(&g, tex, 2, 1);
+		struct rnd_image img;
+		bool ok = quad_over_ground(__LINE__, &img, &g);
+		free_pngs(&g);
+		if (!ok) return;
+		double left = mean_rect(&img, -0.8, -0.2, -0.6, 0.6, 1, 0), right = mean_rect(&img, 0.2, 0.8, -0.6, 0.6, 1, 0);
+		double lit = mean_rect(&img, 2.0, 2.35, -0.6, 0.6, 0, 2), shadow = mean_rect(&img, 1.1, 1.7, -0.6, 0.6, 0, 2);
+		printf("    texCoord %d: red left %.3f right %.3f; ground lit %.3f, under the right half %.3f\n", set, left,
+		       right, lit, shadow);
+		CHECK(left > 0.5, "texCoord %d: the left half is drawn (red %.3f)", set, left);
+		if (set == 1) {
+			CHECK(right < 0.05 && shadow > 0.9 * lit, "texCoord 1: right half red %.3f, its shadow %.3f of %.3f lit",
+			      right, shadow, lit);
+		} else {
+			CHECK(right > 0.5 && shadow < 0.1 * lit, "texCoord 0: right half red %.3f, its shadow %.3f of %.3f lit",
+			      right, shadow, lit);
+		}
+		rnd_image_release(&img);
+	}
 }
 
 /* KHR_materials_transmission 1 on an opaque red quad: drawn as coverage 0.2 (dithered) that

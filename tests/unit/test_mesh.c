@@ -162,6 +162,37 @@ TEST(mesh_counts_mesh_variants)
 	CHECK(rnd_object_triangle_count(&o) == 1, "1 triangle");
 }
 
+/* The second uv set follows the vertices rnd_mesh_write wrote: as given (indexed, with
+ * normals), one per corner (indexed without normals), and each vertex's own uv where the
+ * object has no uvs1 (so a slot on set 1 reads set 0). */
+TEST(mesh_uv1_follows_the_written_vertices)
+{
+	float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+	float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1}, uv1[8] = {10, 11, 12, 13, 14, 15, 16, 17};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	struct rnd_object o = shape(RND_SHAPE_MESH);
+	o.positions = pos; o.vertex_count = 4; o.indices = idx; o.index_count = 6; o.uvs = uv; o.uvs1 = uv1;
+	for (int variant = 0; variant < 3; variant++) {
+		o.normals = variant == 1 ? NULL : nrm;
+		o.uvs1 = variant == 2 ? NULL : uv1;
+		struct tess t;
+		tess_run(&t, &o, 0);
+		REQUIRE(t.r == RND_OK, "%s", t.err.msg);
+		float *out = calloc(2 * (size_t)t.vc, sizeof *out);
+		REQUIRE(out);
+		rnd_mesh_write_uv1(&o, t.v, t.vc, out);
+		int wrong = 0;
+		for (uint32_t k = 0; k < t.vc; k++) {
+			uint32_t src = variant == 1 ? idx[k] : k;
+			const float *want = variant == 2 ? t.v[k].uv : uv1 + 2 * src;
+			wrong += out[2 * k] != want[0] || out[2 * k + 1] != want[1];
+		}
+		CHECK(t.vc == (variant == 1 ? 6u : 4u) && wrong == 0, "variant %d: %u vertices, %d wrong", variant, t.vc, wrong);
+		free(out);
+		tess_free(&t);
+	}
+}
+
 TEST(mesh_sphere_vertices_on_surface)
 {
 	static const uint32_t segs[] = {3, 8, 33, 64};

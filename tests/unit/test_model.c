@@ -646,9 +646,9 @@ TEST(model_cache_threads)
 }
 
 /* What of a file's material the renderer does not do is listed, never dropped silently: an
- * unknown extension and a texture on a second uv set come back as the scene's warnings (the
- * Umbra-Warnings header), each under the pointer of the object that brought them; a file
- * without such things has none. */
+ * unknown extension, a texture on a second uv set the mesh lacks and one on a third set come
+ * back as the scene's warnings (the Umbra-Warnings header), each under the pointer of the
+ * object that brought them; a file without such things has none. */
 TEST(model_glb_unsupported_material_data_warned)
 {
 	size_t n;
@@ -659,8 +659,18 @@ TEST(model_glb_unsupported_material_data_warned)
 	free(glb);
 	REQUIRE(s, "parse failed: %d %s: %s", p.status, p.pointer, p.detail);
 	const char *w = s->warnings;
-	CHECK(!strncmp(w, "/objects/0: ", 12) && strstr(w, "KHR_materials_clearcoat") && strstr(w, "TEXCOORD_1"),
+	CHECK(!strncmp(w, "/objects/0: ", 12) && strstr(w, "KHR_materials_clearcoat") &&
+	      strstr(w, "baseColorTexture reads TEXCOORD_1, which the mesh lacks: drawn with TEXCOORD_0"),
 	      "warnings: %s", w[0] ? w : "(none)");
+	api_scene_free(s);
+	/* a third uv set: the renderer has two */
+	glb = quad_glb_ex(",\"texCoord\":2", "", &n);
+	REQUIRE(glb);
+	s = parse_model(glb, n, "", &p);
+	free(glb);
+	REQUIRE(s, "parse failed: %d %s: %s", p.status, p.pointer, p.detail);
+	CHECK(strstr(s->warnings, "baseColorTexture reads TEXCOORD_2, drawn with TEXCOORD_0"), "warnings: %s",
+	      s->warnings[0] ? s->warnings : "(none)");
 	api_scene_free(s);
 	glb = quad_glb(&n);
 	REQUIRE(glb);

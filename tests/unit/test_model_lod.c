@@ -172,6 +172,42 @@ TEST(model_lod_error_ignores_a_part_close_by)
 	free(pos); free(nrm); free(idx); free(pos2); free(nrm2); free(idx2); free(p); free(n); free(x);
 }
 
+/* Both uv sets travel into the levels: each level vertex has the uvs of a full-mesh vertex at
+ * its position (here uv = (x, y), uv1 = (z, x + y): a function of the position, so exact). */
+TEST(model_lod_levels_carry_both_uv_sets)
+{
+	float *pos, *nrm;
+	uint32_t *idx, nv, ni;
+	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni);
+	float *uv = malloc(nv * 8), *uv1 = malloc(nv * 8);
+	REQUIRE(uv && uv1);
+	for (uint32_t v = 0; v < nv; v++) {
+		uv[2 * v] = pos[3 * v];
+		uv[2 * v + 1] = pos[3 * v + 1];
+		uv1[2 * v] = pos[3 * v + 2];
+		uv1[2 * v + 1] = pos[3 * v] + pos[3 * v + 1];
+	}
+	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .uvs1 = uv1, .indices = idx,
+	                            .vertex_count = nv, .index_count = ni};
+	CHECK(api_mesh_wants_levels(&me));
+	size_t bytes;
+	struct rnd_mesh_lod keep[4];
+	struct api_arena *a = build_levels(&me, keep, &bytes);
+	REQUIRE(me.lod_count >= 1, "levels: %u", me.lod_count);
+	for (uint32_t l = 0; l < me.lod_count; l++) {
+		const struct rnd_mesh_lod *lv = &me.lods[l];
+		REQUIRE(lv->uvs && lv->uvs1, "level %u has uvs %p, uvs1 %p", l + 1, (void *)lv->uvs, (void *)lv->uvs1);
+		uint32_t wrong = 0;
+		for (uint32_t v = 0; v < lv->vertex_count; v++) {
+			const float *p = lv->positions + 3 * v, *t = lv->uvs + 2 * v, *t1 = lv->uvs1 + 2 * v;
+			wrong += t[0] != p[0] || t[1] != p[1] || t1[0] != p[2] || t1[1] != p[0] + p[1];
+		}
+		CHECK(wrong == 0, "level %u: %u of %u vertices with other uvs", l + 1, wrong, lv->vertex_count);
+	}
+	api_arena_destroy(a);
+	free(pos); free(nrm); free(idx); free(uv); free(uv1);
+}
+
 TEST(model_lod_small_meshes_get_no_levels)
 {
 	float *pos, *nrm;

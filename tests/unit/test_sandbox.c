@@ -360,6 +360,63 @@ TEST(sandbox_reply_decoder_refuses_malformed)
 	api_wire_buf_release(&b);
 }
 
+/* The second uv set (glTF TEXCOORD_1), in a mesh and in its level, and a slot's choice of it
+ * cross the wire as they were; every truncation of such a reply is refused, and so is a uv1
+ * that is not finite. */
+TEST(sandbox_reply_second_uv_set_round_trip)
+{
+	static uint8_t px[2 * 2 * 4] = {255, 0, 0, 255};
+	static struct rnd_texture tex = {px, 2, 2};
+	float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, uv[8] = {0};
+	float uv1[8] = {0.25f, 0.5f, 1, 0.5f, 0.25f, 1, 0, 0}, lv_uv1[6] = {0.5f, 0.75f, 1, 0, 0, 1};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	struct rnd_mesh_lod level = {pos, nrm, uv, idx, 3, 3, 0.5f, lv_uv1};
+	struct rnd_material mat;
+	rnd_material_defaults(&mat);
+	mat.base_color_texture = mat.occlusion_texture = &tex;
+	mat.sampling[RND_TEX_OCCLUSION].uv_set = 1;
+	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .uvs = uv, .uvs1 = uv1, .indices = idx,
+	                              .vertex_count = 4, .index_count = 6, .material = 0, .lods = &level, .lod_count = 1};
+	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
+	                      .materials = &mat, .material_count = 1};
+	for (int nan = 0; nan < 2; nan++) {
+		uv1[3] = nan ? NAN : 0.5f;
+		struct api_wire_buf b = {0};
+		api_wire_put_header(&b, API_WIRE_MODEL, API_WIRE_OK, NULL);
+		api_wire_put_model(&b, &m);
+		REQUIRE(!b.failed);
+		enum api_wire_kind k;
+		enum api_wire_status st;
+		const uint8_t *body;
+		size_t blen, bytes;
+		char err[300];
+		REQUIRE(api_wire_header(b.data, b.len, &k, &st, NULL, 0, &body, &blen, err, sizeof err) == API_OK, "%s", err);
+		struct api_arena *a = api_arena_create();
+		struct api_model out;
+		enum api_result rc = api_wire_decode_model(body, blen, a, 1u << 20, &out, &bytes, err, sizeof err);
+		if (nan) {
+			CHECK(rc == API_ERR && strstr(err, "finite"), "a NaN uv1: %d %s", rc, err);
+		} else {
+			REQUIRE(rc == API_OK, "%s", err);
+			CHECK(out.meshes[0].uvs1 && !memcmp(out.meshes[0].uvs1, uv1, sizeof uv1), "uvs1 changed on the wire");
+			CHECK(out.meshes[0].lod_count == 1 && out.meshes[0].lods[0].uvs1 &&
+			      !memcmp(out.meshes[0].lods[0].uvs1, lv_uv1, sizeof lv_uv1), "the level's uvs1 changed on the wire");
+			CHECK(out.materials[0].sampling[RND_TEX_OCCLUSION].uv_set == 1 &&
+			      out.materials[0].sampling[RND_TEX_BASE].uv_set == 0, "uv sets %u %u",
+			      out.materials[0].sampling[RND_TEX_BASE].uv_set, out.materials[0].sampling[RND_TEX_OCCLUSION].uv_set);
+			int accepted = 0;
+			for (size_t cut = 0; cut < b.len; cut++) {
+				struct api_model part;
+				accepted += decode(b.data, cut, &part, err, sizeof err) == API_OK;
+			}
+			CHECK(accepted == 0, "%d truncations accepted", accepted);
+		}
+		api_arena_destroy(a);
+		api_wire_buf_release(&b);
+	}
+}
+
 /* A binary STL whose stored facet normal opposes its winding (common from some exporters):
  * the normal follows the winding (counter-clockwise seen from the front, as glTF and the
  * renderer's culling assume), so the model is not shaded from behind. */

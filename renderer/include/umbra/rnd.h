@@ -136,6 +136,9 @@ struct rnd_material {
 		uint8_t wrap_s, wrap_t;             /* enum rnd_wrap */
 		bool mag_nearest, min_nearest;
 		uint8_t mip;                        /* enum rnd_mip */
+		/* The uv set the slot samples: 0 the object's uvs, 1 its uvs1 (glTF texCoord 1;
+		 * an object without uvs1 draws it with uvs). */
+		uint8_t uv_set;
 		bool transformed;                   /* KHR_texture_transform: uv' = M (u, v, 1) */
 		float transform[6];                 /* rows of M: (m00 m01 m02), (m10 m11 m12) */
 	} sampling[RND_TEX_SLOTS];
@@ -149,6 +152,8 @@ struct rnd_mesh_lod {
 	const uint32_t *indices;
 	uint32_t vertex_count, index_count;
 	float error;          /* largest deviation from the full mesh, object-space units */
+	const float *uvs1;    /* the second uv set, where the mesh has one (a level without it is
+	                         not used for an object with uvs1) */
 };
 
 struct rnd_object {
@@ -165,6 +170,9 @@ struct rnd_object {
 	uint32_t index_count;
 	const float *normals;
 	const float *uvs;
+	/* optional second uv set (glTF TEXCOORD_1), uv per vertex, for the material slots whose
+	 * sampling says uv_set 1; NULL: those slots read uvs. Its lods need their uvs1 too. */
+	const float *uvs1;
 	const uint8_t *colors;  /* optional linear RGBA8 per vertex (glTF COLOR_0): multiplies base colour */
 	const float *tangents;  /* optional xyzw per vertex (w = bitangent sign), for normal maps */
 	const struct rnd_mesh_lod *lods; uint32_t lod_count; /* mesh: coarser levels, finest first, or none */
