@@ -11,8 +11,8 @@ its .bin, so the files a model refers to travel as parts). Checked:
     --resume renders nothing, and a changed model (new hash) is rendered again;
   - --shard K/3: the three shards cover every input exactly once;
   - a bad scene is `invalid` with the same problem text (status, pointer, detail) as locally;
-  - one daemon SIGKILLed and one SIGTERMed while the farm runs: every input ok, one line each,
-    the local bytes;
+  - one daemon SIGKILLed (and restarted on its port) and one SIGTERMed while the farm runs:
+    every input ok, one line each, the local bytes;
   - against a fake server: 503 + Retry-After then 200 (retried), 502 (bounded retries then
     failed), 400 (invalid, sent once), X-Umbra-Affinity = the report's hash.
 Faults are driven by the farm's progress lines, never by time. Prints "ok - x" / "FAIL - x" and
@@ -316,12 +316,32 @@ def invalid_same_as_local(c, tmp):
 
 
 def daemons_die(c, tmp, inputs, ref):
+    restarted = []
+
+    def restart_killed():
+        c.daemons[0].wait(30)
+        try:
+            c.restart(0)
+            restarted.append(True)
+        except Exception as e:  # reported by the check below
+            restarted.append(e)
+
     def faults(n):
         if n == 6:
             c.kill(0, signal.SIGKILL)
+            # Restarted on its port while the farm goes on (off the line reader: its warm-up
+            # takes seconds); whether it serves any of this farm's renders is not asserted.
+            t = threading.Thread(target=restart_killed, daemon=True)
+            t.start()
+            restarter.append(t)
         elif n == 12:
             c.kill(1, signal.SIGTERM)
+    restarter = []
     code, err, lines = farm(inputs, os.path.join(tmp, "faults"), "--server", c.url, "-j", "4", on_line=faults)
+    for t in restarter:
+        t.join(300)
+    ok("the SIGKILLed daemon restarts on its port and is UP again",
+       restarted == [True] and c.wait_status({c.daemons[0].name: "UP"}, 60), restarted)
     files = [l["file"] for l in lines]
     ok("a daemon SIGKILLed and one SIGTERMed mid-run: every input ok (exit 0)", code == 0 and
        all(l["status"] == "ok" for l in lines), (code, [l for l in lines if l["status"] != "ok"][:3], err[-400:]))
