@@ -60,6 +60,18 @@ static size_t index_order_remap(const int32_t *keys, uint32_t nv, const uint32_t
 	return count;
 }
 
+/* The box of n points (lo, hi; empty: +inf, -inf) and its largest side. */
+static float points_box(const float *p, size_t n, float lo[3], float hi[3])
+{
+	for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
+	for (size_t v = 0; v < n; v++)
+		for (int k = 0; k < 3; k++) {
+			lo[k] = fminf(lo[k], p[3 * v + k]);
+			hi[k] = fmaxf(hi[k], p[3 * v + k]);
+		}
+	return fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+}
+
 static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *w)
 {
 	unsigned int *remap = malloc((size_t)me->vertex_count * sizeof *remap);
@@ -67,11 +79,7 @@ static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *
 	if (!remap || !q) { free(remap); free(q); return false; }
 	/* Positions equal to 2^-20 of the extent are one: a seam written with sin(2 pi) != 0 is
 	 * closed (otherwise it is a border the simplifier must keep, with long slivers along it). */
-	float lo[3] = {INFINITY, INFINITY, INFINITY}, ext = 0.0f;
-	for (uint32_t v = 0; v < me->vertex_count; v++)
-		for (int k = 0; k < 3; k++) lo[k] = fminf(lo[k], me->positions[3 * (size_t)v + (size_t)k]);
-	for (uint32_t v = 0; v < me->vertex_count; v++)
-		for (int k = 0; k < 3; k++) ext = fmaxf(ext, me->positions[3 * (size_t)v + (size_t)k] - lo[k]);
+	float lo[3], hi[3], ext = points_box(me->positions, me->vertex_count, lo, hi);
 	float unit = ext > 0.0f ? ext / 1048576.0f : 1.0f;
 	for (uint32_t v = 0; v < me->vertex_count; v++)
 		for (int k = 0; k < 3; k++)
@@ -121,16 +129,10 @@ static uint32_t cell_of(const struct grid *g, const float p[3], int k)
 	return i >= g->dim[k] ? g->dim[k] - 1 : i;
 }
 
-static bool grid_build(struct grid *g, const struct welded *w)
+/* The grid over w's points, whose box is lo..hi of largest side ext (points_box). */
+static bool grid_build(struct grid *g, const struct welded *w, const float lo[3], const float hi[3], float ext)
 {
-	float hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	for (int k = 0; k < 3; k++) g->lo[k] = INFINITY;
-	for (size_t v = 0; v < w->count; v++)
-		for (int k = 0; k < 3; k++) {
-			g->lo[k] = fminf(g->lo[k], w->pos[3 * v + k]);
-			hi[k] = fmaxf(hi[k], w->pos[3 * v + k]);
-		}
-	float ext = fmaxf(fmaxf(hi[0] - g->lo[0], hi[1] - g->lo[1]), hi[2] - g->lo[2]);
+	memcpy(g->lo, lo, sizeof g->lo);
 	/* about two vertices per cell of a surface: cells of extent / sqrt(count / 2); but at most
 	 * 8 cells a vertex in all (a surface fills few of a volume's cells: for a 1M-triangle mesh
 	 * the rule alone made 125M cells, half a gigabyte to clear, 12 % of its import) */
@@ -428,38 +430,39 @@ static bool corner_normals(const struct api_model_mesh *me, const struct welded 
 static bool write_level(struct api_arena *arena, const struct api_model_mesh *me, const struct welded *w,
                         const uint32_t *idx, size_t ni, struct rnd_mesh_lod *out, size_t *bytes)
 {
-	float *cp = malloc(ni * 12), *cn = malloc(ni * 12), *cu = me->uvs ? malloc(ni * 8) : NULL;
-	float *cu1 = me->uvs1 ? malloc(ni * 8) : NULL;
+	const float *src[2] = {me->uvs, me->uvs1};
+	float *cp = malloc(ni * 12), *cn = malloc(ni * 12), *cu[2] = {NULL, NULL}, *uv[2] = {NULL, NULL};
 	unsigned int *remap = malloc(ni * sizeof *remap);
-	bool ok = false;
-	if (!cp || !cn || (me->uvs && !cu) || (me->uvs1 && !cu1) || !remap || !corner_normals(me, w, idx, ni, cn)) goto done;
-	for (size_t i = 0; i < ni; i++) {
-		memcpy(cp + 3 * i, w->pos + 3 * (size_t)idx[i], 12);
-		if (cu) memcpy(cu + 2 * i, me->uvs + 2 * (size_t)w->rep[idx[i]], 8);
-		if (cu1) memcpy(cu1 + 2 * i, me->uvs1 + 2 * (size_t)w->rep[idx[i]], 8);
-	}
+	bool ok = cp && cn && remap;
 	struct meshopt_Stream st[4] = {{cp, 12, 12}, {cn, 12, 12}};
 	size_t ns = 2;
-	if (cu) st[ns++] = (struct meshopt_Stream){cu, 8, 8};
-	if (cu1) st[ns++] = (struct meshopt_Stream){cu1, 8, 8};
+	for (int k = 0; k < 2; k++)
+		if (src[k] && (ok = ok && (cu[k] = malloc(ni * 8)))) st[ns++] = (struct meshopt_Stream){cu[k], 8, 8};
+	if (!ok || !corner_normals(me, w, idx, ni, cn)) goto done;
+	for (size_t i = 0; i < ni; i++) {
+		memcpy(cp + 3 * i, w->pos + 3 * (size_t)idx[i], 12);
+		for (int k = 0; k < 2; k++)
+			if (cu[k]) memcpy(cu[k] + 2 * i, src[k] + 2 * (size_t)w->rep[idx[i]], 8);
+	}
 	size_t nv = meshopt_generateVertexRemapMulti(remap, NULL, ni, ni, st, ns);
 	float *pos = api_arena_alloc(arena, nv * 12), *nrm = api_arena_alloc(arena, nv * 12);
-	float *uv = cu ? api_arena_alloc(arena, nv * 8) : NULL, *uv1 = cu1 ? api_arena_alloc(arena, nv * 8) : NULL;
 	uint32_t *ix = api_arena_alloc(arena, ni * 4);
-	if (!pos || !nrm || (cu && !uv) || (cu1 && !uv1) || !ix) goto done;
+	ok = pos && nrm && ix;
+	for (int k = 0; k < 2; k++)
+		if (cu[k]) ok = ok && (uv[k] = api_arena_alloc(arena, nv * 8));
+	if (!ok) goto done;
 	meshopt_remapVertexBuffer(pos, cp, ni, 12, remap);
 	meshopt_remapVertexBuffer(nrm, cn, ni, 12, remap);
-	if (cu) meshopt_remapVertexBuffer(uv, cu, ni, 8, remap);
-	if (cu1) meshopt_remapVertexBuffer(uv1, cu1, ni, 8, remap);
+	for (int k = 0; k < 2; k++)
+		if (cu[k]) meshopt_remapVertexBuffer(uv[k], cu[k], ni, 8, remap);
 	meshopt_remapIndexBuffer(ix, NULL, ni, remap);
-	*out = (struct rnd_mesh_lod){pos, nrm, uv, ix, (uint32_t)nv, (uint32_t)ni, 0.0f, uv1};
-	*bytes += nv * (24 + (cu ? 8 : 0) + (cu1 ? 8 : 0)) + ni * 4;
-	ok = true;
+	*out = (struct rnd_mesh_lod){pos, nrm, uv[0], ix, (uint32_t)nv, (uint32_t)ni, 0.0f, uv[1]};
+	*bytes += nv * (24 + (cu[0] ? 8 : 0) + (cu[1] ? 8 : 0)) + ni * 4;
 done:
 	free(cp);
 	free(cn);
-	free(cu);
-	free(cu1);
+	free(cu[0]);
+	free(cu[1]);
 	free(remap);
 	return ok;
 }
@@ -483,15 +486,12 @@ static size_t drop_degenerate(const struct welded *w, uint32_t *idx, size_t ni)
 
 void api_mesh_bounds(struct api_model_mesh *me)
 {
-	float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-	for (uint32_t v = 0; v < me->vertex_count; v++) {
-		const float *p = me->positions + 3 * (size_t)v;
-		for (int k = 0; k < 3; k++) {
-			lo[k] = v == 0 || p[k] < lo[k] ? p[k] : lo[k];
-			hi[k] = v == 0 || p[k] > hi[k] ? p[k] : hi[k];
-		}
+	float lo[3], hi[3];
+	points_box(me->positions, me->vertex_count, lo, hi);
+	for (int k = 0; k < 3; k++) {
+		me->bounds[k] = me->vertex_count ? lo[k] : 0.0f;
+		me->bounds[3 + k] = me->vertex_count ? hi[k] : 0.0f;
 	}
-	for (int k = 0; k < 3; k++) { me->bounds[k] = lo[k]; me->bounds[3 + k] = hi[k]; }
 }
 
 /* Welds me by position into idx and w (the caller frees w's arrays); false when out of memory. */
@@ -507,18 +507,6 @@ static void welded_free(struct welded *w)
 	free(w->rep);
 }
 
-/* The largest side of w's bounds: what meshoptimizer's relative errors are relative to. */
-static float welded_extent(const struct welded *w)
-{
-	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	for (size_t v = 0; v < w->count; v++)
-		for (int k = 0; k < 3; k++) {
-			lo[k] = fminf(lo[k], w->pos[3 * v + k]);
-			hi[k] = fmaxf(hi[k], w->pos[3 * v + k]);
-		}
-	return fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-}
-
 /* One level of me (welded w, indices cur) within relative error `want` as measured
  * (level_error), simplified in one step from the full mesh: what the request that imports the
  * model can use, without the levels in between. meshoptimizer's target is its own figure, which
@@ -532,8 +520,11 @@ static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, co
 	struct grid g = {0};
 	struct walk k = {0};
 	size_t ni = me->index_count;
-	float extent = welded_extent(w), target = 0.25f * want;
-	if (!lod || !next || !(extent > 0.0f) || !grid_build(&g, w) || !walk_build(&k, w, cur, ni)) goto done;
+	/* The box of the welded mesh, once: the grid's, and the extent meshoptimizer's relative
+	 * errors are relative to. */
+	float lo[3], hi[3], extent = points_box(w->pos, w->count, lo, hi), target = 0.25f * want;
+	if (!lod || !next || !(extent > 0.0f) || !grid_build(&g, w, lo, hi, extent) || !walk_build(&k, w, cur, ni))
+		goto done;
 	for (int attempt = 0; attempt < 2; attempt++) {
 		size_t got = meshopt_simplify(next, cur, ni, w->pos, w->count, 12, 3, target, 0, NULL);
 		if (got < 3 || got * 4 > ni * 3) break;
