@@ -426,12 +426,47 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	return (enum api_wire_status)st;
 }
 
+/* Why Assimp read nothing (its error string; under import_mu), into err: the status. */
+static enum api_wire_status import_error(enum api_model_format format, char *err, size_t errsize)
+{
+	const char *msg = aiGetErrorString();
+	if (msg && strstr(msg, "contains no faces"))   /* ValidateDataStructure's "Mesh  contains no faces" */
+		api_err_set(err, errsize, "the %s file has a mesh with no faces (points or lines only): only surfaces are "
+		            "drawn, point clouds are not", FORMAT_NAMES[format]);
+	else api_err_set(err, errsize, "%s", msg && msg[0] ? msg : "Assimp could not read it");
+	/* Assimp turns std::bad_alloc into its error string. */
+	return msg && strstr(msg, "bad_alloc") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
+}
+
+/* Assimp's post-processing for a file of this format. */
+static unsigned import_flags(enum api_model_format format, bool face_colors)
+{
+	unsigned flags = aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
+	                 aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+	/* STL facet normals are often wrong (opposite the winding, or zero): flat normals from the
+	 * winding instead, as STL viewers shade them. Assimp's join of identical vertices compares
+	 * them by searching space (its documentation: senseless with GenNormals) and cost a
+	 * 1M-triangle STL ~1 s; convert_mesh joins the corners of coplanar facets by hashing
+	 * (join_vertices, 0.25 s), and model_lod.c welds by position where it needs to. */
+	if (format == API_MODEL_STL)
+		flags = (flags & ~(unsigned)(aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)) |
+		        aiProcess_DropNormals | aiProcess_GenNormals;
+	/* Assimp 5.2's join of identical vertices ignores their colours: the corners of a red and a
+	 * green face became one vertex. */
+	if (face_colors) flags &= ~(unsigned)aiProcess_JoinIdenticalVertices;
+	/* Normal maps need tangents: the file's, or made from the uvs where it has none. */
+	if (format == API_MODEL_GLB || format == API_MODEL_GLTF) flags |= aiProcess_CalcTangentSpace;
+	return flags;
+}
+
 /* A glTF document made readable for Assimp 5.2 (api/gltf_decode.h, api/gltf_instancing.h) and
  * its materials tagged (api/gltf_material.h): *tagged the bytes to import (NULL: the file as
- * it is), b the buffers with what was made. 0, or -1 with err. */
+ * it is), b the buffers with what was made, *io_files the files Assimp is served (the
+ * made buffer's among them). 0, or -1 with err. */
 static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb, const struct api_model_file *files,
                         size_t nfiles, struct api_conv *c, struct api_gltf_bufs *b, uint8_t **tagged,
-                        size_t *tagged_len, char *err, size_t errsize)
+                        size_t *tagged_len, const struct api_model_file **io_files, size_t *io_nfiles, char *err,
+                        size_t errsize)
 {
 	api_gltf_bufs_init(b, root, data, len, glb, files, nfiles);
 	int dec = api_gltf_decode(b, err, errsize);
@@ -444,7 +479,8 @@ static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb,
 	/* Materials renamed to their glTF index, to find them again (see gltf_material.h); the
 	 * document handed to Assimp also when it was changed here. */
 	*tagged = api_gltf_tag_materials(root, data, len, glb, changed, tagged_len);
-	if (!*tagged && changed) return api_err_set(err, errsize, "out of memory"), -1;
+	if ((!*tagged && changed) || api_gltf_bufs_files(b, io_files, io_nfiles) != 0)
+		return api_err_set(err, errsize, "out of memory"), -1;
 	return 0;
 }
 
@@ -471,11 +507,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	if (gltf) {
 		size_t tagged_len = 0;
 		int rc = prepare_gltf(root, data, len, format == API_MODEL_GLB, files, nfiles, &c, &bufs, &tagged, &tagged_len,
-		                      err, errsize);
-		if (rc == 0 && api_gltf_bufs_files(&bufs, &io_files, &io_nfiles) != 0) {
-			api_err_set(err, errsize, "out of memory");
-			rc = -1;
-		}
+		                      &io_files, &io_nfiles, err, errsize);
 		json_decref(root);
 		if (rc != 0) {
 			free(tagged);
@@ -487,9 +519,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 			data = tagged;
 			len = tagged_len;
 		}
-		root = NULL;
 	}
-	json_decref(root);
 	size_t strips_len = 0;
 	uint8_t *strips = NULL;
 	bool face_colors = false;
@@ -507,36 +537,14 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	/* Points and lines are dropped by SortByPType: only triangles reach us. */
 	aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
 	aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
-	unsigned flags = aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
-	                 aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-	/* STL facet normals are often wrong (opposite the winding, or zero): flat normals from the
-	 * winding instead, as STL viewers shade them. Assimp's join of identical vertices compares
-	 * them by searching space (its documentation: senseless with GenNormals) and cost a
-	 * 1M-triangle STL ~1 s; convert_mesh joins the corners of coplanar facets by hashing
-	 * (join_vertices, 0.25 s), and model_lod.c welds by position where it needs to. */
-	if (format == API_MODEL_STL)
-		flags = (flags & ~(unsigned)(aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices)) |
-		        aiProcess_DropNormals | aiProcess_GenNormals;
-	/* Assimp 5.2's join of identical vertices ignores their colours: the corners of a red and a
-	 * green face became one vertex. convert_mesh joins them by position, normal and colour. */
-	if (face_colors) {
-		flags &= ~(unsigned)aiProcess_JoinIdenticalVertices;
-		c.join = true;
-	}
-	/* Normal maps need tangents: the file's, or made from the uvs where it has none. */
-	if (gltf) flags |= aiProcess_CalcTangentSpace;
+	unsigned flags = import_flags(format, face_colors);
+	/* Assimp 5.2's join of identical vertices ignores their colours (import_flags leaves it
+	 * out): convert_mesh joins them by position, normal and colour. */
+	if (face_colors) c.join = true;
 	enum api_wire_status st = API_WIRE_OK;
-	pthread_mutex_lock(&import_mu);
+	pthread_mutex_lock(&import_mu);   /* Assimp's error string is global: read under the lock */
 	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, flags, &io, props);
-	if (!sc) {
-		const char *msg = aiGetErrorString();
-		if (msg && strstr(msg, "contains no faces"))   /* ValidateDataStructure's "Mesh  contains no faces" */
-			api_err_set(err, errsize, "the %s file has a mesh with no faces (points or lines only): only surfaces are "
-			            "drawn, point clouds are not", FORMAT_NAMES[format]);
-		else api_err_set(err, errsize, "%s", msg && msg[0] ? msg : "Assimp could not read it");
-		/* Assimp turns std::bad_alloc into its error string. */
-		st = msg && strstr(msg, "bad_alloc") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
-	}
+	if (!sc) st = import_error(format, err, errsize);
 	pthread_mutex_unlock(&import_mu);
 	aiReleasePropertyStore(props);
 	free(strips);   /* Assimp copied what it needed */
@@ -546,8 +554,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		api_gltf_info_free(&c.gi);
 		return st;
 	}
-
-c.sc = sc;
+	c.sc = sc;
 	c.files = files;
 	c.nfiles = nfiles;
 	int rc = convert(&c);
