@@ -165,9 +165,17 @@ int api_parse_model(struct pctx *c, json_t *j)
 	}
 	if (!first) return api_fail(c, "a model needs one of data (base64 file), path or part");
 	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
-	int f;
-	if (api_get_enum(c, j, "format", formats, &f) < 0) return -1;
-	bool given = json_object_get(j, "format") != NULL;
+	/* A hint for the importer, not a value of the parsed scene: checked, not recorded as read
+	 * (scene_internal.h), so that it stays in the ETag's hash as written. */
+	int f = -1;
+	json_t *fv = json_object_get(j, "format");
+	bool given = fv != NULL;
+	if (given) {
+		size_t o2 = api_ptr_push(c, "format");
+		int frc = api_check_enum(c, "format", fv, formats, &f);
+		api_ptr_pop(c, o2);
+		if (frc < 0) return -1;
+	}
 	json_t *v = json_object_get(j, first);
 	size_t old = api_ptr_push(c, first);
 	bool by_path = !strcmp(first, "path");
@@ -303,7 +311,6 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 		api_big_strings_free(&big);
 		return API_ERR;
 	}
-	uint64_t scene_hash = api_scene_hash(root, &big, parts, nparts);   /* the merged document, before the walk */
 	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts, .big = &big};
 	c.arena = api_arena_create();
 	struct api_scene *s = c.arena ? api_arena_alloc(c.arena, sizeof *s) : NULL;
@@ -322,13 +329,19 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->quality = -1;
 
 	int rc = parse_root(&c, root, s);
-	json_decref(c.mat_index);
-	json_decref(root);
-	api_big_strings_free(&big);
 	if (rc == 0 && c.pending) {
 		*p = c.pend;
 		rc = -1;
 	}
+	/* The parsed scene with its defaults, and what of the document it does not hold. */
+	if (rc == 0) {
+		memcpy(s->warnings, c.warnings, sizeof s->warnings);
+		s->scene_hash = api_scene_hash(root, &big, parts, nparts, c.reads_lost ? NULL : c.reads, c.nreads, s);
+	}
+	free(c.reads);
+	json_decref(c.mat_index);
+	json_decref(root);
+	api_big_strings_free(&big);
 	if (rc < 0) {
 		model_refs_release(c.models);
 		api_arena_destroy(c.arena);
@@ -338,9 +351,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
-	s->scene_hash = scene_hash;
 	s->import = c.import;
-	memcpy(s->warnings, c.warnings, sizeof s->warnings);
 	api_set_pixels(s);   /* again: the format's own warnings follow the document's */
 	*out = s;
 	return API_OK;

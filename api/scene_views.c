@@ -202,9 +202,10 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 		 * decides once that choice is made. */
 		if (!rc && o->aovs && s->format_explicit && s->format != API_FORMAT_EXR)
 			rc = api_fail(c, "aovs need format \"exr\": a %s has no room for AOV channels",
-			              s->format == API_FORMAT_WEBP ? "WebP" : "PNG");
+			              api_format_label(s->format));
 		api_ptr_pop(c, old);
 		if (rc) return -1;
+		api_member_read(c, j, "aovs");   /* in o->aovs */
 	}
 	return 0;
 }
