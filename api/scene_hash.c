@@ -186,7 +186,7 @@ static uint64_t parsed(uint64_t h, const struct api_scene *s)
 	int32_t own[4] = {(int32_t)s->format, s->format_explicit, (int32_t)s->bit_depth, s->png_level};
 	h = item(h, 'A', own, sizeof own);
 	h = item(h, 'q', &s->quality, sizeof s->quality);
-	/* The PNG-only members given decide warnings when the answer is an EXR or a WebP (scene_views.c);
+	/* The PNG-only members given decide warnings when the answer is an EXR, WebP or AVIF (scene_views.c);
 	 * the answer is a PNG whatever the Accept when output.format says so. */
 	unsigned png_only = s->format_explicit && s->format == API_FORMAT_PNG ? 0 : s->png_only_;
 	h = item(h, 'p', &png_only, sizeof png_only);

@@ -370,24 +370,23 @@ enum api_result api_scene_check_output(const struct api_scene *s, struct api_pro
 	struct api_problem scratch;
 	if (!p) p = &scratch;
 	if (!s) return API_OK;
-	bool webp = s->format == API_FORMAT_WEBP;
+	const char *label = api_format_label(s->format);
 	if (s->format != API_FORMAT_EXR && s->scene.output.aovs)
 		return api_problem_set(p, 400, "/output/aovs", "aovs need an EXR answer (output.format \"exr\", "
 		                       "Accept: image/x-exr, or an .exr output file): %s has no room for AOV channels",
-		                       webp ? "a WebP" : "the default format PNG");
-	if (!webp && s->quality >= 0)
-		return api_problem_set(p, 400, "/output/quality", "quality (lossy WebP, 0..100) needs a WebP answer "
-		                       "(output.format \"webp\", Accept: image/webp, or a .webp output file), not %s",
-		                       s->format == API_FORMAT_EXR ? "an EXR" : "a PNG");
-	/* A sheet of views may pass WebP's bound (one view cannot: 8192 a side at most). */
-	uint32_t cols = 1, rows = 1;
+		                       s->format == API_FORMAT_PNG ? "the default format PNG" : label);
+	if (!api_format_lossy(s->format) && s->quality >= 0)
+		return api_problem_set(p, 400, "/output/quality", "quality (lossy WebP or AVIF, 0..100) needs a WebP or "
+		                       "AVIF answer (output.format \"webp\" or \"avif\", Accept: image/webp or image/avif, "
+		                       "or a .webp or .avif output file), not %s", label);
+	/* A sheet of views may pass WebP's or AVIF's bound (one view cannot: 8192 a side at most). */
+	uint32_t cols = 1, rows = 1, side = api_format_max_side(s->format);
 	if (s->scene.view_count > 1) rnd_sheet_layout(s->scene.view_count, &cols, &rows);
 	char at[16];
 	snprintf(at, sizeof at, "/%s", s->views_key_ ? s->views_key_ : "width");
-	if (webp && ((uint64_t)s->scene.width * cols > API_WEBP_MAX_SIDE ||
-	             (uint64_t)s->scene.height * rows > API_WEBP_MAX_SIDE))
-		return api_problem_set(p, 422, at, "a WebP is at most %u pixels a side; this image is %llux%llu (a sheet of %u x %u "
-		                       "views)", API_WEBP_MAX_SIDE, (unsigned long long)s->scene.width * cols,
+	if (side && ((uint64_t)s->scene.width * cols > side || (uint64_t)s->scene.height * rows > side))
+		return api_problem_set(p, 422, at, "%s is at most %u pixels a side; this image is %llux%llu (a sheet of %u x "
+		                       "%u views)", label, side, (unsigned long long)s->scene.width * cols,
 		                       (unsigned long long)s->scene.height * rows, cols, rows);
 	return API_OK;
 }
@@ -398,8 +397,8 @@ enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, str
 	if (!p) p = &scratch;
 	if (!s) return api_problem_set(p, 500, "", "api_scene_set_format: no scene");
 	if (f != API_FORMAT_EXR && s->scene.output.aovs)
-		return api_problem_set(p, 400, "/output/aovs", "aovs need format \"exr\": a %s has no room for AOV "
-		                       "channels", f == API_FORMAT_WEBP ? "WebP" : "PNG");
+		return api_problem_set(p, 400, "/output/aovs", "aovs need format \"exr\": %s has no room for AOV "
+		                       "channels", api_format_label(f));
 	s->format = f;
 	s->format_explicit = 1;
 	api_set_pixels(s);

@@ -6,29 +6,8 @@
 #include <string.h>
 #include <webp/decode.h>
 #include "api.h"
+#include "models.h"
 #include "test.h"
-
-/* A render-like RGBA8 image: a smooth gradient, a dark disc (a shadow) and, unless opaque, an
- * alpha ramp with a fully transparent border whose colours must survive too (exact mode). */
-static struct rnd_image make_rgba8(uint32_t w, uint32_t h, bool opaque)
-{
-	struct rnd_image img = {0};
-	img.width = w;
-	img.height = h;
-	img.format = RND_PIXELS_RGBA8;
-	img.stride = (size_t)w * 4 + 12;   /* padded rows: the stride is honoured */
-	img.pixels = calloc(h, img.stride);
-	for (uint32_t y = 0; y < h; y++)
-		for (uint32_t x = 0; x < w; x++) {
-			uint8_t *px = (uint8_t *)img.pixels + y * img.stride + 4 * x;
-			double dx = x - w / 2.0, dy = y - h / 2.0, shade = dx * dx + dy * dy < w * h / 16.0 ? 0.4 : 1.0;
-			px[0] = (uint8_t)(shade * (60 + 150.0 * x / w));
-			px[1] = (uint8_t)(shade * (80 + 120.0 * y / h));
-			px[2] = (uint8_t)(shade * 170);
-			px[3] = opaque ? 255 : x < 2 || y < 2 ? 0 : (uint8_t)(128 + 127.0 * x / w);
-		}
-	return img;
-}
 
 static uint8_t *webp_decode(const uint8_t *data, size_t len, int *w, int *h, WebPBitstreamFeatures *f)
 {
@@ -36,25 +15,9 @@ static uint8_t *webp_decode(const uint8_t *data, size_t len, int *w, int *h, Web
 	return WebPDecodeRGBA(data, len, w, h);
 }
 
-/* Peak signal-to-noise ratio of the RGB channels, dB; *alpha_diff the largest alpha error. */
-static double psnr_rgb(const struct rnd_image *img, const uint8_t *rgba, int *alpha_diff)
-{
-	double se = 0;
-	*alpha_diff = 0;
-	for (uint32_t y = 0; y < img->height; y++)
-		for (uint32_t x = 0; x < img->width; x++) {
-			const uint8_t *a = (const uint8_t *)img->pixels + y * img->stride + 4 * x;
-			const uint8_t *b = rgba + 4 * ((size_t)y * img->width + x);
-			for (int c = 0; c < 3; c++) se += (double)(a[c] - b[c]) * (a[c] - b[c]);
-			if (abs(a[3] - b[3]) > *alpha_diff) *alpha_diff = abs(a[3] - b[3]);
-		}
-	double mse = se / (3.0 * img->width * img->height);
-	return mse > 0 ? 10 * log10(255.0 * 255.0 / mse) : INFINITY;
-}
-
 static void check_lossless(bool opaque)
 {
-	struct rnd_image img = make_rgba8(61, 37, opaque);
+	struct rnd_image img = test_rgba8_image(61, 37, opaque);
 	uint8_t *out = NULL;
 	size_t len = 0;
 	struct api_problem p;
@@ -86,7 +49,7 @@ TEST(webp_lossless_opaque_exact_without_alpha) { check_lossless(true); }
 
 TEST(webp_lossy_q80_psnr_and_exact_alpha)
 {
-	struct rnd_image img = make_rgba8(128, 96, false);
+	struct rnd_image img = test_rgba8_image(128, 96, false);
 	uint8_t *lossy = NULL, *lossless = NULL;
 	size_t len = 0, lossless_len = 0;
 	struct api_problem p;
@@ -97,7 +60,7 @@ TEST(webp_lossy_q80_psnr_and_exact_alpha)
 	uint8_t *rgba = webp_decode(lossy, len, &w, &h, &f);
 	REQUIRE(rgba && w == 128 && h == 96, "decoded %dx%d", w, h);
 	CHECK(f.format == 1 && f.has_alpha, "lossy with alpha (format %d, alpha %d)", f.format, f.has_alpha);
-	double db = psnr_rgb(&img, rgba, &alpha_diff);
+	double db = test_psnr_rgb(&img, rgba, &alpha_diff);
 	/* Fully transparent pixels may be given any colour by a lossy encoder: the border is
 	 * 2 pixels wide, so its share of the error stays small. */
 	CHECK(db > 30, "PSNR %.1f dB at quality 80", db);
@@ -111,7 +74,7 @@ TEST(webp_lossy_q80_psnr_and_exact_alpha)
 
 TEST(webp_refuses_what_it_cannot_write)
 {
-	struct rnd_image img = make_rgba8(4, 4, true);
+	struct rnd_image img = test_rgba8_image(4, 4, true);
 	uint8_t *out = NULL;
 	size_t len = 0;
 	struct api_problem p;
@@ -141,7 +104,7 @@ TEST(webp_dispatch_from_output_format)
 	CHECK(s->format == API_FORMAT_WEBP && s->quality < 0 && s->scene.output.pixels == RND_PIXELS_RGBA8);
 	CHECK(!strcmp(api_format_mime(s->format), "image/webp"));
 	CHECK(strstr(s->warnings, "/output/bit_depth: not used, the answer is WebP"), "%s", s->warnings);
-	struct rnd_image img = make_rgba8(16, 8, false);
+	struct rnd_image img = test_rgba8_image(16, 8, false);
 	uint8_t *out = NULL;
 	size_t len = 0;
 	REQUIRE(api_encode(s, &img, &out, &len, &p) == API_OK, "%s", p.detail);
@@ -154,7 +117,7 @@ TEST(webp_dispatch_from_output_format)
 	s = parse(DOC("{\"format\":\"webp\",\"quality\":80}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(s->quality == 80);
-	img = make_rgba8(16, 8, true);
+	img = test_rgba8_image(16, 8, true);
 	REQUIRE(api_encode(s, &img, &out, &len, &p) == API_OK, "%s", p.detail);
 	CHECK(WebPGetFeatures(out, len, &f) == VP8_STATUS_OK && f.format == 1 && !f.has_alpha);
 	free(out);
