@@ -208,18 +208,17 @@ rc=$?
 check "thumb --transparent: exit 0" [ $rc = 0 ]
 a=$($PNG px "$T/tr/cube.png" 0 0 2>/dev/null | cut -d' ' -f4)
 check "thumb --transparent: corner alpha 0" [ "$a" = 0 ]
-cli thumb "$T/models/cube.obj" -o "$T/trw" --size 64 --transparent --format webp --no-progress 2>/dev/null
-check "thumb --format webp: DIR/NAME.webp, lossless with alpha, the PNG thumbnail's pixels" sh -c \
-	"[ \"\$(python3 tests/util/webp.py info '$T/trw/cube.webp' 2>&1)\" = '64 64 lossless alpha' ] &&
-	 [ \"\$(python3 tests/util/webp.py compare '$T/trw/cube.webp' '$T/tr/cube.png' 2>&1)\" = 'inf 0' ]"
-cli thumb "$T/models/cube.obj" -o "$T/trq" --size 64 --format WebP --quality 80 --no-progress 2>/dev/null
-check "thumb --format webp --quality 80: lossy" [ "$(python3 tests/util/webp.py info "$T/trq/cube.webp" 2>&1)" = "64 64 lossy opaque" ]
-cli thumb "$T/models/cube.obj" -o "$T/tra" --size 64 --transparent --format avif --no-progress 2>/dev/null
-check "thumb --format avif: DIR/NAME.avif, lossless with alpha, the PNG thumbnail's pixels" sh -c \
-	"[ \"\$(python3 tests/util/avif.py info '$T/tra/cube.avif' 2>&1)\" = '64 64 lossless alpha' ] &&
-	 [ \"\$(python3 tests/util/avif.py compare '$T/tra/cube.avif' '$T/tr/cube.png' 2>&1)\" = 'inf 0' ]"
-cli thumb "$T/models/cube.obj" -o "$T/traq" --size 64 --format avif --quality 60 --no-progress 2>/dev/null
-check "thumb --format avif --quality 60: lossy" [ "$(python3 tests/util/avif.py info "$T/traq/cube.avif" 2>&1)" = "64 64 lossy opaque" ]
+# WebP and AVIF thumbnails: lossless (the PNG thumbnail's pixels, alpha too; decoded by the system's
+# libwebp and libavif's avifdec: tests/util/webp.py, avif.py) and lossy with --quality.
+for f in webp:WebP:80 avif:avif:60; do
+	ext=${f%%:*}; name=${f#*:}; name=${name%%:*}; q=${f##*:}
+	cli thumb "$T/models/cube.obj" -o "$T/tr-$ext" --size 64 --transparent --format "$name" --no-progress 2>/dev/null
+	check "thumb --format $name: DIR/NAME.$ext, lossless with alpha, the PNG thumbnail's pixels" sh -c \
+		"[ \"\$(python3 tests/util/$ext.py info '$T/tr-$ext/cube.$ext' 2>&1)\" = '64 64 lossless alpha' ] &&
+		 [ \"\$(python3 tests/util/$ext.py compare '$T/tr-$ext/cube.$ext' '$T/tr/cube.png' 2>&1)\" = 'inf 0' ]"
+	cli thumb "$T/models/cube.obj" -o "$T/trq-$ext" --size 64 --format "$name" --quality "$q" --no-progress 2>/dev/null
+	check "thumb --format $name --quality $q: lossy" [ "$(python3 tests/util/$ext.py info "$T/trq-$ext/cube.$ext" 2>&1)" = "64 64 lossy opaque" ]
+done
 cli thumb "$T/models/cube.obj" -o "$T/trq2" --quality 80 2>"$T/trq2.err"
 rc=$?
 check "thumb --quality without --format webp: refused (exit 1)" eval '[ $rc = 1 ] && grep -q "format webp" "$T/trq2.err"'

@@ -1,4 +1,4 @@
-/* tests — AVIF output: api/encode_avif.c decoded back by libavif's decoder (lossless: every
+/* tests — AVIF output (and both 8-bit encoders' refusals): api/encode_avif.c decoded back by libavif's decoder (lossless: every
  * sample; lossy: a PSNR bound, alpha exact), the same bytes on every encode, api_encode()'s
  * dispatch, and the output members (format "avif", quality) as the parser takes or refuses them. */
 #include <avif/avif.h>
@@ -8,6 +8,7 @@
 #include "api.h"
 #include "models.h"
 #include "test.h"
+#include "util.h"
 
 /* The decoded image as packed RGBA8 (malloc'd), its size and whether it has an alpha plane;
  * NULL when libavif cannot decode it. */
@@ -92,26 +93,27 @@ TEST(avif_lossy_q80_psnr_and_exact_alpha)
 	rnd_image_release(&img);
 }
 
-TEST(avif_refuses_what_it_cannot_write)
+/* Both 8-bit encoders refuse another pixel format (500) and a side over their format's bound (422). */
+TEST(webp_and_avif_refuse_what_they_cannot_write)
 {
-	struct rnd_image img = test_rgba8_image(4, 4, true);
-	uint8_t *out = NULL;
-	size_t len = 0;
-	struct api_problem p;
-	img.format = RND_PIXELS_RGBA16;
-	CHECK(api_avif_encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 500 && !out);
-	img.format = RND_PIXELS_RGBA8;
-	img.width = API_AVIF_MAX_SIDE + 1;   /* the check comes before any pixel is read */
-	img.stride = (size_t)img.width * 4;
-	CHECK(api_avif_encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 422 && !out, "%d", p.status);
-	rnd_image_release(&img);
-}
-
-static struct api_scene *parse(const char *doc, struct api_problem *p)
-{
-	struct api_scene *s = NULL;
-	memset(p, 0, sizeof *p);
-	return api_scene_parse(doc, strlen(doc), NULL, &s, p) == API_OK ? s : NULL;
+	static const struct {
+		enum api_result (*encode)(const struct rnd_image *, float, uint8_t **, size_t *, struct api_problem *);
+		uint32_t max_side;
+	} enc[] = {{api_webp_encode, API_WEBP_MAX_SIDE}, {api_avif_encode, API_AVIF_MAX_SIDE}};
+	for (size_t i = 0; i < sizeof enc / sizeof enc[0]; i++) {
+		struct rnd_image img = test_rgba8_image(4, 4, true);
+		uint8_t *out = NULL;
+		size_t len = 0;
+		struct api_problem p;
+		img.format = RND_PIXELS_RGBA16;
+		CHECK(enc[i].encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 500 && !out, "encoder %zu", i);
+		img.format = RND_PIXELS_RGBA8;
+		img.width = enc[i].max_side + 1;   /* the check comes before any pixel is read */
+		img.stride = (size_t)img.width * 4;
+		CHECK(enc[i].encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 422 && !out, "encoder %zu: %d", i,
+		      p.status);
+		rnd_image_release(&img);
+	}
 }
 
 #define DOC(output) "{\"camera\":{},\"objects\":[],\"output\":" output "}"
@@ -119,7 +121,7 @@ static struct api_scene *parse(const char *doc, struct api_problem *p)
 TEST(avif_dispatch_and_members)
 {
 	struct api_problem p;
-	struct api_scene *s = parse(DOC("{\"format\":\"avif\",\"quality\":60,\"bit_depth\":16}"), &p);
+	struct api_scene *s = test_parse_scene(DOC("{\"format\":\"avif\",\"quality\":60,\"bit_depth\":16}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(s->format == API_FORMAT_AVIF && s->quality == 60 && s->scene.output.pixels == RND_PIXELS_RGBA8);
 	CHECK(!strcmp(api_format_mime(s->format), "image/avif") && !strcmp(api_format_name(s->format), "avif"));
@@ -133,16 +135,16 @@ TEST(avif_dispatch_and_members)
 	rnd_image_release(&img);
 	api_scene_free(s);
 
-	s = parse(DOC("{\"format\":\"avif\",\"aovs\":[\"depth\"]}"), &p);
+	s = test_parse_scene(DOC("{\"format\":\"avif\",\"aovs\":[\"depth\"]}"), &p);
 	CHECK(!s && p.status == 400 && !strcmp(p.pointer, "/output/aovs") && strstr(p.detail, "an AVIF has no room"),
 	      "%s %s", p.pointer, p.detail);
 	api_scene_free(s);
-	s = parse(DOC("{\"format\":\"png\",\"quality\":80}"), &p);
+	s = test_parse_scene(DOC("{\"format\":\"png\",\"quality\":80}"), &p);
 	CHECK(!s && !strcmp(p.pointer, "/output/quality") && strstr(p.detail, "\"avif\""), "%s", p.detail);
 	api_scene_free(s);
 
 	/* quality without a format waits for Accept or the output name. */
-	s = parse(DOC("{\"quality\":50}"), &p);
+	s = test_parse_scene(DOC("{\"quality\":50}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(api_scene_set_format(s, API_FORMAT_AVIF, &p) == API_OK && api_scene_check_output(s, &p) == API_OK);
 	api_scene_free(s);

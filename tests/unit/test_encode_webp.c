@@ -8,6 +8,7 @@
 #include "api.h"
 #include "models.h"
 #include "test.h"
+#include "util.h"
 
 static uint8_t *webp_decode(const uint8_t *data, size_t len, int *w, int *h, WebPBitstreamFeatures *f)
 {
@@ -72,34 +73,12 @@ TEST(webp_lossy_q80_psnr_and_exact_alpha)
 	rnd_image_release(&img);
 }
 
-TEST(webp_refuses_what_it_cannot_write)
-{
-	struct rnd_image img = test_rgba8_image(4, 4, true);
-	uint8_t *out = NULL;
-	size_t len = 0;
-	struct api_problem p;
-	img.format = RND_PIXELS_RGBA16;
-	CHECK(api_webp_encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 500 && !out);
-	img.format = RND_PIXELS_RGBA8;
-	img.width = API_WEBP_MAX_SIDE + 1;   /* the check comes before any pixel is read */
-	img.stride = (size_t)img.width * 4;
-	CHECK(api_webp_encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 422 && !out, "%d", p.status);
-	rnd_image_release(&img);
-}
-
-static struct api_scene *parse(const char *doc, struct api_problem *p)
-{
-	struct api_scene *s = NULL;
-	memset(p, 0, sizeof *p);
-	return api_scene_parse(doc, strlen(doc), NULL, &s, p) == API_OK ? s : NULL;
-}
-
 #define DOC(output) "{\"camera\":{},\"objects\":[],\"output\":" output "}"
 
 TEST(webp_dispatch_from_output_format)
 {
 	struct api_problem p;
-	struct api_scene *s = parse(DOC("{\"format\":\"webp\",\"transparent\":true,\"bit_depth\":16}"), &p);
+	struct api_scene *s = test_parse_scene(DOC("{\"format\":\"webp\",\"transparent\":true,\"bit_depth\":16}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(s->format == API_FORMAT_WEBP && s->quality < 0 && s->scene.output.pixels == RND_PIXELS_RGBA8);
 	CHECK(!strcmp(api_format_mime(s->format), "image/webp"));
@@ -114,7 +93,7 @@ TEST(webp_dispatch_from_output_format)
 	rnd_image_release(&img);
 	api_scene_free(s);
 
-	s = parse(DOC("{\"format\":\"webp\",\"quality\":80}"), &p);
+	s = test_parse_scene(DOC("{\"format\":\"webp\",\"quality\":80}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(s->quality == 80);
 	img = test_rgba8_image(16, 8, true);
@@ -140,7 +119,7 @@ TEST(webp_output_members_refused)
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
 		struct api_problem p;
-		struct api_scene *s = parse(bad[i].doc, &p);
+		struct api_scene *s = test_parse_scene(bad[i].doc, &p);
 		CHECK(!s && p.status == 400 && !strcmp(p.pointer, bad[i].pointer) && strstr(p.detail, bad[i].detail),
 		      "%s: %d %s %s", bad[i].doc, p.status, p.pointer, p.detail);
 		api_scene_free(s);
@@ -152,7 +131,7 @@ TEST(webp_output_members_refused)
 TEST(webp_quality_waits_for_the_format)
 {
 	struct api_problem p;
-	struct api_scene *s = parse(DOC("{\"quality\":50}"), &p);
+	struct api_scene *s = test_parse_scene(DOC("{\"quality\":50}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(api_scene_check_output(s, &p) == API_ERR && p.status == 400 && !strcmp(p.pointer, "/output/quality"),
 	      "%d %s", p.status, p.pointer);
@@ -163,7 +142,7 @@ TEST(webp_quality_waits_for_the_format)
 
 	/* A sheet of views wider than WebP's 16383 pixels: 422 at /views once the answer is WebP. */
 	const char *wide = "{\"width\":8192,\"height\":64,\"views\":[{},{}],\"objects\":[]}";
-	s = parse(wide, &p);
+	s = test_parse_scene(wide, &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(api_scene_check_output(s, &p) == API_OK);
 	CHECK(api_scene_set_format(s, API_FORMAT_WEBP, &p) == API_OK);
