@@ -255,13 +255,11 @@ uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, ui
 static void warn_missing_uv1(struct api_conv *c, const struct aiMesh *am, const struct api_model_mesh *me,
                              const struct rnd_material *m)
 {
-	static const char *const slot[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
-	                                                 "occlusionTexture", "emissiveTexture"};
 	if (me->uvs1) return;
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++)
 		if (m->textures[k] && m->sampling[k].uv_set == 1)
 			api_gltf_warn(&c->gi, "mesh \"%.40s\": its material's %s reads TEXCOORD_1, which the mesh lacks: drawn "
-			              "with TEXCOORD_0", am->mName.data, slot[k]);
+			              "with TEXCOORD_0", am->mName.data, api_gltf_slot_name(k));
 }
 
 static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
@@ -475,6 +473,7 @@ static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb,
 	if (api_gltf_bufs_finish(b) != 0) return api_err_set(err, errsize, "out of memory"), -1;
 	api_gltf_drop_fallbacks(root);
 	api_gltf_info_read(root, &c->gi);
+	api_gltf_ext_images(&c->gi, b);
 	bool changed = dec > 0 || inst > 0;
 	/* Materials renamed to their glTF index, to find them again (see gltf_material.h); the
 	 * document handed to Assimp also when it was changed here. */
