@@ -492,5 +492,5 @@ void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info)
 
 uint32_t rnd_context_validation_messages(const struct rnd_context *ctx)
 {
-	return (uint32_t)__atomic_load_n(&ctx->validation_count, __ATOMIC_RELAXED);
+	return ctx ? (uint32_t)__atomic_load_n(&ctx->validation_count, __ATOMIC_RELAXED) : 0;
 }

@@ -452,6 +452,9 @@ struct rnd_context_desc {
 	 * RND_MAX_TEXTURES_CEILING (rnd_info.max_textures says what was granted); each slot holds
 	 * two descriptor sets per texture (rnd_texture_sets). Materials sharing textures share a set. */
 	uint32_t max_textures;
+	/* Tests: give vertex and index buffers their CPU mirror even in host-cached memory, so the
+	 * path a GPU's uncached BAR memory takes (renderer/memory.c) runs on lavapipe too. */
+	bool mirror_buffers;
 	rnd_log_fn log; void *log_user;
 };
 
