@@ -214,7 +214,9 @@ static void scene_warnings(struct api_gltf_info *gi, json_t *root)
 			if (json_array_size(json_object_get(p, "targets")))
 				api_gltf_warn(gi, "morph targets are not applied (drawn in the base shape)");
 			json_t *mode = json_object_get(p, "mode");
-			if (json_is_integer(mode) && json_integer_value(mode) < 4) api_gltf_warn(gi, "points and lines are not drawn");
+			if (json_is_integer(mode) && json_integer_value(mode) < 4)
+				api_gltf_warn(gi, "points and lines drawn as thin prisms and dots 1/250 and 1/100 of the model's size "
+				              "wide (not one pixel wide)");
 		}
 	}
 }
