@@ -31,7 +31,7 @@ static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "
 static const char *const LACKS[][2] = {
 	{"KHR_materials_transmission", "transmission drawn as see-through coverage (dithered), not refraction"},
 	{"KHR_materials_volume", "volume drawn as the coverage's tint and density (its attenuation through "
-	                         "thicknessFactor), no refraction"},
+	                         "thicknessFactor x its texture's mean), no refraction"},
 	{"KHR_materials_iridescence", "iridescence not drawn"},
 	{"KHR_materials_anisotropy", "anisotropy not drawn (isotropic highlights)"},
 	{"KHR_materials_variants", "variants: the default materials drawn"},
@@ -163,7 +163,9 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 	gm->emissive_strength = 1;
 	gm->normal_scale = 1;
 	gm->occlusion_strength = 1;
-	for (int k = 0; k < 3; k++) gm->specular.color[k] = gm->transmittance[k] = 1;
+	for (int k = 0; k < 3; k++) gm->specular.color[k] = gm->attenuation[k] = 1;
+	gm->thickness_mean = 1;
+	gm->thickness_image = -1;
 	gm->specular.factor = 1;
 	gm->specular.ior = 1.5f;
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) gm->ext_image[k] = -1;
@@ -257,7 +259,8 @@ void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, s
 		m->metal_rough_texture = NULL;
 	}
 	if (gm->transmission > 0 && m->alpha_mode != RND_ALPHA_MASK) {
-		const float *t = gm->transmittance;
+		float t[3];
+		api_gltf_volume_transmittance(gm, t);
 		m->alpha_mode = RND_ALPHA_BLEND;
 		m->base_color[3] *= 1 - 0.8f * gm->transmission * (t[0] + t[1] + t[2]) / 3;
 		for (int k = 0; k < 3; k++) m->base_color[k] *= t[k];

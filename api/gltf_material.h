@@ -36,8 +36,11 @@ struct api_gltf_material {
 	bool spec_gloss;
 	float diffuse[4], glossiness;
 	/* KHR_materials_transmission's factor (0): drawn as partial coverage, see shading; and
-	 * KHR_materials_volume's transmittance through thicknessFactor (1, 1, 1). */
-	float transmission, transmittance[3];
+	 * KHR_materials_volume's medium: attenuation colour (1, 1, 1), distance (0: none),
+	 * thicknessFactor, and its thicknessTexture's image (-1: none; drawn as the mean of its G
+	 * over the texture, thickness_mean, which api/model_material.c sets once it is decoded). */
+	float transmission, attenuation[3], attenuation_distance, thickness, thickness_mean;
+	int32_t thickness_image;
 	/* KHR_materials_clearcoat, _sheen, _specular and _ior as rnd_material has them
 	 * (api/gltf_material_ext.c); ext_image: per extension texture slot, its image's index in
 	 * api_gltf_info.images (-1: none). */
@@ -106,6 +109,10 @@ void api_gltf_read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, 
 void api_gltf_read_material_ext(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, json_t *ext,
                                 struct api_gltf_material *gm);
 void api_gltf_material_ext_apply(const struct api_gltf_material *gm, struct rnd_material *m);
+/* KHR_materials_volume's transmittance t per channel through thickness x thickness_mean:
+ * attenuationColor ^ (thickness / attenuationDistance) (Beer's law, as the sample viewer
+ * attenuates what it refracts); 1 without a distance or a thickness. */
+void api_gltf_volume_transmittance(const struct api_gltf_material *gm, float t[3]);
 /* Takes the uri or the bytes of every image an extension slot reads (b: the document's
  * buffers, api/gltf_buffers.h) into gi->images. Never fails: an image it cannot take is
  * warned and left out. */

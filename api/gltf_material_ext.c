@@ -2,7 +2,8 @@
  * api/gltf_material_ext — the glTF 2.0 PBR extensions of a material, read from the document's
  * JSON (see gltf_material.h): KHR_materials_clearcoat, _sheen, _specular, _ior (drawn by the
  * renderer's extension lobes, shaders/material_ext.glsl), _transmission and _volume (drawn as
- * see-through coverage), each with its textures where the renderer has a slot for them.
+ * see-through coverage), each with its textures where the renderer has a slot for them (the
+ * volume's thicknessTexture as its mean over the texture).
  *
  * Assimp 5.2 hands over some of these (clearcoat, sheen, transmission, volume; not specular),
  * and only when their factor is not zero, and loads only the images its own materials name:
@@ -83,18 +84,27 @@ static void read_specular(struct api_gltf_info *gi, json_t *root, uint32_t mi, c
 	ext_texture(gi, root, mi, mname, e, "specularColorTexture", RND_TEX_SPECULAR_COLOR, gm);
 }
 
-/* KHR_materials_volume: the transmittance of thicknessFactor through the medium, per channel,
- * attenuationColor^(thickness / attenuationDistance) (Beer's law, as the sample viewer
- * attenuates what it refracts); 1 without a distance. thicknessTexture is not read. */
-static void read_volume(struct api_gltf_info *gi, uint32_t mi, const char *mname, json_t *e, struct api_gltf_material *gm)
+/* KHR_materials_volume: the medium (its transmittance: api_gltf_volume_transmittance). */
+static void read_volume(struct api_gltf_info *gi, json_t *root, json_t *e, struct api_gltf_material *gm)
 {
-	float thick = num(e, "thicknessFactor", 0, 0, 1e6f), dist = num(e, "attenuationDistance", 0, 0, 1e30f), c[3];
-	color3(e, "attenuationColor", 1, c);
+	gm->thickness = num(e, "thicknessFactor", 0, 0, 1e6f);
+	gm->attenuation_distance = num(e, "attenuationDistance", 0, 0, 1e30f);
+	color3(e, "attenuationColor", 1, gm->attenuation);
+	json_t *info = json_object_get(e, "thicknessTexture");
+	if (!json_is_object(info)) return;
+	json_t *tex = json_array_get(json_object_get(root, "textures"), (size_t)json_integer_value(json_object_get(info, "index")));
+	json_t *src = json_object_get(tex, "source");
+	json_int_t n = (json_int_t)json_array_size(json_object_get(root, "images"));
+	if (json_is_integer(src) && json_integer_value(src) >= 0 && json_integer_value(src) < n)
+		gm->thickness_image = (int32_t)json_integer_value(src);
+	(void)gi;
+}
+
+void api_gltf_volume_transmittance(const struct api_gltf_material *gm, float t[3])
+{
+	float thick = gm->thickness * gm->thickness_mean, dist = gm->attenuation_distance;
 	for (int k = 0; k < 3; k++)
-		gm->transmittance[k] = dist > 0 && thick > 0 ? powf(fminf(fmaxf(c[k], 1e-6f), 1), thick / dist) : 1;
-	if (json_object_get(e, "thicknessTexture"))
-		api_gltf_warn(gi, "material %u (\"%.40s\"): KHR_materials_volume's thicknessTexture not used (thicknessFactor "
-		              "drawn)", mi, mname);
+		t[k] = dist > 0 && thick > 0 ? powf(fminf(fmaxf(gm->attenuation[k], 1e-6f), 1), thick / dist) : 1;
 }
 
 /* gm holds the defaults (api/gltf_material.c read_material): specular 1 x white, ior 1.5,
@@ -109,7 +119,7 @@ void api_gltf_read_material_ext(struct api_gltf_info *gi, json_t *root, uint32_t
 		if (!strcmp(key, "KHR_materials_clearcoat")) read_clearcoat(gi, root, mi, mname, v, gm);
 		if (!strcmp(key, "KHR_materials_sheen")) read_sheen(gi, root, mi, mname, v, gm);
 		if (!strcmp(key, "KHR_materials_specular")) read_specular(gi, root, mi, mname, v, gm);
-		if (!strcmp(key, "KHR_materials_volume")) read_volume(gi, mi, mname, v, gm);
+		if (!strcmp(key, "KHR_materials_volume")) read_volume(gi, root, v, gm);
 		if (!strcmp(key, "KHR_materials_transmission"))
 			gm->transmission = num(v, "transmissionFactor", 0, 0, 1);
 		if (!strcmp(key, "KHR_materials_ior")) {
@@ -166,16 +176,17 @@ void api_gltf_ext_images(struct api_gltf_info *gi, struct api_gltf_bufs *b)
 	if (!n || n > 65536 || !(gi->images = calloc(n, sizeof *gi->images))) return;
 	gi->image_count = (uint32_t)n;
 	for (uint32_t m = 0; m < gi->material_count; m++)
-		for (uint32_t k = RND_TEX_CLEARCOAT; k < RND_TEX_SLOTS; k++) {
-			int32_t i = gi->materials[m].ext_image[k];
+		for (uint32_t k = RND_TEX_CLEARCOAT; k <= RND_TEX_SLOTS; k++) {   /* k == RND_TEX_SLOTS: the thickness */
+			int32_t *slot_image = k < RND_TEX_SLOTS ? &gi->materials[m].ext_image[k] : &gi->materials[m].thickness_image;
+			int32_t i = *slot_image;
 			struct api_gltf_image *im = i >= 0 ? &gi->images[i] : NULL;
 			if (!im || im->uri || im->bytes) continue;
 			char e[160];
 			if (take_image(b, json_array_get(images, (size_t)i), im, e, sizeof e) != 0) {
-				api_gltf_warn(gi, "image %d (%s): %s (not drawn)", i, api_gltf_slot_name(k), e);
+				api_gltf_warn(gi, "image %d (%s): %s (not drawn)", i, k < RND_TEX_SLOTS ? api_gltf_slot_name(k) : "thicknessTexture", e);
 				free(im->bytes);
 				im->bytes = NULL;
-				gi->materials[m].ext_image[k] = -1;
+				*slot_image = -1;
 			}
 		}
 }

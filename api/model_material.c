@@ -117,6 +117,34 @@ static const enum aiTextureType SLOT_TYPES[RND_TEX_CLEARCOAT][3] = {
 	{aiTextureType_EMISSIVE, aiTextureType_NONE, aiTextureType_NONE},
 };
 
+/* KHR_materials_volume's thicknessTexture of glTF material gi as one number, the mean of its G
+ * over the texture, into its thickness_mean (drawn per material: the coverage it changes is a
+ * material's, see api_gltf_material_shading). An image that is a file beside the model or
+ * cannot be decoded leaves 1 (thicknessFactor alone). */
+static int thickness_mean(struct api_conv *c, int gi)
+{
+	struct api_gltf_material *gm = &c->gi.materials[gi];
+	int32_t i = gm->thickness_image;
+	struct api_gltf_image *im = i >= 0 && (uint32_t)i < c->gi.image_count ? &c->gi.images[i] : NULL;
+	const struct rnd_texture *t = NULL;
+	if (im && im->uri) {
+		int ti = find_texture(c, im->uri);
+		if (ti >= 0 && !(t = texture(c, ti, RND_TEX_METAL_ROUGH, false))) return -1;
+	} else if (im && im->bytes) {
+		if (!im->tex && !(im->tex = decode(c, im->bytes, im->len, "thicknessTexture", RND_TEX_METAL_ROUGH, false)))
+			return -1;
+		t = im->tex;
+	}
+	if (!t || !t->width || !t->height) return 0;
+	double sum = 0;
+	size_t n = (size_t)t->width * t->height;
+	for (size_t p = 0; p < n; p++) sum += t->rgba[4 * p + 1];
+	gm->thickness_mean = (float)(sum / (255.0 * (double)n));
+	api_gltf_warn(&c->gi, "material %d: KHR_materials_volume's thicknessTexture drawn as its mean, %.2f", gi,
+	              gm->thickness_mean);
+	return 0;
+}
+
 /* The PBR extensions' textures of glTF material gi: their images as taken from the document
  * (api_gltf_ext_images), a file beside the model by its uri, else their bytes. */
 static int extension_textures(struct api_conv *c, int gi, struct rnd_material *m)
@@ -139,7 +167,7 @@ static int extension_textures(struct api_conv *c, int gi, struct rnd_material *m
 			m->textures[k] = im->tex;
 		}
 	}
-	return 0;
+	return thickness_mean(c, gi);
 }
 
 static int material_textures(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m)
