@@ -76,26 +76,36 @@ TEST(materials_mask_alpha_on_the_second_uv_set)
 /* KHR_materials_transmission 1 on an opaque red quad: drawn as coverage 0.2 (dithered) that
  * lets 0.8 of the light through to its shadow; before, the glass was drawn opaque (coverage
  * 1, a full shadow). */
-TEST(materials_transmission_as_partial_coverage)
+/* The red quad of `material` against the opaque red quad: the share of its red (the coverage
+ * with the drawn pixels' colour) and the share of the light its shadow takes. */
+static bool red_and_shadow(int line, const char *material, const char *extensions_used, double *red, double *share)
 {
-	struct rnd_image op, tr;
-	if (!blend_render(__LINE__, &op, false)) return;
-	if (!material_render(__LINE__, &tr,
-	                     "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],\"metallicFactor\":0,"
-	                     "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1}}}",
-	                     "[\"KHR_materials_transmission\"]")) {
+	struct rnd_image op, q;
+	if (!blend_render(line, &op, false)) return false;
+	if (!material_render(line, &q, material, extensions_used)) {
 		rnd_image_release(&op);
-		return;
+		return false;
 	}
 	double lit = mean_rect(&op, 2.0, 2.35, -0.6, 0.6, 0, 2);
-	double sh_op = mean_rect(&op, 1.1, 1.7, -0.6, 0.6, 0, 2), sh_tr = mean_rect(&tr, 1.1, 1.7, -0.6, 0.6, 0, 2);
-	double share = (lit - sh_tr) / (lit - sh_op);
-	double red_op = mean_rect(&op, -0.8, 0.8, -0.8, 0.8, 1, 0), red_tr = mean_rect(&tr, -0.8, 0.8, -0.8, 0.8, 1, 0);
-	printf("    transmission 1: coverage %.2f, shadow share %.2f\n", red_tr / red_op, share);
-	CHECK(red_tr / red_op > 0.1 && red_tr / red_op < 0.3, "transmission 1 coverage %.2f, want ~0.2", red_tr / red_op);
-	CHECK(share > 0.1 && share < 0.3, "transmission 1 takes %.2f of the light, want ~0.2", share);
+	double sh_op = mean_rect(&op, 1.1, 1.7, -0.6, 0.6, 0, 2), sh_q = mean_rect(&q, 1.1, 1.7, -0.6, 0.6, 0, 2);
+	*share = (lit - sh_q) / (lit - sh_op);
+	*red = mean_rect(&q, -0.8, 0.8, -0.8, 0.8, 1, 0) / mean_rect(&op, -0.8, 0.8, -0.8, 0.8, 1, 0);
 	rnd_image_release(&op);
-	rnd_image_release(&tr);
+	rnd_image_release(&q);
+	return true;
+}
+
+TEST(materials_transmission_as_partial_coverage)
+{
+	double red, share;
+	if (!red_and_shadow(__LINE__,
+	                    "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],\"metallicFactor\":0,"
+	                    "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1}}}",
+	                    "[\"KHR_materials_transmission\"]", &red, &share))
+		return;
+	printf("    transmission 1: coverage %.2f, shadow share %.2f\n", red, share);
+	CHECK(red > 0.1 && red < 0.3, "transmission 1 coverage %.2f, want ~0.2", red);
+	CHECK(share > 0.1 && share < 0.3, "transmission 1 takes %.2f of the light, want ~0.2", share);
 }
 
 /* ---- mipmaps ---- */
@@ -160,25 +170,16 @@ TEST(materials_mipmaps_average_a_fine_checker)
  * red 0.3 of the opaque quad's. Before, the volume was ignored: 0.2 and 0.2. */
 TEST(materials_volume_tints_and_thickens_transmission)
 {
-	struct rnd_image op, vo;
-	if (!blend_render(__LINE__, &op, false)) return;
-	if (!material_render(__LINE__, &vo,
-	                     "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],\"metallicFactor\":0,"
-	                     "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
-	                     "\"KHR_materials_volume\":{\"thicknessFactor\":1,\"attenuationDistance\":1,"
-	                     "\"attenuationColor\":[0.5,0.5,0.5]}}}",
-	                     "[\"KHR_materials_transmission\",\"KHR_materials_volume\"]")) {
-		rnd_image_release(&op);
+	double red, share;
+	if (!red_and_shadow(__LINE__,
+	                    "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],\"metallicFactor\":0,"
+	                    "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+	                    "\"KHR_materials_volume\":{\"thicknessFactor\":1,\"attenuationDistance\":1,"
+	                    "\"attenuationColor\":[0.5,0.5,0.5]}}}",
+	                    "[\"KHR_materials_transmission\",\"KHR_materials_volume\"]", &red, &share))
 		return;
-	}
-	double lit = mean_rect(&op, 2.0, 2.35, -0.6, 0.6, 0, 2);
-	double sh_op = mean_rect(&op, 1.1, 1.7, -0.6, 0.6, 0, 2), sh_vo = mean_rect(&vo, 1.1, 1.7, -0.6, 0.6, 0, 2);
-	double share = (lit - sh_vo) / (lit - sh_op);
-	double red = mean_rect(&vo, -0.8, 0.8, -0.8, 0.8, 1, 0) / mean_rect(&op, -0.8, 0.8, -0.8, 0.8, 1, 0);
 	printf("    volume T 0.5: the quad's red %.2f of the opaque one's (want 0.3), shadow share %.2f (want 0.6)\n", red,
 	       share);
 	CHECK(red > 0.22 && red < 0.38, "volume: red %.2f of the opaque quad's, want ~0.3", red);
 	CHECK(share > 0.48 && share < 0.72, "volume: takes %.2f of the light, want ~0.6", share);
-	rnd_image_release(&op);
-	rnd_image_release(&vo);
 }
