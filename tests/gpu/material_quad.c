@@ -98,14 +98,20 @@ void cam_of(struct gpu_cam *cam, bool below)
 	else gpu_cam_ortho(cam, v3_make(0, 5, 0), v3_make(0, 0, 0), v3_make(0, 0, -1), MORTHO, MW, MH);
 }
 
+char *quad_data(const struct mglb *g)
+{
+	size_t n;
+	uint8_t *glb = glb_of(g, &n);
+	char *enc = glb ? test_b64(glb, n) : NULL;
+	free(glb);
+	return enc;
+}
+
 /* Renders the quad model: `light` "none" or a directional light straight down of intensity pi
  * (so a white Lambert surface facing it has radiance 1); no ambient; no tone map. */
 bool render_quad(int line, struct rnd_image *img, const struct mglb *g, bool light, bool below)
 {
-	size_t n;
-	uint8_t *glb = glb_of(g, &n);
-	char *enc = test_b64(glb, n);
-	free(glb);
+	char *enc = quad_data(g);
 	bool ok = gpu_render_at(__FILE__, line, img,
 	                        "{'width':%d,'height':%d,"
 	                        "'camera':{'type':'orthographic','position':[0,%d,0],'target':[0,0,0],'up':[0,0,-1],"
@@ -148,10 +154,7 @@ void free_pngs(struct mglb *g)
  * covers about half its pixels (dithered) and its shadow takes about half the light. */
 bool quad_over_ground(int line, struct rnd_image *img, const struct mglb *g)
 {
-	size_t n;
-	uint8_t *glb = glb_of(g, &n);
-	char *enc = test_b64(glb, n);
-	free(glb);
+	char *enc = quad_data(g);
 	bool ok = gpu_render_at(__FILE__, line, img,
 	                        "{'width':%d,'height':%d,"
 	                        "'camera':{'type':'orthographic','position':[0.6,5,0],'target':[0.6,0,0],'up':[0,0,-1],"

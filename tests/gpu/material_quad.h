@@ -43,6 +43,8 @@ struct mglb {
 
 /* The .glb of g (malloc'd, *len bytes), or NULL. */
 uint8_t *glb_of(const struct mglb *g, size_t *len);
+/* The .glb of g as base64 (malloc'd), for a model object's data; NULL when out of memory. */
+char *quad_data(const struct mglb *g);
 /* The orthographic camera straight down on the quad (from below: `below`). */
 void cam_of(struct gpu_cam *cam, bool below);
 /* Renders the quad model: `light` none or a directional light straight down of intensity pi

@@ -226,10 +226,7 @@ TEST(materials_normal_map_in_the_normal_aov)
  * (strength 0.5). Under the direct light alone it changes nothing: 0.51. */
 static bool render_ambient(int line, struct rnd_image *img, const struct mglb *g, bool ambient)
 {
-	size_t n;
-	uint8_t *glb = glb_of(g, &n);
-	char *enc = test_b64(glb, n);
-	free(glb);
+	char *enc = quad_data(g);
 	bool ok = gpu_render_at(__FILE__, line, img,
 	                        "{'width':%d,'height':%d,"
 	                        "'camera':{'type':'orthographic','position':[0,5,0],'target':[0,0,0],'up':[0,0,-1],"
