@@ -173,7 +173,8 @@ static uint64_t parsed(uint64_t h, const struct api_scene *s)
 	sc.cancel_user = NULL;
 	h = item(h, 'S', &sc, sizeof sc);
 	h = frame(h, 'V', sc.view_count);
-	h = rnd_hash(h, s->scene.views, sc.view_count * sizeof *s->scene.views);   /* no pointers, no padding */
+	if (sc.view_count)   /* no pointers, no padding; NULL when none (memcpy's NULL is UB even for 0 bytes) */
+		h = rnd_hash(h, s->scene.views, sc.view_count * sizeof *s->scene.views);
 	h = frame(h, 'M', sc.material_count);
 	for (uint32_t i = 0; i < sc.material_count; i++)
 		h = material_bytes(h, &s->scene.materials[i]);
@@ -181,7 +182,8 @@ static uint64_t parsed(uint64_t h, const struct api_scene *s)
 	for (uint32_t i = 0; i < sc.object_count; i++)
 		h = object_bytes(h, &s->scene.objects[i]);
 	h = frame(h, 'L', sc.light_count);
-	h = rnd_hash(h, s->scene.lights, sc.light_count * sizeof *s->scene.lights);   /* no pointers */
+	if (sc.light_count)   /* no pointers */
+		h = rnd_hash(h, s->scene.lights, sc.light_count * sizeof *s->scene.lights);
 	/* The answer's own members (api.h), and what the image leaves out. */
 	int32_t own[4] = {(int32_t)s->format, s->format_explicit, (int32_t)s->bit_depth, s->png_level};
 	h = item(h, 'A', own, sizeof own);
