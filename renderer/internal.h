@@ -28,9 +28,6 @@
 #define RND_SURFACES_FORMAT VK_FORMAT_R32G32B32A32_SFLOAT
 #define RND_SURFACE_NORMALS_FORMAT VK_FORMAT_R16G16B16A16_SNORM
 #define RND_VISIBILITY_FORMAT VK_FORMAT_R16_UNORM
-/* Layers of the visibility image: at least 2, so that its view is an array (layers beyond a
- * render's lights are not read). */
-#define RND_VIS_MIN_LAYERS 2u
 #define RND_MAX_VARIANTS 1024
 
 /* Map a VkResult to a result + message "what: VK_ERROR_..." */

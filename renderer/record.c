@@ -14,20 +14,6 @@
 #include "mesh.h"
 #include "record.h"
 
-/* Culling back faces of a closed primitive changes nothing in the picture as long as the
- * viewer is outside it and it lies wholly beyond the near plane; it halves the triangles
- * lavapipe rasterises and shades. */
-bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b)
-{
-	for (int i = 0; i < 8; i++) {
-		float p[3] = {i & 1 ? b->max[0] : b->min[0], i & 2 ? b->max[1] : b->min[1], i & 4 ? b->max[2] : b->min[2]};
-		float d[3];
-		rnd_v3_sub(d, p, cam->pos);
-		if (rnd_v3_dot(d, cam->fwd) <= cam->znear * 1.01f) return false;
-	}
-	return true;
-}
-
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
                           VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)

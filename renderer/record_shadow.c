@@ -5,26 +5,13 @@
  * drawn in parts, one submit each (record_shadow_part, sized by renderer/submit.c).
  */
 #include <string.h>
+#include "casters.h"
 #include "moments.h"
 #include "record.h"
 
-static bool point_outside(const float p[3], const struct rnd_aabb *b, float pad)
-{
-	for (int k = 0; k < 3; k++)
-		if (p[k] < b->min[k] - pad || p[k] > b->max[k] + pad) return true;
-	return false;
-}
-
 bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, int *cull)
 {
-	const struct rnd_shadow_plan *sp = rv->sp;
-	const struct draw *d = &rv->draws[i];
-	if (!d->cast || !d->index_count) return false;
-	if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) return false;
-	const struct rnd_light *L = &rv->sc->lights[sp->view_light[v]];
-	*cull = d->single_sided ||
-	        (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
-	return true;
+	return rnd_shadow_view_draws(rv->sp, rv->sc->lights, rv->draws, v, i, cull);
 }
 
 /* Begins a later part of a map: the earlier part's depth (an earlier submit) loaded. */

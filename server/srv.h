@@ -239,10 +239,23 @@ int srv_context_open(struct srv_server *s);         /* create + info; 0 or -1 (l
 /* After RND_ERR_DEVICE_LOST from the context of generation gen: recreates and warms it up once. */
 void srv_context_recover(struct srv_server *s, unsigned gen);
 int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged); server/warmup.c */
-/* Renders on the shared context (context.c). On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the
- * lost context's generation + 1, and the daemon is marked not ready. */
-enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
-                           struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
+/* A render plan made on the shared context (context.c), and that context's generation: a
+ * render after a recovery makes its plan again on the new context. */
+struct srv_plan {
+	struct rnd_plan *plan;
+	unsigned gen;
+};
+/* The plan of scene on the shared context (rnd_plan_create): RND_OK, the plan's own error, or
+ * RND_ERR_DEVICE_LOST when there is no context (the render reports it). */
+enum rnd_result srv_plan(struct srv_server *s, const struct rnd_scene *scene, struct srv_plan *out,
+                         struct rnd_error *err);
+void srv_plan_release(struct srv_plan *p);
+/* Renders scene by its plan on the shared context (context.c): plan->plan made before (admission
+ * reads its estimate), or made here when it is NULL or of an older context. On
+ * RND_ERR_DEVICE_LOST, *lost_gen (if given) is the lost context's generation + 1, and the daemon
+ * is marked not ready. */
+enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct srv_plan *plan,
+                           struct rnd_image *img, struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
 /* Memory back to the system: shadow maps unused for idle_s seconds, the atlases' pages once no
  * map is left (rnd_context_trim), then malloc's free pages. Returns the atlas bytes released. */
 uint64_t srv_context_trim(struct srv_server *s, double idle_s);

@@ -65,34 +65,6 @@ static uint64_t input_bytes(const struct srv_request *req)
 	return n;
 }
 
-/* Admission by memory: the renderer's estimate of what the scene allocates, against
- * --max-memory (admit.h). Limits no retry can cure (one allocation over the device's limit)
- * answer 422 here, before the render. held: what its parse holds already (api_memory_gate).
- * 0 admitted (*need, held included, to release), else p is filled (held still to release). */
-static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t held,
-                 uint64_t *need, struct api_problem *p)
-{
-	struct rnd_estimate est;
-	struct rnd_error err = {0};
-	enum rnd_result r = RND_ERR_DEVICE_LOST;
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	if (s->ctx) r = rnd_render_estimate(s->ctx, &sc->scene, &est, &err);
-	pthread_rwlock_unlock(&s->ctx_lock);
-	if (r == RND_ERR_DEVICE_LOST) return 0; /* the render itself reports it */
-	if (r != RND_OK) {
-		api_problem_from_render(p, sc, &err, r == RND_ERR_LIMIT ? 422 : 400);
-		return -1;
-	}
-	uint64_t n = est.device_bytes + est.host_bytes;
-	double deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0;
-	if (srv_admit_grow(&s->admit, sc, held, n, deadline, p) != 0) {
-		if (p->status == 504) srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
-		return -1;
-	}
-	*need = held + n;
-	return 0;
-}
-
 static int render_status(enum rnd_result r)
 {
 	switch (r) {
@@ -103,6 +75,29 @@ static int render_status(enum rnd_result r)
 	case RND_ERR_DEVICE_LOST: return 503;   /* the context is recreated: a retry can succeed */
 	default: return 500;
 	}
+}
+
+/* Admission by memory: the render plan's estimate of what the scene allocates (the plan the
+ * render then executes: made once, here), against --max-memory (admit.h). held: what its
+ * parse holds already (api_memory_gate). 0 admitted (*need, held included, to release); -1
+ * refused (p is filled; held still to release); -2 no plan (*r, *err: the render's error, a
+ * limit no retry can cure among them: one allocation over the device's). */
+static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t held,
+                 struct srv_plan *plan, uint64_t *need, enum rnd_result *r, struct rnd_error *err, struct api_problem *p)
+{
+	struct rnd_estimate est;
+	*r = srv_plan(s, &sc->scene, plan, err);
+	if (*r == RND_ERR_DEVICE_LOST) return 0; /* the render itself reports it */
+	if (*r != RND_OK) return -2;
+	rnd_plan_estimate(plan->plan, &est);
+	uint64_t n = est.device_bytes + est.host_bytes;
+	double deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0;
+	if (srv_admit_grow(&s->admit, sc, held, n, deadline, p) != 0) {
+		if (p->status == 504) srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
+		return -1;
+	}
+	*need = held + n;
+	return 0;
 }
 
 /* The renderer's cancel callback: yield to a request that has waited half its deadline. */
@@ -323,7 +318,7 @@ static void job_render_stages(struct srv_server *s, const struct rnd_timings *t)
  * api_import_stage: only with a model read or imported), `parse` what is left of parsing (the
  * JSON, the checks, the cache look-ups), `device-wait` the wait for the device (one render at a
  * time on a CPU device: server/gate.h), so that the stages add up to all but the gaps between
- * them. */
+ * them. `plan` is the render plan's (made at admission, before the device wait). */
 static void format_timing(struct srv_request *req, const struct api_scene *sc, const struct rnd_timings *t,
                           double queue_ms, double parse_ms, double gate_ms, double encode_ms, double total_ms)
 {
@@ -338,10 +333,10 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 			if (w > 0) n += (size_t)w;
 		}
 	snprintf(req->server_timing, sizeof req->server_timing,
-	         "queue;dur=%.3f, parse;dur=%.3f%s, device-wait;dur=%.3f, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
-	         "readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
-	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, gate_ms, t->upload_ms, t->shadow_ms,
-	         t->main_ms, t->readback_ms, encode_ms, total_ms);
+	         "queue;dur=%.3f, parse;dur=%.3f%s, plan;dur=%.3f, device-wait;dur=%.3f, upload;dur=%.3f, shadow;dur=%.3f, "
+	         "main;dur=%.3f, readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
+	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, t->plan_ms, gate_ms, t->upload_ms,
+	         t->shadow_ms, t->main_ms, t->readback_ms, encode_ms, total_ms);
 }
 
 /* One request from the queue: parse, admit by memory, render, encode, answer. Returns the
@@ -364,6 +359,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	struct rnd_image img = { 0 };
 	struct rnd_timings t = { 0 };
 	struct rnd_error err = { 0 };
+	struct srv_plan plan = { 0 };
 	uint8_t *bytes = NULL;
 	size_t len = 0;
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
@@ -381,10 +377,11 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 		job_deadline(s, req, "before rendering", t1);
 		goto out;
 	}
-	if (admit(s, req, sc, admitted, &admitted, &p) != 0) {
-		job_problem(req, &p);
-		goto out;
-	}
+	enum rnd_result r = RND_OK;
+	int ar = admit(s, req, sc, admitted, &plan, &admitted, &r, &err, &p);
+	if (ar == -2) job_render_failed(s, req, sc, r, &err, false);
+	else if (ar != 0) job_problem(req, &p);
+	if (ar != 0) goto out;
 	struct render_watch watch = { .srv = s };
 	if (s->cfg.deadline_ms) {
 		sc->scene.deadline_ns = (uint64_t)((req->t_queued + s->cfg.deadline_ms / 1000.0) * 1e9);
@@ -400,7 +397,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 		goto out;
 	}
 	double gate_ms = (srv_now() - t_gate) * 1000.0;
-	enum rnd_result r = srv_render(s, &sc->scene, &img, &t, &err, &lost_gen);
+	r = srv_render(s, &sc->scene, &plan, &img, &t, &err, &lost_gen);
 	srv_gate_leave(&s->gate);
 	if (r != RND_OK) {
 		job_render_failed(s, req, sc, r, &err, watch.yielded);
@@ -427,6 +424,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	              (t3 - req->t_queued) * 1000.0);
 out:
 	rnd_image_release(&img);
+	srv_plan_release(&plan);
 	api_scene_free(sc);
 	srv_admit_release(&s->admit, admitted);
 	/* After an enormous request, its memory back to the system now: its freed heap, and its
