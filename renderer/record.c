@@ -308,6 +308,7 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		uint32_t i = k % ndraw;
 		const struct draw *d = &draws[i];
 		if (!d->index_count || d->closed != (k < ndraw)) continue;
+		if (rv->drawn_camera && rv->band_y == 0) *rv->drawn_camera += d->cam_index_count / 3;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
 		struct umbra_push_main push;

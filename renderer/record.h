@@ -39,6 +39,10 @@ struct record_view {
 	const double *map_ms;
 	const uint64_t *map_tris;
 	double row_ms, band_ms;
+	/* What the recorders drew, counted as they record (struct rnd_timings; NULL: not counted):
+	 * the camera's triangles in the main pass of the view's first band, the casters' triangles
+	 * of every shadow map drawn. */
+	uint64_t *drawn_camera, *drawn_shadow;
 };
 
 /* The rows of the view that this submit draws (band_y, band_h). */

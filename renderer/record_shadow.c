@@ -59,6 +59,7 @@ static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const s
 		uint64_t n = d.index_count / 3, a = lo > at ? lo - at : 0, b = hi - at < n ? hi - at : n;
 		at += n;
 		if (a >= b) continue;
+		if (rv->drawn_shadow) *rv->drawn_shadow += b - a;
 		d.first_index += (uint32_t)(3 * a);
 		d.index_count = (uint32_t)(3 * (b - a));
 		record_depth_draw(ctx, s, &d, cull, &push, &bound);

@@ -243,7 +243,6 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	enum rnd_result r;
 	rnd_plan_view_shadows(p, v, rq->sp);
 	rnd_plan_view_cull(p, v, rq->draws);
-	rq->tm.camera_triangles += vp->camera_triangles;
 	if (!rq->granted && (r = grant_tiles(rq, err)) != RND_OK) return r;
 	if ((r = place_tiles(rq, v, err)) != RND_OK) return r;
 	if (vp->contact && (r = rnd_slot_scene_depth(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
@@ -262,6 +261,7 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.color_offset = cell * sh->px, .aov_offset = sh->color_bytes + cell * 16, .aov_stride = sh->att_bytes,
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = vp->contact, .vis = vp->vis,
 		.map_ms = rq->map_ms, .map_tris = rq->map_tris, .row_ms = vp->row_ms, .band_ms = vp->band_ms,
+		.drawn_camera = &rq->tm.camera_triangles, .drawn_shadow = &rq->tm.shadow_triangles,
 	};
 	double shadow0 = rq->tm.shadow_ms, main0 = rq->tm.main_ms;
 	uint32_t bands0 = rq->pacer.measured;

@@ -106,10 +106,13 @@ enum srv_route {
 	SRV_ROUTE_PLAYGROUND,          /* GET / and /playground (server/playground.c) */
 	SRV_ROUTE_RENDERS,             /* POST /v1/renders: render, store, 303 to the GET form */
 	SRV_ROUTE_RESULT,              /* GET /v1/renders/{hash}.{ext} (server/renders_route.c) */
+	SRV_ROUTE_EXPLAIN,             /* POST /v1/explain: the render plan, nothing rendered (explain.c) */
 	SRV_ROUTE_OTHER,
 	SRV_ROUTE_COUNT
 };
 const char *srv_route_name(enum srv_route r);
+/* The routes that take a scene by POST: /v1/render, /v1/renders, /v1/explain. */
+bool srv_route_posts(enum srv_route r);
 
 enum srv_priority { SRV_PRIO_INTERACTIVE, SRV_PRIO_BULK, SRV_PRIO_COUNT };
 
@@ -204,6 +207,8 @@ struct srv_request {
 	struct srv_kept_scene kept;    /* POST /v1/renders: the scene for the result cache (results.h) */
 	char location[64];             /* the Location of a 303 */
 	int want;                      /* Accept's choice (enum srv_accept: PNG, EXR or WebP) */
+	bool explain;                  /* POST /v1/render?explain=1: the image and its plan (explain.c) */
+	char mime[128];                 /* content_type when it is made per answer (multipart/mixed) */
 	bool close_after;              /* answer with Connection: close (framing error) */
 	char cors_origin[SRV_ORIGIN_MAX]; /* an allowed cross-origin caller's Origin, echoed; "" = none */
 	bool cors_private_network;     /* its preflight asked Access-Control-Request-Private-Network */

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "explain.h"
 #include "imports.h"
 #include "log.h"
 #include "metrics.h"
@@ -167,6 +168,8 @@ static int job_identity(struct srv_server *s, struct srv_request *req, const str
 {
 	struct api_problem p = { 0 };
 	const char *mime = api_format_mime(sc->format);
+	if (req->route == SRV_ROUTE_EXPLAIN)
+		return 0;   /* a plan is no image: no ETag, no condition, nothing stored */
 	pthread_rwlock_rdlock(&s->ctx_lock);
 	req->etag_hash = srv_etag_of(sc->scene_hash, sc->asset_hash, mime, s->info.device_name, s->info.driver_info);
 	pthread_rwlock_unlock(&s->ctx_lock);
@@ -339,10 +342,43 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 	         t->shadow_ms, t->main_ms, t->readback_ms, encode_ms, total_ms);
 }
 
-/* One request from the queue: parse, admit by memory, render, encode, answer. Returns the
- * lost context's generation + 1 when its render lost the device (the caller recovers after
- * answering), else 0. */
-/* Answers req (or, on a worker, parks it for an import thread: *parked). Returns the lost
+/* After a render: the image encoded and answered (with its plan for ?explain=1: explain.c),
+ * unless the deadline passed meanwhile; Server-Timing. ms: queue, parse and device-wait. */
+static void job_encode(struct srv_server *s, struct srv_request *req, const struct api_scene *sc,
+                       const struct srv_plan *plan, const struct rnd_image *img, const struct rnd_timings *t,
+                       const double ms[3])
+{
+	struct api_problem p = { 0 };
+	uint8_t *bytes = NULL;
+	size_t len = 0;
+	double t2 = srv_now();
+	if (api_encode(sc, img, &bytes, &len, &p) != API_OK) {
+		job_problem(req, &p);
+		return;
+	}
+	double encode_s = srv_now() - t2;
+	srv_metrics_stage(s->metrics, SRV_STAGE_ENCODE, encode_s);
+	double t3 = srv_now();
+	if (past_deadline(s, req, t3)) {
+		free(bytes);
+		job_deadline(s, req, "while rendering", t3);
+		return;
+	}
+	if (!req->explain) {
+		job_answer(s, req, sc, bytes, len);
+	} else {
+		struct api_plan_times pt = { ms[1], encode_s * 1000.0, (t3 - req->t_queued) * 1000.0 };
+		if (!srv_explain_multipart(req, sc, plan->plan, &pt, bytes, len)) {
+			api_problem_set(&p, 503, "", "out of memory for the render's plan; retry, or ask without explain");
+			job_problem(req, &p);
+			return;
+		}
+	}
+	format_timing(req, sc, t, ms[0], ms[1], ms[2], encode_s * 1000.0, (t3 - req->t_queued) * 1000.0);
+}
+
+/* One request from the queue: parse, admit by memory, render, encode, answer (POST
+ * /v1/explain: parse and plan, explain.c). Answers req (or, on a worker, parks it for an import thread: *parked). Returns the lost
  * context's generation + 1 after a device loss, else 0. */
 static unsigned job_run(struct srv_server *s, struct srv_request *req, bool importer, bool *parked)
 {
@@ -360,8 +396,6 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	struct rnd_timings t = { 0 };
 	struct rnd_error err = { 0 };
 	struct srv_plan plan = { 0 };
-	uint8_t *bytes = NULL;
-	size_t len = 0;
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
 	double parse_s = 0;
 	uint64_t sent = input_bytes(req);
@@ -371,6 +405,10 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	admitted = ticket.reserved;
 	*parked = pr == 2;
 	if (pr) goto out;
+	if (req->route == SRV_ROUTE_EXPLAIN) {
+		srv_explain_answer(s, req, sc, parse_s * 1000.0);
+		goto out;
+	}
 
 	double t1 = srv_now();
 	if (past_deadline(s, req, t1)) {
@@ -404,24 +442,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 		goto out;
 	}
 	job_render_stages(s, &t);
-
-	double t2 = srv_now();
-	if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
-		job_problem(req, &p);
-		goto out;
-	}
-	double encode_s = srv_now() - t2;
-	srv_metrics_stage(s->metrics, SRV_STAGE_ENCODE, encode_s);
-
-	double t3 = srv_now();
-	if (past_deadline(s, req, t3)) {
-		free(bytes);
-		job_deadline(s, req, "while rendering", t3);
-		goto out;
-	}
-	job_answer(s, req, sc, bytes, len);
-	format_timing(req, sc, &t, (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, gate_ms, encode_s * 1000.0,
-	              (t3 - req->t_queued) * 1000.0);
+	job_encode(s, req, sc, &plan, &img, &t, (double[]){ (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, gate_ms });
 out:
 	rnd_image_release(&img);
 	srv_plan_release(&plan);

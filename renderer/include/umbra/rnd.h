@@ -426,6 +426,7 @@ struct rnd_timings {
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
 	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
+	uint64_t shadow_triangles; /* casters' triangles the shadow maps drew */
 	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
 	uint32_t shadow_parts;     /* submits of shadow maps drawn in parts (too costly for one) */
 };
