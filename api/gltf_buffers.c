@@ -113,7 +113,7 @@ int api_gltf_view_bytes(struct api_gltf_bufs *b, json_t *view, const char *what,
 	return 0;
 }
 
-static int type_comps(const char *t)
+int api_gltf_type_components(const char *t)
 {
 	static const char *const NAMES[] = {"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"};
 	static const int COMPS[] = {1, 2, 3, 4, 4, 9, 16};
@@ -122,7 +122,7 @@ static int type_comps(const char *t)
 	return 0;
 }
 
-static size_t comp_size(json_int_t ct)
+size_t api_gltf_component_size(json_int_t ct)
 {
 	return ct == 5126 || ct == 5125 ? 4 : ct == 5120 || ct == 5121 ? 1 : ct == 5122 || ct == 5123 ? 2 : 0;
 }
@@ -145,8 +145,8 @@ int api_gltf_accessor_floats(struct api_gltf_bufs *b, json_t *acc, const char *w
 	*out = NULL;
 	json_int_t ct = json_integer_value(json_object_get(acc, "componentType"));
 	json_int_t n = json_integer_value(json_object_get(acc, "count"));
-	int nc = type_comps(json_string_value(json_object_get(acc, "type")));
-	size_t cs = comp_size(ct);
+	int nc = api_gltf_type_components(json_string_value(json_object_get(acc, "type")));
+	size_t cs = api_gltf_component_size(ct);
 	if (!nc || !cs || n < 1 || n > (1 << 28))
 		return api_err_set(err, errsize, "%s: an accessor of an unknown type or count", what), -1;
 	json_t *views = json_object_get(b->root, "bufferViews"), *vi = json_object_get(acc, "bufferView");
@@ -182,7 +182,7 @@ long api_gltf_made_bytes(struct api_gltf_bufs *b, const void *bytes, size_t n)
 		size_t cap = b->made_cap ? b->made_cap : 4096;
 		while (cap < at + n) cap *= 2;
 		uint8_t *m = realloc(b->made, cap);
-		if (!m) return -1;
+		if (!m) return b->oom = true, -1;
 		memset(m + b->made_cap, 0, cap - b->made_cap);
 		b->made = m;
 		b->made_cap = cap;

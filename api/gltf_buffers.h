@@ -48,6 +48,7 @@ struct api_gltf_bufs {
 	long made_index;                  /* -1 until the first api_gltf_made_bytes */
 	struct api_gltf_bytes made_view_;  /* api_gltf_buffer(made_index): the made bytes so far */
 	struct api_model_file *all_files; /* api_gltf_bufs_files */
+	bool oom;                         /* an allocation failed: over the memory limit, not a bad file */
 };
 
 void api_gltf_bufs_init(struct api_gltf_bufs *b, json_t *root, const uint8_t *data, size_t len, bool glb,
@@ -62,6 +63,10 @@ int api_gltf_buffer(struct api_gltf_bufs *b, size_t bi, const struct api_gltf_by
 /* bufferView `vi`'s bytes, checked inside its buffer. 0, or -1 with err naming `what`. */
 int api_gltf_view_bytes(struct api_gltf_bufs *b, json_t *view, const char *what, const uint8_t **p, size_t *n,
                         char *err, size_t errsize);
+/* The components of an accessor type ("SCALAR" 1 .. "MAT4" 16; 0 unknown) and the bytes of
+ * a componentType (5120 BYTE .. 5126 FLOAT; 0 unknown). */
+int api_gltf_type_components(const char *type);
+size_t api_gltf_component_size(json_int_t component_type);
 /* Accessor `acc` (an object of the document) as count x comps floats (malloc'd, yours; *count
  * its count; comps from its type, at most 16), normalized integers mapped as glTF says,
  * plain integers as their values. 0, or -1 with err naming `what` (out of its view, no
@@ -69,7 +74,7 @@ int api_gltf_view_bytes(struct api_gltf_bufs *b, json_t *view, const char *what,
 int api_gltf_accessor_floats(struct api_gltf_bufs *b, json_t *acc, const char *what, float **out, size_t *count,
                              int *comps, char *err, size_t errsize);
 /* Appends n bytes (at a 4-aligned offset) to the made buffer: that offset in it (its buffer
- * index is b->made_index), or -1 (out of memory, or past 2 GB). */
+ * index is b->made_index), or -1 (out of memory: b->oom, or past 2 GB). */
 long api_gltf_made_bytes(struct api_gltf_bufs *b, const void *bytes, size_t n);
 /* The same, and a bufferView of them added to the document: its index, or -1. */
 long api_gltf_made_view(struct api_gltf_bufs *b, const void *bytes, size_t n);

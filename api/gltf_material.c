@@ -26,7 +26,7 @@ static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "
                                              "KHR_materials_clearcoat", "KHR_materials_sheen",
                                              "KHR_materials_specular", "KHR_materials_ior",
                                              "EXT_mesh_gpu_instancing", "EXT_meshopt_compression",
-                                             "KHR_mesh_quantization", NULL};
+                                             "KHR_mesh_quantization", "KHR_draco_mesh_compression", NULL};
 /* Extensions known and not drawn (or drawn in part): what the picture lacks. */
 static const char *const LACKS[][2] = {
 	{"KHR_materials_transmission", "transmission drawn as see-through coverage (dithered), not refraction"},
@@ -38,7 +38,6 @@ static const char *const LACKS[][2] = {
 	{"KHR_texture_basisu", "KTX2/Basis textures not decoded: those materials drawn without their textures"},
 	{"EXT_texture_webp", "WebP textures not decoded: those materials drawn without their textures (or with a PNG/JPEG fallback)"},
 	{"KHR_lights_punctual", "the file's lights not used (the scene's lights are)"},
-	{"KHR_draco_mesh_compression", "Draco meshes not decoded: the uncompressed fallback drawn"},
 	{NULL, NULL},
 };
 

@@ -533,10 +533,11 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		                      &io_files, &io_nfiles, err, errsize);
 		json_decref(root);
 		if (rc != 0) {
+			bool oom = bufs.oom;   /* a decode over the memory limit, not a bad file */
 			free(tagged);
 			api_gltf_bufs_release(&bufs);
 			api_gltf_info_free(&c.gi);
-			return API_WIRE_BAD_INPUT;
+			return oom ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 		}
 		if (tagged) {
 			data = tagged;

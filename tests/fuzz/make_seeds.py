@@ -92,6 +92,10 @@ j += b" " * (-len(j) % 4)
 qbuf += b"\0" * (-len(qbuf) % 4)
 put("fuzz_model_glb", "quantized.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(qbuf)) +
     struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(qbuf)) + b"BIN\0" + qbuf)
+# draco.glb (KHR_draco_mesh_compression, a quad) is not written here: Python has no Draco
+# encoder. It is tests/util/models.c's test_draco_glb() of the quad (0,0,0)..(1,1,0) with
+# normals +z and uvs, edgebreaker, 11-bit positions, UNSIGNED_SHORT indices, written by a
+# three-line C main linked with tests/util/models.o and draco_encode.o; committed as is.
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
     return b"UMBRAIMP" + struct.pack("<IIII", 5, kind, status, len(msg)) + msg
