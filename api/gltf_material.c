@@ -20,7 +20,7 @@
 static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {
 	"baseColorTexture", "metallicRoughnessTexture", "normalTexture", "occlusionTexture", "emissiveTexture",
 	"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture", "sheenColorTexture",
-	"sheenRoughnessTexture", "specularTexture", "specularColorTexture"};
+	"sheenRoughnessTexture", "specularTexture", "specularColorTexture", "transmissionTexture"};
 static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform",
                                              "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
                                              "KHR_materials_clearcoat", "KHR_materials_sheen",
@@ -133,29 +133,6 @@ void api_gltf_read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, 
 	if (slot == RND_TEX_OCCLUSION) gm->occlusion_strength = fminf(fmaxf(num(info, "strength", 1), 0), 1);
 }
 
-/* The specular-glossiness model has no exact metallic-roughness equal; what is kept is what
- * shows most in a picture (the diffuse colour and how glossy), what is not is warned. */
-static void read_spec_gloss(struct api_gltf_info *gi, uint32_t mi, const char *mname, json_t *sg,
-                            struct api_gltf_material *gm)
-{
-	gm->spec_gloss = true;
-	json_t *d = json_object_get(sg, "diffuseFactor"), *sp = json_object_get(sg, "specularFactor");
-	for (int k = 0; k < 4; k++) {
-		json_t *e = json_array_get(d, (size_t)k);
-		double x = json_is_number(e) ? json_number_value(e) : 1;
-		gm->diffuse[k] = isfinite(x) ? fminf(fmaxf((float)x, 0), 1) : 1;
-	}
-	gm->glossiness = fminf(fmaxf(num(sg, "glossinessFactor", 1), 0), 1);
-	bool white = true;
-	for (int k = 0; k < 3; k++) {
-		json_t *e = json_array_get(sp, (size_t)k);
-		white = white && (!json_is_number(e) || json_number_value(e) == 1);
-	}
-	if (json_object_get(sg, "specularGlossinessTexture") || !white)
-		api_gltf_warn(gi, "material %u (\"%.40s\"): specular-glossiness drawn as metallic-roughness (diffuse as base "
-		              "colour, glossinessFactor as roughness; the specular colour and texture are not used)", mi, mname);
-}
-
 static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, json_t *mat, struct api_gltf_material *gm)
 {
 	memset(gm, 0, sizeof *gm);
@@ -185,9 +162,9 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 			gm->emissive_strength = s >= 0 ? s : 1;
 		}
 		if (!strcmp(key, "KHR_materials_unlit")) gm->unlit = true;
-		if (!strcmp(key, "KHR_materials_pbrSpecularGlossiness") && !pbr) read_spec_gloss(gi, mi, name, v, gm);
 	}
-	api_gltf_read_material_ext(gi, root, mi, name, ext, gm);
+	/* Specular-glossiness where the file has no metallic-roughness fallback. */
+	api_gltf_read_material_ext(gi, root, mi, name, ext, !pbr, gm);
 }
 
 /* Extensions the renderer does not know, and parts of a scene it does not draw. */
@@ -252,17 +229,24 @@ void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, s
 	if (index >= gi->material_count) return;
 	const struct api_gltf_material *gm = &gi->materials[index];
 	if (gm->spec_gloss) {
+		/* F0 is the specular colour (api_gltf_read_material_ext); the metallic-roughness
+		 * slot, when there is a specularGlossinessTexture, is made of its alpha
+		 * (api/model_material.c): roughness 1 - glossiness x A. */
 		memcpy(m->base_color, gm->diffuse, sizeof gm->diffuse);
 		m->metallic = 0;
-		m->roughness = 1 - gm->glossiness;
-		m->metal_rough_texture = NULL;
+		m->roughness = m->metal_rough_texture ? 1 : 1 - gm->glossiness;
 	}
 	if (gm->transmission > 0 && m->alpha_mode != RND_ALPHA_MASK) {
 		float t[3];
 		api_gltf_volume_transmittance(gm, t);
+		float see = 0.8f * gm->transmission * (t[0] + t[1] + t[2]) / 3;
 		m->alpha_mode = RND_ALPHA_BLEND;
-		m->base_color[3] *= 1 - 0.8f * gm->transmission * (t[0] + t[1] + t[2]) / 3;
+		/* transmissionTexture R scales the factor per pixel: the renderer's see-through slot */
+		if (m->transmission_texture) m->see_through = see;
+		else m->base_color[3] *= 1 - see;
 		for (int k = 0; k < 3; k++) m->base_color[k] *= t[k];
+	} else {
+		m->transmission_texture = NULL;
 	}
 	if (gm->unlit) {
 		for (int k = 0; k < 3; k++) {

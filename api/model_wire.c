@@ -63,13 +63,16 @@ void api_wire_put_image(struct api_wire_buf *b, const uint8_t *rgba, uint32_t w,
 	put(b, rgba, (size_t)w * h * 4);
 }
 
+/* Beside the RND_EXT_* bits of a material on the wire: its specular.spec_gloss. */
+#define WIRE_SPEC_GLOSS (1u << 16)
+
 static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, const struct rnd_texture *const *tex,
                          uint32_t ntex)
 {
 	float f[13] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
 	               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff,
-	               mt->normal_scale, mt->occlusion_strength, 0};
-	put(b, f, sizeof f); /* the last one reserved, zero */
+	               mt->normal_scale, mt->occlusion_strength, mt->see_through};
+	put(b, f, sizeof f);
 	put_u32(b, (uint32_t)mt->alpha_mode);
 	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
 		int32_t ti = -1;
@@ -84,7 +87,7 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 		           (uint32_t)(ts->uv_set == 1) << 9);
 		put(b, ts->transform, sizeof ts->transform);
 	}
-	put_u32(b, mt->extensions);
+	put_u32(b, mt->extensions | (mt->specular.spec_gloss ? WIRE_SPEC_GLOSS : 0));
 	float e[11] = {mt->clearcoat.factor, mt->clearcoat.roughness, mt->clearcoat.normal_scale, mt->sheen.color[0],
 	               mt->sheen.color[1], mt->sheen.color[2], mt->sheen.roughness, mt->specular.factor,
 	               mt->specular.color[0], mt->specular.color[1], mt->specular.color[2]};
@@ -307,6 +310,8 @@ static enum api_result decode_extensions(struct dec *d, uint32_t i, struct rnd_m
 	uint32_t bits;
 	float e[12];
 	if (!take_u32(&d->r, &bits) || !take(&d->r, e, sizeof e)) return bad(&d->r, "material %u is cut short", i);
+	m->specular.spec_gloss = bits & WIRE_SPEC_GLOSS;
+	bits &= ~WIRE_SPEC_GLOSS;
 	bool ok = bits <= (RND_EXT_CLEARCOAT | RND_EXT_SHEEN | RND_EXT_SPECULAR) && in_range(e, 2, 0, 1) &&
 	          in_range(e + 2, 1, -1e3f, 1e3f) && in_range(e + 3, 5, 0, 1) && in_range(e + 8, 3, 0, 1e6f) &&
 	          in_range(e + 11, 1, 0, 1e6f);
@@ -335,7 +340,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++)
 			if (!take_u32(&d->r, &packed[s]) || !take(&d->r, tf[s], sizeof tf[s]))
 				return bad(&d->r, "material %u is cut short", i);
-		bool ok = finite_all(f, 13) && f[12] == 0;
+		bool ok = finite_all(f, 13) && f[12] >= 0 && f[12] <= 1;
 		for (int k = 0; k < 3; k++) ok = ok && f[k] >= 0 && f[k] <= 1e6f && f[6 + k] >= 0 && f[6 + k] <= 1e6f;
 		ok = ok && f[3] >= 0 && f[3] <= 1 && f[4] >= 0 && f[4] <= 1 && f[5] >= 0 && f[5] <= 1 && f[9] >= 0 &&
 		     f[9] <= 1 && fabsf(f[10]) <= 1e3f && f[11] >= 0 && f[11] <= 1;
@@ -366,6 +371,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 		m->alpha_cutoff = f[9];
 		m->normal_scale = f[10];
 		m->occlusion_strength = f[11];
+		m->see_through = f[12];
 		m->alpha_mode = (enum rnd_alpha_mode)mode;
 	}
 	return API_OK;
