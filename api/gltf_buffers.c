@@ -38,6 +38,46 @@ void api_gltf_bufs_release(struct api_gltf_bufs *b)
 	memset(b, 0, sizeof *b);
 }
 
+const char *api_gltf_json_of(const uint8_t *d, size_t len, bool glb, const char **json, size_t *jlen)
+{
+	*json = (const char *)d;
+	*jlen = len;
+	if (!glb) return NULL;
+	if (len < 20 || memcmp(d + 16, "JSON", 4)) return "the glb has no JSON chunk";
+	uint32_t n = le32(d + 12);
+	if (n > len - 20) return "the glb's JSON chunk is longer than the file";
+	*json = (const char *)d + 20;
+	*jlen = n;
+	return NULL;
+}
+
+uint8_t *api_gltf_with_json(const uint8_t *d, size_t len, bool glb, const char *js, size_t jn, size_t *out_len)
+{
+	uint8_t *out = NULL;
+	if (!glb) {
+		if ((out = malloc(jn ? jn : 1))) memcpy(out, js, jn);
+		*out_len = jn;
+		return out;
+	}
+	/* header, the new JSON chunk, then the original chunks after the JSON one */
+	size_t jpad = (jn + 3) & ~(size_t)3;
+	size_t rest_at = len >= 20 ? 20 + (size_t)le32(d + 12) : len, rest = rest_at <= len ? len - rest_at : 0;
+	size_t total = 20 + jpad + rest;
+	if (total > UINT32_MAX || !(out = malloc(total))) return NULL;
+	memcpy(out, d, 12);
+	uint32_t t32 = (uint32_t)total, j32 = (uint32_t)jpad;
+	for (int k = 0; k < 4; k++) {
+		out[8 + k] = (uint8_t)(t32 >> (8 * k));
+		out[12 + k] = (uint8_t)(j32 >> (8 * k));
+	}
+	memcpy(out + 16, "JSON", 4);
+	memcpy(out + 20, js, jn);
+	memset(out + 20 + jn, ' ', jpad - jn);
+	memcpy(out + 20 + jpad, d + rest_at, rest);
+	*out_len = total;
+	return out;
+}
+
 /* A glb's BIN chunk: the chunk after the JSON one, if its type is BIN. */
 static void glb_bin(const uint8_t *d, size_t len, struct api_gltf_bytes *out)
 {

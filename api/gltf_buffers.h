@@ -80,6 +80,13 @@ long api_gltf_made_bytes(struct api_gltf_bufs *b, const void *bytes, size_t n);
 long api_gltf_made_view(struct api_gltf_bufs *b, const void *bytes, size_t n);
 /* Adds the made buffer to root's buffers (uri API_GLTF_MADE_FILE) if there is one. */
 int api_gltf_bufs_finish(struct api_gltf_bufs *b);
+/* The glTF JSON of a model file: a .glb's JSON chunk (*json, *jlen inside d), or the whole of
+ * a .gltf. NULL, or what is wrong with the glb ("the glb has no JSON chunk", ...). */
+const char *api_gltf_json_of(const uint8_t *d, size_t len, bool glb, const char **json, size_t *jlen);
+/* The model file d with its JSON replaced by js[0..jn) (a .glb keeps its chunks after the JSON
+ * one, the JSON chunk padded with spaces): malloc'd (*out_len bytes; you free it), or NULL
+ * (out of memory, over 4 GB). */
+uint8_t *api_gltf_with_json(const uint8_t *d, size_t len, bool glb, const char *js, size_t jn, size_t *out_len);
 /* Removes `name` from root's list `key` ("extensionsUsed", "extensionsRequired") if there. */
 void api_gltf_drop_extension_name(json_t *root, const char *key, const char *name);
 /* The files to import with: the caller's, and the made buffer when there is one (b owns the

@@ -6,7 +6,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "gltf_buffers.h"
 #include "gltf_material.h"
+#include "gltf_variants.h"
 
 /* glTF sampler enums (OpenGL's) */
 #define GL_NEAREST 9728
@@ -34,7 +36,6 @@ static const char *const LACKS[][2] = {
 	                         "thicknessFactor x its texture's mean), no refraction"},
 	{"KHR_materials_iridescence", "iridescence not drawn"},
 	{"KHR_materials_anisotropy", "anisotropy not drawn (isotropic highlights)"},
-	{"KHR_materials_variants", "variants: the default materials drawn"},
 	{"KHR_texture_basisu", "KTX2/Basis textures not decoded: those materials drawn without their textures"},
 	{"EXT_texture_webp", "WebP textures not decoded: those materials drawn without their textures (or with a PNG/JPEG fallback)"},
 	{"KHR_lights_punctual", "the file's lights not used (the scene's lights are)"},
@@ -175,6 +176,13 @@ static void scene_warnings(struct api_gltf_info *gi, json_t *root)
 	json_array_foreach(used, i, e) {
 		const char *s = json_string_value(e);
 		bool known = false;
+		if (s && !strcmp(s, "KHR_materials_variants")) {   /* a variant picked leaves no name here */
+			char names[200];
+			api_gltf_variant_names(root, names, sizeof names);
+			api_gltf_warn(gi, "KHR_materials_variants: the default materials drawn (the model object's \"variant\" "
+			              "picks one of %s)", names[0] ? names : "none");
+			continue;
+		}
 		for (int k = 0; s && SUPPORTED_EXT[k]; k++) known = known || !strcmp(s, SUPPORTED_EXT[k]);
 		for (int k = 0; s && !known && LACKS[k][0]; k++)
 			if (!strcmp(s, LACKS[k][0])) {
@@ -312,31 +320,7 @@ uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, b
 	}
 	char *js = json_dumps(root, JSON_COMPACT);
 	if (!js) return NULL;
-	size_t jn = strlen(js), jpad = (jn + 3) & ~(size_t)3;
-	uint8_t *out = NULL;
-	if (!glb) {
-		out = malloc(jn ? jn : 1);
-		if (out) memcpy(out, js, jn);
-		*out_len = jn;
-	} else {
-		/* header, the new JSON chunk, then the original chunks after the JSON one */
-		uint32_t old = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 | (uint32_t)data[15] << 24;
-		size_t rest_at = 20 + (size_t)old, rest = rest_at <= len ? len - rest_at : 0;
-		size_t total = 20 + jpad + rest;
-		if (total <= UINT32_MAX && (out = malloc(total))) {
-			memcpy(out, data, 12);
-			uint32_t t32 = (uint32_t)total, j32 = (uint32_t)jpad;
-			for (int k = 0; k < 4; k++) {
-				out[8 + k] = (uint8_t)(t32 >> (8 * k));
-				out[12 + k] = (uint8_t)(j32 >> (8 * k));
-			}
-			memcpy(out + 16, "JSON", 4);
-			memcpy(out + 20, js, jn);
-			memset(out + 20 + jn, ' ', jpad - jn);
-			memcpy(out + 20 + jpad, data + rest_at, rest);
-			*out_len = total;
-		}
-	}
+	uint8_t *out = api_gltf_with_json(data, len, glb, js, strlen(js), out_len);
 	free(js);
 	return out;
 }
