@@ -106,6 +106,29 @@ static void stop_server(void)
 	server_pid = -1;
 }
 
+char **api_sbx_helper_env(char *const *env, char **own)
+{
+	static const char tunable[] = "glibc.malloc.hugetlb=1";
+	size_t n = 0;
+	const char *old = NULL;
+	for (; env[n]; n++)
+		if (!strncmp(env[n], "GLIBC_TUNABLES=", 15)) old = env[n] + 15;
+	char **out = calloc(n + 2, sizeof *out);
+	size_t len = sizeof "GLIBC_TUNABLES=" + sizeof tunable + (old ? strlen(old) + 1 : 0);
+	*own = malloc(len);
+	if (!out || !*own) {
+		free(out);
+		free(*own);
+		return *own = NULL, NULL;
+	}
+	snprintf(*own, len, "GLIBC_TUNABLES=%s%s%s", old ? old : "", old ? ":" : "", tunable);
+	size_t k = 0;
+	for (size_t i = 0; i < n; i++)
+		if (strncmp(env[i], "GLIBC_TUNABLES=", 15)) out[k++] = env[i];
+	out[k] = *own;
+	return out;
+}
+
 /* With start_mu held. posix_spawn (vfork-like) is safe in a multithreaded process. */
 static int start_server(char *err, size_t errsize)
 {
@@ -132,9 +155,11 @@ static int start_server(char *err, size_t errsize)
 	posix_spawnattr_setsigmask(&at, &none);
 	posix_spawnattr_setsigdefault(&at, &all);
 	posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-	char *argv[] = {helper, "--fork-server", NULL};
+	char *argv[] = {helper, "--fork-server", NULL}, *tunables = NULL, **env = api_sbx_helper_env(environ, &tunables);
 	pid_t pid;
-	int rc = child_end < 0 ? errno : posix_spawn(&pid, helper, &fa, &at, argv, environ);
+	int rc = child_end < 0 ? errno : posix_spawn(&pid, helper, &fa, &at, argv, env ? env : environ);
+	free(env);
+	free(tunables);
 	posix_spawn_file_actions_destroy(&fa);
 	posix_spawnattr_destroy(&at);
 	if (child_end >= 0) close(child_end);

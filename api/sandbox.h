@@ -134,6 +134,15 @@ struct api_sbx_status {
 	uint32_t reserved;
 };
 
+/* The helper's environment: env with glibc's malloc asked for transparent huge pages
+ * (GLIBC_TUNABLES gets glibc.malloc.hugetlb=1 appended, or is added: madvise on the heap and
+ * on big blocks; glibc 2.35+, a no-op where the kernel's THP is off). An import writes its
+ * memory once, fresh from the kernel: with 4 KiB pages a 1M-triangle STL took a page fault
+ * every 4 KiB, a fifth of its time on a virtualised machine, and its whole import took twice
+ * as long. Returns a malloc'd array (the variables point into env, but GLIBC_TUNABLES into
+ * *own, malloc'd too), or NULL (and *own NULL) when out of memory. */
+char **api_sbx_helper_env(char *const *env, char **own);
+
 /* The helper's main (api/helper/umbra_import.c calls it): `umbra-import --fork-server`. */
 int api_sandbox_helper_main(int argc, char **argv);
 

@@ -440,3 +440,22 @@ TEST(sandbox_stl_normals_follow_the_winding)
 	      m->meshes[0].vertex_count);
 	api_model_release(m);
 }
+
+/* ---- the helper's environment ---- */
+
+TEST(sandbox_helper_env_asks_for_huge_pages)
+{
+	char *plain[] = {"PATH=/bin", "HOME=/x", NULL}, *tuned[] = {"A=1", "GLIBC_TUNABLES=glibc.malloc.arena_max=2", "B=2", NULL};
+	char *own = NULL, **env = api_sbx_helper_env(plain, &own);
+	REQUIRE(env && own);
+	CHECK(!strcmp(env[0], "PATH=/bin") && !strcmp(env[1], "HOME=/x"), "the rest kept: %s %s", env[0], env[1]);
+	CHECK(!strcmp(env[2], "GLIBC_TUNABLES=glibc.malloc.hugetlb=1") && !env[3], "added: %s", env[2]);
+	free(env);
+	free(own);
+	env = api_sbx_helper_env(tuned, &own);
+	REQUIRE(env && own);
+	CHECK(!strcmp(env[0], "A=1") && !strcmp(env[1], "B=2") && !env[3], "the rest kept, once each");
+	CHECK(!strcmp(env[2], "GLIBC_TUNABLES=glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1"), "appended: %s", env[2]);
+	free(env);
+	free(own);
+}
