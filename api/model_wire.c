@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <unistd.h>
 #include "model_wire.h"
 
 #define MAX_TEXTURES 4096u
@@ -21,9 +23,37 @@ void api_wire_buf_release(struct api_wire_buf *b)
 	memset(b, 0, sizeof *b);
 }
 
+/* Sink: what is staged, written out to b->fd. */
+static void sink_write(struct api_wire_buf *b, const uint8_t *p, size_t n)
+{
+	while (n && !b->failed) {
+		ssize_t w = write(b->fd, p, n);
+		if (w < 0 && errno == EINTR) continue;
+		if (w <= 0) b->failed = 1;
+		else p += w, n -= (size_t)w;
+	}
+}
+
+int api_wire_flush(struct api_wire_buf *b)
+{
+	if (b->fd > 0 && b->staged) sink_write(b, b->data, b->staged);
+	b->staged = 0;
+	return b->failed ? -1 : 0;
+}
+
 static void put(struct api_wire_buf *b, const void *p, size_t n)
 {
 	if (b->failed || !n) return;
+	if (b->fd > 0) {
+		/* Small puts gather in a staging buffer; big arrays go straight from where they are. */
+		enum { STAGE = 64 * 1024 };
+		if (!b->data && !(b->data = malloc(STAGE))) { b->failed = 1; return; }
+		if (b->staged + n > STAGE) api_wire_flush(b);
+		if (n >= STAGE) sink_write(b, p, n);
+		else memcpy(b->data + b->staged, p, n), b->staged += n;
+		b->len += n;
+		return;
+	}
 	if (n > b->cap - b->len) {
 		size_t cap = b->cap ? b->cap : 4096;
 		while (cap - b->len < n) {
@@ -130,6 +160,8 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 	put_u32(b, m->instance_count);
 	put_u32(b, (uint32_t)wlen);
 	put(b, m->warnings, wlen);
+	static const uint8_t zero[4];
+	put(b, zero, (4 - wlen % 4) % 4);   /* what follows stays 4-byte aligned */
 	for (uint32_t i = 0; i < ntex; i++) api_wire_put_image(b, tex[i]->rgba, tex[i]->width, tex[i]->height);
 	for (uint32_t i = 0; i < m->material_count; i++) put_material(b, &m->materials[i], tex, ntex);
 	for (uint32_t i = 0; i < m->mesh_count; i++) {
@@ -234,15 +266,22 @@ enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_k
 	return API_OK;
 }
 
-static enum api_result read_image(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h, const uint8_t **px)
+/* An image's size, checked against max_pixels and the bytes left: its pixels follow. */
+static enum api_result read_image_size(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h)
 {
 	if (!take_u32(r, w) || !take_u32(r, h)) return bad(r, "an image size is cut short");
 	uint64_t n = (uint64_t)*w * *h;
 	if (!n || n > max_pixels) return bad(r, "an image of %ux%u pixels", *w, *h);
 	if (!fits(r, n, 4)) return bad(r, "an image's pixels are cut short");
+	return API_OK;
+}
+
+static enum api_result read_image(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h, const uint8_t **px)
+{
+	if (read_image_size(r, max_pixels, w, h) != API_OK) return API_ERR;
 	*px = r->p;
-	r->p += n * 4;
-	r->left -= n * 4;
+	r->p += (size_t)*w * *h * 4;
+	r->left -= (size_t)*w * *h * 4;
 	return API_OK;
 }
 
@@ -267,12 +306,31 @@ struct dec {
 	struct rd r;
 	struct api_arena *arena;
 	size_t bytes;
+	unsigned flags;   /* API_WIRE_IN_PLACE */
 };
 
 static void *dec_alloc(struct dec *d, size_t n, size_t size)
 {
 	void *p = api_arena_calloc(d->arena, n ? n : 1, size);
 	if (p) d->bytes += (n ? n : 1) * size;
+	return p;
+}
+
+/* The next n * size bytes (the caller checked that they remain) as an array: where they lie
+ * (API_WIRE_IN_PLACE, 4-byte aligned) or a copy in the arena; NULL when out of memory. */
+static void *take_array(struct dec *d, size_t n, size_t size)
+{
+	void *p;
+	if ((d->flags & API_WIRE_IN_PLACE) && !((uintptr_t)d->r.p & 3)) {
+		p = (void *)d->r.p;
+		d->bytes += n * size;
+	} else if (!(p = dec_alloc(d, n, size))) {
+		return NULL;
+	} else {
+		memcpy(p, d->r.p, n * size);
+	}
+	d->r.p += n * size;
+	d->r.left -= n * size;
 	return p;
 }
 
@@ -345,21 +403,16 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 255)
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
 	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 128 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
-	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u is cut short", i);
-	float *pos = dec_alloc(d, nv, 12), *nrm = flags & 1 ? dec_alloc(d, nv, 12) : NULL;
-	float *uv = flags & 2 ? dec_alloc(d, nv, 8) : NULL, *uv1 = flags & 128 ? dec_alloc(d, nv, 8) : NULL;
-	uint8_t *col = flags & 4 ? dec_alloc(d, nv, 4) : NULL;
-	float *tan = flags & 8 ? dec_alloc(d, nv, 16) : NULL;
-	uint32_t *idx = dec_alloc(d, ni, 4);
+	/* (per_vertex <= 60 and ni * 4 fit the reply: nothing below overflows) */
+	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4) || (uint64_t)nv * per_vertex > d->r.left - (uint64_t)ni * 4)
+		return bad(&d->r, "mesh %u is cut short", i);
+	const float *pos = take_array(d, nv, 12), *nrm = flags & 1 ? take_array(d, nv, 12) : NULL;
+	const float *uv = flags & 2 ? take_array(d, nv, 8) : NULL, *uv1 = flags & 128 ? take_array(d, nv, 8) : NULL;
+	const uint8_t *col = flags & 4 ? take_array(d, nv, 4) : NULL;
+	const float *tan = flags & 8 ? take_array(d, nv, 16) : NULL;
+	const uint32_t *idx = take_array(d, ni, 4);
 	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || ((flags & 128) && !uv1) || ((flags & 4) && !col) || ((flags & 8) && !tan) || !idx)
 		return bad(&d->r, "out of memory");
-	take(&d->r, pos, (size_t)nv * 12);
-	if (nrm) take(&d->r, nrm, (size_t)nv * 12);
-	if (uv) take(&d->r, uv, (size_t)nv * 8);
-	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
-	if (col) take(&d->r, col, (size_t)nv * 4);
-	if (tan) take(&d->r, tan, (size_t)nv * 16);
-	if (!take(&d->r, idx, (size_t)ni * 4)) return bad(&d->r, "mesh %u is cut short", i);
 	if (!finite_all(pos, (size_t)nv * 3) || (nrm && !finite_all(nrm, (size_t)nv * 3)) ||
 	    (uv && !finite_all(uv, (size_t)nv * 2)) || (uv1 && !finite_all(uv1, (size_t)nv * 2)) ||
 	    (tan && !finite_all(tan, (size_t)nv * 4)))
@@ -380,11 +433,11 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 	return API_OK;
 }
 
-enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct api_arena *arena,
+enum api_result api_wire_decode_model(const uint8_t *body, size_t len, unsigned flags, struct api_arena *arena,
                                       uint64_t max_texture_pixels, struct api_model *out, size_t *bytes,
                                       char *err, size_t errsize)
 {
-	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
+	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0, flags};
 	uint32_t ntex, nmat, nmesh, ninst, nwarn, tside, tmax;
 	float times[4];
 	if (!take(&d.r, times, sizeof times) || !take_u32(&d.r, &tside) || !take_u32(&d.r, &tmax))
@@ -403,6 +456,8 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 		for (uint32_t k = 0; k < nwarn; k++)
 			if (warn[k] < 0x20 || warn[k] > 0x7e) warn[k] = '?';
 	}
+	uint8_t pad[4] = {0};
+	if (!take(&d.r, pad, (4 - nwarn % 4) % 4) || pad[0] || pad[1] || pad[2]) return bad(&d.r, "the warnings' padding");
 	/* Each item has a smallest size on the wire (texture 8, material 216, mesh 16, instance 68
 	 * bytes): counts the reply's bytes cannot hold are lies caught before allocating (the arrays
 	 * are larger in memory than on the wire, and zeroed). */
@@ -415,12 +470,8 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 	struct api_model_instance *inst = dec_alloc(&d, ninst, sizeof *inst);
 	if (!tex || !mats || !meshes || !inst) return bad(&d.r, "out of memory");
 	for (uint32_t i = 0; i < ntex; i++) {
-		const uint8_t *px;
-		if (read_image(&d.r, max_texture_pixels, &tex[i].width, &tex[i].height, &px) != API_OK) return API_ERR;
-		uint8_t *copy = dec_alloc(&d, (size_t)tex[i].width * tex[i].height, 4);
-		if (!copy) return bad(&d.r, "out of memory");
-		memcpy(copy, px, (size_t)tex[i].width * tex[i].height * 4);
-		tex[i].rgba = copy;
+		if (read_image_size(&d.r, max_texture_pixels, &tex[i].width, &tex[i].height) != API_OK) return API_ERR;
+		if (!(tex[i].rgba = take_array(&d, (size_t)tex[i].width * tex[i].height, 4))) return bad(&d.r, "out of memory");
 	}
 	if (decode_materials(&d, nmat, tex, ntex, mats) != API_OK) return API_ERR;
 	for (uint32_t i = 0; i < nmesh; i++)
@@ -475,16 +526,12 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 		return bad(&d->r, "mesh %u level %u: %u vertices, %u indices, flags %u, error %g", i, l, nv, ni, flags,
 		           (double)error);
 	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0) + (flags & 2 ? 8 : 0);
-	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u level %u is cut short", i, l);
-	float *pos = dec_alloc(d, nv, 12), *nrm = dec_alloc(d, nv, 12), *uv = flags & 1 ? dec_alloc(d, nv, 8) : NULL;
-	float *uv1 = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
-	uint32_t *idx = dec_alloc(d, ni, 4);
+	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4) || (uint64_t)nv * per_vertex > d->r.left - (uint64_t)ni * 4)
+		return bad(&d->r, "mesh %u level %u is cut short", i, l);
+	const float *pos = take_array(d, nv, 12), *nrm = take_array(d, nv, 12), *uv = flags & 1 ? take_array(d, nv, 8) : NULL;
+	const float *uv1 = flags & 2 ? take_array(d, nv, 8) : NULL;
+	const uint32_t *idx = take_array(d, ni, 4);
 	if (!pos || !nrm || ((flags & 1) && !uv) || ((flags & 2) && !uv1) || !idx) return bad(&d->r, "out of memory");
-	take(&d->r, pos, (size_t)nv * 12);
-	take(&d->r, nrm, (size_t)nv * 12);
-	if (uv) take(&d->r, uv, (size_t)nv * 8);
-	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
-	take(&d->r, idx, (size_t)ni * 4);
 	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)) ||
 	    (uv1 && !finite_all(uv1, (size_t)nv * 2)))
 		return bad(&d->r, "mesh %u level %u has a value that is not finite", i, l);
@@ -517,11 +564,12 @@ static enum api_result decode_mesh_levels(struct dec *d, uint32_t i, const struc
 	return API_OK;
 }
 
-enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, const struct api_model_mesh *const *meshes,
-                                       uint32_t nmesh, struct api_arena *arena, struct api_mesh_levels *out,
-                                       size_t *bytes, char *err, size_t errsize)
+enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, unsigned flags,
+                                       const struct api_model_mesh *const *meshes, uint32_t nmesh,
+                                       struct api_arena *arena, struct api_mesh_levels *out, size_t *bytes,
+                                       char *err, size_t errsize)
 {
-	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
+	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0, flags};
 	uint32_t n = 0;
 	if (!take_u32(&d.r, &n) || n != nmesh) return bad(&d.r, "levels of %u meshes for %u", n, nmesh);
 	for (uint32_t i = 0; i < nmesh; i++)
