@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "model_lod.h"
-#include "remap.h"
+#include "weld.h"
 #include "umbra/rnd_math.h"
 
 /* A mesh welded by position: what the simplifier works on. meshoptimizer treats vertices at
@@ -32,33 +32,6 @@ struct welded {
 	uint32_t *rep;        /* the first original vertex of each (for uvs, and which side is out) */
 	size_t count;
 };
-
-/* meshopt_generateVertexRemap(remap, idx, ni, keys, nv, 12), through api_remap_keys (its
- * hashing was most of a 1M-triangle import): the vertices idx refers to, one number for equal
- * keys, numbered in the order idx first meets them; ~0u for the others. SIZE_MAX without
- * memory. */
-static size_t index_order_remap(const int32_t *keys, uint32_t nv, const uint32_t *idx, uint32_t ni, unsigned int *remap)
-{
-	uint32_t *group = malloc((size_t)nv * sizeof *group), *first = NULL;
-	size_t groups = group ? api_remap_keys(keys, nv, 12, group) : SIZE_MAX;
-	if (groups != SIZE_MAX && !(first = malloc((groups ? groups : 1) * sizeof *first))) groups = SIZE_MAX;
-	if (groups == SIZE_MAX) {
-		free(group);
-		return SIZE_MAX;
-	}
-	memset(first, 0xff, groups * sizeof *first);
-	memset(remap, 0xff, (size_t)nv * sizeof *remap);
-	size_t count = 0;
-	for (uint32_t i = 0; i < ni; i++) {
-		uint32_t v = idx[i];
-		if (remap[v] != ~0u) continue;
-		if (first[group[v]] == ~0u) first[group[v]] = (uint32_t)count++;
-		remap[v] = first[group[v]];
-	}
-	free(group);
-	free(first);
-	return count;
-}
 
 /* The box of n points (lo, hi; empty: +inf, -inf) and its largest side. */
 static float points_box(const float *p, size_t n, float lo[3], float hi[3])
@@ -72,29 +45,17 @@ static float points_box(const float *p, size_t n, float lo[3], float hi[3])
 	return fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
 }
 
+/* me welded by position into idx and w (api_weld_mesh: the importer's groups when its join made
+ * them, me->weld_group_, else sorted now), with the welded vertices' normals. */
 static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *w)
 {
-	unsigned int *remap = malloc((size_t)me->vertex_count * sizeof *remap);
-	int32_t *q = malloc((size_t)me->vertex_count * 12);
-	if (!remap || !q) { free(remap); free(q); return false; }
-	/* Positions equal to 2^-20 of the extent are one: a seam written with sin(2 pi) != 0 is
-	 * closed (otherwise it is a border the simplifier must keep, with long slivers along it). */
-	float lo[3], hi[3], ext = points_box(me->positions, me->vertex_count, lo, hi);
-	float unit = ext > 0.0f ? ext / 1048576.0f : 1.0f;
-	for (uint32_t v = 0; v < me->vertex_count; v++)
-		for (int k = 0; k < 3; k++)
-			q[3 * (size_t)v + (size_t)k] = (int32_t)lrintf((me->positions[3 * (size_t)v + (size_t)k] - lo[k]) / unit);
-	w->count = index_order_remap(q, me->vertex_count, me->indices, me->index_count, remap);
-	free(q);
-	if (w->count == SIZE_MAX) { free(remap); w->count = 0; return false; }
-	w->pos = malloc(w->count * 12);
-	w->rep = malloc(w->count * sizeof *w->rep);
-	if (!w->pos || !w->rep) { free(remap); return false; }
-	meshopt_remapVertexBuffer(w->pos, me->positions, me->vertex_count, 12, remap);
-	meshopt_remapIndexBuffer(idx, me->indices, me->index_count, remap);
-	for (uint32_t v = me->vertex_count; v-- > 0;)
-		if (remap[v] != ~0u) w->rep[remap[v]] = v;
-	free(remap);
+	struct api_welded wm;
+	bool ok = api_weld_mesh(me->positions, me->vertex_count, me->indices, me->index_count, me->weld_group_,
+	                        me->weld_groups_, idx, &wm);
+	w->pos = wm.pos;
+	w->rep = wm.rep;
+	w->count = wm.count;
+	if (!ok) return false;
 	/* Vertex normals of the welded full mesh (degenerate facets, whose file normals are noise,
 	 * weigh nothing); oriented like the file's. */
 	w->nrm = calloc(w->count * 3, sizeof *w->nrm);

@@ -508,3 +508,29 @@ TEST(sandbox_helper_env_asks_for_huge_pages)
 	free(env);
 	free(own);
 }
+
+/* A binary STL cone of 200 facets: its apex joins 200 corners, sorted by key in the sandbox
+ * (glibc's qsort asks the system how much memory there is first: a call the filter allowed
+ * only once the join began to sort). */
+TEST(sandbox_stl_cone_apex_joins)
+{
+	enum { N = 200 };
+	size_t len = 84 + (size_t)N * 50;
+	uint8_t *d = calloc(1, len);
+	uint32_t n = N;
+	memcpy(d + 80, &n, 4);
+	for (uint32_t i = 0; i < N; i++) {
+		float a0 = 6.2831853f * (float)i / N, a1 = 6.2831853f * (float)(i + 1) / N;
+		float t[12] = {0, 0, 0, 0, 2, 0, cosf(a1), 0, sinf(a1), cosf(a0), 0, sinf(a0)};
+		memcpy(d + 84 + (size_t)i * 50, t, sizeof t);
+	}
+	struct api_limits l = limits(5000);
+	struct api_arena *a = api_arena_create();
+	struct api_model m;
+	size_t bytes;
+	char err[400];
+	int st;
+	CHECK(api_sandbox_import_model(d, len, API_MODEL_STL, &l, a, &m, &bytes, &st, err, sizeof err) == API_OK, "%s", err);
+	api_arena_destroy(a);
+	free(d);
+}
