@@ -19,6 +19,7 @@
 #include <meshoptimizer.h>
 #include <stdlib.h>
 #include <string.h>
+#include "lod_simplify.h"
 #include "model_lod.h"
 #include "weld.h"
 #include "umbra/rnd_math.h"
@@ -487,7 +488,7 @@ static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, co
 	if (!lod || !next || !(extent > 0.0f) || !grid_build(&g, w, lo, hi, extent) || !walk_build(&k, w, cur, ni))
 		goto done;
 	for (int attempt = 0; attempt < 2; attempt++) {
-		size_t got = meshopt_simplify(next, cur, ni, w->pos, w->count, 12, 3, target, 0, NULL);
+		size_t got = api_lod_simplify(next, cur, ni, w->pos, w->count, extent, target);
 		if (got < 3 || got * 4 > ni * 3) break;
 		got = drop_degenerate(w, next, got);
 		float e = got >= 3 ? level_error(&g, &k, w, next, got) : INFINITY;
