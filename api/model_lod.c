@@ -34,14 +34,17 @@ struct welded {
 	size_t count;
 };
 
-/* The box of n points (lo, hi; empty: +inf, -inf) and its largest side. */
+/* The box of n points (lo, hi; empty: +inf, -inf) and its largest side. (Comparisons, not
+ * fminf/fmaxf: those are calls into libm, for their NaN rules, and positions are finite; the
+ * daemon runs this over every mesh of a reply, api_mesh_bounds.) */
 static float points_box(const float *p, size_t n, float lo[3], float hi[3])
 {
 	for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
 	for (size_t v = 0; v < n; v++)
 		for (int k = 0; k < 3; k++) {
-			lo[k] = fminf(lo[k], p[3 * v + k]);
-			hi[k] = fmaxf(hi[k], p[3 * v + k]);
+			float x = p[3 * v + (size_t)k];
+			if (x < lo[k]) lo[k] = x;
+			if (x > hi[k]) hi[k] = x;
 		}
 	return fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
 }
@@ -203,6 +206,18 @@ static void walk_free(struct walk *k)
 	free(k->queue);
 }
 
+/* fminf(acc, x) and fmaxf(acc, x) for an accumulator that is never NaN, inline (those are
+ * calls into libm): a NaN x (a degenerate face's distance) leaves acc as it is, as they do. */
+static inline float min_f(float acc, float x)
+{
+	return x < acc ? x : acc;
+}
+
+static inline float max_f(float acc, float x)
+{
+	return x > acc ? x : acc;
+}
+
 /* Squared distance from p to o + t e. */
 static float d2_along(const float p[3], const float o[3], const float e[3], float t)
 {
@@ -282,7 +297,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 		for (int c = 0; c < 3; c++) {
 			float d[3];
 			rnd_v3_sub(d, v[c], s[0]);
-			r2 = fmaxf(r2, rnd_v3_dot(d, d));
+			r2 = max_f(r2, rnd_v3_dot(d, d));
 		}
 		r2 *= 2.25f;
 		float best[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
@@ -306,7 +321,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 				const uint32_t *fi = k->idx + 3 * (size_t)f;
 				const float *a = w->pos + 3 * (size_t)fi[0], *b = w->pos + 3 * (size_t)fi[1], *c = w->pos + 3 * (size_t)fi[2];
 				float most = 0.0f;
-				for (int q = 0; q < 4; q++) most = fmaxf(most, best[q] = fminf(best[q], point_triangle_d2(s[q], a, b, c)));
+				for (int q = 0; q < 4; q++) most = max_f(most, best[q] = min_f(best[q], point_triangle_d2(s[q], a, b, c)));
 				/* Every sample already this near a face: the rest of the walk can only find
 				 * nearer ones, and this triangle cannot raise the level's worst. */
 				if (most <= worst2) { head = tail; break; }
@@ -320,7 +335,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 				}
 			}
 		}
-		for (int q = 0; q < 4; q++) worst2 = fmaxf(worst2, best[q]);
+		for (int q = 0; q < 4; q++) worst2 = max_f(worst2, best[q]);
 	}
 	return sqrtf(worst2);
 }
@@ -364,7 +379,7 @@ static bool corner_normals(const struct api_model_mesh *me, const struct welded 
 		for (int k = 0; k < 3; k++) {
 			float e[3];
 			rnd_v3_sub(e, w->pos + 3 * (size_t)idx[3 * t + (size_t)k], w->pos + 3 * (size_t)idx[3 * t + (size_t)(k + 1) % 3]);
-			edge = fmaxf(edge, rnd_v3_dot(e, e));
+			edge = max_f(edge, rnd_v3_dot(e, e));
 		}
 		/* A sliver's own normal is noise: it takes its vertices' normals whatever the angle. */
 		bool sliver = rnd_v3_length(fn + 3 * t) < 0.02f * edge;

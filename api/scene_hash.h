@@ -12,7 +12,8 @@
  * the order the client sent them in. Files read by `path` are not here: api_scene.asset_hash.
  *
  * Each value is framed by a type tag and its length, so that no two different trees give the
- * same byte stream. The hash is the project's 64-bit FNV-1a (umbra/rnd_math.h).
+ * same byte stream. The hash is the project's 64-bit FNV-1a for the framing and rnd_hash (a
+ * word at a time, umbra/rnd_math.h) for the bytes.
  *
  * Usage (api/scene_parse.c, after api_preset_apply): s->scene_hash = api_scene_hash(root, &big,
  * parts, nparts). Internal to api/ (it exposes jansson). Thread-safe, no allocation but the
