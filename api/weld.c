@@ -67,8 +67,12 @@ uint64_t *api_radix_sort(uint64_t *keys, uint64_t *tmp, uint32_t *vals, uint32_t
 	while (bits < 64 && (any ^ all) >> bits) bits++;
 	while (top < 11 && (size_t)2048 << top < n) top++;   /* buckets of about 2048 keys */
 	uint32_t *v;
+	if (n <= 32) {   /* (a histogram of 2048 counters a digit would cost more than the keys) */
+		insertion(keys, vals, n);
+		return keys;
+	}
 	size_t *start = n >= ((size_t)1 << 16) && bits > top ? calloc(((size_t)1 << top) + 1, sizeof *start) : NULL;
-	if (!start) return lsd(keys, tmp, vals, vtmp, n, bits, 11, &v);
+	if (!start) return lsd(keys, tmp, vals, vtmp, n, bits, n < 4096 ? 8 : 11, &v);
 	/* Many keys: one stable scatter by the top digit, then each bucket (its keys stay in the
 	 * cache) sorted by the bits below it; only the first pass runs through memory. The sorted
 	 * keys end in tmp (the values in vtmp). */

@@ -191,18 +191,18 @@ TEST(weld_leaves_out_unnamed_vertices)
 	api_welded_release(&w);
 }
 
-/* Small and large inputs (the large are scattered by their top bits first), with values and
- * without: sorted, ties in their first order. */
+/* Inputs of every path (a few: insertion; small: 8-bit digits; medium: 11-bit; large: scattered
+ * by their top bits first), with values and without: sorted, ties in their first order. */
 TEST(weld_radix_sort_is_stable)
 {
-	static const uint32_t sizes[2] = {5000, 200000};
-	for (int z = 0; z < 2; z++) {
+	static const uint32_t sizes[4] = {20, 1000, 5000, 200000};
+	for (int z = 0; z < 4; z++) {
 		uint32_t n = sizes[z], x = 7;
 		uint64_t *k = malloc(n * 8ull), *t = malloc(n * 8ull), *k2 = malloc(n * 8ull), *t2 = malloc(n * 8ull);
 		uint32_t *v = malloc(n * 4ull), *vt = malloc(n * 4ull);
 		for (uint32_t i = 0; i < n; i++) {
 			x = x * 1103515245u + 12345u;
-			k[i] = k2[i] = (uint64_t)(x >> 20) << 40 | (uint64_t)(x >> 28) << (z * 9);   /* few values: many ties */
+			k[i] = k2[i] = (uint64_t)(x >> 20) << 40 | (uint64_t)(x >> 28) << (z % 2 * 9);   /* few values: many ties */
 			v[i] = i;
 		}
 		const uint64_t *s = api_radix_sort(k, t, v, vt, n), *s2 = api_radix_sort(k2, t2, NULL, NULL, n);
