@@ -63,6 +63,7 @@ struct pctx {
 	struct api_model *cur_model;
 	/* Ground placement (api/ground.h): margin per document object, > 0 for placement "ground". */
 	float *ground_margin;
+	bool *up_auto;            /* per object: a model with "up": "auto" (api/model_up.h), decided once imported */
 	size_t cur_object;
 	char warnings[sizeof(((struct api_scene *)0)->warnings)]; /* what is drawn other than asked ("; " between) */
 	const struct api_big_strings *big;  /* base64 members left in the document (api/big_strings.h) */

@@ -52,7 +52,8 @@ static int usage(FILE *f, int code)
 	           "  --size N     thumbnail width and height (default 512)\n"
 	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
 	           "  --up AXIS    thumbnails: the models' up axis, z y x -z -y -x (default y; z for most STL and\n"
-	           "               CAD/3D-printing OBJ files): the model object's \"up\"\n"
+	           "               CAD/3D-printing OBJ files), or auto (y or z, from where the model would touch\n"
+	           "               the ground; docs/models.md): the model object's \"up\"\n"
 	           "  --format F   thumbnails: png (default), webp (lossless) or exr: output.format\n"
 	           "  --quality Q  thumbnails with --format webp: lossy WebP at quality 0..100: output.quality\n"
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
@@ -214,8 +215,8 @@ static unsigned uint_arg(const char *s, unsigned max)
 /* --up's value: "z", "+z", "-z", ... as the scene's "+z" etc.; NULL when it is none. */
 static const char *up_arg(const char *s)
 {
-	static const char *const axes[] = {"+y", "-y", "+z", "-z", "+x", "-x"};
-	for (int i = 0; i < 6; i++)
+	static const char *const axes[] = {"+y", "-y", "+z", "-z", "+x", "-x", "auto"};
+	for (int i = 0; i < 7; i++)
 		if (!strcasecmp(s, axes[i]) || (axes[i][0] == '+' && !strcasecmp(s, axes[i] + 1))) return axes[i];
 	return NULL;
 }
@@ -290,7 +291,7 @@ static int parse_args(int argc, char **argv, struct args *a)
 			return usage(stderr, 1);
 		case O_UP:
 			if ((a->farm.up = up_arg(optarg))) break;
-			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x)\n", optarg);
+			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x auto)\n", optarg);
 			return usage(stderr, 1);
 		case O_FORMAT:
 			if ((a->farm.format = format_arg(optarg, &a->format))) break;

@@ -121,8 +121,8 @@ python3 - "$T/models/coat.gltf" <<'PY'
 import base64, json, struct, sys
 pos = struct.pack('<9f', -1, 0, 0, 1, 0, 0, 0, 1, 0)
 g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-     "extensionsUsed": ["KHR_materials_clearcoat"],
-     "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}}],
+     "extensionsUsed": ["KHR_materials_iridescence"],
+     "materials": [{"extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}}],
      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + base64.b64encode(pos).decode()}],
      "bufferViews": [{"buffer": 0, "byteLength": 36}],
@@ -131,7 +131,7 @@ json.dump(g, open(sys.argv[1], "w"))
 PY
 cli thumb "$T/models/coat.gltf" "$T/models/cube.obj" -o "$T/thumbw/" --size 64 --no-progress 2>/dev/null
 check "thumb: report carries a model's material warnings" \
-	grep -q '"file":"[^"]*coat.gltf".*"warnings":"/objects/0: KHR_materials_clearcoat: the clear coat layer not drawn' "$T/thumbw/report.jsonl"
+	grep -q '"file":"[^"]*coat.gltf".*"warnings":"/objects/0: KHR_materials_iridescence: iridescence not drawn' "$T/thumbw/report.jsonl"
 check "thumb: no warnings for a model without such data" grep -q '"file":"[^"]*cube.obj".*"warnings":null' "$T/thumbw/report.jsonl"
 check "thumb: summary line" grep -q '3 ok, 1 invalid, 0 failed, 0 skipped of 4' "$T/thumb.err"
 

@@ -214,8 +214,8 @@ python3 - "$T/small.json" "$T/model-warn.json" <<'PY'
 import base64, json, struct, sys
 pos = struct.pack('<9f', -1, 0, 0, 1, 0, 0, 0, 1, 0)
 g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-     "extensionsUsed": ["KHR_materials_clearcoat"],
-     "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}}],
+     "extensionsUsed": ["KHR_materials_iridescence"],
+     "materials": [{"extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}}],
      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + base64.b64encode(pos).decode()}],
      "bufferViews": [{"buffer": 0, "byteLength": 36}],
@@ -226,7 +226,7 @@ json.dump(doc, open(sys.argv[2], "w"))
 PY
 c=$(post mwarn "$T/model-warn.json")
 w=$(hdr mwarn Umbra-Warnings)
-case "$w" in /objects/*KHR_materials_clearcoat*) wok=1 ;; *) wok=0 ;; esac
+case "$w" in /objects/*KHR_materials_iridescence*) wok=1 ;; *) wok=0 ;; esac
 check "model with an unsupported material extension: 200" [ "$c" = 200 ]
 check "Umbra-Warnings names the extension under its object's pointer ($w)" [ "$wok" = 1 ]
 check "a model without such data: no Umbra-Warnings" [ -z "$(hdr mp Umbra-Warnings)" ]
