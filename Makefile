@@ -21,7 +21,7 @@ GLSLANG ?= glslangValidator
 # The packages of each module (server -> api -> renderer): each compiles with its own packages'
 # cflags only; everything links with all of them.
 PKGS_RENDERER := vulkan
-PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp
+PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp libdeflate
 PKGS_SERVER := libmicrohttpd
 PKGS := $(PKGS_RENDERER) $(PKGS_API) $(PKGS_SERVER)
 
@@ -34,7 +34,7 @@ LDFLAGS += -pthread $(SAN)
 # Each module sees only the headers it may use (server -> api -> renderer -> shaders): an
 # include across the layering is a compile error, not a review comment. Tests see everything.
 # Their packages' cflags likewise (PKG_CFLAGS_* below): the renderer gets Vulkan's, api/ those of
-# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg, libseccomp and libwebp (meshoptimizer has no .pc),
+# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg, libseccomp, libwebp and libdeflate (meshoptimizer has no .pc),
 # the server libmicrohttpd's.
 INC_RENDERER = -Irenderer/include -Irenderer -Ishaders -I$(BUILD)/shaders $(PKG_CFLAGS_RENDERER)
 INC_API = -Irenderer/include -Iapi $(PKG_CFLAGS_API)
