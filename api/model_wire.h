@@ -57,6 +57,7 @@
 #define API_WIRE_MAGIC "UMBRAIMP"
 #define API_WIRE_VERSION 6u
 #define API_WIRE_MAX_MESSAGE 1024u
+#define API_WIRE_MAX_TEXTURES 4096u   /* distinct textures in one reply */
 
 enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2, API_WIRE_LEVELS = 3 };
 /* What the importer says about the input (a crash says nothing: see api/sandbox.h). */

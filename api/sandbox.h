@@ -144,6 +144,11 @@ struct api_sbx_status {
 	uint32_t reserved;
 };
 
+/* Sends rq with its fds (data socket, status pipe's write end, reply memfd) to the fork server,
+ * starting it first, or again once when it is gone (api/sandbox_server.c). 0, or -1 with err. */
+int api_sbx_send(const struct api_sbx_request *rq, int data_fd, int status_fd, int reply_fd, char *err,
+                 size_t errsize);
+
 /* The helper's environment: env with glibc's malloc asked for transparent huge pages
  * (GLIBC_TUNABLES gets glibc.malloc.hugetlb=1 appended, or is added: madvise on the heap and
  * on big blocks; glibc 2.35+, a no-op where the kernel's THP is off). An import writes its
