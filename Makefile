@@ -185,10 +185,11 @@ bench-tools:
 		$(BUILD)/tests/edge_error
 	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor
 
-$(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a \
+		$(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/edge_error: $(BUILD)/obj/tests/bench/edge_error.o

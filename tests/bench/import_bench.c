@@ -18,6 +18,7 @@
 #include "arena.h"
 #include "model_import.h"
 #include "sandbox.h"
+#include "util.h"
 
 static double now_ms(void)
 {
@@ -99,20 +100,6 @@ static double run(const uint8_t *d, size_t len, int sandboxed, int n, uint64_t *
 	return med;
 }
 
-static uint8_t *read_all(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	uint8_t *d = n > 0 ? malloc((size_t)n) : NULL;
-	if (d && fread(d, 1, (size_t)n, f) != (size_t)n) { free(d); d = NULL; }
-	fclose(f);
-	*len = (size_t)n;
-	return d;
-}
-
 /* --stages: per-stage medians of sandboxed imports of real files. */
 static int stages(int argc, char **argv)
 {
@@ -129,7 +116,7 @@ static int stages(int argc, char **argv)
 	printf(" %9s\n", "total");
 	for (; i < argc; i++) {
 		size_t len = 0;
-		uint8_t *d = read_all(argv[i], &len);
+		uint8_t *d = test_read_file(argv[i], &len);
 		const char *dot = strrchr(argv[i], '.');
 		int fmt = -1;
 		for (int k = 0; dot && k < 5; k++)
