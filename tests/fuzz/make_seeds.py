@@ -98,7 +98,7 @@ put("fuzz_model_glb", "quantized.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + 
 # three-line C main linked with tests/util/models.o and draco_encode.o; committed as is.
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
-    return b"UMBRAIMP" + struct.pack("<IIII", 6, kind, status, len(msg)) + msg
+    return b"UMBRAIMP" + struct.pack("<IIII", 7, kind, status, len(msg)) + msg
 tex = struct.pack("<II", 2, 1) + bytes([255, 0, 0, 255, 0, 255, 0, 255])
 # material: 13 floats (the last the see-through share, 0.5 here), alpha mode, a texture per
 # slot (base, metal-rough, normal, occlusion, emissive, clearcoat, its roughness and normal,
@@ -118,7 +118,8 @@ inst = struct.pack("<I", 0) + struct.pack("<16f", 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 
 warn = b"skins are not applied (drawn in the bind pose)"
 # the importer's stage times f32[4], texture_side texture_max, then the counts
 times = struct.pack("<4f", 1, 2, 0, 0) + struct.pack("<II", 0, 2)
-put("fuzz_import_reply", "model.bin", header(1, 0) + times + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn + tex + mat + mesh +
-    inst)
+# the warnings padded with zeros to a multiple of 4 bytes
+put("fuzz_import_reply", "model.bin", header(1, 0) + times + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn +
+    b"\0" * (-len(warn) % 4) + tex + mat + mesh + inst)
 put("fuzz_import_reply", "image.bin", header(2, 0) + tex)
 put("fuzz_import_reply", "error.bin", header(1, 1, b"PLY: bad header"))

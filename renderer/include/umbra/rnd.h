@@ -124,6 +124,9 @@ void rnd_texture_build_chain(const uint8_t *rgba, uint32_t w, uint32_t h, bool s
  * in *w x *h: a texture decoded smaller than stored (api/image_decode.c). Pure; any thread. */
 void rnd_texture_reduce(uint8_t *rgba, uint32_t *w, uint32_t *h, bool srgb, uint32_t levels);
 
+/* Every rnd_*_defaults() below zeroes its whole struct before setting members: api/scene_hash.c
+ * hashes a parsed scene by the bytes of these structs (padding included; pointers as set or
+ * not), so a new pointer member needs its line there. */
 struct rnd_material {
 	float base_color[4];  /* linear RGBA, default 0.8 0.8 0.8 1 */
 	float roughness;      /* 0.5 */
