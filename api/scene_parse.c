@@ -22,6 +22,7 @@
 #include <strings.h>
 #include "big_strings.h"
 #include "asset.h"
+#include "gltf_variants.h"
 #include "model.h"
 #include "model_paths.h"
 #include "model_refs.h"
@@ -152,6 +153,23 @@ static int model_refs(struct pctx *c, json_t *j, const char *first, json_t *v, c
 	return 0;
 }
 
+/* The model's bytes with its glTF material variant `variant` applied (api/gltf_variants.h),
+ * into *out (malloc'd); a problem at the object's "variant" (the pointer is popped to the
+ * object's: `obj`). */
+static int pick_variant(struct pctx *c, size_t obj, const char *variant, const uint8_t *b, size_t len,
+                        enum api_model_format fmt, uint8_t **out, size_t *out_len)
+{
+	char err[400];
+	bool oom;
+	if (fmt == API_MODEL_GLB || fmt == API_MODEL_GLTF)
+		*out = api_gltf_pick_variant(b, len, fmt == API_MODEL_GLB, variant, out_len, &oom, err, sizeof err);
+	else snprintf(err, sizeof err, "variant picks a glTF material variant (KHR_materials_variants); this model is %s %s "
+	              "file", fmt == API_MODEL_OBJ ? "an" : "a", api_model_format_name(fmt));
+	if (*out) return 0;
+	api_ptr_pop(c, obj);
+	return api_fail_at(c, "variant", "%s", err);
+}
+
 int api_parse_model(struct pctx *c, json_t *j)
 {
 	static const char *const sources[] = {"data", "path", "part"};
@@ -164,6 +182,8 @@ int api_parse_model(struct pctx *c, json_t *j)
 		first = sources[i];
 	}
 	if (!first) return api_fail(c, "a model needs one of data (base64 file), path or part");
+	const char *variant = NULL;
+	if (api_get_string(c, j, "variant", &variant) < 0) return -1;
 	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
 	/* A hint for the importer, not a value of the parsed scene: checked, not recorded as read
 	 * (scene_internal.h), so that it stays in the ETag's hash as written. */
@@ -180,7 +200,8 @@ int api_parse_model(struct pctx *c, json_t *j)
 	size_t old = api_ptr_push(c, first);
 	bool by_path = !strcmp(first, "path");
 	struct api_model_path_key key = {c->lim->asset_root, json_string_value(v), given ? f : -1};
-	int rc = by_path ? model_remembered(c, v, &key) : 0;
+	/* A variant is another model (api/gltf_variants.h): found in the cache by its own bytes. */
+	int rc = by_path && !variant ? model_remembered(c, v, &key) : 0;
 	if (rc != 0) {
 		api_ptr_pop(c, old);
 		return rc < 0 ? -1 : 0;
@@ -198,11 +219,14 @@ int api_parse_model(struct pctx *c, json_t *j)
 	struct api_model_refs refs = {0};
 	if (rc == 0) rc = model_refs(c, j, first, v, b, len, fmt, &refs);
 	c->import.ms[API_IMPORT_READ] += (float)(api_clock_ms() - t0);   /* the model and the files it names */
+	uint8_t *vb = NULL;
+	size_t vlen = 0;
+	if (rc == 0 && variant) rc = pick_variant(c, old, variant, b, len, fmt, &vb, &vlen);
 	struct api_model *m = NULL;
 	char err[400];
 	int status;
-	if (rc == 0 && api_model_get_timed(b, len, refs.files, refs.count, fmt, c->lim, &m, &c->import, &status, err,
-	                                   sizeof err) != API_OK) {
+	if (rc == 0 && api_model_get_timed(vb ? vb : b, vb ? vlen : len, refs.files, refs.count, fmt, c->lim, &m,
+	                                   &c->import, &status, err, sizeof err) != API_OK) {
 		/* 400 for a bad file, 422 over the import time/memory limit, 500 when the importer cannot run. */
 		const char *what = model_label(j, first, v);
 		if (what)
@@ -217,9 +241,11 @@ int api_parse_model(struct pctx *c, json_t *j)
 		if (refs.asset_hash) api_asset_hash(&h, NULL, (const uint8_t *)&refs.asset_hash, 8);
 		api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
 		/* A model remembered is attached without its bytes: only one with nothing to say is. */
-		if (!refs.warning[0] && !said[0]) api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
+		if (!refs.warning[0] && !said[0] && !variant)
+			api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
 	}
 	if (rc == 0) rc = attach_model(c, m);
+	free(vb);
 	api_model_refs_release(&refs);
 	if (by_path) free(b);
 	api_ptr_pop(c, old);

@@ -256,7 +256,7 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 	 * 0's two samplers, so the device's per-stage bound limits a material, not a scene: a
 	 * scene's distinct textures are bounded by memory (the estimate and admission count
 	 * their texels) and by the descriptor sets each slot preallocates for them, which
-	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. A main-pass draw binds UMBRA_TEX_SLOTS (12,
+	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. A main-pass draw binds UMBRA_TEX_SLOTS (13,
 	 * the glTF PBR extensions' textures among them) beside set 0's up to 7 samplers: more than
 	 * the 16 per stage Vulkan guarantees, fewer than any desktop driver or lavapipe offers
 	 * (lavapipe and NVIDIA: 10^6), so a device under that says so here rather than failing

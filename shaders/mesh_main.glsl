@@ -19,6 +19,7 @@ umbra_material draw_material()
 		m.clearcoat = materials[pc.info.x].clearcoat;
 		m.sheen = materials[pc.info.x].sheen;
 		m.specular = materials[pc.info.x].specular;
+		m.ext = materials[pc.info.x].ext;
 	}
 	return m;
 }
@@ -44,7 +45,13 @@ void main()
 	metal = clamp(metal, 0.0, 1.0);
 	vec3 f0 = mix(vec3(0.04), base, metal);
 	vec3 c_diff = base * (1.0 - metal);
-	if (SC_MATERIAL_EXT != 0u) f0 = ext_surface_at(m, N, n_geo, V, base, metal, f0);
+	float f0_ambient = metal;   // the ambient reflects a metal's F0 ...
+	if (SC_MATERIAL_EXT != 0u) {
+		f0 = ext_surface_at(m, N, n_geo, V, base, metal, f0);
+		// ... and a specular-glossiness surface's, whose diffuse keeps 1 - max(F0) (the sample viewer's)
+		c_diff *= 1.0 - ext_s.spec_gloss * ext_max3(f0);
+		f0_ambient = max(metal, ext_s.spec_gloss);
+	}
 	bool receive = (flags & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	vec3 lit, unshadowed;
 	float debug_vis;
@@ -55,7 +62,7 @@ void main()
 	float ao = 1.0;
 	if (has_tex(m, UMBRA_TEX_OCCLUSION))
 		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv, v_uv1).r - 1.0);
-	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * metal) * ao;
+	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * f0_ambient) * ao;
 	if (SC_MATERIAL_EXT != 0u) ambient = ext_ambient(ambient, mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * ao, N, V);
 	vec3 emissive = m.emissive.rgb;
 	if (has_tex(m, UMBRA_TEX_EMISSIVE))

@@ -68,7 +68,10 @@
 #define UMBRA_TEX_SHEEN_ROUGHNESS    9  /* A sheen roughness (sRGB class) */
 #define UMBRA_TEX_SPECULAR           10 /* A specular factor (sRGB class) */
 #define UMBRA_TEX_SPECULAR_COLOR     11 /* sRGB: rgb specular colour */
-#define UMBRA_TEX_SLOTS              12
+/* R: the see-through share of the coverage (umbra_material.ext.z): alpha x (1 - ext.z x R),
+ * main pass and alpha-tested depth passes alike. */
+#define UMBRA_TEX_TRANSMISSION       12 /* linear */
+#define UMBRA_TEX_SLOTS              13
 #define UMBRA_BINDING_BASE_TEXTURE       UMBRA_TEX_BASE
 #define UMBRA_BINDING_METAL_ROUGH_TEXTURE UMBRA_TEX_METAL_ROUGH
 #define UMBRA_BINDING_NORMAL_TEXTURE     UMBRA_TEX_NORMAL
@@ -211,7 +214,9 @@ struct umbra_material {
 	U_VEC4 clearcoat;        /* x factor, y roughness, z normal scale, w the coat's F0 (from the ior) */
 	U_VEC4 sheen;            /* rgb colour, w roughness */
 	U_VEC4 specular;         /* rgb the dielectric F0 (from the ior) x specular colour, w specular factor */
-	U_UVEC4 ext;             /* x UMBRA_EXT_* bits */
+	U_UVEC4 ext;             /* x UMBRA_EXT_* bits, y 1 = the specular-glossiness model (the
+	                            diffuse x (1 - max(F0)), the ambient reflects F0), z the float bits of
+	                            the see-through share (UMBRA_TEX_TRANSMISSION) */
 	/* per texture slot, the uv transform (KHR_texture_transform) as two rows:
 	 * uv' = (dot(uvx[2s].xy, uv) + uvx[2s].z, dot(uvx[2s+1].xy, uv) + uvx[2s+1].z) */
 	U_VEC4 uvx[2 * UMBRA_TEX_SLOTS];

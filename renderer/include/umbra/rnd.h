@@ -76,11 +76,12 @@ enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYL
 enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK, RND_ALPHA_BLEND };
 
 /* Texture slots of a material (the order of rnd_material.textures): glTF's core five, then
- * those of the PBR extensions (read only where the material has that extension). */
+ * those of the PBR extensions (read only where the material has that extension), then the
+ * see-through share of the coverage (rnd_material.see_through). */
 enum rnd_texture_slot { RND_TEX_BASE, RND_TEX_METAL_ROUGH, RND_TEX_NORMAL, RND_TEX_OCCLUSION, RND_TEX_EMISSIVE,
                         RND_TEX_CLEARCOAT, RND_TEX_CLEARCOAT_ROUGHNESS, RND_TEX_CLEARCOAT_NORMAL,
                         RND_TEX_SHEEN_COLOR, RND_TEX_SHEEN_ROUGHNESS, RND_TEX_SPECULAR, RND_TEX_SPECULAR_COLOR,
-                        RND_TEX_SLOTS };
+                        RND_TEX_TRANSMISSION, RND_TEX_SLOTS };
 /* rnd_material.extensions: the glTF 2.0 PBR extensions a material has (0: none; the members
  * of the others are not read). */
 enum rnd_material_ext {
@@ -143,12 +144,16 @@ struct rnd_material {
 			                         *occlusion_texture, *emissive_texture;
 			const struct rnd_texture *clearcoat_texture, *clearcoat_roughness_texture, *clearcoat_normal_texture,
 			                         *sheen_color_texture, *sheen_roughness_texture, *specular_texture,
-			                         *specular_color_texture;
+			                         *specular_color_texture, *transmission_texture;
 		};
 		const struct rnd_texture *textures[RND_TEX_SLOTS];
 	};
 	float normal_scale;        /* 1 */
 	float occlusion_strength;  /* 1 */
+	/* With transmission_texture: the coverage (alpha, as MASK or BLEND draw it, shadows too) is
+	 * alpha x (1 - see_through x the texture's R), per pixel (0..1; 0 default: none). api/
+	 * draws KHR_materials_transmission's texture so (api_gltf_material_shading). */
+	float see_through;
 	/* How each slot's texture is sampled (zero = repeat, linear, untransformed). */
 	struct rnd_texture_sampling {
 		uint8_t wrap_s, wrap_t;             /* enum rnd_wrap */
@@ -177,6 +182,11 @@ struct rnd_material {
 		float factor;          /* 0..1 the specular weight (x specular_texture A); glTF default 1 */
 		float color[3];        /* linear, multiplies the dielectric F0 (x specular_color_texture); default 1 */
 		float ior;             /* >= 1 (KHR_materials_ior; 1.5 gives F0 0.04) */
+		/* The specular-glossiness model (KHR_materials_pbrSpecularGlossiness, as the sample
+		 * viewer draws it): F0 is the whole specular (the colour, ior ~infinite), the diffuse
+		 * keeps 1 - max(F0) of the base colour, and the ambient light reflects F0 as it does a
+		 * metal's base colour. false (default): a dielectric's F0, no ambient term (the core's). */
+		bool spec_gloss;
 	} specular;
 };
 
