@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "internal.h"
+#include "env.h"
 #include "moments.h"
 #include "shadow_cache.h"
 
@@ -426,10 +427,13 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if ((r = rnd_moments_init(ctx, err)) != RND_OK) goto fail_moments;
 	if ((r = rnd_slots_init(ctx, err)) != RND_OK) goto fail_slots;
 	if ((r = rnd_cache_init(ctx, err)) != RND_OK) goto fail_cache;
+	if ((r = rnd_env_init(ctx, err)) != RND_OK) goto fail_env;
 	rnd_log(ctx, 2, "device '%s' (%s %s)", ctx->props.deviceName, ctx->driver_name, ctx->driver_info);
 	*out = ctx;
 	return RND_OK;
 
+fail_env:
+	rnd_cache_release_all(ctx);
 fail_cache:
 	rnd_slots_release(ctx);
 fail_slots:
@@ -453,6 +457,7 @@ void rnd_context_destroy(struct rnd_context *ctx)
 {
 	if (!ctx) return;
 	if (ctx->device) vkDeviceWaitIdle(ctx->device); /* once, at shutdown: nothing may be in flight */
+	rnd_env_release_all(ctx);
 	rnd_cache_release_all(ctx);
 	rnd_slots_release(ctx);
 	rnd_moments_release(ctx);

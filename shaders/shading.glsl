@@ -60,8 +60,8 @@ layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any li
 layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
 layout(constant_id = UMBRA_SC_SAMPLES) const uint SC_SAMPLES = 1u;      // samples the pass rasterises
 
-#ifdef UMBRA_VIS_PASS
-// vis.frag: the surface comes from the surfaces image, not from a triangle.
+#if defined(UMBRA_VIS_PASS) || defined(UMBRA_ENV_PASS_FRAG)
+// vis.frag, env_vis.frag: the surface comes from a surfaces image, not from a triangle.
 vec3 v_pos;
 vec3 v_nrm;
 vec2 v_uv;
