@@ -250,7 +250,7 @@ void rnd_env_record(struct rnd_context *ctx, VkCommandBuffer cmd, const struct r
 }
 
 void rnd_env_write(const struct rnd_env_use *use, const struct rnd_environment *env, const float inv_view_proj[16],
-                   uint32_t first_light, struct umbra_env *out)
+                   uint32_t first_light, uint32_t pass_scale, struct umbra_env *out)
 {
 	memset(out, 0, sizeof *out);
 	memcpy(out->inv_view_proj, inv_view_proj, sizeof out->inv_view_proj);
@@ -267,6 +267,7 @@ void rnd_env_write(const struct rnd_env_use *use, const struct rnd_environment *
 	out->params[2] = (float)first_light;
 	out->params[3] = (float)use->mapped;
 	memcpy(out->ground, use->ground_n, sizeof use->ground_n);
+	out->pass[0] = (float)pass_scale;
 	out->ground[3] = (float)use->ndirs;
 	for (uint32_t i = 0; i < use->ndirs; i++) {
 		memcpy(out->dirs[i], use->dirs[i].dir, 3 * sizeof(float));

@@ -69,9 +69,10 @@ void rnd_env_shadow_dirs(struct rnd_env_use *use, const struct rnd_environment *
  * command buffer, before anything samples it. */
 void rnd_env_record(struct rnd_context *ctx, VkCommandBuffer cmd, const struct rnd_env_use *use);
 /* The umbra_env block of a view: inv_view_proj the camera's clip -> world, first_light the
- * index of the first environment direction among the frame's lights. */
+ * index of the first environment direction among the frame's lights, pass_scale the view's
+ * pixels per texel of its environment pass (env_pass.h). */
 void rnd_env_write(const struct rnd_env_use *use, const struct rnd_environment *env, const float inv_view_proj[16],
-                   uint32_t first_light, struct umbra_env *out);
+                   uint32_t first_light, uint32_t pass_scale, struct umbra_env *out);
 /* The images of bindings UMBRA_BINDING_ENV_SPECULAR, _MAP and _BRDF (the slot's white stand-ins
  * without a map). */
 void rnd_env_images(const struct rnd_context *ctx, const struct rnd_env_use *use, const struct rnd_slot *s,

@@ -32,10 +32,17 @@ bool rnd_env_pass_wanted(const struct rnd_scene *sc, const struct rnd_env_use *e
 	return !(force && strcmp(force, "0") == 0);
 }
 
+uint32_t rnd_env_pass_scale(uint32_t w, uint32_t h)
+{
+	uint32_t side = w > h ? w : h, s = (side + RND_ENV_PASS_GRID - 1) / RND_ENV_PASS_GRID;
+	return s < UMBRA_ENV_PASS_SCALE ? UMBRA_ENV_PASS_SCALE : s > RND_ENV_PASS_MAX_SCALE ? RND_ENV_PASS_MAX_SCALE : s;
+}
+
 void rnd_env_pass_size(uint32_t w, uint32_t h, uint32_t *pw, uint32_t *ph)
 {
-	*pw = (w + UMBRA_ENV_PASS_SCALE - 1) / UMBRA_ENV_PASS_SCALE;
-	*ph = (h + UMBRA_ENV_PASS_SCALE - 1) / UMBRA_ENV_PASS_SCALE;
+	uint32_t s = rnd_env_pass_scale(w, h);
+	*pw = (w + s - 1) / s;
+	*ph = (h + s - 1) / s;
 }
 
 void rnd_env_pass_release(struct rnd_context *ctx, struct rnd_slot *s)
@@ -119,13 +126,12 @@ enum rnd_result record_env_pass(struct rnd_context *ctx, struct rnd_slot *s, con
 	if (r != RND_OK) return r;
 	uint32_t pw, ph;
 	rnd_env_pass_size(rv->sc->width, rv->sc->height, &pw, &ph);
-	/* The surfaces: the view's projection over a viewport of 1 / UMBRA_ENV_PASS_SCALE of the
-	 * view's size (a fraction of a texel beyond it where the scale does not divide the size), so
-	 * that texel t's centre is at the view's (t + 0.5) UMBRA_ENV_PASS_SCALE, as env_pass_read
-	 * reads it. */
-	struct rnd_surface_targets grid = {&s->env_surfaces, &s->env_normals, &s->env_depth,
-	                                   (float)rv->sc->width / UMBRA_ENV_PASS_SCALE,
-	                                   (float)rv->sc->height / UMBRA_ENV_PASS_SCALE};
+	/* The surfaces: the view's projection over a viewport of 1 / scale of the view's size (a
+	 * fraction of a texel beyond it where the scale does not divide the size), so that texel
+	 * t's centre is at the view's (t + 0.5) scale, as env_pass_read reads it. */
+	float scale = (float)rnd_env_pass_scale(rv->sc->width, rv->sc->height);
+	struct rnd_surface_targets grid = {&s->env_surfaces, &s->env_normals, &s->env_depth, (float)rv->sc->width / scale,
+	                                   (float)rv->sc->height / scale};
 	record_surfaces(ctx, s, rv, (VkRect2D){{0, 0}, {pw, ph}}, &grid);
 	record_vis(ctx, s, pipe, pw, ph);
 	return RND_OK;

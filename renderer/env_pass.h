@@ -1,6 +1,6 @@
 /*
  * renderer/env_pass.h — the environment pass: the environment map's shadows computed once per
- * texel of a grid UMBRA_ENV_PASS_SCALE times coarser than the view (env_pass.c says why), which
+ * texel of a grid coarser than the view (rnd_env_pass_scale; env_pass.c says why), which
  * the main pass reads back with a bilateral upsample (shaders/ibl.glsl env_pass_read).
  *
  * Usage: render.c asks rnd_env_pass_wanted() per view and sizes the slot's images
@@ -18,6 +18,11 @@
  * environment_shadow's. UMBRA_ENV_PASS=0 computes them per fragment instead (tests). */
 bool rnd_env_pass_wanted(const struct rnd_scene *sc, const struct rnd_env_use *env, const struct draw *draws,
                          uint32_t ndraw);
+/* The view's pixels per texel of the pass's grid, a side: UMBRA_ENV_PASS_SCALE (2), more for
+ * views larger than RND_ENV_PASS_GRID texels a side at that scale, at most RND_ENV_PASS_MAX_SCALE. */
+#define RND_ENV_PASS_GRID 192u
+#define RND_ENV_PASS_MAX_SCALE 4u
+uint32_t rnd_env_pass_scale(uint32_t w, uint32_t h);
 /* The pass's grid for a w x h view: ceil(w / scale) x ceil(h / scale). */
 void rnd_env_pass_size(uint32_t w, uint32_t h, uint32_t *pw, uint32_t *ph);
 /* Makes the slot's pass images match a w x h view. */

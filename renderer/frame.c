@@ -10,6 +10,7 @@
 #include <string.h>
 #include "contact.h"
 #include "env.h"
+#include "env_pass.h"
 #include "frame.h"
 #include "material.h"
 #include "moments.h"
@@ -292,7 +293,8 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
 	float inv_vp[16];
 	if (!rnd_mat4_invert(inv_vp, cam->view_proj)) memset(inv_vp, 0, sizeof inv_vp);
 	static const struct rnd_env_use none;
-	rnd_env_write(env ? env : &none, &sc->environment, inv_vp, shaded, (struct umbra_env *)(base + lay.off_env));
+	rnd_env_write(env ? env : &none, &sc->environment, inv_vp, shaded, rnd_env_pass_scale(sc->width, sc->height),
+	              (struct umbra_env *)(base + lay.off_env));
 	write_materials((struct umbra_material *)(base + lay.off_mat), sc);
 	struct umbra_light *l = (struct umbra_light *)(base + lay.off_light);
 	for (uint32_t i = 0; i < sc->light_count; i++) write_light(ctx, &l[i], sc, sp, i);

@@ -5,7 +5,7 @@
 #include "shading.glsl"
 #include "ibl.glsl"
 // The environment pass (renderer/env_pass.c): a fullscreen triangle over the view's surfaces at
-// 1 / UMBRA_ENV_PASS_SCALE of its pixels a side, writing the environment's visibility there
+// 1 / env.pass.x of its pixels a side, writing the environment's visibility there
 // (ibl.glsl env_visibility: a PCSS lookup per shadow direction, weighed by its light on the
 // geometric normal). Its shadows are soft: computed once per pass texel, not per fragment of
 // every triangle the main pass shades, and read back with a bilateral upsample (env_pass_read).

@@ -125,7 +125,7 @@ float env_visibility(vec3 p_shadow, vec3 n_shadow, vec3 N)
 // pass texel): their plain bilinear mean.
 float env_pass_read(vec3 pos, vec3 n)
 {
-	const float S = float(UMBRA_ENV_PASS_SCALE);
+	float S = env.pass.x;
 	vec2 q = gl_FragCoord.xy / S - 0.5;
 	ivec2 b = ivec2(floor(q)), size = textureSize(env_vis_image, 0);
 	vec2 f = q - vec2(b);

@@ -38,7 +38,8 @@
 #define UMBRA_BINDING_ENV_NORMALS    17 /* sampler2D (RGBA16 snorm, texelFetch): geometric normal */
 #define UMBRA_BINDING_ENV_VIS        18 /* sampler2D (R16 unorm, texelFetch): occluded / unoccluded */
 #define UMBRA_BINDING_COUNT          19
-#define UMBRA_ENV_PASS_SCALE         2  /* the view's pixels per environment-pass texel, a side */
+#define UMBRA_ENV_PASS_SCALE         2  /* the view's pixels per environment-pass texel, a side, at least
+                                           (larger views take more: env_pass.c rnd_env_pass_scale) */
 /* env_prefilter.comp's and env_brdf.comp's own set 0 */
 #define UMBRA_ENVC_BINDING_SOURCE    0  /* sampler2D: the equirectangular map (prefilter) */
 #define UMBRA_ENVC_BINDING_OUT       1  /* storage image: a cube level as a 2D array (rgba16f) / the table (rg16f) */
@@ -254,6 +255,7 @@ struct umbra_env {
 	U_VEC4 ground;           /* xyz the normal of a ground plane that hides every direction below it
 	                            (those come after the mapped ones, with no map), w all directions */
 	U_MAT4 inv_view_proj;    /* the camera's clip -> world (the background's rays) */
+	U_VEC4 pass;             /* x the environment pass's view pixels per texel, a side (env_pass.c) */
 	U_VEC4 dirs[UMBRA_MAX_ENV_DIRECTIONS];      /* xyz unit direction towards the sky, w its share of the
 	                                               map's light (energy; the shares sum to 1) */
 	U_VEC4 sizes[UMBRA_MAX_ENV_DIRECTIONS / 4]; /* sin of each direction's angular radius, four a vec4 */
