@@ -60,6 +60,11 @@ uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, ui
 /* Material `index` of the scene into *m (defaults for Assimp's default material), with its
  * textures decoded into the arena; *single_sided from glTF's doubleSided. -1 with c->err (and
  * c->oom when an allocation failed) on failure. */
+/* Mesh am's points and lines (faces of 1 and 2 indices) as triangles into out (api/model_strokes.c):
+ * a prism of radius r along each segment, an octahedron of radius 2.5 r at each point; out
+ * without triangles when am has none. 0, or -1 with c's error. */
+int api_conv_strokes(struct api_conv *c, const struct aiMesh *am, float r, struct api_model_mesh *out);
+
 int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m,
                       bool *single_sided);
 

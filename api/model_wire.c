@@ -84,6 +84,12 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 		           (uint32_t)(ts->uv_set == 1) << 9);
 		put(b, ts->transform, sizeof ts->transform);
 	}
+	put_u32(b, mt->extensions);
+	float e[11] = {mt->clearcoat.factor, mt->clearcoat.roughness, mt->clearcoat.normal_scale, mt->sheen.color[0],
+	               mt->sheen.color[1], mt->sheen.color[2], mt->sheen.roughness, mt->specular.factor,
+	               mt->specular.color[0], mt->specular.color[1], mt->specular.color[2]};
+	put(b, e, sizeof e);
+	put(b, &mt->specular.ior, 4);
 }
 
 static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh *me)
@@ -287,6 +293,36 @@ static bool sampling_ok(uint32_t packed, const float *t)
 	return true;
 }
 
+static bool in_range(const float *v, int n, float lo, float hi)
+{
+	for (int k = 0; k < n; k++)
+		if (!(v[k] >= lo && v[k] <= hi)) return false;   /* NaN fails */
+	return true;
+}
+
+/* A material's PBR extensions: RND_EXT_* bits, then clearcoat factor roughness normal_scale,
+ * sheen colour[3] roughness, specular factor colour[3] ior (f32). */
+static enum api_result decode_extensions(struct dec *d, uint32_t i, struct rnd_material *m)
+{
+	uint32_t bits;
+	float e[12];
+	if (!take_u32(&d->r, &bits) || !take(&d->r, e, sizeof e)) return bad(&d->r, "material %u is cut short", i);
+	bool ok = bits <= (RND_EXT_CLEARCOAT | RND_EXT_SHEEN | RND_EXT_SPECULAR) && in_range(e, 2, 0, 1) &&
+	          in_range(e + 2, 1, -1e3f, 1e3f) && in_range(e + 3, 5, 0, 1) && in_range(e + 8, 3, 0, 1e6f) &&
+	          in_range(e + 11, 1, 0, 1e6f);
+	if (!ok) return bad(&d->r, "material %u has an extension value out of range", i);
+	m->extensions = bits;
+	m->clearcoat.factor = e[0];
+	m->clearcoat.roughness = e[1];
+	m->clearcoat.normal_scale = e[2];
+	memcpy(m->sheen.color, e + 3, 3 * sizeof(float));
+	m->sheen.roughness = e[6];
+	m->specular.factor = e[7];
+	memcpy(m->specular.color, e + 8, 3 * sizeof(float));
+	m->specular.ior = e[11];
+	return API_OK;
+}
+
 static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd_texture *tex, uint32_t ntex,
                                         struct rnd_material *mats)
 {
@@ -322,6 +358,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 			ts->uv_set = (uint8_t)(packed[s] >> 9 & 1);
 			memcpy(ts->transform, tf[s], sizeof tf[s]);
 		}
+		if (decode_extensions(d, i, m) != API_OK) return API_ERR;
 		memcpy(m->base_color, f, 4 * sizeof(float));
 		m->roughness = f[4];
 		m->metallic = f[5];
@@ -403,10 +440,10 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 		for (uint32_t k = 0; k < nwarn; k++)
 			if (warn[k] < 0x20 || warn[k] > 0x7e) warn[k] = '?';
 	}
-	/* Each item has a smallest size on the wire (texture 8, material 216, mesh 16, instance 68
+	/* Each item has a smallest size on the wire (texture 8, material 488, mesh 16, instance 68
 	 * bytes): counts the reply's bytes cannot hold are lies caught before allocating (the arrays
 	 * are larger in memory than on the wire, and zeroed). */
-	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 216 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
+	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 488 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
 	if (ntex > MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, min_wire, 1))
 		return bad(&d.r, "%u textures, %u materials, %u meshes, %u instances", ntex, nmat, nmesh, ninst);
 	struct rnd_texture *tex = dec_alloc(&d, ntex, sizeof *tex);

@@ -22,10 +22,12 @@
  *            textures:  width height, width*height*4 bytes RGBA8
  *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff normal_scale
  *                       occlusion_strength reserved (f32, reserved = 0), alpha_mode (u32),
- *                       texture[5] (i32 per rnd_texture_slot, -1 = none), then per slot the
+ *                       texture[12] (i32 per rnd_texture_slot, -1 = none), then per slot the
  *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
  *                       transformed << 6 | mip << 7 (u32, enum rnd_mip) | uv_set << 9 (0 or 1),
- *                       transform f32[6]
+ *                       transform f32[6]; then the PBR extensions: bits (u32, RND_EXT_*),
+ *                       clearcoat factor roughness normal_scale, sheen colour[3] roughness,
+ *                       specular factor colour[3] ior (f32)
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
  *                       8 tangents, 16 single-sided, 32 closed, 64 levels, 128 second uv set),
  *                       positions f32[3v], normals f32[3v], uvs f32[2v], uvs1 f32[2v], colours
@@ -52,7 +54,7 @@
 #include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 4u
+#define API_WIRE_VERSION 5u
 #define API_WIRE_MAX_MESSAGE 1024u
 
 enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2, API_WIRE_LEVELS = 3 };

@@ -176,6 +176,7 @@ enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, c
 	 * output, tone map or materials share one variant. */
 	key.sc[UMBRA_SC_LINEAR] = key.sc[UMBRA_SC_TONEMAP] = key.sc[UMBRA_SC_CATCHER] = 0;
 	key.sc[UMBRA_SC_TEXTURES] = key.sc[UMBRA_SC_MASKED] = key.sc[UMBRA_SC_DEBUG] = key.sc[UMBRA_SC_ENV] = 0;
+	key.sc[UMBRA_SC_MATERIAL_EXT] = 0;
 	key.format = 0;
 	key.samples = 1;
 	key.cull_back = key.prepass = key.aov = key.atlas_view = 0;

@@ -162,14 +162,48 @@ float env_shadow(vec3 p_shadow, vec3 n_shadow, vec3 N)
 // perceptual roughness rough, split sum), both darkened by the material's occlusion ao and the
 // environment's visibility vis (the specular through Lagarde's specular occlusion, "Moving
 // Frostbite to PBR" 2014). *diffuse_open: the diffuse part without either (shadow catchers).
+// The prefiltered light arriving along R at perceptual roughness rough (intensity applied).
+vec3 env_prefiltered(vec3 R, float rough)
+{
+	return textureLod(env_specular, env_rotate_to_map(R, env.rot.x, env.rot.y), rough * env.rot.w).rgb * env.rot.z;
+}
+
+// Lagarde's specular occlusion from the diffuse one (occ) at N.V ndv and roughness rough.
+float env_specular_occlusion(float ndv, float occ, float rough)
+{
+	return clamp(pow(ndv + occ, exp2(-16.0 * rough - 1.0)) - 1.0 + occ, 0.0, 1.0);
+}
+
+// The glTF extension lobes under the map (material_ext.glsl, ext_s set for this pixel; folded
+// away unless a drawn material has one): KHR_materials_specular's F90 in the split sum
+// (F0 A + F90 B), the sheen as its albedo x the irradiance, the coat as its own split-sum
+// lobe about its normal, stacked over the base by ext_layer() as for a light.
+vec3 env_light_ext(vec3 diffuse, vec3 pre, vec2 ab, vec3 f0, float so, vec3 N, vec3 V, float ndv, float occ)
+{
+	vec3 base = diffuse + pre * (f0 * ab.x + (EXT_SPECULAR ? ext_s.f90 : vec3(1.0)) * ab.y) * so;
+	if (!EXT_SHEEN && !EXT_CLEARCOAT) return base;
+	vec3 sheen = EXT_SHEEN ? ext_s.sheen * ext_sheen_albedo(ndv, ext_s.sheen_r) * env_irradiance(N) * occ : vec3(0.0);
+	float coat = 0.0;
+	vec3 coat_rgb = vec3(0.0);
+	if (EXT_CLEARCOAT) {
+		float cv = max(dot(ext_s.cc_n, V), 1e-4);
+		vec2 cab = textureLod(env_brdf, vec2(cv, ext_s.cc_rough), 0.0).rg;
+		coat_rgb = env_prefiltered(reflect(-V, ext_s.cc_n), ext_s.cc_rough) * (ext_s.cc_f0 * cab.x + cab.y)
+		         * env_specular_occlusion(cv, occ, ext_s.cc_rough);
+	}
+	// ext_layer takes the coat as one number per light; here it is a colour: layered by hand.
+	vec3 c = ext_layer(base, ext_s.sheen_keep, sheen, coat);
+	return EXT_CLEARCOAT ? c + ext_s.cc * coat_rgb : c;
+}
+
 vec3 env_light(vec3 N, vec3 V, vec3 c_diff, vec3 f0, float rough, float ao, float vis, out vec3 diffuse_open)
 {
 	float ndv = max(dot(N, V), 1e-4);
-	vec3 R = reflect(-V, N);
 	vec2 ab = textureLod(env_brdf, vec2(ndv, rough), 0.0).rg;
-	vec3 pre = textureLod(env_specular, env_rotate_to_map(R, env.rot.x, env.rot.y), rough * env.rot.w).rgb * env.rot.z;
+	vec3 pre = env_prefiltered(reflect(-V, N), rough);
 	float occ = ao * vis;
-	float so = clamp(pow(ndv + occ, exp2(-16.0 * rough - 1.0)) - 1.0 + occ, 0.0, 1.0);
+	float so = env_specular_occlusion(ndv, occ, rough);
 	diffuse_open = env_irradiance(N) * c_diff;
+	if (SC_MATERIAL_EXT != 0u) return env_light_ext(diffuse_open * occ, pre, ab, f0, so, N, V, ndv, occ);
 	return diffuse_open * occ + pre * (f0 * ab.x + ab.y) * so;
 }

@@ -16,6 +16,11 @@ umbra_material draw_material()
 	m.params = pc.params;
 	m.tex = pc.tex;
 	if ((SC_TEXTURES & ~(UMBRA_TEXBIT_VERTEX_COLOR | UMBRA_TEXBIT_UV1)) != 0u) m.uvx = materials[pc.info.x].uvx;
+	if (SC_MATERIAL_EXT != 0u) {   // the extensions' members, where a drawn material has one (material_ext.glsl)
+		m.clearcoat = materials[pc.info.x].clearcoat;
+		m.sheen = materials[pc.info.x].sheen;
+		m.specular = materials[pc.info.x].specular;
+	}
 	return m;
 }
 
@@ -40,6 +45,7 @@ void main()
 	metal = clamp(metal, 0.0, 1.0);
 	vec3 f0 = mix(vec3(0.04), base, metal);
 	vec3 c_diff = base * (1.0 - metal);
+	if (SC_MATERIAL_EXT != 0u) f0 = ext_surface_at(m, N, n_geo, V, base, metal, f0);
 	bool receive = (flags & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	vec3 lit, unshadowed;
 	float debug_vis;
@@ -51,6 +57,7 @@ void main()
 	if (has_tex(m, UMBRA_TEX_OCCLUSION))
 		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv, v_uv1).r - 1.0);
 	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * metal) * ao;
+	if (SC_MATERIAL_EXT != 0u) ambient = ext_ambient(ambient, mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * ao, N, V);
 	// The environment map's light and its shadows (ibl.glsl; folded away without a map).
 	float env_vis = 1.0;
 	vec3 env_open = vec3(0.0);

@@ -58,6 +58,13 @@ char *test_model_doc(const uint8_t *d, size_t n, const char *format)
 	return doc;
 }
 
+struct api_scene *test_parse_scene(const char *doc, struct api_problem *p)
+{
+	struct api_scene *s = NULL;
+	memset(p, 0, sizeof *p);
+	return api_scene_parse(doc, strlen(doc), NULL, &s, p) == API_OK ? s : NULL;
+}
+
 struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *format, struct api_problem *p)
 {
 	char *doc = test_model_doc(d, n, format);

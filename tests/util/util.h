@@ -27,5 +27,8 @@ char *test_model_doc(const uint8_t *d, size_t n, const char *format);
 struct api_scene;
 struct api_problem;
 struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *format, struct api_problem *p);
+/* A scene document parsed (api_scene_parse, default limits): the scene, or NULL with *p its
+ * problem (*p zeroed first). */
+struct api_scene *test_parse_scene(const char *doc, struct api_problem *p);
 
 #endif
