@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "api.h"
+#include "env_map.h"
 #include "envmaps.h"
 #include "test.h"
 #include "util.h"
@@ -133,4 +134,42 @@ TEST(env_parse_problems)
 		CHECK(!strcmp(p.pointer, BAD[i].pointer), "case %zu: pointer %s, want %s", i, p.pointer, BAD[i].pointer);
 		CHECK(strstr(p.detail, BAD[i].detail) != NULL, "case %zu: detail \"%s\" lacks \"%s\"", i, p.detail, BAD[i].detail);
 	}
+}
+
+/* The ETag's scene hash (api/scene_hash.c): the map by its pixels, never its address; its
+ * members by their parsed values. */
+TEST(env_parse_scene_hash)
+{
+	/* Every slot of the map cache held by other maps: each parse decodes the sky anew, so two
+	 * scenes alive at once hold its pixels at two addresses. */
+	struct api_env_map *held[8] = {0};
+	for (int i = 0; i < 8; i++) {
+		float *m = test_patch_map(16, 8, 45.0f * (float)i, 0, 60, 2.0f + (float)i, 0.5f);   /* 8 different maps */
+		size_t n = 0;
+		uint8_t *b = m ? test_hdr_bytes(m, 16, 8, false, &n) : NULL;
+		int status;
+		char err[128];
+		CHECK(b && api_env_map_get(b, n, &held[i], &status, err, sizeof err) == API_OK, "map %d", i);
+		free(m);
+		free(b);
+	}
+	struct api_problem p;
+	struct api_scene *a = parse_env(&p, SCENE "'environment':{'map':{'part':'sky'}}}");
+	REQUIRE(a, "%s: %s", p.pointer, p.detail);
+	struct api_scene *b = parse_env(&p, SCENE "'environment':{'map':{'part':'sky','rotation':0,'intensity':1}}}");
+	REQUIRE(b, "%s: %s", p.pointer, p.detail);
+	CHECK(a->scene.environment.map.rgb != b->scene.environment.map.rgb, "decoded twice");
+	CHECK(a->scene_hash == b->scene_hash, "the same map, defaults written or not: one hash");
+	api_scene_free(b);
+	for (int i = 0; i < 8; i++) api_env_map_release(held[i]);
+	const char *other[] = {SCENE "'environment':{'map':{'part':'sky','rotation':90}}}",
+	                       SCENE "'environment':{'map':{'preset':'studio'}}}",
+	                       SCENE "'environment':{'map':{'part':'sky'},'shadow':false}}"};
+	for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) {
+		b = parse_env(&p, other[i]);
+		REQUIRE(b, "%s: %s", p.pointer, p.detail);
+		CHECK(a->scene_hash != b->scene_hash, "case %zu hashes apart", i);
+		api_scene_free(b);
+	}
+	api_scene_free(a);
 }
