@@ -108,10 +108,15 @@ static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityF
 	 * tiles while another render copies a new map into another tile, and one image has one
 	 * layout. The layer's performance hint that a copy into GENERAL would be faster in
 	 * TRANSFER_DST_OPTIMAL (UNASSIGNED-CoreValidation-DrawState-InvalidImageLayout) is
-	 * expected there, and only there. */
+	 * expected there, and only there. The atlas is known by its name or by its handle: with
+	 * two renders recording at once the layer has printed it nameless ("VkImage 0x...[]"). */
 	if ((type & VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT) && data->messageIdNumber == 0x4dae5635 &&
-	    data->pMessage && strstr(data->pMessage, "[shadow depth atlas]") && strstr(data->pMessage, "GENERAL"))
-		return VK_FALSE;
+	    data->pMessage && strstr(data->pMessage, "GENERAL")) {
+		char atlas[48];
+		snprintf(atlas, sizeof atlas, "VkImage 0x%llx[", (unsigned long long)(uintptr_t)ctx->atlas_depth.img);
+		if (strstr(data->pMessage, "[shadow depth atlas]") || (ctx->atlas_depth.img && strstr(data->pMessage, atlas)))
+			return VK_FALSE;
+	}
 	if (sev >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
 		__atomic_add_fetch(&ctx->validation_count, 1, __ATOMIC_RELAXED);
 		rnd_log(ctx, 0, "vulkan validation: %s", data->pMessage ? data->pMessage : "(no message)");
