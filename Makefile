@@ -21,7 +21,7 @@ GLSLANG ?= glslangValidator
 # The packages of each module (server -> api -> renderer): each compiles with its own packages'
 # cflags only; everything links with all of them.
 PKGS_RENDERER := vulkan
-PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp libavif
+PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp libavif libdeflate
 PKGS_SERVER := libmicrohttpd
 PKGS := $(PKGS_RENDERER) $(PKGS_API) $(PKGS_SERVER)
 
@@ -34,7 +34,7 @@ LDFLAGS += -pthread $(SAN)
 # Each module sees only the headers it may use (server -> api -> renderer -> shaders): an
 # include across the layering is a compile error, not a review comment. Tests see everything.
 # Their packages' cflags likewise (PKG_CFLAGS_* below): the renderer gets Vulkan's, api/ those of
-# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg, libseccomp, libwebp and libavif (meshoptimizer has no .pc),
+# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg, libseccomp, libwebp, libavif and libdeflate (meshoptimizer has no .pc),
 # the server libmicrohttpd's.
 INC_RENDERER = -Irenderer/include -Irenderer -Ishaders -I$(BUILD)/shaders $(PKG_CFLAGS_RENDERER)
 INC_API = -Irenderer/include -Iapi $(PKG_CFLAGS_API)
@@ -186,10 +186,11 @@ bench-tools:
 		$(BUILD)/tests/edge_error
 	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor
 
-$(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a \
+		$(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/edge_error: $(BUILD)/obj/tests/bench/edge_error.o

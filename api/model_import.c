@@ -31,7 +31,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <jansson.h>
-#include <meshoptimizer.h>
 #include "errmsg.h"
 #include "gltf_buffers.h"
 #include "gltf_decode.h"
@@ -43,7 +42,6 @@
 #include "model_lod.h"
 #include "ply_colors.h"
 #include "ply_strips.h"
-#include "remap.h"
 #include "stl_import.h"
 #include "umbra/rnd_math.h"
 
@@ -209,48 +207,6 @@ static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_
 	return 0;
 }
 
-/* What join_vertices compares of a corner. */
-struct join_key {
-	float pos[3];
-	int16_t nrm[3];
-	uint8_t col[4];
-	int16_t pad;   /* zero: meshoptimizer compares every byte */
-};
-
-uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
-{
-	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
-	struct join_key *key = calloc(nv, sizeof *key);
-	if (!remap || !key) {
-		free(remap);
-		free(key);
-		return nv;
-	}
-	for (uint32_t v = 0; v < nv; v++) {
-		for (int k = 0; k < 3; k++) {
-			key[v].pos[k] = pos[3 * (size_t)v + (size_t)k] + 0.0f;   /* -0 is 0 */
-			key[v].nrm[k] = (int16_t)lrintf(nrm[3 * (size_t)v + (size_t)k] * 16384.0f);
-		}
-		if (col) memcpy(key[v].col, col + 4 * (size_t)v, 4);
-	}
-	size_t unique = api_remap_keys(key, nv, sizeof *key, remap);
-	free(key);
-	if (unique == SIZE_MAX) {
-		free(remap);
-		return nv;
-	}
-	/* new ids follow first occurrences: remap[v] <= v, so moving down in order is safe */
-	for (uint32_t v = 0; v < nv; v++)
-		if (remap[v] != v) {
-			memcpy(pos + 3 * (size_t)remap[v], pos + 3 * (size_t)v, 12);
-			memcpy(nrm + 3 * (size_t)remap[v], nrm + 3 * (size_t)v, 12);
-			if (col) memcpy(col + 4 * (size_t)remap[v], col + 4 * (size_t)v, 4);
-		}
-	meshopt_remapIndexBuffer(idx, idx, ni, remap);
-	free(remap);
-	return (uint32_t)unique;
-}
-
 /* A material slot on TEXCOORD_1 of a mesh without that set: the renderer draws it with
  * TEXCOORD_0 (rnd.h uvs1), and the model says so. */
 static void warn_missing_uv1(struct api_conv *c, const struct aiMesh *am, const struct api_model_mesh *me,
@@ -283,7 +239,8 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 	out->material = am->mMaterialIndex;
 	/* the colours are ours (the arena) until the model is shared */
 	if (c->join && nrm && !uv && !uv1 && !out->tangents && nv)
-		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
+		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count, c->arena,
+		                                      &out->weld_group_, &out->weld_groups_);
 	return 0;
 }
 

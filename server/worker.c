@@ -338,7 +338,7 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 			if (w > 0) n += (size_t)w;
 		}
 	/* The environment map: the CPU's share of preparing it (0 once it is kept) and the shadow
-	 * directions drawn (their maps are in `shadow`, their lookups in `main`). */
+	 * directions drawn (their maps and the environment pass are in `shadow`). */
 	char env[80] = "";
 	if (sc->scene.environment.source != RND_ENV_AMBIENT)
 		snprintf(env, sizeof env, ", environment;dur=%.3f;desc=\"%u directions\"", t->env_ms, t->env_directions);

@@ -42,24 +42,10 @@ struct rnd_context *gpu_ctx(void)
 struct rnd_timings gpu_last_timings;
 const char *gpu_asset_root;
 
-uint8_t *gpu_read_file(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	uint8_t *b = n > 0 ? malloc((size_t)n + 1) : NULL;
-	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
-	fclose(f);
-	if (b) { b[n] = 0; *len = (size_t)n; }
-	return b;
-}
-
 float *gpu_read_grey(const char *path, uint32_t w, uint32_t h)
 {
 	size_t len;
-	uint8_t *png = gpu_read_file(path, &len), *rgba = NULL;
+	uint8_t *png = test_read_file(path, &len), *rgba = NULL;
 	uint32_t pw = 0, ph = 0;
 	char err[200];
 	float *out = NULL;

@@ -80,8 +80,6 @@ enum { GPU_CLS_BG = 0, GPU_CLS_OBJ = 1, GPU_CLS_LIT = 2, GPU_CLS_SHADOW = 3, GPU
  * distance `band`. */
 bool gpu_near_edge(const uint8_t *cls, int w, int h, int i, int j, int band);
 
-/* A file's bytes (malloc'd, NUL-terminated; *len without the NUL), NULL when unreadable. */
-uint8_t *gpu_read_file(const char *path, size_t *len);
 /* A grey (or RGBA: its red) PNG as 0..1 floats, w x h (malloc'd); NULL when missing or of
  * another size. */
 float *gpu_read_grey(const char *path, uint32_t w, uint32_t h);

@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include "api.h"
 #include "envmaps.h"
+#include "util.h"
 #include "gpu_util.h"
 #include "test.h"
 
@@ -180,7 +181,7 @@ static void render_truth_scene(const char *name, struct rnd_image *img, bool per
 	char path[160];
 	snprintf(path, sizeof path, TRUTH_ENV "%s.json", name);
 	size_t len;
-	char *doc = (char *)gpu_read_file(path, &len);
+	char *doc = (char *)test_read_file(path, &len);
 	REQUIRE(doc, "%s is missing", path);
 	/* the stored scene with the environment's debug view, one sample a pixel */
 	char *brace = strrchr(doc, '}');

@@ -15,6 +15,7 @@
 #include "model.h"
 #include "gpu_util.h"
 #include "test.h"
+#include "util.h"
 
 #define TRUTH_DIR "tests/gpu/truth/"
 
@@ -101,7 +102,7 @@ static void check_scene(const char *name, double max_rmse, double min_iou, doubl
 	char path[256];
 	size_t len;
 	snprintf(path, sizeof path, TRUTH_DIR "%s.json", name);
-	char *doc = (char *)gpu_read_file(path, &len);
+	char *doc = (char *)test_read_file(path, &len);
 	REQUIRE(doc, "cannot read %s", path);
 	const int w = 128, h = 128;
 	snprintf(path, sizeof path, TRUTH_DIR "%s.vis.png", name);
@@ -229,7 +230,7 @@ TEST(truth_contact_shadows_sun_low_res_map)
 {
 	const int w = 128, h = 128;
 	size_t len;
-	char *doc = (char *)gpu_read_file(TRUTH_DIR "contact_sun.json", &len);
+	char *doc = (char *)test_read_file(TRUTH_DIR "contact_sun.json", &len);
 	REQUIRE(doc, "cannot read " TRUTH_DIR "contact_sun.json");
 	float *truth = gpu_read_grey(TRUTH_DIR "contact_sun.vis.png", w, h);
 	float *mask = gpu_read_grey(TRUTH_DIR "contact_sun.mask.png", w, h);
@@ -289,7 +290,7 @@ TEST(truth_soft_spot_contact_on_meets_missing_contact)
 {
 	const int w = 128, h = 128;
 	size_t len;
-	char *doc = (char *)gpu_read_file(TRUTH_DIR "spot_pcss.json", &len);
+	char *doc = (char *)test_read_file(TRUTH_DIR "spot_pcss.json", &len);
 	REQUIRE(doc, "cannot read " TRUTH_DIR "spot_pcss.json");
 	float *truth = gpu_read_grey(TRUTH_DIR "spot_pcss.vis.png", w, h);
 	float *mask = gpu_read_grey(TRUTH_DIR "spot_pcss.mask.png", w, h);
