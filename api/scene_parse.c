@@ -23,6 +23,7 @@
 #include "big_strings.h"
 #include "asset.h"
 #include "gltf_variants.h"
+#include "env_map.h"
 #include "model.h"
 #include "model_paths.h"
 #include "model_refs.h"
@@ -72,27 +73,45 @@ static int model_bytes(struct pctx *c, const char *first, json_t *v, const char 
 		else if (!len) rc = api_fail(c, "data must not be empty");
 	} else if (!strcmp(first, "path")) {
 		const char *s = json_string_value(v);
-		char perr[200];
-		if (api_asset_check_path(s, perr, sizeof perr) != API_OK) rc = api_fail(c, "%s", perr);
-		else rc = read_asset(c, s, &b, &len, stamp);
+		rc = api_path_bytes(c, s, &b, &len, stamp);
 		if (!rc && !*given) { /* the extension says what the bytes may not (obj, ascii stl) */
 			const char *dot = strrchr(s, '.');
 			for (int i = 0; dot && formats[i]; i++)
 				if (!strcasecmp(dot + 1, formats[i])) { *f = i; *given = true; }
 		}
-	} else if (!json_string_length(v)) {
-		rc = api_fail(c, "part must name a part of the multipart request");
 	} else {
-		const char *name = json_string_value(v);
-		size_t i = 0;
-		while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
-		if (i == c->nparts) rc = api_fail(c, "part \"%.64s\" is not a part of this request", name);
-		else if (!c->parts[i].len) rc = api_fail(c, "part \"%.64s\" is empty", name);
-		else b = (unsigned char *)c->parts[i].data, len = c->parts[i].len;
+		const uint8_t *pb;
+		rc = api_part_bytes(c, v, &pb, &len);
+		b = (unsigned char *)pb;
 	}
 	*out = b;
 	*out_len = len;
 	return rc;
+}
+
+int api_path_bytes(struct pctx *c, const char *path, unsigned char **out, size_t *len, struct api_asset_stamp *stamp)
+{
+	char perr[200];
+	*out = NULL;
+	*len = 0;
+	if (api_asset_check_path(path, perr, sizeof perr) != API_OK) return api_fail(c, "%s", perr);
+	return read_asset(c, path, out, len, stamp);
+}
+
+int api_part_bytes(struct pctx *c, json_t *v, const uint8_t **out, size_t *len)
+{
+	*out = NULL;
+	*len = 0;
+	if (!json_is_string(v)) return api_fail(c, "part must be a string, not %s", api_type_name(v));
+	if (!json_string_length(v)) return api_fail(c, "part must name a part of the multipart request");
+	const char *name = json_string_value(v);
+	size_t i = 0;
+	while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
+	if (i == c->nparts) return api_fail(c, "part \"%.64s\" is not a part of this request", name);
+	if (!c->parts[i].len) return api_fail(c, "part \"%.64s\" is empty", name);
+	*out = c->parts[i].data;
+	*len = c->parts[i].len;
+	return 0;
 }
 
 /* Makes m (one reference, given to the scene) the current model. */
@@ -292,6 +311,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 	if (api_parse_root_shadow(c, root, &root_shadow) < 0) return -1;
 	if (api_parse_lights(c, root, sc, &root_shadow) < 0) return -1;
 	if (api_parse_root_output(c, root, s) < 0) return -1;
+	if (api_check_environment(c, &root_shadow, sc) < 0) return -1;
 	api_set_pixels(s);
 	api_check_size(c, root, sc);
 	sc->materials = c->mats;
@@ -370,10 +390,12 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	api_big_strings_free(&big);
 	if (rc < 0) {
 		model_refs_release(c.models);
+		api_env_map_release(c.env_map);
 		api_arena_destroy(c.arena);
 		return API_ERR;
 	}
 	s->models_ = c.models;
+	s->env_map_ = c.env_map;
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
@@ -388,6 +410,7 @@ void api_scene_free(struct api_scene *s)
 	/* The scene itself lives in its arena; the models it points into are referenced. */
 	if (!s) return;
 	model_refs_release(s->models_);
+	api_env_map_release(s->env_map_);
 	api_arena_destroy(s->arena_);
 }
 

@@ -62,8 +62,8 @@ layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + 
 layout(constant_id = UMBRA_SC_SAMPLES) const uint SC_SAMPLES = 1u;      // samples the pass rasterises
 layout(constant_id = UMBRA_SC_MATERIAL_EXT) const uint SC_MATERIAL_EXT = 0u; // UMBRA_EXT_* lobes (material_ext.glsl)
 
-#ifdef UMBRA_VIS_PASS
-// vis.frag: the surface comes from the surfaces image, not from a triangle.
+#if defined(UMBRA_VIS_PASS) || defined(UMBRA_ENV_PASS_FRAG)
+// vis.frag, env_vis.frag: the surface comes from a surfaces image, not from a triangle.
 vec3 v_pos;
 vec3 v_nrm;
 vec2 v_uv;

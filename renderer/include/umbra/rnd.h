@@ -235,7 +235,9 @@ struct rnd_object {
 enum rnd_light_type { RND_LIGHT_DIRECTIONAL, RND_LIGHT_SPOT, RND_LIGHT_POINT };
 
 enum rnd_filter { RND_FILTER_AUTO, RND_FILTER_HARD, RND_FILTER_PCF, RND_FILTER_PCSS, RND_FILTER_VSM, RND_FILTER_EVSM };
-enum rnd_dir_mode { RND_DIR_AUTO, RND_DIR_FIT, RND_DIR_CASCADES, RND_DIR_CLIPMAP };
+/* RND_DIR_CASTERS: one map fitted to what casts shadows (not the whole scene), the light's
+ * resolution across it: the environment's shadow directions (renderer/env_shadow.c). */
+enum rnd_dir_mode { RND_DIR_AUTO, RND_DIR_FIT, RND_DIR_CASCADES, RND_DIR_CLIPMAP, RND_DIR_CASTERS };
 enum rnd_vsm_precision { RND_VSM_AUTO, RND_VSM_FP32, RND_VSM_FP16 };
 
 /* Resolved shadow settings of one light (api/ merges root `shadows` and the light's `shadow`).
@@ -293,7 +295,10 @@ struct rnd_camera {
 };
 
 enum rnd_tonemap { RND_TONEMAP_NEUTRAL, RND_TONEMAP_ACES, RND_TONEMAP_NONE };
-enum rnd_debug { RND_DEBUG_NONE, RND_DEBUG_SHADOW, RND_DEBUG_CASCADES, RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS };
+/* RND_DEBUG_ENV_SHADOW: the share of the environment's cosine-weighted diffuse light that
+ * reaches each pixel (occluded / unoccluded), written as `shadow` writes a light's. */
+enum rnd_debug { RND_DEBUG_NONE, RND_DEBUG_SHADOW, RND_DEBUG_CASCADES, RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS,
+                 RND_DEBUG_ENV_SHADOW };
 
 /* What the renderer writes into rnd_image.pixels. */
 enum rnd_pixel_format {
@@ -321,11 +326,40 @@ struct rnd_output {
 	uint32_t debug_light;
 };
 
+/* Where the environment's light comes from: the hemisphere ambient alone (sky and ground
+ * colours), an equirectangular map, or the built-in studio (renderer/env_studio.c, generated). */
+enum rnd_env_source { RND_ENV_AMBIENT, RND_ENV_MAP, RND_ENV_STUDIO };
+
+/* An equirectangular map: linear RGB floats, width x height texels, rows from the zenith (top)
+ * to the nadir; the scene direction d = (x, y, z) reads it at u = 0.5 + atan2(z, x) / 2pi (from
+ * the left edge), v = 0.5 - asin(y) / pi (from the top): the centre column is +X, the column at
+ * width/4 is -Z (three.js' equirectUv, ../shared/truth-cycles/envmap.py). */
+struct rnd_env_map {
+	const float *rgb;     /* width * height * 3 */
+	uint32_t width, height;
+	/* The caller's hash of the pixels (the prefiltered copy on the device is kept under it:
+	 * renderer/env.c), 0 = the renderer hashes them. */
+	uint64_t key;
+};
+
 struct rnd_environment {
 	float background[4];  /* linear RGBA, default 0.5 0.5 0.5 1 */
 	float ambient_sky[3], ambient_ground[3];
 	float ambient_intensity;
+	enum rnd_env_source source;   /* AMBIENT */
+	struct rnd_env_map map;       /* source MAP */
+	float rotation;               /* radians about +Y (right hand): the map's d appears at R_y d */
+	float intensity;              /* multiplies the map's radiance, default 1 */
+	bool background_map;          /* the map (tone mapped like the scene) behind the scene */
+	/* Shadows of the map's light: directions drawn as shadow maps, each over the map's brightest
+	 * region of equal energy (0 = no environment shadows; at most RND_MAX_ENV_DIRECTIONS), and
+	 * the side of their maps (0 = renderer: RND_DEFAULT_ENV_SHADOW_RESOLUTION). */
+	uint32_t shadow_directions;   /* RND_DEFAULT_ENV_DIRECTIONS */
+	uint32_t shadow_resolution;
 };
+#define RND_MAX_ENV_DIRECTIONS 32u
+#define RND_DEFAULT_ENV_DIRECTIONS 12u
+#define RND_DEFAULT_ENV_SHADOW_RESOLUTION 512u
 
 struct rnd_scene {
 	uint32_t width, height;   /* of one view */
@@ -437,6 +471,9 @@ struct rnd_timings {
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
 	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
 	uint32_t shadow_parts;     /* submits of shadow maps drawn in parts (too costly for one) */
+	uint32_t env_directions;   /* environment shadow directions drawn (maps rendered or reused) */
+	double env_ms;             /* this render's share of preparing the environment (CPU analysis and
+	                              the device's prefiltering, once per map: 0 when it was ready) */
 };
 
 /* ---- context ---- */
@@ -521,6 +558,8 @@ struct rnd_stats {
 	uint32_t cached_maps;            /* shadow maps kept for reuse (spot, point, a sun's fit map) */
 	uint64_t shadow_cache_hits;      /* lights whose shadow passes were skipped */
 	uint64_t shadow_cache_misses;
+	uint32_t env_maps;               /* environment maps kept prefiltered (the studio included) */
+	uint64_t env_builds;             /* environment maps prefiltered since create (once per map kept) */
 };
 void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
 /* Idle trim: drops cached shadow maps not used for idle_s seconds (0: all), and once no map
