@@ -109,7 +109,8 @@ enum api_import_stage {
 	API_IMPORT_LEVEL,      /* its one level of detail for the request (api/model_lod.h) */
 	API_IMPORT_TRANSFER,   /* the sandbox round trip less the importer's work: fork, socket copies */
 	API_IMPORT_VALIDATE,   /* the daemon's check and copy of the reply (api/model_wire.h) */
-	API_IMPORT_MIPS,       /* mip chains for a model the cache keeps */
+	API_IMPORT_CACHE,      /* what the cache keeps of a model it lists: its textures' mip chains and
+	                          a copy of its bytes (what confirms a hit) */
 	API_IMPORT_STAGES
 };
 struct api_import_times {
@@ -141,6 +142,7 @@ struct api_scene {
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;
+	void *env_map_;                 /* the environment map the scene points into (api/env_map.h) */
 	const uint32_t *object_source_; /* document object index of each scene.objects[i] (NULL: i) */
 	const char *views_key_;         /* "views" / "turntable" / NULL */
 	unsigned png_only_;             /* output members given that only a PNG answer uses (scene_views.c) */

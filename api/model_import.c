@@ -31,7 +31,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <jansson.h>
-#include <meshoptimizer.h>
 #include "errmsg.h"
 #include "gltf_buffers.h"
 #include "gltf_decode.h"
@@ -43,7 +42,6 @@
 #include "model_lod.h"
 #include "ply_colors.h"
 #include "ply_strips.h"
-#include "remap.h"
 #include "stl_import.h"
 #include "umbra/rnd_math.h"
 
@@ -71,16 +69,10 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
                          size_t errsize)
 {
 	*root_out = NULL;
-	const char *json = (const char *)d;
-	size_t jlen = len;
-	if (f == API_MODEL_GLB) {
-		if (len < 20 || memcmp(d + 16, "JSON", 4))
-			return api_err_set(err, errsize, "the glb has no JSON chunk"), -1;
-		uint32_t n = (uint32_t)d[12] | (uint32_t)d[13] << 8 | (uint32_t)d[14] << 16 | (uint32_t)d[15] << 24;
-		if (n > len - 20) return api_err_set(err, errsize, "the glb's JSON chunk is longer than the file"), -1;
-		json = (const char *)d + 20;
-		jlen = n;
-	}
+	const char *json;
+	size_t jlen;
+	const char *bad = api_gltf_json_of(d, len, f == API_MODEL_GLB, &json, &jlen);
+	if (bad) return api_err_set(err, errsize, "%s", bad), -1;
 	json_error_t je;
 	json_t *root = json_loadb(json, jlen, 0, &je);
 	if (!json_is_object(root)) {
@@ -209,48 +201,6 @@ static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_
 	return 0;
 }
 
-/* What join_vertices compares of a corner. */
-struct join_key {
-	float pos[3];
-	int16_t nrm[3];
-	uint8_t col[4];
-	int16_t pad;   /* zero: meshoptimizer compares every byte */
-};
-
-uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
-{
-	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
-	struct join_key *key = calloc(nv, sizeof *key);
-	if (!remap || !key) {
-		free(remap);
-		free(key);
-		return nv;
-	}
-	for (uint32_t v = 0; v < nv; v++) {
-		for (int k = 0; k < 3; k++) {
-			key[v].pos[k] = pos[3 * (size_t)v + (size_t)k] + 0.0f;   /* -0 is 0 */
-			key[v].nrm[k] = (int16_t)lrintf(nrm[3 * (size_t)v + (size_t)k] * 16384.0f);
-		}
-		if (col) memcpy(key[v].col, col + 4 * (size_t)v, 4);
-	}
-	size_t unique = api_remap_keys(key, nv, sizeof *key, remap);
-	free(key);
-	if (unique == SIZE_MAX) {
-		free(remap);
-		return nv;
-	}
-	/* new ids follow first occurrences: remap[v] <= v, so moving down in order is safe */
-	for (uint32_t v = 0; v < nv; v++)
-		if (remap[v] != v) {
-			memcpy(pos + 3 * (size_t)remap[v], pos + 3 * (size_t)v, 12);
-			memcpy(nrm + 3 * (size_t)remap[v], nrm + 3 * (size_t)v, 12);
-			if (col) memcpy(col + 4 * (size_t)remap[v], col + 4 * (size_t)v, 4);
-		}
-	meshopt_remapIndexBuffer(idx, idx, ni, remap);
-	free(remap);
-	return (uint32_t)unique;
-}
-
 /* A material slot on TEXCOORD_1 of a mesh without that set: the renderer draws it with
  * TEXCOORD_0 (rnd.h uvs1), and the model says so. */
 static void warn_missing_uv1(struct api_conv *c, const struct aiMesh *am, const struct api_model_mesh *me,
@@ -283,7 +233,8 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 	out->material = am->mMaterialIndex;
 	/* the colours are ours (the arena) until the model is shared */
 	if (c->join && nrm && !uv && !uv1 && !out->tangents && nv)
-		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
+		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count, c->arena,
+		                                      &out->weld_group_, &out->weld_groups_);
 	return 0;
 }
 
@@ -533,10 +484,11 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		                      &io_files, &io_nfiles, err, errsize);
 		json_decref(root);
 		if (rc != 0) {
+			bool oom = bufs.oom;   /* a decode over the memory limit, not a bad file */
 			free(tagged);
 			api_gltf_bufs_release(&bufs);
 			api_gltf_info_free(&c.gi);
-			return API_WIRE_BAD_INPUT;
+			return oom ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 		}
 		if (tagged) {
 			data = tagged;

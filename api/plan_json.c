@@ -77,6 +77,7 @@ static json_t *view_object(const struct rnd_plan *plan, uint32_t k)
 	                      (json_int_t)v.camera_triangles, "contact_shadows", v.contact, "visibility_pass", "on",
 	                      v.visibility, "why", v.visibility_why, "estimate_ms", "shadows", ms(v.shadow_estimate_ms),
 	                      "per_row", ms(v.row_ms), "per_band", ms(v.band_ms), "main", ms(v.main_estimate_ms));
+	if (o) put(o, "environment_pass", json_boolean(v.env_pass));
 	if (o && v.analyzed)
 		put(o, "actual_ms", json_pack("{s:o, s:o, s:i}", "shadows", ms(v.shadow_ms), "main", ms(v.main_ms), "bands",
 		                              (json_int_t)v.bands));
@@ -88,7 +89,8 @@ static json_t *map_object(const struct rnd_plan *plan, uint32_t k)
 	struct rnd_plan_map_info m;
 	rnd_plan_map(plan, k, &m);
 	char ptr[32], key[24];
-	snprintf(ptr, sizeof ptr, "/lights/%u", m.light);
+	if (m.environment >= 0) snprintf(ptr, sizeof ptr, "/environment/shadow_directions");
+	else snprintf(ptr, sizeof ptr, "/lights/%u", m.light);
 	snprintf(key, sizeof key, "%016llx", (unsigned long long)m.key);
 	json_t *o = json_pack("{s:i, s:s, s:s, s:s, s:i, s:i, s:i, s:s, s:s, s:s, s:i, s:b, s:s, s:s, s:o, s:i, s:I, s:I, s:o}",
 	                      "light", (json_int_t)m.light, "pointer", ptr, "type", m.light_type, "kind", m.kind, "tiles",
@@ -99,6 +101,9 @@ static json_t *map_object(const struct rnd_plan *plan, uint32_t k)
 	                      "texels", (json_int_t)m.texels, "triangles", (json_int_t)m.triangles, "estimate_ms",
 	                      ms(m.estimate_ms));
 	if (o && m.analyzed) put(o, "actual", json_pack("{s:b}", "cached", m.hit));
+	if (o && m.environment >= 0)
+		put(o, "environment", json_pack("{s:i, s:o, s:o}", "direction_index", (json_int_t)m.environment, "direction",
+		                                vec3(m.direction), "share", json_real(m.share)));
 	return o;
 }
 
@@ -205,6 +210,8 @@ char *api_plan_json(const struct api_scene *s, const struct rnd_plan *plan, cons
 	      put(doc, "planning_ms", ms(in.plan_ms)) || put(doc, "image", image_object(s, &in)) ||
 	      put(doc, "memory", memory_object(&in.estimate)) || put(doc, "totals", totals_object(&in)) ||
 	      put(doc, "bounds", json_pack("{s:o, s:o}", "scene", box(&in.bounds), "casters", box(&in.casters))) ||
+	      put(doc, "environment", json_pack("{s:i, s:i, s:b}", "shadow_directions", (json_int_t)in.env_directions,
+	                                        "weighed", (json_int_t)in.env_weighed, "ground", in.env_ground)) ||
 	      put(doc, "views", list(in.views, view_item, s, plan)) || put(doc, "shadow_maps", list(in.maps, map_item, s, plan)) ||
 	      put(doc, "objects", list(in.objects, object_object, s, plan)) || put(doc, "passes", passes_array(plan, in.passes));
 	if (!bad && in.analyzed) bad = put(doc, "actual", actual_object(&in, t));

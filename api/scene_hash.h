@@ -24,7 +24,8 @@
  * must be added to the pointer lists in scene_hash.c (tests/unit/test_scene_hash.c parses the
  * same scene twice and fails when a pointer's address reaches the hash).
  *
- * The hash is the project's 64-bit FNV-1a (umbra/rnd_math.h).
+ * The hash is the project's 64-bit FNV-1a for the framing and rnd_hash (a word at a time,
+ * umbra/rnd_math.h) for the structs and the parts' bytes.
  *
  * Usage (api/scene_parse.c, after a successful walk): s->scene_hash = api_scene_hash(root, &big,
  * parts, nparts, c.reads, c.nreads, s). It removes the members read from root (which the

@@ -145,25 +145,30 @@ bool rnd_moments_need_ground(const struct rnd_scene *sc)
 /* Whether plane i may shadow any other object of sc where a camera of cams[ncam] may see it
  * (ncam 0: anywhere; rnd_plane_may_shadow_seen), each taken at its bounds as asked;
  * *other: there is another object at all. */
-static bool shadows_others(const struct rnd_scene *sc, const struct draw *draws, uint32_t i,
-                           const struct rnd_camera_plan *cams, uint32_t ncam, bool *other)
+/* Whether plane i shadows another object where a camera sees it, for the scene's lights; and
+ * (*seen_env, when esc has more lights than sc) for the environment's directions too. */
+static bool shadows_others(const struct rnd_scene *sc, const struct rnd_scene *esc, const struct draw *draws, uint32_t i,
+                           const struct rnd_camera_plan *cams, uint32_t ncam, bool *other, bool *seen_env)
 {
 	struct rnd_aabb b;
 	bool seen = false;
-	*other = false;
+	*other = *seen_env = false;
 	for (uint32_t j = 0; j < sc->object_count && !seen; j++) {
 		if (j == i) continue;
 		rnd_object_bounds(sc, j, &draws[j].bounds, &b);
 		if (rnd_aabb_is_empty(&b)) continue;
 		*other = true;
 		seen = rnd_plane_may_shadow_seen(sc, &sc->objects[i], &b, cams, ncam);
+		if (!*seen_env && esc->light_count > sc->light_count)
+			*seen_env = rnd_plane_may_shadow_seen(esc, &sc->objects[i], &b, cams, ncam);
 	}
 	return seen;
 }
 
 /* Why each object casts or not, for the plan's reader (the decisions are made above): a plane
  * that does not cast is told apart as alone, lit side or unseen by the same tests. */
-static void cast_reasons(const struct rnd_scene *sc, const struct draw *draws, const bool *fill_only, uint8_t *why)
+static void cast_reasons(const struct rnd_scene *sc, const struct rnd_scene *esc, const struct draw *draws,
+                         const bool *fill_only, uint8_t *why)
 {
 	for (uint32_t i = 0; i < sc->object_count; i++) {
 		const struct rnd_object *o = &sc->objects[i];
@@ -173,9 +178,10 @@ static void cast_reasons(const struct rnd_scene *sc, const struct draw *draws, c
 		else if (catcher) why[i] = RND_CAST_CATCHER;
 		else if (!plane) why[i] = RND_CAST_YES;
 		else if (!rnd_planes_judged(sc)) why[i] = RND_CAST_UNJUDGED;
-		else if (draws[i].cast) why[i] = i < RND_PLANES_JUDGED_MAX && fill_only[i] ? RND_CAST_FOR_MOMENTS : RND_CAST_YES;
+		else if (draws[i].cast && !(i < RND_PLANES_JUDGED_MAX && fill_only[i])) why[i] = RND_CAST_YES;
+		else if (draws[i].cast) why[i] = rnd_moments_need_ground(sc) ? RND_CAST_FOR_MOMENTS : RND_CAST_FOR_ENV;
 		else {
-			bool other, behind = shadows_others(sc, draws, i, NULL, 0, &other);
+			bool other, env, behind = shadows_others(sc, esc, draws, i, NULL, 0, &other, &env);
 			why[i] = !other ? RND_CAST_ALONE : behind ? RND_CAST_UNSEEN : RND_CAST_LIT_SIDE;
 		}
 	}
@@ -193,8 +199,9 @@ static void cast_reasons(const struct rnd_scene *sc, const struct draw *draws, c
  * 10 m floor: a 2048^2 map whose moments cost ~100 ms on lavapipe, for shadows within a 256^2
  * corner. */
 #define RND_PLANE_CAMERAS 8u   /* renders of more views judge planes on geometry alone */
-void rnd_casters_plan(const struct rnd_scene *sc, struct draw *draws, const struct rnd_aabb *bounds,
-                      const struct rnd_aabb *obj_bounds, struct rnd_aabb *casters, uint8_t *why)
+void rnd_casters_plan(const struct rnd_scene *sc, const struct rnd_scene *esc, struct draw *draws,
+                      const struct rnd_aabb *bounds, const struct rnd_aabb *obj_bounds, struct rnd_aabb *casters,
+                      uint8_t *why)
 {
 	struct rnd_camera_plan cams[RND_PLANE_CAMERAS];
 	struct rnd_error err;
@@ -212,14 +219,16 @@ void rnd_casters_plan(const struct rnd_scene *sc, struct draw *draws, const stru
 	bool fill_only[RND_PLANES_JUDGED_MAX] = {false};
 	for (uint32_t i = 0; i < sc->object_count && rnd_planes_judged(sc); i++) {
 		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
-		bool other, seen = shadows_others(sc, draws, i, cams, ncam, &other);
-		draws[i].cast = seen || (other && moments);
+		/* seen: for the scene's lights; seen_env: for the environment's directions too (the
+		 * plane then casts into their maps, but the box that sizes a sun's map stays the same) */
+		bool other, seen_env, seen = shadows_others(sc, esc, draws, i, cams, ncam, &other, &seen_env);
+		draws[i].cast = seen || seen_env || (other && moments);
 		fill_only[i] = draws[i].cast && !seen;
 	}
 	rnd_aabb_empty(casters);
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		if (draws[i].cast && !(i < RND_PLANES_JUDGED_MAX && fill_only[i])) rnd_aabb_union(casters, &draws[i].bounds);
-	if (why) cast_reasons(sc, draws, fill_only, why);
+	if (why) cast_reasons(sc, esc, draws, fill_only, why);
 }
 
 static bool point_outside(const float p[3], const struct rnd_aabb *b, float pad)

@@ -26,6 +26,8 @@ enum rnd_cast_why {
 	RND_CAST_UNSEEN,         /* a plane whose shadow falls only where no camera sees it */
 	RND_CAST_FOR_MOMENTS,    /* a plane kept only for the moments' blur: out of the casters' box */
 	RND_CAST_UNJUDGED,       /* a plane in a scene of more than RND_PLANES_JUDGED_MAX objects */
+	RND_CAST_FOR_ENV,        /* a plane that shadows others only from the environment's directions:
+	                            in their maps, left out of the casters' box */
 	RND_CAST_WHY_COUNT
 };
 
@@ -61,9 +63,12 @@ bool rnd_moments_need_ground(const struct rnd_scene *sc);
 /* The draws' `cast` after the plane rules (draws[i].cast as the upload set it: the object asks
  * and is no shadow catcher), why[i] for each object (NULL: not wanted), and the box of what
  * casts (*casters), which sizes a `fit` sun map. bounds: the whole scene's, obj_bounds what
- * `fit: objects` frames (the cameras of the plane rule are planned on them). */
-void rnd_casters_plan(const struct rnd_scene *sc, struct draw *draws, const struct rnd_aabb *bounds,
-                      const struct rnd_aabb *obj_bounds, struct rnd_aabb *casters, uint8_t *why);
+ * `fit: objects` frames (the cameras of the plane rule are planned on them). esc: the scene as
+ * the shadow passes see it (sc's lights, then the environment's directions; sc itself without
+ * them): a plane that shadows others only from those directions casts into their maps. */
+void rnd_casters_plan(const struct rnd_scene *sc, const struct rnd_scene *esc, struct draw *draws,
+                      const struct rnd_aabb *bounds, const struct rnd_aabb *obj_bounds, struct rnd_aabb *casters,
+                      uint8_t *why);
 
 /* Whether shadow view v of sp draws draw i (a caster inside its frustum) and, if so, with back
  * faces culled (*cull). lights: the lights sp was planned for. */

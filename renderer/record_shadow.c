@@ -11,7 +11,7 @@
 
 bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, int *cull)
 {
-	return rnd_shadow_view_draws(rv->sp, rv->sc->lights, rv->draws, v, i, cull);
+	return rnd_shadow_view_draws(rv->sp, rv->shadow_lights ? rv->shadow_lights : rv->sc->lights, rv->draws, v, i, cull);
 }
 
 /* Begins a later part of a map: the earlier part's depth (an earlier submit) loaded. */

@@ -22,6 +22,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "env.h"
+#include "env_pass.h"
 #include "frame.h"
 #include "material.h"
 #include "moments.h"
@@ -64,6 +66,8 @@ static void plan_device(struct rnd_context *ctx, struct rnd_plan_device *d)
 	/* UMBRA_VISIBILITY=0 / 1 forces the pass off / on where it can run (tests, comparisons). */
 	const char *env = getenv("UMBRA_VISIBILITY");
 	d->visibility_force = env && strcmp(env, "0") == 0 ? 0 : env && strcmp(env, "1") == 0 ? 1 : -1;
+	const char *ep = getenv("UMBRA_ENV_PASS");   /* 0: the environment's shadows per fragment (tests) */
+	d->env_pass_force = ep && strcmp(ep, "0") == 0 ? 0 : -1;
 	d->cached = cache_probe;
 	d->cache_user = ctx;
 }
@@ -83,7 +87,12 @@ enum rnd_result rnd_plan_create(struct rnd_context *ctx, const struct rnd_scene 
 	struct rnd_plan_device dev;
 	double t0 = now_ms();
 	plan_device(ctx, &dev);
-	enum rnd_result r = rnd_plan_build(sc, &dev, p, err);
+	struct rnd_env_bins *bins = NULL;
+	enum rnd_result r = rnd_env_plan_bins(ctx, &sc->environment, &bins, err);
+	dev.env_bins = bins;
+	if (r == RND_OK) r = rnd_plan_build(sc, &dev, p, err);
+	free(bins);
+	p->dev.env_bins = NULL;
 	if (r != RND_OK) {
 		free(p);
 		return r;
@@ -115,6 +124,7 @@ struct render {
 	struct rnd_context *ctx;
 	struct rnd_plan *plan;
 	const struct rnd_scene *sc;
+	struct rnd_env_use env;       /* its environment map (env.h), held to the end */
 	struct rnd_slot *s;
 	void *arena;                  /* one block: draws, shadow plan, estimates, texture list */
 	struct draw *draws;           /* the plan's, with their textures, culled for the view drawn */
@@ -162,6 +172,14 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	double t0 = now_ms();
 	rnd_pacer_init(&rq->pacer, sc);
 	if ((r = rnd_pacer_check(&rq->pacer, err)) != RND_OK) return r;
+	/* The environment's map before any shadow tile is granted (a render never waits for a map
+	 * while it holds tiles); its shadow directions are the plan's. */
+	double wait_until = sc->deadline_ns ? (double)sc->deadline_ns * 1e-9 : 0.0;
+	if ((r = rnd_env_acquire(ctx, &sc->environment, wait_until, &rq->env, err)) != RND_OK) return r;
+	rnd_env_shadow_dirs(&rq->env, &rq->plan->env);
+	rq->tm.env_directions = rq->env.mapped;
+	rq->pacer.ctx = ctx;
+	rq->pacer.env = &rq->env;
 	if ((r = rnd_upload_scene(ctx, s, rq->plan, &rq->pacer, err)) != RND_OK) return r;
 	if ((r = rnd_material_textures(ctx, s, sc, rq->draws, rq->tex, &rq->ntex, err)) != RND_OK) return r;
 	rq->tm.upload_ms = now_ms() - t0;
@@ -252,7 +270,10 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	            : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
 	if (r != RND_OK) return r;
 	if (vp->vis) rq->tm.visibility_views++;
-	if ((r = rnd_frame_write(ctx, s, sc, &vp->cam, rq->sp, camera->exposure, vp->contact, err)) != RND_OK) return r;
+	if (vp->env_pass && (r = rnd_slot_env_pass(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
+	if ((r = rnd_frame_write(ctx, s, &p->esc, &vp->cam, rq->sp, camera->exposure, vp->contact, &rq->env, vp->env_pass,
+	                         err)) != RND_OK)
+		return r;
 
 	uint32_t col = v % sh->cols, row = v / sh->cols;
 	VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sh->width + (VkDeviceSize)col * sc->width);
@@ -262,6 +283,7 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = vp->contact, .vis = vp->vis,
 		.map_ms = rq->map_ms, .map_tris = rq->map_tris, .row_ms = vp->row_ms, .band_ms = vp->band_ms,
 		.drawn_camera = &rq->tm.camera_triangles, .drawn_shadow = &rq->tm.shadow_triangles,
+		.shadow_lights = p->esc.lights, .env = &rq->env, .env_pass = vp->env_pass,
 	};
 	double shadow0 = rq->tm.shadow_ms, main0 = rq->tm.main_ms;
 	uint32_t bands0 = rq->pacer.measured;
@@ -291,6 +313,8 @@ static void finish(struct render *rq, enum rnd_result r, struct rnd_error *err)
 		rnd_slot_drop_textures(ctx, rq->s);
 		rnd_slot_trim(ctx, rq->s);
 	}
+	rq->tm.env_ms = rq->env.ms;
+	rnd_env_done(ctx, &rq->env, r == RND_OK, rq->gpu_busy);
 	rnd_slot_release(ctx, rq->s);
 	free(rq->arena);
 }

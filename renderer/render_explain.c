@@ -19,6 +19,8 @@ static const char *const cast_why[RND_CAST_WHY_COUNT] = {
 	[RND_CAST_UNSEEN] = "a plane whose shadow falls only where no camera sees it (on parts of objects sunk into it)",
 	[RND_CAST_FOR_MOMENTS] = "a plane drawn into the maps for the VSM/EVSM blur, left out of the casters' box",
 	[RND_CAST_UNJUDGED] = "a plane in a scene of more than 256 objects: planes are not judged, it casts",
+	[RND_CAST_FOR_ENV] = "a plane that shadows others only from the environment's directions: in their maps, "
+	                     "left out of the casters' box",
 };
 
 static const char *const size_why[RND_SIZE_RULE_COUNT] = {
@@ -86,6 +88,9 @@ void rnd_plan_info(const struct rnd_plan *p, struct rnd_plan_info *out)
 		for (uint32_t k = 0; k < p->views[v].shadow_views; k++) out->maps_cached += p->views[v].skip[k] == RND_SKIP_CACHED;
 	}
 	out->sphere_proxies = p->sphere_proxies;
+	out->env_directions = p->env.mapped;
+	out->env_weighed = p->env.ndirs - p->env.mapped;
+	out->env_ground = p->env.ground;
 	out->vertices = p->vertices;
 	out->indices = p->indices;
 	out->estimate = p->est;
@@ -98,6 +103,7 @@ void rnd_plan_info(const struct rnd_plan *p, struct rnd_plan_info *out)
 
 static const char *map_kind(const struct rnd_scene *sc, const struct rnd_light_plan *lp, uint32_t light)
 {
+	if (sc->lights[light].shadow.dir_mode == RND_DIR_CASTERS) return "casters";
 	if (sc->lights[light].type == RND_LIGHT_SPOT) return "spot";
 	if (sc->lights[light].type == RND_LIGHT_POINT) return "cube";
 	return lp->clipmap ? "clipmap" : lp->follows_camera ? "cascades" : "fit";
@@ -106,16 +112,24 @@ static const char *map_kind(const struct rnd_scene *sc, const struct rnd_light_p
 void rnd_plan_map(const struct rnd_plan *p, uint32_t k, struct rnd_plan_map_info *out)
 {
 	memset(out, 0, sizeof *out);
-	const struct rnd_scene *sc = p->sc;
+	const struct rnd_scene *sc = &p->esc;
 	const struct rnd_map_plan *m = &p->maps[k];
 	const struct rnd_light_plan *lp = &p->views[0].lights[m->light];
+	bool env = m->light >= p->sc->light_count;
 	out->light = m->light;
-	out->light_type = light_types[sc->lights[m->light].type % 3];
+	out->environment = env ? (int32_t)(m->light - p->sc->light_count) : -1;
+	out->light_type = env ? "environment" : light_types[sc->lights[m->light].type % 3];
+	if (env) {
+		const struct rnd_env_dir *d = &p->env.dirs[out->environment];
+		memcpy(out->direction, d->dir, sizeof out->direction);
+		out->share = d->share;
+	}
 	out->kind = map_kind(sc, lp, m->light);
 	out->tiles = m->tiles;
 	out->resolution = m->res;
 	out->asked = m->want;
-	out->size = size_why[lp->size_rule % RND_SIZE_RULE_COUNT];
+	out->size = env ? "the environment's shadow_resolution, coarser for a wider region (env_shadow.c)"
+	                : size_why[lp->size_rule % RND_SIZE_RULE_COUNT];
 	out->fitted = m->res == m->want ? "" : m->moments_capped && m->res == p->dev.moments_max_res
 	                                       ? "moment maps are capped at what the device reads as one buffer"
 	                                       : "halved, the largest first, until every map fits in the atlas";
@@ -166,6 +180,7 @@ void rnd_plan_view(const struct rnd_plan *p, uint32_t v, struct rnd_plan_view_in
 	}
 	out->camera_triangles = vp->camera_triangles;
 	out->contact = vp->contact;
+	out->env_pass = vp->env_pass;
 	out->visibility = vp->vis;
 	out->visibility_why = vis_why[vp->vis_why % RND_VIS_WHY_COUNT];
 	out->row_ms = vp->row_ms;
@@ -255,6 +270,13 @@ uint32_t rnd_plan_passes(const struct rnd_plan *p, struct rnd_plan_pass_info *ou
 			pass.pass = "scene_depth";
 			pass.triangles = vp->camera_triangles;
 			pass.note = "the view's depth, which contact shadows march through";
+			add_pass(out, max, &n, pass);
+		}
+		if (vp->env_pass) {
+			pass.pass = "environment";
+			pass.triangles = vp->camera_triangles;
+			pass.note = "the environment's shadows once per texel of a coarser grid (surfaces, then one lookup per "
+			            "direction), read by the main pass";
 			add_pass(out, max, &n, pass);
 		}
 		if (vp->vis) {

@@ -14,6 +14,7 @@
 #include "atlas.h"
 #include "contact.h"
 #include "cost.h"
+#include "env_shadow.h"
 #include "error.h"
 #include "lod.h"
 #include "mesh.h"
@@ -174,6 +175,24 @@ static enum rnd_result plan_draw(struct rnd_plan *p, uint32_t i, uint64_t *kept,
 	return RND_OK;
 }
 
+/* The environment's shadow directions (its map's light cut into regions: env_analysis.c) over
+ * the ground the scene stands on, and the lights the shadow passes draw them as (env_shadow.c):
+ * p->esc. */
+static void plan_env(struct rnd_plan *p)
+{
+	const struct rnd_scene *sc = p->sc;
+	float ground[3];
+	bool has_ground = rnd_env_ground(sc, p->draws, ground);
+	rnd_env_plan_dirs(p->dev.env_bins, &sc->environment, has_ground ? ground : NULL, &p->env);
+	p->esc = *sc;
+	uint32_t n = sc->light_count < UMBRA_MAX_LIGHTS ? sc->light_count : UMBRA_MAX_LIGHTS;
+	if (!p->env.mapped) return;
+	memcpy(p->lights, sc->lights, n * sizeof *p->lights);
+	p->env.mapped = rnd_env_lights(&p->env, &sc->environment, UMBRA_MAX_LIGHTS - n, p->lights + n);
+	p->esc.lights = p->lights;
+	p->esc.light_count = n + p->env.mapped;
+}
+
 static enum rnd_result plan_objects(struct rnd_plan *p, struct rnd_shadow_plan *scratch, struct rnd_error *err)
 {
 	const struct rnd_scene *sc = p->sc;
@@ -204,7 +223,8 @@ static enum rnd_result plan_objects(struct rnd_plan *p, struct rnd_shadow_plan *
 		if (rnd_object_frames(&sc->objects[i], sc->material_count ? sc->materials : NULL))
 			rnd_aabb_union(&p->obj_bounds, &p->draws[i].bounds);
 	if (rnd_aabb_is_empty(&p->obj_bounds)) p->obj_bounds = p->bounds;
-	rnd_casters_plan(sc, p->draws, &p->bounds, &p->obj_bounds, &p->casters, p->cast_why);
+	plan_env(p);
+	rnd_casters_plan(sc, &p->esc, p->draws, &p->bounds, &p->obj_bounds, &p->casters, p->cast_why);
 	p->caster_key = rnd_caster_key(sc, p->draws, p->lod, &p->bounds);
 	return RND_OK;
 }
@@ -276,11 +296,11 @@ static void refit_proxies(struct rnd_plan *p, const struct rnd_camera_plan *cam)
 static enum rnd_result plan_shadows(const struct rnd_plan *p, uint32_t v, const struct rnd_camera_plan *cam,
                                     uint8_t *cascades, struct rnd_shadow_plan *sp, struct rnd_error *err)
 {
-	const struct rnd_scene *sc = p->sc;
+	const struct rnd_scene *sc = p->sc, *esc = &p->esc;
 	enum rnd_result r;
-	if ((r = rnd_shadow_plan_with(sc, &p->bounds, &p->casters, cam, v ? cascades : NULL, sp, err)) != RND_OK) return r;
+	if ((r = rnd_shadow_plan_with(esc, &p->bounds, &p->casters, cam, v ? cascades : NULL, sp, err)) != RND_OK) return r;
 	if (v == 0)
-		for (uint32_t i = 0; i < sc->light_count && i < UMBRA_MAX_LIGHTS; i++)
+		for (uint32_t i = 0; i < esc->light_count && i < UMBRA_MAX_LIGHTS; i++)
 			cascades[i] = sp->lights[i].follows_camera && !sp->lights[i].clipmap;
 	bool any_moments = false;
 	for (uint32_t i = 0; i < sc->light_count; i++)
@@ -300,7 +320,7 @@ static enum rnd_result plan_shadows(const struct rnd_plan *p, uint32_t v, const 
 static enum rnd_result keep_shadows(struct rnd_plan *p, uint32_t v, const struct rnd_shadow_plan *sp, struct rnd_error *err)
 {
 	struct rnd_view_plan *vp = &p->views[v];
-	uint32_t nl = p->sc->light_count, n = sp->view_count;
+	uint32_t nl = p->esc.light_count, n = sp->view_count;
 	vp->shadow_views = n;
 	vp->shadow_res = sp->resolution;
 	vp->lights = plan_alloc(p, (nl ? nl : 1) * sizeof *vp->lights);
@@ -325,7 +345,7 @@ void rnd_plan_view_shadows(const struct rnd_plan *p, uint32_t v, struct rnd_shad
 	memset(out, 0, sizeof *out);
 	out->resolution = vp->shadow_res;
 	out->view_count = vp->shadow_views;
-	memcpy(out->lights, vp->lights, p->sc->light_count * sizeof *vp->lights);
+	memcpy(out->lights, vp->lights, p->esc.light_count * sizeof *vp->lights);
 	memcpy(out->views, vp->views, vp->shadow_views * sizeof *vp->views);
 	memcpy(out->view_light, vp->view_light, vp->shadow_views * sizeof *vp->view_light);
 	memcpy(out->view_ortho, vp->view_ortho, vp->shadow_views * sizeof *vp->view_ortho);
@@ -340,7 +360,7 @@ void rnd_plan_view_shadows(const struct rnd_plan *p, uint32_t v, struct rnd_shad
  * clipmap levels are transient. Sizes: a function of the request alone (rnd_atlas_fit). */
 static enum rnd_result plan_maps(struct rnd_plan *p, const struct rnd_shadow_plan *sp, struct rnd_error *err)
 {
-	const struct rnd_scene *sc = p->sc;
+	const struct rnd_scene *sc = &p->esc;
 	uint32_t tiles[UMBRA_MAX_LIGHTS] = {0}, want[UMBRA_MAX_LIGHTS] = {0}, res[UMBRA_MAX_LIGHTS], n = 0;
 	uint64_t min_texels = 0;
 	for (uint32_t i = 0; i < sc->light_count; i++) {
@@ -404,11 +424,12 @@ static enum rnd_result plan_view_work(struct rnd_plan *p, uint32_t v, struct rnd
 	rnd_plan_view_cull(p, v, draws);
 	for (uint32_t k = 0; k < sp->view_count; k++)
 		if (vp->skip[k] != RND_SKIP_EARLIER_VIEW)
-			vp->map_ms[k] = rnd_cost_shadow_view_ms(sp, sc->lights, draws, sc->object_count, k, &vp->map_tris[k]);
+			vp->map_ms[k] = rnd_cost_shadow_view_ms(sp, p->esc.lights, draws, sc->object_count, k, &vp->map_tris[k]);
 	for (uint32_t i = 0; i < sc->object_count; i++) vp->camera_triangles += draws[i].cam_index_count / 3;
 	vp->contact = rnd_contact_any(sc, sp);
 	vp->vis = rnd_visibility_wanted(p->dev.visibility_pass, p->dev.visibility_force, sc, sp, draws, sc->object_count,
 	                                &vp->vis_why);
+	vp->env_pass = rnd_env_pass_wanted(sc, p->env.mapped, draws, sc->object_count, p->dev.env_pass_force);
 	double units = rnd_cost_pixel_units(sc, sp, vp->vis, p->sheet.passes);
 	rnd_cost_main(sc, vp->cam.view_proj, draws, sc->object_count, units, &vp->row_ms, &vp->band_ms);
 	return RND_OK;

@@ -13,6 +13,7 @@
  *   each object's level of detail, sphere proxies .. lod.c, proxy.c
  *   each draw: where it lies, its bounds and area .. mesh.c (rnd_mesh_measure), draw.h
  *   the cameras ..................................... camera.c
+ *   the environment's shadow directions, its pass ... env_analysis.c, env_shadow.c (as lights)
  *   what casts shadows, into which map .............. casters.c
  *   each light's maps: kind, size, filter, views .... plan.c
  *   the maps' tile sizes in the atlas ............... atlas.c (rnd_atlas_fit)
@@ -31,6 +32,7 @@
 
 #include "casters.h"
 #include "draw.h"
+#include "env_analysis.h"
 #include "estimate.h"
 #include "plan.h"
 #include "mesh.h"
@@ -54,6 +56,10 @@ struct rnd_plan_device {
 	float evsm_max_exponent_fp16;          /* and in fp16 (vsm.precision "fp16") */
 	bool visibility_pass;                  /* the device can run the visibility pass */
 	int visibility_force;                  /* UMBRA_VISIBILITY: -1 unset, 0 off, 1 on */
+	int env_pass_force;                    /* UMBRA_ENV_PASS: -1 unset, 0 off */
+	/* The environment map's bins (env.c rnd_env_plan_bins; NULL: no map, or no shadow directions
+	 * asked), read while the plan is built. */
+	const struct rnd_env_bins *env_bins;
 	/* Whether the cache holds a completed map of key (shadow_cache.c rnd_cache_probe); NULL:
 	 * it holds none. */
 	bool (*cached)(void *user, uint64_t key, uint32_t tiles, uint32_t res);
@@ -94,6 +100,7 @@ struct rnd_view_plan {
 	bool contact;                          /* the view's depth for contact shadows */
 	bool vis;                              /* shadows from the visibility pass */
 	uint8_t vis_why;                       /* enum rnd_vis_why */
+	bool env_pass;                         /* the environment's shadows from its pass (env_pass.h) */
 	uint64_t camera_triangles;
 	double row_ms, band_ms;                /* the main pass: per row, per band (cost.c) */
 };
@@ -127,6 +134,12 @@ struct rnd_plan {
 	uint32_t sphere_proxies;
 	struct rnd_aabb bounds, obj_bounds, casters;
 	uint64_t caster_key;
+	/* The environment's shadow directions (env_analysis.h), and the scene as the shadow passes
+	 * see it: sc's lights, then a directional light per mapped direction (env_shadow.c), as
+	 * many as fit in UMBRA_MAX_LIGHTS. Every light index below counts in esc. */
+	struct rnd_env_plan env;
+	struct rnd_scene esc;
+	struct rnd_light lights[UMBRA_MAX_LIGHTS];
 	/* views and maps */
 	uint32_t nviews;
 	struct rnd_view_plan *views;           /* [nviews] */

@@ -54,6 +54,21 @@ def extra_scenes(out, bench):
     d["output"] = {"format": "png", "msaa": 1}
     d["shadows"] = {"filter": "pcf", "pcf_radius": 4, "resolution": 1024}
     save("wide-pcf", d)
+    # The environment's directions and pass (the plan's since the merge of 'env'): the studio
+    # over the plane ground (directions below it only weighed), a turned studio behind the
+    # scene, a masked caster (no environment pass), 20 directions at 256 texels.
+    d = copy.deepcopy(thumb)
+    d["environment"] = {"map": {"preset": "studio"}}
+    save("env-studio", d)
+    d = copy.deepcopy(thumb)
+    d["environment"] = {"map": {"preset": "studio", "rotation": 1.2}, "background": "map"}
+    d["lights"] = []
+    save("env-turned", d)
+    d = copy.deepcopy(thumb)
+    d["environment"] = {"map": {"preset": "studio"}, "shadow": {"directions": 20, "resolution": 256}}
+    d["materials"]["leaf"] = {"base_color": [0.2, 0.7, 0.2, 0.3], "alpha_mode": "mask", "alpha_cutoff": 0.2}
+    d["objects"].append({"shape": "box", "size": [1, 0.05, 1], "material": "leaf", "transform": {"translation": [1, 2, 0.5]}})
+    save("env-masked", d)
 
 
 def thumbs(out):

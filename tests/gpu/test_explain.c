@@ -145,3 +145,43 @@ TEST(explain_bigger_output_bigger_hard_light_map)
 	api_scene_free(small);
 	api_scene_free(big);
 }
+
+/* The studio environment's shadow directions are the plan's: each a map the render draws (its
+ * counts equal the plan's), the directions below the plane ground only weighed, and the
+ * environment pass planned and run. */
+TEST(explain_environment_directions_are_planned_and_drawn)
+{
+	if (!gpu_ctx()) return;
+	struct api_scene *s = gpu_parse(
+		"{'width': 96, 'height': 96, 'camera': {'position': [4, 3, 4], 'target': [0, 0.8, 0]},"
+		" 'environment': {'map': {'preset': 'studio', 'rotation': 17}, 'shadow': {'directions': 8}},"
+		" 'objects': [{'shape': 'plane', 'size': [10, 10]},"
+		" {'shape': 'box', 'size': [1, 1, 1], 'transform': {'translation': [0, 0.5, 0.03]}}]}");
+	if (!s) return;
+	struct rnd_plan_info in;
+	struct rnd_timings tm;
+	if (plan_and_render(s, &in, &tm, NULL)) {
+		check_counts(&in, &tm);
+		CHECK(in.env_directions == 8 && in.env_weighed == 4 && in.env_ground, "%u directions, %u weighed, ground %d",
+		      in.env_directions, in.env_weighed, in.env_ground);
+		CHECK(tm.env_directions == 8 && in.maps == 8 && in.maps_drawn + in.maps_cached == 8, "render %u directions, %u maps",
+		      tm.env_directions, in.maps);
+		struct rnd_plan *plan = NULL;
+		struct rnd_error err;
+		if (rnd_plan_create(gpu_ctx(), &s->scene, &plan, &err) == RND_OK) {
+			struct rnd_plan_view_info v;
+			struct rnd_plan_map_info m;
+			rnd_plan_view(plan, 0, &v);
+			rnd_plan_map(plan, 0, &m);
+			CHECK(v.env_pass, "no environment pass");
+			CHECK(m.environment == 0 && !strcmp(m.light_type, "environment") && !strcmp(m.kind, "casters") &&
+			      m.direction[1] > 0, "map 0: %s %s, direction y %g", m.light_type, m.kind, m.direction[1]);
+			/* made after the render: the cache holds every direction's map now */
+			struct rnd_plan_info again;
+			rnd_plan_info(plan, &again);
+			CHECK(again.maps_cached == 8 && again.maps_drawn == 0, "%u cached, %u drawn", again.maps_cached, again.maps_drawn);
+		}
+		rnd_plan_destroy(plan);
+	}
+	api_scene_free(s);
+}

@@ -1,11 +1,13 @@
 /* tests/unit — the render plan (renderer/render_plan.c) without a GPU: the decisions one
  * render makes, made once from the scene and a described device, and how a change of request
  * moves them the way docs/renderer.md says (a bigger output: bigger maps for a hard light; a
- * soft light: PCSS; a cached map: not drawn; a later view: no second fit map). */
+ * soft light: PCSS; a cached map: not drawn; a later view: no second fit map; an environment
+ * map's directions: lights of their own, a map each, the environment pass). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "atlas.h"
+#include "envmaps.h"
 #include "render_plan.h"
 #include "test.h"
 #include "thumb_scene.h"
@@ -25,6 +27,7 @@ static void device(struct rnd_plan_device *d)
 	d->evsm_max_exponent_fp16 = 5.54f;
 	d->visibility_pass = true;
 	d->visibility_force = -1;
+	d->env_pass_force = -1;
 }
 
 static uint64_t cached_key;
@@ -318,4 +321,59 @@ TEST(render_plan_measure_is_what_the_upload_writes)
 	rnd_aabb_empty(&b);
 	CHECK(rnd_mesh_measure(&bad, NULL, NULL, &b, &area, &err) == RND_ERR_INVALID && strstr(err.msg, "missing vertex"),
 	      "%s", err.msg);
+}
+
+/* The environment's shadow directions are planned lights: a map each (fitted to the casters,
+ * keyed like any sun's), after the scene's own; a ground keeps those below it out of the maps;
+ * the rotation turns them; the environment pass is the plan's decision. */
+TEST(render_plan_environment_directions_are_planned_lights)
+{
+	static struct rnd_env_bins bins;
+	float *m = test_patch_map(256, 128, 30, 40, 8, 50.0f, 0.05f);
+	REQUIRE(m != NULL, "no map");
+	rnd_env_bin(m, 256, 128, &bins);
+	free(m);
+	struct rnd_scene sc;
+	struct rnd_object obj[2];
+	struct rnd_light sun;
+	thumb_scene(&sc, obj, &sun, 256);
+	sc.environment.source = RND_ENV_MAP;
+	sc.environment.shadow_directions = 6;
+	struct rnd_plan_device dev;
+	device(&dev);
+	struct rnd_plan none, p, turned, perfrag;
+	struct rnd_error err = {0};
+	REQUIRE(rnd_plan_build(&sc, &dev, &none, &err) == RND_OK, "%s", err.msg);   /* no bins: no directions */
+	CHECK(none.env.mapped == 0 && none.nmaps == 1 && none.esc.light_count == 1 && !none.views[0].env_pass,
+	      "without a map: %u directions, %u maps", none.env.mapped, none.nmaps);
+	dev.env_bins = &bins;
+	REQUIRE(rnd_plan_build(&sc, &dev, &p, &err) == RND_OK, "%s", err.msg);
+	/* The ground holds the sphere: 6 directions above it get maps, 4 below are only weighed. */
+	CHECK(p.env.ground && p.env.mapped == 6 && p.env.ndirs == 10, "ground %d, %u mapped of %u", p.env.ground,
+	      p.env.mapped, p.env.ndirs);
+	CHECK(p.esc.light_count == 7 && p.nmaps == 7, "%u lights as the shadow passes see them, %u maps", p.esc.light_count,
+	      p.nmaps);
+	for (uint32_t k = 1; k < p.nmaps; k++) {
+		const struct rnd_light *L = &p.esc.lights[p.maps[k].light];
+		CHECK(p.maps[k].light == k && L->shadow.dir_mode == RND_DIR_CASTERS && L->intensity == 0 && p.maps[k].key,
+		      "map %u: light %u, mode %d", k, p.maps[k].light, (int)L->shadow.dir_mode);
+		CHECK(L->direction[1] < 0, "direction %u points up: %g", k, L->direction[1]);
+	}
+	CHECK(p.views[0].env_pass && p.views[0].shadow_views == 7, "env pass %d, %u shadow views", p.views[0].env_pass,
+	      p.views[0].shadow_views);
+	/* Turned by a quarter: the same regions, their directions turned about +Y. */
+	sc.environment.rotation = (float)(3.14159265358979323846 / 2);
+	REQUIRE(rnd_plan_build(&sc, &dev, &turned, &err) == RND_OK, "%s", err.msg);
+	const float *a = p.env.dirs[0].dir, *b = turned.env.dirs[0].dir;
+	CHECK(fabsf(b[0] - a[2]) < 1e-4f && fabsf(b[2] + a[0]) < 1e-4f && fabsf(b[1] - a[1]) < 1e-6f,
+	      "(%g %g %g) turned is (%g %g %g)", a[0], a[1], a[2], b[0], b[1], b[2]);
+	CHECK(turned.maps[1].key != p.maps[1].key, "a turned direction's map is another map");
+	/* UMBRA_ENV_PASS=0: the same maps, the shadows per fragment. */
+	dev.env_pass_force = 0;
+	REQUIRE(rnd_plan_build(&sc, &dev, &perfrag, &err) == RND_OK, "%s", err.msg);
+	CHECK(!perfrag.views[0].env_pass && perfrag.nmaps == 7, "env pass %d", perfrag.views[0].env_pass);
+	rnd_plan_release(&none);
+	rnd_plan_release(&p);
+	rnd_plan_release(&turned);
+	rnd_plan_release(&perfrag);
 }

@@ -74,3 +74,17 @@ struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *forma
 	free(doc);
 	return s;
 }
+
+uint8_t *test_read_file(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	uint8_t *b = n >= 0 ? malloc((size_t)n + 1) : NULL;
+	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
+	fclose(f);
+	if (b) { b[n] = 0; *len = (size_t)n; }
+	return b;
+}

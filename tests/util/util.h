@@ -15,6 +15,8 @@ char *test_b64(const void *d, size_t n);
 /* Writes text to dir/name (created or truncated); a file that cannot be written is left as
  * it is (the test's own checks then fail on what it reads). */
 void test_put_file(const char *dir, const char *name, const char *text);
+/* A whole file, malloc'd with a NUL after it (*len without it); NULL when it cannot be read. */
+uint8_t *test_read_file(const char *path, size_t *len);
 /* A scene document from a printf format in which ' stands for " (so that tests can write
  * "{'width': %d}"). NULL when out of memory. */
 char *test_vdoc(const char *fmt, va_list ap);

@@ -32,6 +32,11 @@ struct rnd_plan_info {
 	uint64_t camera_triangles;          /* what the cameras draw, each view counted */
 	uint32_t sphere_proxies;            /* spheres the camera draws as a proxy (renderer/proxy.h) */
 	uint64_t vertices, indices;         /* the geometry the render writes */
+	/* The environment map's shadows (env_analysis.h): the directions drawn as shadow maps (each a
+	 * directional light after the scene's: struct rnd_plan_map_info.environment), and those a
+	 * ground hides, only weighed; whether the scene stands on such a ground. */
+	uint32_t env_directions, env_weighed;
+	bool env_ground;
 	struct rnd_estimate estimate;       /* memory (admission reads it) */
 	struct rnd_aabb bounds, casters;    /* the scene's, and what casts shadows */
 	double estimate_ms;                 /* the deadline's estimates summed (lavapipe milliseconds) */
@@ -43,8 +48,11 @@ void rnd_plan_info(const struct rnd_plan *plan, struct rnd_plan_info *out);
 
 /* One light's shadow maps: its tiles in the atlas. */
 struct rnd_plan_map_info {
-	uint32_t light;
-	const char *light_type;             /* "directional", "spot", "point" */
+	uint32_t light;                     /* among the scene's lights, then the environment's directions */
+	int32_t environment;                /* -1: a light of the scene; k: the environment's direction k */
+	float direction[3];                 /* environment: towards the sky, the scene's frame */
+	float share;                        /* environment: its region's part of the map's light */
+	const char *light_type;             /* "directional", "spot", "point", "environment" */
 	const char *kind;                   /* "fit", "cascades", "clipmap", "spot", "cube" */
 	uint32_t tiles;                     /* 1, 6 cube faces, or the cascades / levels */
 	uint32_t resolution;                /* texels a side of each tile */
@@ -74,6 +82,7 @@ struct rnd_plan_view_info {
 	uint32_t shadow_views, maps_drawn;
 	uint64_t texels_drawn, shadow_triangles, camera_triangles;
 	bool contact;                       /* a depth pass for contact shadows */
+	bool env_pass;                      /* the environment's shadows from their pass (env_pass.h) */
 	bool visibility;                    /* shadows from the visibility pass */
 	const char *visibility_why;
 	double shadow_estimate_ms, row_ms, band_ms, main_estimate_ms;
@@ -100,8 +109,8 @@ void rnd_plan_object(const struct rnd_plan *plan, uint32_t i, struct rnd_plan_ob
 
 /* The passes in the order the render runs them. */
 struct rnd_plan_pass_info {
-	const char *pass;                   /* "upload", "shadow_map", "scene_depth", "visibility", "main",
-	                                       "aov", "readback" */
+	const char *pass;                   /* "upload", "shadow_map", "scene_depth", "environment",
+	                                       "visibility", "main", "aov", "readback" */
 	int32_t view;                       /* -1: the render's, not one view's */
 	int32_t map, light, tile;           /* shadow_map: which (else -1) */
 	uint32_t resolution;
