@@ -311,27 +311,29 @@ static bool shard_arg(const char *s, struct farm_opts *o)
 }
 
 /* getopt_long, as umbrad's flags.c: options and inputs in any order ("-" is an input: stdin). */
+/* The long options (getopt_long). */
+enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
+       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY, O_SERVER, O_RESUME, O_SHARD, O_EXPLAIN, O_JSON };
+static const struct option cli_options[] = {
+	{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
+	{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
+	{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
+	{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
+	{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
+	{"up", required_argument, NULL, O_UP}, {"format", required_argument, NULL, O_FORMAT},
+	{"quality", required_argument, NULL, O_QUALITY}, {"server", required_argument, NULL, O_SERVER},
+	{"resume", no_argument, NULL, O_RESUME}, {"shard", required_argument, NULL, O_SHARD},
+	{"explain", optional_argument, NULL, O_EXPLAIN}, {"json", no_argument, NULL, O_JSON}, {0},
+};
+
 static int parse_args(int argc, char **argv, struct args *a)
 {
-	enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
-	       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY, O_SERVER, O_RESUME, O_SHARD, O_EXPLAIN, O_JSON };
-	static const struct option lopts[] = {
-		{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
-		{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
-		{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
-		{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
-		{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
-		{"up", required_argument, NULL, O_UP}, {"format", required_argument, NULL, O_FORMAT},
-		{"quality", required_argument, NULL, O_QUALITY}, {"server", required_argument, NULL, O_SERVER},
-		{"resume", no_argument, NULL, O_RESUME}, {"shard", required_argument, NULL, O_SHARD},
-		{"explain", optional_argument, NULL, O_EXPLAIN}, {"json", no_argument, NULL, O_JSON}, {0},
-	};
 	a->farm.progress = -1;
 	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
 	if (!a->inputs) return 1;
 	optind = 1;
 	if (argc > 1 && !strcmp(argv[1], "thumb")) a->thumb = true, optind = 2;
-	for (int c; (c = getopt_long(argc, argv, "ho:j:", lopts, NULL)) != -1;) {
+	for (int c; (c = getopt_long(argc, argv, "ho:j:", cli_options, NULL)) != -1;) {
 		switch (c) {
 		case 'h': return usage(stdout, 0) - 1;
 		case 'o': a->out = optarg; break;
@@ -346,13 +348,12 @@ static int parse_args(int argc, char **argv, struct args *a)
 		case O_RESUME: a->farm.resume = true; break;
 		case O_JSON: a->json = true; break;
 		case O_EXPLAIN:
-			if (!optarg || !strcmp(optarg, "plan")) a->explain = CLI_EXPLAIN_PLAN;
-			else if (!strcmp(optarg, "analyze")) a->explain = CLI_EXPLAIN_ANALYZE;
-			else {
-				fprintf(stderr, "umbra-render: bad option --explain=%s (plan or analyze)\n", optarg);
-				return usage(stderr, 1);
-			}
-			break;
+			a->explain = !optarg || !strcmp(optarg, "plan") ? CLI_EXPLAIN_PLAN
+			             : !strcmp(optarg, "analyze")      ? CLI_EXPLAIN_ANALYZE
+			                                               : CLI_EXPLAIN_NONE;
+			if (a->explain) break;
+			fprintf(stderr, "umbra-render: bad option --explain=%s (plan or analyze)\n", optarg);
+			return usage(stderr, 1);
 		case O_SHARD:
 			if (shard_arg(optarg, &a->farm)) break;
 			fprintf(stderr, "umbra-render: bad option --shard %s (K/N with 0 <= K < N, e.g. 0/4)\n", optarg);
