@@ -414,6 +414,12 @@ static enum rnd_result place_tiles(struct render *rq, uint32_t v, struct rnd_err
 		bool skip = grants[k].hit || (v > 0 && !lp->follows_camera);
 		for (uint32_t t = 0; t < lp->view_count; t++) {
 			float *rect = sp->views[lp->first_view + t].rect;
+			/* A tile granted smaller than planned (the atlas full: shadow_cache.c halves the
+			 * largest request) covers the same view with fewer texels: the texel's world size
+			 * (params[0], planned at rect[2]) grows with it, or PCSS, the contact march and
+			 * the normal offset measure in texels 2-4x too small (issue 31: a point light at
+			 * resolution 4096, granted 1024, had a 4x over-wide penumbra). */
+			sp->views[lp->first_view + t].params[0] *= rect[2] / (float)grants[k].res;
 			rect[0] = (float)grants[k].tile[t].x;
 			rect[1] = (float)grants[k].tile[t].y;
 			rect[2] = (float)grants[k].res;
