@@ -413,6 +413,12 @@ static enum rnd_result plan_view_work(struct rnd_plan *p, uint32_t v, struct rnd
 		uint8_t skip = m->cached ? RND_SKIP_CACHED : v > 0 && !lp->follows_camera ? RND_SKIP_EARLIER_VIEW : RND_SKIP_NONE;
 		for (uint32_t t = 0; t < lp->view_count; t++) {
 			float *rect = sp->views[lp->first_view + t].rect;
+			/* A tile fitted smaller than the light's plan asked (rnd_atlas_fit: the atlas full)
+			 * covers the same view with fewer texels: the texel's world size (params[0], planned
+			 * at rect[2]) grows with it, or PCSS, the contact march and the normal offset measure
+			 * in texels 2-4x too small (issue 31: a point light at resolution 4096, fitted to
+			 * 1024, had a 4x over-wide penumbra). */
+			sp->views[lp->first_view + t].params[0] *= rect[2] / (float)m->res;
 			rect[2] = (float)m->res;
 			rect[3] = (float)p->dev.atlas_size;
 			vp->skip[lp->first_view + t] = skip;

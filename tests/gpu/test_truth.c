@@ -15,87 +15,10 @@
 #include "model.h"
 #include "gpu_util.h"
 #include "test.h"
+#include "truth_score.h"
 #include "util.h"
 
 #define TRUTH_DIR "tests/gpu/truth/"
-
-struct truth_score {
-	double rmse, iou, disagree_core, hf_cand, hf_truth;
-	double missing_contact;   /* truth-shadowed px within 8 px of a geometry edge left lit */
-	double false_core;        /* truth-lit px away from shadow edges made shadowed */
-	long valid, shadow;
-};
-
-static bool is_edge(const float *t, int w, int h, int x, int y)
-{
-	bool s = t[y * w + x] < 0.5f;
-	static const int d[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-	for (int k = 0; k < 4; k++) {
-		int nx = x + d[k][0], ny = y + d[k][1];
-		if (nx >= 0 && ny >= 0 && nx < w && ny < h && (t[ny * w + nx] < 0.5f) != s) return true;
-	}
-	return false;
-}
-
-static double laplacian(const float *v, int w, int x, int y)
-{
-	return 4.0 * v[y * w + x] - v[y * w + x - 1] - v[y * w + x + 1] - v[(y - 1) * w + x] - v[(y + 1) * w + x];
-}
-
-static void score(const float *truth, const float *cand, const float *mask, const float *edge, int w, int h,
-                  struct truth_score *s)
-{
-	memset(s, 0, sizeof *s);
-	uint8_t *near_edge = calloc((size_t)w * h, 1);
-	if (!near_edge) return;
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++)
-			if (is_edge(truth, w, h, x, y))
-				for (int dy = -2; dy <= 2; dy++)
-					for (int dx = -2; dx <= 2; dx++)
-						if (x + dx >= 0 && y + dy >= 0 && x + dx < w && y + dy < h) near_edge[(y + dy) * w + x + dx] = 1;
-	/* Within 8 px (Chebyshev) of a geometry edge: where shadows meet their casters. */
-	uint8_t *near_geom = calloc((size_t)w * h, 1);
-	if (!near_geom) { free(near_edge); return; }
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++)
-			if (edge[y * w + x] > 0.5f)
-				for (int dy = -8; dy <= 8; dy++)
-					for (int dx = -8; dx <= 8; dx++)
-						if (x + dx >= 0 && y + dy >= 0 && x + dx < w && y + dy < h) near_geom[(y + dy) * w + x + dx] = 1;
-	double se = 0;
-	long inter = 0, uni = 0, core = 0, core_bad = 0, pen = 0;
-	long contact = 0, contact_missing = 0, core_lit = 0, core_false = 0;
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++) {
-			int i = y * w + x;
-			if (mask[i] < 0.5f || edge[i] > 0.5f) continue;
-			s->valid++;
-			double e = cand[i] - truth[i];
-			se += e * e;
-			bool t = truth[i] < 0.5f, c = cand[i] < 0.5f;
-			s->shadow += t;
-			inter += t && c;
-			uni += t || c;
-			if (!near_edge[i]) { core++; core_bad += t != c; }
-			if (!near_edge[i] && !t) { core_lit++; core_false += c; }
-			if (near_geom[i] && t) { contact++; contact_missing += !c; }
-			if (x > 0 && y > 0 && x < w - 1 && y < h - 1 && truth[i] > 0.05f && truth[i] < 0.95f) {
-				double lc = laplacian(cand, w, x, y), lt = laplacian(truth, w, x, y);
-				s->hf_cand += lc * lc;
-				s->hf_truth += lt * lt;
-				pen++;
-			}
-		}
-	s->rmse = s->valid ? sqrt(se / s->valid) : 0;
-	s->iou = uni ? (double)inter / uni : 1;
-	s->disagree_core = core ? (double)core_bad / core : 0;
-	if (pen) { s->hf_cand /= pen; s->hf_truth /= pen; }
-	s->missing_contact = contact ? (double)contact_missing / contact : 0;
-	s->false_core = core_lit ? (double)core_false / core_lit : 0;
-	free(near_edge);
-	free(near_geom);
-}
 
 static void check_scene(const char *name, double max_rmse, double min_iou, double max_disagree_core, double max_hf)
 {
@@ -118,7 +41,7 @@ static void check_scene(const char *name, double max_rmse, double min_iou, doubl
 		for (int y = 0; y < h; y++)
 			for (int x = 0; x < w; x++) cand[y * w + x] = gpu_px8(&img, x, y)[0] / 255.0f;
 		struct truth_score s;
-		score(truth, cand, mask, edge, w, h, &s);
+		truth_score(truth, cand, mask, edge, w, h, &s);
 		printf("    [%s vs traced reference] %ld valid px, %ld shadowed: rmse %.4f, iou %.4f, disagree_core %.4f, "
 		       "missing_contact %.4f, false_core %.4f; penumbra high-frequency energy %.5f (reference %.5f)\n", name,
 		       s.valid, s.shadow, s.rmse, s.iou, s.disagree_core, s.missing_contact, s.false_core, s.hf_cand,
@@ -189,35 +112,6 @@ TEST(truth_grazing_sun_default_filter)
 
 /* ---- contact shadows (issue 13 item 3) ---- */
 
-/* Replaces the first `from` in doc by `to` (a new string; NULL when absent or out of memory). */
-static char *replaced(const char *doc, const char *from, const char *to)
-{
-	const char *at = strstr(doc, from);
-	if (!at) return NULL;
-	size_t head = (size_t)(at - doc), nf = strlen(from), nt = strlen(to), tail = strlen(at + nf);
-	char *out = malloc(head + nt + tail + 1);
-	if (!out) return NULL;
-	memcpy(out, doc, head);
-	memcpy(out + head, to, nt);
-	memcpy(out + head + nt, at + nf, tail + 1);
-	return out;
-}
-
-/* Renders doc (a debug "shadow" view) and scores its visibility; keeps the image in *img. */
-static bool render_scored(const char *doc, const float *truth, const float *mask, const float *edge, int w, int h,
-                          struct rnd_image *img, struct truth_score *s)
-{
-	float *cand = malloc(sizeof *cand * w * h);
-	bool ok = cand && gpu_render(img, "%s", doc);
-	if (ok) {
-		for (int y = 0; y < h; y++)
-			for (int x = 0; x < w; x++) cand[y * w + x] = gpu_px8(img, x, y)[0] / 255.0f;
-		score(truth, cand, mask, edge, w, h, s);
-	}
-	free(cand);
-	return ok;
-}
-
 /* A sun 30 degrees up over an 8 cm plank, a 0.4 m cube and a ball on the ground, seen from
  * close (pixels about 2.5 cm) with a 128-texel map (texels about 6 cm): the map alone detaches
  * and shrinks the shadows next to their casters. Contact shadows (the default distance: 8 map
@@ -235,15 +129,15 @@ TEST(truth_contact_shadows_sun_low_res_map)
 	float *truth = gpu_read_grey(TRUTH_DIR "contact_sun.vis.png", w, h);
 	float *mask = gpu_read_grey(TRUTH_DIR "contact_sun.mask.png", w, h);
 	float *edge = gpu_read_grey(TRUTH_DIR "contact_sun.edge.png", w, h);
-	char *off = replaced(doc, "\"contact\": {\"enabled\": true}", "\"contact\": {\"enabled\": false}");
-	char *exr = replaced(doc, "\"output\": {\"debug\": \"shadow\", \"msaa\": 1}",
+	char *off = truth_replaced(doc, "\"contact\": {\"enabled\": true}", "\"contact\": {\"enabled\": false}");
+	char *exr = truth_replaced(doc, "\"output\": {\"debug\": \"shadow\", \"msaa\": 1}",
 	                     "\"output\": {\"format\": \"exr\", \"aovs\": [\"shadow\"], \"msaa\": 1}");
 	CHECK(truth && mask && edge, "missing reference images for contact_sun in " TRUTH_DIR);
 	CHECK(off && exr, "contact_sun.json lacks the members this test edits");
 	struct rnd_image on_img = {0}, off_img = {0}, again = {0}, aov = {0};
 	struct truth_score son, soff;
-	if (truth && mask && edge && off && exr && render_scored(doc, truth, mask, edge, w, h, &on_img, &son) &&
-	    render_scored(off, truth, mask, edge, w, h, &off_img, &soff)) {
+	if (truth && mask && edge && off && exr && truth_render_scored(doc, truth, mask, edge, w, h, &on_img, &son) &&
+	    truth_render_scored(off, truth, mask, edge, w, h, &off_img, &soff)) {
 		printf("    [contact_sun vs traced reference] contact off: rmse %.4f, iou %.4f, missing_contact %.4f, "
 		       "false_core %.4f; on: %.4f, %.4f, %.4f, %.4f\n", soff.rmse, soff.iou, soff.missing_contact,
 		       soff.false_core, son.rmse, son.iou, son.missing_contact, son.false_core);
@@ -295,13 +189,13 @@ TEST(truth_soft_spot_contact_on_meets_missing_contact)
 	float *truth = gpu_read_grey(TRUTH_DIR "spot_pcss.vis.png", w, h);
 	float *mask = gpu_read_grey(TRUTH_DIR "spot_pcss.mask.png", w, h);
 	float *edge = gpu_read_grey(TRUTH_DIR "spot_pcss.edge.png", w, h);
-	char *on = replaced(doc, "\"shadow\": {\"filter\": \"pcss\"}",
+	char *on = truth_replaced(doc, "\"shadow\": {\"filter\": \"pcss\"}",
 	                    "\"shadow\": {\"filter\": \"pcss\", \"contact\": {\"enabled\": true}}");
 	CHECK(truth && mask && edge, "missing reference images for spot_pcss in " TRUTH_DIR);
 	CHECK(on, "spot_pcss.json lacks the member this test edits");
 	struct rnd_image img = {0};
 	struct truth_score s;
-	if (truth && mask && edge && on && render_scored(on, truth, mask, edge, w, h, &img, &s)) {
+	if (truth && mask && edge && on && truth_render_scored(on, truth, mask, edge, w, h, &img, &s)) {
 		printf("    [spot_pcss contact on vs traced reference] rmse %.4f, iou %.4f, disagree_core %.4f, "
 		       "missing_contact %.4f, false_core %.4f\n", s.rmse, s.iou, s.disagree_core, s.missing_contact, s.false_core);
 		CHECK(s.missing_contact <= 0.02, "missing_contact %.4f > 0.02", s.missing_contact);
