@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "deferred.h"
 #include "internal.h"
 #include "moments.h"
 #include "shadow_cache.h"
@@ -331,6 +332,7 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 	VkFormatFeatureFlags vis_need = VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
 	ctx->visibility_pass = have.fragmentStoresAndAtomics && have.shaderStorageImageExtendedFormats &&
 	                       (fp.optimalTilingFeatures & vis_need) == vis_need;
+	ctx->pixel_shading = rnd_deferred_supported(ctx);
 	ctx->color_formats[RND_PIXELS_RGBA8] = VK_FORMAT_R8G8B8A8_UNORM;
 	ctx->color_formats[RND_PIXELS_RGBA16] = VK_FORMAT_R16G16B16A16_UNORM;
 	ctx->color_formats[RND_PIXELS_RGBA32F] = VK_FORMAT_R32G32B32A32_SFLOAT;

@@ -71,6 +71,8 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	f->camera_pos[3] = cam->ortho ? 1.0f : 0.0f;
 	memcpy(f->camera_fwd, cam->fwd, sizeof cam->fwd);
 	memcpy(f->background, sc->environment.background, sizeof f->background);
+	record_clear_color(sc, f->clear);
+	if (!rnd_mat4_invert(f->inv_view_proj, cam->view_proj)) memset(f->inv_view_proj, 0, sizeof f->inv_view_proj);
 	for (int k = 0; k < 3; k++) {
 		f->ambient_sky[k] = sc->environment.ambient_sky[k] * sc->environment.ambient_intensity;
 		f->ambient_ground[k] = sc->environment.ambient_ground[k] * sc->environment.ambient_intensity;
@@ -184,11 +186,24 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{ctx->pipes.shadow_sampler, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
 		{VK_NULL_HANDLE, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
-	VkWriteDescriptorSet w[12];
+	/* Pixel shading's (deferred.c): its inputs, the shaded colours and the view's depth samples
+	 * (integer and depth formats: the nearest sampler without a border; only texelFetch). */
+	VkDescriptorImageInfo pi[3] = {
+		{ctx->pipes.atlas_sampler, s->shading.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.atlas_sampler, s->shaded.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.atlas_sampler, s->depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL},
+	};
+	VkWriteDescriptorSet w[UMBRA_BINDING_COUNT];
 	for (int i = 0; i < 4; i++)
 		w[8 + i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SURFACES + i,
 			.descriptorCount = 1, .descriptorType = rnd_binding_type[UMBRA_BINDING_SURFACES + i], .pImageInfo = &vi[i],
+		};
+	for (int i = 0; i < 3; i++)
+		w[12 + i] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set,
+			.dstBinding = UMBRA_BINDING_SURFACE_SHADING + i, .descriptorCount = 1,
+			.descriptorType = rnd_binding_type[UMBRA_BINDING_SURFACE_SHADING + i], .pImageInfo = &pi[i],
 		};
 	w[5] = (VkWriteDescriptorSet){
 		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
@@ -210,7 +225,7 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, 12, w, 0, NULL);
+	vkUpdateDescriptorSets(ctx->device, UMBRA_BINDING_COUNT, w, 0, NULL);
 }
 
 /* minmax.comp: the scratch map in, the depth bounds out. moments.frag: the depth atlas and the

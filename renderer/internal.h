@@ -28,6 +28,9 @@
 #define RND_SURFACES_FORMAT VK_FORMAT_R32G32B32A32_SFLOAT
 #define RND_SURFACE_NORMALS_FORMAT VK_FORMAT_R16G16B16A16_SNORM
 #define RND_VISIBILITY_FORMAT VK_FORMAT_R16_UNORM
+/* Pixel shading (deferred.c): what shading a pixel centre's surface needs (umbra_shared.h
+ * UMBRA_SHADING_*); the colour shaded there has the output's colour format. */
+#define RND_SURFACE_SHADING_FORMAT VK_FORMAT_R32G32B32A32_UINT
 /* Layers of the visibility image: at least 2, so that its view is an array (layers beyond a
  * render's lights are not read). */
 #define RND_VIS_MIN_LAYERS 2u
@@ -80,8 +83,10 @@ struct rnd_pipelines {
 	/* [cull] the surfaces pass of the visibility pass (renderer/visibility.c): single-sample,
 	 * world position and normal per pixel */
 	VkPipeline surfaces[2];
+	/* [cull] the same with pixel shading's inputs too (deferred.c) */
+	VkPipeline surfaces_shade[2];
 	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
-	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs;
+	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, vis_shade_fs, resolve_fs;
 	pthread_mutex_t mu;
 	uint32_t variant_count;
 	struct rnd_main_variant {
@@ -94,6 +99,8 @@ struct rnd_pipelines {
 			uint32_t atlas_view;         /* 1 = debug view `atlas` (fullscreen.vert + atlas.frag) */
 			uint32_t vis_pass;           /* 1 = the visibility pass (fullscreen.vert + vis.frag) */
 			uint32_t vis_read;           /* 1 = main pass reading the visibility pass (mesh_vis.frag) */
+			uint32_t vis_shade;          /* with vis_pass: pixel shading's pass (vis_shade.frag, deferred.c) */
+			uint32_t resolve;            /* 1 = pixel shading's resolve (fullscreen.vert + resolve.frag) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;
@@ -143,6 +150,7 @@ struct rnd_context {
 	PFN_vkSetDebugUtilsObjectNameEXT set_object_name;   /* NULL without VK_EXT_debug_utils */
 	bool timestamps;                     /* queue supports timestamps */
 	bool visibility_pass;                /* the device can run the visibility pass (visibility.c) */
+	bool pixel_shading;                  /* ... and shade per pixel (deferred.c) */
 	float timestamp_period;              /* ns per tick */
 	VkFormat color_formats[RND_COLOR_FORMAT_COUNT];
 

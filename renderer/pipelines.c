@@ -22,6 +22,9 @@
 #include "surface.frag.spv.h"
 #include "vis.frag.spv.h"
 #include "mesh_vis.frag.spv.h"
+#include "surface_shade.frag.spv.h"
+#include "vis_shade.frag.spv.h"
+#include "resolve.frag.spv.h"
 
 enum rnd_result rnd_shader_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
                                   VkShaderModule *out, struct rnd_error *err)
@@ -46,6 +49,9 @@ const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
 	[UMBRA_BINDING_SURFACE_NORMALS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VISIBILITY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VISIBILITY_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+	[UMBRA_BINDING_SURFACE_SHADING] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_SHADED] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_VIEW_DEPTH_MS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 };
 
 static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
@@ -133,6 +139,7 @@ struct pipe_desc {
 	bool uv_only;               /* vertex input: position (0), uv (2), colour (3), uv1 (UMBRA_LOCATION_UV1) */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	VkFormat color_rest;        /* when set: the format of attachments 1.. */
+	VkFormat color_last;        /* when set: the format of the last attachment */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
 	const VkSpecializationInfo *spec;  /* fragment stage */
@@ -168,6 +175,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
 	for (uint32_t i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) {
 		formats[i] = i > 0 && d->color_rest ? d->color_rest : d->color;
+		if (d->color_last && i + 1 == ncolor) formats[i] = d->color_last;
 		cbas[i] = (VkPipelineColorBlendAttachmentState){.colorWriteMask = 0xf};
 	}
 	VkPipelineVertexInputStateCreateInfo vi = {
@@ -255,7 +263,7 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r;
 	VkShaderModule shadow_vs = VK_NULL_HANDLE, masked_vs = VK_NULL_HANDLE, masked_fs = VK_NULL_HANDLE;
-	VkShaderModule surface_fs = VK_NULL_HANDLE;
+	VkShaderModule surface_fs = VK_NULL_HANDLE, surface_shade_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
 	if ((r = rnd_shader_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
@@ -269,6 +277,14 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 		goto fail;
 	if ((r = rnd_shader_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
 	if ((r = rnd_shader_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
+		goto fail;
+	if ((r = rnd_shader_module(ctx, spv_surface_shade_frag, sizeof spv_surface_shade_frag, "surface_shade.frag",
+	                           &surface_shade_fs, err)) != RND_OK)
+		goto fail;
+	if ((r = rnd_shader_module(ctx, spv_vis_shade_frag, sizeof spv_vis_shade_frag, "vis_shade.frag", &p->vis_shade_fs,
+	                           err)) != RND_OK)
+		goto fail;
+	if ((r = rnd_shader_module(ctx, spv_resolve_frag, sizeof spv_resolve_frag, "resolve.frag", &p->resolve_fs, err)) != RND_OK)
 		goto fail;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
@@ -315,8 +331,14 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 			.depth = RND_DEPTH_FORMAT, .samples = 1, .cull_back = cull, .name = cull ? "surfaces (cull back)" : "surfaces",
 		};
 		if ((r = make_pipeline(ctx, &d, &p->surfaces[cull], err)) != RND_OK) goto fail;
+		d.fs = surface_shade_fs;
+		d.color_count = 3;
+		d.color_last = RND_SURFACE_SHADING_FORMAT;
+		d.name = cull ? "surfaces + shading (cull back)" : "surfaces + shading";
+		if ((r = make_pipeline(ctx, &d, &p->surfaces_shade[cull], err)) != RND_OK) goto fail;
 	}
 	/* These pipelines keep what they need from their modules. */
+	vkDestroyShaderModule(ctx->device, surface_shade_fs, NULL);
 	vkDestroyShaderModule(ctx->device, surface_fs, NULL);
 	vkDestroyShaderModule(ctx->device, masked_fs, NULL);
 	vkDestroyShaderModule(ctx->device, masked_vs, NULL);
@@ -324,6 +346,7 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	return RND_OK;
 
 fail:
+	if (surface_shade_fs) vkDestroyShaderModule(ctx->device, surface_shade_fs, NULL);
 	if (surface_fs) vkDestroyShaderModule(ctx->device, surface_fs, NULL);
 	if (masked_fs) vkDestroyShaderModule(ctx->device, masked_fs, NULL);
 	if (masked_vs) vkDestroyShaderModule(ctx->device, masked_vs, NULL);
@@ -360,7 +383,8 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
 	char name[112];
 	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
-	         key->aov ? "aov" : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",
+	         key->aov ? "aov" : key->resolve ? "resolve" : key->vis_shade ? "pixel shading"
+	         : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",
 	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
 	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10]);
 	struct pipe_desc d = {
@@ -397,6 +421,23 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.samples = 1;
 		d.no_vertices = true;
 		d.depth_less_ro = true;
+		d.after_prepass = false;
+		d.cull_back = false;
+		/* Pixel shading (deferred.c): the colour shaded at each pixel centre into an image of
+		 * the output's format. */
+		if (key->vis_shade) {
+			d.fs = p->vis_shade_fs;
+			d.color = ctx->color_formats[key->format];
+		}
+	}
+	if (key->resolve) {
+		/* Pixel shading's resolve: a fullscreen triangle into the single-sample target. */
+		d.vs = p->fullscreen_vs;
+		d.fs = p->resolve_fs;
+		d.spec = NULL;
+		d.depth = VK_FORMAT_UNDEFINED;
+		d.samples = 1;
+		d.no_vertices = true;
 		d.after_prepass = false;
 		d.cull_back = false;
 	}
@@ -442,8 +483,12 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 			if (p->prepass_masked[m][c]) vkDestroyPipeline(ctx->device, p->prepass_masked[m][c], NULL);
 		}
 	}
-	for (int c = 0; c < 2; c++)
+	for (int c = 0; c < 2; c++) {
 		if (p->surfaces[c]) vkDestroyPipeline(ctx->device, p->surfaces[c], NULL);
+		if (p->surfaces_shade[c]) vkDestroyPipeline(ctx->device, p->surfaces_shade[c], NULL);
+	}
+	if (p->vis_shade_fs) vkDestroyShaderModule(ctx->device, p->vis_shade_fs, NULL);
+	if (p->resolve_fs) vkDestroyShaderModule(ctx->device, p->resolve_fs, NULL);
 	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
 	if (p->vis_fs) vkDestroyShaderModule(ctx->device, p->vis_fs, NULL);
 	if (p->mesh_vis_fs) vkDestroyShaderModule(ctx->device, p->mesh_vis_fs, NULL);

@@ -235,19 +235,22 @@ static void main_barriers(VkCommandBuffer cmd, struct rnd_slot *s, bool ms)
 	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 }
 
-/* The background is the requested colour itself (sRGB-encoded for display outputs), not
- * tone mapped: a caller asking for white gets 255. */
+void record_clear_color(const struct rnd_scene *sc, float out[4])
+{
+	const float *bg = sc->environment.background;
+	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
+	for (int k = 0; k < 3; k++) out[k] = linear ? bg[k] : srgb_encode(bg[k]);
+	out[3] = sc->output.transparent ? 0.0f : bg[3];
+	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
+	 * colour at edges (readback.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
+	if (sc->output.transparent) out[0] = out[1] = out[2] = 0.0f;
+	if (sc->output.debug == RND_DEBUG_SHADOW) out[0] = out[1] = out[2] = out[3] = 1.0f;
+}
+
 static VkClearColorValue main_clear(const struct rnd_scene *sc)
 {
 	VkClearColorValue clear;
-	const float *bg = sc->environment.background;
-	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
-	for (int k = 0; k < 3; k++) clear.float32[k] = linear ? bg[k] : srgb_encode(bg[k]);
-	clear.float32[3] = sc->output.transparent ? 0.0f : bg[3];
-	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
-	 * colour at edges (readback.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
-	if (sc->output.transparent) clear.float32[0] = clear.float32[1] = clear.float32[2] = 0.0f;
-	if (sc->output.debug == RND_DEBUG_SHADOW) clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
+	record_clear_color(sc, clear.float32);
 	return clear;
 }
 

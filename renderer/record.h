@@ -52,6 +52,7 @@ struct record_view {
 	uint32_t band_y, band_h;       /* band_h 0 = every row */
 	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
 	bool vis;                      /* shadows from the visibility pass (visibility.c), drawn per band */
+	bool deferred;                 /* with vis: shaded once per pixel centre (deferred.c) */
 };
 
 /* The rows of the view that this submit draws (band_y, band_h). */
@@ -104,6 +105,10 @@ void record_readback(struct rnd_slot *s, const struct record_view *v);
 /* The public enums as the shaders spell them (umbra_shared.h); the uniforms (frame.c) and
  * the specialization key (record.c) both use these, so they cannot drift apart. */
 uint32_t record_light_type(enum rnd_light_type t);
+/* The background as the main pass's colour target holds it (its clear value): the requested
+ * colour itself, sRGB-encoded for display outputs, not tone mapped (a caller asking for white
+ * gets 255); (0,0,0,0) for a transparent output. */
+void record_clear_color(const struct rnd_scene *sc, float out[4]);
 uint32_t record_tonemap(enum rnd_tonemap t);
 uint32_t record_debug(enum rnd_debug d);
 

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "deferred.h"
 #include "contact.h"
 #include "proxy.h"
 #include "visibility.h"
@@ -414,6 +415,12 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	        : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
 	if (r != RND_OK) return r;
 	if (vis) rq->tm.visibility_views++;
+	/* Pixel shading (deferred.c); its bindings need images whether it runs or not. */
+	bool deferred = rnd_deferred_wanted(ctx, sc, rq->draws, sc->object_count, vis);
+	r = deferred ? rnd_slot_pixel_shading(ctx, s, sc->width, sc->height, ctx->color_formats[sc->output.pixels], err)
+	    : s->shading.img && s->shaded.img ? RND_OK : rnd_slot_pixel_shading(ctx, s, 1, 1, VK_FORMAT_R8G8B8A8_UNORM, err);
+	if (r != RND_OK) return r;
+	if (deferred) rq->tm.pixel_shaded_views++;
 	if ((r = rnd_frame_write(ctx, s, sc, &cam, rq->sp, camera->exposure, contact, err)) != RND_OK) return r;
 
 	uint32_t col = v % sh->cols, row = v / sh->cols;
@@ -422,7 +429,7 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.sc = sc, .cam = &cam, .sp = rq->sp, .draws = rq->draws, .ndraw = sc->object_count, .aov_passes = sh->passes,
 		.color_offset = cell * sh->px, .aov_offset = sh->color_bytes + cell * 16, .aov_stride = sh->att_bytes,
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = contact,
-		.vis = vis,
+		.vis = vis, .deferred = deferred,
 	};
 	return rnd_submit_view(ctx, s, &rv, &rq->pacer, &rq->tm, &rq->gpu_busy, err);
 }

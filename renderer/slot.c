@@ -90,7 +90,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	VkDescriptorPoolSize sizes[4] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 7},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 10},
 		{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
 	};
 	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
@@ -164,6 +164,8 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_image_destroy(ctx, &s->normals);
 	rnd_image_destroy(ctx, &s->surfaces_depth);
 	rnd_image_destroy(ctx, &s->visibility);
+	rnd_image_destroy(ctx, &s->shading);
+	rnd_image_destroy(ctx, &s->shaded);
 	rnd_buffer_destroy(ctx, &s->staging);
 	rnd_image_destroy(ctx, &s->resolve);
 	rnd_image_destroy(ctx, &s->depth);
@@ -258,8 +260,9 @@ enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, Vk
 			goto fail;
 	}
 	snprintf(name, sizeof name, "slot %u depth", s->index);
+	/* Sampled: pixel shading's resolve reads its samples (deferred.c). */
 	if ((r = rnd_image_create(ctx, RND_DEPTH_FORMAT, w, h, 1, samples,
-	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
 	                          VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->depth, err)) != RND_OK)
 		goto fail;
 	return RND_OK;
@@ -353,7 +356,9 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 	}
 	if (image_bytes(ctx, &s->scene_depth) > keep) rnd_image_destroy(ctx, &s->scene_depth);
 	if (image_bytes(ctx, &s->surfaces) + image_bytes(ctx, &s->normals) + image_bytes(ctx, &s->surfaces_depth) +
-	        image_bytes(ctx, &s->visibility) > keep) {
+	        image_bytes(ctx, &s->visibility) + image_bytes(ctx, &s->shading) + image_bytes(ctx, &s->shaded) > keep) {
+		rnd_image_destroy(ctx, &s->shading);
+		rnd_image_destroy(ctx, &s->shaded);
 		rnd_image_destroy(ctx, &s->surfaces);
 		rnd_image_destroy(ctx, &s->normals);
 		rnd_image_destroy(ctx, &s->surfaces_depth);
@@ -415,4 +420,24 @@ enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s,
 	return rnd_image_create(ctx, RND_VISIBILITY_FORMAT, w, h, layers, 1,
 	                        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, name,
 	                        &s->visibility, err);
+}
+
+enum rnd_result rnd_slot_pixel_shading(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, VkFormat color,
+                                       struct rnd_error *err)
+{
+	enum rnd_result r;
+	char name[48];
+	if (!s->shading.img || s->shading.width != w || s->shading.height != h) {
+		rnd_image_destroy(ctx, &s->shading);
+		snprintf(name, sizeof name, "slot %u surface shading", s->index);
+		if ((r = rnd_image_create(ctx, RND_SURFACE_SHADING_FORMAT, w, h, 1, 1,
+		                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+		                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->shading, err)) != RND_OK)
+			return r;
+	}
+	if (s->shaded.img && s->shaded.width == w && s->shaded.height == h && s->shaded.format == color) return RND_OK;
+	rnd_image_destroy(ctx, &s->shaded);
+	snprintf(name, sizeof name, "slot %u shaded", s->index);
+	return rnd_image_create(ctx, color, w, h, 1, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                        VK_IMAGE_ASPECT_COLOR_BIT, name, &s->shaded, err);
 }

@@ -382,11 +382,13 @@ void rnd_image_release(struct rnd_image *img);
 struct rnd_timings {
 	double upload_ms;     /* tessellation + copy to the GPU */
 	double shadow_ms;     /* shadow passes (GPU) */
-	double main_ms;       /* main pass + resolve (GPU) */
+	double main_ms;       /* main pass + resolve (GPU), the visibility pass's included */
+	double visibility_ms; /* of main_ms: the visibility pass (renderer/visibility.c: surfaces, shadows per pixel) */
 	double readback_ms;   /* copy back to host memory */
 	uint32_t shadow_maps_rendered, shadow_maps_reused;
 	uint64_t shadow_texels;     /* texels of the shadow maps drawn (each map res x res) */
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
+	uint32_t pixel_shaded_views; /* of those, views shaded once per pixel centre (renderer/deferred.h) */
 	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
 	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
