@@ -61,7 +61,7 @@ LIBS := $(PKG_LIBS) -lmeshoptimizer -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
-FARM_SRC := server/cli.c server/farm.c server/farm_remote.c server/farm_report.c server/http_client.c
+FARM_SRC := server/cli.c server/farm.c server/farm_local.c server/farm_remote.c server/farm_report.c server/http_client.c
 SRV_SRC := $(filter-out $(FARM_SRC),$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)

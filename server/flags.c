@@ -33,7 +33,7 @@ static const struct opt_def opts[] = {
 	{ "port-file", OPT_STR, "PATH", "write the bound port to PATH once listening", CFG(port_file), 0, 0 },
 	{ "workers", OPT_UINT, "N", "render threads and context slots (default: online CPUs, at most the cgroup CPU quota)", CFG(workers), 1, 256 },
 	{ "device-renders", OPT_UINT, "N", "renders on the device at once; the other workers parse and encode meanwhile (default 0: 1 on a CPU device such as lavapipe, whose one render already uses every core; all workers on a GPU)", CFG(device_renders), 0, 256 },
-	{ "import-slots", OPT_UINT, "N", "threads that import models (sandboxed), beside the --workers threads, which never import: a request whose model the cache lacks waits for one of them holding no thread; a free one takes the request of the client address with the fewest imports running (default 0: as many as --workers)", CFG(import_slots), 0, 256 },
+	{ "import-slots", OPT_UINT, "N", "threads that import models (sandboxed), beside the --workers threads, which never import: a request whose model the cache lacks waits for one of them holding no thread; a free one takes the request of the client address with the fewest imports running (default 0: as many as --workers, and no more than --max-memory / --import-memory); twice as many threads import, so that one whose import is done renders while the next imports", CFG(import_slots), 0, 256 },
 	{ "queue", OPT_UINT, "N", "renders that may wait for a worker before 503 (64)", CFG(queue), 1, 1000000 },
 	{ "max-body", OPT_SIZE, "BYTES", "largest request body, K/M/G suffixes (64M)", CFG(max_body), 1, UINT64_MAX },
 	{ "max-pixels", OPT_SIZE, "N", "largest width*height, 0 = no limit (16777216)", LIM(max_pixels), 0, UINT64_MAX },
@@ -362,5 +362,11 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		}
 	cfg->limits.asset_root = cfg->asset_root;
 	if (!cfg->max_memory) cfg->max_memory = srv_admit_default_budget();
+	/* Import slots: one per worker, and no more import children than --max-memory holds at the
+	 * --import-memory each may take (server/imports.h). */
+	if (!cfg->import_slots) {
+		uint64_t fit = cfg->limits.import_memory ? cfg->max_memory / cfg->limits.import_memory : cfg->workers;
+		cfg->import_slots = fit < 1 ? 1 : fit < cfg->workers ? (unsigned)fit : cfg->workers;
+	}
 	return 0;
 }

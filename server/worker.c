@@ -370,6 +370,8 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	struct parse_ticket ticket;
 	ticket_init(&ticket, s, req, importer);
 	int pr = job_parse(s, req, &ticket, &sc, &parse_s);
+	/* an import thread's import is over: the next model's may start while this one renders */
+	if (importer) srv_imports_imported(s->imports);
 	admitted = ticket.reserved;
 	*parked = pr == 2;
 	if (pr) goto out;
@@ -480,7 +482,7 @@ static void *importer_main(void *arg)
 
 static unsigned import_threads(const struct srv_server *s)
 {
-	return s->cfg.import_slots ? s->cfg.import_slots : s->cfg.workers;
+	return srv_imports_threads(s->cfg.import_slots);
 }
 
 int srv_workers_start(struct srv_server *s)
