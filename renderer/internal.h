@@ -104,7 +104,16 @@ struct rnd_pipelines {
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;
+		uint64_t used;               /* `tick` at its last look-up */
 	} variants[RND_MAX_VARIANTS];
+	uint64_t tick;
+	/* Variants taken out of the table (rnd_context_trim_pipelines), destroyed once no render
+	 * that began before (slot epoch below `epoch`) still runs: it may have recorded them. */
+	struct rnd_retired {
+		VkPipeline pipeline;
+		uint64_t epoch;
+	} retired[RND_MAX_VARIANTS];
+	uint32_t retired_count;
 };
 
 struct rnd_moments {
@@ -160,6 +169,7 @@ struct rnd_context {
 	struct rnd_slot **slots;
 	uint32_t slot_count;
 	bool *slot_busy;
+	uint64_t slot_epoch;                 /* under slot_mu: advanced by each retired pipeline */
 
 	volatile int validation_count;       /* atomically incremented by the messenger */
 	volatile int failed;                 /* device lost: every render fails */
@@ -209,7 +219,15 @@ extern const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT];
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
                                    struct rnd_error *err);
 
+/* Destroys the retired pipeline variants no running render may use (pipelines.c). */
+void rnd_pipelines_reap(struct rnd_context *ctx);
+uint32_t rnd_pipelines_count(struct rnd_context *ctx);
+
 /* slot.c */
+/* The slot epoch after advancing it (a pipeline retired now: renders given a slot from now on
+ * never see it), and the oldest epoch among busy slots (UINT64_MAX: none busy). */
+uint64_t rnd_slot_epoch_advance(struct rnd_context *ctx);
+uint64_t rnd_slot_oldest_busy_epoch(struct rnd_context *ctx);
 struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx);
 void rnd_slot_release(struct rnd_context *ctx, struct rnd_slot *s);
 enum rnd_result rnd_slots_init(struct rnd_context *ctx, struct rnd_error *err);

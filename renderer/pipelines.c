@@ -366,6 +366,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	for (uint32_t i = 0; i < p->variant_count; i++) {
 		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
 			*out = p->variants[i].pipeline;
+			p->variants[i].used = ++p->tick;
 			pthread_mutex_unlock(&p->mu);
 			return RND_OK;
 		}
@@ -464,10 +465,53 @@ out_modules:
 	}
 	p->variants[p->variant_count].key = *key;
 	p->variants[p->variant_count].pipeline = pipe;
+	p->variants[p->variant_count].used = ++p->tick;
 	p->variant_count++;
 	*out = pipe;
 	pthread_mutex_unlock(&p->mu);
 	return RND_OK;
+}
+
+uint32_t rnd_context_trim_pipelines(struct rnd_context *ctx, uint32_t keep)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	uint32_t n = 0;
+	pthread_mutex_lock(&p->mu);
+	while (p->variant_count > keep && p->retired_count < RND_MAX_VARIANTS) {
+		uint32_t lru = 0;
+		for (uint32_t i = 1; i < p->variant_count; i++)
+			if (p->variants[i].used < p->variants[lru].used) lru = i;
+		/* out of the table first: a render that takes a slot from the epoch on cannot find it */
+		VkPipeline pipe = p->variants[lru].pipeline;
+		p->variants[lru] = p->variants[--p->variant_count];
+		p->retired[p->retired_count++] = (struct rnd_retired){pipe, rnd_slot_epoch_advance(ctx)};
+		n++;
+	}
+	pthread_mutex_unlock(&p->mu);
+	rnd_pipelines_reap(ctx);
+	return n;
+}
+
+void rnd_pipelines_reap(struct rnd_context *ctx)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	if (!__atomic_load_n(&p->retired_count, __ATOMIC_RELAXED)) return;
+	uint64_t oldest = rnd_slot_oldest_busy_epoch(ctx);
+	pthread_mutex_lock(&p->mu);
+	for (uint32_t i = 0; i < p->retired_count;) {
+		if (p->retired[i].epoch > oldest) { i++; continue; }
+		vkDestroyPipeline(ctx->device, p->retired[i].pipeline, NULL);
+		p->retired[i] = p->retired[--p->retired_count];
+	}
+	pthread_mutex_unlock(&p->mu);
+}
+
+uint32_t rnd_pipelines_count(struct rnd_context *ctx)
+{
+	pthread_mutex_lock(&ctx->pipes.mu);
+	uint32_t n = ctx->pipes.variant_count;
+	pthread_mutex_unlock(&ctx->pipes.mu);
+	return n;
 }
 
 void rnd_pipelines_release(struct rnd_context *ctx)
@@ -475,6 +519,7 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 	struct rnd_pipelines *p = &ctx->pipes;
 	if (!ctx->device) return;
 	for (uint32_t i = 0; i < p->variant_count; i++) vkDestroyPipeline(ctx->device, p->variants[i].pipeline, NULL);
+	for (uint32_t i = 0; i < p->retired_count; i++) vkDestroyPipeline(ctx->device, p->retired[i].pipeline, NULL);
 	for (int c = 0; c < 2; c++) {
 		if (p->shadow[c]) vkDestroyPipeline(ctx->device, p->shadow[c], NULL);
 		if (p->shadow_masked[c]) vkDestroyPipeline(ctx->device, p->shadow_masked[c], NULL);

@@ -454,6 +454,7 @@ static void finish(struct render *rq, enum rnd_result r, struct rnd_error *err)
 		rnd_slot_trim(ctx, rq->s);
 	}
 	rnd_slot_release(ctx, rq->s);
+	rnd_pipelines_reap(ctx);   /* variants retired while this render ran */
 	free(rq->arena);
 }
 

@@ -221,11 +221,43 @@ struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx)
 		for (uint32_t i = 0; i < ctx->slot_count; i++) {
 			if (!ctx->slot_busy[i]) {
 				ctx->slot_busy[i] = true;
+				ctx->slots[i]->epoch = ctx->slot_epoch;
 				pthread_mutex_unlock(&ctx->slot_mu);
 				return ctx->slots[i];
 			}
 		}
 		pthread_cond_wait(&ctx->slot_cv, &ctx->slot_mu);
+	}
+}
+
+uint64_t rnd_slot_epoch_advance(struct rnd_context *ctx)
+{
+	pthread_mutex_lock(&ctx->slot_mu);
+	uint64_t e = ++ctx->slot_epoch;
+	pthread_mutex_unlock(&ctx->slot_mu);
+	return e;
+}
+
+uint64_t rnd_slot_oldest_busy_epoch(struct rnd_context *ctx)
+{
+	uint64_t oldest = UINT64_MAX;
+	pthread_mutex_lock(&ctx->slot_mu);
+	for (uint32_t i = 0; i < ctx->slot_count; i++)
+		if (ctx->slot_busy[i] && ctx->slots[i]->epoch < oldest) oldest = ctx->slots[i]->epoch;
+	pthread_mutex_unlock(&ctx->slot_mu);
+	return oldest;
+}
+
+void rnd_context_trim_slots(struct rnd_context *ctx)
+{
+	for (uint32_t i = 0; i < ctx->slot_count; i++) {
+		pthread_mutex_lock(&ctx->slot_mu);
+		bool idle = !ctx->slot_busy[i];
+		if (idle) ctx->slot_busy[i] = true;   /* held while its targets go */
+		pthread_mutex_unlock(&ctx->slot_mu);
+		if (!idle) continue;
+		rnd_slot_trim_to(ctx, ctx->slots[i], 0);
+		rnd_slot_release(ctx, ctx->slots[i]);
 	}
 }
 
@@ -342,7 +374,11 @@ static VkDeviceSize image_bytes(const struct rnd_context *ctx, const struct rnd_
 
 void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 {
-	const VkDeviceSize keep = RND_SLOT_KEEP_BYTES;
+	rnd_slot_trim_to(ctx, s, RND_SLOT_KEEP_BYTES);
+}
+
+void rnd_slot_trim_to(struct rnd_context *ctx, struct rnd_slot *s, VkDeviceSize keep)
+{
 	VkDeviceSize aov = image_bytes(ctx, &s->aov_depth);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) aov += image_bytes(ctx, &s->aov[i]);
 	if (aov > keep) {

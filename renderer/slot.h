@@ -17,6 +17,7 @@ enum { RND_TS_START, RND_TS_SHADOW_END, RND_TS_VIS_END, RND_TS_MAIN_END, RND_TS_
 
 struct rnd_slot {
 	uint32_t index;
+	uint64_t epoch;               /* ctx->slot_epoch when this render took the slot */
 	VkCommandPool pool;
 	VkCommandBuffer cmd;
 	VkFence fence;
@@ -88,5 +89,7 @@ void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 #define RND_SLOT_KEEP_BYTES (40ull << 20)
 /* Frees what is over RND_SLOT_KEEP_BYTES. Only after the slot's work has completed. */
 void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s);
+/* The same with a bound of keep bytes (0: every target and buffer goes). */
+void rnd_slot_trim_to(struct rnd_context *ctx, struct rnd_slot *s, VkDeviceSize keep);
 
 #endif

@@ -95,6 +95,7 @@ int main(int argc, char **argv)
 		goto out_http;
 	if (srv_warmup(s) != 0)
 		goto out_context;
+	srv_rss_bound_settle(s);
 	if (srv_workers_start(s) != 0)
 		goto out_workers;
 	/* Tests only: counted from here, so the warm-up's own submits never hit it. */

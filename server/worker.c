@@ -456,6 +456,8 @@ static void *worker_main(void *arg)
 		unsigned lost_gen = job_run(s, req, false, &parked);
 		if (!parked) srv_request_finish(req);
 		srv_queue_done(s->queue);
+		/* answered: now back under --max-rss (context.c) */
+		if (!parked) srv_context_fit_rss(s);
 		/* After the answer: the client learns of the failure at once, /readyz is already 503. */
 		if (lost_gen)
 			srv_context_recover(s, lost_gen - 1);
@@ -474,6 +476,7 @@ static void *importer_main(void *arg)
 		unsigned lost_gen = job_run(s, req, true, &parked);
 		srv_request_finish(req);
 		srv_imports_done(s->imports, client);
+		srv_context_fit_rss(s);
 		if (lost_gen)
 			srv_context_recover(s, lost_gen - 1);
 	}

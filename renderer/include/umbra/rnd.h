@@ -474,6 +474,7 @@ struct rnd_stats {
 	uint32_t cached_maps;            /* shadow maps kept for reuse (spot, point, a sun's fit map) */
 	uint64_t shadow_cache_hits;      /* lights whose shadow passes were skipped */
 	uint64_t shadow_cache_misses;
+	uint32_t pipeline_variants;      /* main-pass pipeline variants compiled and kept */
 };
 void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
 /* Idle trim: drops cached shadow maps not used for idle_s seconds (0: all), and once no map
@@ -481,6 +482,16 @@ void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
  * memory (lavapipe), so the atlases are resident only while tiles use them. Does nothing while
  * a render holds tiles. Returns the bytes released (0 when nothing was). Any thread. */
 uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s);
+/* What a context keeps between renders beyond rnd_context_trim()'s, for a process held to a
+ * memory bound (umbrad --max-rss): the targets and buffers of the render slots no render holds
+ * now (the next render there makes them again), and the main-pass pipeline variants but the
+ * `keep` most recently used (a variant is compiled again at its next use: lavapipe keeps ~14 MB
+ * of JIT code and state per variant, 0.1-0.4 s to make). A variant a running render may have
+ * recorded is destroyed only once that render is over. Any thread. trim_pipelines returns the
+ * variants taken out. */
+void rnd_context_trim_slots(struct rnd_context *ctx);
+uint32_t rnd_context_trim_pipelines(struct rnd_context *ctx, uint32_t keep);
+
 /* Writes the pipeline cache to desc.pipeline_cache_path (atomic rename). */
 enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error *err);
 
