@@ -137,6 +137,7 @@ struct pipe_desc {
 	bool shadow;                /* depth bias + clamp, LESS compare; else reversed-Z */
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
 	bool uv_only;               /* vertex input: position (0), uv (2), colour (3), uv1 (UMBRA_LOCATION_UV1) */
+	bool dynamic_cull;          /* cull mode set per draw (vkCmdSetCullMode), cull_back ignored */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	VkFormat color_rest;        /* when set: the format of attachments 1.. */
 	VkFormat color_last;        /* when set: the format of the last attachment */
@@ -218,12 +219,13 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
 		.attachmentCount = ncolor, .pAttachments = cbas,
 	};
-	VkDynamicState dyn[4] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_DEPTH_BIAS,
-	                         VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE};
-	if (!d->shadow) dyn[2] = dyn[3];
+	VkDynamicState dyn[5] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+	uint32_t ndyn = 2;
+	if (d->shadow) dyn[ndyn++] = VK_DYNAMIC_STATE_DEPTH_BIAS;
+	if (!d->no_vertices) dyn[ndyn++] = VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE;
+	if (d->dynamic_cull) dyn[ndyn++] = VK_DYNAMIC_STATE_CULL_MODE;   /* core in Vulkan 1.3 */
 	VkPipelineDynamicStateCreateInfo dy = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-		.dynamicStateCount = (d->shadow ? 3u : 2u) + (d->no_vertices ? 0u : 1u), .pDynamicStates = dyn,
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, .dynamicStateCount = ndyn, .pDynamicStates = dyn,
 	};
 	VkPipelineRenderingCreateInfo rci = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
@@ -391,6 +393,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	struct pipe_desc d = {
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
+		.dynamic_cull = true,
 	};
 	VkShaderModule fs_fs = VK_NULL_HANDLE;
 	if (key->atlas_view) {
@@ -403,6 +406,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.no_vertices = true;
 		d.after_prepass = false;
 		d.cull_back = false;
+		d.dynamic_cull = false;
 	}
 	if (key->aov) {
 		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
@@ -424,6 +428,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.depth_less_ro = true;
 		d.after_prepass = false;
 		d.cull_back = false;
+		d.dynamic_cull = false;
 		/* Pixel shading (deferred.c): the colour shaded at each pixel centre into an image of
 		 * the output's format. */
 		if (key->vis_shade) {
@@ -441,6 +446,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.no_vertices = true;
 		d.after_prepass = false;
 		d.cull_back = false;
+		d.dynamic_cull = false;
 	}
 	values[UMBRA_SC_SAMPLES] = d.samples;
 	VkPipeline pipe;

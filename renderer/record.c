@@ -194,18 +194,23 @@ void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	}
 }
 
-/* The main-pass pipelines key k needs: one per culling mode the draws use. */
+/* The main-pass pipeline key k needs, for both culling modes: its cull mode is dynamic state,
+ * set per draw (record_cull), so one variant serves closed and open draws alike (on lavapipe
+ * each pipeline JIT-compiles its shaders: a variant per mode was twice the ~14 MB). */
 static enum rnd_result cull_pipelines(struct rnd_context *ctx, struct rnd_main_key *key, const struct draw *draws,
                                       uint32_t ndraw, VkPipeline pipes[2], struct rnd_error *err)
 {
-	for (uint32_t i = 0; i < ndraw; i++) {
-		uint32_t c = draws[i].cull_back;
-		if (!draws[i].index_count || pipes[c]) continue;
-		key->cull_back = c;
-		enum rnd_result r = rnd_pipelines_main(ctx, key, &pipes[c], err);
-		if (r != RND_OK) return r;
-	}
-	return RND_OK;
+	(void)draws; (void)ndraw;
+	key->cull_back = 0;
+	enum rnd_result r = rnd_pipelines_main(ctx, key, &pipes[0], err);
+	pipes[1] = pipes[0];
+	return r;
+}
+
+/* The cull mode of draw d, for the main-pass and AOV variants (dynamic state). */
+static void record_cull(VkCommandBuffer cmd, const struct draw *d)
+{
+	vkCmdSetCullMode(cmd, d->cull_back ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
 }
 
 /* The colour (and resolve) and depth targets of the main pass, ready to be drawn. */
@@ -326,6 +331,7 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		if (!d->index_count || d->closed != (k < ndraw)) continue;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+		record_cull(cmd, d);
 		struct umbra_push_main push;
 		main_push(rv->sc, d, &push);
 		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
@@ -468,6 +474,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 			/* A shadow catcher is geometry for the AOVs (contract §7). */
 			VkPipeline p = pipes[d->cull_back];
 			if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+			record_cull(cmd, d);
 			struct umbra_push push = {.info = {d->material, d->flags, first_light, 0}};
 			vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
 			                   sizeof push, &push);

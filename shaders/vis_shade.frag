@@ -28,7 +28,7 @@ void main()
 	vec3 n_geo = oct_decode(unpackSnorm2x16(g.x));
 	v_color = vec4(unpackUnorm2x16(g.y), unpackUnorm2x16(g.z));
 	umbra_material m = materials[g.w & ((1u << UMBRA_SHADING_MATERIAL_BITS) - 1u)];
-	vec4 bc = m.base_color;
-	if ((SC_TEXTURES & UMBRA_TEXBIT_VERTEX_COLOR) != 0u) bc *= v_color;
+	// the vertex colour is white where the mesh has none (mesh.vert): one variant for both
+	vec4 bc = m.base_color * v_color;
 	o_color = shade(m, g.w >> UMBRA_SHADING_MATERIAL_BITS, bc, n_geo, v_pos, n_shadow);
 }
