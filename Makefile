@@ -1,13 +1,13 @@
 # umbra — one non-recursive Makefile.
 #   make            build/librenderer.a, build/umbra-render, build/umbrad
-#   make run        install deps, build, start umbrad on 127.0.0.1:8080
+#   make run        install deps, build, start umbrad on 127.0.0.1:8080 (UMBRA_LISTEN=ADDR:PORT for another)
 #   make test       install deps, build, run every test (last line: "N passed, N failed")
 #   make test-asan  the same suite built with AddressSanitizer + UBSan
 #   make fuzz       libFuzzer targets in build/fuzz (clang); make test runs each briefly
 #   make bench      warm-process and HTTP benchmarks of ../shared/bench, the floor, the ratio table
 #   make bench-quick  only the ratio table's rows (BENCH_ONLY=ratios)
 #   make bench-farm   only the farm benchmark on new models: farm CLI, umbrad c=4, f3d (BENCH_ONLY=farm)
-#   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404), Ctrl-C stops
+#   make cluster    three umbrad behind HAProxy on 127.0.0.1:8080 (stats :8404; CLUSTER_PORT, CLUSTER_STATS_PORT), Ctrl-C stops
 #   make test-cluster   the HAProxy fail-over test alone (also part of make test)
 #   make test-farm      umbra-render --server on three daemons behind HAProxy (also part of make test)
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
@@ -21,7 +21,7 @@ GLSLANG ?= glslangValidator
 # The packages of each module (server -> api -> renderer): each compiles with its own packages'
 # cflags only; everything links with all of them.
 PKGS_RENDERER := vulkan
-PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp
+PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp libavif libdeflate
 PKGS_SERVER := libmicrohttpd
 PKGS := $(PKGS_RENDERER) $(PKGS_API) $(PKGS_SERVER)
 
@@ -34,7 +34,7 @@ LDFLAGS += -pthread $(SAN)
 # Each module sees only the headers it may use (server -> api -> renderer -> shaders): an
 # include across the layering is a compile error, not a review comment. Tests see everything.
 # Their packages' cflags likewise (PKG_CFLAGS_* below): the renderer gets Vulkan's, api/ those of
-# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg, libseccomp and libwebp (meshoptimizer has no .pc),
+# jansson, Assimp, libpng, OpenEXR, zlib, libjpeg, libseccomp, libwebp, libavif and libdeflate (meshoptimizer has no .pc),
 # the server libmicrohttpd's.
 INC_RENDERER = -Irenderer/include -Irenderer -Ishaders -I$(BUILD)/shaders $(PKG_CFLAGS_RENDERER)
 INC_API = -Irenderer/include -Iapi $(PKG_CFLAGS_API)
@@ -147,9 +147,10 @@ $(BUILD)/tests/gpu_tests: $(GPU_OBJ) $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 
+# umbrad's defaults (127.0.0.1:8080); its UMBRA_* variables change them (UMBRA_LISTEN=ADDR:PORT).
 run: deps
 	@$(MAKE) --no-print-directory all
-	$(BUILD)/umbrad --listen 127.0.0.1:8080
+	$(BUILD)/umbrad
 
 test: deps
 	@$(MAKE) --no-print-directory all
@@ -185,10 +186,11 @@ bench-tools:
 		$(BUILD)/tests/edge_error
 	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor
 
-$(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
+$(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a \
+		$(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/edge_error: $(BUILD)/obj/tests/bench/edge_error.o
@@ -198,9 +200,12 @@ $(BUILD)/tests/http_bench: $(BUILD)/obj/tests/bench/http_bench.o
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^
 
+# The balancer's and its stats page's ports (0 = any free port).
+CLUSTER_PORT ?= 8080
+CLUSTER_STATS_PORT ?= 8404
 cluster: deps
 	@$(MAKE) --no-print-directory all
-	python3 deploy/cluster.py up --build $(BUILD)
+	python3 deploy/cluster.py up --build $(BUILD) --port $(CLUSTER_PORT) --stats-port $(CLUSTER_STATS_PORT)
 
 test-cluster: deps
 	@$(MAKE) --no-print-directory all

@@ -93,9 +93,11 @@ struct api_limits {
 };
 void api_limits_defaults(struct api_limits *l);
 
-enum api_format { API_FORMAT_PNG, API_FORMAT_EXR, API_FORMAT_WEBP };
+enum api_format { API_FORMAT_PNG, API_FORMAT_EXR, API_FORMAT_WEBP, API_FORMAT_AVIF, API_FORMAT_COUNT };
 /* WebP's own bound on each side of an image (its 14-bit dimensions). */
 #define API_WEBP_MAX_SIDE 16383u
+/* AVIF's: what libavif's decoders take by default (16384 x 16384 pixels), browsers included. */
+#define API_AVIF_MAX_SIDE 16384u
 
 /* Where the time of a request's model imports went, ms (Server-Timing's model-* stages; the
  * importer measures its own in the sandbox, api/model.c the daemon's). */
@@ -107,7 +109,8 @@ enum api_import_stage {
 	API_IMPORT_LEVEL,      /* its one level of detail for the request (api/model_lod.h) */
 	API_IMPORT_TRANSFER,   /* the sandbox round trip less the importer's work: fork, socket copies */
 	API_IMPORT_VALIDATE,   /* the daemon's check and copy of the reply (api/model_wire.h) */
-	API_IMPORT_MIPS,       /* mip chains for a model the cache keeps */
+	API_IMPORT_CACHE,      /* what the cache keeps of a model it lists: its textures' mip chains and
+	                          a copy of its bytes (what confirms a hit) */
 	API_IMPORT_STAGES
 };
 struct api_import_times {
@@ -203,8 +206,8 @@ enum api_result api_scene_check_output(const struct api_scene *s, struct api_pro
 enum api_result api_problem_from_render(struct api_problem *p, const struct api_scene *s, const struct rnd_error *e,
                                         int status);
 
-/* Encodes a rendered image as the scene asks (PNG 8/16-bit, EXR with AOVs, or WebP). Several
- * views: the PNG and the WebP are the sheet as rendered; the EXR is multi-part (api_exr_encode). */
+/* Encodes a rendered image as the scene asks (PNG 8/16-bit, EXR with AOVs, WebP or AVIF). Several
+ * views: the PNG, WebP and AVIF are the sheet as rendered; the EXR is multi-part (api_exr_encode). */
 enum api_result api_encode(const struct api_scene *s, const struct rnd_image *img, uint8_t **out, size_t *len,
                            struct api_problem *p);
 /* PNG of an RGBA8 or RGBA16 image; level -1 = chosen by size. */
@@ -222,11 +225,23 @@ enum api_result api_exr_encode(const struct rnd_image *img, uint8_t **out, size_
 enum api_result api_webp_encode(const struct rnd_image *img, float quality, uint8_t **out, size_t *len,
                                 struct api_problem *p);
 
-/* "image/png", "image/x-exr", "image/webp". */
+/* AVIF of an RGBA8 image (api/encode_avif.c, libavif + libaom), as api_webp_encode: lossless when
+ * quality < 0, else lossy at quality 0..100 with a lossless alpha plane; no alpha when fully
+ * opaque. A side over API_AVIF_MAX_SIDE is a 422; the bytes are malloc'd. */
+enum api_result api_avif_encode(const struct rnd_image *img, float quality, uint8_t **out, size_t *len,
+                                struct api_problem *p);
+/* The formats whose answer may be lossy (output.quality): WebP and AVIF. */
+bool api_format_lossy(enum api_format f);
+/* The largest side of an image in format f (WebP, AVIF), 0 = no bound of the format's own. */
+uint32_t api_format_max_side(enum api_format f);
+
+/* "image/png", "image/x-exr", "image/webp", "image/avif". */
 const char *api_format_mime(enum api_format f);
-/* "png", "exr", "webp": output.format's name, and the extension of the format's files. */
+/* "png", "exr", "webp", "avif": output.format's name, and the extension of the format's files. */
 const char *api_format_name(enum api_format f);
-/* The format an output file name's extension names (.png, .exr, .webp, in any case): true with
+/* "a PNG", "an EXR", "a WebP", "an AVIF": for messages. */
+const char *api_format_label(enum api_format f);
+/* The format an output file name's extension names (.png, .exr, .webp, .avif, in any case): true with
  * *f set; false (*f untouched) for any other name. */
 bool api_format_from_name(const char *name, enum api_format *f);
 

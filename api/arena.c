@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include "arena.h"
 
 #define ARENA_CHUNK (64u * 1024u)
@@ -17,9 +18,16 @@ struct chunk {
 	_Alignas(16) unsigned char data[];
 };
 
+struct mapping {
+	struct mapping *next;
+	void *p;
+	size_t len;
+};
+
 struct api_arena {
 	struct chunk *head;   /* the chunk small allocations come from */
 	struct chunk *big;    /* dedicated chunks of big allocations */
+	struct mapping *maps; /* api_arena_own_mapping's (their records in the chunks) */
 };
 
 struct api_arena *api_arena_create(void)
@@ -39,6 +47,7 @@ static void free_list(struct chunk *c)
 void api_arena_destroy(struct api_arena *a)
 {
 	if (!a) return;
+	for (struct mapping *m = a->maps; m; m = m->next) munmap(m->p, m->len);
 	free_list(a->head);
 	free_list(a->big);
 	free(a);
@@ -96,4 +105,13 @@ char *api_arena_strdup(struct api_arena *a, const char *s)
 	char *d = api_arena_alloc(a, n);
 	if (d) memcpy(d, s, n);
 	return d;
+}
+
+int api_arena_own_mapping(struct api_arena *a, void *p, size_t len)
+{
+	struct mapping *m = api_arena_alloc(a, sizeof *m);
+	if (!m) return -1;
+	*m = (struct mapping){a->maps, p, len};
+	a->maps = m;
+	return 0;
 }

@@ -20,5 +20,8 @@ void *api_arena_alloc(struct api_arena *a, size_t n);
 /* n * size bytes with an overflow check. */
 void *api_arena_calloc(struct api_arena *a, size_t n, size_t size);
 char *api_arena_strdup(struct api_arena *a, const char *s);
+/* From now on the arena owns the mapping p[0..len) (mmap's): api_arena_destroy() unmaps it.
+ * 0, or -1 when out of memory (the caller still owns it then). */
+int api_arena_own_mapping(struct api_arena *a, void *p, size_t len);
 
 #endif

@@ -180,6 +180,7 @@ enum api_result api_encode(const struct api_scene *s, const struct rnd_image *im
 	if (api_scene_check_output(s, p) != API_OK) return API_ERR;
 	if (s->format == API_FORMAT_EXR) return api_exr_encode(img, out, len, p);
 	if (s->format == API_FORMAT_WEBP) return api_webp_encode(img, s->quality, out, len, p);
+	if (s->format == API_FORMAT_AVIF) return api_avif_encode(img, s->quality, out, len, p);
 	/* A debug view is always opaque grey; otherwise alpha is kept when the caller asked for it. */
 	bool keep_alpha = s->scene.output.transparent && s->scene.output.debug == RND_DEBUG_NONE;
 	return png_encode(img, s->png_level, keep_alpha, out, len, p);

@@ -224,3 +224,33 @@ out:
 	free(map);
 	free(used);
 }
+
+bool api_gltf_drop_skins(json_t *root)
+{
+	bool changed = false;
+	json_t *m, *p, *n;
+	size_t i, j;
+	json_array_foreach(json_object_get(root, "meshes"), i, m) {
+		json_array_foreach(json_object_get(m, "primitives"), j, p) {
+			json_t *attrs = json_object_get(p, "attributes");
+			const char *key;
+			void *tmp;
+			json_t *v;
+			json_object_foreach_safe(attrs, tmp, key, v) {
+				if (strncmp(key, "JOINTS_", 7) && strncmp(key, "WEIGHTS_", 8)) continue;
+				json_object_del(attrs, key);
+				changed = true;
+			}
+		}
+	}
+	json_array_foreach(json_object_get(root, "nodes"), i, n)
+		if (json_object_get(n, "skin")) {
+			json_object_del(n, "skin");
+			changed = true;
+		}
+	if (json_object_get(root, "skins")) {
+		json_object_del(root, "skins");
+		changed = true;
+	}
+	return changed;
+}

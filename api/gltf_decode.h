@@ -18,6 +18,7 @@
 #ifndef UMBRA_API_GLTF_DECODE_H
 #define UMBRA_API_GLTF_DECODE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <jansson.h>
 #include "gltf_buffers.h"
@@ -29,5 +30,11 @@ int api_gltf_decode(struct api_gltf_bufs *b, char *err, size_t errsize);
 /* Removes the buffers no bufferView names any more and that have no uri (meshopt's
  * fallbacks), renumbering the views' buffer indices. */
 void api_gltf_drop_fallbacks(json_t *root);
+/* Skins are not applied (meshes are drawn in their bind pose, and the model says so): drops
+ * every primitive's JOINTS_n and WEIGHTS_n and every node's skin before Assimp reads the
+ * document. Assimp 5.2 refused the common unsigned-short JOINTS_0 of skinned files
+ * ("elemSize 16 > targetElemSize 8": CesiumMan, Fox, BrainStem, RiggedFigure). Returns
+ * whether it changed root. */
+bool api_gltf_drop_skins(json_t *root);
 
 #endif

@@ -17,20 +17,21 @@
 #define GL_CLAMP_TO_EDGE 33071
 #define GL_MIRRORED_REPEAT 33648
 
-static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
-                                                       "occlusionTexture", "emissiveTexture"};
+static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {
+	"baseColorTexture", "metallicRoughnessTexture", "normalTexture", "occlusionTexture", "emissiveTexture",
+	"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture", "sheenColorTexture",
+	"sheenRoughnessTexture", "specularTexture", "specularColorTexture"};
 static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform",
                                              "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
+                                             "KHR_materials_clearcoat", "KHR_materials_sheen",
+                                             "KHR_materials_specular", "KHR_materials_ior",
                                              "EXT_mesh_gpu_instancing", "EXT_meshopt_compression",
                                              "KHR_mesh_quantization", NULL};
 /* Extensions known and not drawn (or drawn in part): what the picture lacks. */
 static const char *const LACKS[][2] = {
 	{"KHR_materials_transmission", "transmission drawn as see-through coverage (dithered), not refraction"},
-	{"KHR_materials_volume", "volume (thickness, attenuation) not drawn: thin surfaces"},
-	{"KHR_materials_clearcoat", "the clear coat layer not drawn (the base layer only)"},
-	{"KHR_materials_sheen", "sheen not drawn"},
-	{"KHR_materials_specular", "specular strength and colour not used (F0 0.04)"},
-	{"KHR_materials_ior", "ior not used (1.5)"},
+	{"KHR_materials_volume", "volume drawn as the coverage's tint and density (its attenuation through "
+	                         "thicknessFactor x its texture's mean), no refraction"},
 	{"KHR_materials_iridescence", "iridescence not drawn"},
 	{"KHR_materials_anisotropy", "anisotropy not drawn (isotropic highlights)"},
 	{"KHR_materials_variants", "variants: the default materials drawn"},
@@ -95,8 +96,13 @@ static void transform_of(json_t *tt, struct rnd_texture_sampling *ts)
 	ts->transformed = true;
 }
 
-static void read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, uint32_t slot,
-                         json_t *info, struct api_gltf_material *gm)
+const char *api_gltf_slot_name(uint32_t k)
+{
+	return k < RND_TEX_SLOTS ? SLOT_NAMES[k] : "texture";
+}
+
+void api_gltf_read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, uint32_t slot,
+                           json_t *info, struct api_gltf_material *gm)
 {
 	if (!json_is_object(info)) return;
 	struct rnd_texture_sampling *ts = &gm->sampling[slot];
@@ -157,15 +163,21 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 	gm->emissive_strength = 1;
 	gm->normal_scale = 1;
 	gm->occlusion_strength = 1;
+	for (int k = 0; k < 3; k++) gm->specular.color[k] = gm->attenuation[k] = 1;
+	gm->thickness_mean = 1;
+	gm->thickness_image = -1;
+	gm->specular.factor = 1;
+	gm->specular.ior = 1.5f;
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) gm->ext_image[k] = -1;
 	if (!json_is_object(mat)) return;
 	const char *name = json_string_value(json_object_get(mat, "name"));
 	name = name ? name : "";
 	gm->double_sided = json_is_true(json_object_get(mat, "doubleSided"));
 	json_t *pbr = json_object_get(mat, "pbrMetallicRoughness");
-	json_t *infos[RND_TEX_SLOTS] = {json_object_get(pbr, SLOT_NAMES[0]), json_object_get(pbr, SLOT_NAMES[1]),
+	json_t *infos[RND_TEX_EMISSIVE + 1] = {json_object_get(pbr, SLOT_NAMES[0]), json_object_get(pbr, SLOT_NAMES[1]),
 	                                json_object_get(mat, SLOT_NAMES[2]), json_object_get(mat, SLOT_NAMES[3]),
 	                                json_object_get(mat, SLOT_NAMES[4])};
-	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) read_texinfo(gi, root, mi, name, k, infos[k], gm);
+	for (uint32_t k = 0; k <= RND_TEX_EMISSIVE; k++) api_gltf_read_texinfo(gi, root, mi, name, k, infos[k], gm);
 	json_t *ext = json_object_get(mat, "extensions"), *v;
 	const char *key;
 	json_object_foreach(ext, key, v) {
@@ -174,10 +186,9 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 			gm->emissive_strength = s >= 0 ? s : 1;
 		}
 		if (!strcmp(key, "KHR_materials_unlit")) gm->unlit = true;
-		if (!strcmp(key, "KHR_materials_transmission"))
-			gm->transmission = fminf(fmaxf(num(v, "transmissionFactor", 0), 0), 1);
 		if (!strcmp(key, "KHR_materials_pbrSpecularGlossiness") && !pbr) read_spec_gloss(gi, mi, name, v, gm);
 	}
+	api_gltf_read_material_ext(gi, root, mi, name, ext, gm);
 }
 
 /* Extensions the renderer does not know, and parts of a scene it does not draw. */
@@ -205,7 +216,9 @@ static void scene_warnings(struct api_gltf_info *gi, json_t *root)
 			if (json_array_size(json_object_get(p, "targets")))
 				api_gltf_warn(gi, "morph targets are not applied (drawn in the base shape)");
 			json_t *mode = json_object_get(p, "mode");
-			if (json_is_integer(mode) && json_integer_value(mode) < 4) api_gltf_warn(gi, "points and lines are not drawn");
+			if (json_is_integer(mode) && json_integer_value(mode) < 4)
+				api_gltf_warn(gi, "points and lines drawn as thin prisms and dots 1/250 and 1/100 of the model's size "
+				              "wide (not one pixel wide)");
 		}
 	}
 }
@@ -231,6 +244,7 @@ void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, str
 	memcpy(m->sampling, gm->sampling, sizeof m->sampling);
 	m->normal_scale = fminf(fmaxf(gm->normal_scale, -1e3f), 1e3f);
 	m->occlusion_strength = gm->occlusion_strength;   /* clamped to 0..1 when read */
+	api_gltf_material_ext_apply(gm, m);
 	*single_sided = !gm->double_sided;
 }
 
@@ -245,8 +259,11 @@ void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, s
 		m->metal_rough_texture = NULL;
 	}
 	if (gm->transmission > 0 && m->alpha_mode != RND_ALPHA_MASK) {
+		float t[3];
+		api_gltf_volume_transmittance(gm, t);
 		m->alpha_mode = RND_ALPHA_BLEND;
-		m->base_color[3] *= 1 - 0.8f * gm->transmission;
+		m->base_color[3] *= 1 - 0.8f * gm->transmission * (t[0] + t[1] + t[2]) / 3;
+		for (int k = 0; k < 3; k++) m->base_color[k] *= t[k];
 	}
 	if (gm->unlit) {
 		for (int k = 0; k < 3; k++) {
@@ -285,6 +302,13 @@ void api_vertex_tangents(const float *t, const float *b, const float *nrm, uint3
 void api_gltf_info_free(struct api_gltf_info *gi)
 {
 	if (!gi) return;
+	for (uint32_t i = 0; i < gi->image_count; i++) {
+		free(gi->images[i].uri);
+		free(gi->images[i].bytes);
+	}
+	free(gi->images);
+	gi->images = NULL;
+	gi->image_count = 0;
 	free(gi->materials);
 	gi->materials = NULL;
 	gi->material_count = 0;

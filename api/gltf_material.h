@@ -35,16 +35,40 @@ struct api_gltf_material {
 	 * the base colour's DIFFUSE texture) and roughness 1 - glossinessFactor. */
 	bool spec_gloss;
 	float diffuse[4], glossiness;
-	/* KHR_materials_transmission's factor (0): drawn as partial coverage, see shading. */
-	float transmission;
+	/* KHR_materials_transmission's factor (0): drawn as partial coverage, see shading; and
+	 * KHR_materials_volume's medium: attenuation colour (1, 1, 1), distance (0: none),
+	 * thicknessFactor, and its thicknessTexture's image (-1: none; drawn as the mean of its G
+	 * over the texture, thickness_mean, which api/model_material.c sets once it is decoded). */
+	float transmission, attenuation[3], attenuation_distance, thickness, thickness_mean;
+	int32_t thickness_image;
+	/* KHR_materials_clearcoat, _sheen, _specular and _ior as rnd_material has them
+	 * (api/gltf_material_ext.c); ext_image: per extension texture slot, its image's index in
+	 * api_gltf_info.images (-1: none). */
+	uint32_t extensions;
+	struct { float factor, roughness, normal_scale; } clearcoat;
+	struct { float color[3], roughness; } sheen;
+	struct { float factor, color[3], ior; } specular;
+	int32_t ext_image[RND_TEX_SLOTS];
 	bool double_sided;                 /* false (glTF's default) */
 	float normal_scale, occlusion_strength;    /* 1, 1 */
 	struct rnd_texture_sampling sampling[RND_TEX_SLOTS];
 };
 
+/* An image the extensions' textures read, taken from the document before Assimp (which loads
+ * only the images its own materials name): its file's uri, or its encoded bytes (a
+ * bufferView, a data: URI); tex: decoded once, by the first slot that reads it. */
+struct api_gltf_image {
+	char *uri;
+	uint8_t *bytes;
+	size_t len;
+	const struct rnd_texture *tex;
+};
+
 struct api_gltf_info {
 	struct api_gltf_material *materials;
 	uint32_t material_count;
+	struct api_gltf_image *images;     /* per image of the document (image_count) */
+	uint32_t image_count;
 	char warnings[API_MODEL_MAX_WARNINGS + 1];   /* "" when none */
 };
 
@@ -69,9 +93,31 @@ void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, str
  * colour black, alpha kept; normal and occlusion maps dropped); the specular-glossiness
  * stand-in (metallic 0, base colour diffuseFactor, roughness 1 - glossiness);
  * KHR_materials_transmission as dithered coverage (alpha mode BLEND, alpha x (1 - 0.8 x
- * transmission): clear glass shows a fifth of its surface and lets four fifths of the light
- * through to its shadow), not refraction. */
+ * transmission x the mean of the volume's transmittance): clear glass shows a fifth of its
+ * surface and lets four fifths of the light through to its shadow; with KHR_materials_volume
+ * the shown part is tinted by the transmittance and denser glass shows more of it), not
+ * refraction. */
 void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, struct rnd_material *m);
+/* The name of texture slot k in a glTF material ("baseColorTexture", ..., "specularColorTexture"). */
+const char *api_gltf_slot_name(uint32_t k);
+/* Texture info `info` of material mi into gm->sampling[slot] (sampler, transform, uv set;
+ * the normal scale and occlusion strength of those slots). */
+void api_gltf_read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, uint32_t slot,
+                           json_t *info, struct api_gltf_material *gm);
+/* The PBR extensions of material mi (its "extensions" object ext) into gm
+ * (api/gltf_material_ext.c), and from gm into m (what api_gltf_material_apply adds). */
+void api_gltf_read_material_ext(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, json_t *ext,
+                                struct api_gltf_material *gm);
+void api_gltf_material_ext_apply(const struct api_gltf_material *gm, struct rnd_material *m);
+/* KHR_materials_volume's transmittance t per channel through thickness x thickness_mean:
+ * attenuationColor ^ (thickness / attenuationDistance) (Beer's law, as the sample viewer
+ * attenuates what it refracts); 1 without a distance or a thickness. */
+void api_gltf_volume_transmittance(const struct api_gltf_material *gm, float t[3]);
+/* Takes the uri or the bytes of every image an extension slot reads (b: the document's
+ * buffers, api/gltf_buffers.h) into gi->images. Never fails: an image it cannot take is
+ * warned and left out. */
+struct api_gltf_bufs;
+void api_gltf_ext_images(struct api_gltf_info *gi, struct api_gltf_bufs *b);
 /* Vertex data: n RGBA float colours -> linear RGBA8 (clamped); n tangents, bitangents and
  * normals (xyz floats) -> xyzw tangents, w = the side of the bitangent (+1 / -1). */
 void api_vertex_colors(const float *rgba, uint32_t n, uint8_t *out);

@@ -1,6 +1,6 @@
 /*
- * api/image_decode — PNG (libpng) and JPEG (libjpeg-turbo) to RGBA8, for the
- * base-colour textures of imported models (and of materials). See model.h.
+ * api/image_decode — PNG (libdeflate for the common ones, api/png_fast.h; libpng) and JPEG
+ * (libjpeg-turbo) to RGBA8, for the textures of imported models (and of materials). See model.h.
  *
  * Both decoders check the header's size against max_pixels before allocating, so a small file
  * that claims to be 100000x100000 costs nothing. Both libraries report errors through longjmp;
@@ -15,6 +15,7 @@
 #include <png.h>
 #include <jpeglib.h>
 #include "model.h"
+#include "png_fast.h"
 
 #define DEFAULT_MAX_PIXELS (64ull << 20)
 
@@ -74,6 +75,10 @@ static void png_to_rgba8(png_structp png, png_infop info)
 static enum api_result decode_png(const uint8_t *data, size_t len, uint64_t max_pixels, uint8_t **rgba,
                                   uint32_t *w, uint32_t *h, char *err, size_t errsize)
 {
+	/* The common PNG without libpng (api/png_fast.h); the rest, and anything odd, with it. */
+	int fast = api_png_decode_fast(data, len, max_pixels, rgba, w, h);
+	if (fast == 0) return API_OK;
+	if (fast == API_PNG_NO_MEMORY) return err_set(err, errsize, "PNG: %s", "out of memory");
 	struct png_src src = {data, len, 0, ""};
 	png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, png_on_error, png_quiet);
 	png_infop info = png ? png_create_info_struct(png) : NULL;

@@ -53,8 +53,8 @@ static json_t *limits_object(const struct api_info *in)
 char *api_info_json(const struct api_info *in, size_t *len)
 {
 	static const char *const filters[] = {"hard", "pcf", "pcss", "vsm", "evsm", NULL};
-	static const char *const formats[] = {"png", "exr", "webp", NULL};
-	static const char *const media[] = {"image/png", "image/x-exr", "image/webp", NULL};
+	static const char *const formats[] = {"png", "exr", "webp", "avif", NULL};
+	static const char *const media[] = {"image/png", "image/x-exr", "image/webp", "image/avif", NULL};
 	static const char *const priorities[] = {"interactive", "bulk", NULL};
 	char vk[32];
 	snprintf(vk, sizeof vk, "%u.%u.%u", (in->vulkan_api >> 22) & 0x7fu, (in->vulkan_api >> 12) & 0x3ffu,

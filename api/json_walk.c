@@ -159,6 +159,24 @@ static int edit_distance(const char *a, const char *b)
 	return row[lb];
 }
 
+/* The member key of obj was read into the parsed scene (scene_internal.h). Out of memory:
+ * c->reads_lost, and the whole document is hashed as it came. */
+void api_member_read(struct pctx *c, json_t *obj, const char *key)
+{
+	if (c->reads_lost) return;
+	if (c->nreads == c->reads_cap) {
+		size_t cap = c->reads_cap ? 2 * c->reads_cap : 64;
+		struct api_member_read *r = realloc(c->reads, cap * sizeof *r);
+		if (!r) {
+			c->reads_lost = true;
+			return;
+		}
+		c->reads = r;
+		c->reads_cap = cap;
+	}
+	c->reads[c->nreads++] = (struct api_member_read){obj, key};
+}
+
 /* Rejects members of obj named in neither list. `what` names the object in the message. */
 int api_check_members(struct pctx *c, json_t *obj, const char *const *list, const char *const *list2,
                          const char *what)
@@ -229,7 +247,9 @@ int api_get_num(struct pctx *c, json_t *obj, const char *key, const struct range
 	size_t old = api_ptr_push(c, key);
 	int rc = api_check_num(c, key, v, r, out);
 	api_ptr_pop(c, old);
-	return rc < 0 ? -1 : 1;
+	if (rc < 0) return -1;
+	api_member_read(c, obj, key);
+	return 1;
 }
 
 int api_get_float(struct pctx *c, json_t *obj, const char *key, const struct range *r, float *out)
@@ -275,7 +295,9 @@ int api_get_int(struct pctx *c, json_t *obj, const char *key, long long lo, long
 	size_t old = api_ptr_push(c, key);
 	int rc = api_check_int(c, key, v, lo, hi, out);
 	api_ptr_pop(c, old);
-	return rc < 0 ? -1 : 1;
+	if (rc < 0) return -1;
+	api_member_read(c, obj, key);
+	return 1;
 }
 
 int api_get_u32(struct pctx *c, json_t *obj, const char *key, long long lo, long long hi, uint32_t *out)
@@ -292,6 +314,7 @@ int api_get_bool(struct pctx *c, json_t *obj, const char *key, bool *out)
 	if (!v) return 0;
 	if (!json_is_boolean(v)) return api_fail_at(c, key, "%s must be true or false, not %s", key, api_type_name(v));
 	*out = json_is_true(v);
+	api_member_read(c, obj, key);
 	return 1;
 }
 
@@ -326,7 +349,9 @@ int api_get_enum(struct pctx *c, json_t *obj, const char *key, const char *const
 	size_t old = api_ptr_push(c, key);
 	int rc = api_check_enum(c, key, v, names, out);
 	api_ptr_pop(c, old);
-	return rc < 0 ? -1 : 1;
+	if (rc < 0) return -1;
+	api_member_read(c, obj, key);
+	return 1;
 }
 
 
@@ -372,6 +397,7 @@ int api_get_vec(struct pctx *c, json_t *obj, const char *key, float *out, int nm
 	size_t old = api_ptr_push(c, key);
 	int rc = api_check_vec(c, key, v, out, nmin, nmax, flags);
 	api_ptr_pop(c, old);
+	if (rc > 0) api_member_read(c, obj, key);
 	return rc;
 }
 

@@ -70,6 +70,11 @@ struct api_model_mesh {
 	uint32_t lod_count;
 	bool closed;              /* watertight and wound outward (api/model_lod.h, set by the importer) */
 	float bounds[6];          /* min xyz, max xyz of positions (api_mesh_bounds) */
+	/* private, in the importer only (never on the wire): the weld its join sorted the vertices
+	 * by (api/weld.h: group of each vertex, and how many), for the closedness check and the
+	 * level to use instead of sorting again; NULL: none made. */
+	const uint32_t *weld_group_;
+	uint32_t weld_groups_;
 };
 
 /* A node's use of a mesh: one rnd_object. */

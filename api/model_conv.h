@@ -52,14 +52,23 @@ static inline void *api_conv_alloc(struct api_conv *c, size_t n, size_t size)
 /* Joins the corners of a mesh of positions and normals (and colours: an STL's per-facet
  * colours) that share a position, a colour and a normal to within 2^-14 (coplanar facets'
  * normals, normalised cross products of different edges, differ in their last bits), in place:
- * corners where facets of one plane meet become one vertex, as Assimp's join made them.
- * Returns the vertices left; without memory for the tables they all stay (the same picture).
- * (api/model_import.c; api/stl_import.c uses it too.) */
-uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni);
+ * corners where facets of one plane meet become one vertex, as Assimp's join made them. The
+ * corners are found by sorting them by position (api/weld.h), and that weld is handed on:
+ * *weld_group (in arena) the weld group of each joined vertex, *weld_groups how many, for the
+ * mesh's weld_group_ (the closedness check and the level use it instead of sorting again).
+ * Returns the vertices left; without memory they all stay (the same picture) and *weld_group
+ * is NULL. (api/model_import.c; api/stl_import.c uses it too.) */
+uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni,
+                           struct api_arena *arena, const uint32_t **weld_group, uint32_t *weld_groups);
 
 /* Material `index` of the scene into *m (defaults for Assimp's default material), with its
  * textures decoded into the arena; *single_sided from glTF's doubleSided. -1 with c->err (and
  * c->oom when an allocation failed) on failure. */
+/* Mesh am's points and lines (faces of 1 and 2 indices) as triangles into out (api/model_strokes.c):
+ * a prism of radius r along each segment, an octahedron of radius 2.5 r at each point; out
+ * without triangles when am has none. 0, or -1 with c's error. */
+int api_conv_strokes(struct api_conv *c, const struct aiMesh *am, float r, struct api_model_mesh *out);
+
 int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m,
                       bool *single_sided);
 

@@ -9,7 +9,8 @@
  * disk (the sandbox's system-call filter would refuse an open anyway); a name it was not given
  * fails. The node tree is walked with
  * every node's transform (Assimp's aiMatrix4x4 is row-major; ours are column-major), each
- * (node, mesh) pair becoming one instance; meshes keep triangles only.
+ * (node, mesh) pair becoming one instance; meshes keep triangles, and points and lines become
+ * thin geometry (api/model_strokes.c).
  *
  * Materials: glTF's core material model (every texture slot, samplers, texture transforms,
  * emissive strength, doubleSided: what Assimp 5.2 does not hand over reliably is read from the
@@ -30,7 +31,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <jansson.h>
-#include <meshoptimizer.h>
 #include "errmsg.h"
 #include "gltf_buffers.h"
 #include "gltf_decode.h"
@@ -42,7 +42,6 @@
 #include "model_lod.h"
 #include "ply_colors.h"
 #include "ply_strips.h"
-#include "remap.h"
 #include "stl_import.h"
 #include "umbra/rnd_math.h"
 
@@ -208,60 +207,16 @@ static int convert_data(struct api_conv *c, const struct aiMesh *am, struct api_
 	return 0;
 }
 
-/* What join_vertices compares of a corner. */
-struct join_key {
-	float pos[3];
-	int16_t nrm[3];
-	uint8_t col[4];
-	int16_t pad;   /* zero: meshoptimizer compares every byte */
-};
-
-uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni)
-{
-	uint32_t *remap = malloc((size_t)nv * sizeof *remap);
-	struct join_key *key = calloc(nv, sizeof *key);
-	if (!remap || !key) {
-		free(remap);
-		free(key);
-		return nv;
-	}
-	for (uint32_t v = 0; v < nv; v++) {
-		for (int k = 0; k < 3; k++) {
-			key[v].pos[k] = pos[3 * (size_t)v + (size_t)k] + 0.0f;   /* -0 is 0 */
-			key[v].nrm[k] = (int16_t)lrintf(nrm[3 * (size_t)v + (size_t)k] * 16384.0f);
-		}
-		if (col) memcpy(key[v].col, col + 4 * (size_t)v, 4);
-	}
-	size_t unique = api_remap_keys(key, nv, sizeof *key, remap);
-	free(key);
-	if (unique == SIZE_MAX) {
-		free(remap);
-		return nv;
-	}
-	/* new ids follow first occurrences: remap[v] <= v, so moving down in order is safe */
-	for (uint32_t v = 0; v < nv; v++)
-		if (remap[v] != v) {
-			memcpy(pos + 3 * (size_t)remap[v], pos + 3 * (size_t)v, 12);
-			memcpy(nrm + 3 * (size_t)remap[v], nrm + 3 * (size_t)v, 12);
-			if (col) memcpy(col + 4 * (size_t)remap[v], col + 4 * (size_t)v, 4);
-		}
-	meshopt_remapIndexBuffer(idx, idx, ni, remap);
-	free(remap);
-	return (uint32_t)unique;
-}
-
 /* A material slot on TEXCOORD_1 of a mesh without that set: the renderer draws it with
  * TEXCOORD_0 (rnd.h uvs1), and the model says so. */
 static void warn_missing_uv1(struct api_conv *c, const struct aiMesh *am, const struct api_model_mesh *me,
                              const struct rnd_material *m)
 {
-	static const char *const slot[RND_TEX_SLOTS] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
-	                                                 "occlusionTexture", "emissiveTexture"};
 	if (me->uvs1) return;
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++)
 		if (m->textures[k] && m->sampling[k].uv_set == 1)
 			api_gltf_warn(&c->gi, "mesh \"%.40s\": its material's %s reads TEXCOORD_1, which the mesh lacks: drawn "
-			              "with TEXCOORD_0", am->mName.data, slot[k]);
+			              "with TEXCOORD_0", am->mName.data, api_gltf_slot_name(k));
 }
 
 static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_model_mesh *out)
@@ -284,7 +239,8 @@ static int convert_mesh(struct api_conv *c, const struct aiMesh *am, struct api_
 	out->material = am->mMaterialIndex;
 	/* the colours are ours (the arena) until the model is shared */
 	if (c->join && nrm && !uv && !uv1 && !out->tangents && nv)
-		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count);
+		out->vertex_count = api_join_vertices(pos, nrm, (uint8_t *)out->colors, nv, idx, out->index_count, c->arena,
+		                                      &out->weld_group_, &out->weld_groups_);
 	return 0;
 }
 
@@ -319,6 +275,23 @@ static int walk(struct api_conv *c, const struct aiNode *node, const float paren
 	return 0;
 }
 
+/* The radius points and lines are drawn with (api/model_strokes.c): 1/500 of the diagonal of
+ * the box of every mesh's vertices (node transforms left out: a size, not a place). */
+static float stroke_radius(const struct aiScene *sc)
+{
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (unsigned i = 0; i < sc->mNumMeshes; i++)
+		for (unsigned v = 0; v < sc->mMeshes[i]->mNumVertices; v++) {
+			const struct aiVector3D *p = &sc->mMeshes[i]->mVertices[v];
+			const float q[3] = {p->x, p->y, p->z};
+			for (int k = 0; k < 3; k++)
+				if (isfinite(q[k])) lo[k] = fminf(lo[k], q[k]), hi[k] = fmaxf(hi[k], q[k]);
+		}
+	float d = 0;
+	for (int k = 0; k < 3; k++) d += hi[k] > lo[k] ? (hi[k] - lo[k]) * (hi[k] - lo[k]) : 0;
+	return d > 0 && isfinite(d) ? sqrtf(d) / 500 : 1e-3f;
+}
+
 static int convert(struct api_conv *c)
 {
 	const struct aiScene *sc = c->sc;
@@ -341,11 +314,16 @@ static int convert(struct api_conv *c)
 	struct api_model_mesh *meshes = api_conv_alloc(c, sc->mNumMeshes, sizeof *meshes);
 	if (!meshes) return api_err_set(c->err, c->errsize, "out of memory importing the model"), -1;
 	uint32_t nmesh = 0;
+	float stroke = stroke_radius(sc);
 	for (unsigned i = 0; i < sc->mNumMeshes; i++) {
 		const struct aiMesh *am = sc->mMeshes[i];
 		c->mesh_map[i] = -1;
-		if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || !am->mNumVertices) continue;
-		if (convert_mesh(c, am, &meshes[nmesh]) < 0) return -1;
+		if (!am->mNumVertices) continue;
+		if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {   /* points and lines (SortByPType split them off) */
+			if (api_conv_strokes(c, am, stroke, &meshes[nmesh]) < 0) return -1;
+		} else if (convert_mesh(c, am, &meshes[nmesh]) < 0) {
+			return -1;
+		}
 		if (!meshes[nmesh].index_count) continue;
 		if (meshes[nmesh].material >= nmat) meshes[nmesh].material = 0;
 		warn_missing_uv1(c, am, &meshes[nmesh], &mats[meshes[nmesh].material]);
@@ -474,8 +452,10 @@ static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb,
 	if (inst < 0) return -1;
 	if (api_gltf_bufs_finish(b) != 0) return api_err_set(err, errsize, "out of memory"), -1;
 	api_gltf_drop_fallbacks(root);
-	api_gltf_info_read(root, &c->gi);
-	bool changed = dec > 0 || inst > 0;
+	api_gltf_info_read(root, &c->gi);   /* it warns of the skins before they go */
+	api_gltf_ext_images(&c->gi, b);
+	bool skins = api_gltf_drop_skins(root);
+	bool changed = dec > 0 || inst > 0 || skins;
 	/* Materials renamed to their glTF index, to find them again (see gltf_material.h); the
 	 * document handed to Assimp also when it was changed here. */
 	*tagged = api_gltf_tag_materials(root, data, len, glb, changed, tagged_len);
@@ -534,8 +514,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	struct aiFileIO io;
 	api_mem_io_init(&mi, &io);
 	struct aiPropertyStore *props = aiCreatePropertyStore();
-	/* Points and lines are dropped by SortByPType: only triangles reach us. */
-	aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+	/* SortByPType puts points and lines in meshes of their own: drawn as thin geometry (convert). */
 	aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
 	unsigned flags = import_flags(format, face_colors);
 	/* Assimp 5.2's join of identical vertices ignores their colours (import_flags leaves it

@@ -19,8 +19,9 @@
 #include <meshoptimizer.h>
 #include <stdlib.h>
 #include <string.h>
+#include "lod_simplify.h"
 #include "model_lod.h"
-#include "remap.h"
+#include "weld.h"
 #include "umbra/rnd_math.h"
 
 /* A mesh welded by position: what the simplifier works on. meshoptimizer treats vertices at
@@ -33,68 +34,32 @@ struct welded {
 	size_t count;
 };
 
-/* meshopt_generateVertexRemap(remap, idx, ni, keys, nv, 12), through api_remap_keys (its
- * hashing was most of a 1M-triangle import): the vertices idx refers to, one number for equal
- * keys, numbered in the order idx first meets them; ~0u for the others. SIZE_MAX without
- * memory. */
-static size_t index_order_remap(const int32_t *keys, uint32_t nv, const uint32_t *idx, uint32_t ni, unsigned int *remap)
-{
-	uint32_t *group = malloc((size_t)nv * sizeof *group), *first = NULL;
-	size_t groups = group ? api_remap_keys(keys, nv, 12, group) : SIZE_MAX;
-	if (groups != SIZE_MAX && !(first = malloc((groups ? groups : 1) * sizeof *first))) groups = SIZE_MAX;
-	if (groups == SIZE_MAX) {
-		free(group);
-		return SIZE_MAX;
-	}
-	memset(first, 0xff, groups * sizeof *first);
-	memset(remap, 0xff, (size_t)nv * sizeof *remap);
-	size_t count = 0;
-	for (uint32_t i = 0; i < ni; i++) {
-		uint32_t v = idx[i];
-		if (remap[v] != ~0u) continue;
-		if (first[group[v]] == ~0u) first[group[v]] = (uint32_t)count++;
-		remap[v] = first[group[v]];
-	}
-	free(group);
-	free(first);
-	return count;
-}
-
-/* The box of n points (lo, hi; empty: +inf, -inf) and its largest side. */
+/* The box of n points (lo, hi; empty: +inf, -inf) and its largest side. (Comparisons, not
+ * fminf/fmaxf: those are calls into libm, for their NaN rules, and positions are finite; the
+ * daemon runs this over every mesh of a reply, api_mesh_bounds.) */
 static float points_box(const float *p, size_t n, float lo[3], float hi[3])
 {
 	for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
 	for (size_t v = 0; v < n; v++)
 		for (int k = 0; k < 3; k++) {
-			lo[k] = fminf(lo[k], p[3 * v + k]);
-			hi[k] = fmaxf(hi[k], p[3 * v + k]);
+			float x = p[3 * v + (size_t)k];
+			if (x < lo[k]) lo[k] = x;
+			if (x > hi[k]) hi[k] = x;
 		}
 	return fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
 }
 
+/* me welded by position into idx and w (api_weld_mesh: the importer's groups when its join made
+ * them, me->weld_group_, else sorted now), with the welded vertices' normals. */
 static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *w)
 {
-	unsigned int *remap = malloc((size_t)me->vertex_count * sizeof *remap);
-	int32_t *q = malloc((size_t)me->vertex_count * 12);
-	if (!remap || !q) { free(remap); free(q); return false; }
-	/* Positions equal to 2^-20 of the extent are one: a seam written with sin(2 pi) != 0 is
-	 * closed (otherwise it is a border the simplifier must keep, with long slivers along it). */
-	float lo[3], hi[3], ext = points_box(me->positions, me->vertex_count, lo, hi);
-	float unit = ext > 0.0f ? ext / 1048576.0f : 1.0f;
-	for (uint32_t v = 0; v < me->vertex_count; v++)
-		for (int k = 0; k < 3; k++)
-			q[3 * (size_t)v + (size_t)k] = (int32_t)lrintf((me->positions[3 * (size_t)v + (size_t)k] - lo[k]) / unit);
-	w->count = index_order_remap(q, me->vertex_count, me->indices, me->index_count, remap);
-	free(q);
-	if (w->count == SIZE_MAX) { free(remap); w->count = 0; return false; }
-	w->pos = malloc(w->count * 12);
-	w->rep = malloc(w->count * sizeof *w->rep);
-	if (!w->pos || !w->rep) { free(remap); return false; }
-	meshopt_remapVertexBuffer(w->pos, me->positions, me->vertex_count, 12, remap);
-	meshopt_remapIndexBuffer(idx, me->indices, me->index_count, remap);
-	for (uint32_t v = me->vertex_count; v-- > 0;)
-		if (remap[v] != ~0u) w->rep[remap[v]] = v;
-	free(remap);
+	struct api_welded wm;
+	bool ok = api_weld_mesh(me->positions, me->vertex_count, me->indices, me->index_count, me->weld_group_,
+	                        me->weld_groups_, idx, &wm);
+	w->pos = wm.pos;
+	w->rep = wm.rep;
+	w->count = wm.count;
+	if (!ok) return false;
 	/* Vertex normals of the welded full mesh (degenerate facets, whose file normals are noise,
 	 * weigh nothing); oriented like the file's. */
 	w->nrm = calloc(w->count * 3, sizeof *w->nrm);
@@ -241,6 +206,18 @@ static void walk_free(struct walk *k)
 	free(k->queue);
 }
 
+/* fminf(acc, x) and fmaxf(acc, x) for an accumulator that is never NaN, inline (those are
+ * calls into libm): a NaN x (a degenerate face's distance) leaves acc as it is, as they do. */
+static inline float min_f(float acc, float x)
+{
+	return x < acc ? x : acc;
+}
+
+static inline float max_f(float acc, float x)
+{
+	return x > acc ? x : acc;
+}
+
 /* Squared distance from p to o + t e. */
 static float d2_along(const float p[3], const float o[3], const float e[3], float t)
 {
@@ -320,7 +297,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 		for (int c = 0; c < 3; c++) {
 			float d[3];
 			rnd_v3_sub(d, v[c], s[0]);
-			r2 = fmaxf(r2, rnd_v3_dot(d, d));
+			r2 = max_f(r2, rnd_v3_dot(d, d));
 		}
 		r2 *= 2.25f;
 		float best[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
@@ -344,7 +321,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 				const uint32_t *fi = k->idx + 3 * (size_t)f;
 				const float *a = w->pos + 3 * (size_t)fi[0], *b = w->pos + 3 * (size_t)fi[1], *c = w->pos + 3 * (size_t)fi[2];
 				float most = 0.0f;
-				for (int q = 0; q < 4; q++) most = fmaxf(most, best[q] = fminf(best[q], point_triangle_d2(s[q], a, b, c)));
+				for (int q = 0; q < 4; q++) most = max_f(most, best[q] = min_f(best[q], point_triangle_d2(s[q], a, b, c)));
 				/* Every sample already this near a face: the rest of the walk can only find
 				 * nearer ones, and this triangle cannot raise the level's worst. */
 				if (most <= worst2) { head = tail; break; }
@@ -358,7 +335,7 @@ static float level_error(const struct grid *g, struct walk *k, const struct weld
 				}
 			}
 		}
-		for (int q = 0; q < 4; q++) worst2 = fmaxf(worst2, best[q]);
+		for (int q = 0; q < 4; q++) worst2 = max_f(worst2, best[q]);
 	}
 	return sqrtf(worst2);
 }
@@ -402,7 +379,7 @@ static bool corner_normals(const struct api_model_mesh *me, const struct welded 
 		for (int k = 0; k < 3; k++) {
 			float e[3];
 			rnd_v3_sub(e, w->pos + 3 * (size_t)idx[3 * t + (size_t)k], w->pos + 3 * (size_t)idx[3 * t + (size_t)(k + 1) % 3]);
-			edge = fmaxf(edge, rnd_v3_dot(e, e));
+			edge = max_f(edge, rnd_v3_dot(e, e));
 		}
 		/* A sliver's own normal is noise: it takes its vertices' normals whatever the angle. */
 		bool sliver = rnd_v3_length(fn + 3 * t) < 0.02f * edge;
@@ -526,7 +503,7 @@ static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, co
 	if (!lod || !next || !(extent > 0.0f) || !grid_build(&g, w, lo, hi, extent) || !walk_build(&k, w, cur, ni))
 		goto done;
 	for (int attempt = 0; attempt < 2; attempt++) {
-		size_t got = meshopt_simplify(next, cur, ni, w->pos, w->count, 12, 3, target, 0, NULL);
+		size_t got = api_lod_simplify(next, cur, ni, w->pos, w->count, extent, target);
 		if (got < 3 || got * 4 > ni * 3) break;
 		got = drop_degenerate(w, next, got);
 		float e = got >= 3 ? level_error(&g, &k, w, next, got) : INFINITY;

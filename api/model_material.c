@@ -37,47 +37,62 @@ static int find_texture(const struct api_conv *c, const char *path)
 	return k < 0 ? -1 : (int)(sc->mNumTextures + (unsigned)k);
 }
 
-/* Texture ti (decoded once; the first slot that reads it decides): for a sampler with mip
- * levels no larger than the request's images need (api_image_decode_fit), else as stored (a
- * minFilter without mipmaps reads level 0, aliasing and all, as the file asks). */
+static const struct rnd_texture *oom(struct api_conv *c)
+{
+	api_err_set(c->err, c->errsize, "out of memory importing the model");
+	return NULL;
+}
+
+/* A PNG or JPEG file's bytes decoded into the arena: for a sampler with mip levels no larger
+ * than the request's images need (api_image_decode_fit), else as stored (a minFilter without
+ * mipmaps reads level 0, aliasing and all, as the file asks). what: the error's subject. */
+static const struct rnd_texture *decode(struct api_conv *c, const uint8_t *bytes, size_t len, const char *what,
+                                        enum rnd_texture_slot slot, bool mipmapped)
+{
+	struct rnd_texture *t = api_conv_alloc(c, 1, sizeof *t);
+	if (!t) return oom(c);
+	uint8_t *px;
+	uint32_t w, h, stored;
+	char e[200];
+	double t0 = api_clock_ms();
+	enum api_result r = api_image_decode_fit(bytes, len, MAX_TEXTURE_PIXELS,
+	                                         mipmapped ? c->texture_side * API_TEXTURE_SIDE_PER_PIXEL : 0,
+	                                         rnd_texture_slot_srgb(slot), &px, &w, &h, &stored, e, sizeof e);
+	c->texture_ms += api_clock_ms() - t0;
+	if (r != API_OK) return api_err_set(c->err, c->errsize, "%s: %s", what, e), NULL;
+	if (stored > c->texture_max) c->texture_max = stored;
+	uint8_t *copy = api_conv_alloc(c, (size_t)w * h, 4);
+	if (copy) memcpy(copy, px, (size_t)w * h * 4);
+	free(px);
+	if (!copy) return oom(c);
+	t->rgba = copy;
+	t->width = w;
+	t->height = h;
+	return t;
+}
+
+/* Texture ti (decoded once; the first slot that reads it decides the mip levels kept). */
 static const struct rnd_texture *texture(struct api_conv *c, int ti, enum rnd_texture_slot slot, bool mipmapped)
 {
 	if (c->tex[ti]) return c->tex[ti];
 	unsigned nemb = c->sc->mNumTextures;
 	const struct aiTexture *at = (unsigned)ti < nemb ? c->sc->mTextures[ti] : NULL;
 	const struct api_model_file *file = at ? NULL : &c->files[(unsigned)ti - nemb];
-	struct rnd_texture *t = api_conv_alloc(c, 1, sizeof *t);
-	if (!t) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+	const struct rnd_texture *done = NULL;
 	if (file || at->mHeight == 0) {
 		/* Compressed: mWidth bytes of a PNG or JPEG file, or a whole file beside the model. */
-		uint8_t *px;
-		uint32_t w, h;
-		char e[200];
-		uint32_t stored;
-		double t0 = api_clock_ms();
-		enum api_result r = api_image_decode_fit(file ? file->data : (const uint8_t *)at->pcData,
-		                                         file ? file->len : at->mWidth, MAX_TEXTURE_PIXELS,
-		                                         mipmapped ? c->texture_side * API_TEXTURE_SIDE_PER_PIXEL : 0,
-		                                         rnd_texture_slot_srgb(slot), &px, &w, &h, &stored, e, sizeof e);
-		c->texture_ms += api_clock_ms() - t0;
-		if (r == API_OK && stored > c->texture_max) c->texture_max = stored;
-		if (r != API_OK) {
-			if (file) return api_err_set(c->err, c->errsize, "texture \"%.128s\": %s", file->name, e), NULL;
-			return api_err_set(c->err, c->errsize, "embedded texture %d: %s", ti, e), NULL;
-		}
-		uint8_t *copy = api_conv_alloc(c, (size_t)w * h, 4);
-		if (copy) memcpy(copy, px, (size_t)w * h * 4);
-		free(px);
-		if (!copy) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
-		t->rgba = copy;
-		t->width = w;
-		t->height = h;
+		char what[160];
+		if (file) snprintf(what, sizeof what, "texture \"%.128s\"", file->name);
+		else snprintf(what, sizeof what, "embedded texture %d", ti);
+		done = decode(c, file ? file->data : (const uint8_t *)at->pcData, file ? file->len : at->mWidth, what, slot,
+		              mipmapped);
 	} else {
 		uint64_t n = (uint64_t)at->mWidth * at->mHeight;
 		if (n > MAX_TEXTURE_PIXELS)
 			return api_err_set(c->err, c->errsize, "embedded texture %d is over the texture size limit", ti), NULL;
+		struct rnd_texture *t = api_conv_alloc(c, 1, sizeof *t);
 		uint8_t *px = api_conv_alloc(c, (size_t)n, 4);
-		if (!px) return api_err_set(c->err, c->errsize, "out of memory importing the model"), NULL;
+		if (!t || !px) return oom(c);
 		for (size_t i = 0; i < n; i++) { /* aiTexel is BGRA */
 			px[4 * i] = at->pcData[i].r;
 			px[4 * i + 1] = at->pcData[i].g;
@@ -87,14 +102,14 @@ static const struct rnd_texture *texture(struct api_conv *c, int ti, enum rnd_te
 		t->rgba = px;
 		t->width = at->mWidth;
 		t->height = at->mHeight;
+		done = t;
 	}
-	c->tex[ti] = t;
-	return t;
+	return c->tex[ti] = (struct rnd_texture *)done;
 }
 
 /* Assimp's texture types per slot, in the order tried (glTF: base colour also as DIFFUSE;
  * metallic-roughness as UNKNOWN, 5.2's name for it; occlusion as LIGHTMAP). */
-static const enum aiTextureType SLOT_TYPES[RND_TEX_SLOTS][3] = {
+static const enum aiTextureType SLOT_TYPES[RND_TEX_CLEARCOAT][3] = {
 	{aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, aiTextureType_NONE},
 	{aiTextureType_UNKNOWN, aiTextureType_METALNESS, aiTextureType_DIFFUSE_ROUGHNESS},
 	{aiTextureType_NORMALS, aiTextureType_NONE, aiTextureType_NONE},
@@ -102,10 +117,63 @@ static const enum aiTextureType SLOT_TYPES[RND_TEX_SLOTS][3] = {
 	{aiTextureType_EMISSIVE, aiTextureType_NONE, aiTextureType_NONE},
 };
 
+/* KHR_materials_volume's thicknessTexture of glTF material gi as one number, the mean of its G
+ * over the texture, into its thickness_mean (drawn per material: the coverage it changes is a
+ * material's, see api_gltf_material_shading). An image that is a file beside the model or
+ * cannot be decoded leaves 1 (thicknessFactor alone). */
+static int thickness_mean(struct api_conv *c, int gi)
+{
+	struct api_gltf_material *gm = &c->gi.materials[gi];
+	int32_t i = gm->thickness_image;
+	struct api_gltf_image *im = i >= 0 && (uint32_t)i < c->gi.image_count ? &c->gi.images[i] : NULL;
+	const struct rnd_texture *t = NULL;
+	if (im && im->uri) {
+		int ti = find_texture(c, im->uri);
+		if (ti >= 0 && !(t = texture(c, ti, RND_TEX_METAL_ROUGH, false))) return -1;
+	} else if (im && im->bytes) {
+		if (!im->tex && !(im->tex = decode(c, im->bytes, im->len, "thicknessTexture", RND_TEX_METAL_ROUGH, false)))
+			return -1;
+		t = im->tex;
+	}
+	if (!t || !t->width || !t->height) return 0;
+	double sum = 0;
+	size_t n = (size_t)t->width * t->height;
+	for (size_t p = 0; p < n; p++) sum += t->rgba[4 * p + 1];
+	gm->thickness_mean = (float)(sum / (255.0 * (double)n));
+	api_gltf_warn(&c->gi, "material %d: KHR_materials_volume's thicknessTexture drawn as its mean, %.2f", gi,
+	              gm->thickness_mean);
+	return 0;
+}
+
+/* The PBR extensions' textures of glTF material gi: their images as taken from the document
+ * (api_gltf_ext_images), a file beside the model by its uri, else their bytes. */
+static int extension_textures(struct api_conv *c, int gi, struct rnd_material *m)
+{
+	if (gi < 0 || (uint32_t)gi >= c->gi.material_count) return 0;
+	const struct api_gltf_material *gm = &c->gi.materials[gi];
+	for (uint32_t k = RND_TEX_CLEARCOAT; k < RND_TEX_SLOTS; k++) {
+		int32_t i = gm->ext_image[k];
+		struct api_gltf_image *im = i >= 0 && (uint32_t)i < c->gi.image_count ? &c->gi.images[i] : NULL;
+		bool mip = m->sampling[k].mip != RND_MIP_NONE;
+		if (im && im->uri) {
+			int ti = find_texture(c, im->uri);
+			if (ti < 0) api_gltf_warn(&c->gi, "material %d: %s \"%.60s\" is not in the file (not drawn)", gi,
+			                          api_gltf_slot_name(k), im->uri);
+			else if (!(m->textures[k] = texture(c, ti, (enum rnd_texture_slot)k, mip))) return -1;
+		} else if (im && im->bytes) {
+			char what[48];
+			snprintf(what, sizeof what, "image %d", i);
+			if (!im->tex && !(im->tex = decode(c, im->bytes, im->len, what, (enum rnd_texture_slot)k, mip))) return -1;
+			m->textures[k] = im->tex;
+		}
+	}
+	return thickness_mean(c, gi);
+}
+
 static int material_textures(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m)
 {
 	struct aiString s;
-	for (uint32_t k = 0; k < (c->gltf ? RND_TEX_SLOTS : 1u); k++) {
+	for (uint32_t k = 0; k < (c->gltf ? RND_TEX_CLEARCOAT : 1u); k++) {
 		for (int j = 0; j < 3 && SLOT_TYPES[k][j] != aiTextureType_NONE; j++) {
 			if (aiGetMaterialTexture(am, SLOT_TYPES[k][j], 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS)
 				continue;
@@ -156,7 +224,7 @@ int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t 
 			m->alpha_cutoff = clampf(f, 0, 1);
 	}
 	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
-	if (material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m) != 0) return -1;
+	if (material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m) != 0 || extension_textures(c, gi, m) != 0) return -1;
 	if (gi >= 0) api_gltf_material_shading(&c->gi, (uint32_t)gi, m);
 	return 0;
 }

@@ -1,6 +1,7 @@
 /*
- * api/model_wire — writer (sandboxed child) and validating reader (daemon) of the importer's
- * reply. See model_wire.h for the layout and why the reader trusts nothing.
+ * api/model_wire — the validating reader (daemon) of the importer's reply; its writer (the
+ * sandboxed child) is api/model_wire_put.c. See model_wire.h for the layout and why the reader
+ * trusts nothing.
  */
 #include <math.h>
 #include <stdarg.h>
@@ -9,151 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "model_wire.h"
-
-#define MAX_TEXTURES 4096u
-
-/* ---- writer ---- */
-
-void api_wire_buf_release(struct api_wire_buf *b)
-{
-	if (!b) return;
-	free(b->data);
-	memset(b, 0, sizeof *b);
-}
-
-static void put(struct api_wire_buf *b, const void *p, size_t n)
-{
-	if (b->failed || !n) return;
-	if (n > b->cap - b->len) {
-		size_t cap = b->cap ? b->cap : 4096;
-		while (cap - b->len < n) {
-			if (cap > SIZE_MAX / 2) { b->failed = 1; return; }
-			cap *= 2;
-		}
-		uint8_t *d = realloc(b->data, cap);
-		if (!d) { b->failed = 1; return; }
-		b->data = d;
-		b->cap = cap;
-	}
-	memcpy(b->data + b->len, p, n);
-	b->len += n;
-}
-
-static void put_u32(struct api_wire_buf *b, uint32_t v)
-{
-	put(b, &v, 4);
-}
-
-void api_wire_put_header(struct api_wire_buf *b, enum api_wire_kind kind, enum api_wire_status st, const char *msg)
-{
-	size_t n = msg ? strlen(msg) : 0;
-	if (n > API_WIRE_MAX_MESSAGE) n = API_WIRE_MAX_MESSAGE;
-	put(b, API_WIRE_MAGIC, 8);
-	put_u32(b, API_WIRE_VERSION);
-	put_u32(b, (uint32_t)kind);
-	put_u32(b, (uint32_t)st);
-	put_u32(b, (uint32_t)n);
-	put(b, msg, n);
-}
-
-void api_wire_put_image(struct api_wire_buf *b, const uint8_t *rgba, uint32_t w, uint32_t h)
-{
-	put_u32(b, w);
-	put_u32(b, h);
-	put(b, rgba, (size_t)w * h * 4);
-}
-
-static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, const struct rnd_texture *const *tex,
-                         uint32_t ntex)
-{
-	float f[13] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
-	               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff,
-	               mt->normal_scale, mt->occlusion_strength, 0};
-	put(b, f, sizeof f); /* the last one reserved, zero */
-	put_u32(b, (uint32_t)mt->alpha_mode);
-	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
-		int32_t ti = -1;
-		for (uint32_t k = 0; mt->textures[s] && k < ntex; k++)
-			if (tex[k] == mt->textures[s]) ti = (int32_t)k;
-		put(b, &ti, 4);
-	}
-	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
-		const struct rnd_texture_sampling *ts = &mt->sampling[s];
-		put_u32(b, (uint32_t)ts->wrap_s | (uint32_t)ts->wrap_t << 2 | (uint32_t)ts->mag_nearest << 4 |
-		           (uint32_t)ts->min_nearest << 5 | (uint32_t)ts->transformed << 6 | (uint32_t)(ts->mip % 3u) << 7 |
-		           (uint32_t)(ts->uv_set == 1) << 9);
-		put(b, ts->transform, sizeof ts->transform);
-	}
-}
-
-static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh *me)
-{
-	put_u32(b, me->lod_count);
-	for (uint32_t l = 0; l < me->lod_count; l++) {
-		const struct rnd_mesh_lod *lv = &me->lods[l];
-		put_u32(b, lv->vertex_count);
-		put_u32(b, lv->index_count);
-		put_u32(b, (lv->uvs ? 1u : 0u) | (lv->uvs1 ? 2u : 0u));
-		put(b, &lv->error, 4);
-		put(b, lv->positions, (size_t)lv->vertex_count * 12);
-		put(b, lv->normals, (size_t)lv->vertex_count * 12);
-		if (lv->uvs) put(b, lv->uvs, (size_t)lv->vertex_count * 8);
-		if (lv->uvs1) put(b, lv->uvs1, (size_t)lv->vertex_count * 8);
-		put(b, lv->indices, (size_t)lv->index_count * 4);
-	}
-}
-
-void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
-{
-	/* Textures are shared between materials by pointer: each goes once, by its first index. */
-	const struct rnd_texture *tex[MAX_TEXTURES];
-	uint32_t ntex = 0;
-	for (uint32_t i = 0; i < m->material_count; i++) {
-		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
-			const struct rnd_texture *t = m->materials[i].textures[s];
-			uint32_t k = 0;
-			while (t && k < ntex && tex[k] != t) k++;
-			if (t && k == ntex) {
-				if (ntex == MAX_TEXTURES) { b->failed = 1; return; }
-				tex[ntex++] = t;
-			}
-		}
-	}
-	size_t wlen = m->warnings ? strlen(m->warnings) : 0;
-	if (wlen > API_MODEL_MAX_WARNINGS) wlen = API_MODEL_MAX_WARNINGS;
-	put(b, &m->times.ms[API_IMPORT_PARSE], 4 * sizeof(float));   /* parse, textures, closed, level */
-	put_u32(b, m->texture_side);
-	put_u32(b, m->texture_max);
-	put_u32(b, ntex);
-	put_u32(b, m->material_count);
-	put_u32(b, m->mesh_count);
-	put_u32(b, m->instance_count);
-	put_u32(b, (uint32_t)wlen);
-	put(b, m->warnings, wlen);
-	for (uint32_t i = 0; i < ntex; i++) api_wire_put_image(b, tex[i]->rgba, tex[i]->width, tex[i]->height);
-	for (uint32_t i = 0; i < m->material_count; i++) put_material(b, &m->materials[i], tex, ntex);
-	for (uint32_t i = 0; i < m->mesh_count; i++) {
-		const struct api_model_mesh *me = &m->meshes[i];
-		put_u32(b, me->vertex_count);
-		put_u32(b, me->index_count);
-		put_u32(b, me->material);
-		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u) | (me->colors ? 4u : 0u) | (me->tangents ? 8u : 0u) |
-		           (me->single_sided ? 16u : 0u) | (me->closed ? 32u : 0u) | (me->lod_count ? 64u : 0u) |
-		           (me->uvs1 ? 128u : 0u));
-		put(b, me->positions, (size_t)me->vertex_count * 12);
-		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
-		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
-		if (me->uvs1) put(b, me->uvs1, (size_t)me->vertex_count * 8);
-		if (me->colors) put(b, me->colors, (size_t)me->vertex_count * 4);
-		if (me->tangents) put(b, me->tangents, (size_t)me->vertex_count * 16);
-		put(b, me->indices, (size_t)me->index_count * 4);
-		if (me->lod_count) put_mesh_levels(b, me);
-	}
-	for (uint32_t i = 0; i < m->instance_count; i++) {
-		put_u32(b, m->instances[i].mesh);
-		put(b, m->instances[i].model, 64);
-	}
-}
 
 /* ---- reader ---- */
 
@@ -234,15 +90,22 @@ enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_k
 	return API_OK;
 }
 
-static enum api_result read_image(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h, const uint8_t **px)
+/* An image's size, checked against max_pixels and the bytes left: its pixels follow. */
+static enum api_result read_image_size(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h)
 {
 	if (!take_u32(r, w) || !take_u32(r, h)) return bad(r, "an image size is cut short");
 	uint64_t n = (uint64_t)*w * *h;
 	if (!n || n > max_pixels) return bad(r, "an image of %ux%u pixels", *w, *h);
 	if (!fits(r, n, 4)) return bad(r, "an image's pixels are cut short");
+	return API_OK;
+}
+
+static enum api_result read_image(struct rd *r, uint64_t max_pixels, uint32_t *w, uint32_t *h, const uint8_t **px)
+{
+	if (read_image_size(r, max_pixels, w, h) != API_OK) return API_ERR;
 	*px = r->p;
-	r->p += n * 4;
-	r->left -= n * 4;
+	r->p += (size_t)*w * *h * 4;
+	r->left -= (size_t)*w * *h * 4;
 	return API_OK;
 }
 
@@ -267,12 +130,31 @@ struct dec {
 	struct rd r;
 	struct api_arena *arena;
 	size_t bytes;
+	unsigned flags;   /* API_WIRE_IN_PLACE */
 };
 
 static void *dec_alloc(struct dec *d, size_t n, size_t size)
 {
 	void *p = api_arena_calloc(d->arena, n ? n : 1, size);
 	if (p) d->bytes += (n ? n : 1) * size;
+	return p;
+}
+
+/* The next n * size bytes (the caller checked that they remain) as an array: where they lie
+ * (API_WIRE_IN_PLACE, 4-byte aligned) or a copy in the arena; NULL when out of memory. */
+static void *take_array(struct dec *d, size_t n, size_t size)
+{
+	void *p;
+	if ((d->flags & API_WIRE_IN_PLACE) && !((uintptr_t)d->r.p & 3)) {
+		p = (void *)d->r.p;
+		d->bytes += n * size;
+	} else if (!(p = dec_alloc(d, n, size))) {
+		return NULL;
+	} else {
+		memcpy(p, d->r.p, n * size);
+	}
+	d->r.p += n * size;
+	d->r.left -= n * size;
 	return p;
 }
 
@@ -285,6 +167,36 @@ static bool sampling_ok(uint32_t packed, const float *t)
 	for (int k = 0; k < 6; k++)
 		if (!isfinite(t[k]) || fabsf(t[k]) > 1e6f) return false;
 	return true;
+}
+
+static bool in_range(const float *v, int n, float lo, float hi)
+{
+	for (int k = 0; k < n; k++)
+		if (!(v[k] >= lo && v[k] <= hi)) return false;   /* NaN fails */
+	return true;
+}
+
+/* A material's PBR extensions: RND_EXT_* bits, then clearcoat factor roughness normal_scale,
+ * sheen colour[3] roughness, specular factor colour[3] ior (f32). */
+static enum api_result decode_extensions(struct dec *d, uint32_t i, struct rnd_material *m)
+{
+	uint32_t bits;
+	float e[12];
+	if (!take_u32(&d->r, &bits) || !take(&d->r, e, sizeof e)) return bad(&d->r, "material %u is cut short", i);
+	bool ok = bits <= (RND_EXT_CLEARCOAT | RND_EXT_SHEEN | RND_EXT_SPECULAR) && in_range(e, 2, 0, 1) &&
+	          in_range(e + 2, 1, -1e3f, 1e3f) && in_range(e + 3, 5, 0, 1) && in_range(e + 8, 3, 0, 1e6f) &&
+	          in_range(e + 11, 1, 0, 1e6f);
+	if (!ok) return bad(&d->r, "material %u has an extension value out of range", i);
+	m->extensions = bits;
+	m->clearcoat.factor = e[0];
+	m->clearcoat.roughness = e[1];
+	m->clearcoat.normal_scale = e[2];
+	memcpy(m->sheen.color, e + 3, 3 * sizeof(float));
+	m->sheen.roughness = e[6];
+	m->specular.factor = e[7];
+	memcpy(m->specular.color, e + 8, 3 * sizeof(float));
+	m->specular.ior = e[11];
+	return API_OK;
 }
 
 static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd_texture *tex, uint32_t ntex,
@@ -322,6 +234,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 			ts->uv_set = (uint8_t)(packed[s] >> 9 & 1);
 			memcpy(ts->transform, tf[s], sizeof tf[s]);
 		}
+		if (decode_extensions(d, i, m) != API_OK) return API_ERR;
 		memcpy(m->base_color, f, 4 * sizeof(float));
 		m->roughness = f[4];
 		m->metallic = f[5];
@@ -345,21 +258,16 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 255)
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
 	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 128 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
-	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u is cut short", i);
-	float *pos = dec_alloc(d, nv, 12), *nrm = flags & 1 ? dec_alloc(d, nv, 12) : NULL;
-	float *uv = flags & 2 ? dec_alloc(d, nv, 8) : NULL, *uv1 = flags & 128 ? dec_alloc(d, nv, 8) : NULL;
-	uint8_t *col = flags & 4 ? dec_alloc(d, nv, 4) : NULL;
-	float *tan = flags & 8 ? dec_alloc(d, nv, 16) : NULL;
-	uint32_t *idx = dec_alloc(d, ni, 4);
+	/* (per_vertex <= 60 and ni * 4 fit the reply: nothing below overflows) */
+	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4) || (uint64_t)nv * per_vertex > d->r.left - (uint64_t)ni * 4)
+		return bad(&d->r, "mesh %u is cut short", i);
+	const float *pos = take_array(d, nv, 12), *nrm = flags & 1 ? take_array(d, nv, 12) : NULL;
+	const float *uv = flags & 2 ? take_array(d, nv, 8) : NULL, *uv1 = flags & 128 ? take_array(d, nv, 8) : NULL;
+	const uint8_t *col = flags & 4 ? take_array(d, nv, 4) : NULL;
+	const float *tan = flags & 8 ? take_array(d, nv, 16) : NULL;
+	const uint32_t *idx = take_array(d, ni, 4);
 	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || ((flags & 128) && !uv1) || ((flags & 4) && !col) || ((flags & 8) && !tan) || !idx)
 		return bad(&d->r, "out of memory");
-	take(&d->r, pos, (size_t)nv * 12);
-	if (nrm) take(&d->r, nrm, (size_t)nv * 12);
-	if (uv) take(&d->r, uv, (size_t)nv * 8);
-	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
-	if (col) take(&d->r, col, (size_t)nv * 4);
-	if (tan) take(&d->r, tan, (size_t)nv * 16);
-	if (!take(&d->r, idx, (size_t)ni * 4)) return bad(&d->r, "mesh %u is cut short", i);
 	if (!finite_all(pos, (size_t)nv * 3) || (nrm && !finite_all(nrm, (size_t)nv * 3)) ||
 	    (uv && !finite_all(uv, (size_t)nv * 2)) || (uv1 && !finite_all(uv1, (size_t)nv * 2)) ||
 	    (tan && !finite_all(tan, (size_t)nv * 4)))
@@ -380,11 +288,11 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 	return API_OK;
 }
 
-enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct api_arena *arena,
+enum api_result api_wire_decode_model(const uint8_t *body, size_t len, unsigned flags, struct api_arena *arena,
                                       uint64_t max_texture_pixels, struct api_model *out, size_t *bytes,
                                       char *err, size_t errsize)
 {
-	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
+	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0, flags};
 	uint32_t ntex, nmat, nmesh, ninst, nwarn, tside, tmax;
 	float times[4];
 	if (!take(&d.r, times, sizeof times) || !take_u32(&d.r, &tside) || !take_u32(&d.r, &tmax))
@@ -403,11 +311,13 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 		for (uint32_t k = 0; k < nwarn; k++)
 			if (warn[k] < 0x20 || warn[k] > 0x7e) warn[k] = '?';
 	}
-	/* Each item has a smallest size on the wire (texture 8, material 216, mesh 16, instance 68
+	uint8_t pad[4] = {0};
+	if (!take(&d.r, pad, (4 - nwarn % 4) % 4) || pad[0] || pad[1] || pad[2]) return bad(&d.r, "the warnings' padding");
+	/* Each item has a smallest size on the wire (texture 8, material 488, mesh 16, instance 68
 	 * bytes): counts the reply's bytes cannot hold are lies caught before allocating (the arrays
 	 * are larger in memory than on the wire, and zeroed). */
-	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 216 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
-	if (ntex > MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, min_wire, 1))
+	uint64_t min_wire = (uint64_t)ntex * 8 + (uint64_t)nmat * 488 + (uint64_t)nmesh * 16 + (uint64_t)ninst * 68;
+	if (ntex > API_WIRE_MAX_TEXTURES || !nmat || !nmesh || !ninst || !fits(&d.r, min_wire, 1))
 		return bad(&d.r, "%u textures, %u materials, %u meshes, %u instances", ntex, nmat, nmesh, ninst);
 	struct rnd_texture *tex = dec_alloc(&d, ntex, sizeof *tex);
 	struct rnd_material *mats = dec_alloc(&d, nmat, sizeof *mats);
@@ -415,12 +325,8 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 	struct api_model_instance *inst = dec_alloc(&d, ninst, sizeof *inst);
 	if (!tex || !mats || !meshes || !inst) return bad(&d.r, "out of memory");
 	for (uint32_t i = 0; i < ntex; i++) {
-		const uint8_t *px;
-		if (read_image(&d.r, max_texture_pixels, &tex[i].width, &tex[i].height, &px) != API_OK) return API_ERR;
-		uint8_t *copy = dec_alloc(&d, (size_t)tex[i].width * tex[i].height, 4);
-		if (!copy) return bad(&d.r, "out of memory");
-		memcpy(copy, px, (size_t)tex[i].width * tex[i].height * 4);
-		tex[i].rgba = copy;
+		if (read_image_size(&d.r, max_texture_pixels, &tex[i].width, &tex[i].height) != API_OK) return API_ERR;
+		if (!(tex[i].rgba = take_array(&d, (size_t)tex[i].width * tex[i].height, 4))) return bad(&d.r, "out of memory");
 	}
 	if (decode_materials(&d, nmat, tex, ntex, mats) != API_OK) return API_ERR;
 	for (uint32_t i = 0; i < nmesh; i++)
@@ -453,11 +359,6 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct ap
 
 /* ---- levels of detail (API_WIRE_LEVELS) ---- */
 
-void api_wire_put_levels(struct api_wire_buf *b, const struct api_model *m)
-{
-	put_u32(b, m->mesh_count);
-	for (uint32_t i = 0; i < m->mesh_count; i++) put_mesh_levels(b, &m->meshes[i]);
-}
 
 /* One level of mesh `me` (the one it simplifies): coarser than what it follows (fewer indices),
  * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs (each set)
@@ -475,16 +376,12 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 		return bad(&d->r, "mesh %u level %u: %u vertices, %u indices, flags %u, error %g", i, l, nv, ni, flags,
 		           (double)error);
 	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0) + (flags & 2 ? 8 : 0);
-	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4)) return bad(&d->r, "mesh %u level %u is cut short", i, l);
-	float *pos = dec_alloc(d, nv, 12), *nrm = dec_alloc(d, nv, 12), *uv = flags & 1 ? dec_alloc(d, nv, 8) : NULL;
-	float *uv1 = flags & 2 ? dec_alloc(d, nv, 8) : NULL;
-	uint32_t *idx = dec_alloc(d, ni, 4);
+	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4) || (uint64_t)nv * per_vertex > d->r.left - (uint64_t)ni * 4)
+		return bad(&d->r, "mesh %u level %u is cut short", i, l);
+	const float *pos = take_array(d, nv, 12), *nrm = take_array(d, nv, 12), *uv = flags & 1 ? take_array(d, nv, 8) : NULL;
+	const float *uv1 = flags & 2 ? take_array(d, nv, 8) : NULL;
+	const uint32_t *idx = take_array(d, ni, 4);
 	if (!pos || !nrm || ((flags & 1) && !uv) || ((flags & 2) && !uv1) || !idx) return bad(&d->r, "out of memory");
-	take(&d->r, pos, (size_t)nv * 12);
-	take(&d->r, nrm, (size_t)nv * 12);
-	if (uv) take(&d->r, uv, (size_t)nv * 8);
-	if (uv1) take(&d->r, uv1, (size_t)nv * 8);
-	take(&d->r, idx, (size_t)ni * 4);
 	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)) ||
 	    (uv1 && !finite_all(uv1, (size_t)nv * 2)))
 		return bad(&d->r, "mesh %u level %u has a value that is not finite", i, l);
@@ -517,11 +414,12 @@ static enum api_result decode_mesh_levels(struct dec *d, uint32_t i, const struc
 	return API_OK;
 }
 
-enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, const struct api_model_mesh *const *meshes,
-                                       uint32_t nmesh, struct api_arena *arena, struct api_mesh_levels *out,
-                                       size_t *bytes, char *err, size_t errsize)
+enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, unsigned flags,
+                                       const struct api_model_mesh *const *meshes, uint32_t nmesh,
+                                       struct api_arena *arena, struct api_mesh_levels *out, size_t *bytes,
+                                       char *err, size_t errsize)
 {
-	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0};
+	struct dec d = {{body, body ? len : 0, err, errsize}, arena, 0, flags};
 	uint32_t n = 0;
 	if (!take_u32(&d.r, &n) || n != nmesh) return bad(&d.r, "levels of %u meshes for %u", n, nmesh);
 	for (uint32_t i = 0; i < nmesh; i++)

@@ -18,14 +18,17 @@
  *   model    the importer's stage times f32[4] (parse, textures, closed, level: ms, finite, >= 0),
  *            texture_side texture_max (u32: api_model's),
  *            texture_count material_count mesh_count instance_count warnings_len,
- *            warnings_len bytes of warnings (printable ASCII, at most API_MODEL_MAX_WARNINGS)
+ *            warnings_len bytes of warnings (printable ASCII, at most API_MODEL_MAX_WARNINGS),
+ *            zeros to a multiple of 4 bytes (every array below starts 4-byte aligned)
  *            textures:  width height, width*height*4 bytes RGBA8
  *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff normal_scale
  *                       occlusion_strength reserved (f32, reserved = 0), alpha_mode (u32),
- *                       texture[5] (i32 per rnd_texture_slot, -1 = none), then per slot the
+ *                       texture[12] (i32 per rnd_texture_slot, -1 = none), then per slot the
  *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
  *                       transformed << 6 | mip << 7 (u32, enum rnd_mip) | uv_set << 9 (0 or 1),
- *                       transform f32[6]
+ *                       transform f32[6]; then the PBR extensions: bits (u32, RND_EXT_*),
+ *                       clearcoat factor roughness normal_scale, sheen colour[3] roughness,
+ *                       specular factor colour[3] ior (f32)
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
  *                       8 tangents, 16 single-sided, 32 closed, 64 levels, 128 second uv set),
  *                       positions f32[3v], normals f32[3v], uvs f32[2v], uvs1 f32[2v], colours
@@ -39,7 +42,7 @@
  *            f32[2v], uvs1 f32[2v], indices u32[i]
  *
  * Usage (parent): api_wire_header(); then api_wire_decode_model() / _image() on the body.
- * Usage (child):  struct api_wire_buf b = {0}; api_wire_put_model(&b, model); write b.data.
+ * Usage (child):  struct api_wire_buf b = {.fd = fd}; api_wire_put_model(&b, model); api_wire_flush(&b).
  * Threading: no shared state.
  */
 #ifndef UMBRA_API_MODEL_WIRE_H
@@ -52,20 +55,28 @@
 #include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 4u
+#define API_WIRE_VERSION 6u
 #define API_WIRE_MAX_MESSAGE 1024u
+#define API_WIRE_MAX_TEXTURES 4096u   /* distinct textures in one reply */
 
 enum api_wire_kind { API_WIRE_MODEL = 1, API_WIRE_IMAGE = 2, API_WIRE_LEVELS = 3 };
 /* What the importer says about the input (a crash says nothing: see api/sandbox.h). */
 enum api_wire_status { API_WIRE_OK = 0, API_WIRE_BAD_INPUT = 1, API_WIRE_OVER_MEMORY = 2 };
 
-/* A growable output buffer (child side). Any failed put leaves failed set and keeps data. */
+/* An output buffer (child side): growable in memory (zero-initialised), or a sink (.fd set):
+ * written out to that file as it goes (the importer's reply file, api/sandbox.h), small puts
+ * gathered in data, big arrays written from where they lie; len counts every byte put. Any
+ * failed put (out of memory, a failed write) leaves failed set and keeps data. */
 struct api_wire_buf {
 	uint8_t *data;
 	size_t len, cap;
 	int failed;
+	int fd;          /* > 0: a sink */
+	size_t staged;   /* a sink's bytes in data not written yet */
 };
 void api_wire_buf_release(struct api_wire_buf *b);
+/* A sink's staged bytes written out: 0, or -1 when any put or write failed. */
+int api_wire_flush(struct api_wire_buf *b);
 /* Header with a message (status != OK) or with none (OK; the body follows). */
 void api_wire_put_header(struct api_wire_buf *b, enum api_wire_kind kind, enum api_wire_status st,
                          const char *msg);
@@ -78,20 +89,27 @@ enum api_result api_wire_header(const uint8_t *data, size_t len, enum api_wire_k
                                 enum api_wire_status *status, char *msg, size_t msgsize,
                                 const uint8_t **body, size_t *body_len, char *err, size_t errsize);
 
+/* How the decoders keep the arrays: copied into the arena (0), or, with API_WIRE_IN_PLACE,
+ * pointed to where they lie in the body when 4-byte aligned (copied when not): the caller
+ * promises that the body stays, unchanged, as long as the arena (the sandbox's replies: a
+ * sealed mapping the arena then owns, api/sandbox.c). Checked the same either way. */
+#define API_WIRE_IN_PLACE 1u
+
 /* Decodes a model body into arena memory: fills the public part of *out (meshes, instances,
- * materials with their textures, triangles) and *bytes (what it allocated). max_texture_pixels
- * bounds each texture. API_ERR with a sentence in err: nothing of *out is valid then (the
- * arena still owns whatever was allocated). */
-enum api_result api_wire_decode_model(const uint8_t *body, size_t len, struct api_arena *arena,
+ * materials with their textures, triangles) and *bytes (what it allocated, or for arrays kept
+ * in place what they hold). max_texture_pixels bounds each texture. API_ERR with a sentence in
+ * err: nothing of *out is valid then (the arena still owns whatever was allocated). */
+enum api_result api_wire_decode_model(const uint8_t *body, size_t len, unsigned flags, struct api_arena *arena,
                                       uint64_t max_texture_pixels, struct api_model *out, size_t *bytes,
                                       char *err, size_t errsize);
 void api_wire_put_levels(struct api_wire_buf *b, const struct api_model *m);
 /* Decodes a levels body for meshes[0..nmesh) (those the job was sent, in that order; their
  * bounds set) into out[nmesh]: every level coarser than the one before, its vertices inside the
  * mesh's bounds, its error no smaller than the one before. */
-enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, const struct api_model_mesh *const *meshes,
-                                       uint32_t nmesh, struct api_arena *arena, struct api_mesh_levels *out,
-                                       size_t *bytes, char *err, size_t errsize);
+enum api_result api_wire_decode_levels(const uint8_t *body, size_t len, unsigned flags,
+                                       const struct api_model_mesh *const *meshes, uint32_t nmesh,
+                                       struct api_arena *arena, struct api_mesh_levels *out, size_t *bytes,
+                                       char *err, size_t errsize);
 /* Decodes an image body into malloc'd RGBA8 (*rgba, you free it). */
 enum api_result api_wire_decode_image(const uint8_t *body, size_t len, uint64_t max_pixels, uint8_t **rgba,
                                       uint32_t *w, uint32_t *h, char *err, size_t errsize);

@@ -118,21 +118,40 @@ void api_limits_defaults(struct api_limits *l)
 	l->max_textures = RND_DEFAULT_MAX_TEXTURES;
 }
 
+static const char *const FORMAT_MIME[API_FORMAT_COUNT] = {"image/png", "image/x-exr", "image/webp", "image/avif"};
+static const char *const FORMAT_NAME[API_FORMAT_COUNT] = {"png", "exr", "webp", "avif"};
+
 const char *api_format_mime(enum api_format f)
 {
-	return f == API_FORMAT_EXR ? "image/x-exr" : f == API_FORMAT_WEBP ? "image/webp" : "image/png";
+	return (unsigned)f < API_FORMAT_COUNT ? FORMAT_MIME[f] : FORMAT_MIME[API_FORMAT_PNG];
 }
 
 const char *api_format_name(enum api_format f)
 {
-	return f == API_FORMAT_EXR ? "exr" : f == API_FORMAT_WEBP ? "webp" : "png";
+	return (unsigned)f < API_FORMAT_COUNT ? FORMAT_NAME[f] : FORMAT_NAME[API_FORMAT_PNG];
+}
+
+const char *api_format_label(enum api_format f)
+{
+	static const char *const label[API_FORMAT_COUNT] = {"a PNG", "an EXR", "a WebP", "an AVIF"};
+	return (unsigned)f < API_FORMAT_COUNT ? label[f] : label[API_FORMAT_PNG];
+}
+
+bool api_format_lossy(enum api_format f)
+{
+	return f == API_FORMAT_WEBP || f == API_FORMAT_AVIF;
+}
+
+uint32_t api_format_max_side(enum api_format f)
+{
+	return f == API_FORMAT_WEBP ? API_WEBP_MAX_SIDE : f == API_FORMAT_AVIF ? API_AVIF_MAX_SIDE : 0;
 }
 
 bool api_format_from_name(const char *name, enum api_format *f)
 {
 	const char *dot = name ? strrchr(name, '.') : NULL;
 	if (!dot || strchr(dot, '/')) return false;
-	for (int k = API_FORMAT_PNG; k <= API_FORMAT_WEBP; k++)
+	for (int k = API_FORMAT_PNG; k < API_FORMAT_COUNT; k++)
 		if (!strcasecmp(dot + 1, api_format_name((enum api_format)k))) {
 			*f = (enum api_format)k;
 			return true;

@@ -1,23 +1,21 @@
 /*
- * api/sandbox — the daemon's side of the sandboxed importer (see sandbox.h): starts the fork
- * server, hands it one job at a time per calling thread, and turns how the job ended into an
- * answer. The helper's side is api/sandbox_child.c.
+ * api/sandbox — the daemon's side of the sandboxed importer (see sandbox.h): hands the fork
+ * server (started by api/sandbox_server.c) one job at a time per calling thread, maps its reply
+ * and turns how the job ended into an answer. The helper's side is api/sandbox_child.c.
  */
 #include <errno.h>
 #include <math.h>
 #include <fcntl.h>
-#include <limits.h>
 #include <poll.h>
-#include <pthread.h>
 #include <signal.h>
-#include <spawn.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 #include "model_lod.h"
@@ -26,18 +24,10 @@
 #include "sandbox_stats.h"
 #include "umbra/rnd_math.h"
 
-extern char **environ;
-
 /* The daemon waits this long past the job's timeout for the fork server to report: it kills
  * the child at the timeout, so only a stuck fork server could make the daemon wait longer. */
 #define GRACE_MS 2000
-#define CTL_SEND_MS 2000
 #define MAX_TEXTURE_PIXELS (64ull << 20)
-
-static pthread_mutex_t start_mu = PTHREAD_MUTEX_INITIALIZER;
-static int ctl_fd = -1;
-static pid_t server_pid = -1;
-static char helper[PATH_MAX];
 
 __attribute__((format(printf, 5, 6)))
 static enum api_result fail(int *status, int code, char *err, size_t errsize, const char *fmt, ...)
@@ -57,132 +47,6 @@ static int64_t now_ms(void)
 	struct timespec t;
 	clock_gettime(CLOCK_MONOTONIC, &t);
 	return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
-}
-
-/* UMBRA_IMPORT_HELPER, else umbra-import next to the running executable, else one directory
- * up (the test binaries live in build/tests/). With start_mu held. */
-static void find_helper(void)
-{
-	const char *env = getenv("UMBRA_IMPORT_HELPER");
-	if (env && env[0]) {
-		snprintf(helper, sizeof helper, "%s", env);
-		return;
-	}
-	char exe[PATH_MAX];
-	ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-	if (n <= 0) {
-		snprintf(helper, sizeof helper, "umbra-import");
-		return;
-	}
-	exe[n] = 0;
-	char *slash = strrchr(exe, '/');
-	if (slash) *slash = 0;
-	snprintf(helper, sizeof helper, "%.*s/umbra-import", PATH_MAX - 16, exe);
-	if (access(helper, X_OK) == 0 || !(slash = strrchr(exe, '/'))) return;
-	*slash = 0;
-	char up[PATH_MAX];
-	snprintf(up, sizeof up, "%.*s/umbra-import", PATH_MAX - 16, exe);
-	if (access(up, X_OK) == 0) memcpy(helper, up, sizeof up);
-}
-
-const char *api_sandbox_helper_path(void)
-{
-	pthread_mutex_lock(&start_mu);
-	if (!helper[0]) find_helper();
-	pthread_mutex_unlock(&start_mu);
-	return helper;
-}
-
-/* With start_mu held. */
-static void stop_server(void)
-{
-	if (ctl_fd >= 0) close(ctl_fd);
-	ctl_fd = -1;
-	if (server_pid > 0) {
-		/* Closing the control socket ends it; SIGKILL in case it is what went wrong. */
-		kill(server_pid, SIGKILL);
-		waitpid(server_pid, NULL, 0);
-	}
-	server_pid = -1;
-}
-
-/* With start_mu held. posix_spawn (vfork-like) is safe in a multithreaded process. */
-static int start_server(char *err, size_t errsize)
-{
-	if (!helper[0]) find_helper();
-	int sv[2];
-	if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) < 0) {
-		snprintf(err, errsize, "cannot create the importer's socket: %s", strerror(errno));
-		return -1;
-	}
-	/* Above fd 3, so the dup2 to 3 below always happens and clears close-on-exec. */
-	int child_end = fcntl(sv[1], F_DUPFD_CLOEXEC, 10);
-	posix_spawn_file_actions_t fa;
-	posix_spawnattr_t at;
-	posix_spawn_file_actions_init(&fa);
-	posix_spawnattr_init(&at);
-	posix_spawn_file_actions_adddup2(&fa, child_end, API_SBX_CTL_FD);
-	posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-	sigset_t none, all;
-	sigemptyset(&none);
-	sigfillset(&all);
-	sigdelset(&all, SIGKILL);
-	sigdelset(&all, SIGSTOP);
-	posix_spawnattr_setsigmask(&at, &none);
-	posix_spawnattr_setsigdefault(&at, &all);
-	posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-	char *argv[] = {helper, "--fork-server", NULL};
-	pid_t pid;
-	int rc = child_end < 0 ? errno : posix_spawn(&pid, helper, &fa, &at, argv, environ);
-	posix_spawn_file_actions_destroy(&fa);
-	posix_spawnattr_destroy(&at);
-	if (child_end >= 0) close(child_end);
-	close(sv[1]);
-	if (rc) {
-		close(sv[0]);
-		snprintf(err, errsize, "cannot start the model importer (umbra-import): %s", strerror(rc));
-		return -1;
-	}
-	ctl_fd = sv[0];
-	server_pid = pid;
-	api_sbx_stats_server_started();
-	return 0;
-}
-
-/* Sends the request and the two fds; restarts the fork server once when it is gone. The lock
- * covers one sendmsg on a socket the fork server drains at once, bounded by CTL_SEND_MS. */
-static int send_request(const struct api_sbx_request *rq, int data_fd, int status_fd, char *err, size_t errsize)
-{
-	int fds[2] = {data_fd, status_fd};
-	union { struct cmsghdr h; char buf[CMSG_SPACE(sizeof fds)]; } cm;
-	memset(&cm, 0, sizeof cm);
-	struct iovec iov = {(void *)rq, sizeof *rq};
-	struct msghdr msg = {.msg_iov = &iov, .msg_iovlen = 1, .msg_control = cm.buf, .msg_controllen = sizeof cm.buf};
-	struct cmsghdr *c = CMSG_FIRSTHDR(&msg);
-	c->cmsg_level = SOL_SOCKET;
-	c->cmsg_type = SCM_RIGHTS;
-	c->cmsg_len = CMSG_LEN(sizeof fds);
-	memcpy(CMSG_DATA(c), fds, sizeof fds);
-	int rc = -1;
-	pthread_mutex_lock(&start_mu);
-	for (int attempt = 0; attempt < 2 && rc < 0; attempt++) {
-		if (ctl_fd < 0 && start_server(err, errsize) < 0) break;
-		int64_t until = now_ms() + CTL_SEND_MS;
-		for (;;) {
-			if (sendmsg(ctl_fd, &msg, MSG_NOSIGNAL | MSG_DONTWAIT) == (ssize_t)sizeof *rq) { rc = 0; break; }
-			if (errno == EINTR) continue;
-			if (errno != EAGAIN || now_ms() >= until) {
-				snprintf(err, errsize, "the model importer does not answer (%s)", strerror(errno));
-				stop_server(); /* dead or stuck: the next attempt starts a fresh one */
-				break;
-			}
-			struct pollfd p = {ctl_fd, POLLOUT, 0};
-			poll(&p, 1, 50);
-		}
-	}
-	pthread_mutex_unlock(&start_mu);
-	return rc;
 }
 
 /* Writes the input and reads the reply at the same time until EOF or the deadline. */
@@ -320,48 +184,84 @@ static void job_ended(uint32_t kind, enum api_sbx_outcome how, double t0_ms)
 	api_sbx_stats_ended(job_of(kind), how, (api_clock_ms() - t0_ms) / 1e3);
 }
 
-/* One job: its reply (malloc'd, header checked) or a classified failure, *how the outcome
- * (API_SBX_OUT_OK with API_OK; the caller's check of the body may still refuse it). */
-static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, const struct api_limits *lim,
-                               uint8_t **reply, const uint8_t **body, size_t *body_len, enum api_sbx_outcome *how,
-                               int *status, char *err, size_t errsize)
+/* A job's reply: its sealed memfd mapped read-only, and the body after the header. */
+struct reply {
+	void *map;              /* NULL: none */
+	size_t len;
+	const uint8_t *body;
+	size_t body_len;
+};
+
+static void reply_release(struct reply *r)
 {
-	struct api_limits def;
-	if (!lim) {
-		api_limits_defaults(&def);
-		lim = &def;
-	}
-	rq->magic = API_SBX_MAGIC;
-	rq->timeout_ms = lim->import_timeout_ms ? lim->import_timeout_ms : 10000;
-	rq->memory = lim->import_memory;
-	*reply = NULL;
-	*how = API_SBX_OUT_ERROR;
-	api_sbx_stats_started(job_of(rq->kind));
+	if (r->map) munmap(r->map, r->len);
+	r->map = NULL;
+}
+
+/* The reply's memory hands over to arena (released with it): 0, or -1 (the caller keeps it). */
+static int reply_to_arena(struct reply *r, struct api_arena *arena)
+{
+	if (api_arena_own_mapping(arena, r->map, r->len) != 0) return -1;
+	r->map = NULL;
+	return 0;
+}
+
+/* The reply file of an exited child, which says it wrote len bytes: exactly that long, sealed
+ * against writing, growing and shrinking (refused while any writable mapping is left: none
+ * is, the child has exited and nobody else had the file), mapped read-only. 0, or -1. */
+static int map_reply(int fd, uint64_t len, struct reply *r)
+{
+	struct stat st;
+	if (!len || len > SIZE_MAX || fstat(fd, &st) < 0 || (uint64_t)st.st_size != len ||
+	    fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_WRITE | F_SEAL_SEAL) < 0)
+		return -1;
+	void *p = mmap(NULL, (size_t)len, PROT_READ, MAP_SHARED | MAP_POPULATE, fd, 0);
+	if (p == MAP_FAILED) return -1;
+	r->map = p;
+	r->len = (size_t)len;
+	return 0;
+}
+
+/* The reply file for a job: an empty memfd the child writes (up to its RLIMIT_FSIZE). -1 with
+ * err. */
+static int reply_file(int *status, char *err, size_t errsize)
+{
+	int fd = memfd_create("umbra-import-reply", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+	if (fd < 0) fail(status, 500, err, errsize, "cannot create the importer's reply file: %s", strerror(errno));
+	return fd;
+}
+
+/* Hands the job to the fork server and waits for the child: 0 when it exited 0 and wrote
+ * the reply's length (*len), else -1 with the failure classified (*how, *status, err). */
+static int await_child(struct api_sbx_request *rq, const uint8_t *data, int reply_fd, uint64_t *len,
+                       enum api_sbx_outcome *how, int *status, char *err, size_t errsize)
+{
 	int ds[2], ps[2];
 	if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ds) < 0)
-		return fail(status, 500, err, errsize, "cannot create a socket for the importer: %s", strerror(errno));
+		return fail(status, 500, err, errsize, "cannot create a socket for the importer: %s", strerror(errno)), -1;
 	if (pipe2(ps, O_CLOEXEC) < 0) {
 		close(ds[0]);
 		close(ds[1]);
-		return fail(status, 500, err, errsize, "cannot create a pipe for the importer: %s", strerror(errno));
+		return fail(status, 500, err, errsize, "cannot create a pipe for the importer: %s", strerror(errno)), -1;
 	}
 	char serr[200];
-	int sent = send_request(rq, ds[1], ps[1], serr, sizeof serr);
+	int sent = api_sbx_send(rq, ds[1], ps[1], reply_fd, serr, sizeof serr), rc = -1;
 	close(ds[1]);
 	close(ps[1]);
-	enum api_result rc = API_ERR;
 	if (sent < 0) {
 		fail(status, 500, err, errsize, "%s", serr);
 		goto out;
 	}
 	int64_t deadline = now_ms() + rq->timeout_ms + GRACE_MS;
-	/* A reply is never bigger than the child's memory; without a limit, 4 GiB. */
-	size_t max_reply = rq->memory ? (size_t)rq->memory : (size_t)4 << 30;
-	size_t rlen = 0;
-	bool got = exchange(ds[0], data, rq->input_len, deadline, max_reply, reply, &rlen) == 0;
-	/* A reply we stopped reading (over max_reply): the child's writes fail at once instead of
-	 * blocking it until the timeout. */
-	if (!got) shutdown(ds[0], SHUT_RDWR);
+	/* On the socket only the length (u64); a little room to see anything more. */
+	uint8_t *got = NULL;
+	size_t glen = 0;
+	bool replied = exchange(ds[0], data, rq->input_len, deadline, 16, &got, &glen) == 0 && glen == sizeof *len;
+	if (replied) memcpy(len, got, sizeof *len);
+	free(got);
+	/* A child that said more than it should: its writes fail at once instead of blocking it
+	 * until the timeout. */
+	if (!replied) shutdown(ds[0], SHUT_RDWR);
 	struct api_sbx_status st;
 	if (read_status(ps[0], deadline, &st) < 0) {
 		if (now_ms() >= deadline) {
@@ -372,12 +272,47 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 		}
 		goto out;
 	}
-	if (classify(&st, got, rq, status, how, err, errsize) < 0) goto out;
+	rc = classify(&st, replied, rq, status, how, err, errsize);
+out:
+	close(ds[0]);
+	close(ps[0]);
+	return rc;
+}
+
+/* One job: its reply (mapped, header checked) or a classified failure, *how the outcome
+ * (API_SBX_OUT_OK with API_OK; the caller's check of the body may still refuse it). */
+static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, const struct api_limits *lim,
+                               struct reply *reply, enum api_sbx_outcome *how, int *status, char *err,
+                               size_t errsize)
+{
+	struct api_limits def;
+	if (!lim) {
+		api_limits_defaults(&def);
+		lim = &def;
+	}
+	rq->magic = API_SBX_MAGIC;
+	rq->timeout_ms = lim->import_timeout_ms ? lim->import_timeout_ms : 10000;
+	rq->memory = lim->import_memory;
+	memset(reply, 0, sizeof *reply);
+	*how = API_SBX_OUT_ERROR;
+	api_sbx_stats_started(job_of(rq->kind));
+	/* A reply is never bigger than the child's memory; without a limit, 4 GiB. */
+	uint64_t len = 0;
+	rq->reply_size = rq->memory ? rq->memory : (uint64_t)4 << 30;
+	int fd = reply_file(status, err, errsize);
+	enum api_result rc = API_ERR;
+	if (fd < 0 || await_child(rq, data, fd, &len, how, status, err, errsize) < 0) goto out;
+	if (len > rq->reply_size || map_reply(fd, len, reply) < 0) {
+		*how = API_SBX_OUT_INVALID;
+		fail(status, 400, err, errsize, "the importer's reply (%llu bytes, it says) cannot be mapped",
+		     (unsigned long long)len);
+		goto out;
+	}
 	enum api_wire_kind kind = rq->kind;
 	enum api_wire_status ws;
 	char msg[API_WIRE_MAX_MESSAGE + 1], werr[200];
-	if (api_wire_header(*reply, rlen, &kind, &ws, msg, sizeof msg, body, body_len, werr, sizeof werr) != API_OK ||
-	    kind != rq->kind) {
+	if (api_wire_header(reply->map, reply->len, &kind, &ws, msg, sizeof msg, &reply->body, &reply->body_len, werr,
+	                    sizeof werr) != API_OK || kind != rq->kind) {
 		*how = API_SBX_OUT_INVALID;
 		fail(status, 400, err, errsize, "%s", kind != rq->kind ? "the importer's reply is of the wrong kind" : werr);
 		goto out;
@@ -389,11 +324,9 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 		     (unsigned long long)(rq->memory >> 20), msg);
 	else rc = API_OK;
 out:
-	close(ds[0]);
-	close(ps[0]);
+	if (fd >= 0) close(fd);
 	if (rc != API_OK) {
-		free(*reply);
-		*reply = NULL;
+		reply_release(reply);
 		limit_hint(lim, *how, err, errsize);
 	}
 	return rc;
@@ -408,18 +341,20 @@ enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_l
 	struct api_sbx_request rq = {.kind = API_WIRE_MODEL, .format = (uint32_t)format,
 	                             .max_pixels = MAX_TEXTURE_PIXELS, .input_len = bundle_len, .model_len = len,
 	                             .file_count = (uint32_t)nfiles, .output_side = lim ? lim->output_side : 0};
-	uint8_t *reply;
-	const uint8_t *body;
-	size_t blen;
+	struct reply reply;
 	enum api_sbx_outcome how;
 	double t0 = api_clock_ms();
-	if (run_job(&rq, bundle, lim, &reply, &body, &blen, &how, status, err, errsize) != API_OK) {
+	if (run_job(&rq, bundle, lim, &reply, &how, status, err, errsize) != API_OK) {
 		job_ended(rq.kind, how, t0);
 		return API_ERR;
 	}
 	double t1 = api_clock_ms();
-	enum api_result rc = api_wire_decode_model(body, blen, arena, MAX_TEXTURE_PIXELS, out, bytes, err, errsize);
-	if (rc != API_OK) *status = 400;
+	/* The model's arrays stay in the reply's mapping, which its arena now owns. */
+	enum api_result rc = reply_to_arena(&reply, arena) == 0 ? API_OK : API_ERR;
+	if (rc != API_OK) fail(status, 500, err, errsize, "out of memory");
+	else if ((rc = api_wire_decode_model(reply.body, reply.body_len, API_WIRE_IN_PLACE, arena, MAX_TEXTURE_PIXELS, out,
+	                                     bytes, err, errsize)) != API_OK)
+		*status = 400;
 	job_ended(rq.kind, rc == API_OK ? API_SBX_OUT_OK : API_SBX_OUT_INVALID, t0);
 	/* the round trip less what the importer says it spent (its clock is this machine's) */
 	float work = 0;
@@ -427,7 +362,7 @@ enum api_result api_sandbox_import_bundle(const uint8_t *bundle, size_t bundle_l
 	out->times.ms[API_IMPORT_TRANSFER] = fmaxf((float)(t1 - t0) - work, 0.0f);
 	out->times.ms[API_IMPORT_VALIDATE] = (float)(api_clock_ms() - t1);
 	out->format = format;
-	free(reply);
+	reply_release(&reply);
 	return rc;
 }
 
@@ -485,18 +420,21 @@ enum api_result api_sandbox_build_levels(const struct api_model *m, uint32_t sid
 	}
 	struct api_sbx_request rq = {.kind = API_WIRE_LEVELS, .max_pixels = 1, .input_len = in.len, .model_len = in.len,
 	                             .output_side = side};
-	uint8_t *reply;
-	const uint8_t *body;
-	size_t blen;
+	struct reply reply;
 	enum api_sbx_outcome how;
 	double t0 = api_clock_ms();
-	if (run_job(&rq, in.data, lim, &reply, &body, &blen, &how, status, err, errsize) != API_OK) {
+	if (run_job(&rq, in.data, lim, &reply, &how, status, err, errsize) != API_OK) {
 		job_ended(rq.kind, how, t0);
 		goto out;
 	}
-	rc = api_wire_decode_levels(body, blen, sent, n, arena, got, bytes, err, errsize);
+	if (reply_to_arena(&reply, arena) != 0) {
+		fail(status, 500, err, errsize, "out of memory building levels of detail");
+		reply_release(&reply);
+		job_ended(rq.kind, API_SBX_OUT_ERROR, t0);
+		goto out;
+	}
+	rc = api_wire_decode_levels(reply.body, reply.body_len, API_WIRE_IN_PLACE, sent, n, arena, got, bytes, err, errsize);
 	job_ended(rq.kind, rc == API_OK ? API_SBX_OUT_OK : API_SBX_OUT_INVALID, t0);
-	free(reply);
 	if (rc != API_OK) {
 		*status = 400;
 		goto out;
@@ -520,18 +458,16 @@ enum api_result api_sandbox_decode_image(const uint8_t *data, size_t len, uint64
 	*rgba = NULL;
 	if (!max_pixels) max_pixels = MAX_TEXTURE_PIXELS;
 	struct api_sbx_request rq = {.kind = API_WIRE_IMAGE, .max_pixels = max_pixels, .input_len = len};
-	uint8_t *reply;
-	const uint8_t *body;
-	size_t blen;
+	struct reply reply;
 	enum api_sbx_outcome how;
 	double t0 = api_clock_ms();
-	if (run_job(&rq, data, lim, &reply, &body, &blen, &how, status, err, errsize) != API_OK) {
+	if (run_job(&rq, data, lim, &reply, &how, status, err, errsize) != API_OK) {
 		job_ended(rq.kind, how, t0);
 		return API_ERR;
 	}
-	enum api_result rc = api_wire_decode_image(body, blen, max_pixels, rgba, w, h, err, errsize);
+	enum api_result rc = api_wire_decode_image(reply.body, reply.body_len, max_pixels, rgba, w, h, err, errsize);
 	if (rc != API_OK) *status = 400;
 	job_ended(rq.kind, rc == API_OK ? API_SBX_OUT_OK : API_SBX_OUT_INVALID, t0);
-	free(reply);
+	reply_release(&reply);
 	return rc;
 }

@@ -15,13 +15,19 @@
  *     device; a fork of it would copy locks held by other threads and driver state. Spawning a
  *     fresh executable per import would cost a dynamic link of Assimp (~10 ms) each time; the
  *     fork server pays that once and forks a clean, single-threaded copy of itself per job.
- *   - One job = one child. The daemon makes a socketpair (data) and a pipe (status), sends the
- *     request and the two fds over the control socket (SOCK_SEQPACKET: each request is one
- *     atomic message, so threads send concurrently without a lock), writes the input into the
- *     data socket and reads the reply back until EOF. Nothing global is held meanwhile: imports
- *     of different requests run in parallel, each in its own child.
- *   - The child, before it reads a byte: closes every other fd, sets RLIMIT_CPU (the timeout,
- *     rounded up to seconds), RLIMIT_AS (the memory limit), RLIMIT_FSIZE/NOFILE/CORE/NPROC,
+ *   - One job = one child. The daemon makes a socketpair (data), a pipe (status) and a memfd
+ *     (the reply), sends the request and the three fds over the control socket (SOCK_SEQPACKET:
+ *     each request is one atomic message, so threads send concurrently without a lock), and
+ *     writes the input into the data socket. The child writes its reply into the memfd through
+ *     a shared mapping and its length on the data socket. Once the child has exited, the daemon
+ *     shrinks the memfd to that length, seals it (no write, grow or shrink, by anyone: the seal
+ *     on writing is refused while any writable mapping exists), maps it read-only and decodes
+ *     it there: a model's arrays stay in that mapping, owned by its arena, with no copy (a
+ *     1M-triangle model's 84 MB went through the socket and two copies before). Nothing global
+ *     is held meanwhile: imports of different requests run in parallel, each in its own child.
+ *   - The child, before it reads a byte: closes every fd but its data socket and reply file,
+ *     sets RLIMIT_CPU (the timeout, rounded up to seconds), RLIMIT_AS (the memory limit: the
+ *     reply's mapping counts in it), RLIMIT_FSIZE/NOFILE/CORE/NPROC,
  *     PR_SET_NO_NEW_PRIVS and a seccomp filter (libseccomp) that allows only what parsing needs
  *     (read/write on its fds, memory management without PROT_EXEC, futex, exit, signals to
  *     itself). No open, no socket, no exec: the child can touch no file beyond its fds.
@@ -95,9 +101,11 @@ const char *api_sandbox_helper_path(void);
 #define API_SBX_MAGIC 0x756d6272u      /* "umbr" */
 #define API_SBX_CTL_FD 3               /* the fork server's control socket */
 #define API_SBX_DATA_FD 3              /* a child's data socket */
+#define API_SBX_REPLY_FD 4             /* a child's reply file (a memfd the daemon made) */
 #define API_SBX_MAX_CHILDREN 1024
 
-/* Sent over the control socket with SCM_RIGHTS {data socket, status pipe's write end}. */
+/* Sent over the control socket with SCM_RIGHTS {data socket, status pipe's write end, reply
+ * memfd}. */
 struct api_sbx_request {
 	uint32_t magic;
 	uint32_t kind;          /* enum api_wire_kind */
@@ -109,6 +117,8 @@ struct api_sbx_request {
 	uint64_t model_len;     /* model: the model file's bytes at the start of the input ... */
 	uint32_t file_count;    /* ... followed by this many files (api_sbx_bundle_encode) */
 	uint32_t output_side;   /* model: api_limits.output_side (api_model_finish_import) */
+	uint32_t reserved;      /* 0 */
+	uint64_t reply_size;    /* the reply file's size: no reply may be longer */
 };
 
 /* A model's input with the files it refers to: the model's bytes, then per file
@@ -133,6 +143,20 @@ struct api_sbx_status {
 	int32_t code;           /* exit code or signal */
 	uint32_t reserved;
 };
+
+/* Sends rq with its fds (data socket, status pipe's write end, reply memfd) to the fork server,
+ * starting it first, or again once when it is gone (api/sandbox_server.c). 0, or -1 with err. */
+int api_sbx_send(const struct api_sbx_request *rq, int data_fd, int status_fd, int reply_fd, char *err,
+                 size_t errsize);
+
+/* The helper's environment: env with glibc's malloc asked for transparent huge pages
+ * (GLIBC_TUNABLES gets glibc.malloc.hugetlb=1 appended, or is added: madvise on the heap and
+ * on big blocks; glibc 2.35+, a no-op where the kernel's THP is off). An import writes its
+ * memory once, fresh from the kernel: with 4 KiB pages a 1M-triangle STL took a page fault
+ * every 4 KiB, a fifth of its time on a virtualised machine, and its whole import took twice
+ * as long. Returns a malloc'd array (the variables point into env, but GLIBC_TUNABLES into
+ * *own, malloc'd too), or NULL (and *own NULL) when out of memory. */
+char **api_sbx_helper_env(char *const *env, char **own);
 
 /* The helper's main (api/helper/umbra_import.c calls it): `umbra-import --fork-server`. */
 int api_sandbox_helper_main(int argc, char **argv);

@@ -60,6 +60,9 @@ static int apply_filter(void)
 		SCMP_SYS(rt_sigreturn), SCMP_SYS(rt_sigaction), SCMP_SYS(rt_sigprocmask), SCMP_SYS(getpid),
 		SCMP_SYS(gettid), SCMP_SYS(clock_gettime), SCMP_SYS(gettimeofday), SCMP_SYS(getrandom),
 		SCMP_SYS(sched_yield), SCMP_SYS(sigaltstack),
+		/* glibc's qsort asks for the machine's memory (sysconf(_SC_PHYS_PAGES)) before sorting
+		 * more than 1 KiB: the join sorts the corners around a cone's apex with it. */
+		SCMP_SYS(sysinfo),
 	};
 	int rc = 0;
 	for (size_t i = 0; i < sizeof allow / sizeof allow[0] && !rc; i++)
@@ -78,8 +81,10 @@ static int set_limits(const struct api_sbx_request *rq)
 {
 	rlim_t cpu = (rq->timeout_ms + 999) / 1000;
 	struct rlimit r_cpu = {cpu ? cpu : 1, (cpu ? cpu : 1) + 1}, zero = {0, 0};
-	struct rlimit r_nofile = {API_SBX_DATA_FD + 1, API_SBX_DATA_FD + 1};
-	if (setrlimit(RLIMIT_CPU, &r_cpu) || setrlimit(RLIMIT_FSIZE, &zero) || setrlimit(RLIMIT_CORE, &zero) ||
+	/* The only file it can write is its reply file, up to the size the daemon allows. */
+	struct rlimit r_fsize = {rq->reply_size, rq->reply_size};
+	struct rlimit r_nofile = {API_SBX_REPLY_FD + 1, API_SBX_REPLY_FD + 1};
+	if (setrlimit(RLIMIT_CPU, &r_cpu) || setrlimit(RLIMIT_FSIZE, &r_fsize) || setrlimit(RLIMIT_CORE, &zero) ||
 	    setrlimit(RLIMIT_NOFILE, &r_nofile) || setrlimit(RLIMIT_NPROC, &zero))
 		return -1;
 	/* The sanitizers reserve terabytes of address space for their shadow: no RLIMIT_AS there. */
@@ -103,67 +108,93 @@ static bool io_all(int fd, void *buf, size_t n, bool wr)
 	return true;
 }
 
-static void do_job(const struct api_sbx_request *rq, const uint8_t *in, struct api_wire_buf *out)
-{
+/* What a job answers; emit() writes it twice: once to size it, once where the daemon maps it. */
+struct answer {
+	enum api_wire_kind kind;
+	enum api_wire_status st;
 	char err[API_WIRE_MAX_MESSAGE];
-	err[0] = 0;
-	if (rq->kind == API_WIRE_IMAGE) {
-		uint8_t *px;
-		uint32_t w, h;
-		if (api_image_decode(in, rq->input_len, rq->max_pixels, &px, &w, &h, err, sizeof err) != API_OK) {
-			enum api_wire_status st = strstr(err, "out of memory") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
-			api_wire_put_header(out, API_WIRE_IMAGE, st, err);
-			return;
-		}
-		api_wire_put_header(out, API_WIRE_IMAGE, API_WIRE_OK, NULL);
-		api_wire_put_image(out, px, w, h);
-		free(px);
+	struct api_model m;              /* MODEL; LEVELS: the model whose meshes carry them */
+	uint8_t *px;                     /* IMAGE */
+	uint32_t w, h;
+};
+
+static void emit(const struct answer *a, struct api_wire_buf *b)
+{
+	api_wire_put_header(b, a->kind, a->st, a->st == API_WIRE_OK ? NULL : a->err);
+	if (a->st != API_WIRE_OK) return;
+	if (a->kind == API_WIRE_IMAGE) api_wire_put_image(b, a->px, a->w, a->h);
+	else if (a->kind == API_WIRE_LEVELS) api_wire_put_levels(b, &a->m);
+	else api_wire_put_model(b, &a->m);
+}
+
+static void do_job(const struct api_sbx_request *rq, const uint8_t *in, struct answer *a)
+{
+	a->kind = rq->kind == API_WIRE_IMAGE || rq->kind == API_WIRE_LEVELS ? (enum api_wire_kind)rq->kind : API_WIRE_MODEL;
+	if (a->kind == API_WIRE_IMAGE) {
+		a->st = API_WIRE_OK;
+		if (api_image_decode(in, rq->input_len, rq->max_pixels, &a->px, &a->w, &a->h, a->err, sizeof a->err) != API_OK)
+			a->st = strstr(a->err, "out of memory") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 		return;
 	}
-	struct api_arena *arena = api_arena_create();
-	struct api_model m;
+	struct api_arena *arena = api_arena_create();   /* never destroyed: the process ends after the reply */
 	size_t bytes;
-	if (rq->kind == API_WIRE_LEVELS) {
-		/* The meshes that want levels, as a model (api_sandbox_build_levels). */
-		enum api_wire_status st = API_WIRE_BAD_INPUT;
-		if (!arena) st = API_WIRE_OVER_MEMORY, snprintf(err, sizeof err, "out of memory");
-		else if (api_wire_decode_model(in, rq->input_len, arena, 1, &m, &bytes, err, sizeof err) == API_OK)
-			st = API_WIRE_OK;
+	if (a->kind == API_WIRE_LEVELS) {
+		/* The meshes that want levels, as a model (api_sandbox_build_levels); the input stays
+		 * until the process ends. */
+		a->st = API_WIRE_BAD_INPUT;
+		if (!arena) a->st = API_WIRE_OVER_MEMORY, snprintf(a->err, sizeof a->err, "out of memory");
+		else if (api_wire_decode_model(in, rq->input_len, API_WIRE_IN_PLACE, arena, 1, &a->m, &bytes, a->err,
+		                               sizeof a->err) == API_OK)
+			a->st = API_WIRE_OK;
 		/* (api_wire_decode_model has set every mesh's bounds) */
-		if (st == API_WIRE_OK) api_model_build_level(&m, rq->output_side, arena, &bytes);
-		api_wire_put_header(out, API_WIRE_LEVELS, st, err);
-		if (st == API_WIRE_OK) api_wire_put_levels(out, &m);
+		if (a->st == API_WIRE_OK) api_model_build_level(&a->m, rq->output_side, arena, &bytes);
 		return;
 	}
 	/* The model's bytes, then the files it refers to (api_sbx_bundle_encode). */
 	struct api_model_file *files = calloc(rq->file_count + 1u, sizeof *files);
-	enum api_wire_status st = API_WIRE_OVER_MEMORY;
-	if (!arena || !files) snprintf(err, sizeof err, "out of memory");
+	a->st = API_WIRE_OVER_MEMORY;
+	if (!arena || !files) snprintf(a->err, sizeof a->err, "out of memory");
 	else if (api_sbx_bundle_decode(in, rq->input_len, rq->model_len, rq->file_count, files) < 0)
-		st = API_WIRE_BAD_INPUT, snprintf(err, sizeof err, "the importer's input is inconsistent");
-	else st = api_model_import_files(in, rq->model_len, files, rq->file_count, (enum api_model_format)rq->format,
-	                                 rq->output_side, arena, &m, &bytes, err, sizeof err);
+		a->st = API_WIRE_BAD_INPUT, snprintf(a->err, sizeof a->err, "the importer's input is inconsistent");
+	else a->st = api_model_import_files(in, rq->model_len, files, rq->file_count, (enum api_model_format)rq->format,
+	                                    rq->output_side, arena, &a->m, &bytes, a->err, sizeof a->err);
 	/* Closedness and the request's one level of detail, here under the import's limits. */
-	if (st == API_WIRE_OK) api_model_finish_import(&m, rq->output_side, arena, &bytes);
-	api_wire_put_header(out, API_WIRE_MODEL, st, err);
-	if (st == API_WIRE_OK) api_wire_put_model(out, &m);
-	/* No api_arena_destroy: the process ends right after the reply. */
+	if (a->st == API_WIRE_OK) api_model_finish_import(&a->m, rq->output_side, arena, &bytes);
 }
 
-static void child_main(int data_fd, const struct api_sbx_request *rq)
+/* The answer into the daemon's reply file (API_SBX_REPLY_FD, a memfd), written as it is
+ * serialised (the kernel copies it there from the arrays where they are: no buffer of the
+ * whole reply, no fresh pages mapped here), and its length (u64) on the data socket. A reply
+ * longer than the file may grow (RLIMIT_FSIZE: the reply size the daemon allows) fails its
+ * write (SIGXFSZ is ignored): over the memory limit. Exits on failure. */
+static void send_answer(const struct answer *a)
+{
+	struct api_wire_buf out = {.fd = API_SBX_REPLY_FD};
+	emit(a, &out);
+	uint64_t n = out.len;
+	if (api_wire_flush(&out) != 0) _exit(API_SBX_EXIT_OOM);
+	if (!io_all(API_SBX_DATA_FD, &n, sizeof n, true)) _exit(API_SBX_EXIT_IO);
+}
+
+static void child_main(int data_fd, int reply_fd, const struct api_sbx_request *rq)
 {
 	if (prctl(PR_SET_PDEATHSIG, SIGKILL) || getppid() == 1) _exit(API_SBX_EXIT_SETUP);
-	if (data_fd != API_SBX_DATA_FD && dup2(data_fd, API_SBX_DATA_FD) < 0) _exit(API_SBX_EXIT_SETUP);
+	/* Both above the fds they go to first, so that neither dup2 closes the other. */
+	data_fd = fcntl(data_fd, F_DUPFD, API_SBX_REPLY_FD + 1);
+	reply_fd = fcntl(reply_fd, F_DUPFD, API_SBX_REPLY_FD + 1);
+	if (data_fd < 0 || reply_fd < 0 || dup2(data_fd, API_SBX_DATA_FD) < 0 || dup2(reply_fd, API_SBX_REPLY_FD) < 0)
+		_exit(API_SBX_EXIT_SETUP);
 	/* stdin/stdout/stderr are the daemon's: a compromised child must not write into its log. */
 	int dn = open("/dev/null", O_RDWR | O_CLOEXEC);
 	if (dn < 0 || dup2(dn, 0) < 0 || dup2(dn, 1) < 0 || dup2(dn, 2) < 0) _exit(API_SBX_EXIT_SETUP);
-	close_range(API_SBX_DATA_FD + 1, ~0u, 0);
+	close_range(API_SBX_REPLY_FD + 1, ~0u, 0);
 	sigset_t none;
 	sigemptyset(&none);
 	sigprocmask(SIG_SETMASK, &none, NULL);
 	struct sigaction sa = {.sa_handler = on_fatal, .sa_flags = SA_RESETHAND};
 	static const int fatal[] = {SIGSEGV, SIGBUS, SIGABRT, SIGILL, SIGFPE};
 	for (size_t i = 0; i < sizeof fatal / sizeof fatal[0]; i++) sigaction(fatal[i], &sa, NULL);
+	signal(SIGXFSZ, SIG_IGN);   /* a reply past RLIMIT_FSIZE: its write fails (EFBIG) */
 	prctl(PR_SET_DUMPABLE, 0);
 	/* jansson (the glTF pre-check) seeds its hash from /dev/urandom on first use: done here,
 	 * while files can still be opened, and fresh in every child. */
@@ -173,10 +204,10 @@ static void child_main(int data_fd, const struct api_sbx_request *rq)
 	uint8_t *in = malloc(rq->input_len ? rq->input_len : 1);
 	if (!in) _exit(API_SBX_EXIT_OOM);
 	if (!io_all(API_SBX_DATA_FD, in, rq->input_len, false)) _exit(API_SBX_EXIT_IO);
-	struct api_wire_buf out = {0};
-	do_job(rq, in, &out);
-	if (out.failed) _exit(API_SBX_EXIT_OOM);
-	if (!io_all(API_SBX_DATA_FD, out.data, out.len, true)) _exit(API_SBX_EXIT_IO);
+	struct answer a;
+	memset(&a, 0, sizeof a);
+	do_job(rq, in, &a);
+	send_answer(&a);
 	_exit(0);
 }
 
@@ -240,39 +271,41 @@ static long police(void)
 	return next;
 }
 
-/* One request from the control socket: 1 handled, 0 EOF, -1 error. */
+/* One request from the control socket with its fds {data socket, status pipe, reply memfd}:
+ * 1 handled, 0 EOF, -1 error. */
 static int take_request(int ctl)
 {
 	struct api_sbx_request rq;
-	union { struct cmsghdr h; char buf[CMSG_SPACE(2 * sizeof(int))]; } cm;
+	union { struct cmsghdr h; char buf[CMSG_SPACE(3 * sizeof(int))]; } cm;
 	struct iovec iov = {&rq, sizeof rq};
 	struct msghdr msg = {.msg_iov = &iov, .msg_iovlen = 1, .msg_control = cm.buf, .msg_controllen = sizeof cm.buf};
 	ssize_t n = recvmsg(ctl, &msg, MSG_CMSG_CLOEXEC);
 	if (n == 0) return 0;
 	if (n < 0) return errno == EINTR || errno == EAGAIN ? 1 : -1;
-	int fds[2] = {-1, -1}, nfds = 0;
+	int fds[3] = {-1, -1, -1}, nfds = 0;
 	for (struct cmsghdr *c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c))
 		if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_RIGHTS) {
 			int k = (int)((c->cmsg_len - CMSG_LEN(0)) / sizeof(int));
 			for (int i = 0; i < k; i++) {
 				int fd;
 				memcpy(&fd, CMSG_DATA(c) + i * sizeof(int), sizeof fd);
-				if (nfds < 2) fds[nfds++] = fd; else close(fd);
+				if (nfds < 3) fds[nfds++] = fd; else close(fd);
 			}
 		}
-	if (nfds != 2 || n != (ssize_t)sizeof rq || rq.magic != API_SBX_MAGIC || (msg.msg_flags & MSG_CTRUNC)) {
-		if (nfds == 2) send_status(fds[1], API_SBX_REFUSED, 0);
-		else if (nfds == 1) close(fds[0]);
-		if (nfds == 2) close(fds[0]);
+	if (nfds != 3 || n != (ssize_t)sizeof rq || rq.magic != API_SBX_MAGIC || (msg.msg_flags & MSG_CTRUNC)) {
+		if (nfds >= 2) send_status(fds[1], API_SBX_REFUSED, 0);
+		if (nfds >= 1) close(fds[0]);
+		if (nfds == 3) close(fds[2]);
 		return 1;
 	}
 	pid_t pid = nkids < API_SBX_MAX_CHILDREN ? fork() : -1;
 	if (pid == 0) {
 		close(ctl);
 		close(fds[1]);
-		child_main(fds[0], &rq);
+		child_main(fds[0], fds[2], &rq);
 	}
 	close(fds[0]);
+	close(fds[2]);
 	if (pid < 0) {
 		send_status(fds[1], API_SBX_REFUSED, errno);
 		return 1;

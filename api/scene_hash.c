@@ -1,19 +1,23 @@
 /*
- * api/scene_hash — the canonical hash of a merged scene document and its parts (scene_hash.h).
+ * api/scene_hash — the canonical hash of a parsed scene, the document it does not hold, and
+ * the parts (scene_hash.h).
  */
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "scene_hash.h"
 #include "umbra/rnd_math.h"
 
-/* One framed item: a tag byte and a 64-bit length, then the bytes. */
+/* One framed item: a tag byte and a 64-bit length, then the bytes (a word at a time,
+ * rnd_hash: byte-at-a-time FNV-1a was ~70 ms over a 50 MB model part, paid by each parse of
+ * the request, the worker's and the import thread's). */
 static uint64_t item(uint64_t h, char tag, const void *data, size_t len)
 {
 	uint64_t n = len;
 	h = rnd_fnv1a(h, &tag, 1);
 	h = rnd_fnv1a(h, &n, sizeof n);
-	return len ? rnd_fnv1a(h, data, len) : h;
+	return len ? rnd_hash(h, data, len) : h;
 }
 
 /* A container's tag and count. */
@@ -103,10 +107,107 @@ static int part_cmp(const void *a, const void *b)
 	return strcmp(x->name ? x->name : "", y->name ? y->name : "");
 }
 
-uint64_t api_scene_hash(const json_t *root, const struct api_big_strings *big, const struct api_part *parts,
-                        size_t nparts)
+/* ---- the document less what the parsed scene holds ---- */
+
+/* Drops the object members of v that are (or become) empty objects; true when v is an empty
+ * object afterwards. Arrays keep their elements (their count is in the parsed scene anyway). */
+static bool prune(json_t *v, unsigned depth)
 {
-	uint64_t h = value(RND_FNV_SEED, root, big, 0);
+	if (depth > 256)
+		return false;
+	if (json_is_array(v)) {
+		for (size_t i = 0; i < json_array_size(v); i++)
+			prune(json_array_get(v, i), depth + 1);
+		return false;
+	}
+	if (!json_is_object(v))
+		return false;
+	const char *k;
+	json_t *m;
+	void *tmp;
+	json_object_foreach_safe(v, tmp, k, m) {
+		if (prune(m, depth + 1))
+			json_object_del(v, k);
+	}
+	return json_object_size(v) == 0;
+}
+
+/* ---- the parsed scene ---- */
+
+/* A pointer member as whether it is set (what it points to is hashed by its source). */
+#define AS_SET(p) ((p) = (p) ? (__typeof__(p))(uintptr_t)1 : NULL)
+
+static uint64_t object_bytes(uint64_t h, const struct rnd_object *src)
+{
+	struct rnd_object o;
+	memcpy(&o, src, sizeof o);
+	AS_SET(o.positions);
+	AS_SET(o.indices);
+	AS_SET(o.normals);
+	AS_SET(o.uvs);
+	AS_SET(o.uvs1);
+	AS_SET(o.colors);
+	AS_SET(o.tangents);
+	AS_SET(o.lods);
+	AS_SET(o.mesh_bounds);
+	return rnd_hash(h, &o, sizeof o);
+}
+
+static uint64_t material_bytes(uint64_t h, const struct rnd_material *src)
+{
+	struct rnd_material m;
+	memcpy(&m, src, sizeof m);
+	for (int i = 0; i < RND_TEX_SLOTS; i++)
+		AS_SET(m.textures[i]);
+	return rnd_hash(h, &m, sizeof m);
+}
+
+static uint64_t parsed(uint64_t h, const struct api_scene *s)
+{
+	struct rnd_scene sc;
+	memcpy(&sc, &s->scene, sizeof sc);
+	AS_SET(sc.views);
+	AS_SET(sc.materials);
+	AS_SET(sc.objects);
+	AS_SET(sc.lights);
+	sc.deadline_ns = 0;   /* how long, not what: set per request */
+	sc.cancel = NULL;
+	sc.cancel_user = NULL;
+	h = item(h, 'S', &sc, sizeof sc);
+	h = frame(h, 'V', sc.view_count);
+	if (sc.view_count)   /* no pointers, no padding; NULL when none (memcpy's NULL is UB even for 0 bytes) */
+		h = rnd_hash(h, s->scene.views, sc.view_count * sizeof *s->scene.views);
+	h = frame(h, 'M', sc.material_count);
+	for (uint32_t i = 0; i < sc.material_count; i++)
+		h = material_bytes(h, &s->scene.materials[i]);
+	h = frame(h, 'O', sc.object_count);
+	for (uint32_t i = 0; i < sc.object_count; i++)
+		h = object_bytes(h, &s->scene.objects[i]);
+	h = frame(h, 'L', sc.light_count);
+	if (sc.light_count)   /* no pointers */
+		h = rnd_hash(h, s->scene.lights, sc.light_count * sizeof *s->scene.lights);
+	/* The answer's own members (api.h), and what the image leaves out. */
+	int32_t own[4] = {(int32_t)s->format, s->format_explicit, (int32_t)s->bit_depth, s->png_level};
+	h = item(h, 'A', own, sizeof own);
+	h = item(h, 'q', &s->quality, sizeof s->quality);
+	/* The PNG-only members given decide warnings when the answer is an EXR, WebP or AVIF (scene_views.c);
+	 * the answer is a PNG whatever the Accept when output.format says so. */
+	unsigned png_only = s->format_explicit && s->format == API_FORMAT_PNG ? 0 : s->png_only_;
+	h = item(h, 'p', &png_only, sizeof png_only);
+	return item(h, 'w', s->warnings, strlen(s->warnings));
+}
+
+uint64_t api_scene_hash(json_t *root, const struct api_big_strings *big, const struct api_part *parts,
+                        size_t nparts, const struct api_member_read *reads, size_t nreads,
+                        const struct api_scene *s)
+{
+	uint64_t h = parsed(RND_FNV_SEED, s);
+	if (reads) {
+		for (size_t i = 0; i < nreads; i++)
+			json_object_del(reads[i].obj, reads[i].key);
+		prune(root, 0);
+	}
+	h = value(h, root, big, 0);
 	if (!nparts)
 		return h;
 	const struct api_part **order = malloc(nparts * sizeof *order);

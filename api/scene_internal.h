@@ -29,6 +29,7 @@
 #include "api.h"
 #include "arena.h"
 #include "big_strings.h"
+#include "scene_hash.h"
 
 #define DEG2RAD (3.14159265358979323846 / 180.0)
 #define PROBLEMS "https://umbra.dev/problems/"
@@ -63,9 +64,18 @@ struct pctx {
 	struct api_model *cur_model;
 	/* Ground placement (api/ground.h): margin per document object, > 0 for placement "ground". */
 	float *ground_margin;
+	bool *up_auto;            /* per object: a model with "up": "auto" (api/model_up.h), decided once imported */
 	size_t cur_object;
 	char warnings[sizeof(((struct api_scene *)0)->warnings)]; /* what is drawn other than asked ("; " between) */
 	const struct api_big_strings *big;  /* base64 members left in the document (api/big_strings.h) */
+	/* Members whose value the walk read into the parsed scene (the api_get_* getters of numbers,
+	 * booleans, enums and vectors record theirs): the ETag's hash takes the parsed scene for
+	 * them, so their spelling, or their being left out for the default, does not count
+	 * (api/scene_hash.h). A member whose value goes elsewhere (a model's format hint, read by
+	 * the importer) is checked with api_check_*, which records nothing. */
+	struct api_member_read *reads;
+	size_t nreads, reads_cap;
+	bool reads_lost;                /* out of memory recording one: the document is hashed whole */
 };
 
 /* ---- json_walk.c: the pointer, problems, typed members ---- */
@@ -86,6 +96,9 @@ void api_defer(struct pctx *c, bool unsupported, const char *key, const char *fm
 void api_warn(struct pctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* "an object", "a number"...: for messages. */
 const char *api_type_name(const json_t *v);
+/* Records that obj's member key was read into the parsed scene (c->reads): for a member read
+ * without a getter (`"shadows": false`, `aovs`). */
+void api_member_read(struct pctx *c, json_t *obj, const char *key);
 /* `extras` and `x-*`: members any object may carry, never checked. */
 bool api_free_member(const char *key);
 /* Rejects members of obj named in neither list (suggesting a near miss). `what` names obj. */
@@ -112,7 +125,10 @@ enum {
 };
 
 /* check_*: the value v (named `name` in messages) at the current pointer; 0 or -1.
- * get_*: the member `key` of obj; 1 present and valid, 0 absent, -1. */
+ * get_*: the member `key` of obj; 1 present and valid, 0 absent, -1. The getters of numbers,
+ * booleans, enums and vectors record a member present and valid with api_member_read(): its
+ * value must then be in the parsed scene (api_scene or its rnd_scene), which the ETag hashes
+ * in its place. */
 int api_check_num(struct pctx *c, const char *name, json_t *v, const struct range *r, double *out);
 int api_get_num(struct pctx *c, json_t *obj, const char *key, const struct range *r, double *out);
 int api_get_float(struct pctx *c, json_t *obj, const char *key, const struct range *r, float *out);

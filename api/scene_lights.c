@@ -65,6 +65,7 @@ static int parse_light(struct pctx *c, json_t *j, struct rnd_light *l, const str
 	json_t *sh = json_object_get(j, "shadow");
 	if (json_is_boolean(sh)) {
 		l->shadow.enabled = json_is_true(sh);
+		api_member_read(c, j, "shadow");
 	} else if (sh) {
 		size_t old = api_ptr_push(c, "shadow");
 		int rc = json_is_object(sh) ? api_parse_shadow(c, sh, &l->shadow, "shadow")

@@ -9,6 +9,7 @@
 #include <string.h>
 #include "ground.h"
 #include "model.h"
+#include "model_up.h"
 #include "scene_internal.h"
 #include "umbra/rnd_math.h"
 
@@ -59,7 +60,8 @@ static int parse_transform(struct pctx *c, json_t *j, float model[16])
  *   "+z" -90° about X: (x, y, z) -> (x, z, -y) (a Z-up file's front, -Y, faces +Z);
  *   "-z" +90° about X: (x, y, z) -> (x, -z, y);
  *   "+x" +90° about Z: (x, y, z) -> (-y, x, z); "-x" -90° about Z: (x, y, z) -> (y, -x, z). */
-static const char *const UP_AXES[] = {"+y", "-y", "+z", "-z", "+x", "-x", NULL};
+static const char *const UP_AXES[] = {"+y", "-y", "+z", "-z", "+x", "-x", "auto", NULL};
+enum { UP_Z = 2, UP_AUTO = 6 };
 static const signed char UP_COLUMNS[][3][3] = {   /* the images of the file's x, y, z axes */
 	{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
 	{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
@@ -238,7 +240,8 @@ static int parse_object(struct pctx *c, json_t *j, struct rnd_object *o)
 		api_ptr_pop(c, old);
 		if (rc < 0) return -1;
 	}
-	apply_up(up, o->model);   /* under the object's transform */
+	if (up == UP_AUTO) c->up_auto[c->cur_object] = true;   /* expand_models decides, once the model is read */
+	else apply_up(up, o->model);   /* under the object's transform */
 	if (object_material(c, j, o) < 0) return -1;
 	if (api_get_bool(c, j, "cast_shadows", &o->cast_shadows) < 0 ||
 	    api_get_bool(c, j, "receive_shadows", &o->receive_shadows) < 0 ||
@@ -286,6 +289,15 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 		}
 		bool own = json_object_get(json_array_get(objs, i), "material") != NULL;
 		uint32_t base = nm;
+		float top[16];   /* the object's transform, and under it "auto"'s choice */
+		memcpy(top, sc->objects[i].model, sizeof top);
+		if (c->up_auto[i]) {
+			double cy, cz;
+			char axis = api_model_auto_up(m, &cy, &cz);
+			if (axis == 'z') apply_up(UP_Z, top);
+			api_warn(c, "/objects/%u: up \"auto\" chose +%c (surface flat on the lowest plane, facing down: y %.2f %%, "
+			         "z %.2f %%)", i, axis, 100 * cy, 100 * cz);
+		}
 		if (!own) {
 			memcpy(mats + nm, m->materials, m->material_count * sizeof *mats);
 			nm += m->material_count;
@@ -314,7 +326,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->mesh_bounds = me->vertex_count ? me->bounds : NULL;
 			/* glTF doubleSided: false culls back faces (the object can only add sidedness). */
 			o->double_sided = o->double_sided && !me->single_sided;
-			rnd_mat4_mul(o->model, sc->objects[i].model, in->model);
+			rnd_mat4_mul(o->model, top, in->model);
 			if (!own) o->material = base + me->material;
 		}
 	}
@@ -346,8 +358,9 @@ int api_parse_objects(struct pctx *c, json_t *objs, struct api_scene *s)
 	size_t nobj = json_array_size(objs);
 	struct rnd_object *objects = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *objects);
 	c->ground_margin = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *c->ground_margin);
+	c->up_auto = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *c->up_auto);
 	struct api_model **models = api_arena_calloc(c->arena, nobj ? nobj : 1, sizeof *models);
-	if (!objects || !c->ground_margin || !models) return api_fail(c, "out of memory");
+	if (!objects || !c->ground_margin || !c->up_auto || !models) return api_fail(c, "out of memory");
 	size_t old = api_ptr_push(c, "objects");
 	uint64_t total = 0;
 	int rc = 0;

@@ -165,9 +165,17 @@ int api_parse_model(struct pctx *c, json_t *j)
 	}
 	if (!first) return api_fail(c, "a model needs one of data (base64 file), path or part");
 	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
-	int f;
-	if (api_get_enum(c, j, "format", formats, &f) < 0) return -1;
-	bool given = json_object_get(j, "format") != NULL;
+	/* A hint for the importer, not a value of the parsed scene: checked, not recorded as read
+	 * (scene_internal.h), so that it stays in the ETag's hash as written. */
+	int f = -1;
+	json_t *fv = json_object_get(j, "format");
+	bool given = fv != NULL;
+	if (given) {
+		size_t o2 = api_ptr_push(c, "format");
+		int frc = api_check_enum(c, "format", fv, formats, &f);
+		api_ptr_pop(c, o2);
+		if (frc < 0) return -1;
+	}
 	json_t *v = json_object_get(j, first);
 	size_t old = api_ptr_push(c, first);
 	bool by_path = !strcmp(first, "path");
@@ -303,7 +311,6 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 		api_big_strings_free(&big);
 		return API_ERR;
 	}
-	uint64_t scene_hash = api_scene_hash(root, &big, parts, nparts);   /* the merged document, before the walk */
 	struct pctx c = {.p = p, .lim = limits, .default_mat = UINT32_MAX, .parts = parts, .nparts = nparts, .big = &big};
 	c.arena = api_arena_create();
 	struct api_scene *s = c.arena ? api_arena_alloc(c.arena, sizeof *s) : NULL;
@@ -322,13 +329,19 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->quality = -1;
 
 	int rc = parse_root(&c, root, s);
-	json_decref(c.mat_index);
-	json_decref(root);
-	api_big_strings_free(&big);
 	if (rc == 0 && c.pending) {
 		*p = c.pend;
 		rc = -1;
 	}
+	/* The parsed scene with its defaults, and what of the document it does not hold. */
+	if (rc == 0) {
+		memcpy(s->warnings, c.warnings, sizeof s->warnings);
+		s->scene_hash = api_scene_hash(root, &big, parts, nparts, c.reads_lost ? NULL : c.reads, c.nreads, s);
+	}
+	free(c.reads);
+	json_decref(c.mat_index);
+	json_decref(root);
+	api_big_strings_free(&big);
 	if (rc < 0) {
 		model_refs_release(c.models);
 		api_arena_destroy(c.arena);
@@ -338,9 +351,7 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
-	s->scene_hash = scene_hash;
 	s->import = c.import;
-	memcpy(s->warnings, c.warnings, sizeof s->warnings);
 	api_set_pixels(s);   /* again: the format's own warnings follow the document's */
 	*out = s;
 	return API_OK;
@@ -359,24 +370,23 @@ enum api_result api_scene_check_output(const struct api_scene *s, struct api_pro
 	struct api_problem scratch;
 	if (!p) p = &scratch;
 	if (!s) return API_OK;
-	bool webp = s->format == API_FORMAT_WEBP;
+	const char *label = api_format_label(s->format);
 	if (s->format != API_FORMAT_EXR && s->scene.output.aovs)
 		return api_problem_set(p, 400, "/output/aovs", "aovs need an EXR answer (output.format \"exr\", "
 		                       "Accept: image/x-exr, or an .exr output file): %s has no room for AOV channels",
-		                       webp ? "a WebP" : "the default format PNG");
-	if (!webp && s->quality >= 0)
-		return api_problem_set(p, 400, "/output/quality", "quality (lossy WebP, 0..100) needs a WebP answer "
-		                       "(output.format \"webp\", Accept: image/webp, or a .webp output file), not %s",
-		                       s->format == API_FORMAT_EXR ? "an EXR" : "a PNG");
-	/* A sheet of views may pass WebP's bound (one view cannot: 8192 a side at most). */
-	uint32_t cols = 1, rows = 1;
+		                       s->format == API_FORMAT_PNG ? "the default format PNG" : label);
+	if (!api_format_lossy(s->format) && s->quality >= 0)
+		return api_problem_set(p, 400, "/output/quality", "quality (lossy WebP or AVIF, 0..100) needs a WebP or "
+		                       "AVIF answer (output.format \"webp\" or \"avif\", Accept: image/webp or image/avif, "
+		                       "or a .webp or .avif output file), not %s", label);
+	/* A sheet of views may pass WebP's or AVIF's bound (one view cannot: 8192 a side at most). */
+	uint32_t cols = 1, rows = 1, side = api_format_max_side(s->format);
 	if (s->scene.view_count > 1) rnd_sheet_layout(s->scene.view_count, &cols, &rows);
 	char at[16];
 	snprintf(at, sizeof at, "/%s", s->views_key_ ? s->views_key_ : "width");
-	if (webp && ((uint64_t)s->scene.width * cols > API_WEBP_MAX_SIDE ||
-	             (uint64_t)s->scene.height * rows > API_WEBP_MAX_SIDE))
-		return api_problem_set(p, 422, at, "a WebP is at most %u pixels a side; this image is %llux%llu (a sheet of %u x %u "
-		                       "views)", API_WEBP_MAX_SIDE, (unsigned long long)s->scene.width * cols,
+	if (side && ((uint64_t)s->scene.width * cols > side || (uint64_t)s->scene.height * rows > side))
+		return api_problem_set(p, 422, at, "%s is at most %u pixels a side; this image is %llux%llu (a sheet of %u x "
+		                       "%u views)", label, side, (unsigned long long)s->scene.width * cols,
 		                       (unsigned long long)s->scene.height * rows, cols, rows);
 	return API_OK;
 }
@@ -387,8 +397,8 @@ enum api_result api_scene_set_format(struct api_scene *s, enum api_format f, str
 	if (!p) p = &scratch;
 	if (!s) return api_problem_set(p, 500, "", "api_scene_set_format: no scene");
 	if (f != API_FORMAT_EXR && s->scene.output.aovs)
-		return api_problem_set(p, 400, "/output/aovs", "aovs need format \"exr\": a %s has no room for AOV "
-		                       "channels", f == API_FORMAT_WEBP ? "WebP" : "PNG");
+		return api_problem_set(p, 400, "/output/aovs", "aovs need format \"exr\": %s has no room for AOV "
+		                       "channels", api_format_label(f));
 	s->format = f;
 	s->format_explicit = 1;
 	api_set_pixels(s);

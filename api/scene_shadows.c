@@ -102,6 +102,7 @@ int api_parse_root_shadow(struct pctx *c, json_t *root, struct rnd_shadow *s)
 	json_t *shj = json_object_get(root, "shadows");
 	if (json_is_boolean(shj)) {
 		s->enabled = json_is_true(shj);
+		api_member_read(c, root, "shadows");
 	} else if (shj) {
 		size_t old = api_ptr_push(c, "shadows");
 		int rc = api_parse_shadow(c, shj, s, "shadows");

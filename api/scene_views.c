@@ -12,12 +12,12 @@
 
 static const char *const OUTPUT_MEMBERS[] = {"format", "bit_depth", "transparent", "tonemap", "msaa", "aovs",
                                              "debug", "debug_light", "png_level", "quality", NULL};
-/* Output members that only a PNG answer uses, and why an EXR (or a WebP: NULL where it does
- * use the member) has no use for them. */
+/* Output members that only a PNG answer uses, and why an EXR (or a WebP or AVIF: NULL where it
+ * does use the member) has no use for them. */
 static const char *const PNG_ONLY[] = {"bit_depth", "tonemap", "png_level", NULL};
 static const char *const PNG_ONLY_WHY[] = {"a half-float image; bit_depth 16 is for PNG",
                                            "linear scene-referred; tonemap is for PNG", "zlib level of a PNG"};
-static const char *const PNG_ONLY_WEBP_WHY[] = {"8 bits per channel; bit_depth 16 is for PNG", NULL,
+static const char *const PNG_ONLY_8BIT_WHY[] = {"8 bits per channel; bit_depth 16 is for PNG", NULL,
                                                 "zlib level of a PNG"};
 static const char *const TURNTABLE_MEMBERS[] = {"frames", "elevation", "distance", NULL};
 
@@ -142,8 +142,9 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 	struct rnd_output *o = &s->scene.output;
 	if (api_require_object(c, j, "output") < 0 || api_check_members(c, j, OUTPUT_MEMBERS, NULL, "output") < 0)
 		return -1;
-	static const char *const formats[] = {"png", "exr", "webp", NULL};
-	static const enum api_format format_values[] = {API_FORMAT_PNG, API_FORMAT_EXR, API_FORMAT_WEBP};
+	static const char *const formats[] = {"png", "exr", "webp", "avif", NULL};
+	static const enum api_format format_values[] = {API_FORMAT_PNG, API_FORMAT_EXR, API_FORMAT_WEBP,
+	                                                API_FORMAT_AVIF};
 	static const char *const tonemaps[] = {"neutral", "aces", "none", NULL};
 	static const enum rnd_tonemap tonemap_values[] = {RND_TONEMAP_NEUTRAL, RND_TONEMAP_ACES, RND_TONEMAP_NONE};
 	static const char *const debugs[] = {"none", "shadow", "cascades", "normals", "depth", "atlas", NULL};
@@ -155,12 +156,12 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 		s->format = format_values[e];
 		s->format_explicit = 1;
 	}
-	/* quality makes the WebP lossy; without it the WebP is lossless. */
+	/* quality makes the WebP or AVIF lossy; without it they are lossless. */
 	static const struct range percent = {0, 100, false, false};
 	if ((rc = api_get_float(c, j, "quality", &percent, &s->quality)) < 0) return -1;
-	if (rc && s->format_explicit && s->format != API_FORMAT_WEBP)
-		return api_fail_at(c, "quality", "quality (lossy WebP, 0..100) needs format \"webp\", not \"%s\"",
-		                   formats[s->format]);
+	if (rc && s->format_explicit && !api_format_lossy(s->format))
+		return api_fail_at(c, "quality", "quality (lossy WebP or AVIF, 0..100) needs format \"webp\" or \"avif\", "
+		                   "not \"%s\"", formats[s->format]);
 	if ((rc = api_get_u32(c, j, "bit_depth", 8, 16, &s->bit_depth)) < 0) return -1;
 	if (rc && s->bit_depth != 8 && s->bit_depth != 16)
 		return api_fail_at(c, "bit_depth", "bit_depth must be 8 or 16 (got %u)", s->bit_depth);
@@ -202,9 +203,10 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 		 * decides once that choice is made. */
 		if (!rc && o->aovs && s->format_explicit && s->format != API_FORMAT_EXR)
 			rc = api_fail(c, "aovs need format \"exr\": a %s has no room for AOV channels",
-			              s->format == API_FORMAT_WEBP ? "WebP" : "PNG");
+			              api_format_label(s->format));
 		api_ptr_pop(c, old);
 		if (rc) return -1;
+		api_member_read(c, j, "aovs");   /* in o->aovs */
 	}
 	return 0;
 }
@@ -237,8 +239,10 @@ static void sync_png_only(struct api_scene *s)
 	for (int k = 0; PNG_ONLY[k]; k++) {
 		if (!(s->png_only_ & (1u << k))) continue;
 		sync_warning(s, PNG_ONLY[k], "EXR", PNG_ONLY_WHY[k], s->format == API_FORMAT_EXR);
-		if (PNG_ONLY_WEBP_WHY[k])
-			sync_warning(s, PNG_ONLY[k], "WebP", PNG_ONLY_WEBP_WHY[k], s->format == API_FORMAT_WEBP);
+		if (PNG_ONLY_8BIT_WHY[k]) {
+			sync_warning(s, PNG_ONLY[k], "WebP", PNG_ONLY_8BIT_WHY[k], s->format == API_FORMAT_WEBP);
+			sync_warning(s, PNG_ONLY[k], "AVIF", PNG_ONLY_8BIT_WHY[k], s->format == API_FORMAT_AVIF);
+		}
 	}
 }
 
@@ -246,7 +250,7 @@ void api_set_pixels(struct api_scene *s)
 {
 	sync_png_only(s);
 	if (s->format == API_FORMAT_EXR) s->scene.output.pixels = RND_PIXELS_RGBA32F;
-	else if (s->format == API_FORMAT_WEBP) s->scene.output.pixels = RND_PIXELS_RGBA8;
+	else if (api_format_lossy(s->format)) s->scene.output.pixels = RND_PIXELS_RGBA8;   /* WebP, AVIF */
 	else s->scene.output.pixels = s->bit_depth == 16 ? RND_PIXELS_RGBA16 : RND_PIXELS_RGBA8;
 }
 

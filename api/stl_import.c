@@ -77,7 +77,7 @@ int api_stl_import_binary(const uint8_t *d, size_t len, struct api_arena *arena,
 	if (!area) return API_STL_NOT_MINE;
 	rnd_material_defaults(mat);
 	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .indices = idx, .index_count = nv, .material = 0};
-	me->vertex_count = api_join_vertices(pos, nrm, NULL, nv, idx, nv);
+	me->vertex_count = api_join_vertices(pos, nrm, NULL, nv, idx, nv, arena, &me->weld_group_, &me->weld_groups_);
 	inst->mesh = 0;
 	rnd_mat4_identity(inst->model);
 	*out = (struct api_model){.meshes = me, .mesh_count = 1, .instances = inst, .instance_count = 1, .materials = mat,

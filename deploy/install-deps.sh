@@ -16,12 +16,13 @@ set -eu
 PKGS="build-essential pkg-config ca-certificates curl python3
 libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
 glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
-libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev libmeshoptimizer-dev libwebp-dev xxd"
+libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev libmeshoptimizer-dev libwebp-dev libavif-dev libdeflate-dev xxd"
 # Test tools (make test): the load balancer of the cluster test, YAML for the deploy checks,
 # chromium and node for the playground's browser test, clang + libFuzzer for the fuzz targets,
-# nginx (nginx-light) for the shared cache in front of the GET form (tests/http/cache.sh).
+# nginx (nginx-light) for the shared cache in front of the GET form (tests/http/cache.sh),
+# avifdec (libavif-bin) to decode the AVIF answers the tests check.
 if [ "${1:-}" != "--no-test-tools" ]; then
-  PKGS="$PKGS haproxy python3-yaml chromium clang libclang-rt-14-dev nginx-light"
+  PKGS="$PKGS haproxy python3-yaml chromium clang libclang-rt-14-dev nginx-light libavif-bin"
   # make bench: f3d + Xvfb (the peer renderer of the farm benchmark), cjpeg (its JPEG textures)
   [ "${1:-}" = "--bench" ] && PKGS="$PKGS f3d xvfb xauth libjpeg-turbo-progs"
   command -v node >/dev/null 2>&1 || PKGS="$PKGS nodejs"

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "deferred.h"
+#include "material.h"
 #include "visibility.h"
 
 bool rnd_deferred_supported(struct rnd_context *ctx)
@@ -21,12 +22,13 @@ bool rnd_deferred_supported(struct rnd_context *ctx)
 }
 
 /* A draw shade.glsl can shade from the surfaces pass alone: no texture (the fullscreen pass has
- * no uv derivatives and binds no material's set), opaque (no alpha test or dither: the surfaces
- * pass cuts no texel out), not a sphere's proxy (it shades the true sphere, not the mesh the
- * surfaces pass keeps). */
-static bool plain(const struct draw *d)
+ * no uv derivatives and binds no material's set), no material extension's lobe (their textures
+ * and coat normal), opaque (no alpha test or dither: the surfaces pass cuts no texel out), not a
+ * sphere's proxy (it shades the true sphere, not the mesh the surfaces pass keeps). */
+static bool plain(const struct rnd_scene *sc, const struct draw *d)
 {
-	return !d->masked && !(d->tex_bits & ((1u << UMBRA_TEX_SLOTS) - 1u)) && !(d->flags & UMBRA_DRAW_SPHERE);
+	return !d->masked && !(d->tex_bits & ((1u << UMBRA_TEX_SLOTS) - 1u)) && !(d->flags & UMBRA_DRAW_SPHERE) &&
+	       !(sc->material_count && rnd_material_ext_bits(&sc->materials[d->material]));
 }
 
 bool rnd_deferred_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct draw *draws,
@@ -34,7 +36,7 @@ bool rnd_deferred_wanted(const struct rnd_context *ctx, const struct rnd_scene *
 {
 	if (!vis || !ctx->pixel_shading || sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return false;
 	for (uint32_t i = 0; i < ndraw; i++)
-		if (draws[i].index_count && !plain(&draws[i])) return false;
+		if (draws[i].index_count && !plain(sc, &draws[i])) return false;
 	const char *env = getenv("UMBRA_PIXEL_SHADING");
 	return !(env && strcmp(env, "0") == 0);
 }

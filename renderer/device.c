@@ -257,8 +257,16 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 	 * 0's two samplers, so the device's per-stage bound limits a material, not a scene: a
 	 * scene's distinct textures are bounded by memory (the estimate and admission count
 	 * their texels) and by the descriptor sets each slot preallocates for them, which
-	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. (Vulkan guarantees 16 sampled images per
-	 * stage, more than the 7 a draw binds.) */
+	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. A main-pass draw binds UMBRA_TEX_SLOTS (12,
+	 * the glTF PBR extensions' textures among them) beside set 0's up to 7 samplers: more than
+	 * the 16 per stage Vulkan guarantees, fewer than any desktop driver or lavapipe offers
+	 * (lavapipe and NVIDIA: 10^6), so a device under that says so here rather than failing
+	 * in a pipeline layout. */
+	uint32_t stage_samplers = UMBRA_TEX_SLOTS + 7;
+	if (ctx->props.limits.maxPerStageDescriptorSamplers < stage_samplers ||
+	    ctx->props.limits.maxPerStageDescriptorSampledImages < stage_samplers)
+		return rnd_fail(err, RND_ERR_NO_DEVICE, "device '%s' binds %u samplers per shader stage; umbra's main pass needs %u",
+		                ctx->props.deviceName, ctx->props.limits.maxPerStageDescriptorSamplers, stage_samplers);
 	ctx->device_max_textures = RND_MAX_TEXTURES_CEILING;
 
 	VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
@@ -507,5 +515,5 @@ void rnd_context_info(const struct rnd_context *ctx, struct rnd_info *info)
 
 uint32_t rnd_context_validation_messages(const struct rnd_context *ctx)
 {
-	return (uint32_t)__atomic_load_n(&ctx->validation_count, __ATOMIC_RELAXED);
+	return ctx ? (uint32_t)__atomic_load_n(&ctx->validation_count, __ATOMIC_RELAXED) : 0;
 }

@@ -45,6 +45,11 @@ struct rnd_buffer {
 	VkDeviceMemory mem;
 	VkDeviceSize size;
 	void *map;               /* persistently mapped (all our buffers are host-visible) */
+	/* Where the CPU writes and reads the contents: `map` itself where the memory is host-cached
+	 * (lavapipe, readback and staging buffers), else (vertex and index buffers in a GPU's
+	 * device-local, uncached BAR memory, which a CPU reads at a few MB/s) a heap mirror that
+	 * rnd_buffer_publish copies into `map` in one sequential write. */
+	void *cpu;
 };
 
 struct rnd_image_res {
@@ -187,6 +192,9 @@ void rnd_name(const struct rnd_context *ctx, VkObjectType type, uint64_t handle,
 enum rnd_result rnd_buffer_create(struct rnd_context *ctx, VkDeviceSize size, VkBufferUsageFlags usage,
                                   const char *name, struct rnd_buffer *out, struct rnd_error *err);
 void rnd_buffer_destroy(struct rnd_context *ctx, struct rnd_buffer *b);
+/* Copies bytes [off, off + n) of a mirrored buffer's `cpu` into its mapping; nothing where
+ * `cpu` is the mapping. Call after the CPU's last write and before the GPU reads. */
+void rnd_buffer_publish(struct rnd_buffer *b, VkDeviceSize off, VkDeviceSize n);
 /* Grows b to at least size (power-of-two steps); contents are not kept. */
 enum rnd_result rnd_buffer_reserve(struct rnd_context *ctx, struct rnd_buffer *b, VkDeviceSize size,
                                    VkBufferUsageFlags usage, const char *name, struct rnd_error *err);

@@ -11,6 +11,7 @@
  * says uv_set 1 has its bit (1 << (UMBRA_TEX_UV1_SHIFT + slot)) in tex.x, and the scene's
  * UMBRA_TEXBIT_UV1 turns on the shaders' second-uv path only where the slot has that set.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,7 +20,8 @@
 
 bool rnd_texture_slot_srgb(enum rnd_texture_slot slot)
 {
-	return slot == RND_TEX_BASE || slot == RND_TEX_EMISSIVE;
+	return slot == RND_TEX_BASE || slot == RND_TEX_EMISSIVE || slot == RND_TEX_SHEEN_COLOR ||
+	       slot == RND_TEX_SHEEN_ROUGHNESS || slot == RND_TEX_SPECULAR || slot == RND_TEX_SPECULAR_COLOR;
 }
 
 void rnd_material_record(const struct rnd_scene *sc, uint32_t index, struct umbra_material *out)
@@ -35,6 +37,57 @@ void rnd_material_record(const struct rnd_scene *sc, uint32_t index, struct umbr
 	out->emissive[3] = d.roughness;
 }
 
+/* The extension lobe (RND_EXT_*) a texture slot belongs to; 0 for the core slots. */
+static uint32_t slot_extension(uint32_t k)
+{
+	if (k >= RND_TEX_CLEARCOAT && k <= RND_TEX_CLEARCOAT_NORMAL) return RND_EXT_CLEARCOAT;
+	if (k == RND_TEX_SHEEN_COLOR || k == RND_TEX_SHEEN_ROUGHNESS) return RND_EXT_SHEEN;
+	if (k == RND_TEX_SPECULAR || k == RND_TEX_SPECULAR_COLOR) return RND_EXT_SPECULAR;
+	return 0;
+}
+
+/* Slot k's texture as drawn: NULL where the material lacks the slot's extension. */
+static const struct rnd_texture *slot_texture(const struct rnd_material *m, uint32_t k)
+{
+	uint32_t e = slot_extension(k);
+	return e && !(m->extensions & e) ? NULL : m->textures[k];
+}
+
+uint32_t rnd_material_ext_bits(const struct rnd_material *m)
+{
+	uint32_t bits = 0;
+	if ((m->extensions & RND_EXT_CLEARCOAT) && m->clearcoat.factor > 0) bits |= UMBRA_EXT_CLEARCOAT;
+	if ((m->extensions & RND_EXT_SHEEN) && (m->sheen.color[0] > 0 || m->sheen.color[1] > 0 || m->sheen.color[2] > 0))
+		bits |= UMBRA_EXT_SHEEN;
+	if (m->extensions & RND_EXT_SPECULAR) bits |= UMBRA_EXT_SPECULAR;
+	return bits;
+}
+
+static float clamp01(float v)
+{
+	return !(v >= 0) ? 0 : v > 1 ? 1 : v;   /* NaN -> 0 */
+}
+
+/* The extensions' members of the record (umbra_shared.h): F0 from the ior as the sample
+ * viewer has it, ((ior - 1) / (ior + 1))^2, for the base layer's dielectric and the coat. */
+static void write_extensions(const struct rnd_material *in, struct umbra_material *out)
+{
+	uint32_t bits = rnd_material_ext_bits(in);
+	out->ext[0] = bits;
+	float ior = (in->extensions & RND_EXT_SPECULAR) && in->specular.ior >= 1 ? in->specular.ior : 1.5f;
+	float r = (ior - 1) / (ior + 1), f0 = r * r;
+	out->clearcoat[0] = clamp01(in->clearcoat.factor);
+	out->clearcoat[1] = clamp01(in->clearcoat.roughness);
+	out->clearcoat[2] = in->clearcoat.normal_scale;
+	out->clearcoat[3] = f0;
+	for (int k = 0; k < 3; k++) {
+		out->sheen[k] = clamp01(in->sheen.color[k]);
+		out->specular[k] = bits & UMBRA_EXT_SPECULAR ? f0 * fmaxf(in->specular.color[k], 0) : 0.04f;
+	}
+	out->sheen[3] = clamp01(in->sheen.roughness);
+	out->specular[3] = bits & UMBRA_EXT_SPECULAR ? clamp01(in->specular.factor) : 1;
+}
+
 void rnd_material_write(const struct rnd_material *in, struct umbra_material *out)
 {
 	memset(out, 0, sizeof *out);
@@ -47,10 +100,12 @@ void rnd_material_write(const struct rnd_material *in, struct umbra_material *ou
 	out->params[3] = in->occlusion_strength;
 	out->tex[1] = in->alpha_mode == RND_ALPHA_MASK ? UMBRA_ALPHA_MASK
 	            : in->alpha_mode == RND_ALPHA_BLEND ? UMBRA_ALPHA_BLEND : UMBRA_ALPHA_OPAQUE;
+	write_extensions(in, out);
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
 		const struct rnd_texture_sampling *ts = &in->sampling[k];
-		if (in->textures[k]) out->tex[0] |= 1u << k;
-		if (in->textures[k] && ts->uv_set == 1) out->tex[0] |= 1u << (UMBRA_TEX_UV1_SHIFT + k);
+		const struct rnd_texture *t = slot_texture(in, k);
+		if (t) out->tex[0] |= 1u << k;
+		if (t && ts->uv_set == 1) out->tex[0] |= 1u << (UMBRA_TEX_UV1_SHIFT + k);
 		float *r0 = out->uvx[2 * k], *r1 = out->uvx[2 * k + 1];
 		if (ts->transformed) {
 			memcpy(r0, ts->transform, 3 * sizeof(float));
@@ -95,7 +150,7 @@ static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene 
 {
 	const struct rnd_material *m = &sc->materials[mi];
 	bool any = false;
-	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) any = any || m->textures[k];
+	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) any = any || slot_texture(m, k);
 	*set = 0;
 	if (!any) return RND_OK;
 	int16_t img[UMBRA_TEX_SLOTS];
@@ -105,7 +160,7 @@ static enum rnd_result plan_material(struct tex_plan *p, const struct rnd_scene 
 		smp[k] = 0;
 	}
 	for (uint32_t k = 0; k < RND_TEX_SLOTS; k++) {
-		const struct rnd_texture *t = m->textures[k];
+		const struct rnd_texture *t = slot_texture(m, k);
 		if (!t) continue;
 		if (!t->rgba || !t->width || !t->height || t->width > RND_MAX_TEXTURE_SIDE || t->height > RND_MAX_TEXTURE_SIDE)
 			return rnd_fail(err, RND_ERR_INVALID, "material %u: texture of %ux%u", mi, t->width, t->height);
@@ -183,7 +238,7 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 		}
 		draws[i].texture_set = set_of[mi] - 1;
 		for (uint32_t k = 0; k < RND_TEX_SLOTS; k++)
-			if (sc->materials[mi].textures[k]) {
+			if (slot_texture(&sc->materials[mi], k)) {
 				draws[i].tex_bits |= 1u << k;
 				/* the uv1 path only where the scene has the set (else binding 1 is uv0) */
 				if (sc->materials[mi].sampling[k].uv_set == 1 && s->has_uv1) draws[i].tex_bits |= UMBRA_TEXBIT_UV1;

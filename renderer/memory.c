@@ -4,9 +4,15 @@
  * A render uses a handful of long-lived allocations per slot (they grow and are kept), so one
  * vkAllocateMemory per resource is within every driver's allocation count limit.
  * Buffers are host-visible and persistently mapped: on lavapipe all memory is, and on a GPU
- * we prefer HOST_VISIBLE|DEVICE_LOCAL (resizable BAR) and fall back to plain HOST_VISIBLE.
+ * the buffers the GPU reads while drawing prefer HOST_VISIBLE|DEVICE_LOCAL (resizable BAR),
+ * falling back to plain HOST_VISIBLE; those the CPU reads (readback) or builds in place
+ * (texture staging: each mip level is made from the one before) prefer HOST_CACHED. BAR memory
+ * is uncached: a CPU read of it crosses the bus at a few MB/s (an H200 in a VM: tessellating and
+ * hashing a mesh in place took ~400 ms a render), so vertex and index buffers there get a heap
+ * mirror for the CPU (`cpu`), published in one sequential write.
  */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "internal.h"
 
@@ -30,12 +36,13 @@ enum rnd_result rnd_buffer_create(struct rnd_context *ctx, VkDeviceSize size, Vk
 		return rnd_fail_vk(err, vr, "vkCreateBuffer");
 	VkMemoryRequirements req;
 	vkGetBufferMemoryRequirements(ctx->device, out->buf, &req);
-	/* Readback wants cached memory (CPU reads), everything else write-combined is fine. */
 	VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 	int type = -1;
-	/* Only the readback buffers (copy targets the CPU reads, never bound as storage) */
-	bool readback = (usage & VK_BUFFER_USAGE_TRANSFER_DST_BIT) && !(usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-	if (readback) type = find_memory_type(ctx, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+	/* Copy sources and targets only (staging, readback): the CPU reads them. */
+	const VkBufferUsageFlags drawn = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
+	                                 VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
+	bool cpu_reads = !(usage & drawn);
+	if (cpu_reads) type = find_memory_type(ctx, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
 	else type = find_memory_type(ctx, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
 	if (type < 0) type = find_memory_type(ctx, req.memoryTypeBits, host);
 	if (type < 0) {
@@ -72,6 +79,14 @@ enum rnd_result rnd_buffer_create(struct rnd_context *ctx, VkDeviceSize size, Vk
 		rnd_fail_vk(err, vr, "vkMapMemory");
 		goto fail_memory;
 	}
+	out->cpu = out->map;
+	bool cached = ctx->mem_props.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+	if ((!cached || ctx->desc.mirror_buffers) && (usage & (VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT)) &&
+	    !(out->cpu = malloc(size))) {
+		rnd_fail(err, RND_ERR_OOM, "out of memory for the CPU copy of buffer '%s' (%llu bytes)", name,
+		         (unsigned long long)size);
+		goto fail_memory;
+	}
 	out->size = size;
 	RND_NAME(ctx, VK_OBJECT_TYPE_BUFFER, out->buf, "%s", name);
 	RND_NAME(ctx, VK_OBJECT_TYPE_DEVICE_MEMORY, out->mem, "%s memory", name);
@@ -88,9 +103,15 @@ fail_buffer:
 void rnd_buffer_destroy(struct rnd_context *ctx, struct rnd_buffer *b)
 {
 	if (!b) return;
+	if (b->cpu != b->map) free(b->cpu);
 	if (b->buf) vkDestroyBuffer(ctx->device, b->buf, NULL);
 	if (b->mem) vkFreeMemory(ctx->device, b->mem, NULL); /* unmaps implicitly */
 	memset(b, 0, sizeof *b);
+}
+
+void rnd_buffer_publish(struct rnd_buffer *b, VkDeviceSize off, VkDeviceSize n)
+{
+	if (b->cpu != b->map && n) memcpy((uint8_t *)b->map + off, (const uint8_t *)b->cpu + off, n);
 }
 
 enum rnd_result rnd_buffer_reserve(struct rnd_context *ctx, struct rnd_buffer *b, VkDeviceSize size,

@@ -384,12 +384,13 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	for (uint32_t i = 0; i <= UMBRA_SC_COUNT; i++)
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
-	char name[112];
-	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
+	char name[128];
+	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
 	         key->aov ? "aov" : key->resolve ? "resolve" : key->vis_shade ? "pixel shading"
 	         : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",
 	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
-	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10]);
+	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10],
+	         key->sc[11]);
 	struct pipe_desc d = {
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,

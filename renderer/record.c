@@ -180,6 +180,7 @@ void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	for (uint32_t i = 0; i < ndraw; i++) {
 		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
 		k->sc[UMBRA_SC_TEXTURES] |= draws[i].tex_bits;
+		if (sc->material_count) k->sc[UMBRA_SC_MATERIAL_EXT] |= rnd_material_ext_bits(&sc->materials[draws[i].material]);
 		if (draws[i].masked) k->sc[UMBRA_SC_MASKED] |= 1u << (uint32_t)sc->materials[draws[i].material].alpha_mode;
 		if (!draws[i].cull_back) dense += draws[i].cam_index_count / 3;
 	}
@@ -456,6 +457,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	key.sc[UMBRA_SC_LINEAR] = 1;
 	key.sc[UMBRA_SC_TONEMAP] = 0;
 	key.sc[UMBRA_SC_CATCHER] = 0;
+	key.sc[UMBRA_SC_MATERIAL_EXT] = 0;   /* the AOVs hold no lobe */
 	key.format = RND_PIXELS_RGBA32F;
 	key.samples = 1;
 	key.aov = 1;

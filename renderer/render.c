@@ -201,16 +201,16 @@ static uint64_t caster_key(const struct render *rq)
 		if (!d->cast || !d->index_count) continue;
 		uint32_t flags[3] = {d->single_sided, d->closed, d->masked};
 		geo = rnd_hash(geo, flags, sizeof flags);
-		geo = rnd_hash(geo, (const struct rnd_vertex *)s->vertices.map + d->first_vertex,
+		geo = rnd_hash(geo, (const struct rnd_vertex *)s->vertices.cpu + d->first_vertex,
 		               (size_t)d->vertex_count * sizeof(struct rnd_vertex));
-		geo = rnd_hash(geo, (const uint32_t *)s->indices.map + d->first_index, (size_t)d->index_count * 4);
+		geo = rnd_hash(geo, (const uint32_t *)s->indices.cpu + d->first_index, (size_t)d->index_count * 4);
 		if (d->masked) {
 			const struct rnd_material *m = &sc->materials[sc->objects[i].material];
 			geo = rnd_hash(geo, &m->alpha_cutoff, sizeof m->alpha_cutoff);
 			geo = rnd_hash(geo, &m->alpha_mode, sizeof m->alpha_mode);
 			geo = rnd_hash(geo, &m->sampling[RND_TEX_BASE], sizeof m->sampling[RND_TEX_BASE]);
 			if (s->has_uv1 && m->sampling[RND_TEX_BASE].uv_set == 1)   /* the alpha test reads uv1 */
-				geo = rnd_hash(geo, (const float *)s->uvs1.map + 2 * (size_t)d->first_vertex, (size_t)d->vertex_count * 8);
+				geo = rnd_hash(geo, (const float *)s->uvs1.cpu + 2 * (size_t)d->first_vertex, (size_t)d->vertex_count * 8);
 			geo = rnd_hash(geo, m->base_color, sizeof m->base_color);
 			if (m->base_color_texture)
 				geo = rnd_hash(geo, m->base_color_texture->rgba,
@@ -279,9 +279,16 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 		if (!(d->flags & UMBRA_DRAW_SPHERE)) continue;
 		bool moved;
 		if (rnd_proxy_refit(&rq->proxies[i], cam, &moved)) {
-			if (moved)
-				rnd_proxy_write(&rq->proxies[i], (struct rnd_vertex *)rq->s->vertices.map + d->cam_first_vertex,
-				                (uint32_t *)rq->s->indices.map + d->cam_first_index, d->cam_first_vertex);
+			if (moved) {
+				struct rnd_slot *s = rq->s;
+				rnd_proxy_write(&rq->proxies[i], (struct rnd_vertex *)s->vertices.cpu + d->cam_first_vertex,
+				                (uint32_t *)s->indices.cpu + d->cam_first_index, d->cam_first_vertex);
+				uint32_t nv, ni;
+				rnd_proxy_counts(&rq->proxies[i], &nv, &ni);
+				rnd_buffer_publish(&s->vertices, (VkDeviceSize)d->cam_first_vertex * sizeof(struct rnd_vertex),
+				                   (VkDeviceSize)nv * sizeof(struct rnd_vertex));
+				rnd_buffer_publish(&s->indices, (VkDeviceSize)d->cam_first_index * 4, (VkDeviceSize)ni * 4);
+			}
 			continue;
 		}
 		d->flags &= ~UMBRA_DRAW_SPHERE;
@@ -466,6 +473,7 @@ enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *sc, 
 	if (!err) err = &scratch_err;   /* failure paths below always fill it */
 	memset(out, 0, sizeof *out);
 	memset(err, 0, sizeof *err);
+	if (!ctx) return rnd_fail(err, RND_ERR_NO_DEVICE, "no renderer context (rnd_context_create failed?)");
 	if (__atomic_load_n(&ctx->failed, __ATOMIC_RELAXED))
 		return rnd_fail(err, RND_ERR_DEVICE_LOST, "the Vulkan device was lost earlier; the context must be recreated");
 	if ((r = validate(ctx, sc, err)) != RND_OK) return r;

@@ -48,9 +48,10 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 	if ((r = rnd_buffer_reserve(ctx, &s->indices, ibytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "slot indices", err)) != RND_OK)
 		return r;
 	if ((r = reserve_uv1(ctx, s, sc, nv, err)) != RND_OK) return r;
-	float *uv1 = s->has_uv1 ? s->uvs1.map : NULL;
-	struct rnd_vertex *vtx = s->vertices.map;
-	uint32_t *idx = s->indices.map;
+	/* Written and read back (transforms, areas) in `cpu`: memory.c says why not in the mapping. */
+	float *uv1 = s->has_uv1 ? s->uvs1.cpu : NULL;
+	struct rnd_vertex *vtx = s->vertices.cpu;
+	uint32_t *idx = s->indices.cpu;
 	uint32_t vbase = 0, ibase = 0;
 	rnd_aabb_empty(bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++) {
@@ -104,6 +105,9 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		draws[i].cam_first_vertex = vbase;
 		vbase += v; ibase += x;
 	}
+	rnd_buffer_publish(&s->vertices, 0, (VkDeviceSize)vbase * sizeof(struct rnd_vertex));
+	rnd_buffer_publish(&s->indices, 0, (VkDeviceSize)ibase * sizeof(uint32_t));
+	if (uv1) rnd_buffer_publish(&s->uvs1, 0, (VkDeviceSize)vbase * 8);
 	return RND_OK;
 }
 

@@ -178,9 +178,10 @@ static enum rnd_result vis_pipeline(struct rnd_context *ctx, const struct record
 		key.sc[UMBRA_SC_MASKED] = key.sc[UMBRA_SC_DEBUG] = 0;
 		key.format = 0;
 	}
-	/* vis.frag samples no texture; vis_shade.frag (plain draws only) always multiplies by the
-	 * vertex colour, white where a mesh has none: one variant with and without */
-	key.sc[UMBRA_SC_TEXTURES] = 0;
+	/* vis.frag samples no texture; vis_shade.frag (plain draws only: no texture, no material
+	 * extension) always multiplies by the vertex colour, white where a mesh has none: one
+	 * variant with and without */
+	key.sc[UMBRA_SC_TEXTURES] = key.sc[UMBRA_SC_MATERIAL_EXT] = 0;
 	key.samples = 1;
 	key.cull_back = key.prepass = key.aov = key.atlas_view = 0;
 	key.vis_pass = 1;

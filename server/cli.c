@@ -1,7 +1,7 @@
 /*
  * server/cli.c — umbra-render: renders scenes with the renderer library, no server.
  *
- *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp] [--timings] [--device NAME]
+ *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp|OUT.avif] [--timings] [--device NAME]
  *   umbra-render SCENE.json... -o DIR/ [batch options]            many scenes, one process
  *   umbra-render --manifest LIST.jsonl -o DIR/ [batch options]    {"scene": ..., "output": ...} per line
  *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]
@@ -36,13 +36,13 @@
 
 static int usage(FILE *f, int code)
 {
-	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp] [--timings] [--device NAME]\n"
+	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp|OUT.avif] [--timings] [--device NAME]\n"
 	           "       umbra-render SCENE.json... -o DIR/ [batch options]\n"
 	           "       umbra-render --manifest LIST.jsonl -o DIR/ [batch options]\n"
 	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]\n"
 	           "                    [batch options]\n"
 	           "  Renders scenes (contract: scene-v1). Exit 0 ok, 2 invalid input, 1 other failure, 130 interrupted.\n"
-	           "  -o FILE      output file; .png, .exr or .webp picks the format (default: stdout, output.format)\n"
+	           "  -o FILE      output file; .png, .exr, .webp or .avif picks the format (default: stdout, output.format)\n"
 	           "  -o DIR/      batch: one image per input in DIR (name of the input, extension of the format)\n"
 	           "  --timings    print per-stage milliseconds to stderr (one scene)\n"
 	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n"
@@ -52,9 +52,10 @@ static int usage(FILE *f, int code)
 	           "  --size N     thumbnail width and height (default 512)\n"
 	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
 	           "  --up AXIS    thumbnails: the models' up axis, z y x -z -y -x (default y; z for most STL and\n"
-	           "               CAD/3D-printing OBJ files): the model object's \"up\"\n"
-	           "  --format F   thumbnails: png (default), webp (lossless) or exr: output.format\n"
-	           "  --quality Q  thumbnails with --format webp: lossy WebP at quality 0..100: output.quality\n"
+	           "               CAD/3D-printing OBJ files), or auto (y or z, from where the model would touch\n"
+	           "               the ground; docs/models.md): the model object's \"up\"\n"
+	           "  --format F   thumbnails: png (default), webp or avif (lossless), or exr: output.format\n"
+	           "  --quality Q  thumbnails with --format webp or avif: lossy at quality 0..100: output.quality\n"
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
 	           "  -j N         batch: threads that read, parse and import (default: one per core); renders run on\n"
 	           "               one more (a CPU device) or N more (a GPU)\n"
@@ -97,8 +98,8 @@ static int load_scene(const char *in, const char *out, const char *asset_root, s
 		const char *dot = strrchr(out, '.');
 		enum api_format f = (*scene)->format;
 		if (!api_format_from_name(out, &f) && dot && !strchr(dot, '/'))
-			r = api_problem_set(&prob, 400, "", "cannot write '%s': umbra-render writes PNG (.png), EXR (.exr) or "
-			                    "WebP (.webp)", out);
+			r = api_problem_set(&prob, 400, "", "cannot write '%s': umbra-render writes PNG (.png), EXR (.exr), "
+			                    "WebP (.webp) or AVIF (.avif)", out);
 		if (r == API_OK) r = api_scene_set_format(*scene, f, &prob);
 	}
 	if (r == API_OK) r = api_scene_check_output(*scene, &prob);
@@ -215,16 +216,16 @@ static unsigned uint_arg(const char *s, unsigned max)
 /* --up's value: "z", "+z", "-z", ... as the scene's "+z" etc.; NULL when it is none. */
 static const char *up_arg(const char *s)
 {
-	static const char *const axes[] = {"+y", "-y", "+z", "-z", "+x", "-x"};
-	for (int i = 0; i < 6; i++)
+	static const char *const axes[] = {"+y", "-y", "+z", "-z", "+x", "-x", "auto"};
+	for (int i = 0; i < 7; i++)
 		if (!strcasecmp(s, axes[i]) || (axes[i][0] == '+' && !strcasecmp(s, axes[i] + 1))) return axes[i];
 	return NULL;
 }
 
-/* --format's value: png, webp or exr (any case) as output.format names it; NULL when it is none. */
+/* --format's value: png, webp, avif or exr (any case) as output.format names it; NULL when it is none. */
 static const char *format_arg(const char *s, enum api_format *f)
 {
-	for (int k = API_FORMAT_PNG; k <= API_FORMAT_WEBP; k++)
+	for (int k = API_FORMAT_PNG; k < API_FORMAT_COUNT; k++)
 		if (!strcasecmp(s, api_format_name((enum api_format)k))) return api_format_name(*f = (enum api_format)k);
 	return NULL;
 }
@@ -291,11 +292,11 @@ static int parse_args(int argc, char **argv, struct args *a)
 			return usage(stderr, 1);
 		case O_UP:
 			if ((a->farm.up = up_arg(optarg))) break;
-			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x)\n", optarg);
+			fprintf(stderr, "umbra-render: bad option --up %s (one of z y x -z -y -x auto)\n", optarg);
 			return usage(stderr, 1);
 		case O_FORMAT:
 			if ((a->farm.format = format_arg(optarg, &a->format))) break;
-			fprintf(stderr, "umbra-render: bad option --format %s (png, webp or exr)\n", optarg);
+			fprintf(stderr, "umbra-render: bad option --format %s (png, webp, avif or exr)\n", optarg);
 			return usage(stderr, 1);
 		case O_QUALITY:
 			if ((a->farm.lossy = quality_arg(optarg, &a->farm.quality))) break;
@@ -323,8 +324,8 @@ static int parse_args(int argc, char **argv, struct args *a)
 		fprintf(stderr, "umbra-render: --format is for thumb (a scene says output.format, or -o names it)\n");
 		return usage(stderr, 1);
 	}
-	if (a->farm.lossy && a->format != API_FORMAT_WEBP) {
-		fprintf(stderr, "umbra-render: --quality is for thumb --format webp (lossy WebP)\n");
+	if (a->farm.lossy && !api_format_lossy(a->format)) {
+		fprintf(stderr, "umbra-render: --quality is for thumb --format webp or avif (lossy)\n");
 		return usage(stderr, 1);
 	}
 	return 0;

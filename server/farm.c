@@ -212,7 +212,7 @@ enum job_status farm_job_scene(struct farm *f, size_t i, const struct job_input 
 	enum api_format fmt = (*s)->format;
 	if (j->out) {
 		if (!api_format_from_name(j->out, &fmt)) {
-			snprintf(r->error, sizeof r->error, "output '%s' must end in .png, .exr or .webp", j->out);
+			snprintf(r->error, sizeof r->error, "output '%s' must end in .png, .exr, .webp or .avif", j->out);
 			api_scene_free(*s);
 			*s = NULL;
 			return JOB_INVALID;

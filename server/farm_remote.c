@@ -111,7 +111,7 @@ static enum job_status take_image(struct farm *f, size_t i, const struct srv_htt
 	const struct farm_job *j = &f->jobs[i];
 	struct job_result *r = &f->res[i];
 	int got = -1;
-	for (int k = API_FORMAT_PNG; k <= API_FORMAT_WEBP; k++) {
+	for (int k = API_FORMAT_PNG; k < API_FORMAT_COUNT; k++) {
 		const char *mime = api_format_mime((enum api_format)k);
 		if (!strncasecmp(resp->content_type, mime, strlen(mime))) got = k;
 	}
@@ -163,7 +163,7 @@ enum job_status farm_remote_job(struct farm *f, size_t i, const struct job_input
 	}
 	char headers[512];
 	if (request_headers(f, i, &m, headers, sizeof headers) < 0) {
-		snprintf(r->error, sizeof r->error, "output '%s' must end in .png, .exr or .webp", f->jobs[i].out);
+		snprintf(r->error, sizeof r->error, "output '%s' must end in .png, .exr, .webp or .avif", f->jobs[i].out);
 		multipart_release(&m);
 		return JOB_INVALID;
 	}

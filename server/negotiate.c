@@ -39,8 +39,12 @@ enum srv_accept srv_accept_choice(const char *accept)
 {
 	if (!accept || !*accept)
 		return SRV_ACCEPT_PNG;
-	double q_png = -1, q_exr = -1, q_webp = -1, q_wild = -1;
-	bool spec_png = false, spec_exr = false, spec_webp = false;
+	/* In the order a tie goes: PNG, then WebP, then AVIF, then EXR. */
+	static const char *const types[] = {"image/png", "image/webp", "image/avif", "image/x-exr"};
+	static const enum srv_accept choice[] = {SRV_ACCEPT_PNG, SRV_ACCEPT_WEBP, SRV_ACCEPT_AVIF, SRV_ACCEPT_EXR};
+	enum { N = sizeof types / sizeof types[0] };
+	double q_of[N], q_wild = -1;
+	bool named[N] = {false};
 	const char *p = accept;
 	while (*p) {
 		while (*p == ' ' || *p == ',')
@@ -64,31 +68,21 @@ enum srv_accept srv_accept_choice(const char *accept)
 		char *end = buf + strlen(buf);
 		while (end > buf && (end[-1] == ' ' || end[-1] == '\t'))
 			*--end = 0;
-		if (!strcasecmp(buf, "image/png")) {
-			q_png = q;
-			spec_png = true;
-		} else if (!strcasecmp(buf, "image/x-exr")) {
-			q_exr = q;
-			spec_exr = true;
-		} else if (!strcasecmp(buf, "image/webp")) {
-			q_webp = q;
-			spec_webp = true;
-		} else if (!strcasecmp(buf, "image/*") || !strcasecmp(buf, "*/*")) {
-			if (q > q_wild)
-				q_wild = q;
-		}
+		for (int k = 0; k < N; k++)
+			if (!strcasecmp(buf, types[k])) {
+				q_of[k] = q;
+				named[k] = true;
+			}
+		if ((!strcasecmp(buf, "image/*") || !strcasecmp(buf, "*/*")) && q > q_wild)
+			q_wild = q;
 	}
-	if (!spec_png)
-		q_png = q_wild;
-	if (!spec_exr)
-		q_exr = q_wild;
-	if (!spec_webp)
-		q_webp = q_wild;
-	if (q_png <= 0 && q_exr <= 0 && q_webp <= 0)
-		return SRV_ACCEPT_NONE;
-	if (q_png >= q_webp && q_png >= q_exr)
-		return SRV_ACCEPT_PNG;
-	return q_webp >= q_exr ? SRV_ACCEPT_WEBP : SRV_ACCEPT_EXR;
+	int best = -1;
+	for (int k = 0; k < N; k++) {
+		double q = named[k] ? q_of[k] : q_wild;
+		if (q > 0 && (best < 0 || q > (named[best] ? q_of[best] : q_wild)))
+			best = k;
+	}
+	return best < 0 ? SRV_ACCEPT_NONE : choice[best];
 }
 
 /* ---- ETag ---- */

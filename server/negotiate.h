@@ -25,11 +25,11 @@ bool srv_json_content_type(const char *content_type);
 /* multipart/form-data (with its parameters). */
 bool srv_multipart_content_type(const char *content_type);
 
-/* What an Accept header asks of a render: the format of highest q among PNG, EXR (image/x-exr)
- * and WebP (image/webp); PNG without the header, and on a tie PNG, then WebP, then EXR; or none
- * (every candidate at q = 0 or not named, no wildcard): a 406. Wildcards count with their q for
- * each format not named. */
-enum srv_accept { SRV_ACCEPT_PNG, SRV_ACCEPT_EXR, SRV_ACCEPT_NONE, SRV_ACCEPT_WEBP };
+/* What an Accept header asks of a render: the format of highest q among PNG, EXR (image/x-exr),
+ * WebP (image/webp) and AVIF (image/avif); PNG without the header, and on a tie PNG, then WebP,
+ * then AVIF, then EXR; or none (every candidate at q = 0 or not named, no wildcard): a 406.
+ * Wildcards count with their q for each format not named. */
+enum srv_accept { SRV_ACCEPT_PNG, SRV_ACCEPT_EXR, SRV_ACCEPT_NONE, SRV_ACCEPT_WEBP, SRV_ACCEPT_AVIF };
 enum srv_accept srv_accept_choice(const char *accept);
 
 /* The ETag of a render, and the name of its stored result (GET /v1/renders/{hash}.{ext}): the

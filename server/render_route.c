@@ -126,7 +126,7 @@ enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection 
 	const char *accept = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
 	enum srv_accept choice = srv_accept_choice(accept);
 	if (choice == SRV_ACCEPT_NONE)
-		return srv_respond_problem(req, 406, NULL, "", "this server answers image/png, image/webp or image/x-exr (or a "
+		return srv_respond_problem(req, 406, NULL, "", "this server answers image/png, image/webp, image/avif or image/x-exr (or a "
 		                       "problem+json document); Accept: %.200s names none of them", accept);
 	req->want = choice;
 	req->state = SRV_REQ_BODY;

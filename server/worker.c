@@ -240,7 +240,9 @@ static int job_parse(struct srv_server *s, struct srv_request *req, struct parse
 	/* A header value is one line of printable ASCII: file names from a model may hold anything. */
 	for (size_t i = 0; i + 1 < sizeof req->warnings && (req->warnings[i] = sc->warnings[i]); i++)
 		if ((unsigned char)req->warnings[i] < 0x20 || (unsigned char)req->warnings[i] > 0x7e) req->warnings[i] = '?';
-	enum api_format accepted = req->want == SRV_ACCEPT_EXR ? API_FORMAT_EXR : API_FORMAT_WEBP;
+	enum api_format accepted = req->want == SRV_ACCEPT_EXR    ? API_FORMAT_EXR
+	                           : req->want == SRV_ACCEPT_AVIF ? API_FORMAT_AVIF
+	                                                          : API_FORMAT_WEBP;
 	if ((req->want != SRV_ACCEPT_PNG && !sc->format_explicit && api_scene_set_format(sc, accepted, &p) != API_OK) ||
 	    api_scene_check_output(sc, &p) != API_OK) {
 		job_problem(req, &p);

@@ -75,18 +75,25 @@ bool alpha_keep(umbra_material m, float alpha, vec2 frag)
 // The shading normal: the normal map (tangent space, xy times normalTexture.scale) in the
 // frame of the interpolated tangent when `mapped`, else the geometric normal. The main pass
 // shades with it and the AOV pass writes it (N.X/Y/Z), so both show the same surface.
-vec3 material_normal(umbra_material m, vec3 n_geo, bool mapped)
+// A tangent-space normal map's normal (texture slot `slot` of m, xy times scale) in the frame of
+// the interpolated tangent around n_geo; n_geo where the uvs give no usable tangent.
+vec3 tangent_normal(sampler2D s, umbra_material m, uint slot, vec3 n_geo, float scale)
 {
-	if (!mapped) return n_geo;
 	vec3 t = v_tangent.xyz - n_geo * dot(n_geo, v_tangent.xyz);
 	float tl = length(t);
 	if (tl < 1e-4) return n_geo;   // no usable tangent here (degenerate uvs)
 	t /= tl;
 	vec3 b = cross(n_geo, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-	vec3 tn = material_texture(normal_texture, m, UMBRA_TEX_NORMAL, v_uv, v_uv1).xyz * 2.0 - 1.0;
-	tn.xy *= m.params.z;
+	vec3 tn = material_texture(s, m, slot, v_uv, v_uv1).xyz * 2.0 - 1.0;
+	tn.xy *= scale;
 	vec3 n = t * tn.x + b * tn.y + n_geo * tn.z;
 	float nl = length(n);
 	return nl > 1e-6 ? n / nl : n_geo;
+}
+
+vec3 material_normal(umbra_material m, vec3 n_geo, bool mapped)
+{
+	if (!mapped) return n_geo;
+	return tangent_normal(normal_texture, m, UMBRA_TEX_NORMAL, n_geo, m.params.z);
 }
 #endif

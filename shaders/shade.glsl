@@ -23,6 +23,7 @@ vec4 shade(umbra_material m, uint flags, vec4 bc, vec3 n_geo, vec3 p_shadow, vec
 	metal = clamp(metal, 0.0, 1.0);
 	vec3 f0 = mix(vec3(0.04), base, metal);
 	vec3 c_diff = base * (1.0 - metal);
+	if (SC_MATERIAL_EXT != 0u) f0 = ext_surface_at(m, N, n_geo, V, base, metal, f0);
 	bool receive = (flags & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	vec3 lit, unshadowed;
 	float debug_vis;
@@ -34,6 +35,7 @@ vec4 shade(umbra_material m, uint flags, vec4 bc, vec3 n_geo, vec3 p_shadow, vec
 	if (has_tex(m, UMBRA_TEX_OCCLUSION))
 		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv, v_uv1).r - 1.0);
 	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * metal) * ao;
+	if (SC_MATERIAL_EXT != 0u) ambient = ext_ambient(ambient, mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * ao, N, V);
 	vec3 emissive = m.emissive.rgb;
 	if (has_tex(m, UMBRA_TEX_EMISSIVE))
 		emissive *= material_texture(emissive_texture, m, UMBRA_TEX_EMISSIVE, v_uv, v_uv1).rgb;

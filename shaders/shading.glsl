@@ -54,11 +54,12 @@ layout(constant_id = UMBRA_SC_TONEMAP) const uint SC_TONEMAP = 0u;     // UMBRA_
 layout(constant_id = UMBRA_SC_CATCHER) const uint SC_CATCHER = 0u;     // scene has shadow catchers
 layout(constant_id = UMBRA_SC_LIGHT_TYPES) const uint SC_LIGHT_TYPES = 7u; // bit (1 << UMBRA_LIGHT_*)
 layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any directional light has cascades
-layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 127u; // bit (1 << UMBRA_TEX_*) | vertex colour | uv1
+layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 16383u; // bit (1 << UMBRA_TEX_*) | vertex colour | uv1
 layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1 << UMBRA_ALPHA_*)
 layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any light marches contact shadows
 layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
 layout(constant_id = UMBRA_SC_SAMPLES) const uint SC_SAMPLES = 1u;      // samples the pass rasterises
+layout(constant_id = UMBRA_SC_MATERIAL_EXT) const uint SC_MATERIAL_EXT = 0u; // UMBRA_EXT_* lobes (material_ext.glsl)
 
 #ifdef UMBRA_VIS_PASS
 // vis.frag: the surface comes from the surfaces image, not from a triangle.
@@ -91,6 +92,8 @@ bool has_tex(umbra_material m, uint slot)
 }
 
 const float PI = 3.14159265358979;
+
+#include "material_ext.glsl"
 
 // ---- shadow sampling -------------------------------------------------------------------
 
@@ -540,6 +543,7 @@ void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 p_shadow, vec3 V, vec3 c_
 		float vis_g = 0.5 / (ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2));
 		vec3 F = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
 		vec3 brdf = c_diff / PI + F * (D * vis_g);
+		if (SC_MATERIAL_EXT != 0u) brdf = ext_light(brdf, D * vis_g, vdh, N, V, l, ndl);
 		vec3 e = L.color.rgb * atten * ndl;
 		unshadowed += brdf * e;
 		lit += brdf * e * vis;

@@ -68,7 +68,18 @@
 #define UMBRA_TEX_NORMAL             2  /* linear tangent-space normal */
 #define UMBRA_TEX_OCCLUSION          3  /* linear: R ambient occlusion */
 #define UMBRA_TEX_EMISSIVE           4  /* sRGB */
-#define UMBRA_TEX_SLOTS              5
+/* The glTF PBR extensions' textures (material_ext.glsl), read only where the scene has that
+ * lobe (UMBRA_SC_MATERIAL_EXT). The sRGB class for the colour ones and for those read in
+ * alpha (sRGB leaves alpha linear), so an exporter's one image for colour and alpha (specular
+ * colour + specular, sheen colour + sheen roughness) is one image. */
+#define UMBRA_TEX_CLEARCOAT          5  /* linear: R clearcoat factor */
+#define UMBRA_TEX_CLEARCOAT_ROUGHNESS 6 /* linear: G clearcoat roughness */
+#define UMBRA_TEX_CLEARCOAT_NORMAL   7  /* linear tangent-space normal of the coat */
+#define UMBRA_TEX_SHEEN_COLOR        8  /* sRGB: rgb sheen colour */
+#define UMBRA_TEX_SHEEN_ROUGHNESS    9  /* A sheen roughness (sRGB class) */
+#define UMBRA_TEX_SPECULAR           10 /* A specular factor (sRGB class) */
+#define UMBRA_TEX_SPECULAR_COLOR     11 /* sRGB: rgb specular colour */
+#define UMBRA_TEX_SLOTS              12
 #define UMBRA_BINDING_BASE_TEXTURE       UMBRA_TEX_BASE
 #define UMBRA_BINDING_METAL_ROUGH_TEXTURE UMBRA_TEX_METAL_ROUGH
 #define UMBRA_BINDING_NORMAL_TEXTURE     UMBRA_TEX_NORMAL
@@ -82,7 +93,7 @@
 #define UMBRA_TEXBIT_UV1             (1u << (UMBRA_TEX_SLOTS + 1))
 /* umbra_material.tex.x, bit (1 << (UMBRA_TEX_UV1_SHIFT + UMBRA_TEX_*)): that slot samples
  * the second uv set (glTF TEXCOORD_1) instead of the first. */
-#define UMBRA_TEX_UV1_SHIFT          8
+#define UMBRA_TEX_UV1_SHIFT          16
 /* Vertex input: binding 0 the interleaved vertices (locations 0..4: position, normal, uv,
  * colour, tangent), binding 1 the second uv set, a float2 per vertex at this location (the
  * vertices' own buffer bound there when the scene has no second uv set: never read then). */
@@ -156,10 +167,17 @@
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
 #define UMBRA_SC_PCF_RADIUS  10   /* 2 when every PCF-filtered light has the default radius 1; 0: read per light */
-#define UMBRA_SC_COUNT       11
+#define UMBRA_SC_MATERIAL_EXT 11  /* UMBRA_EXT_* bits of the drawn materials: the extension lobes compiled in */
+#define UMBRA_SC_COUNT       12
 /* Not in the key's sc[]: pipelines.c sets it from the pipeline's own sample count (the key
  * has that already, so it makes no variant of its own). */
-#define UMBRA_SC_SAMPLES     11   /* rasterization samples: 1 or 4 */
+#define UMBRA_SC_SAMPLES     12   /* rasterization samples: 1 or 4 */
+
+/* umbra_material.ext.x and UMBRA_SC_MATERIAL_EXT: the glTF PBR extensions a material uses
+ * (shaders/material_ext.glsl draws them; a scene without any compiles none of their code). */
+#define UMBRA_EXT_CLEARCOAT 1u    /* KHR_materials_clearcoat: a second specular lobe over the base */
+#define UMBRA_EXT_SHEEN     2u    /* KHR_materials_sheen: a Charlie sheen lobe over the base */
+#define UMBRA_EXT_SPECULAR  4u    /* KHR_materials_specular / _ior: the dielectric F0, F90 and weight */
 
 /* umbra_material.params.z flags */
 #define UMBRA_MATERIAL_SHADOW_CATCHER 1u
@@ -202,6 +220,11 @@ struct umbra_material {
 	U_VEC4 params;           /* x metallic, y alpha cutoff, z normal scale, w occlusion strength */
 	U_UVEC4 tex;             /* x texture bits (1 << UMBRA_TEX_*) and uv-set-1 bits
 	                            (1 << (UMBRA_TEX_UV1_SHIFT + UMBRA_TEX_*)), y UMBRA_ALPHA_* */
+	/* The extensions (read only where UMBRA_SC_MATERIAL_EXT has their bit): */
+	U_VEC4 clearcoat;        /* x factor, y roughness, z normal scale, w the coat's F0 (from the ior) */
+	U_VEC4 sheen;            /* rgb colour, w roughness */
+	U_VEC4 specular;         /* rgb the dielectric F0 (from the ior) x specular colour, w specular factor */
+	U_UVEC4 ext;             /* x UMBRA_EXT_* bits */
 	/* per texture slot, the uv transform (KHR_texture_transform) as two rows:
 	 * uv' = (dot(uvx[2s].xy, uv) + uvx[2s].z, dot(uvx[2s+1].xy, uv) + uvx[2s+1].z) */
 	U_VEC4 uvx[2 * UMBRA_TEX_SLOTS];

@@ -56,6 +56,8 @@ run_suite unit env LD_PRELOAD="$PRELOAD" "$BUILD/tests/unit_tests"
 [ -x "$BUILD/umbrad" ] && run_suite http-assets sh tests/http/assets.sh
 [ -x "$BUILD/umbrad" ] && run_suite http-origin sh tests/http/origin.sh
 [ -x "$BUILD/umbrad" ] && run_suite clients sh tests/clients/run.sh
+# Every command of README.md run as written, against a real umbrad (tests/readme/check.py).
+[ -x "$BUILD/umbrad" ] && [ -x "$BUILD/umbra-render" ] && run_suite readme sh tests/readme/run.sh
 [ -z "${ASAN:-}" ] && run_suite deploy sh deploy/check.sh
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_cluster.py
 # umbra-render thumb --server: the farm on three daemons behind HAProxy (and a fake server).

@@ -13,6 +13,7 @@
 #include <string.h>
 #include <time.h>
 #include "api.h"
+#include "util.h"
 #include "umbra/rnd.h"
 
 static double now_ms(void)
@@ -32,20 +33,6 @@ static double median(double *v, int n)
 {
 	qsort(v, (size_t)n, sizeof *v, cmp);
 	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static char *slurp(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	char *b = malloc((size_t)n + 1);
-	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
-	fclose(f);
-	*len = (size_t)n;
-	return b;
 }
 
 enum { S_PARSE, S_UPLOAD, S_SHADOW, S_MAIN, S_READBACK, S_ENCODE, S_TOTAL, S_VIS, S_COUNT };
@@ -86,7 +73,7 @@ int main(int argc, char **argv)
 	int rc = 0;
 	for (int a = first; a < argc; a++) {
 		size_t len;
-		char *json = slurp(argv[a], &len);
+		char *json = (char *)test_read_file(argv[a], &len);
 		if (!json) { fprintf(stderr, "bench: cannot read %s\n", argv[a]); rc = 1; continue; }
 		double *t = calloc((size_t)(n * S_COUNT), sizeof *t);
 		size_t bytes_out = 0;

@@ -121,8 +121,8 @@ python3 - "$T/models/coat.gltf" <<'PY'
 import base64, json, struct, sys
 pos = struct.pack('<9f', -1, 0, 0, 1, 0, 0, 0, 1, 0)
 g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-     "extensionsUsed": ["KHR_materials_clearcoat"],
-     "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}}],
+     "extensionsUsed": ["KHR_materials_iridescence"],
+     "materials": [{"extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}}],
      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + base64.b64encode(pos).decode()}],
      "bufferViews": [{"buffer": 0, "byteLength": 36}],
@@ -131,7 +131,7 @@ json.dump(g, open(sys.argv[1], "w"))
 PY
 cli thumb "$T/models/coat.gltf" "$T/models/cube.obj" -o "$T/thumbw/" --size 64 --no-progress 2>/dev/null
 check "thumb: report carries a model's material warnings" \
-	grep -q '"file":"[^"]*coat.gltf".*"warnings":"/objects/0: KHR_materials_clearcoat: the clear coat layer not drawn' "$T/thumbw/report.jsonl"
+	grep -q '"file":"[^"]*coat.gltf".*"warnings":"/objects/0: KHR_materials_iridescence: iridescence not drawn' "$T/thumbw/report.jsonl"
 check "thumb: no warnings for a model without such data" grep -q '"file":"[^"]*cube.obj".*"warnings":null' "$T/thumbw/report.jsonl"
 check "thumb: summary line" grep -q '3 ok, 1 invalid, 0 failed, 0 skipped of 4' "$T/thumb.err"
 
@@ -208,18 +208,23 @@ rc=$?
 check "thumb --transparent: exit 0" [ $rc = 0 ]
 a=$($PNG px "$T/tr/cube.png" 0 0 2>/dev/null | cut -d' ' -f4)
 check "thumb --transparent: corner alpha 0" [ "$a" = 0 ]
-cli thumb "$T/models/cube.obj" -o "$T/trw" --size 64 --transparent --format webp --no-progress 2>/dev/null
-check "thumb --format webp: DIR/NAME.webp, lossless with alpha, the PNG thumbnail's pixels" sh -c \
-	"[ \"\$(python3 tests/util/webp.py info '$T/trw/cube.webp' 2>&1)\" = '64 64 lossless alpha' ] &&
-	 [ \"\$(python3 tests/util/webp.py compare '$T/trw/cube.webp' '$T/tr/cube.png' 2>&1)\" = 'inf 0' ]"
-cli thumb "$T/models/cube.obj" -o "$T/trq" --size 64 --format WebP --quality 80 --no-progress 2>/dev/null
-check "thumb --format webp --quality 80: lossy" [ "$(python3 tests/util/webp.py info "$T/trq/cube.webp" 2>&1)" = "64 64 lossy opaque" ]
+# WebP and AVIF thumbnails: lossless (the PNG thumbnail's pixels, alpha too; decoded by the system's
+# libwebp and libavif's avifdec: tests/util/webp.py, avif.py) and lossy with --quality.
+for f in webp:WebP:80 avif:avif:60; do
+	ext=${f%%:*}; name=${f#*:}; name=${name%%:*}; q=${f##*:}
+	cli thumb "$T/models/cube.obj" -o "$T/tr-$ext" --size 64 --transparent --format "$name" --no-progress 2>/dev/null
+	check "thumb --format $name: DIR/NAME.$ext, lossless with alpha, the PNG thumbnail's pixels" sh -c \
+		"[ \"\$(python3 tests/util/$ext.py info '$T/tr-$ext/cube.$ext' 2>&1)\" = '64 64 lossless alpha' ] &&
+		 [ \"\$(python3 tests/util/$ext.py compare '$T/tr-$ext/cube.$ext' '$T/tr/cube.png' 2>&1)\" = 'inf 0' ]"
+	cli thumb "$T/models/cube.obj" -o "$T/trq-$ext" --size 64 --format "$name" --quality "$q" --no-progress 2>/dev/null
+	check "thumb --format $name --quality $q: lossy" [ "$(python3 tests/util/$ext.py info "$T/trq-$ext/cube.$ext" 2>&1)" = "64 64 lossy opaque" ]
+done
 cli thumb "$T/models/cube.obj" -o "$T/trq2" --quality 80 2>"$T/trq2.err"
 rc=$?
 check "thumb --quality without --format webp: refused (exit 1)" eval '[ $rc = 1 ] && grep -q "format webp" "$T/trq2.err"'
 cli thumb "$T/models/cube.obj" -o "$T/trq3" --format jpeg 2>"$T/trq3.err"
 rc=$?
-check "thumb --format jpeg: refused (exit 1), naming the formats" eval '[ $rc = 1 ] && grep -q "png, webp or exr" "$T/trq3.err"'
+check "thumb --format jpeg: refused (exit 1), naming the formats" eval '[ $rc = 1 ] && grep -q "png, webp, avif or exr" "$T/trq3.err"'
 
 # ---- thumb --up: a Z-up model (a post 0.3 x 0.3 x 2 along Z, as CAD and 3D-printing STLs lie)
 # stands up: its opaque pixels are taller than wide; without --up it lies on its side.
@@ -304,6 +309,11 @@ rc=$?
 check "quality with -o .png: exit 2 at /output/quality" eval '[ $rc = 2 ] && grep -q "/output/quality" "$T/q.err"'
 cli "$T/ground-q.json" -o "$T/ground-q.webp" 2>/dev/null
 check "quality with -o .webp: a lossy WebP" [ "$($WEBP info "$T/ground-q.webp" 2>&1)" = "96 96 lossy opaque" ]
+cli "$T/ground-q.json" -o "$T/ground-q.avif" 2>/dev/null
+check "quality with -o .avif: a lossy AVIF" [ "$(python3 tests/util/avif.py info "$T/ground-q.avif" 2>&1)" = "96 96 lossy opaque" ]
+cli "$T/ground-t.json" -o "$T/ground-t.avif" 2>/dev/null
+check "-o .avif: a lossless AVIF with the transparent PNG's pixels" \
+	[ "$(python3 tests/util/avif.py compare "$T/ground-t.avif" "$T/ground-t.png" 2>&1)" = "inf 0" ]
 # A model by `path`: only under --asset-root, never outside it.
 mkdir -p "$T/assets"
 printf 'v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n' >"$T/assets/tri.obj"
@@ -319,7 +329,7 @@ check "--asset-root: a path leaving it is exit 2" [ $? = 2 ]
 cli "$T/ground.json" -o "$T/ground.jpg" 2>"$T/jpg.err"
 rc=$?
 check "-o x.jpg: exit 2, nothing written, the reason on stderr" \
-	eval '[ $rc = 2 ] && [ ! -e "$T/ground.jpg" ] && grep -q "writes PNG (.png), EXR (.exr) or WebP (.webp)" "$T/jpg.err"'
+	eval '[ $rc = 2 ] && [ ! -e "$T/ground.jpg" ] && grep -q "writes PNG (.png), EXR (.exr), WebP (.webp) or AVIF (.avif)" "$T/jpg.err"'
 
 # ---- several scenes and a manifest in one process ----
 mkdir -p "$T/scenes"

@@ -94,13 +94,16 @@ put("fuzz_model_glb", "quantized.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + 
     struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(qbuf)) + b"BIN\0" + qbuf)
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
-    return b"UMBRAIMP" + struct.pack("<IIII", 4, kind, status, len(msg)) + msg
+    return b"UMBRAIMP" + struct.pack("<IIII", 5, kind, status, len(msg)) + msg
 tex = struct.pack("<II", 2, 1) + bytes([255, 0, 0, 255, 0, 255, 0, 255])
 # material: 13 floats, alpha mode, a texture per slot (base, metal-rough, normal, occlusion,
-# emissive), per slot the sampling (packed modes + a 2x3 uv transform; bit 9: the second uv
-# set, here on the occlusion slot)
-mat = struct.pack("<13f", 1, 1, 1, 1, 0.5, 0, 1, 1, 1, 0.5, 1, 1, 0) + struct.pack("<I5i", 2, 0, -1, 0, -1, 0) + \
-      b"".join(struct.pack("<I6f", 0x45 | (0x200 if s == 3 else 0), 1, 0, 0.5, 0, 1, 0) for s in range(5))
+# emissive, clearcoat, its roughness and normal, sheen colour and roughness, specular and its
+# colour), per slot the sampling (packed modes + a 2x3 uv transform; bit 9: the second uv set,
+# here on the occlusion slot), then the PBR extensions (bits: clearcoat and sheen; 11 floats
+# and the ior)
+mat = struct.pack("<13f", 1, 1, 1, 1, 0.5, 0, 1, 1, 1, 0.5, 1, 1, 0) + struct.pack("<I12i", 2, 0, -1, 0, -1, 0, 0, -1, -1, 0, -1, -1, -1) + \
+      b"".join(struct.pack("<I6f", 0x45 | (0x200 if s == 3 else 0), 1, 0, 0.5, 0, 1, 0) for s in range(12)) + \
+      struct.pack("<I12f", 3, 1, 0.1, 1, 0.5, 0.5, 0.5, 0.8, 1, 1, 1, 1, 1.5)
 # mesh: normals, uvs, colours, tangents, single-sided, a second uv set (flag 128, after the uvs)
 mesh = struct.pack("<4I", 3, 3, 0, 31 | 128) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + \
        struct.pack("<6f", 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0.5, 0.5, 1, 0.5, 0.5, 1) + \

@@ -15,28 +15,15 @@
 #include "model.h"
 #include "gpu_util.h"
 #include "test.h"
+#include "util.h"
 
 #define TRUTH_DIR "tests/gpu/truth/"
-
-static uint8_t *read_file(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	uint8_t *b = n > 0 ? malloc((size_t)n + 1) : NULL;
-	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
-	fclose(f);
-	if (b) { b[n] = 0; *len = (size_t)n; }
-	return b;
-}
 
 /* A grey PNG of the reference as 0..1 floats (w x h); NULL when missing. */
 static float *read_grey(const char *path, uint32_t w, uint32_t h)
 {
 	size_t len;
-	uint8_t *png = read_file(path, &len), *rgba = NULL;
+	uint8_t *png = test_read_file(path, &len), *rgba = NULL;
 	uint32_t pw = 0, ph = 0;
 	char err[200];
 	float *out = NULL;
@@ -131,7 +118,7 @@ static void check_scene(const char *name, double max_rmse, double min_iou, doubl
 	char path[256];
 	size_t len;
 	snprintf(path, sizeof path, TRUTH_DIR "%s.json", name);
-	char *doc = (char *)read_file(path, &len);
+	char *doc = (char *)test_read_file(path, &len);
 	REQUIRE(doc, "cannot read %s", path);
 	const int w = 128, h = 128;
 	snprintf(path, sizeof path, TRUTH_DIR "%s.vis.png", name);
@@ -259,7 +246,7 @@ TEST(truth_contact_shadows_sun_low_res_map)
 {
 	const int w = 128, h = 128;
 	size_t len;
-	char *doc = (char *)read_file(TRUTH_DIR "contact_sun.json", &len);
+	char *doc = (char *)test_read_file(TRUTH_DIR "contact_sun.json", &len);
 	REQUIRE(doc, "cannot read " TRUTH_DIR "contact_sun.json");
 	float *truth = read_grey(TRUTH_DIR "contact_sun.vis.png", w, h);
 	float *mask = read_grey(TRUTH_DIR "contact_sun.mask.png", w, h);
@@ -319,7 +306,7 @@ TEST(truth_soft_spot_contact_on_meets_missing_contact)
 {
 	const int w = 128, h = 128;
 	size_t len;
-	char *doc = (char *)read_file(TRUTH_DIR "spot_pcss.json", &len);
+	char *doc = (char *)test_read_file(TRUTH_DIR "spot_pcss.json", &len);
 	REQUIRE(doc, "cannot read " TRUTH_DIR "spot_pcss.json");
 	float *truth = read_grey(TRUTH_DIR "spot_pcss.vis.png", w, h);
 	float *mask = read_grey(TRUTH_DIR "spot_pcss.mask.png", w, h);

@@ -48,6 +48,13 @@ c=$(curl -s --max-time 30 -I -o /dev/null -D "$T/ghead.hdr" -w '%{http_code} %{s
 check "HEAD: 200 image/png, no body ($c)" sh -c "[ '$c' = '200 0' ] && [ '$(hdr ghead Content-Type)' = image/png ]"
 c=$(renders p2 "$URL" "$T/thumb2.json" "$T/cube.obj")
 check "re-serialized JSON (keys reordered, whitespace, 128.0): the same Location" sh -c "[ '$c' = 303 ] && [ '$(hdr p2 Location)' = '$loc' ]"
+# Defaults written out: the ETag is of the parsed scene with its defaults filled.
+printf '{"preset": "thumbnail", "width": 128, "height": 128, "objects": [{"shape": "model", "part": "m", "format": "obj", "cast_shadows": true, "transform": {"scale": [1, 1, 1]}}], "output": {"msaa": 4}, "camera": {"exposure": 0}}' >"$T/thumb3.json"
+c=$(renders p2d "$URL" "$T/thumb3.json" "$T/cube.obj")
+check "defaults written out (cast_shadows true, scale 1, msaa 4, exposure 0): the same Location" sh -c "[ '$c' = 303 ] && [ '$(hdr p2d Location)' = '$loc' ]"
+sed 's/"exposure": 0/"exposure": 0.5/' "$T/thumb3.json" >"$T/thumb4.json"
+c=$(renders p2e "$URL" "$T/thumb4.json" "$T/cube.obj")
+check "a value that is not the default (exposure 0.5): another Location" sh -c "[ '$c' = 303 ] && [ '$(hdr p2e Location)' != '$loc' ]"
 c=$(renders p3 "$URL" "$T/thumb.json" "$T/cube2.obj")
 check "a changed model: another Location" sh -c "[ '$c' = 303 ] && [ -n '$(hdr p3 Location)' ] && [ '$(hdr p3 Location)' != '$loc' ]"
 c=$(renders p412 "$URL" "$T/thumb.json" "$T/cube.obj" -H "If-None-Match: $etag")

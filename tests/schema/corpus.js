@@ -61,9 +61,12 @@ module.exports = [
   ['format exr with aovs', 'accept', out({ format: 'exr', aovs: ['depth', 'shadow'] })],
   ['format webp', 'accept', out({ format: 'webp', transparent: true })],
   ['format webp with quality', 'accept', out({ format: 'webp', quality: 80 })],
+  ['format avif', 'accept', out({ format: 'avif', transparent: true })],
+  ['format avif with quality', 'accept', out({ format: 'avif', quality: 70 })],
   // Without output.format the Accept header chooses: the schema takes the document, which is
   // valid for the answer these name (the 4th element: the request's Accept).
   ['quality without format, Accept: image/webp', 'accept', out({ quality: 80 }), 'image/webp'],
+  ['quality without format, Accept: image/avif', 'accept', out({ quality: 60 }), 'image/avif'],
   ['aovs without format, Accept: image/x-exr', 'accept', out({ aovs: ['normal'] }), 'image/x-exr'],
   ['png bit_depth 16, png_level 9, tonemap aces', 'accept', out({ bit_depth: 16, png_level: 9, tonemap: 'aces' })],
   ['preset', 'accept', preset()],
@@ -111,6 +114,8 @@ module.exports = [
   ['quality 101', 'reject', out({ format: 'webp', quality: 101 })],
   ['aovs with format png', 'reject', out({ format: 'png', aovs: ['depth'] })],
   ['aovs with format webp', 'reject', out({ format: 'webp', aovs: ['depth'] })],
+  ['aovs with format avif', 'reject', out({ format: 'avif', aovs: ['depth'] })],
+  ['quality with format exr', 'reject', out({ format: 'exr', quality: 70 })],
   ['bit_depth 12', 'reject', out({ bit_depth: 12 })],
   ['msaa 2', 'reject', out({ msaa: 2 })],
   ['preset with "camera": null and no views (the camera is then missing)', 'reject', preset({ camera: null })],

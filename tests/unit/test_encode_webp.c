@@ -6,29 +6,9 @@
 #include <string.h>
 #include <webp/decode.h>
 #include "api.h"
+#include "models.h"
 #include "test.h"
-
-/* A render-like RGBA8 image: a smooth gradient, a dark disc (a shadow) and, unless opaque, an
- * alpha ramp with a fully transparent border whose colours must survive too (exact mode). */
-static struct rnd_image make_rgba8(uint32_t w, uint32_t h, bool opaque)
-{
-	struct rnd_image img = {0};
-	img.width = w;
-	img.height = h;
-	img.format = RND_PIXELS_RGBA8;
-	img.stride = (size_t)w * 4 + 12;   /* padded rows: the stride is honoured */
-	img.pixels = calloc(h, img.stride);
-	for (uint32_t y = 0; y < h; y++)
-		for (uint32_t x = 0; x < w; x++) {
-			uint8_t *px = (uint8_t *)img.pixels + y * img.stride + 4 * x;
-			double dx = x - w / 2.0, dy = y - h / 2.0, shade = dx * dx + dy * dy < w * h / 16.0 ? 0.4 : 1.0;
-			px[0] = (uint8_t)(shade * (60 + 150.0 * x / w));
-			px[1] = (uint8_t)(shade * (80 + 120.0 * y / h));
-			px[2] = (uint8_t)(shade * 170);
-			px[3] = opaque ? 255 : x < 2 || y < 2 ? 0 : (uint8_t)(128 + 127.0 * x / w);
-		}
-	return img;
-}
+#include "util.h"
 
 static uint8_t *webp_decode(const uint8_t *data, size_t len, int *w, int *h, WebPBitstreamFeatures *f)
 {
@@ -36,25 +16,9 @@ static uint8_t *webp_decode(const uint8_t *data, size_t len, int *w, int *h, Web
 	return WebPDecodeRGBA(data, len, w, h);
 }
 
-/* Peak signal-to-noise ratio of the RGB channels, dB; *alpha_diff the largest alpha error. */
-static double psnr_rgb(const struct rnd_image *img, const uint8_t *rgba, int *alpha_diff)
-{
-	double se = 0;
-	*alpha_diff = 0;
-	for (uint32_t y = 0; y < img->height; y++)
-		for (uint32_t x = 0; x < img->width; x++) {
-			const uint8_t *a = (const uint8_t *)img->pixels + y * img->stride + 4 * x;
-			const uint8_t *b = rgba + 4 * ((size_t)y * img->width + x);
-			for (int c = 0; c < 3; c++) se += (double)(a[c] - b[c]) * (a[c] - b[c]);
-			if (abs(a[3] - b[3]) > *alpha_diff) *alpha_diff = abs(a[3] - b[3]);
-		}
-	double mse = se / (3.0 * img->width * img->height);
-	return mse > 0 ? 10 * log10(255.0 * 255.0 / mse) : INFINITY;
-}
-
 static void check_lossless(bool opaque)
 {
-	struct rnd_image img = make_rgba8(61, 37, opaque);
+	struct rnd_image img = test_rgba8_image(61, 37, opaque);
 	uint8_t *out = NULL;
 	size_t len = 0;
 	struct api_problem p;
@@ -86,7 +50,7 @@ TEST(webp_lossless_opaque_exact_without_alpha) { check_lossless(true); }
 
 TEST(webp_lossy_q80_psnr_and_exact_alpha)
 {
-	struct rnd_image img = make_rgba8(128, 96, false);
+	struct rnd_image img = test_rgba8_image(128, 96, false);
 	uint8_t *lossy = NULL, *lossless = NULL;
 	size_t len = 0, lossless_len = 0;
 	struct api_problem p;
@@ -97,7 +61,7 @@ TEST(webp_lossy_q80_psnr_and_exact_alpha)
 	uint8_t *rgba = webp_decode(lossy, len, &w, &h, &f);
 	REQUIRE(rgba && w == 128 && h == 96, "decoded %dx%d", w, h);
 	CHECK(f.format == 1 && f.has_alpha, "lossy with alpha (format %d, alpha %d)", f.format, f.has_alpha);
-	double db = psnr_rgb(&img, rgba, &alpha_diff);
+	double db = test_psnr_rgb(&img, rgba, &alpha_diff);
 	/* Fully transparent pixels may be given any colour by a lossy encoder: the border is
 	 * 2 pixels wide, so its share of the error stays small. */
 	CHECK(db > 30, "PSNR %.1f dB at quality 80", db);
@@ -109,39 +73,17 @@ TEST(webp_lossy_q80_psnr_and_exact_alpha)
 	rnd_image_release(&img);
 }
 
-TEST(webp_refuses_what_it_cannot_write)
-{
-	struct rnd_image img = make_rgba8(4, 4, true);
-	uint8_t *out = NULL;
-	size_t len = 0;
-	struct api_problem p;
-	img.format = RND_PIXELS_RGBA16;
-	CHECK(api_webp_encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 500 && !out);
-	img.format = RND_PIXELS_RGBA8;
-	img.width = API_WEBP_MAX_SIDE + 1;   /* the check comes before any pixel is read */
-	img.stride = (size_t)img.width * 4;
-	CHECK(api_webp_encode(&img, -1, &out, &len, &p) == API_ERR && p.status == 422 && !out, "%d", p.status);
-	rnd_image_release(&img);
-}
-
-static struct api_scene *parse(const char *doc, struct api_problem *p)
-{
-	struct api_scene *s = NULL;
-	memset(p, 0, sizeof *p);
-	return api_scene_parse(doc, strlen(doc), NULL, &s, p) == API_OK ? s : NULL;
-}
-
 #define DOC(output) "{\"camera\":{},\"objects\":[],\"output\":" output "}"
 
 TEST(webp_dispatch_from_output_format)
 {
 	struct api_problem p;
-	struct api_scene *s = parse(DOC("{\"format\":\"webp\",\"transparent\":true,\"bit_depth\":16}"), &p);
+	struct api_scene *s = test_parse_scene(DOC("{\"format\":\"webp\",\"transparent\":true,\"bit_depth\":16}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(s->format == API_FORMAT_WEBP && s->quality < 0 && s->scene.output.pixels == RND_PIXELS_RGBA8);
 	CHECK(!strcmp(api_format_mime(s->format), "image/webp"));
 	CHECK(strstr(s->warnings, "/output/bit_depth: not used, the answer is WebP"), "%s", s->warnings);
-	struct rnd_image img = make_rgba8(16, 8, false);
+	struct rnd_image img = test_rgba8_image(16, 8, false);
 	uint8_t *out = NULL;
 	size_t len = 0;
 	REQUIRE(api_encode(s, &img, &out, &len, &p) == API_OK, "%s", p.detail);
@@ -151,10 +93,10 @@ TEST(webp_dispatch_from_output_format)
 	rnd_image_release(&img);
 	api_scene_free(s);
 
-	s = parse(DOC("{\"format\":\"webp\",\"quality\":80}"), &p);
+	s = test_parse_scene(DOC("{\"format\":\"webp\",\"quality\":80}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(s->quality == 80);
-	img = make_rgba8(16, 8, true);
+	img = test_rgba8_image(16, 8, true);
 	REQUIRE(api_encode(s, &img, &out, &len, &p) == API_OK, "%s", p.detail);
 	CHECK(WebPGetFeatures(out, len, &f) == VP8_STATUS_OK && f.format == 1 && !f.has_alpha);
 	free(out);
@@ -177,7 +119,7 @@ TEST(webp_output_members_refused)
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
 		struct api_problem p;
-		struct api_scene *s = parse(bad[i].doc, &p);
+		struct api_scene *s = test_parse_scene(bad[i].doc, &p);
 		CHECK(!s && p.status == 400 && !strcmp(p.pointer, bad[i].pointer) && strstr(p.detail, bad[i].detail),
 		      "%s: %d %s %s", bad[i].doc, p.status, p.pointer, p.detail);
 		api_scene_free(s);
@@ -189,7 +131,7 @@ TEST(webp_output_members_refused)
 TEST(webp_quality_waits_for_the_format)
 {
 	struct api_problem p;
-	struct api_scene *s = parse(DOC("{\"quality\":50}"), &p);
+	struct api_scene *s = test_parse_scene(DOC("{\"quality\":50}"), &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(api_scene_check_output(s, &p) == API_ERR && p.status == 400 && !strcmp(p.pointer, "/output/quality"),
 	      "%d %s", p.status, p.pointer);
@@ -200,7 +142,7 @@ TEST(webp_quality_waits_for_the_format)
 
 	/* A sheet of views wider than WebP's 16383 pixels: 422 at /views once the answer is WebP. */
 	const char *wide = "{\"width\":8192,\"height\":64,\"views\":[{},{}],\"objects\":[]}";
-	s = parse(wide, &p);
+	s = test_parse_scene(wide, &p);
 	REQUIRE(s, "%s", p.detail);
 	CHECK(api_scene_check_output(s, &p) == API_OK);
 	CHECK(api_scene_set_format(s, API_FORMAT_WEBP, &p) == API_OK);

@@ -193,7 +193,8 @@ TEST(model_levels_reply_is_validated)
 		struct api_mesh_levels out[1];
 		size_t bytes;
 		char err[300] = "";
-		enum api_result r = api_wire_decode_levels(b.data, b.len, sent, 1, a, out, &bytes, err, sizeof err);
+		enum api_result r = api_wire_decode_levels(b.data, b.len, (unsigned)c & API_WIRE_IN_PLACE, sent, 1, a, out, &bytes, err,
+		                                            sizeof err);
 		if (c == 0) CHECK(r == API_OK && out[0].count == 1 && out[0].lods[0].index_count == 6, "%s: %s", what[c], err);
 		else CHECK(r == API_ERR && strstr(err, "malformed"), "%s: refused (%s)", what[c], err);
 		api_arena_destroy(a);

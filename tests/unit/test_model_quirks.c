@@ -300,3 +300,24 @@ TEST(model_path_empty_or_too_large_says_which)
 	unlink(big);
 	rmdir(root);
 }
+
+/* Points and lines are drawn as thin geometry (api/model_strokes.c), no longer dropped: an
+ * .obj of one triangle, one line (`l`) and one point (`p`) imports as the triangle, a prism
+ * of 6 triangles along the line and an octahedron of 8 at the point, of radius 1/500 and
+ * 2.5/500 of the box's diagonal (here 5: 0.01 and 0.025). Before: the triangle alone. */
+TEST(model_points_and_lines_drawn_as_thin_geometry)
+{
+	static const char obj[] = "v 0 0 0\nv 4 0 0\nv 0 3 0\nv 4 3 0\nf 1 2 3\nl 2 4\np 4\n";
+	struct api_problem p;
+	struct api_scene *s = parse_inline(obj, strlen(obj), "obj", "", &p);
+	REQUIRE(s, "parse failed: %d %s", p.status, p.detail);
+	uint32_t tris = 0;
+	for (uint32_t i = 0; i < s->scene.object_count; i++) tris += s->scene.objects[i].index_count / 3;
+	struct rnd_aabb b = world_bounds(&s->scene);
+	printf("    %u objects, %u triangles; x %.3f..%.3f, y %.3f..%.3f\n", s->scene.object_count, tris, b.min[0], b.max[0],
+	       b.min[1], b.max[1]);
+	CHECK(tris == 1 + 6 + 8, "triangles %u, want 15 (the triangle, a prism, an octahedron)", tris);
+	/* the octahedron at (4, 3, 0) reaches 0.025 past it; the prism along x = 4 reaches 0.01 */
+	CHECK(fabsf(b.max[0] - 4.025f) < 1e-3f && fabsf(b.max[1] - 3.025f) < 1e-3f, "box max %.4f %.4f", b.max[0], b.max[1]);
+	api_scene_free(s);
+}

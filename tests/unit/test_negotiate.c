@@ -41,7 +41,13 @@ TEST(negotiate_accept)
 	CHECK(srv_accept_choice("image/webp") == SRV_ACCEPT_WEBP);
 	CHECK(srv_accept_choice("image/webp, image/png") == SRV_ACCEPT_PNG, "a tie keeps the default");
 	CHECK(srv_accept_choice("image/webp, image/x-exr") == SRV_ACCEPT_WEBP, "a tie: WebP before EXR");
-	CHECK(srv_accept_choice("image/avif,image/webp,*/*;q=0.8") == SRV_ACCEPT_WEBP, "a browser's image Accept");
+	CHECK(srv_accept_choice("image/avif,image/webp,*/*;q=0.8") == SRV_ACCEPT_WEBP, "a tie: WebP before AVIF");
+	CHECK(srv_accept_choice("image/avif") == SRV_ACCEPT_AVIF);
+	CHECK(srv_accept_choice("image/avif, image/x-exr") == SRV_ACCEPT_AVIF, "a tie: AVIF before EXR");
+	CHECK(srv_accept_choice("image/avif, image/webp;q=0.9, image/png;q=0.5") == SRV_ACCEPT_AVIF);
+	CHECK(srv_accept_choice("image/avif,image/webp,image/apng,image/*,*/*;q=0.8") == SRV_ACCEPT_PNG,
+	      "a browser's image Accept: image/* names PNG at q 1, and a tie keeps PNG");
+	CHECK(srv_accept_choice("image/avif;q=0, image/png;q=0, image/webp;q=0, image/x-exr;q=0") == SRV_ACCEPT_NONE);
 	CHECK(srv_accept_choice("image/webp;q=0.5, image/x-exr;q=0.9") == SRV_ACCEPT_EXR);
 	CHECK(srv_accept_choice("image/webp, image/*;q=0") == SRV_ACCEPT_WEBP);
 	CHECK(srv_accept_choice("image/webp;q=0, image/png;q=0, image/x-exr;q=0") == SRV_ACCEPT_NONE);

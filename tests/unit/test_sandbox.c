@@ -296,6 +296,7 @@ static void wire_model(struct api_wire_buf *b, uint32_t index2, float x0)
 	api_wire_put_model(b, &m);
 }
 
+/* Decoded both ways (copied, and in place): the same answer, or API_ERR with err. */
 static enum api_result decode(const uint8_t *d, size_t n, struct api_model *m, char *err, size_t errsize)
 {
 	enum api_wire_kind k;
@@ -303,10 +304,14 @@ static enum api_result decode(const uint8_t *d, size_t n, struct api_model *m, c
 	const uint8_t *body;
 	size_t blen, bytes;
 	if (api_wire_header(d, n, &k, &st, NULL, 0, &body, &blen, err, errsize) != API_OK) return API_ERR;
-	struct api_arena *a = api_arena_create();
-	enum api_result rc = api_wire_decode_model(body, blen, a, 1u << 20, m, &bytes, err, errsize);
-	api_arena_destroy(a); /* m's arrays die here: callers look only at counts */
-	return rc;
+	enum api_result rc[2];
+	for (unsigned f = 0; f < 2; f++) {
+		struct api_arena *a = api_arena_create();
+		rc[f] = api_wire_decode_model(body, blen, f ? API_WIRE_IN_PLACE : 0, a, 1u << 20, m, &bytes, err, errsize);
+		api_arena_destroy(a); /* m's arrays die here: callers look only at counts */
+	}
+	CHECK(rc[0] == rc[1], "copied %d, in place %d", rc[0], rc[1]);
+	return rc[1];
 }
 
 TEST(sandbox_reply_decoder_refuses_malformed)
@@ -327,8 +332,9 @@ TEST(sandbox_reply_decoder_refuses_malformed)
 	longer[b.len] = 0;
 	CHECK(decode(longer, b.len + 1, &m, err, sizeof err) == API_ERR);
 	free(longer);
-	/* Counts that lie: each of the four count fields set to 0xffffffff. */
-	size_t counts = 24;
+	/* Counts that lie: each of the four count fields set to 0xffffffff (after the header, the
+	 * stage times and the texture sizes). */
+	size_t counts = 24 + 16 + 8;
 	for (int f = 0; f < 4; f++) {
 		uint32_t save, lie = 0xffffffffu;
 		memcpy(&save, b.data + counts + 4 * f, 4);
@@ -343,12 +349,12 @@ TEST(sandbox_reply_decoder_refuses_malformed)
 	uint8_t *body = calloc(1, BODY);
 	REQUIRE(body);
 	uint32_t lie_counts[4] = {0, 1, 1, BODY / 8 - 2};
-	memcpy(body, lie_counts, sizeof lie_counts);
+	memcpy(body + 24, lie_counts, sizeof lie_counts);   /* after the stage times and texture sizes */
 	struct api_arena *a = api_arena_create();
 	size_t bytes;
 	err[0] = 0;
-	CHECK(api_wire_decode_model(body, BODY, a, 1u << 20, &m, &bytes, err, sizeof err) == API_ERR &&
-	      strstr(err, "instances"), "%s", err);
+	CHECK(api_wire_decode_model(body, BODY, 0, a, 1u << 20, &m, &bytes, err, sizeof err) == API_ERR &&
+	      strstr(err, "0 textures, 1 materials, 1 meshes, 8190 instances"), "%s", err);
 	api_arena_destroy(a);
 	free(body);
 	/* An index past the vertices, a NaN position. */
@@ -382,6 +388,7 @@ TEST(sandbox_reply_second_uv_set_round_trip)
 	                      .materials = &mat, .material_count = 1};
 	for (int nan = 0; nan < 2; nan++) {
 		uv1[3] = nan ? NAN : 0.5f;
+		mat.sampling[RND_TEX_BASE].transform[0] = 1.0f;
 		struct api_wire_buf b = {0};
 		api_wire_put_header(&b, API_WIRE_MODEL, API_WIRE_OK, NULL);
 		api_wire_put_model(&b, &m);
@@ -394,12 +401,15 @@ TEST(sandbox_reply_second_uv_set_round_trip)
 		REQUIRE(api_wire_header(b.data, b.len, &k, &st, NULL, 0, &body, &blen, err, sizeof err) == API_OK, "%s", err);
 		struct api_arena *a = api_arena_create();
 		struct api_model out;
-		enum api_result rc = api_wire_decode_model(body, blen, a, 1u << 20, &out, &bytes, err, sizeof err);
+		unsigned in_place = (unsigned)nan ^ 1u;   /* the good reply decoded in place, the bad one copied */
+		enum api_result rc = api_wire_decode_model(body, blen, in_place, a, 1u << 20, &out, &bytes, err, sizeof err);
 		if (nan) {
 			CHECK(rc == API_ERR && strstr(err, "finite"), "a NaN uv1: %d %s", rc, err);
 		} else {
 			REQUIRE(rc == API_OK, "%s", err);
 			CHECK(out.meshes[0].uvs1 && !memcmp(out.meshes[0].uvs1, uv1, sizeof uv1), "uvs1 changed on the wire");
+			const uint8_t *u = (const uint8_t *)out.meshes[0].uvs1, *t = out.materials[0].base_color_texture->rgba;
+			CHECK(u > body && u < body + blen && t > body && t < body + blen, "in place: the arrays are the reply's");
 			CHECK(out.meshes[0].lod_count == 1 && out.meshes[0].lods[0].uvs1 &&
 			      !memcmp(out.meshes[0].lods[0].uvs1, lv_uv1, sizeof lv_uv1), "the level's uvs1 changed on the wire");
 			CHECK(out.materials[0].sampling[RND_TEX_OCCLUSION].uv_set == 1 &&
@@ -439,4 +449,88 @@ TEST(sandbox_stl_normals_follow_the_winding)
 	CHECK(up == (int)m->meshes[0].vertex_count, "%d of %u normals along +z (the winding's side)", up,
 	      m->meshes[0].vertex_count);
 	api_model_release(m);
+}
+
+/* The line of /proc/self/maps whose range holds p, into line ("" when none). */
+static void mapping_of(const void *p, char *line, size_t n)
+{
+	FILE *f = fopen("/proc/self/maps", "r");
+	line[0] = 0;
+	while (f && fgets(line, (int)n, f)) {
+		unsigned long lo, hi;
+		if (sscanf(line, "%lx-%lx", &lo, &hi) == 2 && (uintptr_t)p >= lo && (uintptr_t)p < hi) break;
+		line[0] = 0;
+	}
+	if (f) fclose(f);
+}
+
+/* The importer's reply comes back in a sealed memfd that the model's arrays stay in, mapped
+ * read-only and shared (no copy): a write through them would fault; and the mapping goes with
+ * the model. */
+TEST(sandbox_reply_is_mapped_read_only)
+{
+	size_t len;
+	uint8_t *d = stl_triangles(50, &len);
+	struct api_limits l = limits(5000);
+	struct api_arena *a = api_arena_create();
+	struct api_model m;
+	size_t bytes;
+	char err[400], line[512];
+	int st;
+	REQUIRE(api_sandbox_import_model(d, len, API_MODEL_STL, &l, a, &m, &bytes, &st, err, sizeof err) == API_OK, "%s", err);
+	const void *pos = m.meshes[0].positions;
+	mapping_of(pos, line, sizeof line);
+	CHECK(strstr(line, "memfd:umbra-import-reply") != NULL, "positions in: %s", line);
+	CHECK(strstr(line, " r--s ") != NULL, "mapped read-only, shared: %s", line);
+	mapping_of(m.meshes[0].indices, line, sizeof line);
+	CHECK(strstr(line, "memfd:umbra-import-reply") != NULL, "indices in: %s", line);
+	api_arena_destroy(a);
+	mapping_of(pos, line, sizeof line);
+	CHECK(!strstr(line, "memfd:umbra-import-reply"), "unmapped with the arena: %s", line);
+	free(d);
+}
+
+/* ---- the helper's environment ---- */
+
+TEST(sandbox_helper_env_asks_for_huge_pages)
+{
+	char *plain[] = {"PATH=/bin", "HOME=/x", NULL}, *tuned[] = {"A=1", "GLIBC_TUNABLES=glibc.malloc.arena_max=2", "B=2", NULL};
+	char *own = NULL, **env = api_sbx_helper_env(plain, &own);
+	REQUIRE(env && own);
+	CHECK(!strcmp(env[0], "PATH=/bin") && !strcmp(env[1], "HOME=/x"), "the rest kept: %s %s", env[0], env[1]);
+	CHECK(!strcmp(env[2], "GLIBC_TUNABLES=glibc.malloc.hugetlb=1") && !env[3], "added: %s", env[2]);
+	free(env);
+	free(own);
+	env = api_sbx_helper_env(tuned, &own);
+	REQUIRE(env && own);
+	CHECK(!strcmp(env[0], "A=1") && !strcmp(env[1], "B=2") && !env[3], "the rest kept, once each");
+	CHECK(!strcmp(env[2], "GLIBC_TUNABLES=glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1"), "appended: %s", env[2]);
+	free(env);
+	free(own);
+}
+
+/* A binary STL cone of 200 facets: its apex joins 200 corners, sorted by key in the sandbox
+ * (glibc's qsort asks the system how much memory there is first: a call the filter allowed
+ * only once the join began to sort). */
+TEST(sandbox_stl_cone_apex_joins)
+{
+	enum { N = 200 };
+	size_t len = 84 + (size_t)N * 50;
+	uint8_t *d = calloc(1, len);
+	uint32_t n = N;
+	memcpy(d + 80, &n, 4);
+	for (uint32_t i = 0; i < N; i++) {
+		float a0 = 6.2831853f * (float)i / N, a1 = 6.2831853f * (float)(i + 1) / N;
+		float t[12] = {0, 0, 0, 0, 2, 0, cosf(a1), 0, sinf(a1), cosf(a0), 0, sinf(a0)};
+		memcpy(d + 84 + (size_t)i * 50, t, sizeof t);
+	}
+	struct api_limits l = limits(5000);
+	struct api_arena *a = api_arena_create();
+	struct api_model m;
+	size_t bytes;
+	char err[400];
+	int st;
+	CHECK(api_sandbox_import_model(d, len, API_MODEL_STL, &l, a, &m, &bytes, &st, err, sizeof err) == API_OK, "%s", err);
+	api_arena_destroy(a);
+	free(d);
 }

@@ -11,6 +11,41 @@ void test_put32(uint8_t *p, uint32_t v)
 	p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
 }
 
+struct rnd_image test_rgba8_image(uint32_t w, uint32_t h, bool opaque)
+{
+	struct rnd_image img = {0};
+	img.width = w;
+	img.height = h;
+	img.format = RND_PIXELS_RGBA8;
+	img.stride = (size_t)w * 4 + 12;   /* padded rows: the stride is honoured */
+	img.pixels = calloc(h, img.stride);
+	for (uint32_t y = 0; img.pixels && y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			uint8_t *px = (uint8_t *)img.pixels + y * img.stride + 4 * x;
+			double dx = x - w / 2.0, dy = y - h / 2.0, shade = dx * dx + dy * dy < w * h / 16.0 ? 0.4 : 1.0;
+			px[0] = (uint8_t)(shade * (60 + 150.0 * x / w));
+			px[1] = (uint8_t)(shade * (80 + 120.0 * y / h));
+			px[2] = (uint8_t)(shade * 170);
+			px[3] = opaque ? 255 : x < 2 || y < 2 ? 0 : (uint8_t)(128 + 127.0 * x / w);
+		}
+	return img;
+}
+
+double test_psnr_rgb(const struct rnd_image *img, const uint8_t *rgba, int *alpha_diff)
+{
+	double se = 0;
+	*alpha_diff = 0;
+	for (uint32_t y = 0; y < img->height; y++)
+		for (uint32_t x = 0; x < img->width; x++) {
+			const uint8_t *a = (const uint8_t *)img->pixels + y * img->stride + 4 * x;
+			const uint8_t *b = rgba + 4 * ((size_t)y * img->width + x);
+			for (int c = 0; c < 3; c++) se += (double)(a[c] - b[c]) * (a[c] - b[c]);
+			if (abs(a[3] - b[3]) > *alpha_diff) *alpha_diff = abs(a[3] - b[3]);
+		}
+	double mse = se / (3.0 * img->width * img->height);
+	return mse > 0 ? 10 * log10(255.0 * 255.0 / mse) : INFINITY;
+}
+
 uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len)
 {
 	png_image img;

@@ -7,11 +7,21 @@
 #ifndef UMBRA_TEST_MODELS_H
 #define UMBRA_TEST_MODELS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "umbra/rnd.h"
+
 /* Little-endian uint32 at p. */
 void test_put32(uint8_t *p, uint32_t v);
+/* A render-like RGBA8 image for the encoders (rnd_image_release() frees it): a smooth gradient,
+ * a dark disc (a shadow) and, unless opaque, an alpha ramp with a fully transparent 2-pixel
+ * border whose colours a lossless encoder must keep too; rows padded (stride > 4 w). */
+struct rnd_image test_rgba8_image(uint32_t w, uint32_t h, bool opaque);
+/* Peak signal-to-noise ratio of the RGB channels of rgba (w x h, packed) against img, dB
+ * (INFINITY when equal); *alpha_diff the largest alpha error. */
+double test_psnr_rgb(const struct rnd_image *img, const uint8_t *rgba, int *alpha_diff);
 /* A straight-alpha RGBA8 PNG of w x h texels; NULL on failure. */
 uint8_t *test_png_rgba(const uint8_t *px, int w, int h, size_t *len);
 /* An RGB8 PNG of w x h texels (rgb: 3 bytes each, rows top to bottom) with a gAMA chunk of

@@ -58,6 +58,13 @@ char *test_model_doc(const uint8_t *d, size_t n, const char *format)
 	return doc;
 }
 
+struct api_scene *test_parse_scene(const char *doc, struct api_problem *p)
+{
+	struct api_scene *s = NULL;
+	memset(p, 0, sizeof *p);
+	return api_scene_parse(doc, strlen(doc), NULL, &s, p) == API_OK ? s : NULL;
+}
+
 struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *format, struct api_problem *p)
 {
 	char *doc = test_model_doc(d, n, format);
@@ -66,4 +73,18 @@ struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *forma
 	if (!doc || api_scene_parse(doc, strlen(doc), NULL, &s, p) != API_OK) s = NULL;
 	free(doc);
 	return s;
+}
+
+uint8_t *test_read_file(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	uint8_t *b = n >= 0 ? malloc((size_t)n + 1) : NULL;
+	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
+	fclose(f);
+	if (b) { b[n] = 0; *len = (size_t)n; }
+	return b;
 }

@@ -15,6 +15,8 @@ char *test_b64(const void *d, size_t n);
 /* Writes text to dir/name (created or truncated); a file that cannot be written is left as
  * it is (the test's own checks then fail on what it reads). */
 void test_put_file(const char *dir, const char *name, const char *text);
+/* A whole file, malloc'd with a NUL after it (*len without it); NULL when it cannot be read. */
+uint8_t *test_read_file(const char *path, size_t *len);
 /* A scene document from a printf format in which ' stands for " (so that tests can write
  * "{'width': %d}"). NULL when out of memory. */
 char *test_vdoc(const char *fmt, va_list ap);
@@ -27,5 +29,8 @@ char *test_model_doc(const uint8_t *d, size_t n, const char *format);
 struct api_scene;
 struct api_problem;
 struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *format, struct api_problem *p);
+/* A scene document parsed (api_scene_parse, default limits): the scene, or NULL with *p its
+ * problem (*p zeroed first). */
+struct api_scene *test_parse_scene(const char *doc, struct api_problem *p);
 
 #endif

@@ -55,15 +55,10 @@ def decode(data):
     return w.value, h.value, out
 
 
-def main():
-    cmd = sys.argv[1]
-    data = open(sys.argv[2], 'rb').read()
-    if cmd == 'info':
-        w, h, kind, alpha = info(data)
-        print(w, h, kind, 'alpha' if alpha else 'opaque')
-        return
-    w, h, rgba = decode(data)
-    pw, ph, bpp, rows = png.read(sys.argv[3])
+def compare(w, h, rgba, png_path):
+    """Prints "PSNR MAXALPHA" of decoded RGBA8 pixels against the PNG (see the module's help);
+    exit 1 on a size mismatch. Also used by tests/util/avif.py."""
+    pw, ph, bpp, rows = png.read(png_path)
     if (w, h) != (pw, ph):
         print('size %dx%d, PNG %dx%d' % (w, h, pw, ph))
         sys.exit(1)
@@ -78,6 +73,17 @@ def main():
                 n += 1
     mse = se / (3.0 * max(n, 1))
     print('inf' if mse == 0 else '%.1f' % (10 * math.log10(255 * 255 / mse)), amax)
+
+
+def main():
+    cmd = sys.argv[1]
+    data = open(sys.argv[2], 'rb').read()
+    if cmd == 'info':
+        w, h, kind, alpha = info(data)
+        print(w, h, kind, 'alpha' if alpha else 'opaque')
+        return
+    w, h, rgba = decode(data)
+    compare(w, h, rgba, sys.argv[3])
 
 
 if __name__ == '__main__':

@@ -75,9 +75,19 @@ enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYL
  * same test, so a surface of coverage a casts a shadow of about a once filtered. */
 enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK, RND_ALPHA_BLEND };
 
-/* Texture slots of a material (the order of rnd_material.textures). */
+/* Texture slots of a material (the order of rnd_material.textures): glTF's core five, then
+ * those of the PBR extensions (read only where the material has that extension). */
 enum rnd_texture_slot { RND_TEX_BASE, RND_TEX_METAL_ROUGH, RND_TEX_NORMAL, RND_TEX_OCCLUSION, RND_TEX_EMISSIVE,
+                        RND_TEX_CLEARCOAT, RND_TEX_CLEARCOAT_ROUGHNESS, RND_TEX_CLEARCOAT_NORMAL,
+                        RND_TEX_SHEEN_COLOR, RND_TEX_SHEEN_ROUGHNESS, RND_TEX_SPECULAR, RND_TEX_SPECULAR_COLOR,
                         RND_TEX_SLOTS };
+/* rnd_material.extensions: the glTF 2.0 PBR extensions a material has (0: none; the members
+ * of the others are not read). */
+enum rnd_material_ext {
+	RND_EXT_CLEARCOAT = 1,   /* KHR_materials_clearcoat */
+	RND_EXT_SHEEN = 2,       /* KHR_materials_sheen */
+	RND_EXT_SPECULAR = 4,    /* KHR_materials_specular and / or KHR_materials_ior */
+};
 enum rnd_wrap { RND_WRAP_REPEAT, RND_WRAP_CLAMP, RND_WRAP_MIRROR };
 /* Between mip levels (every texture gets its full chain, built at upload): linear (glTF's
  * *_MIPMAP_LINEAR and an absent minFilter), none (minFilter NEAREST or LINEAR: level 0 only),
@@ -97,7 +107,9 @@ struct rnd_texture {
 	const uint8_t *chain;
 	bool chain_srgb;
 };
-/* The colour space a slot reads its texture in: base colour and emissive sRGB, the others linear. */
+/* The colour space a slot reads its texture in: base colour, emissive, sheen colour and
+ * specular colour sRGB, and the slots read in alpha (sheen roughness, specular) too (alpha is
+ * linear either way: a texture holding colour and alpha is then one image); the others linear. */
 bool rnd_texture_slot_srgb(enum rnd_texture_slot slot);
 /* Bytes of the full RGBA8 chain of a w x h texture down to 1x1, levels packed one after the
  * other (level 0 first). */
@@ -111,6 +123,9 @@ void rnd_texture_build_chain(const uint8_t *rgba, uint32_t w, uint32_t h, bool s
  * in *w x *h: a texture decoded smaller than stored (api/image_decode.c). Pure; any thread. */
 void rnd_texture_reduce(uint8_t *rgba, uint32_t *w, uint32_t *h, bool srgb, uint32_t levels);
 
+/* Every rnd_*_defaults() below zeroes its whole struct before setting members: api/scene_hash.c
+ * hashes a parsed scene by the bytes of these structs (padding included; pointers as set or
+ * not), so a new pointer member needs its line there. */
 struct rnd_material {
 	float base_color[4];  /* linear RGBA, default 0.8 0.8 0.8 1 */
 	float roughness;      /* 0.5 */
@@ -126,6 +141,9 @@ struct rnd_material {
 		struct {
 			const struct rnd_texture *base_color_texture, *metal_rough_texture, *normal_texture,
 			                         *occlusion_texture, *emissive_texture;
+			const struct rnd_texture *clearcoat_texture, *clearcoat_roughness_texture, *clearcoat_normal_texture,
+			                         *sheen_color_texture, *sheen_roughness_texture, *specular_texture,
+			                         *specular_color_texture;
 		};
 		const struct rnd_texture *textures[RND_TEX_SLOTS];
 	};
@@ -142,6 +160,24 @@ struct rnd_material {
 		bool transformed;                   /* KHR_texture_transform: uv' = M (u, v, 1) */
 		float transform[6];                 /* rows of M: (m00 m01 m02), (m10 m11 m12) */
 	} sampling[RND_TEX_SLOTS];
+	/* The glTF PBR extensions, drawn as the Khronos sample viewer draws them under punctual
+	 * lights (shaders/material_ext.glsl); each group is read only where `extensions` has its
+	 * bit, so a zeroed material has none. Textures: the slots above, factor x texture. */
+	uint32_t extensions;       /* RND_EXT_* */
+	struct {
+		float factor;          /* 0..1: how much of the coat (x clearcoat_texture R) */
+		float roughness;       /* 0..1 (x clearcoat_roughness_texture G) */
+		float normal_scale;    /* clearcoat_normal_texture's xy scale (no texture: the geometric normal) */
+	} clearcoat;
+	struct {
+		float color[3];        /* linear, 0 = no sheen (x sheen_color_texture) */
+		float roughness;       /* 0..1 (x sheen_roughness_texture A) */
+	} sheen;
+	struct {
+		float factor;          /* 0..1 the specular weight (x specular_texture A); glTF default 1 */
+		float color[3];        /* linear, multiplies the dielectric F0 (x specular_color_texture); default 1 */
+		float ior;             /* >= 1 (KHR_materials_ior; 1.5 gives F0 0.04) */
+	} specular;
 };
 
 /* A coarser version of a mesh object's geometry (api/model_lod.c builds them for imported
@@ -421,6 +457,9 @@ struct rnd_context_desc {
 	 * RND_MAX_TEXTURES_CEILING (rnd_info.max_textures says what was granted); each slot holds
 	 * two descriptor sets per texture (rnd_texture_sets). Materials sharing textures share a set. */
 	uint32_t max_textures;
+	/* Tests: give vertex and index buffers their CPU mirror even in host-cached memory, so the
+	 * path a GPU's uncached BAR memory takes (renderer/memory.c) runs on lavapipe too. */
+	bool mirror_buffers;
 	rnd_log_fn log; void *log_user;
 };
 

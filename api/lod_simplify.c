@@ -1,0 +1,108 @@
+/*
+ * api/lod_simplify.c — meshoptimizer's simplification of a welded mesh, in pieces that fit the
+ * cache when the mesh is large (see lod_simplify.h).
+ */
+#include <meshoptimizer.h>
+#include <stdlib.h>
+#include <string.h>
+#include "lod_simplify.h"
+
+/* Each triangle's piece: its centroid's cell of a k x k x k grid over lo..hi. */
+static uint32_t piece_of(const float *pos, const uint32_t *t, const float lo[3], const float hi[3], uint32_t k)
+{
+	uint32_t c[3];
+	for (int a = 0; a < 3; a++) {
+		float m = (pos[3 * (size_t)t[0] + a] + pos[3 * (size_t)t[1] + a] + pos[3 * (size_t)t[2] + a]) / 3.0f;
+		float f = hi[a] > lo[a] ? (m - lo[a]) / (hi[a] - lo[a]) * (float)k : 0.0f;
+		c[a] = f <= 0.0f ? 0 : f >= (float)k ? k - 1 : (uint32_t)f;
+	}
+	return (c[2] * k + c[1]) * k + c[0];
+}
+
+/* The triangles of idx grouped by piece into by[] (piece p: by[3 * start[p] .. 3 * start[p + 1])). */
+static void group_pieces(const float *pos, const uint32_t *idx, size_t nt, const float lo[3], const float hi[3],
+                         uint32_t k, uint32_t *by, size_t *start, uint32_t *piece)
+{
+	uint32_t np = k * k * k;
+	memset(start, 0, (np + 1) * sizeof *start);
+	for (size_t t = 0; t < nt; t++) start[(piece[t] = piece_of(pos, idx + 3 * t, lo, hi, k)) + 1]++;
+	for (uint32_t p = 0; p < np; p++) start[p + 1] += start[p];
+	for (size_t t = 0; t < nt; t++) memcpy(by + 3 * start[piece[t]]++, idx + 3 * t, 12);
+	for (uint32_t p = np; p > 0; p--) start[p] = start[p - 1];
+	start[0] = 0;
+}
+
+/* Scratch for simplify_part: a vertex's local id (~0u outside the part in hand), the local
+ * vertices' global ids and positions, the part's local indices. */
+struct part {
+	uint32_t *local, *global, *lidx;
+	float *lpos;
+};
+
+/* Triangles tri[0..n) (global ids) simplified on their own, within abs_target (object units),
+ * with meshoptimizer's options; appended to out (global ids), which may be tri. */
+static size_t simplify_part(const float *pos, const uint32_t *tri, size_t n, float abs_target, unsigned options,
+                            struct part *s, uint32_t *out)
+{
+	size_t nv = 0;
+	for (size_t i = 0; i < n; i++) {
+		uint32_t v = tri[i];
+		if (s->local[v] == ~0u) {
+			s->global[nv] = v;
+			memcpy(s->lpos + 3 * nv, pos + 3 * (size_t)v, 12);
+			s->local[v] = (uint32_t)nv++;
+		}
+		s->lidx[i] = s->local[v];
+	}
+	/* meshoptimizer's error is relative to the extent of what it is given */
+	float scale = meshopt_simplifyScale(s->lpos, nv, 12);
+	size_t got = n && scale > 0.0f ? meshopt_simplify(s->lidx, s->lidx, n, s->lpos, nv, 12, 3, abs_target / scale,
+	                                                  options, NULL) : 0;
+	for (size_t i = 0; i < got; i++) out[i] = s->global[s->lidx[i]];
+	for (size_t i = 0; i < nv; i++) s->local[s->global[i]] = ~0u;
+	return got;
+}
+
+size_t api_lod_simplify(uint32_t *dst, const uint32_t *idx, size_t ni, const float *pos, size_t nv, float extent,
+                        float target)
+{
+	size_t nt = ni / 3;
+	uint32_t k = 1;
+	while (k < 8 && (size_t)(k + 1) * (k + 1) * (k + 1) * API_LOD_PIECE_TRIANGLES <= nt) k++;
+	uint32_t np = k * k * k;
+	struct part s = {0};
+	uint32_t *by = k > 1 ? malloc(ni * sizeof *by) : NULL, *piece = by ? malloc(nt * sizeof *piece) : NULL;
+	size_t *start = piece ? malloc((np + 1) * sizeof *start) : NULL;
+	if (start) {
+		s.local = malloc(nv * sizeof *s.local);
+		s.global = malloc(nv * sizeof *s.global);
+		s.lidx = malloc(ni * sizeof *s.lidx);
+		s.lpos = malloc(nv * 12);
+	}
+	size_t got = 0;
+	if (s.local && s.global && s.lidx && s.lpos) {
+		float lo[3] = {pos[0], pos[1], pos[2]}, hi[3] = {pos[0], pos[1], pos[2]};
+		for (size_t v = 0; v < nv; v++)
+			for (int a = 0; a < 3; a++) {
+				if (pos[3 * v + a] < lo[a]) lo[a] = pos[3 * v + a];
+				if (pos[3 * v + a] > hi[a]) hi[a] = pos[3 * v + a];
+			}
+		group_pieces(pos, idx, nt, lo, hi, k, by, start, piece);
+		memset(s.local, 0xff, nv * sizeof *s.local);
+		for (uint32_t p = 0; p < np; p++)
+			got += simplify_part(pos, by + 3 * start[p], 3 * (start[p + 1] - start[p]), target * extent,
+			                     meshopt_SimplifyLockBorder, &s, dst + got);
+		/* then the whole, a fraction of its size now: the cuts, kept so far, go too */
+		got = simplify_part(pos, dst, got, target * extent, 0, &s, dst);
+	} else {
+		got = meshopt_simplify(dst, idx, ni, pos, nv, 12, 3, target, 0, NULL);
+	}
+	free(by);
+	free(piece);
+	free(start);
+	free(s.local);
+	free(s.global);
+	free(s.lidx);
+	free(s.lpos);
+	return got;
+}

@@ -1,0 +1,215 @@
+/*
+ * api/weld.c — vertices grouped by quantized position with a radix sort (see weld.h).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "weld.h"
+
+/* LSD passes over the bits below `bits` of keys[0..n), `digit` (at most 11) bits a pass: the
+ * histograms in one read, then a stable scatter per digit that is not the same in every key
+ * (the high bits of small ids, an axis a flat mesh does not use). Returns where the keys
+ * ended, *vals_out where the values did. */
+static uint64_t *lsd(uint64_t *keys, uint64_t *tmp, uint32_t *vals, uint32_t *vtmp, size_t n, unsigned bits,
+                     unsigned digit, uint32_t **vals_out)
+{
+	const uint64_t mask = ((uint64_t)1 << digit) - 1;
+	unsigned passes = (bits + digit - 1) / digit;
+	uint32_t count[8][1u << 11];
+	for (unsigned p = 0; p < passes; p++) memset(count[p], 0, (mask + 1) * sizeof count[p][0]);
+	for (size_t i = 0; i < n; i++)
+		for (unsigned p = 0; p < passes; p++) count[p][(keys[i] >> (p * digit)) & mask]++;
+	for (unsigned p = 0; p < passes; p++) {
+		unsigned shift = p * digit;
+		uint32_t *c = count[p], sum = 0;
+		if (!n || c[(keys[0] >> shift) & mask] == n) continue;
+		for (size_t d = 0; d <= mask; d++) {
+			uint32_t k = c[d];
+			c[d] = sum;
+			sum += k;
+		}
+		if (vals)
+			for (size_t i = 0; i < n; i++) {
+				uint32_t at = c[(keys[i] >> shift) & mask]++;
+				tmp[at] = keys[i];
+				vtmp[at] = vals[i];
+			}
+		else
+			for (size_t i = 0; i < n; i++) tmp[c[(keys[i] >> shift) & mask]++] = keys[i];
+		uint64_t *t = keys; keys = tmp; tmp = t;
+		uint32_t *v = vals; vals = vtmp; vtmp = v;
+	}
+	*vals_out = vals;
+	return keys;
+}
+
+/* A few keys (and values), in place: insertion, stable. */
+static void insertion(uint64_t *k, uint32_t *v, size_t n)
+{
+	for (size_t i = 1; i < n; i++) {
+		uint64_t x = k[i];
+		uint32_t y = v ? v[i] : 0;
+		size_t j = i;
+		for (; j > 0 && k[j - 1] > x; j--) {
+			k[j] = k[j - 1];
+			if (v) v[j] = v[j - 1];
+		}
+		k[j] = x;
+		if (v) v[j] = y;
+	}
+}
+
+uint64_t *api_radix_sort(uint64_t *keys, uint64_t *tmp, uint32_t *vals, uint32_t *vtmp, size_t n)
+{
+	uint64_t any = 0, all = ~0ull;
+	for (size_t i = 0; i < n; i++) any |= keys[i], all &= keys[i];
+	unsigned bits = 0, top = 4;
+	while (bits < 64 && (any ^ all) >> bits) bits++;
+	while (top < 11 && (size_t)2048 << top < n) top++;   /* buckets of about 2048 keys */
+	uint32_t *v;
+	if (n <= 32) {   /* (a histogram of 2048 counters a digit would cost more than the keys) */
+		insertion(keys, vals, n);
+		return keys;
+	}
+	size_t *start = n >= ((size_t)1 << 16) && bits > top ? calloc(((size_t)1 << top) + 1, sizeof *start) : NULL;
+	if (!start) return lsd(keys, tmp, vals, vtmp, n, bits, n < 4096 ? 8 : 11, &v);
+	/* Many keys: one stable scatter by the top digit, then each bucket (its keys stay in the
+	 * cache) sorted by the bits below it; only the first pass runs through memory. The sorted
+	 * keys end in tmp (the values in vtmp). */
+	const unsigned shift = bits - top;
+	const uint64_t mask = ((uint64_t)1 << top) - 1;
+	for (size_t i = 0; i < n; i++) start[((keys[i] >> shift) & mask) + 1]++;
+	for (size_t d = 0; d <= mask; d++) start[d + 1] += start[d];
+	for (size_t i = 0; i < n; i++) {
+		size_t j = start[(keys[i] >> shift) & mask]++;   /* ends as the next bucket's start */
+		tmp[j] = keys[i];
+		if (vals) vtmp[j] = vals[i];
+	}
+	for (size_t d = 0, b = 0; d <= mask; b = start[d++]) {
+		size_t m = start[d] - b;
+		if (m <= 32) {
+			insertion(tmp + b, vals ? vtmp + b : NULL, m);
+			continue;
+		}
+		uint64_t *k = lsd(tmp + b, keys + b, vals ? vtmp + b : NULL, vals ? vals + b : NULL, m, shift, 8, &v);
+		if (k != tmp + b) {
+			memcpy(tmp + b, k, m * sizeof *k);
+			if (vals) memcpy(vtmp + b, v, m * sizeof *v);
+		}
+	}
+	free(start);
+	return tmp;
+}
+
+void api_weld_release(struct api_weld *w)
+{
+	free(w->group);
+	free(w->order);
+	free(w->start);
+	memset(w, 0, sizeof *w);
+}
+
+/* Each position's key: its grid point's three 21-bit coordinates. */
+static void position_keys(const float *pos, uint32_t nv, uint64_t *key)
+{
+	/* (plain comparisons and rounding: fminf and lrintf are calls into libm here, for their
+	 * NaN and errno rules, and positions are finite) */
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (size_t v = 0; v < nv; v++)
+		for (int k = 0; k < 3; k++) {
+			float p = pos[3 * v + (size_t)k];
+			if (p < lo[k]) lo[k] = p;
+			if (p > hi[k]) hi[k] = p;
+		}
+	float ext = fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+	float unit = ext > 0.0f ? ext / 1048576.0f : 1.0f;
+	for (size_t v = 0; v < nv; v++) {
+		uint64_t k = 0;
+		for (int a = 0; a < 3; a++)   /* 0 .. 2^20 (a little more by rounding): 21 bits */
+			k = k << 21 | ((uint64_t)api_round_even((pos[3 * v + (size_t)a] - lo[a]) / unit) & 0x1fffff);
+		key[v] = k;
+	}
+}
+
+bool api_weld_sort(const float *pos, uint32_t nv, struct api_weld *w)
+{
+	memset(w, 0, sizeof *w);
+	size_t n = nv ? nv : 1;
+	uint64_t *key = malloc(n * sizeof *key), *tmp = malloc(n * sizeof *tmp);
+	uint32_t *vtmp = malloc(n * sizeof *vtmp);
+	w->order = malloc(n * sizeof *w->order);
+	w->group = malloc(n * sizeof *w->group);
+	bool ok = key && tmp && vtmp && w->order && w->group;
+	if (ok) {
+		position_keys(pos, nv, key);
+		for (uint32_t v = 0; v < nv; v++) w->order[v] = v;
+		const uint64_t *sorted = api_radix_sort(key, tmp, w->order, vtmp, nv);
+		if (sorted != key) memcpy(w->order, vtmp, (size_t)nv * sizeof *vtmp);
+		size_t groups = 0;
+		for (size_t i = 0; i < nv; i++) groups += !i || sorted[i] != sorted[i - 1];
+		w->start = malloc((groups + 1) * sizeof *w->start);
+		ok = w->start != NULL;
+		for (size_t i = 0, g = 0; ok && i < nv; i++) {
+			if (i && sorted[i] != sorted[i - 1]) g++;
+			if (!i || sorted[i] != sorted[i - 1]) w->start[g] = (uint32_t)i;
+			w->group[w->order[i]] = (uint32_t)g;
+		}
+		if (ok) w->start[groups] = nv;
+		w->groups = groups;
+	}
+	free(key);
+	free(tmp);
+	free(vtmp);
+	if (!ok) api_weld_release(w);
+	return ok;
+}
+
+bool api_weld_mesh(const float *pos, uint32_t nv, const uint32_t *indices, uint32_t ni, const uint32_t *group,
+                   size_t groups, uint32_t *idx, struct api_welded *out)
+{
+	memset(out, 0, sizeof *out);
+	struct api_weld sorted = {0};
+	if (!group) {
+		if (!api_weld_sort(pos, nv, &sorted)) return false;
+		group = sorted.group;
+		groups = sorted.groups;
+	}
+	uint32_t *id = malloc((groups ? groups : 1) * sizeof *id), *last = NULL;
+	bool ok = id != NULL;
+	if (ok) {
+		memset(id, 0xff, groups * sizeof *id);
+		for (uint32_t i = 0; i < ni; i++) {
+			uint32_t *g = &id[group[indices[i]]];
+			if (*g == ~0u) *g = (uint32_t)out->count++;
+			idx[i] = *g;
+		}
+	}
+	free(id);
+	api_weld_release(&sorted);
+	size_t n = out->count ? out->count : 1;
+	out->pos = malloc(n * 12);
+	out->rep = malloc(n * sizeof *out->rep);
+	last = malloc(n * sizeof *last);
+	if (!ok || !out->pos || !out->rep || !last) {
+		free(last);
+		return false;
+	}
+	/* The first and the last vertex the indices name in each group. */
+	memset(out->rep, 0xff, out->count * sizeof *out->rep);
+	memset(last, 0, out->count * sizeof *last);
+	for (uint32_t i = 0; i < ni; i++) {
+		uint32_t v = indices[i], c = idx[i];
+		if (v < out->rep[c]) out->rep[c] = v;
+		if (v > last[c]) last[c] = v;
+	}
+	for (size_t c = 0; c < out->count; c++) memcpy(out->pos + 3 * c, pos + 3 * (size_t)last[c], 12);
+	free(last);
+	return true;
+}
+
+void api_welded_release(struct api_welded *w)
+{
+	free(w->pos);
+	free(w->rep);
+	memset(w, 0, sizeof *w);
+}
