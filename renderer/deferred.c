@@ -31,21 +31,42 @@ static bool plain(const struct rnd_scene *sc, const struct draw *d)
 	       !(sc->material_count && rnd_material_ext_bits(&sc->materials[d->material]));
 }
 
+/* Without the visibility pass (no light with a wide shadow filter), pixel shading runs the
+ * surfaces pass for itself where an environment map lights the view: its shading (the map's
+ * light and the environment pass's bilateral read, ibl.glsl) is what lavapipe would otherwise run
+ * per triangle per 4x4 block. It pays over dense meshes, as the visibility pass does for one wide
+ * light: at least one face towards the camera per RND_DEFERRED_PIXELS_PER_FACE pixels. */
+#define RND_DEFERRED_PIXELS_PER_FACE 16u
+
 bool rnd_deferred_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct draw *draws,
-                         uint32_t ndraw, bool vis)
+                         uint32_t ndraw, bool vis, bool env_lit)
 {
-	if (!vis || !ctx->pixel_shading || sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return false;
+	if (!ctx->pixel_shading || sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return false;
+	/* An environment map behind the scene is drawn where the main pass left the far plane
+	 * (record.c, env_background.frag); the resolve writes the clear colour there. */
+	if (sc->environment.source != RND_ENV_AMBIENT && sc->environment.background_map && !sc->output.transparent)
+		return false;
 	for (uint32_t i = 0; i < ndraw; i++)
 		if (draws[i].index_count && !plain(sc, &draws[i])) return false;
+	if (!vis) {
+		if (!ctx->visibility_pass || !env_lit || !rnd_surfaces_bytes(sc, 0)) return false;
+		if (rnd_camera_faces(draws, ndraw) * RND_DEFERRED_PIXELS_PER_FACE < (uint64_t)sc->width * sc->height)
+			return false;
+	}
 	const char *env = getenv("UMBRA_PIXEL_SHADING");
 	return !(env && strcmp(env, "0") == 0);
 }
 
 uint64_t rnd_deferred_bytes(const struct rnd_scene *sc)
 {
-	if (!rnd_visibility_bytes(sc) || sc->output.msaa != 4) return 0;
+	if (sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return 0;
+	/* the surfaces pass's images where the visibility pass has none (an environment map's view) */
+	uint64_t surfaces = 0;
+	if (!rnd_visibility_bytes(sc)) {
+		if (sc->environment.source == RND_ENV_AMBIENT || !(surfaces = rnd_surfaces_bytes(sc, 0))) return 0;
+	}
 	/* the shading inputs (RGBA32UI) and the shaded colour (at most RGBA32F) */
-	return (uint64_t)sc->width * sc->height * (16 + 16);
+	return surfaces + (uint64_t)sc->width * sc->height * (16 + 16);
 }
 
 /* The view's depth, every sample, of the band's rows: every draw with the depth pre-pass's
@@ -103,14 +124,7 @@ enum rnd_result record_deferred_main(struct rnd_context *ctx, struct rnd_slot *s
 	VkRect2D area = record_band_area(rv);
 	draw_depth(ctx, s, rv, area);
 	/* The single-sample target, as record_main leaves it (the readback copies it). */
-	record_image_barrier(cmd, s->resolve.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
-	                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-	VkRenderingAttachmentInfo ca = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->resolve.view,
-		.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-		.storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-	};
+	VkRenderingAttachmentInfo ca = record_color_overwrite(cmd, &s->resolve, VK_PIPELINE_STAGE_2_TRANSFER_BIT);
 	VkRenderingInfo ri = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,
 		.colorAttachmentCount = 1, .pColorAttachments = &ca,

@@ -21,8 +21,11 @@
  *     pixel centre that shows it.
  *
  * When (rnd_deferred_wanted): the view runs the visibility pass (dense triangles, wide shadow
- * filters), MSAA 4, no debug view, and every draw is plain: opaque, no texture (vertex colours
- * are fine), not an analytic sphere's proxy. UMBRA_PIXEL_SHADING=0 / 1 forces it off / on where
+ * filters) or is lit by an environment map over dense triangles (one face per 16 pixels: the
+ * thumbnail preset's studio), MSAA 4, no debug view, no environment map as the background, and
+ * every draw is plain: opaque, no texture (vertex colours are fine), no glTF material extension
+ * lobe (clearcoat, sheen, specular, spec-gloss: the forward path draws those), not an analytic
+ * sphere's proxy. The environment's light and shadows are shade.glsl's, as per fragment. UMBRA_PIXEL_SHADING=0 / 1 forces it off / on where
  * the device and the scene allow it. No state of its own; the images belong to the slot
  * (rnd_slot_pixel_shading), the pipelines to the context.
  */
@@ -34,9 +37,11 @@
 /* Whether the device can: standard sample locations (resolve.frag assumes them), a sampled
  * 4-sample depth image, RGBA32UI colour attachments that can be sampled. Once, at create. */
 bool rnd_deferred_supported(struct rnd_context *ctx);
-/* Whether a view of sc that runs the visibility pass (vis) is shaded per pixel. */
+/* Whether a view of sc is shaded per pixel: vis, it runs the visibility pass; env_lit, an
+ * environment map lights it (then pixel shading may run the surfaces pass for itself: the
+ * caller runs the visibility pass's passes wherever this says yes). */
 bool rnd_deferred_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct draw *draws,
-                         uint32_t ndraw, bool vis);
+                         uint32_t ndraw, bool vis, bool env_lit);
 /* The bytes of pixel shading's images for a view of sc (estimate.c: beside the visibility pass's). */
 uint64_t rnd_deferred_bytes(const struct rnd_scene *sc);
 /* The main pass of a pixel-shaded band (after record_visibility): depth only, MSAA 4, then the

@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "contact.h"
+#include "env.h"
+#include "env_pass.h"
 #include "frame.h"
 #include "material.h"
 #include "moments.h"
@@ -42,7 +44,7 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 
 /* Where each region starts in the slot's parameter buffer. */
 struct params_layout {
-	VkDeviceSize off_frame, off_mat, off_light, off_view, total;
+	VkDeviceSize off_frame, off_mat, off_light, off_view, off_env, total;
 	uint32_t nmat, nlight, nview;
 };
 
@@ -58,12 +60,13 @@ static void params_layout(const struct rnd_context *ctx, const struct rnd_scene 
 	VkDeviceSize off_mat = align_up(sizeof(struct umbra_frame), al);
 	VkDeviceSize off_light = align_up(off_mat + nmat * sizeof(struct umbra_material), al);
 	VkDeviceSize off_view = align_up(off_light + nlight * sizeof(struct umbra_light), al);
-	VkDeviceSize total = off_view + nview * sizeof(struct umbra_shadow_view);
-	*lay = (struct params_layout){off_frame, off_mat, off_light, off_view, total, nmat, nlight, nview};
+	VkDeviceSize off_env = align_up(off_view + nview * sizeof(struct umbra_shadow_view), al);
+	VkDeviceSize total = off_env + sizeof(struct umbra_env);
+	*lay = (struct params_layout){off_frame, off_mat, off_light, off_view, off_env, total, nmat, nlight, nview};
 }
 
 static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const struct rnd_camera_plan *cam,
-                        float exposure)
+                        float exposure, uint32_t shaded_lights)
 {
 	memcpy(f->view_proj, cam->view_proj, sizeof f->view_proj);
 	memcpy(f->view, cam->view, sizeof f->view);
@@ -83,7 +86,7 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	f->mode[0] = record_tonemap(sc->output.tonemap);
 	f->mode[1] = record_debug(sc->output.debug);
 	f->mode[2] = sc->output.debug_light;
-	f->mode[3] = sc->light_count;
+	f->mode[3] = shaded_lights;
 	f->mode2[0] = sc->output.pixels == RND_PIXELS_RGBA32F ? 1u : 0u;
 	f->mode2[1] = sc->output.transparent ? 1u : 0u;
 	/* UMBRA_LIGHT_CULL=0: every pixel shades every light, for the test that culling
@@ -154,30 +157,25 @@ static void write_light(const struct rnd_context *ctx, struct umbra_light *l, co
 	if (rnd_contact_on(sc, sp, i)) rnd_contact_params(&in->shadow, l->contact);
 }
 
-/* Set 0 of the draw pipelines: the four regions, the depth and moment atlases, the camera depth. */
-static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay, bool contact)
+/* w[0 .. n - 1]: bindings binding .. binding + n - 1 of set 0, images each of its own type. */
+static uint32_t put_images(VkWriteDescriptorSet *w, VkDescriptorSet set, uint32_t binding, uint32_t n,
+                           const VkDescriptorImageInfo *ii)
 {
-	VkDescriptorBufferInfo bi[4] = {
-		{s->params.buf, lay->off_frame, sizeof(struct umbra_frame)},
-		{s->params.buf, lay->off_mat, lay->nmat * sizeof(struct umbra_material)},
-		{s->params.buf, lay->off_light, lay->nlight * sizeof(struct umbra_light)},
-		{s->params.buf, lay->off_view, lay->nview * sizeof(struct umbra_shadow_view)},
-	};
-	VkDescriptorImageInfo ii = {ctx->pipes.atlas_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
-	/* Without a moment atlas (no storage images) no light uses moments; the binding still
-	 * needs an image. */
-	VkDescriptorImageInfo mi = ctx->atlas_moments.view
-		? (VkDescriptorImageInfo){ctx->moments.sampler, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL}
-		: (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
-	/* Contact shadows read the view's depth (drawn before the main pass); other renders bind
-	 * the white texture, which their pipelines never read. */
-	VkDescriptorImageInfo di = contact
-		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, s->scene_depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL}
-		: (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-	/* Lights without depth bounds never read them (umbra_light.shadow.w). */
-	VkDescriptorImageInfo bounds_ii = ctx->atlas_bounds.view
-		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL}
-		: ii;
+	for (uint32_t i = 0; i < n; i++)
+		w[i] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = set, .dstBinding = binding + i,
+			.descriptorCount = 1, .descriptorType = rnd_binding_type[binding + i], .pImageInfo = &ii[i],
+		};
+	return n;
+}
+
+/* Set 0's bindings of the passes beside the main one: the visibility pass's, the environment's
+ * and pixel shading's (UMBRA_BINDING_SURFACES on). */
+static void bind_passes(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay,
+                        const struct rnd_env_use *env, bool env_pass)
+{
+	VkWriteDescriptorSet w[UMBRA_BINDING_COUNT - UMBRA_BINDING_SURFACES];
+	uint32_t n = 0;
 	/* The visibility pass's images (visibility.c): only the pipelines of renders that use it
 	 * declare them; other renders bind whatever images the slot has (render.c). */
 	VkDescriptorImageInfo vi[4] = {
@@ -186,6 +184,21 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{ctx->pipes.shadow_sampler, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
 		{VK_NULL_HANDLE, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
+	n += put_images(w + n, s->set, UMBRA_BINDING_SURFACES, 4, vi);
+	/* The environment: its block and images (the slot's white stand-ins without a map), the
+	 * environment pass's images (stand-ins without the pass). */
+	VkDescriptorBufferInfo ebi = {s->params.buf, lay->off_env, sizeof(struct umbra_env)};
+	w[n++] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_ENV,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &ebi,
+	};
+	VkDescriptorImageInfo ei[6];
+	rnd_env_images(ctx, env, s, ei);
+	const struct rnd_image_res *pass[3] = {&s->env_surfaces, &s->env_normals, &s->env_vis};
+	for (int i = 0; i < 3; i++)
+		ei[3 + i] = env_pass ? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, pass[i]->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}
+		                     : (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	n += put_images(w + n, s->set, UMBRA_BINDING_ENV_SPECULAR, 6, ei);
 	/* Pixel shading's (deferred.c): its inputs, the shaded colours and the view's depth samples
 	 * (integer and depth formats: the nearest sampler without a border; only texelFetch). */
 	VkDescriptorImageInfo pi[3] = {
@@ -193,39 +206,47 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{ctx->pipes.atlas_sampler, s->shaded.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
 		{ctx->pipes.atlas_sampler, s->depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL},
 	};
-	VkWriteDescriptorSet w[UMBRA_BINDING_COUNT];
-	for (int i = 0; i < 4; i++)
-		w[8 + i] = (VkWriteDescriptorSet){
-			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SURFACES + i,
-			.descriptorCount = 1, .descriptorType = rnd_binding_type[UMBRA_BINDING_SURFACES + i], .pImageInfo = &vi[i],
-		};
-	for (int i = 0; i < 3; i++)
-		w[12 + i] = (VkWriteDescriptorSet){
-			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set,
-			.dstBinding = UMBRA_BINDING_SURFACE_SHADING + i, .descriptorCount = 1,
-			.descriptorType = rnd_binding_type[UMBRA_BINDING_SURFACE_SHADING + i], .pImageInfo = &pi[i],
-		};
-	w[5] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
+	n += put_images(w + n, s->set, UMBRA_BINDING_SURFACE_SHADING, 3, pi);
+	vkUpdateDescriptorSets(ctx->device, n, w, 0, NULL);
+}
+
+/* Set 0 of the draw pipelines: the four regions, the depth and moment atlases, the camera depth,
+ * then the passes' bindings (bind_passes). */
+static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay, bool contact,
+                        const struct rnd_env_use *env, bool env_pass)
+{
+	VkDescriptorBufferInfo bi[4] = {
+		{s->params.buf, lay->off_frame, sizeof(struct umbra_frame)},
+		{s->params.buf, lay->off_mat, lay->nmat * sizeof(struct umbra_material)},
+		{s->params.buf, lay->off_light, lay->nlight * sizeof(struct umbra_light)},
+		{s->params.buf, lay->off_view, lay->nview * sizeof(struct umbra_shadow_view)},
 	};
-	w[6] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SCENE_DEPTH,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &di,
-	};
-	w[7] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_DEPTH_BOUNDS,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &bounds_ii,
-	};
-	for (int i = 0; i < 5; i++) {
+	VkDescriptorImageInfo ii[4];
+	ii[0] = (VkDescriptorImageInfo){ctx->pipes.atlas_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	/* Without a moment atlas (no storage images) no light uses moments; the binding still
+	 * needs an image. */
+	ii[1] = ctx->atlas_moments.view
+		? (VkDescriptorImageInfo){ctx->moments.sampler, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL}
+		: (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	/* Contact shadows read the view's depth (drawn before the main pass); other renders bind
+	 * the white texture, which their pipelines never read. */
+	ii[2] = contact
+		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, s->scene_depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL}
+		: (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	/* Lights without depth bounds never read them (umbra_light.shadow.w). */
+	ii[3] = ctx->atlas_bounds.view
+		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL}
+		: ii[0];
+	VkWriteDescriptorSet w[UMBRA_BINDING_SURFACES];
+	for (int i = 0; i < 4; i++) {
 		w[i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
-			.descriptorCount = 1,
-			.descriptorType = rnd_binding_type[i],
-			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
+			.descriptorCount = 1, .descriptorType = rnd_binding_type[i], .pBufferInfo = &bi[i],
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, UMBRA_BINDING_COUNT, w, 0, NULL);
+	put_images(w + UMBRA_BINDING_SHADOW_MAP, s->set, UMBRA_BINDING_SHADOW_MAP, 4, ii);
+	vkUpdateDescriptorSets(ctx->device, UMBRA_BINDING_SURFACES, w, 0, NULL);
+	bind_passes(ctx, s, lay, env, env_pass);
 }
 
 /* minmax.comp: the scratch map in, the depth bounds out. moments.frag: the depth atlas and the
@@ -268,7 +289,8 @@ static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
 
 enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                 const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                float exposure, bool contact, struct rnd_error *err)
+                                float exposure, bool contact, const struct rnd_env_use *env, bool env_pass,
+                                struct rnd_error *err)
 {
 	struct params_layout lay;
 	params_layout(ctx, sc, &lay);
@@ -278,12 +300,20 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
 	if (r != RND_OK) return r;
 	uint8_t *base = s->params.map;
 	memset(base, 0, lay.total);
-	write_frame((struct umbra_frame *)(base + lay.off_frame), sc, cam, exposure);
+	/* The environment's directions come after the scene's lights (render.c): lights, but not
+	 * shaded as such (ibl.glsl reads their maps). */
+	uint32_t env_lights = env ? env->mapped : 0, shaded = sc->light_count - env_lights;
+	write_frame((struct umbra_frame *)(base + lay.off_frame), sc, cam, exposure, shaded);
+	float inv_vp[16];
+	if (!rnd_mat4_invert(inv_vp, cam->view_proj)) memset(inv_vp, 0, sizeof inv_vp);
+	static const struct rnd_env_use none;
+	rnd_env_write(env ? env : &none, &sc->environment, inv_vp, shaded, rnd_env_pass_scale(sc->width, sc->height),
+	              (struct umbra_env *)(base + lay.off_env));
 	write_materials((struct umbra_material *)(base + lay.off_mat), sc);
 	struct umbra_light *l = (struct umbra_light *)(base + lay.off_light);
 	for (uint32_t i = 0; i < sc->light_count; i++) write_light(ctx, &l[i], sc, sp, i);
 	memcpy(base + lay.off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));
-	bind_params(ctx, s, &lay, contact);
+	bind_params(ctx, s, &lay, contact, env, env_pass);
 	bind_moments(ctx, s);
 	return RND_OK;
 }

@@ -91,7 +91,8 @@ struct rnd_pipelines {
 	/* [cull] the same with pixel shading's inputs too (deferred.c) */
 	VkPipeline surfaces_shade[2];
 	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
-	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, vis_shade_fs, resolve_fs;
+	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, vis_shade_fs, resolve_fs, background_fs,
+	               env_vis_fs;
 	pthread_mutex_t mu;
 	uint32_t variant_count;
 	struct rnd_main_variant {
@@ -106,6 +107,9 @@ struct rnd_pipelines {
 			uint32_t vis_read;           /* 1 = main pass reading the visibility pass (mesh_vis.frag) */
 			uint32_t vis_shade;          /* with vis_pass: pixel shading's pass (vis_shade.frag, deferred.c) */
 			uint32_t resolve;            /* 1 = pixel shading's resolve (fullscreen.vert + resolve.frag) */
+			uint32_t background;         /* 1 = the environment map behind the scene (fullscreen.vert +
+			                                env_background.frag, where the depth is still the far plane) */
+			uint32_t env_pass;           /* 1 = the environment pass (fullscreen.vert + env_vis.frag, R16) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;
@@ -137,6 +141,7 @@ struct rnd_moments {
 
 struct rnd_slot;
 struct rnd_shadow_cache;
+struct rnd_env_cache;
 
 struct rnd_context {
 	struct rnd_context_desc desc;
@@ -156,6 +161,7 @@ struct rnd_context {
 	struct rnd_pipelines pipes;
 	struct rnd_moments moments;
 	struct rnd_shadow_cache *cache;      /* shadow_cache.c */
+	struct rnd_env_cache *env;           /* env.c: environment maps prefiltered on the device */
 	struct rnd_image_res atlas_depth;    /* D32, GENERAL layout, every shadow view is a tile */
 	struct rnd_image_res atlas_moments;  /* VSM / EVSM moments, same tiles */
 	struct rnd_image_res atlas_bounds;   /* PCSS depth bounds: a texel per UMBRA_BOUNDS_BLOCK² block */
@@ -206,6 +212,10 @@ enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format
                                         uint32_t layers, uint32_t samples, uint32_t levels, VkImageUsageFlags usage,
                                         VkImageAspectFlags aspect, const char *name, struct rnd_image_res *out,
                                         struct rnd_error *err);
+/* A cube map (6 layers, cube-compatible) of `levels` mip levels; its view is a cube of them all. */
+enum rnd_result rnd_image_create_cube(struct rnd_context *ctx, VkFormat format, uint32_t side, uint32_t levels,
+                                      VkImageUsageFlags usage, const char *name, struct rnd_image_res *out,
+                                      struct rnd_error *err);
 void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
 
 /* pipelines.c */

@@ -25,6 +25,8 @@
 #include "surface_shade.frag.spv.h"
 #include "vis_shade.frag.spv.h"
 #include "resolve.frag.spv.h"
+#include "env_background.frag.spv.h"
+#include "env_vis.frag.spv.h"
 
 enum rnd_result rnd_shader_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
                                   VkShaderModule *out, struct rnd_error *err)
@@ -52,6 +54,13 @@ const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
 	[UMBRA_BINDING_SURFACE_SHADING] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_SHADED] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VIEW_DEPTH_MS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_ENV_SPECULAR] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_MAP] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_BRDF] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_SURFACES] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_NORMALS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_VIS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 };
 
 static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
@@ -143,6 +152,7 @@ struct pipe_desc {
 	VkFormat color_last;        /* when set: the format of the last attachment */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
+	bool depth_equal_ro;        /* fullscreen over a depth: test EQUAL (passes where it is still 0), no writes */
 	const VkSpecializationInfo *spec;  /* fragment stage */
 	VkPipelineLayout layout;    /* VK_NULL_HANDLE: the main passes' (ctx->pipes.layout) */
 	const char *name;
@@ -210,9 +220,10 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	};
 	VkPipelineDepthStencilStateCreateInfo ds = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-		.depthTestEnable = !d->no_vertices || d->depth_less_ro,
+		.depthTestEnable = !d->no_vertices || d->depth_less_ro || d->depth_equal_ro,
 		.depthWriteEnable = !d->after_prepass && !d->no_vertices,
 		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL : d->depth_less_ro ? VK_COMPARE_OP_LESS
+		                : d->depth_equal_ro ? VK_COMPARE_OP_EQUAL
 		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
 	};
 	VkPipelineColorBlendStateCreateInfo cb = {
@@ -268,26 +279,23 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	VkShaderModule surface_fs = VK_NULL_HANDLE, surface_shade_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_mesh_vert, sizeof spv_mesh_vert, "mesh.vert", &p->mesh_vs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_mesh_frag, sizeof spv_mesh_frag, "mesh.frag", &p->mesh_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_aov_frag, sizeof spv_aov_frag, "aov.frag", &p->aov_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_masked_vert, sizeof spv_masked_vert, "masked.vert", &masked_vs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_masked_frag, sizeof spv_masked_frag, "masked.frag", &masked_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_surface_frag, sizeof spv_surface_frag, "surface.frag", &surface_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs, err)) != RND_OK)
-		goto fail;
-	if ((r = rnd_shader_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
-		goto fail;
-	if ((r = rnd_shader_module(ctx, spv_surface_shade_frag, sizeof spv_surface_shade_frag, "surface_shade.frag",
-	                           &surface_shade_fs, err)) != RND_OK)
-		goto fail;
-	if ((r = rnd_shader_module(ctx, spv_vis_shade_frag, sizeof spv_vis_shade_frag, "vis_shade.frag", &p->vis_shade_fs,
-	                           err)) != RND_OK)
-		goto fail;
-	if ((r = rnd_shader_module(ctx, spv_resolve_frag, sizeof spv_resolve_frag, "resolve.frag", &p->resolve_fs, err)) != RND_OK)
-		goto fail;
+	/* The modules: those of the pipelines made here (destroyed below) and those the context
+	 * keeps for the variants. */
+	const struct { const uint32_t *code; size_t size; const char *name; VkShaderModule *out; } mods[] = {
+#define MOD(spv, file, out) {spv, sizeof spv, file, out}
+		MOD(spv_shadow_vert, "shadow.vert", &shadow_vs), MOD(spv_masked_vert, "masked.vert", &masked_vs),
+		MOD(spv_masked_frag, "masked.frag", &masked_fs), MOD(spv_surface_frag, "surface.frag", &surface_fs),
+		MOD(spv_surface_shade_frag, "surface_shade.frag", &surface_shade_fs),
+		MOD(spv_mesh_vert, "mesh.vert", &p->mesh_vs), MOD(spv_mesh_frag, "mesh.frag", &p->mesh_fs),
+		MOD(spv_aov_frag, "aov.frag", &p->aov_fs), MOD(spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs),
+		MOD(spv_vis_frag, "vis.frag", &p->vis_fs), MOD(spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs),
+		MOD(spv_vis_shade_frag, "vis_shade.frag", &p->vis_shade_fs), MOD(spv_resolve_frag, "resolve.frag", &p->resolve_fs),
+		MOD(spv_env_background_frag, "env_background.frag", &p->background_fs),
+		MOD(spv_env_vis_frag, "env_vis.frag", &p->env_vis_fs),
+#undef MOD
+	};
+	for (size_t i = 0; i < sizeof mods / sizeof mods[0]; i++)
+		if ((r = rnd_shader_module(ctx, mods[i].code, mods[i].size, mods[i].name, mods[i].out, err)) != RND_OK) goto fail;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
@@ -357,6 +365,62 @@ fail:
 	return r;
 }
 
+/* A fullscreen triangle's pipeline (fullscreen.vert, no vertices) with fragment shader fs:
+ * no pre-pass, no culling. */
+static void fullscreen(struct pipe_desc *d, const struct rnd_pipelines *p, VkShaderModule fs)
+{
+	d->vs = p->fullscreen_vs;
+	d->fs = fs;
+	d->no_vertices = true;
+	d->after_prepass = false;
+	d->cull_back = false;
+	d->dynamic_cull = false;
+}
+
+/* What the passes other than the main one change in the main pass's description d. */
+static void pass_desc(const struct rnd_context *ctx, const struct rnd_main_key *key, struct pipe_desc *d)
+{
+	const struct rnd_pipelines *p = &ctx->pipes;
+	if (key->aov) {
+		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
+		d->fs = p->aov_fs;
+		d->color = VK_FORMAT_R32G32B32A32_SFLOAT;
+		d->color_count = UMBRA_AOV_ATTACHMENTS;
+		d->samples = 1;
+		d->after_prepass = false;
+	}
+	if (key->vis_read) d->fs = p->mesh_vis_fs;
+	if (key->vis_pass) {
+		/* Visibility pass: a fullscreen triangle over the surfaces' depth, one sample, its
+		 * results stored to an image (no colour attachment); with pixel shading (deferred.c)
+		 * the colour shaded at each pixel centre into an image of the output's format. */
+		fullscreen(d, p, key->vis_shade ? p->vis_shade_fs : p->vis_fs);
+		d->color = key->vis_shade ? ctx->color_formats[key->format] : VK_FORMAT_UNDEFINED;
+		d->samples = 1;
+		d->depth_less_ro = true;
+	}
+	if (key->resolve) {
+		/* Pixel shading's resolve: a fullscreen triangle into the single-sample target. */
+		fullscreen(d, p, p->resolve_fs);
+		d->spec = NULL;
+		d->depth = VK_FORMAT_UNDEFINED;
+		d->samples = 1;
+	}
+	if (key->background) {
+		/* The environment behind the scene: a fullscreen triangle at depth 0 (the far plane of
+		 * the reversed Z), kept where the depth is still 0: no geometry, sample by sample. */
+		fullscreen(d, p, p->background_fs);
+		d->depth_equal_ro = true;
+	}
+	if (key->env_pass) {
+		/* The environment pass: a fullscreen triangle over its grid, one R16 target. */
+		fullscreen(d, p, p->env_vis_fs);
+		d->color = VK_FORMAT_R16_UNORM;
+		d->depth = VK_FORMAT_UNDEFINED;
+		d->samples = 1;
+	}
+}
+
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
                                    struct rnd_error *err)
 {
@@ -385,12 +449,13 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
 	char name[128];
-	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
+	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
 	         key->aov ? "aov" : key->resolve ? "resolve" : key->vis_shade ? "pixel shading"
-	         : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",
+	         : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)"
+	         : key->background ? "background" : key->env_pass ? "environment" : "main",
 	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
 	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10],
-	         key->sc[11]);
+	         key->sc[11], key->sc[12]);
 	struct pipe_desc d = {
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
@@ -401,54 +466,10 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		/* Debug view of the depth atlas: a fullscreen triangle. */
 		if ((r = rnd_shader_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
 			goto out_modules;
-		d.vs = p->fullscreen_vs;
-		d.fs = fs_fs;
+		fullscreen(&d, p, fs_fs);
 		d.spec = NULL;
-		d.no_vertices = true;
-		d.after_prepass = false;
-		d.cull_back = false;
-		d.dynamic_cull = false;
 	}
-	if (key->aov) {
-		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
-		d.fs = p->aov_fs;
-		d.color = VK_FORMAT_R32G32B32A32_SFLOAT;
-		d.color_count = UMBRA_AOV_ATTACHMENTS;
-		d.samples = 1;
-		d.after_prepass = false;
-	}
-	if (key->vis_read) d.fs = p->mesh_vis_fs;
-	if (key->vis_pass) {
-		/* Visibility pass: a fullscreen triangle over the surfaces' depth, one sample, its
-		 * results stored to an image (no colour attachment). */
-		d.vs = p->fullscreen_vs;
-		d.fs = p->vis_fs;
-		d.color = VK_FORMAT_UNDEFINED;
-		d.samples = 1;
-		d.no_vertices = true;
-		d.depth_less_ro = true;
-		d.after_prepass = false;
-		d.cull_back = false;
-		d.dynamic_cull = false;
-		/* Pixel shading (deferred.c): the colour shaded at each pixel centre into an image of
-		 * the output's format. */
-		if (key->vis_shade) {
-			d.fs = p->vis_shade_fs;
-			d.color = ctx->color_formats[key->format];
-		}
-	}
-	if (key->resolve) {
-		/* Pixel shading's resolve: a fullscreen triangle into the single-sample target. */
-		d.vs = p->fullscreen_vs;
-		d.fs = p->resolve_fs;
-		d.spec = NULL;
-		d.depth = VK_FORMAT_UNDEFINED;
-		d.samples = 1;
-		d.no_vertices = true;
-		d.after_prepass = false;
-		d.cull_back = false;
-		d.dynamic_cull = false;
-	}
+	pass_desc(ctx, key, &d);
 	values[UMBRA_SC_SAMPLES] = d.samples;
 	VkPipeline pipe;
 	r = make_pipeline(ctx, &d, &pipe, err);
@@ -544,6 +565,8 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
 	if (p->vis_fs) vkDestroyShaderModule(ctx->device, p->vis_fs, NULL);
 	if (p->mesh_vis_fs) vkDestroyShaderModule(ctx->device, p->mesh_vis_fs, NULL);
+	if (p->background_fs) vkDestroyShaderModule(ctx->device, p->background_fs, NULL);
+	if (p->env_vis_fs) vkDestroyShaderModule(ctx->device, p->env_vis_fs, NULL);
 	if (p->fullscreen_vs) vkDestroyShaderModule(ctx->device, p->fullscreen_vs, NULL);
 	for (uint32_t i = 0; i < RND_TEXTURE_SAMPLERS; i++)
 		if (p->texture_samplers[i]) vkDestroySampler(ctx->device, p->texture_samplers[i], NULL);

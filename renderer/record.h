@@ -9,6 +9,8 @@
 #include "plan.h"
 #include "slot.h"
 
+struct rnd_env_use;
+
 /* One object's draw, made by render.c's upload. */
 struct draw {
 	uint32_t first_index, index_count;
@@ -53,6 +55,11 @@ struct record_view {
 	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
 	bool vis;                      /* shadows from the visibility pass (visibility.c), drawn per band */
 	bool deferred;                 /* with vis: shaded once per pixel centre (deferred.c) */
+	/* Every light the shadow passes draw for: the scene's, then the environment's directions
+	 * (render.c, env_shadow.h); NULL: the scene's. */
+	const struct rnd_light *shadow_lights;
+	const struct rnd_env_use *env;  /* the view's environment (NULL: none) */
+	bool env_pass;                 /* its shadows from the environment pass (env_pass.c), drawn once */
 };
 
 /* The rows of the view that this submit draws (band_y, band_h). */
@@ -60,6 +67,10 @@ VkRect2D record_band_area(const struct record_view *rv);
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
                           VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage,
                           VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
+/* A colour target written whole by a fullscreen pass: img made a colour attachment, its old
+ * contents dropped, after its previous use at src_stage; the attachment (not cleared, stored). */
+VkRenderingAttachmentInfo record_color_overwrite(VkCommandBuffer cmd, const struct rnd_image_res *img,
+                                                 VkPipelineStageFlags2 src_stage);
 /* Depth-only passes (shadow maps, the camera depth of contact shadows): img made a depth
  * attachment after its previous use (src_stage, src_access), then rendering begun into its
  * view over (0, 0, w, h), cleared to 1, with that viewport and scissor. */
@@ -91,9 +102,8 @@ void record_shadow_part(struct rnd_context *ctx, struct rnd_slot *s, const struc
 /* Whether shadow view v draws draw i (a caster inside its frustum) and, if so, with back faces
  * culled (*cull). */
 bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, int *cull);
-/* The specialization key of this scene's main pass (see mesh.frag). */
-void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
-                     uint32_t ndraw, struct rnd_main_key *k);
+/* The specialization key of the view's main pass (see mesh.frag) over its first ndraw draws. */
+void record_main_key(const struct record_view *rv, uint32_t ndraw, struct rnd_main_key *k);
 enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
                             struct rnd_error *err);
 enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,

@@ -43,6 +43,7 @@ static enum job_status render_ready(struct farm *f, struct ready *r)
 	struct job_result *res = &f->res[r->i];
 	struct api_scene *s = r->s;
 	res->imp = s->import;
+	res->env = s->scene.environment.source != RND_ENV_AMBIENT;
 	struct rnd_image img = {0};
 	struct rnd_timings tm;
 	struct rnd_error err;

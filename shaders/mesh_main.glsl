@@ -2,7 +2,7 @@
 // reading its shadows from the visibility pass, renderer/visibility.c).
 #define UMBRA_PUSH_MAIN   // the draw's material head arrives in the push constants
 #include "shading.glsl"
-#include "shade.glsl"
+#include "shade.glsl"   // and ibl.glsl
 
 layout(location = 0) out vec4 o_color;
 
@@ -20,6 +20,7 @@ umbra_material draw_material()
 		m.clearcoat = materials[pc.info.x].clearcoat;
 		m.sheen = materials[pc.info.x].sheen;
 		m.specular = materials[pc.info.x].specular;
+		m.ext = materials[pc.info.x].ext;
 	}
 	return m;
 }

@@ -2,14 +2,17 @@
  * pixel centre, each sample then taking the colour of the pixel centre that shows its surface,
  * instead of the main pass shading every fragment. The model: a bumpy closed sphere of ~9,000
  * triangles with a colour per vertex (a binary PLY, under the level-of-detail size: drawn in
- * full), under the thumbnail preset (a soft sun, a ground shadow catcher), 160^2.
+ * full), under the thumbnail preset (the studio environment and its 12 shadow directions, no
+ * light of the scene's own: pixel shading runs the surfaces pass for itself; a ground shadow
+ * catcher), 160^2.
  *   - it ran, and inside surfaces the picture is per-fragment shading's: pixels off the
  *     picture's edges differ by at most a few steps, rarely;
  *   - along edges it is as close to a 4x4-supersampled render of the same scene as per-fragment
  *     shading with MSAA 4 is (box-filtered down, the mean error over the reference's edge
  *     pixels), opaque and transparent (the catcher's alpha);
  *   - it stays off where the surfaces pass cannot carry what shading needs (an alpha-tested
- *     material beside the model, a debug view) and without MSAA. */
+ *     material beside the model, a debug view), without MSAA, and where the environment map is
+ *     the background (the resolve draws the clear colour where nothing was drawn). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -167,6 +170,12 @@ TEST(pixel_shading_stays_off_where_the_surfaces_pass_cannot_shade)
 	v = 1;
 	if (thumb(&img, 96, "1", ",'output':{'debug':'normals'}", &v)) {
 		CHECK(v == 0, "a debug view: shaded per pixel in %u views", v);
+		rnd_image_release(&img);
+	}
+	/* the preset's studio drawn behind the model: the resolve has no environment background */
+	v = 1;
+	if (thumb(&img, 96, "1", ",'environment':{'background':'map'}", &v)) {
+		CHECK(v == 0, "the environment map as the background: shaded per pixel in %u views", v);
 		rnd_image_release(&img);
 	}
 	/* an alpha-tested quad beside the model (the preset's objects are replaced: both given) */
