@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "deferred.h"
 #include "contact.h"
 #include "env_pass.h"
 #include "env_shadow.h"
@@ -456,12 +457,20 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	bool contact = rnd_contact_any(sc, rq->sp);
 	if (contact && (r = rnd_slot_scene_depth(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
 	bool vis = rnd_visibility_wanted(ctx, sc, rq->sp, rq->draws, sc->object_count);
+	if (vis) rq->tm.visibility_views++;
+	/* Pixel shading (deferred.c) on the visibility pass's surfaces, or on its own ones (an
+	 * environment map's view); its bindings need images whether it runs or not. */
+	bool deferred = rnd_deferred_wanted(ctx, sc, rq->draws, sc->object_count, vis, rq->env.entry != NULL);
+	vis = vis || deferred;
 	/* Without the pass its bindings still need images (lavapipe reads every descriptor of a
 	 * bound set): whatever the slot has, or 1x1 ones. */
 	r = vis ? rnd_slot_visibility(ctx, s, sc->width, sc->height, sc->light_count, err)
 	        : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
 	if (r != RND_OK) return r;
-	if (vis) rq->tm.visibility_views++;
+	r = deferred ? rnd_slot_pixel_shading(ctx, s, sc->width, sc->height, ctx->color_formats[sc->output.pixels], err)
+	    : s->shading.img && s->shaded.img ? RND_OK : rnd_slot_pixel_shading(ctx, s, 1, 1, VK_FORMAT_R8G8B8A8_UNORM, err);
+	if (r != RND_OK) return r;
+	if (deferred) rq->tm.pixel_shaded_views++;
 	bool env_pass = rnd_env_pass_wanted(sc, &rq->env, rq->draws, sc->object_count);
 	if (env_pass && (r = rnd_slot_env_pass(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
 	if ((r = rnd_frame_write(ctx, s, &rq->esc, &cam, rq->sp, camera->exposure, contact, &rq->env, env_pass, err)) != RND_OK)
@@ -473,7 +482,7 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.sc = sc, .cam = &cam, .sp = rq->sp, .draws = rq->draws, .ndraw = sc->object_count, .aov_passes = sh->passes,
 		.color_offset = cell * sh->px, .aov_offset = sh->color_bytes + cell * 16, .aov_stride = sh->att_bytes,
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = contact,
-		.vis = vis, .shadow_lights = rq->esc.lights, .env = &rq->env, .env_pass = env_pass,
+		.vis = vis, .deferred = deferred, .shadow_lights = rq->esc.lights, .env = &rq->env, .env_pass = env_pass,
 	};
 	return rnd_submit_view(ctx, s, &rv, &rq->pacer, &rq->tm, &rq->gpu_busy, err);
 }
@@ -500,6 +509,7 @@ static void finish(struct render *rq, enum rnd_result r, struct rnd_error *err)
 	rq->tm.env_ms = rq->env.ms;
 	rnd_env_done(ctx, &rq->env, r == RND_OK, rq->gpu_busy);
 	rnd_slot_release(ctx, rq->s);
+	rnd_pipelines_reap(ctx);   /* variants retired while this render ran */
 	free(rq->arena);
 }
 

@@ -23,6 +23,11 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
  * at all (no shadowed light, a debug view, a view too large): what a render may need beyond
  * its targets (estimate.c counts it, before the plan says whether the pass runs). */
 uint64_t rnd_visibility_bytes(const struct rnd_scene *sc);
+/* The bytes of the slot's images for the surfaces pass of sc's view with `lights` layers of
+ * visibility; 0 over the size the pass may take. */
+uint64_t rnd_surfaces_bytes(const struct rnd_scene *sc, uint32_t lights);
+/* The triangles of draws the camera may see (what pays for the passes: one per N pixels). */
+uint64_t rnd_camera_faces(const struct draw *draws, uint32_t ndraw);
 /* Where the surfaces pass draws: world positions (RND_SURFACES_FORMAT, w 1 where drawn, 0 else)
  * and geometric normals (RND_SURFACE_NORMALS_FORMAT) of what each pixel centre of the targets
  * shows, and their depth; the view fills a viewport of width x height of them (the view's own
@@ -30,6 +35,7 @@ uint64_t rnd_visibility_bytes(const struct rnd_scene *sc);
 struct rnd_surface_targets {
 	const struct rnd_image_res *positions, *normals, *depth;
 	float width, height;
+	const struct rnd_image_res *shading;   /* pixel shading's inputs too (deferred.c), or NULL */
 };
 /* Draws rv's surfaces over area (rows of the targets) into t, left ready for sampling (the depth
  * as a read-only attachment). */
