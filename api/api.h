@@ -255,6 +255,7 @@ struct api_info {
 	uint64_t max_body, max_memory, device_max_allocation;
 	uint32_t max_dimension, device_max_shadow_resolution, deadline_ms, queue, workers;
 	uint32_t max_textures, device_max_textures;   /* in force (--max-textures, capped) / the device's */
+	uint64_t max_rss, rss;            /* the resident-memory bound (0 = none) and the process's now */
 };
 /* The /v1/info document (compact JSON and a newline), malloc'd (the caller frees it); *len its
  * length. NULL when out of memory. api/info.c. */

@@ -41,7 +41,8 @@ static json_t *limits_object(const struct api_info *in)
 	          put(l, "import_timeout_ms", json_integer(in->limits.import_timeout_ms)) |
 	          put(l, "import_memory", json_integer((json_int_t)in->limits.import_memory)) |
 	          put(l, "max_textures", json_integer(in->max_textures)) |
-	          put(l, "device_max_textures", json_integer(in->device_max_textures));
+	          put(l, "device_max_textures", json_integer(in->device_max_textures)) |
+	          put(l, "max_rss", json_integer((json_int_t)in->max_rss));
 	if (bad) {
 		json_decref(l);
 		return NULL;
@@ -66,7 +67,7 @@ char *api_info_json(const struct api_info *in, size_t *len)
 	          put(o, "vulkan_api", json_string(vk)) | put(o, "cpu", json_boolean(in->cpu)) |
 	          put(o, "limits", limits_object(in)) | put(o, "filters", strings(filters)) |
 	          put(o, "formats", strings(formats)) | put(o, "media_types", strings(media)) |
-	          put(o, "priorities", strings(priorities));
+	          put(o, "priorities", strings(priorities)) | put(o, "rss", json_integer((json_int_t)in->rss));
 	char *s = bad ? NULL : json_dumps(o, JSON_COMPACT | JSON_PRESERVE_ORDER);
 	json_decref(o);
 	if (!s) return NULL;

@@ -78,6 +78,7 @@ static json_t *view_object(const struct rnd_plan *plan, uint32_t k)
 	                      v.visibility, "why", v.visibility_why, "estimate_ms", "shadows", ms(v.shadow_estimate_ms),
 	                      "per_row", ms(v.row_ms), "per_band", ms(v.band_ms), "main", ms(v.main_estimate_ms));
 	if (o) put(o, "environment_pass", json_boolean(v.env_pass));
+	if (o) put(o, "pixel_shading", json_pack("{s:b, s:s}", "on", v.pixel_shading, "why", v.pixel_shading_why));
 	if (o && v.analyzed)
 		put(o, "actual_ms", json_pack("{s:o, s:o, s:i}", "shadows", ms(v.shadow_ms), "main", ms(v.main_ms), "bands",
 		                              (json_int_t)v.bands));
@@ -147,14 +148,15 @@ static json_t *pass_object(uint32_t step, const struct rnd_plan_pass_info *p)
 static json_t *actual_object(const struct rnd_plan_info *in, const struct api_plan_times *t)
 {
 	const struct rnd_timings *a = &in->actual;
-	json_t *o = json_pack("{s:o, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:I, s:I, s:I, s:i, s:i}", "upload_ms", ms(a->upload_ms),
+	json_t *o = json_pack("{s:o, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:I, s:I, s:I, s:i, s:i, s:i}", "upload_ms", ms(a->upload_ms),
 	                      "shadow_ms", ms(a->shadow_ms), "main_ms", ms(a->main_ms), "readback_ms", ms(a->readback_ms),
 	                      "submits", (json_int_t)a->submits, "shadow_parts", (json_int_t)a->shadow_parts,
 	                      "shadow_maps_drawn", (json_int_t)a->shadow_maps_rendered, "shadow_maps_reused",
 	                      (json_int_t)a->shadow_maps_reused, "shadow_texels", (json_int_t)a->shadow_texels,
 	                      "shadow_triangles", (json_int_t)a->shadow_triangles, "camera_triangles",
 	                      (json_int_t)a->camera_triangles, "visibility_views",
-	                      (json_int_t)a->visibility_views, "sphere_proxies", (json_int_t)a->sphere_proxies);
+	                      (json_int_t)a->visibility_views, "pixel_shaded_views", (json_int_t)a->pixel_shaded_views,
+	                      "sphere_proxies", (json_int_t)a->sphere_proxies);
 	if (o && t && t->parse_ms >= 0) put(o, "parse_ms", ms(t->parse_ms));
 	if (o && t && t->encode_ms >= 0) put(o, "encode_ms", ms(t->encode_ms));
 	if (o && t && t->total_ms >= 0) put(o, "total_ms", ms(t->total_ms));

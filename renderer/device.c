@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "deferred.h"
 #include "internal.h"
 #include "env.h"
 #include "moments.h"
@@ -296,8 +297,23 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 	return rnd_fail(err, RND_ERR_NO_DEVICE, "device '%s' has no graphics queue", ctx->props.deviceName);
 }
 
+/* The shaders take subgroupOr in fragment shaders (shading.glsl light_all: the lights any pixel
+ * of a block reaches). Vulkan 1.1 promises subgroups in compute shaders only; every desktop
+ * driver and lavapipe have them in fragment shaders too. */
+static bool fragment_subgroups(const struct rnd_context *ctx)
+{
+	VkPhysicalDeviceSubgroupProperties sp = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+	VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &sp};
+	vkGetPhysicalDeviceProperties2(ctx->phys, &p2);
+	return (sp.supportedStages & VK_SHADER_STAGE_FRAGMENT_BIT) &&
+	       (sp.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);
+}
+
 static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *err)
 {
+	if (!fragment_subgroups(ctx))
+		return rnd_fail(err, RND_ERR_NO_DEVICE, "device '%s' has no subgroup arithmetic in fragment shaders",
+		                ctx->props.deviceName);
 	VkPhysicalDeviceFeatures have;
 	vkGetPhysicalDeviceFeatures(ctx->phys, &have);
 	VkPhysicalDeviceVulkan13Features f13 = {
@@ -343,8 +359,15 @@ static enum rnd_result create_device(struct rnd_context *ctx, struct rnd_error *
 	}
 	vkGetPhysicalDeviceFormatProperties(ctx->phys, RND_VISIBILITY_FORMAT, &fp);
 	VkFormatFeatureFlags vis_need = VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
+	/* the surfaces pass renders normals to 16-bit snorm, a colour-attachment format Vulkan does
+	 * not require (lavapipe and the desktop GPUs have it) */
+	VkFormatProperties np;
+	vkGetPhysicalDeviceFormatProperties(ctx->phys, RND_SURFACE_NORMALS_FORMAT, &np);
+	VkFormatFeatureFlags surf_need = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
 	ctx->visibility_pass = have.fragmentStoresAndAtomics && have.shaderStorageImageExtendedFormats &&
-	                       (fp.optimalTilingFeatures & vis_need) == vis_need;
+	                       (fp.optimalTilingFeatures & vis_need) == vis_need &&
+	                       (np.optimalTilingFeatures & surf_need) == surf_need;
+	ctx->pixel_shading = rnd_deferred_supported(ctx);
 	ctx->color_formats[RND_PIXELS_RGBA8] = VK_FORMAT_R8G8B8A8_UNORM;
 	ctx->color_formats[RND_PIXELS_RGBA16] = VK_FORMAT_R16G16B16A16_UNORM;
 	ctx->color_formats[RND_PIXELS_RGBA32F] = VK_FORMAT_R32G32B32A32_SFLOAT;

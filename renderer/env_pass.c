@@ -70,14 +70,7 @@ enum rnd_result rnd_slot_env_pass(struct rnd_context *ctx, struct rnd_slot *s, u
 static void record_vis(struct rnd_context *ctx, struct rnd_slot *s, VkPipeline pipe, uint32_t pw, uint32_t ph)
 {
 	VkCommandBuffer cmd = s->cmd;
-	record_image_barrier(cmd, s->env_vis.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-	                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-	                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-	VkRenderingAttachmentInfo ca = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->env_vis.view,
-		.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-		.storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-	};
+	VkRenderingAttachmentInfo ca = record_color_overwrite(cmd, &s->env_vis, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
 	VkRect2D area = {{0, 0}, {pw, ph}};
 	VkRenderingInfo ri = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,

@@ -103,7 +103,8 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 	uint64_t targets = px * pb * (samples > 1 ? 1 + samples : 1) + px * 4 * samples;
 	uint64_t aov_targets = passes ? px * (16 * UMBRA_AOV_ATTACHMENTS + 4) : 0;
 	/* Each texture twice: its image and the staging buffer that carries it (both with mips). */
-	e->device_bytes = targets + aov_targets + readback + geometry + scratch + 2 * textures + rnd_visibility_bytes(sc);
+	e->device_bytes = targets + aov_targets + readback + geometry + scratch + 2 * textures + rnd_visibility_bytes(sc) +
+	                 rnd_deferred_bytes(sc);
 	/* The image handed back (colour + float AOV planes) and, at most as large, its encoding. */
 	uint64_t image = colour + sheet * 4 * rnd_aov_planes(sc);
 	e->host_bytes = 2 * image;

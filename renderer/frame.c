@@ -74,6 +74,8 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	f->camera_pos[3] = cam->ortho ? 1.0f : 0.0f;
 	memcpy(f->camera_fwd, cam->fwd, sizeof cam->fwd);
 	memcpy(f->background, sc->environment.background, sizeof f->background);
+	record_clear_color(sc, f->clear);
+	if (!rnd_mat4_invert(f->inv_view_proj, cam->view_proj)) memset(f->inv_view_proj, 0, sizeof f->inv_view_proj);
 	for (int k = 0; k < 3; k++) {
 		f->ambient_sky[k] = sc->environment.ambient_sky[k] * sc->environment.ambient_intensity;
 		f->ambient_ground[k] = sc->environment.ambient_ground[k] * sc->environment.ambient_intensity;
@@ -155,7 +157,61 @@ static void write_light(const struct rnd_context *ctx, struct umbra_light *l, co
 	if (rnd_contact_on(sc, sp, i)) rnd_contact_params(&in->shadow, l->contact);
 }
 
-/* Set 0 of the draw pipelines: the four regions, the depth and moment atlases, the camera depth. */
+/* w[0 .. n - 1]: bindings binding .. binding + n - 1 of set 0, images each of its own type. */
+static uint32_t put_images(VkWriteDescriptorSet *w, VkDescriptorSet set, uint32_t binding, uint32_t n,
+                           const VkDescriptorImageInfo *ii)
+{
+	for (uint32_t i = 0; i < n; i++)
+		w[i] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = set, .dstBinding = binding + i,
+			.descriptorCount = 1, .descriptorType = rnd_binding_type[binding + i], .pImageInfo = &ii[i],
+		};
+	return n;
+}
+
+/* Set 0's bindings of the passes beside the main one: the visibility pass's, the environment's
+ * and pixel shading's (UMBRA_BINDING_SURFACES on). */
+static void bind_passes(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay,
+                        const struct rnd_env_use *env, bool env_pass)
+{
+	VkWriteDescriptorSet w[UMBRA_BINDING_COUNT - UMBRA_BINDING_SURFACES];
+	uint32_t n = 0;
+	/* The visibility pass's images (visibility.c): only the pipelines of renders that use it
+	 * declare them; other renders bind whatever images the slot has (render.c). */
+	VkDescriptorImageInfo vi[4] = {
+		{ctx->pipes.shadow_sampler, s->surfaces.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.shadow_sampler, s->normals.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.shadow_sampler, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
+		{VK_NULL_HANDLE, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
+	};
+	n += put_images(w + n, s->set, UMBRA_BINDING_SURFACES, 4, vi);
+	/* The environment: its block and images (the slot's white stand-ins without a map), the
+	 * environment pass's images (stand-ins without the pass). */
+	VkDescriptorBufferInfo ebi = {s->params.buf, lay->off_env, sizeof(struct umbra_env)};
+	w[n++] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_ENV,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &ebi,
+	};
+	VkDescriptorImageInfo ei[6];
+	rnd_env_images(ctx, env, s, ei);
+	const struct rnd_image_res *pass[3] = {&s->env_surfaces, &s->env_normals, &s->env_vis};
+	for (int i = 0; i < 3; i++)
+		ei[3 + i] = env_pass ? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, pass[i]->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}
+		                     : (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	n += put_images(w + n, s->set, UMBRA_BINDING_ENV_SPECULAR, 6, ei);
+	/* Pixel shading's (deferred.c): its inputs, the shaded colours and the view's depth samples
+	 * (integer and depth formats: the nearest sampler without a border; only texelFetch). */
+	VkDescriptorImageInfo pi[3] = {
+		{ctx->pipes.atlas_sampler, s->shading.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.atlas_sampler, s->shaded.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+		{ctx->pipes.atlas_sampler, s->depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL},
+	};
+	n += put_images(w + n, s->set, UMBRA_BINDING_SURFACE_SHADING, 3, pi);
+	vkUpdateDescriptorSets(ctx->device, n, w, 0, NULL);
+}
+
+/* Set 0 of the draw pipelines: the four regions, the depth and moment atlases, the camera depth,
+ * then the passes' bindings (bind_passes). */
 static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay, bool contact,
                         const struct rnd_env_use *env, bool env_pass)
 {
@@ -165,74 +221,32 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{s->params.buf, lay->off_light, lay->nlight * sizeof(struct umbra_light)},
 		{s->params.buf, lay->off_view, lay->nview * sizeof(struct umbra_shadow_view)},
 	};
-	VkDescriptorImageInfo ii = {ctx->pipes.atlas_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
+	VkDescriptorImageInfo ii[4];
+	ii[0] = (VkDescriptorImageInfo){ctx->pipes.atlas_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
 	/* Without a moment atlas (no storage images) no light uses moments; the binding still
 	 * needs an image. */
-	VkDescriptorImageInfo mi = ctx->atlas_moments.view
+	ii[1] = ctx->atlas_moments.view
 		? (VkDescriptorImageInfo){ctx->moments.sampler, ctx->atlas_moments.view, VK_IMAGE_LAYOUT_GENERAL}
 		: (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_depth.view, VK_IMAGE_LAYOUT_GENERAL};
 	/* Contact shadows read the view's depth (drawn before the main pass); other renders bind
 	 * the white texture, which their pipelines never read. */
-	VkDescriptorImageInfo di = contact
+	ii[2] = contact
 		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, s->scene_depth.view, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL}
 		: (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
 	/* Lights without depth bounds never read them (umbra_light.shadow.w). */
-	VkDescriptorImageInfo bounds_ii = ctx->atlas_bounds.view
+	ii[3] = ctx->atlas_bounds.view
 		? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, ctx->atlas_bounds.view, VK_IMAGE_LAYOUT_GENERAL}
-		: ii;
-	/* The visibility pass's images (visibility.c): only the pipelines of renders that use it
-	 * declare them; other renders bind whatever images the slot has (render.c). */
-	VkDescriptorImageInfo vi[4] = {
-		{ctx->pipes.shadow_sampler, s->surfaces.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-		{ctx->pipes.shadow_sampler, s->normals.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-		{ctx->pipes.shadow_sampler, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
-		{VK_NULL_HANDLE, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
-	};
-	VkWriteDescriptorSet w[UMBRA_BINDING_COUNT];
-	/* The environment: its block and images (the slot's white stand-ins without a map), the
-	 * environment pass's images (stand-ins without the pass). */
-	VkDescriptorBufferInfo ebi = {s->params.buf, lay->off_env, sizeof(struct umbra_env)};
-	VkDescriptorImageInfo ei[6];
-	rnd_env_images(ctx, env, s, ei);
-	const struct rnd_image_res *pass[3] = {&s->env_surfaces, &s->env_normals, &s->env_vis};
-	for (int i = 0; i < 3; i++)
-		ei[3 + i] = env_pass ? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, pass[i]->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}
-		                     : (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-	w[12] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_ENV,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &ebi,
-	};
-	for (int i = 0; i < 6; i++)
-		w[13 + i] = (VkWriteDescriptorSet){
-			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_ENV_SPECULAR + i,
-			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ei[i],
-		};
-	for (int i = 0; i < 4; i++)
-		w[8 + i] = (VkWriteDescriptorSet){
-			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SURFACES + i,
-			.descriptorCount = 1, .descriptorType = rnd_binding_type[UMBRA_BINDING_SURFACES + i], .pImageInfo = &vi[i],
-		};
-	w[5] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_MOMENTS,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &mi,
-	};
-	w[6] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SCENE_DEPTH,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &di,
-	};
-	w[7] = (VkWriteDescriptorSet){
-		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_DEPTH_BOUNDS,
-		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &bounds_ii,
-	};
-	for (int i = 0; i < 5; i++) {
+		: ii[0];
+	VkWriteDescriptorSet w[UMBRA_BINDING_SURFACES];
+	for (int i = 0; i < 4; i++) {
 		w[i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = (uint32_t)i,
-			.descriptorCount = 1,
-			.descriptorType = rnd_binding_type[i],
-			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
+			.descriptorCount = 1, .descriptorType = rnd_binding_type[i], .pBufferInfo = &bi[i],
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, UMBRA_BINDING_COUNT, w, 0, NULL);
+	put_images(w + UMBRA_BINDING_SHADOW_MAP, s->set, UMBRA_BINDING_SHADOW_MAP, 4, ii);
+	vkUpdateDescriptorSets(ctx->device, UMBRA_BINDING_SURFACES, w, 0, NULL);
+	bind_passes(ctx, s, lay, env, env_pass);
 }
 
 /* minmax.comp: the scratch map in, the depth bounds out. moments.frag: the depth atlas and the

@@ -28,6 +28,9 @@
 #define RND_SURFACES_FORMAT VK_FORMAT_R32G32B32A32_SFLOAT
 #define RND_SURFACE_NORMALS_FORMAT VK_FORMAT_R16G16B16A16_SNORM
 #define RND_VISIBILITY_FORMAT VK_FORMAT_R16_UNORM
+/* Pixel shading (deferred.c): what shading a pixel centre's surface needs (umbra_shared.h
+ * UMBRA_SHADING_*); the colour shaded there has the output's colour format. */
+#define RND_SURFACE_SHADING_FORMAT VK_FORMAT_R32G32B32A32_UINT
 #define RND_MAX_VARIANTS 1024
 
 /* Map a VkResult to a result + message "what: VK_ERROR_..." */
@@ -82,8 +85,11 @@ struct rnd_pipelines {
 	/* [cull] the surfaces pass of the visibility pass (renderer/visibility.c): single-sample,
 	 * world position and normal per pixel */
 	VkPipeline surfaces[2];
+	/* [cull] the same with pixel shading's inputs too (deferred.c) */
+	VkPipeline surfaces_shade[2];
 	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
-	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, background_fs, env_vis_fs;
+	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, vis_shade_fs, resolve_fs, background_fs,
+	               env_vis_fs;
 	pthread_mutex_t mu;
 	uint32_t variant_count;
 	struct rnd_main_variant {
@@ -96,13 +102,24 @@ struct rnd_pipelines {
 			uint32_t atlas_view;         /* 1 = debug view `atlas` (fullscreen.vert + atlas.frag) */
 			uint32_t vis_pass;           /* 1 = the visibility pass (fullscreen.vert + vis.frag) */
 			uint32_t vis_read;           /* 1 = main pass reading the visibility pass (mesh_vis.frag) */
+			uint32_t vis_shade;          /* with vis_pass: pixel shading's pass (vis_shade.frag, deferred.c) */
+			uint32_t resolve;            /* 1 = pixel shading's resolve (fullscreen.vert + resolve.frag) */
 			uint32_t background;         /* 1 = the environment map behind the scene (fullscreen.vert +
 			                                env_background.frag, where the depth is still the far plane) */
 			uint32_t env_pass;           /* 1 = the environment pass (fullscreen.vert + env_vis.frag, R16) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;
+		uint64_t used;               /* `tick` at its last look-up */
 	} variants[RND_MAX_VARIANTS];
+	uint64_t tick;
+	/* Variants taken out of the table (rnd_context_trim_pipelines), destroyed once no render
+	 * that began before (slot epoch below `epoch`) still runs: it may have recorded them. */
+	struct rnd_retired {
+		VkPipeline pipeline;
+		uint64_t epoch;
+	} retired[RND_MAX_VARIANTS];
+	uint32_t retired_count;
 };
 
 struct rnd_moments {
@@ -150,6 +167,7 @@ struct rnd_context {
 	PFN_vkSetDebugUtilsObjectNameEXT set_object_name;   /* NULL without VK_EXT_debug_utils */
 	bool timestamps;                     /* queue supports timestamps */
 	bool visibility_pass;                /* the device can run the visibility pass (visibility.c) */
+	bool pixel_shading;                  /* ... and shade per pixel (deferred.c) */
 	float timestamp_period;              /* ns per tick */
 	VkFormat color_formats[RND_COLOR_FORMAT_COUNT];
 
@@ -159,6 +177,7 @@ struct rnd_context {
 	struct rnd_slot **slots;
 	uint32_t slot_count;
 	bool *slot_busy;
+	uint64_t slot_epoch;                 /* under slot_mu: advanced by each retired pipeline */
 
 	volatile int validation_count;       /* atomically incremented by the messenger */
 	volatile int failed;                 /* device lost: every render fails */
@@ -215,7 +234,15 @@ extern const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT];
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
                                    struct rnd_error *err);
 
+/* Destroys the retired pipeline variants no running render may use (pipelines.c). */
+void rnd_pipelines_reap(struct rnd_context *ctx);
+uint32_t rnd_pipelines_count(struct rnd_context *ctx);
+
 /* slot.c */
+/* The slot epoch after advancing it (a pipeline retired now: renders given a slot from now on
+ * never see it), and the oldest epoch among busy slots (UINT64_MAX: none busy). */
+uint64_t rnd_slot_epoch_advance(struct rnd_context *ctx);
+uint64_t rnd_slot_oldest_busy_epoch(struct rnd_context *ctx);
 struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx);
 void rnd_slot_release(struct rnd_context *ctx, struct rnd_slot *s);
 enum rnd_result rnd_slots_init(struct rnd_context *ctx, struct rnd_error *err);

@@ -53,7 +53,21 @@ enum rnd_result rnd_buffer_create(struct rnd_context *ctx, VkDeviceSize size, Vk
 	VkMemoryAllocateInfo mai = {
 		.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, .allocationSize = req.size, .memoryTypeIndex = (uint32_t)type,
 	};
-	if ((vr = vkAllocateMemory(ctx->device, &mai, NULL, &out->mem)) != VK_SUCCESS) {
+	vr = vkAllocateMemory(ctx->device, &mai, NULL, &out->mem);
+	/* A GPU without resizable BAR has a HOST_VISIBLE | DEVICE_LOCAL heap of 256 MB: a 1M-triangle
+	 * model's vertices, or several renders' buffers, may not fit there; then system memory,
+	 * which every device maps. */
+	int plain = -1;
+	for (uint32_t i = 0; i < ctx->mem_props.memoryTypeCount && plain < 0; i++) {
+		VkMemoryPropertyFlags f = ctx->mem_props.memoryTypes[i].propertyFlags;
+		if ((req.memoryTypeBits & (1u << i)) && (f & host) == host && !(f & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+			plain = (int)i;
+	}
+	if ((vr == VK_ERROR_OUT_OF_DEVICE_MEMORY || vr == VK_ERROR_OUT_OF_HOST_MEMORY) && plain >= 0 && plain != type) {
+		mai.memoryTypeIndex = (uint32_t)plain;
+		vr = vkAllocateMemory(ctx->device, &mai, NULL, &out->mem);
+	}
+	if (vr != VK_SUCCESS) {
 		rnd_fail_vk(err, vr, "vkAllocateMemory (buffer)");
 		goto fail_buffer;
 	}

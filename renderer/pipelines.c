@@ -22,6 +22,9 @@
 #include "surface.frag.spv.h"
 #include "vis.frag.spv.h"
 #include "mesh_vis.frag.spv.h"
+#include "surface_shade.frag.spv.h"
+#include "vis_shade.frag.spv.h"
+#include "resolve.frag.spv.h"
 #include "env_background.frag.spv.h"
 #include "env_vis.frag.spv.h"
 
@@ -48,6 +51,9 @@ const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
 	[UMBRA_BINDING_SURFACE_NORMALS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VISIBILITY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VISIBILITY_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+	[UMBRA_BINDING_SURFACE_SHADING] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_SHADED] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_VIEW_DEPTH_MS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_ENV] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
 	[UMBRA_BINDING_ENV_SPECULAR] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_ENV_MAP] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -140,8 +146,10 @@ struct pipe_desc {
 	bool shadow;                /* depth bias + clamp, LESS compare; else reversed-Z */
 	bool after_prepass;         /* main pass: depth EQUAL, no depth writes */
 	bool uv_only;               /* vertex input: position (0), uv (2), colour (3), uv1 (UMBRA_LOCATION_UV1) */
+	bool dynamic_cull;          /* cull mode set per draw (vkCmdSetCullMode), cull_back ignored */
 	uint32_t color_count;       /* colour attachments of format `color` (default 1 when color set) */
 	VkFormat color_rest;        /* when set: the format of attachments 1.. */
+	VkFormat color_last;        /* when set: the format of the last attachment */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
 	bool depth_equal_ro;        /* fullscreen over a depth: test EQUAL (passes where it is still 0), no writes */
@@ -178,6 +186,7 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
 	for (uint32_t i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) {
 		formats[i] = i > 0 && d->color_rest ? d->color_rest : d->color;
+		if (d->color_last && i + 1 == ncolor) formats[i] = d->color_last;
 		cbas[i] = (VkPipelineColorBlendAttachmentState){.colorWriteMask = 0xf};
 	}
 	VkPipelineVertexInputStateCreateInfo vi = {
@@ -221,12 +230,13 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
 		.attachmentCount = ncolor, .pAttachments = cbas,
 	};
-	VkDynamicState dyn[4] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_DEPTH_BIAS,
-	                         VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE};
-	if (!d->shadow) dyn[2] = dyn[3];
+	VkDynamicState dyn[5] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+	uint32_t ndyn = 2;
+	if (d->shadow) dyn[ndyn++] = VK_DYNAMIC_STATE_DEPTH_BIAS;
+	if (!d->no_vertices) dyn[ndyn++] = VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE;
+	if (d->dynamic_cull) dyn[ndyn++] = VK_DYNAMIC_STATE_CULL_MODE;   /* core in Vulkan 1.3 */
 	VkPipelineDynamicStateCreateInfo dy = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-		.dynamicStateCount = (d->shadow ? 3u : 2u) + (d->no_vertices ? 0u : 1u), .pDynamicStates = dyn,
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, .dynamicStateCount = ndyn, .pDynamicStates = dyn,
 	};
 	VkPipelineRenderingCreateInfo rci = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
@@ -266,25 +276,26 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r;
 	VkShaderModule shadow_vs = VK_NULL_HANDLE, masked_vs = VK_NULL_HANDLE, masked_fs = VK_NULL_HANDLE;
-	VkShaderModule surface_fs = VK_NULL_HANDLE;
+	VkShaderModule surface_fs = VK_NULL_HANDLE, surface_shade_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_shadow_vert, sizeof spv_shadow_vert, "shadow.vert", &shadow_vs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_mesh_vert, sizeof spv_mesh_vert, "mesh.vert", &p->mesh_vs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_mesh_frag, sizeof spv_mesh_frag, "mesh.frag", &p->mesh_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_aov_frag, sizeof spv_aov_frag, "aov.frag", &p->aov_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_masked_vert, sizeof spv_masked_vert, "masked.vert", &masked_vs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_masked_frag, sizeof spv_masked_frag, "masked.frag", &masked_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_surface_frag, sizeof spv_surface_frag, "surface.frag", &surface_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_fullscreen_vert, sizeof spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs, err)) != RND_OK)
-		goto fail;
-	if ((r = rnd_shader_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
-	if ((r = rnd_shader_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
-		goto fail;
-	if ((r = rnd_shader_module(ctx, spv_env_background_frag, sizeof spv_env_background_frag, "env_background.frag",
-	                           &p->background_fs, err)) != RND_OK ||
-	    (r = rnd_shader_module(ctx, spv_env_vis_frag, sizeof spv_env_vis_frag, "env_vis.frag", &p->env_vis_fs, err)) != RND_OK)
-		goto fail;
+	/* The modules: those of the pipelines made here (destroyed below) and those the context
+	 * keeps for the variants. */
+	const struct { const uint32_t *code; size_t size; const char *name; VkShaderModule *out; } mods[] = {
+#define MOD(spv, file, out) {spv, sizeof spv, file, out}
+		MOD(spv_shadow_vert, "shadow.vert", &shadow_vs), MOD(spv_masked_vert, "masked.vert", &masked_vs),
+		MOD(spv_masked_frag, "masked.frag", &masked_fs), MOD(spv_surface_frag, "surface.frag", &surface_fs),
+		MOD(spv_surface_shade_frag, "surface_shade.frag", &surface_shade_fs),
+		MOD(spv_mesh_vert, "mesh.vert", &p->mesh_vs), MOD(spv_mesh_frag, "mesh.frag", &p->mesh_fs),
+		MOD(spv_aov_frag, "aov.frag", &p->aov_fs), MOD(spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs),
+		MOD(spv_vis_frag, "vis.frag", &p->vis_fs), MOD(spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs),
+		MOD(spv_vis_shade_frag, "vis_shade.frag", &p->vis_shade_fs), MOD(spv_resolve_frag, "resolve.frag", &p->resolve_fs),
+		MOD(spv_env_background_frag, "env_background.frag", &p->background_fs),
+		MOD(spv_env_vis_frag, "env_vis.frag", &p->env_vis_fs),
+#undef MOD
+	};
+	for (size_t i = 0; i < sizeof mods / sizeof mods[0]; i++)
+		if ((r = rnd_shader_module(ctx, mods[i].code, mods[i].size, mods[i].name, mods[i].out, err)) != RND_OK) goto fail;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
@@ -330,8 +341,14 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 			.depth = RND_DEPTH_FORMAT, .samples = 1, .cull_back = cull, .name = cull ? "surfaces (cull back)" : "surfaces",
 		};
 		if ((r = make_pipeline(ctx, &d, &p->surfaces[cull], err)) != RND_OK) goto fail;
+		d.fs = surface_shade_fs;
+		d.color_count = 3;
+		d.color_last = RND_SURFACE_SHADING_FORMAT;
+		d.name = cull ? "surfaces + shading (cull back)" : "surfaces + shading";
+		if ((r = make_pipeline(ctx, &d, &p->surfaces_shade[cull], err)) != RND_OK) goto fail;
 	}
 	/* These pipelines keep what they need from their modules. */
+	vkDestroyShaderModule(ctx->device, surface_shade_fs, NULL);
 	vkDestroyShaderModule(ctx->device, surface_fs, NULL);
 	vkDestroyShaderModule(ctx->device, masked_fs, NULL);
 	vkDestroyShaderModule(ctx->device, masked_vs, NULL);
@@ -339,12 +356,69 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	return RND_OK;
 
 fail:
+	if (surface_shade_fs) vkDestroyShaderModule(ctx->device, surface_shade_fs, NULL);
 	if (surface_fs) vkDestroyShaderModule(ctx->device, surface_fs, NULL);
 	if (masked_fs) vkDestroyShaderModule(ctx->device, masked_fs, NULL);
 	if (masked_vs) vkDestroyShaderModule(ctx->device, masked_vs, NULL);
 	if (shadow_vs) vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
 	rnd_pipelines_release(ctx);
 	return r;
+}
+
+/* A fullscreen triangle's pipeline (fullscreen.vert, no vertices) with fragment shader fs:
+ * no pre-pass, no culling. */
+static void fullscreen(struct pipe_desc *d, const struct rnd_pipelines *p, VkShaderModule fs)
+{
+	d->vs = p->fullscreen_vs;
+	d->fs = fs;
+	d->no_vertices = true;
+	d->after_prepass = false;
+	d->cull_back = false;
+	d->dynamic_cull = false;
+}
+
+/* What the passes other than the main one change in the main pass's description d. */
+static void pass_desc(const struct rnd_context *ctx, const struct rnd_main_key *key, struct pipe_desc *d)
+{
+	const struct rnd_pipelines *p = &ctx->pipes;
+	if (key->aov) {
+		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
+		d->fs = p->aov_fs;
+		d->color = VK_FORMAT_R32G32B32A32_SFLOAT;
+		d->color_count = UMBRA_AOV_ATTACHMENTS;
+		d->samples = 1;
+		d->after_prepass = false;
+	}
+	if (key->vis_read) d->fs = p->mesh_vis_fs;
+	if (key->vis_pass) {
+		/* Visibility pass: a fullscreen triangle over the surfaces' depth, one sample, its
+		 * results stored to an image (no colour attachment); with pixel shading (deferred.c)
+		 * the colour shaded at each pixel centre into an image of the output's format. */
+		fullscreen(d, p, key->vis_shade ? p->vis_shade_fs : p->vis_fs);
+		d->color = key->vis_shade ? ctx->color_formats[key->format] : VK_FORMAT_UNDEFINED;
+		d->samples = 1;
+		d->depth_less_ro = true;
+	}
+	if (key->resolve) {
+		/* Pixel shading's resolve: a fullscreen triangle into the single-sample target. */
+		fullscreen(d, p, p->resolve_fs);
+		d->spec = NULL;
+		d->depth = VK_FORMAT_UNDEFINED;
+		d->samples = 1;
+	}
+	if (key->background) {
+		/* The environment behind the scene: a fullscreen triangle at depth 0 (the far plane of
+		 * the reversed Z), kept where the depth is still 0: no geometry, sample by sample. */
+		fullscreen(d, p, p->background_fs);
+		d->depth_equal_ro = true;
+	}
+	if (key->env_pass) {
+		/* The environment pass: a fullscreen triangle over its grid, one R16 target. */
+		fullscreen(d, p, p->env_vis_fs);
+		d->color = VK_FORMAT_R16_UNORM;
+		d->depth = VK_FORMAT_UNDEFINED;
+		d->samples = 1;
+	}
 }
 
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
@@ -358,6 +432,7 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	for (uint32_t i = 0; i < p->variant_count; i++) {
 		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
 			*out = p->variants[i].pipeline;
+			p->variants[i].used = ++p->tick;
 			pthread_mutex_unlock(&p->mu);
 			return RND_OK;
 		}
@@ -375,7 +450,8 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
 	char name[128];
 	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
-	         key->aov ? "aov" : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)"
+	         key->aov ? "aov" : key->resolve ? "resolve" : key->vis_shade ? "pixel shading"
+	         : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)"
 	         : key->background ? "background" : key->env_pass ? "environment" : "main",
 	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
 	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10],
@@ -383,61 +459,17 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	struct pipe_desc d = {
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
+		.dynamic_cull = true,
 	};
 	VkShaderModule fs_fs = VK_NULL_HANDLE;
 	if (key->atlas_view) {
 		/* Debug view of the depth atlas: a fullscreen triangle. */
 		if ((r = rnd_shader_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
 			goto out_modules;
-		d.vs = p->fullscreen_vs;
-		d.fs = fs_fs;
+		fullscreen(&d, p, fs_fs);
 		d.spec = NULL;
-		d.no_vertices = true;
-		d.after_prepass = false;
-		d.cull_back = false;
 	}
-	if (key->aov) {
-		/* AOV pass: single-sample, its own depth test, four RGBA32F targets. */
-		d.fs = p->aov_fs;
-		d.color = VK_FORMAT_R32G32B32A32_SFLOAT;
-		d.color_count = UMBRA_AOV_ATTACHMENTS;
-		d.samples = 1;
-		d.after_prepass = false;
-	}
-	if (key->vis_read) d.fs = p->mesh_vis_fs;
-	if (key->vis_pass) {
-		/* Visibility pass: a fullscreen triangle over the surfaces' depth, one sample, its
-		 * results stored to an image (no colour attachment). */
-		d.vs = p->fullscreen_vs;
-		d.fs = p->vis_fs;
-		d.color = VK_FORMAT_UNDEFINED;
-		d.samples = 1;
-		d.no_vertices = true;
-		d.depth_less_ro = true;
-		d.after_prepass = false;
-		d.cull_back = false;
-	}
-	if (key->background) {
-		/* The environment behind the scene: a fullscreen triangle at depth 0 (the far plane of
-		 * the reversed Z), kept where the depth is still 0: no geometry, sample by sample. */
-		d.vs = p->fullscreen_vs;
-		d.fs = p->background_fs;
-		d.no_vertices = true;
-		d.depth_equal_ro = true;
-		d.after_prepass = false;
-		d.cull_back = false;
-	}
-	if (key->env_pass) {
-		/* The environment pass: a fullscreen triangle over its grid, one R16 target. */
-		d.vs = p->fullscreen_vs;
-		d.fs = p->env_vis_fs;
-		d.color = VK_FORMAT_R16_UNORM;
-		d.depth = VK_FORMAT_UNDEFINED;
-		d.samples = 1;
-		d.no_vertices = true;
-		d.after_prepass = false;
-		d.cull_back = false;
-	}
+	pass_desc(ctx, key, &d);
 	values[UMBRA_SC_SAMPLES] = d.samples;
 	VkPipeline pipe;
 	r = make_pipeline(ctx, &d, &pipe, err);
@@ -461,10 +493,53 @@ out_modules:
 	}
 	p->variants[p->variant_count].key = *key;
 	p->variants[p->variant_count].pipeline = pipe;
+	p->variants[p->variant_count].used = ++p->tick;
 	p->variant_count++;
 	*out = pipe;
 	pthread_mutex_unlock(&p->mu);
 	return RND_OK;
+}
+
+uint32_t rnd_context_trim_pipelines(struct rnd_context *ctx, uint32_t keep)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	uint32_t n = 0;
+	pthread_mutex_lock(&p->mu);
+	while (p->variant_count > keep && p->retired_count < RND_MAX_VARIANTS) {
+		uint32_t lru = 0;
+		for (uint32_t i = 1; i < p->variant_count; i++)
+			if (p->variants[i].used < p->variants[lru].used) lru = i;
+		/* out of the table first: a render that takes a slot from the epoch on cannot find it */
+		VkPipeline pipe = p->variants[lru].pipeline;
+		p->variants[lru] = p->variants[--p->variant_count];
+		p->retired[p->retired_count++] = (struct rnd_retired){pipe, rnd_slot_epoch_advance(ctx)};
+		n++;
+	}
+	pthread_mutex_unlock(&p->mu);
+	rnd_pipelines_reap(ctx);
+	return n;
+}
+
+void rnd_pipelines_reap(struct rnd_context *ctx)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	if (!__atomic_load_n(&p->retired_count, __ATOMIC_RELAXED)) return;
+	uint64_t oldest = rnd_slot_oldest_busy_epoch(ctx);
+	pthread_mutex_lock(&p->mu);
+	for (uint32_t i = 0; i < p->retired_count;) {
+		if (p->retired[i].epoch > oldest) { i++; continue; }
+		vkDestroyPipeline(ctx->device, p->retired[i].pipeline, NULL);
+		p->retired[i] = p->retired[--p->retired_count];
+	}
+	pthread_mutex_unlock(&p->mu);
+}
+
+uint32_t rnd_pipelines_count(struct rnd_context *ctx)
+{
+	pthread_mutex_lock(&ctx->pipes.mu);
+	uint32_t n = ctx->pipes.variant_count;
+	pthread_mutex_unlock(&ctx->pipes.mu);
+	return n;
 }
 
 void rnd_pipelines_release(struct rnd_context *ctx)
@@ -472,6 +547,7 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 	struct rnd_pipelines *p = &ctx->pipes;
 	if (!ctx->device) return;
 	for (uint32_t i = 0; i < p->variant_count; i++) vkDestroyPipeline(ctx->device, p->variants[i].pipeline, NULL);
+	for (uint32_t i = 0; i < p->retired_count; i++) vkDestroyPipeline(ctx->device, p->retired[i].pipeline, NULL);
 	for (int c = 0; c < 2; c++) {
 		if (p->shadow[c]) vkDestroyPipeline(ctx->device, p->shadow[c], NULL);
 		if (p->shadow_masked[c]) vkDestroyPipeline(ctx->device, p->shadow_masked[c], NULL);
@@ -480,8 +556,12 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 			if (p->prepass_masked[m][c]) vkDestroyPipeline(ctx->device, p->prepass_masked[m][c], NULL);
 		}
 	}
-	for (int c = 0; c < 2; c++)
+	for (int c = 0; c < 2; c++) {
 		if (p->surfaces[c]) vkDestroyPipeline(ctx->device, p->surfaces[c], NULL);
+		if (p->surfaces_shade[c]) vkDestroyPipeline(ctx->device, p->surfaces_shade[c], NULL);
+	}
+	if (p->vis_shade_fs) vkDestroyShaderModule(ctx->device, p->vis_shade_fs, NULL);
+	if (p->resolve_fs) vkDestroyShaderModule(ctx->device, p->resolve_fs, NULL);
 	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
 	if (p->vis_fs) vkDestroyShaderModule(ctx->device, p->vis_fs, NULL);
 	if (p->mesh_vis_fs) vkDestroyShaderModule(ctx->device, p->mesh_vis_fs, NULL);

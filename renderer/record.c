@@ -29,6 +29,19 @@ void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags a
 	vkCmdPipelineBarrier2(cmd, &di);
 }
 
+VkRenderingAttachmentInfo record_color_overwrite(VkCommandBuffer cmd, const struct rnd_image_res *img,
+                                                 VkPipelineStageFlags2 src_stage)
+{
+	record_image_barrier(cmd, img->img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, src_stage, 0,
+	                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+	return (VkRenderingAttachmentInfo){
+		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = img->view,
+		.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+		.storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+	};
+}
+
 /* The rows of the view this submit draws. */
 VkRect2D record_band_area(const struct record_view *rv)
 {
@@ -200,18 +213,23 @@ void record_main_key(const struct record_view *rv, uint32_t ndraw, struct rnd_ma
 	}
 }
 
-/* The main-pass pipelines key k needs: one per culling mode the draws use. */
+/* The main-pass pipeline key k needs, for both culling modes: its cull mode is dynamic state,
+ * set per draw (record_cull), so one variant serves closed and open draws alike (on lavapipe
+ * each pipeline JIT-compiles its shaders: a variant per mode was twice the ~14 MB). */
 static enum rnd_result cull_pipelines(struct rnd_context *ctx, struct rnd_main_key *key, const struct draw *draws,
                                       uint32_t ndraw, VkPipeline pipes[2], struct rnd_error *err)
 {
-	for (uint32_t i = 0; i < ndraw; i++) {
-		uint32_t c = draws[i].cull_back;
-		if (!draws[i].index_count || pipes[c]) continue;
-		key->cull_back = c;
-		enum rnd_result r = rnd_pipelines_main(ctx, key, &pipes[c], err);
-		if (r != RND_OK) return r;
-	}
-	return RND_OK;
+	(void)draws; (void)ndraw;
+	key->cull_back = 0;
+	enum rnd_result r = rnd_pipelines_main(ctx, key, &pipes[0], err);
+	pipes[1] = pipes[0];
+	return r;
+}
+
+/* The cull mode of draw d, for the main-pass and AOV variants (dynamic state). */
+static void record_cull(VkCommandBuffer cmd, const struct draw *d)
+{
+	vkCmdSetCullMode(cmd, d->cull_back ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
 }
 
 /* The colour (and resolve) and depth targets of the main pass, ready to be drawn. */
@@ -241,20 +259,23 @@ static void main_barriers(VkCommandBuffer cmd, struct rnd_slot *s, bool ms)
 	              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 }
 
-/* The background is the requested colour itself (sRGB-encoded for display outputs), not
- * tone mapped: a caller asking for white gets 255. */
+void record_clear_color(const struct rnd_scene *sc, float out[4])
+{
+	const float *bg = sc->environment.background;
+	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
+	for (int k = 0; k < 3; k++) out[k] = linear ? bg[k] : srgb_encode(bg[k]);
+	out[3] = sc->output.transparent ? 0.0f : bg[3];
+	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
+	 * colour at edges (readback.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
+	if (sc->output.transparent) out[0] = out[1] = out[2] = 0.0f;
+	if (sc->output.debug == RND_DEBUG_SHADOW || sc->output.debug == RND_DEBUG_ENV_SHADOW)
+		out[0] = out[1] = out[2] = out[3] = 1.0f;
+}
+
 static VkClearColorValue main_clear(const struct rnd_scene *sc)
 {
 	VkClearColorValue clear;
-	const float *bg = sc->environment.background;
-	bool linear = sc->output.pixels == RND_PIXELS_RGBA32F;
-	for (int k = 0; k < 3; k++) clear.float32[k] = linear ? bg[k] : srgb_encode(bg[k]);
-	clear.float32[3] = sc->output.transparent ? 0.0f : bg[3];
-	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
-	 * colour at edges (readback.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
-	if (sc->output.transparent) clear.float32[0] = clear.float32[1] = clear.float32[2] = 0.0f;
-	if (sc->output.debug == RND_DEBUG_SHADOW || sc->output.debug == RND_DEBUG_ENV_SHADOW)
-		clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
+	record_clear_color(sc, clear.float32);
 	return clear;
 }
 
@@ -331,6 +352,7 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		if (rv->drawn_camera && rv->band_y == 0) *rv->drawn_camera += d->cam_index_count / 3;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+		record_cull(cmd, d);
 		struct umbra_push_main push;
 		main_push(rv->sc, d, &push);
 		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
@@ -490,6 +512,7 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 			/* A shadow catcher is geometry for the AOVs (contract §7). */
 			VkPipeline p = pipes[d->cull_back];
 			if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+			record_cull(cmd, d);
 			struct umbra_push push = {.info = {d->material, d->flags, first_light, 0}};
 			vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
 			                   sizeof push, &push);

@@ -42,9 +42,10 @@ struct record_view {
 	const uint64_t *map_tris;
 	double row_ms, band_ms;
 	/* What the recorders drew, counted as they record (struct rnd_timings; NULL: not counted):
-	 * the camera's triangles in the main pass of the view's first band, the casters' triangles
-	 * of every shadow map drawn. */
+	 * the camera's triangles in the main pass (pixel shading's: its depth pass) of the view's
+	 * first band, the casters' triangles of every shadow map drawn. */
 	uint64_t *drawn_camera, *drawn_shadow;
+	bool deferred;                 /* with vis: shaded once per pixel centre (deferred.c) */
 	/* Every light the shadow passes draw for: the scene's, then the environment's directions
 	 * (render.c, env_shadow.h); NULL: the scene's. */
 	const struct rnd_light *shadow_lights;
@@ -57,6 +58,10 @@ VkRect2D record_band_area(const struct record_view *rv);
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
                           VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage,
                           VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
+/* A colour target written whole by a fullscreen pass: img made a colour attachment, its old
+ * contents dropped, after its previous use at src_stage; the attachment (not cleared, stored). */
+VkRenderingAttachmentInfo record_color_overwrite(VkCommandBuffer cmd, const struct rnd_image_res *img,
+                                                 VkPipelineStageFlags2 src_stage);
 /* Depth-only passes (shadow maps, the camera depth of contact shadows): img made a depth
  * attachment after its previous use (src_stage, src_access), then rendering begun into its
  * view over (0, 0, w, h), cleared to 1, with that viewport and scissor. */
@@ -101,6 +106,10 @@ void record_readback(struct rnd_slot *s, const struct record_view *v);
 /* The public enums as the shaders spell them (umbra_shared.h); the uniforms (frame.c) and
  * the specialization key (record.c) both use these, so they cannot drift apart. */
 uint32_t record_light_type(enum rnd_light_type t);
+/* The background as the main pass's colour target holds it (its clear value): the requested
+ * colour itself, sRGB-encoded for display outputs, not tone mapped (a caller asking for white
+ * gets 255); (0,0,0,0) for a transparent output. */
+void record_clear_color(const struct rnd_scene *sc, float out[4]);
 uint32_t record_tonemap(enum rnd_tonemap t);
 uint32_t record_debug(enum rnd_debug d);
 

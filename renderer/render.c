@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "deferred.h"
 #include "env.h"
 #include "env_pass.h"
 #include "frame.h"
@@ -68,6 +69,9 @@ static void plan_device(struct rnd_context *ctx, struct rnd_plan_device *d)
 	d->visibility_force = env && strcmp(env, "0") == 0 ? 0 : env && strcmp(env, "1") == 0 ? 1 : -1;
 	const char *ep = getenv("UMBRA_ENV_PASS");   /* 0: the environment's shadows per fragment (tests) */
 	d->env_pass_force = ep && strcmp(ep, "0") == 0 ? 0 : -1;
+	d->pixel_shading = ctx->pixel_shading;
+	const char *ps = getenv("UMBRA_PIXEL_SHADING");   /* 0: shaded per fragment (tests, comparisons) */
+	d->pixel_shading_force = ps && strcmp(ps, "0") == 0 ? 0 : -1;
 	d->cached = cache_probe;
 	d->cache_user = ctx;
 }
@@ -264,12 +268,20 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	if (!rq->granted && (r = grant_tiles(rq, err)) != RND_OK) return r;
 	if ((r = place_tiles(rq, v, err)) != RND_OK) return r;
 	if (vp->contact && (r = rnd_slot_scene_depth(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
+	/* Pixel shading (deferred.c) on the visibility pass's surfaces, or on its own ones (an
+	 * environment map's view): the visibility pass's passes run for either; its bindings need
+	 * images whether it runs or not. */
+	bool passes = vp->vis || vp->deferred;
 	/* Without the pass its bindings still need images (lavapipe reads every descriptor of a
 	 * bound set): whatever the slot has, or 1x1 ones. */
-	r = vp->vis ? rnd_slot_visibility(ctx, s, sc->width, sc->height, sc->light_count, err)
-	            : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
+	r = passes ? rnd_slot_visibility(ctx, s, sc->width, sc->height, sc->light_count, err)
+	           : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
 	if (r != RND_OK) return r;
 	if (vp->vis) rq->tm.visibility_views++;
+	r = vp->deferred ? rnd_slot_pixel_shading(ctx, s, sc->width, sc->height, ctx->color_formats[sc->output.pixels], err)
+	    : s->shading.img && s->shaded.img ? RND_OK : rnd_slot_pixel_shading(ctx, s, 1, 1, VK_FORMAT_R8G8B8A8_UNORM, err);
+	if (r != RND_OK) return r;
+	if (vp->deferred) rq->tm.pixel_shaded_views++;
 	if (vp->env_pass && (r = rnd_slot_env_pass(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
 	if ((r = rnd_frame_write(ctx, s, &p->esc, &vp->cam, rq->sp, camera->exposure, vp->contact, &rq->env, vp->env_pass,
 	                         err)) != RND_OK)
@@ -280,9 +292,9 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	struct record_view rv = {
 		.sc = sc, .cam = &vp->cam, .sp = rq->sp, .draws = rq->draws, .ndraw = sc->object_count, .aov_passes = sh->passes,
 		.color_offset = cell * sh->px, .aov_offset = sh->color_bytes + cell * 16, .aov_stride = sh->att_bytes,
-		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = vp->contact, .vis = vp->vis,
-		.map_ms = rq->map_ms, .map_tris = rq->map_tris, .row_ms = vp->row_ms, .band_ms = vp->band_ms,
-		.drawn_camera = &rq->tm.camera_triangles, .drawn_shadow = &rq->tm.shadow_triangles,
+		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = vp->contact, .vis = passes,
+		.deferred = vp->deferred, .map_ms = rq->map_ms, .map_tris = rq->map_tris, .row_ms = vp->row_ms,
+		.band_ms = vp->band_ms, .drawn_camera = &rq->tm.camera_triangles, .drawn_shadow = &rq->tm.shadow_triangles,
 		.shadow_lights = p->esc.lights, .env = &rq->env, .env_pass = vp->env_pass,
 	};
 	double shadow0 = rq->tm.shadow_ms, main0 = rq->tm.main_ms;
@@ -316,6 +328,7 @@ static void finish(struct render *rq, enum rnd_result r, struct rnd_error *err)
 	rq->tm.env_ms = rq->env.ms;
 	rnd_env_done(ctx, &rq->env, r == RND_OK, rq->gpu_busy);
 	rnd_slot_release(ctx, rq->s);
+	rnd_pipelines_reap(ctx);   /* variants retired while this render ran */
 	free(rq->arena);
 }
 

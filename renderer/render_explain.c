@@ -45,6 +45,19 @@ static const char *const vis_why[RND_VIS_WHY_COUNT] = {
 	[RND_VIS_SPARSE] = "too few triangles for its passes to pay",
 };
 
+static const char *const pixel_why[RND_PIXEL_WHY_COUNT] = {
+	[RND_PIXEL_VISIBILITY] = "plain draws: the visibility pass's surfaces shaded once per pixel centre",
+	[RND_PIXEL_ENVIRONMENT] = "an environment map over dense plain draws: its own surfaces pass, shaded once per pixel",
+	[RND_PIXEL_NO_DEVICE] = "the device cannot",
+	[RND_PIXEL_OUTPUT] = "not MSAA 4, or a debug view",
+	[RND_PIXEL_BACKGROUND] = "the environment map is the background",
+	[RND_PIXEL_NOT_PLAIN] = "a textured, alpha-tested or extension material, or a sphere's proxy",
+	[RND_PIXEL_NO_PASS] = "no visibility pass and no environment map",
+	[RND_PIXEL_TOO_LARGE] = "its images would be too large",
+	[RND_PIXEL_SPARSE] = "too few triangles for its passes to pay",
+	[RND_PIXEL_FORCED_OFF] = "UMBRA_PIXEL_SHADING=0",
+};
+
 static const char *const shapes[] = {"plane", "box", "sphere", "cylinder", "mesh"};
 static const char *const light_types[] = {"directional", "spot", "point"};
 
@@ -85,6 +98,8 @@ void rnd_plan_info(const struct rnd_plan *p, struct rnd_plan_info *out)
 		out->shadow_triangles += vi.shadow_triangles;
 		out->camera_triangles += vi.camera_triangles;
 		out->estimate_ms += vi.shadow_estimate_ms + vi.main_estimate_ms;
+		out->visibility_views += vi.visibility;
+		out->pixel_shaded_views += vi.pixel_shading;
 		for (uint32_t k = 0; k < p->views[v].shadow_views; k++) out->maps_cached += p->views[v].skip[k] == RND_SKIP_CACHED;
 	}
 	out->sphere_proxies = p->sphere_proxies;
@@ -181,6 +196,8 @@ void rnd_plan_view(const struct rnd_plan *p, uint32_t v, struct rnd_plan_view_in
 	out->camera_triangles = vp->camera_triangles;
 	out->contact = vp->contact;
 	out->env_pass = vp->env_pass;
+	out->pixel_shading = vp->deferred;
+	out->pixel_shading_why = pixel_why[vp->deferred_why % RND_PIXEL_WHY_COUNT];
 	out->visibility = vp->vis;
 	out->visibility_why = vis_why[vp->vis_why % RND_VIS_WHY_COUNT];
 	out->row_ms = vp->row_ms;
@@ -279,17 +296,20 @@ uint32_t rnd_plan_passes(const struct rnd_plan *p, struct rnd_plan_pass_info *ou
 			            "direction), read by the main pass";
 			add_pass(out, max, &n, pass);
 		}
-		if (vp->vis) {
+		if (vp->vis || vp->deferred) {
 			pass.pass = "visibility";
 			pass.triangles = vp->camera_triangles;
-			pass.note = "each light's shadow once per pixel (a surfaces pass, then a fullscreen pass)";
+			pass.note = vp->deferred ? "the surfaces with their shading inputs, then each pixel centre shaded once, its "
+			                           "shadows with it (pixel shading)"
+			                         : "each light's shadow once per pixel (a surfaces pass, then a fullscreen pass)";
 			add_pass(out, max, &n, pass);
 		}
 		pass.pass = "main";
 		pass.triangles = vp->camera_triangles;
 		pass.estimate_ms = vp->row_ms * sc->height + vp->band_ms;
-		pass.note = sc->output.msaa > 1 ? "MSAA 4, resolved and copied into the readback buffer"
-		                                : "copied into the readback buffer";
+		pass.note = vp->deferred         ? "depth only, MSAA 4; each sample takes a pixel centre's colour (the resolve)"
+		            : sc->output.msaa > 1 ? "MSAA 4, resolved and copied into the readback buffer"
+		                                  : "copied into the readback buffer";
 		add_pass(out, max, &n, pass);
 		if (p->sheet.passes) {
 			pass.pass = "aov";

@@ -17,6 +17,7 @@
 #include "env_shadow.h"
 #include "error.h"
 #include "lod.h"
+#include "material_bits.h"
 #include "mesh.h"
 #include "render_plan.h"
 #include "shadow_keys.h"
@@ -168,6 +169,9 @@ static enum rnd_result plan_draw(struct rnd_plan *p, uint32_t i, uint64_t *kept,
 	/* MASK and dithered BLEND both take the alpha-tested depth passes. */
 	d->masked = sc->material_count && sc->materials[o->material].alpha_mode != RND_ALPHA_OPAQUE;
 	d->texture_set = 0; /* the upload's (material.c rnd_material_textures) */
+	/* the slots its material samples (material.c sets the same, and the second uv set's bit) */
+	d->tex_bits = sc->material_count ? rnd_material_slot_bits(&sc->materials[o->material]) : 0;
+	if (o->shape == RND_SHAPE_MESH && o->colors) d->tex_bits |= UMBRA_TEXBIT_VERTEX_COLOR;
 	d->single_sided = !o->double_sided;
 	d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
 	            (o->shape == RND_SHAPE_MESH && o->closed);
@@ -436,7 +440,10 @@ static enum rnd_result plan_view_work(struct rnd_plan *p, uint32_t v, struct rnd
 	vp->vis = rnd_visibility_wanted(p->dev.visibility_pass, p->dev.visibility_force, sc, sp, draws, sc->object_count,
 	                                &vp->vis_why);
 	vp->env_pass = rnd_env_pass_wanted(sc, p->env.mapped, draws, sc->object_count, p->dev.env_pass_force);
-	double units = rnd_cost_pixel_units(sc, sp, vp->vis, p->sheet.passes);
+	vp->deferred = rnd_pixel_shading_wanted(p->dev.pixel_shading, p->dev.visibility_pass, p->dev.pixel_shading_force, sc,
+	                                        draws, sc->object_count, vp->vis, sc->environment.source != RND_ENV_AMBIENT,
+	                                        &vp->deferred_why);
+	double units = rnd_cost_pixel_units(sc, sp, vp->vis || vp->deferred, p->sheet.passes);
 	rnd_cost_main(sc, vp->cam.view_proj, draws, sc->object_count, units, &vp->row_ms, &vp->band_ms);
 	return RND_OK;
 }

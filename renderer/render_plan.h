@@ -19,7 +19,7 @@
  *   the maps' tile sizes in the atlas ............... atlas.c (rnd_atlas_fit)
  *   cached maps' keys, and which the cache holds .... shadow_keys.c, shadow_cache.c (the probe)
  *   contact shadows' depth pass ..................... contact.c
- *   the visibility pass ............................. visibility_plan.c
+ *   the visibility pass, pixel shading .............. visibility_plan.c
  *   the deadline's bands (cost estimates) ........... cost.c
  *
  * Ownership: rnd_plan_build fills a caller's struct rnd_plan and allocates what it points to;
@@ -57,6 +57,8 @@ struct rnd_plan_device {
 	bool visibility_pass;                  /* the device can run the visibility pass */
 	int visibility_force;                  /* UMBRA_VISIBILITY: -1 unset, 0 off, 1 on */
 	int env_pass_force;                    /* UMBRA_ENV_PASS: -1 unset, 0 off */
+	bool pixel_shading;                    /* the device can shade per pixel (deferred.c) */
+	int pixel_shading_force;               /* UMBRA_PIXEL_SHADING: -1 unset, 0 off */
 	/* The environment map's bins (env.c rnd_env_plan_bins; NULL: no map, or no shadow directions
 	 * asked), read while the plan is built. */
 	const struct rnd_env_bins *env_bins;
@@ -101,6 +103,9 @@ struct rnd_view_plan {
 	bool vis;                              /* shadows from the visibility pass */
 	uint8_t vis_why;                       /* enum rnd_vis_why */
 	bool env_pass;                         /* the environment's shadows from its pass (env_pass.h) */
+	bool deferred;                         /* shaded once per pixel centre (pixel shading, deferred.h):
+	                                          the visibility pass's passes run then even without vis */
+	uint8_t deferred_why;                  /* enum rnd_pixel_why */
 	uint64_t camera_triangles;
 	double row_ms, band_ms;                /* the main pass: per row, per band (cost.c) */
 };

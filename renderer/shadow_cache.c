@@ -382,6 +382,7 @@ void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st)
 	pthread_mutex_unlock(&c->mu);
 	st->shadow_cache_hits = __atomic_load_n(&ctx->stats_hits, __ATOMIC_RELAXED);
 	st->shadow_cache_misses = __atomic_load_n(&ctx->stats_misses, __ATOMIC_RELAXED);
+	st->pipeline_variants = rnd_pipelines_count(ctx);
 	rnd_env_stats(ctx, &st->env_maps, &st->env_builds);
 }
 

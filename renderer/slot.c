@@ -92,7 +92,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	VkDescriptorPoolSize sizes[4] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 4},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 13},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16},
 		{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
 	};
 	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
@@ -172,6 +172,8 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_image_destroy(ctx, &s->normals);
 	rnd_image_destroy(ctx, &s->surfaces_depth);
 	rnd_image_destroy(ctx, &s->visibility);
+	rnd_image_destroy(ctx, &s->shading);
+	rnd_image_destroy(ctx, &s->shaded);
 	rnd_env_pass_release(ctx, s);
 	rnd_buffer_destroy(ctx, &s->staging);
 	rnd_image_destroy(ctx, &s->resolve);
@@ -228,11 +230,43 @@ struct rnd_slot *rnd_slot_acquire(struct rnd_context *ctx)
 		for (uint32_t i = 0; i < ctx->slot_count; i++) {
 			if (!ctx->slot_busy[i]) {
 				ctx->slot_busy[i] = true;
+				ctx->slots[i]->epoch = ctx->slot_epoch;
 				pthread_mutex_unlock(&ctx->slot_mu);
 				return ctx->slots[i];
 			}
 		}
 		pthread_cond_wait(&ctx->slot_cv, &ctx->slot_mu);
+	}
+}
+
+uint64_t rnd_slot_epoch_advance(struct rnd_context *ctx)
+{
+	pthread_mutex_lock(&ctx->slot_mu);
+	uint64_t e = ++ctx->slot_epoch;
+	pthread_mutex_unlock(&ctx->slot_mu);
+	return e;
+}
+
+uint64_t rnd_slot_oldest_busy_epoch(struct rnd_context *ctx)
+{
+	uint64_t oldest = UINT64_MAX;
+	pthread_mutex_lock(&ctx->slot_mu);
+	for (uint32_t i = 0; i < ctx->slot_count; i++)
+		if (ctx->slot_busy[i] && ctx->slots[i]->epoch < oldest) oldest = ctx->slots[i]->epoch;
+	pthread_mutex_unlock(&ctx->slot_mu);
+	return oldest;
+}
+
+void rnd_context_trim_slots(struct rnd_context *ctx)
+{
+	for (uint32_t i = 0; i < ctx->slot_count; i++) {
+		pthread_mutex_lock(&ctx->slot_mu);
+		bool idle = !ctx->slot_busy[i];
+		if (idle) ctx->slot_busy[i] = true;   /* held while its targets go */
+		pthread_mutex_unlock(&ctx->slot_mu);
+		if (!idle) continue;
+		rnd_slot_trim_to(ctx, ctx->slots[i], 0);
+		rnd_slot_release(ctx, ctx->slots[i]);
 	}
 }
 
@@ -267,8 +301,9 @@ enum rnd_result rnd_slot_targets(struct rnd_context *ctx, struct rnd_slot *s, Vk
 			goto fail;
 	}
 	snprintf(name, sizeof name, "slot %u depth", s->index);
+	/* Sampled: pixel shading's resolve reads its samples (deferred.c). */
 	if ((r = rnd_image_create(ctx, RND_DEPTH_FORMAT, w, h, 1, samples,
-	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+	                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
 	                          VK_IMAGE_ASPECT_DEPTH_BIT, name, &s->depth, err)) != RND_OK)
 		goto fail;
 	return RND_OK;
@@ -348,7 +383,11 @@ static VkDeviceSize image_bytes(const struct rnd_context *ctx, const struct rnd_
 
 void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 {
-	const VkDeviceSize keep = RND_SLOT_KEEP_BYTES;
+	rnd_slot_trim_to(ctx, s, RND_SLOT_KEEP_BYTES);
+}
+
+void rnd_slot_trim_to(struct rnd_context *ctx, struct rnd_slot *s, VkDeviceSize keep)
+{
 	VkDeviceSize aov = image_bytes(ctx, &s->aov_depth);
 	for (int i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) aov += image_bytes(ctx, &s->aov[i]);
 	if (aov > keep) {
@@ -362,7 +401,9 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 	}
 	if (image_bytes(ctx, &s->scene_depth) > keep) rnd_image_destroy(ctx, &s->scene_depth);
 	if (image_bytes(ctx, &s->surfaces) + image_bytes(ctx, &s->normals) + image_bytes(ctx, &s->surfaces_depth) +
-	        image_bytes(ctx, &s->visibility) > keep) {
+	        image_bytes(ctx, &s->visibility) + image_bytes(ctx, &s->shading) + image_bytes(ctx, &s->shaded) > keep) {
+		rnd_image_destroy(ctx, &s->shading);
+		rnd_image_destroy(ctx, &s->shaded);
 		rnd_image_destroy(ctx, &s->surfaces);
 		rnd_image_destroy(ctx, &s->normals);
 		rnd_image_destroy(ctx, &s->surfaces_depth);
@@ -427,4 +468,24 @@ enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s,
 	return rnd_image_create(ctx, RND_VISIBILITY_FORMAT, w, h, layers, 1,
 	                        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, name,
 	                        &s->visibility, err);
+}
+
+enum rnd_result rnd_slot_pixel_shading(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, VkFormat color,
+                                       struct rnd_error *err)
+{
+	enum rnd_result r;
+	char name[48];
+	if (!s->shading.img || s->shading.width != w || s->shading.height != h) {
+		rnd_image_destroy(ctx, &s->shading);
+		snprintf(name, sizeof name, "slot %u surface shading", s->index);
+		if ((r = rnd_image_create(ctx, RND_SURFACE_SHADING_FORMAT, w, h, 1, 1,
+		                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+		                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->shading, err)) != RND_OK)
+			return r;
+	}
+	if (s->shaded.img && s->shaded.width == w && s->shaded.height == h && s->shaded.format == color) return RND_OK;
+	rnd_image_destroy(ctx, &s->shaded);
+	snprintf(name, sizeof name, "slot %u shaded", s->index);
+	return rnd_image_create(ctx, color, w, h, 1, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+	                        VK_IMAGE_ASPECT_COLOR_BIT, name, &s->shaded, err);
 }

@@ -12,10 +12,12 @@
 
 #include "internal.h"
 
-enum { RND_TS_START, RND_TS_SHADOW_END, RND_TS_MAIN_END, RND_TS_COPY_END, RND_TS_COUNT };
+enum { RND_TS_START, RND_TS_SHADOW_END, RND_TS_VIS_END, RND_TS_MAIN_END, RND_TS_COPY_END,
+       RND_TS_COUNT };
 
 struct rnd_slot {
 	uint32_t index;
+	uint64_t epoch;               /* ctx->slot_epoch when this render took the slot */
 	VkCommandPool pool;
 	VkCommandBuffer cmd;
 	VkFence fence;
@@ -55,6 +57,8 @@ struct rnd_slot {
 	/* the visibility pass (visibility.c): the view's surface positions and normals, their
 	 * depth, the visibility image */
 	struct rnd_image_res surfaces, normals, surfaces_depth, visibility;
+	/* pixel shading (deferred.c): the surface-shading inputs, the colour shaded per pixel */
+	struct rnd_image_res shading, shaded;
 	/* the environment pass (env_pass.c): the surfaces at its scale, their depth, its visibility */
 	struct rnd_image_res env_surfaces, env_normals, env_depth, env_vis;
 };
@@ -74,6 +78,9 @@ enum rnd_result rnd_slot_scene_depth(struct rnd_context *ctx, struct rnd_slot *s
 /* Makes the visibility pass's images match a w x h view with `layers` lights (at least 2). */
 enum rnd_result rnd_slot_visibility(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
                                     uint32_t layers, struct rnd_error *err);
+/* Makes pixel shading's images (deferred.c) match a w x h view whose colour format is color. */
+enum rnd_result rnd_slot_pixel_shading(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h, VkFormat color,
+                                       struct rnd_error *err);
 /* Destroys the previous render's textures. */
 void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 
@@ -85,5 +92,7 @@ void rnd_slot_drop_textures(struct rnd_context *ctx, struct rnd_slot *s);
 #define RND_SLOT_KEEP_BYTES (40ull << 20)
 /* Frees what is over RND_SLOT_KEEP_BYTES. Only after the slot's work has completed. */
 void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s);
+/* The same with a bound of keep bytes (0: every target and buffer goes). */
+void rnd_slot_trim_to(struct rnd_context *ctx, struct rnd_slot *s, VkDeviceSize keep);
 
 #endif

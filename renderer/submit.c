@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 #include <time.h>
+#include "deferred.h"
 #include "visibility.h"
 #include "env_pass.h"
 #include "submit.h"
@@ -211,6 +212,7 @@ static enum rnd_result cmd_flush(struct rnd_context *ctx, struct rnd_slot *s, st
 		double k = ctx->timestamp_period / 1e6;
 		tm->shadow_ms += (double)(ts[RND_TS_SHADOW_END] - ts[RND_TS_START]) * k;
 		tm->main_ms += (double)(ts[RND_TS_MAIN_END] - ts[RND_TS_SHADOW_END]) * k;
+		tm->visibility_ms += (double)(ts[RND_TS_VIS_END] - ts[RND_TS_SHADOW_END]) * k;
 		tm->readback_ms += (double)(ts[RND_TS_COPY_END] - ts[RND_TS_MAIN_END]) * k;
 	} else {
 		tm->main_ms += t1 - t0;
@@ -328,7 +330,9 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
 		cmd_mark(s, &st, RND_TS_SHADOW_END);
 		if (rv->vis && (r = record_visibility(ctx, s, &band, err)) != RND_OK) goto fail;
-		if ((r = record_main(ctx, s, &band, err)) != RND_OK) goto fail;
+		cmd_mark(s, &st, RND_TS_VIS_END);
+		r = rv->deferred ? record_deferred_main(ctx, s, &band, err) : record_main(ctx, s, &band, err);
+		if (r != RND_OK) goto fail;
 		if (rv->aov_passes && (r = record_aov(ctx, s, &band, err)) != RND_OK) goto fail;
 		cmd_mark(s, &st, RND_TS_MAIN_END);
 		record_readback(s, &band);

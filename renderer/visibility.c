@@ -34,10 +34,12 @@ void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct r
                      const struct rnd_surface_targets *t)
 {
 	VkCommandBuffer cmd = s->cmd;
-	const struct rnd_image_res *img[2] = {t->positions, t->normals};
+	/* with pixel shading (deferred.c) its inputs too */
+	const struct rnd_image_res *img[3] = {t->positions, t->normals, t->shading};
 	const struct rnd_image_res *depth = t->depth;
-	VkRenderingAttachmentInfo ca[2];
-	for (int i = 0; i < 2; i++) {
+	uint32_t nimg = t->shading ? 3 : 2;
+	VkRenderingAttachmentInfo ca[3];
+	for (uint32_t i = 0; i < nimg; i++) {
 		record_image_barrier(cmd, img[i]->img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
 		                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
 		                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
@@ -59,7 +61,7 @@ void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct r
 	};
 	VkRenderingInfo ri = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1,
-		.colorAttachmentCount = 2, .pColorAttachments = ca, .pDepthAttachment = &da,
+		.colorAttachmentCount = nimg, .pColorAttachments = ca, .pDepthAttachment = &da,
 	};
 	vkCmdBeginRendering(cmd, &ri);
 	/* The main pass's viewport (the whole view, at the targets' scale) and the band's rows: the
@@ -72,16 +74,16 @@ void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct r
 	for (uint32_t i = 0; i < rv->ndraw; i++) {
 		const struct draw *d = &rv->draws[i];
 		if (!d->index_count) continue;
-		VkPipeline p = ctx->pipes.surfaces[d->cull_back];
+		VkPipeline p = t->shading ? ctx->pipes.surfaces_shade[d->cull_back] : ctx->pipes.surfaces[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		/* surface.frag reads the draw's flags (a sphere's proxy). */
+		/* surface.frag reads the draw's flags (a sphere's proxy), surface_shade.frag its material */
 		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
 		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
 		                   sizeof push, &push);
 		record_draw_camera(cmd, d);
 	}
 	vkCmdEndRendering(cmd);
-	for (int i = 0; i < 2; i++)
+	for (uint32_t i = 0; i < nimg; i++)
 		record_image_barrier(cmd, img[i]->img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
 		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
 		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
@@ -92,39 +94,56 @@ void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct r
 	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 }
 
+/* The pass's pipeline: vis.frag with the scene's shadow constants only (the rest zeroed, so
+ * that scenes differing in output, tone map or materials share one variant), or with pixel
+ * shading (deferred.c) vis_shade.frag with the shading constants too, into the output's format. */
+static enum rnd_result vis_pipeline(struct rnd_context *ctx, const struct record_view *rv, VkPipeline *pipe,
+                                    struct rnd_error *err)
+{
+	struct rnd_main_key key;
+	record_main_key(rv, rv->ndraw, &key);
+	if (!rv->deferred) {
+		key.sc[UMBRA_SC_LINEAR] = key.sc[UMBRA_SC_TONEMAP] = key.sc[UMBRA_SC_CATCHER] = 0;
+		key.sc[UMBRA_SC_MASKED] = key.sc[UMBRA_SC_DEBUG] = key.sc[UMBRA_SC_ENV] = 0;
+		key.format = 0;
+	}
+	/* vis.frag samples no texture; vis_shade.frag (plain draws only: no texture, no material
+	 * extension) always multiplies by the vertex colour, white where a mesh has none: one
+	 * variant with and without */
+	key.sc[UMBRA_SC_TEXTURES] = key.sc[UMBRA_SC_MATERIAL_EXT] = 0;
+	key.samples = 1;
+	key.cull_back = key.prepass = key.aov = key.atlas_view = 0;
+	key.vis_pass = 1;
+	key.vis_shade = rv->deferred;
+	return rnd_pipelines_main(ctx, &key, pipe, err);
+}
+
 enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
                                   struct rnd_error *err)
 {
 	const struct rnd_scene *sc = rv->sc;
 	VkCommandBuffer cmd = s->cmd;
-	struct rnd_main_key key;
-	record_main_key(rv, rv->ndraw, &key);
-	/* Only the shadow constants shape vis.frag: the rest are zeroed so that scenes differing in
-	 * output, tone map or materials share one variant. */
-	key.sc[UMBRA_SC_LINEAR] = key.sc[UMBRA_SC_TONEMAP] = key.sc[UMBRA_SC_CATCHER] = 0;
-	key.sc[UMBRA_SC_TEXTURES] = key.sc[UMBRA_SC_MASKED] = key.sc[UMBRA_SC_DEBUG] = key.sc[UMBRA_SC_ENV] = 0;
-	key.sc[UMBRA_SC_MATERIAL_EXT] = 0;
-	key.format = 0;
-	key.samples = 1;
-	key.cull_back = key.prepass = key.aov = key.atlas_view = 0;
-	key.vis_pass = 1;
 	VkPipeline pipe;
-	enum rnd_result r = rnd_pipelines_main(ctx, &key, &pipe, err);
+	enum rnd_result r = vis_pipeline(ctx, rv, &pipe, err);
 	if (r != RND_OK) return r;
 	/* The band's rows and one more on either side: the main pass may read a neighbour pixel's
-	 * values (vis_pixel), and nothing of an earlier band's passes is kept. */
+	 * values (vis_pixel, resolve.frag), and nothing of an earlier band's passes is kept. */
 	VkRect2D area = record_band_area(rv);
 	uint32_t y0 = area.offset.y > 0 ? (uint32_t)area.offset.y - 1 : 0;
 	uint32_t y1 = (uint32_t)area.offset.y + area.extent.height + 1;
 	if (y1 > sc->height) y1 = sc->height;
 	area.offset.y = (int32_t)y0;
 	area.extent.height = y1 - y0;
-	struct rnd_surface_targets t = {&s->surfaces, &s->normals, &s->surfaces_depth, (float)sc->width, (float)sc->height};
+	struct rnd_surface_targets t = {&s->surfaces, &s->normals, &s->surfaces_depth, (float)sc->width, (float)sc->height,
+	                                rv->deferred ? &s->shading : NULL};
 	record_surfaces(ctx, s, rv, area, &t);
 
 	record_image_barrier(cmd, s->visibility.img, VK_IMAGE_ASPECT_COLOR_BIT, s->visibility.layers,
 	                     VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
 	                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+	/* Pixel shading: the colour of each pixel centre (an earlier band's resolve read it). */
+	VkRenderingAttachmentInfo ca = {0};
+	if (rv->deferred) ca = record_color_overwrite(cmd, &s->shaded, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
 	VkRenderingAttachmentInfo da = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->surfaces_depth.view,
 		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD,
@@ -132,17 +151,28 @@ enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, c
 	};
 	VkRenderingInfo ri = {
 		.sType = VK_STRUCTURE_TYPE_RENDERING_INFO, .renderArea = area, .layerCount = 1, .pDepthAttachment = &da,
+		.colorAttachmentCount = rv->deferred ? 1 : 0, .pColorAttachments = &ca,
 	};
 	vkCmdBeginRendering(cmd, &ri);
 	VkViewport vp = {0, 0, (float)sc->width, (float)sc->height, 0, 1};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
 	vkCmdSetScissor(cmd, 0, 1, &area);
 	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+	/* shade.glsl names the material textures (set 1): the white ones, never read (no draw of a
+	 * pixel-shaded view has a texture) */
+	if (rv->deferred)
+		vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, UMBRA_SET_MATERIAL, 1,
+		                        &s->texture_sets[0], 0, NULL);
 	vkCmdDraw(cmd, 3, 1, 0, 0);
 	vkCmdEndRendering(cmd);
 	record_image_barrier(cmd, s->visibility.img, VK_IMAGE_ASPECT_COLOR_BIT, s->visibility.layers, VK_IMAGE_LAYOUT_GENERAL,
 	                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 	                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 	                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+	if (rv->deferred)
+		record_image_barrier(cmd, s->shaded.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
 	return RND_OK;
 }

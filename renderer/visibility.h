@@ -22,6 +22,7 @@
 struct rnd_surface_targets {
 	const struct rnd_image_res *positions, *normals, *depth;
 	float width, height;
+	const struct rnd_image_res *shading;   /* pixel shading's inputs too (deferred.c), or NULL */
 };
 /* Draws rv's surfaces over area (rows of the targets) into t, left ready for sampling (the depth
  * as a read-only attachment). */

@@ -4,6 +4,7 @@
  * plan's decision (render_plan.c), made here from the scene, its shadow plan and its draws.
  * Pure: no Vulkan.
  */
+#include "material_bits.h"
 #include "visibility_plan.h"
 
 /* When the pass pays (measured on lavapipe, studio-spots' objects under its seven lights, 768 x
@@ -37,17 +38,32 @@ static bool wide_filter(const struct rnd_light_plan *lp)
 	return lp->filter == UMBRA_FILTER_PCSS || (lp->filter == UMBRA_FILTER_PCF && lp->pcf_radius >= RND_VIS_MIN_PCF_RADIUS);
 }
 
+uint64_t rnd_surfaces_bytes(const struct rnd_scene *sc, uint32_t lights)
+{
+	uint64_t px = (uint64_t)sc->width * sc->height;
+	if (px * lights * 2 > RND_VIS_MAX_BYTES) return 0;
+	/* rnd_slot_visibility's images: surfaces RGBA32F, normals RGBA16 SNORM, their depth D32,
+	 * an R16 layer per light, at least RND_VIS_MIN_LAYERS */
+	uint32_t layers = lights < RND_VIS_MIN_LAYERS ? RND_VIS_MIN_LAYERS : lights;
+	return px * (16 + 8 + 4 + 2ull * layers);
+}
+
 uint64_t rnd_visibility_bytes(const struct rnd_scene *sc)
 {
 	if (sc->output.debug != RND_DEBUG_NONE) return 0;
 	bool shadowed = false;
 	for (uint32_t i = 0; i < sc->light_count; i++) shadowed |= sc->lights[i].shadow.enabled;
-	uint64_t px = (uint64_t)sc->width * sc->height;
-	if (!shadowed || px * sc->light_count * 2 > RND_VIS_MAX_BYTES) return 0;
-	/* rnd_slot_visibility's images: surfaces RGBA32F, normals RGBA16 SNORM, their depth D32,
-	 * an R16 layer per light, at least RND_VIS_MIN_LAYERS */
-	uint32_t layers = sc->light_count < RND_VIS_MIN_LAYERS ? RND_VIS_MIN_LAYERS : sc->light_count;
-	return px * (16 + 8 + 4 + 2ull * layers);
+	return shadowed ? rnd_surfaces_bytes(sc, sc->light_count) : 0;
+}
+
+uint64_t rnd_camera_faces(const struct draw *draws, uint32_t ndraw)
+{
+	/* a back-face culled closed shape shows about half its triangles, a sphere's proxy all of
+	 * its own */
+	uint64_t faces = 0;
+	for (uint32_t i = 0; i < ndraw; i++)
+		faces += draws[i].cam_index_count / 3 / (draws[i].cull_back ? 2 : 1);
+	return faces;
 }
 
 /* Why, for the plan's reader; returns whether that is `on`. */
@@ -74,13 +90,67 @@ bool rnd_visibility_wanted(bool device, int force, const struct rnd_scene *sc, c
 	if (!rnd_visibility_bytes(sc)) return because(why, RND_VIS_TOO_LARGE);   /* over the size cap */
 	if (force >= 0) return because(why, force == 1 ? RND_VIS_FORCED_ON : RND_VIS_FORCED_OFF);
 	if (!wide) return because(why, RND_VIS_NARROW);
-	/* Faces the camera may see: a back-face culled closed shape shows about half its triangles,
-	 * a sphere's proxy all of its own. */
-	uint64_t faces = 0;
-	for (uint32_t i = 0; i < ndraw; i++)
-		faces += draws[i].cam_index_count / 3 / (draws[i].cull_back ? 2 : 1);
+	uint64_t faces = rnd_camera_faces(draws, ndraw);
 	uint64_t px = (uint64_t)sc->width * sc->height;
 	bool dense = wide >= 2 ? faces * RND_VIS_PIXELS_PER_FACE >= px
 	                       : sc->output.msaa > 1 && faces * RND_VIS_PIXELS_PER_FACE_ONE_LIGHT >= px;
 	return because(why, dense ? RND_VIS_DENSE : RND_VIS_SPARSE);
+}
+
+/* ---- pixel shading (deferred.c: what it is and how it is recorded) ---- */
+
+/* Without the visibility pass (no light with a wide shadow filter), pixel shading runs the
+ * surfaces pass for itself where an environment map lights the view: its shading (the map's
+ * light and the environment pass's bilateral read, ibl.glsl) is what lavapipe would otherwise run
+ * per triangle per 4x4 block. It pays over dense meshes, as the visibility pass does for one wide
+ * light: at least one face towards the camera per RND_DEFERRED_PIXELS_PER_FACE pixels. */
+#define RND_DEFERRED_PIXELS_PER_FACE 16u
+
+/* A draw shade.glsl can shade from the surfaces pass alone: no texture (the fullscreen pass has
+ * no uv derivatives and binds no material's set), no material extension's lobe (their textures
+ * and coat normal), opaque (no alpha test or dither: the surfaces pass cuts no texel out), not a
+ * sphere's proxy (it shades the true sphere, not the mesh the surfaces pass keeps). */
+static bool plain(const struct rnd_scene *sc, const struct draw *d)
+{
+	return !d->masked && !(d->tex_bits & ((1u << UMBRA_TEX_SLOTS) - 1u)) && !(d->flags & UMBRA_DRAW_SPHERE) &&
+	       !(sc->material_count && rnd_material_ext_bits(&sc->materials[d->material]));
+}
+
+static bool shade_because(uint8_t *why, enum rnd_pixel_why w)
+{
+	if (why) *why = (uint8_t)w;
+	return w == RND_PIXEL_VISIBILITY || w == RND_PIXEL_ENVIRONMENT;
+}
+
+bool rnd_pixel_shading_wanted(bool device, bool vis_device, int force, const struct rnd_scene *sc,
+                              const struct draw *draws, uint32_t ndraw, bool vis, bool env_lit, uint8_t *why)
+{
+	if (!device) return shade_because(why, RND_PIXEL_NO_DEVICE);
+	if (sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return shade_because(why, RND_PIXEL_OUTPUT);
+	/* An environment map behind the scene is drawn where the main pass left the far plane
+	 * (record.c, env_background.frag); the resolve writes the clear colour there. */
+	if (sc->environment.source != RND_ENV_AMBIENT && sc->environment.background_map && !sc->output.transparent)
+		return shade_because(why, RND_PIXEL_BACKGROUND);
+	for (uint32_t i = 0; i < ndraw; i++)
+		if (draws[i].index_count && !plain(sc, &draws[i])) return shade_because(why, RND_PIXEL_NOT_PLAIN);
+	if (!vis) {
+		if (!vis_device || !env_lit) return shade_because(why, RND_PIXEL_NO_PASS);
+		if (!rnd_surfaces_bytes(sc, 0)) return shade_because(why, RND_PIXEL_TOO_LARGE);
+		if (rnd_camera_faces(draws, ndraw) * RND_DEFERRED_PIXELS_PER_FACE < (uint64_t)sc->width * sc->height)
+			return shade_because(why, RND_PIXEL_SPARSE);
+	}
+	if (force == 0) return shade_because(why, RND_PIXEL_FORCED_OFF);
+	return shade_because(why, vis ? RND_PIXEL_VISIBILITY : RND_PIXEL_ENVIRONMENT);
+}
+
+uint64_t rnd_deferred_bytes(const struct rnd_scene *sc)
+{
+	if (sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return 0;
+	/* the surfaces pass's images where the visibility pass has none (an environment map's view) */
+	uint64_t surfaces = 0;
+	if (!rnd_visibility_bytes(sc)) {
+		if (sc->environment.source == RND_ENV_AMBIENT || !(surfaces = rnd_surfaces_bytes(sc, 0))) return 0;
+	}
+	/* the shading inputs (RGBA32UI) and the shaded colour (at most RGBA32F) */
+	return surfaces + (uint64_t)sc->width * sc->height * (16 + 16);
 }

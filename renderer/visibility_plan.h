@@ -1,6 +1,7 @@
 /*
- * renderer/visibility_plan.h — when the visibility pass runs (see visibility_plan.c; the pass
- * itself: visibility.h). Pure: no Vulkan; thread-safe.
+ * renderer/visibility_plan.h — when the visibility pass runs, and when pixel shading does (see
+ * visibility_plan.c; the passes themselves: visibility.h, deferred.h). Pure: no Vulkan;
+ * thread-safe.
  */
 #ifndef UMBRA_RENDERER_VISIBILITY_PLAN_H
 #define UMBRA_RENDERER_VISIBILITY_PLAN_H
@@ -36,5 +37,36 @@ enum rnd_vis_why {
  * at all (no shadowed light, a debug view, a view too large): what a render may need beyond
  * its targets (estimate.c counts it, before the plan says whether the pass runs). */
 uint64_t rnd_visibility_bytes(const struct rnd_scene *sc);
+/* The bytes of the slot's images for the surfaces pass of sc's view with `lights` layers of
+ * visibility; 0 over the size the pass may take. */
+uint64_t rnd_surfaces_bytes(const struct rnd_scene *sc, uint32_t lights);
+/* The triangles of draws the camera may see (what pays for the passes: one per N pixels). */
+uint64_t rnd_camera_faces(const struct draw *draws, uint32_t ndraw);
+
+/* Whether a view of sc is shaded once per pixel centre (pixel shading, deferred.h), and why
+ * (*why: enum rnd_pixel_why; NULL: not wanted): the view runs the visibility pass (vis), or an
+ * environment map lights it (env_lit) over dense triangles (then pixel shading runs the
+ * surfaces pass for itself: the caller runs the visibility pass's passes wherever this says
+ * yes); MSAA 4, no debug view, no environment map as the background, every draw plain (opaque,
+ * untextured, no material extension lobe, no sphere proxy; draws' tex_bits from the plan).
+ * device: the device can (deferred.c rnd_deferred_supported); vis_device: it can run the
+ * visibility pass; force: UMBRA_PIXEL_SHADING, 0 off, else -1. */
+bool rnd_pixel_shading_wanted(bool device, bool vis_device, int force, const struct rnd_scene *sc,
+                              const struct draw *draws, uint32_t ndraw, bool vis, bool env_lit, uint8_t *why);
+enum rnd_pixel_why {
+	RND_PIXEL_VISIBILITY,   /* on: the visibility pass's surfaces shaded once per pixel centre */
+	RND_PIXEL_ENVIRONMENT,  /* on: an environment map over dense triangles, its own surfaces pass */
+	RND_PIXEL_NO_DEVICE,    /* off: the device cannot */
+	RND_PIXEL_OUTPUT,       /* off: not MSAA 4, or a debug view */
+	RND_PIXEL_BACKGROUND,   /* off: the environment map behind the scene */
+	RND_PIXEL_NOT_PLAIN,    /* off: a textured, alpha-tested or extension material, or a sphere proxy */
+	RND_PIXEL_NO_PASS,      /* off: no visibility pass and no environment map */
+	RND_PIXEL_TOO_LARGE,    /* off: the surfaces pass's images would be too large */
+	RND_PIXEL_SPARSE,       /* off: too few triangles for its passes to pay */
+	RND_PIXEL_FORCED_OFF,   /* off: UMBRA_PIXEL_SHADING=0 */
+	RND_PIXEL_WHY_COUNT
+};
+/* The bytes of pixel shading's images for a view of sc (estimate.c: beside the visibility pass's). */
+uint64_t rnd_deferred_bytes(const struct rnd_scene *sc);
 
 #endif

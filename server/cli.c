@@ -7,7 +7,7 @@
  *   umbra-render --manifest LIST.jsonl -o DIR/ [batch options]    {"scene": ..., "output": ...} per line
  *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]
  *                [batch options]
- *   batch options: -j N (threads and render slots, default one per core), --report FILE (JSON lines,
+ *   batch options: -j N (threads that parse and import, default one per core), --report FILE (JSON lines,
  *                  default DIR/report.jsonl), --progress | --no-progress (default: bar on a tty),
  *                  --server URL (render by umbrad / a balancer: -j N requests in flight, default 8),
  *                  --resume (skip inputs the report has as ok for the same bytes), --shard K/N
@@ -69,7 +69,8 @@ static int usage(FILE *f, int code)
 	           "  --format F   thumbnails: png (default), webp or avif (lossless), or exr: output.format\n"
 	           "  --quality Q  thumbnails with --format webp or avif: lossy at quality 0..100: output.quality\n"
 	           "  --manifest F JSON lines {\"scene\": \"a.json\" | {...}, \"output\": \"a.png\"}; paths relative to F\n"
-	           "  -j N         batch: threads and render slots (default: one per core)\n"
+	           "  -j N         batch: threads that read, parse and import (default: one per core); renders run on\n"
+	           "               one more (a CPU device) or N more (a GPU)\n"
 	           "  --report F   batch: JSON-lines report (file, output, status, ms, error, stages); default DIR/report.jsonl\n"
 	           "  --progress, --no-progress  batch: progress bar / plain lines on stderr (default: bar on a tty)\n"
 	           "  --server URL batch: render by umbrad or a cluster at http://HOST:PORT (-j N requests in flight,\n"

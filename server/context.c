@@ -5,8 +5,10 @@
  * the one way a worker plans and renders on it.
  */
 #include <malloc.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "log.h"
 #include "metrics.h"
@@ -178,6 +180,71 @@ uint64_t srv_context_trim(struct srv_server *s, double idle_s)
 	pthread_rwlock_unlock(&s->ctx_lock);
 	malloc_trim(0);
 	return released;
+}
+
+uint64_t srv_rss_bytes(void)
+{
+	long pages_total = 0, pages_rss = 0;
+	FILE *f = fopen("/proc/self/statm", "r");
+	if (!f)
+		return 0;
+	if (fscanf(f, "%ld %ld", &pages_total, &pages_rss) != 2)
+		pages_rss = 0;
+	fclose(f);
+	long page = sysconf(_SC_PAGESIZE);
+	return pages_rss > 0 && page > 0 ? (uint64_t)pages_rss * (uint64_t)page : 0;
+}
+
+/* issue 28: a warm daemon under 200 MB after any mix of requests (lavapipe: ~150 MB ready) */
+#define RSS_DEFAULT_BOUND (192ull << 20)
+
+/* The main-pass variants a trim keeps: the warm-up's defaults (server/warmup.c) are four. */
+#define RSS_KEEP_VARIANTS 4u
+
+/* One step of srv_context_fit_rss: what the renderer keeps, by how dear it is to make again. */
+static void rss_step(struct srv_server *s, int step)
+{
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	if (s->ctx && step == 0)
+		rnd_context_trim(s->ctx, 0);                       /* maps nobody holds, atlas pages */
+	if (s->ctx && step == 1)
+		rnd_context_trim_slots(s->ctx);                    /* idle slots' targets and buffers */
+	if (s->ctx && step == 2)
+		rnd_context_trim_pipelines(s->ctx, RSS_KEEP_VARIANTS); /* JIT code: ~14 MB a variant on lavapipe */
+	pthread_rwlock_unlock(&s->ctx_lock);
+	if (step == 3) {
+		/* every cached model nobody uses (an import is the dearest thing to make again) */
+		api_model_cache_set_limit(0);
+		api_model_cache_set_limit(s->cfg.model_cache_bytes);
+	}
+	malloc_trim(0);
+}
+
+void srv_rss_bound_settle(struct srv_server *s)
+{
+	if (s->cfg.max_rss_given)
+		return;
+	uint64_t ready = srv_rss_bytes(), bound = ready + ready / 4;
+	s->cfg.max_rss = bound > RSS_DEFAULT_BOUND ? bound : RSS_DEFAULT_BOUND;
+	srv_log(SRV_LOG_INFO, "resident memory %.0f MB ready; --max-rss %.0f MB", ready / 1048576.0,
+	        s->cfg.max_rss / 1048576.0);
+}
+
+void srv_context_fit_rss(struct srv_server *s)
+{
+	static pthread_mutex_t one = PTHREAD_MUTEX_INITIALIZER;
+	if (!s->cfg.max_rss || srv_rss_bytes() <= s->cfg.max_rss || pthread_mutex_trylock(&one) != 0)
+		return;
+	uint64_t before = srv_rss_bytes();
+	int step = 0;
+	for (; step < 4 && srv_rss_bytes() > s->cfg.max_rss; step++)
+		rss_step(s, step);
+	srv_metrics_add(s->metrics, SRV_CTR_RSS_TRIM, 1);
+	uint64_t after = srv_rss_bytes();
+	pthread_mutex_unlock(&one);
+	srv_log(after > s->cfg.max_rss ? SRV_LOG_WARN : SRV_LOG_INFO,
+	        "resident memory %.0f MB over --max-rss %.0f MB: gave back in %d step%s, now %.0f MB", before / 1048576.0,
+	        s->cfg.max_rss / 1048576.0, step, step == 1 ? "" : "s", after / 1048576.0);
 }
 
 int srv_fault_arm(struct srv_server *s)

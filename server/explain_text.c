@@ -75,14 +75,14 @@ static void passes(FILE *f, const struct rnd_plan *plan, uint32_t n)
 
 static void views(FILE *f, const struct rnd_plan *plan, uint32_t n)
 {
-	fprintf(f, "\n%-4s %10s %5s %8s %-7s %-4s %-5s %9s  %s\n", "view", "camera tri", "maps", "Mtexel", "contact", "env",
-	        "vis", "est ms", "visibility pass");
+	fprintf(f, "\n%-4s %10s %5s %8s %-7s %-4s %-5s %-5s %9s  %s\n", "view", "camera tri", "maps", "Mtexel", "contact",
+	        "env", "vis", "pixel", "est ms", "visibility pass");
 	for (uint32_t v = 0; v < n; v++) {
 		struct rnd_plan_view_info w;
 		rnd_plan_view(plan, v, &w);
-		fprintf(f, "%-4u %10llu %5u %8.2f %-7s %-4s %-5s %9.2f  %s", v, (unsigned long long)w.camera_triangles,
+		fprintf(f, "%-4u %10llu %5u %8.2f %-7s %-4s %-5s %-5s %9.2f  %s", v, (unsigned long long)w.camera_triangles,
 		        w.maps_drawn, w.texels_drawn / 1e6, w.contact ? "yes" : "no", w.env_pass ? "pass" : "no",
-		        w.visibility ? "yes" : "no",
+		        w.visibility ? "yes" : "no", w.pixel_shading ? "yes" : "no",
 		        w.shadow_estimate_ms + w.main_estimate_ms, w.visibility_why);
 		if (w.analyzed) fprintf(f, "; measured shadow %.2f, main %.2f ms, %u band%s", w.shadow_ms, w.main_ms, w.bands,
 		                        w.bands == 1 ? "" : "s");

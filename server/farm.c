@@ -151,7 +151,7 @@ static bool input_refused(const struct farm_job *j, struct job_result *r)
 	return true;
 }
 
-static void job_input_release(struct job_input *in)
+void farm_job_input_release(struct job_input *in)
 {
 	free(in->bytes);
 	free(in->parts);
@@ -161,7 +161,7 @@ static void job_input_release(struct job_input *in)
 
 /* Reads job i's bytes once: the scene (or the model, its thumbnail document and the files it
  * refers to) into *in, and the content hash of them all into r->hash. JOB_OK or the failure. */
-static enum job_status job_read(struct farm *f, size_t i, struct job_input *in)
+enum job_status farm_job_read(struct farm *f, size_t i, struct job_input *in)
 {
 	const struct farm_job *j = &f->jobs[i];
 	struct job_result *r = &f->res[i];
@@ -182,7 +182,7 @@ static enum job_status job_read(struct farm *f, size_t i, struct job_input *in)
 		if (thumb_doc(j, f->o, in->thumb, sizeof in->thumb, r->error, sizeof r->error) < 0 ||
 		    model_parts(j->input, (const uint8_t *)in->bytes, in->len, &in->refs, &in->parts, &in->nparts, r->error,
 		                sizeof r->error) < 0) {
-			job_input_release(in);
+			farm_job_input_release(in);
 			return JOB_INVALID;
 		}
 		for (size_t k = 1; k < in->nparts; k++) {   /* the files it refers to, by name and bytes */
@@ -197,7 +197,7 @@ static enum job_status job_read(struct farm *f, size_t i, struct job_input *in)
 }
 
 /* Parses the job's document into *s and settles its output path. JOB_OK or the failure. */
-static enum job_status job_scene(struct farm *f, size_t i, const struct job_input *in, struct api_scene **s)
+enum job_status farm_job_scene(struct farm *f, size_t i, const struct job_input *in, struct api_scene **s)
 {
 	const struct farm_job *j = &f->jobs[i];
 	struct job_result *r = &f->res[i];
@@ -249,60 +249,16 @@ int farm_write_file(const char *path, const uint8_t *b, size_t n, char *err, siz
 	return 0;
 }
 
-/* Renders job i here, on the farm's context, and writes its file. */
-static enum job_status local_job(struct farm *f, size_t i, const struct job_input *in)
-{
-	struct job_result *r = &f->res[i];
-	struct api_scene *s = NULL;
-	double t0 = farm_now_ms();
-	enum job_status st = job_scene(f, i, in, &s);
-	if (st != JOB_OK) return st;
-	r->parse_ms = farm_now_ms() - t0;
-	r->imp = s->import;
-	r->env = s->scene.environment.source != RND_ENV_AMBIENT;
-	struct rnd_image img = {0};
-	struct rnd_timings tm;
-	struct rnd_error err;
-	enum rnd_result rr = rnd_render(f->ctx, &s->scene, &img, &tm, &err);
-	r->tm = tm;
-	if (rr != RND_OK) {
-		bool fault = rr == RND_ERR_INVALID || rr == RND_ERR_LIMIT;
-		if (fault) {
-			struct api_problem prob;
-			api_problem_from_render(&prob, s, &err, rr == RND_ERR_LIMIT ? 422 : 400);
-			api_problem_format(&prob, r->error, sizeof r->error);
-		} else {
-			snprintf(r->error, sizeof r->error, "render failed: %s", err.msg);
-		}
-		api_scene_free(s);
-		return fault ? JOB_INVALID : JOB_FAILED;
-	}
-	snprintf(r->warnings, sizeof r->warnings, "%s", s->warnings);
-	uint8_t *bytes = NULL;
-	size_t n = 0;
-	struct api_problem prob;
-	st = JOB_FAILED;
-	double t1 = farm_now_ms();
-	enum api_result enc = api_encode(s, &img, &bytes, &n, &prob);
-	r->encode_ms = farm_now_ms() - t1;
-	if (enc != API_OK) api_problem_format(&prob, r->error, sizeof r->error);
-	else if (farm_write_file(r->out, bytes, n, r->error, sizeof r->error) == 0) st = JOB_OK;
-	free(bytes);
-	rnd_image_release(&img);
-	api_scene_free(s);
-	return st;
-}
-
-/* Job i: its bytes read and hashed, then skipped (--resume: an earlier run made it), rendered
- * by the server (--server) or here. */
+/* Job i by the server (--server): its bytes read and hashed, then skipped (--resume: an
+ * earlier run made it) or sent. The local farm runs its jobs in two stages (farm_local.c). */
 static enum job_status run_job(struct farm *f, size_t i)
 {
 	struct job_input in;
-	enum job_status st = job_read(f, i, &in);
+	enum job_status st = farm_job_read(f, i, &in);
 	if (st != JOB_OK) return st;
 	if (f->resume && farm_resume_hit(f->resume, f, i)) f->res[i].resumed = true;
-	else st = f->o->server ? farm_remote_job(f, i, &in) : local_job(f, i, &in);
-	job_input_release(&in);
+	else st = farm_remote_job(f, i, &in);
+	farm_job_input_release(&in);
 	return st;
 }
 
@@ -331,6 +287,19 @@ static void progress(struct farm *f, size_t i)
 	if (f->done == f->n) fputc('\n', stderr);
 }
 
+void farm_finish(struct farm *f, size_t i, enum job_status st, double t0)
+{
+	pthread_mutex_lock(&f->mu);
+	f->res[i].status = st;
+	f->res[i].ms = farm_now_ms() - t0;
+	f->done++;
+	f->resumed += f->res[i].resumed;
+	if (st != JOB_OK) f->failed++;
+	farm_journal_line(f, i);   /* before the progress line: a line seen means it is in the report */
+	progress(f, i);
+	pthread_mutex_unlock(&f->mu);
+}
+
 static void *worker(void *arg)
 {
 	struct farm *f = arg;
@@ -339,16 +308,7 @@ static void *worker(void *arg)
 		size_t i = atomic_fetch_add(&f->next, 1);
 		if (i >= f->n) break;
 		double t = farm_now_ms();
-		enum job_status st = run_job(f, i);
-		pthread_mutex_lock(&f->mu);
-		f->res[i].status = st;
-		f->res[i].ms = farm_now_ms() - t;
-		f->done++;
-		f->resumed += f->res[i].resumed;
-		if (st != JOB_OK) f->failed++;
-		farm_journal_line(f, i);   /* before the progress line: a line seen means it is in the report */
-		progress(f, i);
-		pthread_mutex_unlock(&f->mu);
+		farm_finish(f, i, run_job(f, i), t);
 	}
 	return NULL;
 }
@@ -463,11 +423,15 @@ static void run_workers(struct farm *f, unsigned threads)
 	sigemptyset(&sa.sa_mask);
 	sigaction(SIGINT, &sa, &old_int);
 	sigaction(SIGTERM, &sa, &old_term);
-	pthread_t tids[64];
-	unsigned started = 0;
-	while (started < threads && pthread_create(&tids[started], NULL, worker, f) == 0) started++;
-	if (!started) worker(f);   /* no thread could start: work on this one */
-	for (unsigned k = 0; k < started; k++) pthread_join(tids[k], NULL);
+	if (f->o->server) {
+		pthread_t tids[64];
+		unsigned started = 0;
+		while (started < threads && pthread_create(&tids[started], NULL, worker, f) == 0) started++;
+		if (!started) worker(f);   /* no thread could start: work on this one */
+		for (unsigned k = 0; k < started; k++) pthread_join(tids[k], NULL);
+	} else {
+		farm_run_local(f, threads);
+	}
 	sigaction(SIGINT, &old_int, NULL);
 	sigaction(SIGTERM, &old_term, NULL);
 }

@@ -6,9 +6,10 @@
  *   struct farm_opts o = {.threads = 0, .report = "DIR/report.jsonl"};
  *   int code = farm_run(jobs, n, &o);    // exit status: 0 all rendered, 1 some failed, 130 interrupted
  *
- * One renderer context with `threads` render slots and as many worker threads, each taking the
- * next job, rendering it and writing its file (renamed into place when complete), so every core
- * is busy and the device, pipelines and shadow atlas are set up once. A model job renders the
+ * One renderer context; `threads` threads take the next job and parse it (a model's sandboxed
+ * import included) while render threads (one on a CPU device, `threads` on a GPU) render the
+ * parsed ones and write their files (renamed into place when complete): server/farm_local.c.
+ * So every core is busy and the device, pipelines and shadow atlas are set up once. A model job renders the
  * file with `"preset": "thumbnail"` (api/preset.h) as a multipart part, with the files it refers
  * to (a .gltf's .bin and images, an .obj's .mtl and textures) read from the model's own
  * directory as further parts (api/model_refs.h's rules, that directory as the root). Progress goes to

@@ -75,6 +75,17 @@ const char *farm_label(const struct farm_job *j);
 /* Writes bytes to path through a temporary name, so a stopped run never leaves half a file. */
 int farm_write_file(const char *path, const uint8_t *b, size_t n, char *err, size_t esize);
 
+/* farm.c: job i's bytes read once and hashed (*in, r->hash): JOB_OK or its failure. */
+enum job_status farm_job_read(struct farm *f, size_t i, struct job_input *in);
+void farm_job_input_release(struct job_input *in);
+/* Job i's document parsed (the model imported) into *s and its output path settled. */
+enum job_status farm_job_scene(struct farm *f, size_t i, const struct job_input *in, struct api_scene **s);
+/* Job i is over (started at t0): its status, the journal line, the progress. Any thread. */
+void farm_finish(struct farm *f, size_t i, enum job_status st, double t0);
+
+/* farm_local.c: the local farm's jobs over `threads` threads (see there). */
+void farm_run_local(struct farm *f, unsigned threads);
+
 /* farm_remote.c: renders job i by f->o->server, writes its file. */
 enum job_status farm_remote_job(struct farm *f, size_t i, const struct job_input *in);
 

@@ -33,7 +33,7 @@ static const struct opt_def opts[] = {
 	{ "port-file", OPT_STR, "PATH", "write the bound port to PATH once listening", CFG(port_file), 0, 0 },
 	{ "workers", OPT_UINT, "N", "render threads and context slots (default: online CPUs, at most the cgroup CPU quota)", CFG(workers), 1, 256 },
 	{ "device-renders", OPT_UINT, "N", "renders on the device at once; the other workers parse and encode meanwhile (default 0: 1 on a CPU device such as lavapipe, whose one render already uses every core; all workers on a GPU)", CFG(device_renders), 0, 256 },
-	{ "import-slots", OPT_UINT, "N", "threads that import models (sandboxed), beside the --workers threads, which never import: a request whose model the cache lacks waits for one of them holding no thread; a free one takes the request of the client address with the fewest imports running (default 0: as many as --workers)", CFG(import_slots), 0, 256 },
+	{ "import-slots", OPT_UINT, "N", "threads that import models (sandboxed), beside the --workers threads, which never import: a request whose model the cache lacks waits for one of them holding no thread; a free one takes the request of the client address with the fewest imports running (default 0: as many as --workers, and no more than --max-memory / --import-memory); twice as many threads import, so that one whose import is done renders while the next imports", CFG(import_slots), 0, 256 },
 	{ "queue", OPT_UINT, "N", "renders that may wait for a worker before 503 (64)", CFG(queue), 1, 1000000 },
 	{ "max-body", OPT_SIZE, "BYTES", "largest request body, K/M/G suffixes (64M)", CFG(max_body), 1, UINT64_MAX },
 	{ "max-pixels", OPT_SIZE, "N", "largest width*height, 0 = no limit (16777216)", LIM(max_pixels), 0, UINT64_MAX },
@@ -60,6 +60,7 @@ static const struct opt_def opts[] = {
 	{ "max-memory", OPT_SIZE, "BYTES", "memory renders in flight may need together; a render estimated over it is a 422, others wait (half the machine's or container's memory)", CFG(max_memory), 0, UINT64_MAX },
 	{ "header-timeout", OPT_UINT, "S", "close a new connection idle this long before its first request head, 0 = --idle-timeout (10)", CFG(header_timeout_s), 0, 86400 },
 	{ "drain-timeout", OPT_UINT, "S", "at SIGTERM, longest wait for queued work (60)", CFG(drain_timeout_s), 1, 86400 },
+	{ "max-rss", OPT_SIZE, "BYTES", "resident memory the daemon keeps after a request: over it, it gives back unused shadow maps and atlas pages, freed heap, idle render slots' targets, pipeline variants but the most recently used and cached models, in that order, until it is under; 0 = no bound (192M, or a quarter above the ready daemon's where that is more)", CFG(max_rss), 0, UINT64_MAX },
 	{ "idle-trim", OPT_UINT, "S", "after S s without a request, drop shadow maps unused for S s and give the atlas pages and freed heap back to the system, 0 = never (30)", CFG(idle_trim_s), 0, 86400 },
 	{ "result-cache-mb", OPT_UINT, "MB", "images POST /v1/renders keeps for GET /v1/renders/{hash}.{ext} (LRU), and up to an eighth as much (1 MB at least) of their scenes, each up to 1 MB, to render an evicted image again; 0 = off: both routes 404 (64)", CFG(result_cache_mb), 0, 1048576 },
 	{ "cache-control", OPT_STR, "VALUE", "Cache-Control of POST /v1/render and /v1/renders answers (no-cache: a cache must revalidate; the ETag is in the answer); GET /v1/renders/{hash}.{ext} always says public, max-age=31536000, immutable", CFG(cache_control), 0, 0 },
@@ -180,9 +181,10 @@ static int apply(struct srv_config *cfg, const struct opt_def *o, const char *va
 			        (unsigned long long)o->min, (unsigned long long)o->max);
 			return -1;
 		}
+		if (o->offset == CFG(max_rss)) cfg->max_rss_given = true;
 		/* Members are unsigned or uint32_t (4 bytes) or uint64_t (8 bytes). */
 		if (o->offset == CFG(max_body) || o->offset == LIM(max_pixels) || o->offset == LIM(max_triangles) ||
-		    o->offset == CFG(model_cache_bytes) || o->offset == CFG(max_memory) ||
+		    o->offset == CFG(model_cache_bytes) || o->offset == CFG(max_memory) || o->offset == CFG(max_rss) ||
 		    o->offset == LIM(import_memory))
 			*(uint64_t *)(base + o->offset) = v;
 		else
@@ -362,5 +364,11 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		}
 	cfg->limits.asset_root = cfg->asset_root;
 	if (!cfg->max_memory) cfg->max_memory = srv_admit_default_budget();
+	/* Import slots: one per worker, and no more import children than --max-memory holds at the
+	 * --import-memory each may take (server/imports.h). */
+	if (!cfg->import_slots) {
+		uint64_t fit = cfg->limits.import_memory ? cfg->max_memory / cfg->limits.import_memory : cfg->workers;
+		cfg->import_slots = fit < 1 ? 1 : fit < cfg->workers ? (unsigned)fit : cfg->workers;
+	}
 	return 0;
 }

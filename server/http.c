@@ -235,7 +235,7 @@ static enum MHD_Result answer_info(struct srv_request *req)
 		.max_dimension = info.max_image_dimension < RND_MAX_DIMENSION ? info.max_image_dimension : RND_MAX_DIMENSION,
 		.device_max_shadow_resolution = info.max_shadow_resolution, .deadline_ms = c->deadline_ms,
 		.queue = c->queue, .workers = c->workers, .max_textures = info.max_textures,
-		.device_max_textures = info.device_max_textures,
+		.device_max_textures = info.device_max_textures, .max_rss = c->max_rss, .rss = srv_rss_bytes(),
 	};
 	size_t len = 0;
 	char *json = api_info_json(&in, &len);

@@ -1,6 +1,7 @@
 /*
  * umbrad import threads (see imports.h): the parked requests in a FIFO linked through
- * srv_request.next and a count per client among the running imports, under one mutex.
+ * srv_request.next, the imports running (at most `slots`) and a count per client among the
+ * requests taken and not yet answered, under one mutex.
  */
 #include <netinet/in.h>
 #include <pthread.h>
@@ -19,8 +20,9 @@ struct srv_imports {
 	pthread_mutex_t mu;
 	pthread_cond_t parked_cv;
 	unsigned slots, running, parked;
+	unsigned taken;                    /* requests taken, not yet answered (importing or rendering) */
 	bool closed;
-	struct holder *held;               /* [slots]: clients with imports running (n > 0) */
+	struct holder *held;               /* [2 slots]: clients with requests taken (n > 0) */
 	struct srv_request *head, *tail;   /* parked */
 };
 
@@ -29,7 +31,7 @@ struct srv_imports *srv_imports_create(unsigned slots)
 	struct srv_imports *im = calloc(1, sizeof *im);
 	if (!im) return NULL;
 	im->slots = slots ? slots : 1;
-	im->held = calloc(im->slots, sizeof *im->held);
+	im->held = calloc(srv_imports_threads(im->slots), sizeof *im->held);
 	if (!im->held) goto fail;
 	if (pthread_mutex_init(&im->mu, NULL) != 0) goto fail;
 	if (pthread_cond_init(&im->parked_cv, NULL) != 0) {
@@ -68,7 +70,7 @@ void srv_imports_park(struct srv_imports *im, struct srv_request *req)
 static struct holder *holder_of(struct srv_imports *im, uint64_t client, bool or_free)
 {
 	struct holder *free_one = NULL;
-	for (unsigned i = 0; i < im->slots; i++) {
+	for (unsigned i = 0; i < srv_imports_threads(im->slots); i++) {
 		if (im->held[i].n && im->held[i].client == client) return &im->held[i];
 		if (!im->held[i].n && !free_one) free_one = &im->held[i];
 	}
@@ -98,19 +100,31 @@ static struct srv_request *unpark(struct srv_imports *im)
 struct srv_request *srv_imports_take(struct srv_imports *im)
 {
 	pthread_mutex_lock(&im->mu);
-	while (!im->head && !im->closed) pthread_cond_wait(&im->parked_cv, &im->mu);
+	/* a request to import and an import slot free (the threads beyond the slots render what
+	 * they imported meanwhile) */
+	while (!(im->head && im->running < im->slots) && !(im->closed && !im->head))
+		pthread_cond_wait(&im->parked_cv, &im->mu);
 	struct srv_request *req = unpark(im);
 	if (req) {
-		/* one per import thread: running < slots, so a free entry exists if the client has none */
+		/* one per import thread: a free entry exists if the client has none */
 		struct holder *h = holder_of(im, req->client, true);
 		if (h) {
 			h->client = req->client;
 			h->n++;
 		}
 		im->running++;
+		im->taken++;
 	}
 	pthread_mutex_unlock(&im->mu);
 	return req;
+}
+
+void srv_imports_imported(struct srv_imports *im)
+{
+	pthread_mutex_lock(&im->mu);
+	if (im->running) im->running--;
+	pthread_cond_broadcast(&im->parked_cv);
+	pthread_mutex_unlock(&im->mu);
 }
 
 void srv_imports_done(struct srv_imports *im, uint64_t client)
@@ -118,8 +132,13 @@ void srv_imports_done(struct srv_imports *im, uint64_t client)
 	pthread_mutex_lock(&im->mu);
 	struct holder *h = holder_of(im, client, false);
 	if (h) h->n--;
-	if (im->running) im->running--;
+	if (im->taken) im->taken--;
 	pthread_mutex_unlock(&im->mu);
+}
+
+unsigned srv_imports_threads(unsigned slots)
+{
+	return 2 * (slots ? slots : 1);
 }
 
 void srv_imports_close(struct srv_imports *im)

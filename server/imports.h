@@ -10,8 +10,15 @@
  * import allowed, and renders and answers it like a worker. A parked request holds no thread.
  *
  * Share: an import thread that comes free takes the parked request of the client address
- * (IPv4, or an IPv6 /64) with the fewest imports running, first parked among equals; a client
- * alone takes every slot, and another client's request gets the next slot that frees.
+ * (IPv4, or an IPv6 /64) with the fewest requests taken and not yet answered, first parked
+ * among equals; a client alone takes every slot, and another client's request gets the next
+ * slot that frees.
+ *
+ * Overlap (issue 28): at most `slots` imports run at once, but there are twice as many import
+ * threads: a thread whose import is done (srv_imports_imported) gives its slot back before it
+ * waits for the device and renders, so the next model is imported while this one renders. On a
+ * CPU device one render at a time already takes every core lavapipe has (server/gate.h), and an
+ * import is one child process on one core.
  *
  * Levels of a cached model at another size and texture decodes are not gated: each is bounded
  * by the import limits and happens once per model and size.
@@ -35,7 +42,12 @@ void srv_imports_park(struct srv_imports *im, struct srv_request *req);
 /* An import thread: waits for a parked request and counts it running for its client; NULL once
  * closed with none parked. srv_imports_done() when it is answered. */
 struct srv_request *srv_imports_take(struct srv_imports *im);
+/* The taken request's parse (its import) is over, however it ended: its slot is free for the
+ * next import. Once per take, before srv_imports_done. */
+void srv_imports_imported(struct srv_imports *im);
 void srv_imports_done(struct srv_imports *im, uint64_t client);
+/* Import threads for `slots` import slots (0: 1). */
+unsigned srv_imports_threads(unsigned slots);
 /* No more parking after this: the import threads drain what is parked and end. */
 void srv_imports_close(struct srv_imports *im);
 /* Imports running, and requests parked, now. */

@@ -81,7 +81,7 @@ int main(int argc, char **argv)
 	s->queue = srv_queue_create(s->cfg.queue);
 	srv_admit_init(&s->admit, s->cfg.max_memory);
 	srv_gate_init(&s->gate, s->cfg.workers);
-	s->imports = srv_imports_create(s->cfg.import_slots ? s->cfg.import_slots : s->cfg.workers);
+	s->imports = srv_imports_create(s->cfg.import_slots);
 	s->results = srv_results_create((uint64_t)s->cfg.result_cache_mb << 20);
 	if (!s->metrics || !s->queue || !s->imports || (s->cfg.result_cache_mb && !s->results)) {
 		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
@@ -95,6 +95,7 @@ int main(int argc, char **argv)
 		goto out_http;
 	if (srv_warmup(s) != 0)
 		goto out_context;
+	srv_rss_bound_settle(s);
 	if (srv_workers_start(s) != 0)
 		goto out_workers;
 	/* Tests only: counted from here, so the warm-up's own submits never hit it. */

@@ -156,18 +156,6 @@ static void write_gauge(struct srv_buf *b, const char *name, const char *help, d
 	srv_buf_printf(b, "# HELP %s %s\n# TYPE %s gauge\n%s %.17g\n", name, help, name, name, v);
 }
 
-static long process_rss_bytes(void)
-{
-	long pages_total = 0, pages_rss = 0;
-	FILE *f = fopen("/proc/self/statm", "r");
-	if (!f)
-		return 0;
-	if (fscanf(f, "%ld %ld", &pages_total, &pages_rss) != 2)
-		pages_rss = 0;
-	fclose(f);
-	return pages_rss * sysconf(_SC_PAGESIZE);
-}
-
 static long process_open_fds(void)
 {
 	DIR *d = opendir("/proc/self/fd");
@@ -334,6 +322,8 @@ static void write_renders(struct srv_buf *b, const struct srv_metrics *snap)
 	              snap->counter[SRV_CTR_DEVICE_LOST]);
 	write_counter(b, "umbra_response_bytes_total", "Bytes of answer bodies.",
 	              snap->counter[SRV_CTR_BYTES_OUT]);
+	write_counter(b, "umbra_rss_trims_total", "Requests after which the daemon gave memory back to stay under --max-rss.",
+	              snap->counter[SRV_CTR_RSS_TRIM]);
 
 }
 
@@ -386,6 +376,7 @@ static void write_device(struct srv_buf *b, struct srv_server *s)
 	              st.shadow_cache_hits);
 	write_counter(b, "umbra_shadow_cache_misses_total", "Lights whose shadow passes were rendered (cache misses).",
 	              st.shadow_cache_misses);
+	write_gauge(b, "umbra_pipeline_variants", "Main-pass pipeline variants compiled and kept.", st.pipeline_variants);
 	write_gauge(b, "umbra_validation_messages", "Vulkan validation-layer messages since start.", vmsg);
 	srv_buf_printf(b, "# HELP umbra_build_info Build and device.\n# TYPE umbra_build_info gauge\n"
 	                   "umbra_build_info{version=\"%s\",device=\"%s\",driver=\"%s\"} 1\n",
@@ -403,7 +394,10 @@ static void write_process(struct srv_buf *b, struct srv_server *s)
 	            (double)adm_peak);
 	write_gauge(b, "umbra_memory_budget_bytes", "--max-memory: what renders in flight may need together.",
 	            (double)adm_budget);
-	write_gauge(b, "process_resident_memory_bytes", "Resident set size.", (double)process_rss_bytes());
+	write_gauge(b, "process_resident_memory_bytes", "Resident set size.", (double)srv_rss_bytes());
+	write_gauge(b, "umbra_rss_limit_bytes", "--max-rss: resident memory kept after a request (0 = no bound).",
+	            (double)s->cfg.max_rss);
+
 	write_gauge(b, "process_open_fds", "Open file descriptors.", (double)process_open_fds());
 }
 

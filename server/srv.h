@@ -89,6 +89,8 @@ struct srv_config {
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
 	uint64_t model_cache_bytes;    /* api_model_cache_set_limit() at start, default 256 MiB */
 	unsigned idle_trim_s;          /* idle this long: drop unused cached maps, give memory back; 0 = never, default 30 */
+	uint64_t max_rss;              /* resident-memory bound kept after each request (srv_context_fit_rss), 0 = none */
+	bool max_rss_given;            /* --max-rss set: else settled after the warm-up (srv_rss_bound_settle) */
 	uint64_t max_memory;           /* bytes renders in flight may need together (admit.h); 0 = default */
 	bool validation;               /* UMBRA_VALIDATION=1: Vulkan validation layer */
 	bool no_playground;            /* --no-playground / UMBRA_NO_PLAYGROUND=1: no page at / */
@@ -264,6 +266,16 @@ enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, 
 /* Memory back to the system: shadow maps unused for idle_s seconds, the atlases' pages once no
  * map is left (rnd_context_trim), then malloc's free pages. Returns the atlas bytes released. */
 uint64_t srv_context_trim(struct srv_server *s, double idle_s);
+/* The process's resident memory now (bytes, /proc/self/statm). */
+uint64_t srv_rss_bytes(void);
+/* After a request: when the process is over --max-rss, gives back what it keeps between
+ * requests, cheapest to make again first, until it is under (context.c). Any thread; one at a
+ * time (another thread already at it: returns). */
+void srv_context_fit_rss(struct srv_server *s);
+/* The default --max-rss, once the warm-up is done: 192 MiB, or a quarter above the ready
+ * daemon's resident memory where that is more (a GPU driver maps more than lavapipe does, and a
+ * bound under a ready daemon would trim after every request). */
+void srv_rss_bound_settle(struct srv_server *s);
 int srv_context_close(struct srv_server *s);        /* saves the cache; returns validation count */
 int srv_fault_arm(struct srv_server *s);            /* --test-fault; 0 or -1 (logged) */
 /* worker.c */

@@ -407,6 +407,8 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	struct parse_ticket ticket;
 	ticket_init(&ticket, s, req, importer);
 	int pr = job_parse(s, req, &ticket, &sc, &parse_s);
+	/* an import thread's import is over: the next model's may start while this one renders */
+	if (importer) srv_imports_imported(s->imports);
 	admitted = ticket.reserved;
 	*parked = pr == 2;
 	if (pr) goto out;
@@ -480,6 +482,8 @@ static void *worker_main(void *arg)
 		unsigned lost_gen = job_run(s, req, false, &parked);
 		if (!parked) srv_request_finish(req);
 		srv_queue_done(s->queue);
+		/* answered: now back under --max-rss (context.c) */
+		if (!parked) srv_context_fit_rss(s);
 		/* After the answer: the client learns of the failure at once, /readyz is already 503. */
 		if (lost_gen)
 			srv_context_recover(s, lost_gen - 1);
@@ -498,6 +502,7 @@ static void *importer_main(void *arg)
 		unsigned lost_gen = job_run(s, req, true, &parked);
 		srv_request_finish(req);
 		srv_imports_done(s->imports, client);
+		srv_context_fit_rss(s);
 		if (lost_gen)
 			srv_context_recover(s, lost_gen - 1);
 	}
@@ -506,7 +511,7 @@ static void *importer_main(void *arg)
 
 static unsigned import_threads(const struct srv_server *s)
 {
-	return s->cfg.import_slots ? s->cfg.import_slots : s->cfg.workers;
+	return srv_imports_threads(s->cfg.import_slots);
 }
 
 int srv_workers_start(struct srv_server *s)

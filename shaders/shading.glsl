@@ -535,7 +535,7 @@ void light_all(vec3 N, vec3 n_geo, vec3 n_shadow, vec3 p_shadow, vec3 V, vec3 c_
 		float vis = 1.0;
 #if defined(UMBRA_VIS_READ)
 		if (SC_FILTERS != 0u && receive && L.shadow.y != 0u) vis = vis_fetch(vis_px, i);
-#elif !defined(UMBRA_VIS_PASS)
+#elif !defined(UMBRA_VIS_PASS) || defined(UMBRA_VIS_SHADE)
 		if (SC_FILTERS != 0u && receive) vis = shadow_visibility(L, p_shadow, n_shadow, l, SC_FILTERS, view);
 #endif
 		if (i == frame.mode.z) { debug_vis = vis; debug_view = view; }

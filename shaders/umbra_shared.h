@@ -37,7 +37,6 @@
 #define UMBRA_BINDING_ENV_SURFACES   16 /* sampler2D (RGBA32F, texelFetch): world position, w 1 (0 = nothing) */
 #define UMBRA_BINDING_ENV_NORMALS    17 /* sampler2D (RGBA16 snorm, texelFetch): geometric normal */
 #define UMBRA_BINDING_ENV_VIS        18 /* sampler2D (R16 unorm, texelFetch): occluded / unoccluded */
-#define UMBRA_BINDING_COUNT          19
 #define UMBRA_ENV_PASS_SCALE         2  /* the view's pixels per environment-pass texel, a side, at least
                                            (larger views take more: env_pass.c rnd_env_pass_scale) */
 /* env_prefilter.comp's and env_brdf.comp's own set 0 */
@@ -50,6 +49,18 @@
 #define UMBRA_ENV_SHADOWS            2u /* ... with its shadow directions */
 #define UMBRA_ENV_BACKGROUND         4u /* the map is the background (shadow catchers darken it) */
 #define UMBRA_ENV_PASS               8u /* its shadows come from the environment pass (env_pass.c) */
+/* Pixel shading (renderer/deferred.c): bound for every render like the environment's (small
+ * placeholders where unused), declared by the shaders of that path only. */
+#define UMBRA_BINDING_SURFACE_SHADING 19 /* usampler2D (RGBA32UI, texelFetch): what the shading pass needs
+                                           of the surface at each pixel centre (UMBRA_SHADING_*) */
+#define UMBRA_BINDING_SHADED         20 /* sampler2D (the output's colour format, texelFetch): the colour
+                                           shaded at each pixel centre */
+#define UMBRA_BINDING_VIEW_DEPTH_MS  21 /* sampler2DMS (D32): the main view's depth per sample */
+#define UMBRA_BINDING_COUNT          22
+/* The surface-shading texel (surface_shade.frag writes it, vis_shade.frag reads it): x the
+ * interpolated normal, octahedral in snorm 2x16; y, z the vertex colour, unorm 2x16 each; w the
+ * material index (low 16 bits) and the draw's UMBRA_DRAW_* flags (high 16). */
+#define UMBRA_SHADING_MATERIAL_BITS  16
 /* moments.frag's own set 0 (renderer/moments.c) */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* sampler2D: the depth atlas (pass 0 reads the view's tile) */
 #define UMBRA_MOMENTS_BINDING_BLUR   1  /* sampler2D: the slot's blur temporary (pass 1 reads it) */
@@ -213,9 +224,11 @@ typedef uint32_t U_UVEC4[4];
 struct umbra_frame {
 	U_MAT4 view_proj;        /* world -> clip of the camera (reversed Z: near 1, far 0) */
 	U_MAT4 view;             /* world -> view */
+	U_MAT4 inv_view_proj;    /* clip -> world (the pixel-shading resolve: a sample's position) */
 	U_VEC4 camera_pos;       /* xyz; w = 1 orthographic, 0 perspective */
 	U_VEC4 camera_fwd;       /* xyz view direction (for orthographic V) */
 	U_VEC4 background;       /* linear rgba */
+	U_VEC4 clear;            /* the main pass's clear value: the background as the colour target holds it */
 	U_VEC4 ambient_sky;      /* rgb already times intensity */
 	U_VEC4 ambient_ground;
 	U_VEC4 params;           /* x exposure multiplier, y near, z far, w the longest Poisson tap (PCSS) */

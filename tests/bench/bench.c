@@ -3,7 +3,9 @@
  * line N times in one process (after one warm-up render) and prints median milliseconds per
  * stage (parse, upload, shadow, main, readback, encode), the median total and images/s.
  *
- *   build/tests/bench [-n N] [-c] [-a DIR] SCENE.json...   (-c: import models cold every run;
+ *   build/tests/bench [-n N] [-c] [-s] [-a DIR] SCENE.json...   (-c: import models cold every run;
+ *                                                          -s: keep no shadow map between runs, as
+ *                                                              for a model never seen before;
  *                                                          -a: models' "path" is inside DIR)
  */
 #include <stdio.h>
@@ -33,19 +35,21 @@ static double median(double *v, int n)
 	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-enum { S_PARSE, S_UPLOAD, S_SHADOW, S_MAIN, S_READBACK, S_ENCODE, S_TOTAL, S_COUNT };
-static const char *names[S_COUNT] = {"parse", "upload", "shadow", "main", "readback", "encode", "total"};
+enum { S_PARSE, S_UPLOAD, S_SHADOW, S_MAIN, S_READBACK, S_ENCODE, S_TOTAL, S_VIS, S_COUNT };
+static const char *names[S_COUNT] = {"parse", "upload", "shadow", "main", "readback", "encode", "total", "vis"};
 
 int main(int argc, char **argv)
 {
 	int n = 15;
 	int first = 1;
 	int cold_models = 0;   /* -c: no model cache, every run imports its models again */
+	int cold_maps = 0;     /* -s: no shadow map kept, every run draws its maps */
 	int deadline_ms = 0;
 	const char *asset_root = NULL;
 	for (;;) {
 		if (argc > first + 1 && !strcmp(argv[first], "-n")) { n = atoi(argv[first + 1]); first += 2; }
 		else if (argc > first && !strcmp(argv[first], "-c")) { cold_models = 1; first += 1; }
+		else if (argc > first && !strcmp(argv[first], "-s")) { cold_maps = 1; first += 1; }
 		else if (argc > first + 1 && !strcmp(argv[first], "-a")) { asset_root = argv[first + 1]; first += 2; }
 		/* -d MS: each render gets a deadline MS from its start (as umbrad gives one), so the
 		 * submits are split as they are in the daemon. */
@@ -53,7 +57,7 @@ int main(int argc, char **argv)
 		else break;
 	}
 	if (n < 1) n = 1;
-	struct rnd_context_desc cd = {.slots = 1};
+	struct rnd_context_desc cd = {.slots = 1, .shadow_cache_texels = cold_maps ? 1 : 0};
 	struct rnd_context *ctx;
 	struct rnd_error err;
 	if (rnd_context_create(&cd, &ctx, &err) != RND_OK) { fprintf(stderr, "bench: %s\n", err.msg); return 1; }
@@ -61,10 +65,11 @@ int main(int argc, char **argv)
 	rnd_context_info(ctx, &info);
 	printf("device: %s (%s), %d runs per scene after 1 warm-up, medians in ms\n", info.device_name, info.driver_name, n);
 	/* After the times (last run): shadow maps rendered / kept from an earlier request, the
-	 * texels of the maps drawn (millions), the triangles the camera's passes draw (thousands)
-	 * and whether the visibility pass ran (renderer/visibility.c). */
-	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s %9s %6s %8s %3s\n", "scene", "parse", "upload", "shadow", "main",
-	       "readback", "encode", "total", "img/s", "KiB", "maps r/k", "Mtexel", "cam ktri", "vis");
+	 * texels of the maps drawn (millions), the triangles the camera's passes draw (thousands),
+	 * whether the visibility pass ran (renderer/visibility.c) and shaded per pixel
+	 * (renderer/deferred.h), and the median ms of that pass (part of main). */
+	printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s %8s %9s %6s %8s %3s %3s %7s\n", "scene", "parse", "upload", "shadow", "main",
+	       "readback", "encode", "total", "img/s", "KiB", "maps r/k", "Mtexel", "cam ktri", "vis", "px", "vis ms");
 	int rc = 0;
 	for (int a = first; a < argc; a++) {
 		size_t len;
@@ -105,6 +110,7 @@ int main(int argc, char **argv)
 			double *r = t + (size_t)i * S_COUNT;
 			r[S_PARSE] = t1 - t0; r[S_UPLOAD] = tm.upload_ms; r[S_SHADOW] = tm.shadow_ms; r[S_MAIN] = tm.main_ms;
 			r[S_READBACK] = tm.readback_ms; r[S_ENCODE] = t3 - t2; r[S_TOTAL] = t3 - t0;
+			r[S_VIS] = tm.visibility_ms;
 			(void)t2;
 		}
 		if (rc == 0) {
@@ -116,11 +122,11 @@ int main(int argc, char **argv)
 				int m = n < 1024 ? n : 1024;
 				for (int i = 0; i < m; i++) v[i] = t[(size_t)i * S_COUNT + s];
 				col[s] = median(v, m);
-				printf(" %8.2f", col[s]);
+				if (s <= S_TOTAL) printf(" %8.2f", col[s]);
 			}
-			printf(" %8.1f %8zu %4u/%-4u %6.2f %8.1f %3u\n", 1000.0 / col[S_TOTAL], bytes_out / 1024,
+			printf(" %8.1f %8zu %4u/%-4u %6.2f %8.1f %3u %3u %7.2f\n", 1000.0 / col[S_TOTAL], bytes_out / 1024,
 			       last.shadow_maps_rendered, last.shadow_maps_reused, (double)last.shadow_texels / 1e6, (double)last.camera_triangles / 1e3,
-			       last.visibility_views);
+			       last.visibility_views, last.pixel_shaded_views, col[S_VIS]);
 		}
 		free(t);
 		free(json);

@@ -6,7 +6,8 @@ shared machine, so every row divides two numbers from the same run.
 
 Logs (any may be missing; its rows then say "not run"):
   floor.txt   build/floor/limits --steps c, in rounds between umbra's (and the older build's) rows
-  warm.txt    build/tests/bench: thumb-256, thumb-512 (rounds), studio-spots, studio-16lights,
+  warm.txt    build/tests/bench: thumb-256, thumb-512, thumb256-colour-100k/10k (rounds; the last two
+              with -s, a new model's sun map every run), studio-spots, studio-16lights,
               model-1m-path, model-1m
   cold.txt    lines "run i: png X ms, exr+aov Y ms"
   http-ratio.txt  tests/bench/http_bench.sh: thumb-256 at concurrency 4, 600 requests, and the
@@ -89,6 +90,12 @@ print("floor step c: MSAA 4 %s, MSAA 1 %s" % (ms(fl4) if fl4 else "not run", ms(
 print("%-42s %14s %20s %7s %7s %s" % ("target", "umbra", "compared with", "ratio", "goal", "met"))
 row("thumb-512 / floor c MSAA 4", t512, ms, fl4, lambda v: "floor " + ms(v), 1.0, "le")
 row("thumb-256 / floor c MSAA 4", t256, ms, fl4, lambda v: "floor " + ms(v), 0.5, "le")
+# Issue 28: a new model's 256² thumbnail (its shadow map drawn every run), 100k triangles with
+# vertex colours (no level of detail applies), against the floor's whole step c.
+row("new 100k model, full detail, 256² / floor c", warm_total("thumb256-colour-100k.json"), ms, fl4,
+    lambda v: "floor " + ms(v), 1.0, "le")
+row("new 10k model, 256² / floor c", warm_total("thumb256-colour-10k.json"), ms, fl4, lambda v: "floor " + ms(v),
+    None, "le")
 row("studio-spots / thumb-512", warm_total("studio-spots.json"), ms, t512, lambda v: "thumb-512 " + ms(v), 2.5, "le")
 row("16 shadowed lights / thumb-512", warm_total("studio-16lights.json"), ms, t512, lambda v: "thumb-512 " + ms(v),
     4.0, "le")

@@ -92,3 +92,40 @@ save("studio-turntable16.json", d)
 d = copy.deepcopy(studio)
 d["width"], d["height"] = 256, 256
 save("studio-single256.json", d)
+
+# A new model's thumbnail (issue 28): a bumpy closed sphere of ~100k triangles with a colour
+# per vertex as a binary PLY (vertex-coloured meshes get no level of detail: drawn in full),
+# and a 10k one, under the thumbnail preset at 256². build/tests/bench -s draws the sun map
+# every run, as for a model never seen before.
+def bumpy_ply(tris):
+    nu = max(8, int(math.sqrt(tris)))
+    nv = max(4, tris // (2 * nu) + 1)
+    verts, faces = bytearray(), bytearray()
+    for j in range(nv + 1):
+        th = math.pi * j / nv
+        for i in range(nu):
+            ph = 2 * math.pi * i / nu
+            x, y, z = math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph)
+            r = 1 + 0.08 * math.sin(7 * x + 3 * y) * math.cos(5 * z - 2 * y) + 0.03 * math.sin(23 * y + 11 * x)
+            c = (int(127 + 120 * math.sin(3 * y)), int(127 + 120 * math.sin(4 * x + 1)), int(127 + 120 * math.cos(5 * z)))
+            verts += struct.pack("<3f3B", r * x, r * y + 1.0, r * z, *c)
+    count = 0
+    for j in range(nv):
+        for i in range(nu):
+            a, b = j * nu + i, j * nu + (i + 1) % nu
+            c, d = a + nu, b + nu
+            if j > 0:
+                faces += struct.pack("<B3I", 3, a, b, c); count += 1
+            if j < nv - 1:
+                faces += struct.pack("<B3I", 3, b, d, c); count += 1
+    head = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+            "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+            "element face %d\nproperty list uchar uint vertex_indices\nend_header\n" % ((nv + 1) * nu, count))
+    return head.encode() + bytes(verts) + bytes(faces)
+
+for n, label in ((10000, "10k"), (100000, "100k")):
+    with open(os.path.join(out, "colour-%s.ply" % label), "wb") as f:
+        f.write(bumpy_ply(n))
+    save("thumb256-colour-%s.json" % label,
+         {"preset": "thumbnail", "width": 256, "height": 256,
+          "objects": [{"shape": "model", "path": "colour-%s.ply" % label}]})

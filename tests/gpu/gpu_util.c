@@ -265,3 +265,34 @@ long gpu_bytes_differ(const struct rnd_image *a, const struct rnd_image *b, size
 		if (pa[i] != pb[i] && !diff++ && first) *first = i;
 	return diff;
 }
+
+int gpu_px_diff(const struct rnd_image *a, int i, int j, const struct rnd_image *b, int k, int l)
+{
+	const uint8_t *pa = gpu_px8(a, i, j), *pb = gpu_px8(b, k, l);
+	int d = 0;
+	for (int c = 0; c < 4; c++) {
+		int e = abs((int)pa[c] - (int)pb[c]);
+		if (e > d) d = e;
+	}
+	return d;
+}
+
+/* Whether pixel (i, j) of img has a 4-neighbour 12 steps apart. */
+static bool contrast(const struct rnd_image *img, int i, int j)
+{
+	static const int o[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+	for (int k = 0; k < 4; k++) {
+		int x = i + o[k][0], y = j + o[k][1];
+		if (x < 0 || y < 0 || x >= (int)img->width || y >= (int)img->height) continue;
+		if (gpu_px_diff(img, i, j, img, x, y) > 12) return true;
+	}
+	return false;
+}
+
+bool gpu_on_edge(const struct rnd_image *img, int i, int j)
+{
+	for (int y = j - 1; y <= j + 1; y++)
+		for (int x = i - 1; x <= i + 1; x++)
+			if (x >= 0 && y >= 0 && x < (int)img->width && y < (int)img->height && contrast(img, x, y)) return true;
+	return false;
+}

@@ -35,6 +35,14 @@ extern struct rnd_timings gpu_last_timings;
 double gpu_chan(const struct rnd_image *img, int i, int j, int c);
 const uint8_t *gpu_px8(const struct rnd_image *img, int i, int j);
 
+/* Largest channel difference between pixel (i, j) of a and pixel (k, l) of b (RGBA8). */
+int gpu_px_diff(const struct rnd_image *a, int i, int j, const struct rnd_image *b, int k, int l);
+/* Whether pixel (i, j) of img (RGBA8) lies on an edge of the picture: it or a pixel next to it
+ * (8-neighbourhood) has a 4-neighbour 12 steps apart. A silhouette crosses pixels whose own
+ * contrast can be low while the pixel beside them shows it (tessellated spheres over the
+ * floor: a pixel 4 steps off, its neighbour 31 steps from the next). */
+bool gpu_on_edge(const struct rnd_image *img, int i, int j);
+
 double gpu_srgb_encode(double linear);
 double gpu_srgb_decode(double encoded);
 

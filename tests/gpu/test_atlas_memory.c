@@ -3,11 +3,13 @@
  * (umbrad's default) exactly; they must all succeed, rnd_context_trim must give the pages
  * back once they are done (resident memory falls, on a CPU device where device memory is this
  * process's memory), and the same renders after the trim must give the same bytes (the maps are
- * drawn again into the released, now zero, pages). */
+ * drawn again into the released, now zero, pages). And the slots and pipelines trims of a
+ * memory bound, beside a render. */
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "api.h"
 #include "gpu_util.h"
 #include "test.h"
@@ -138,6 +140,64 @@ TEST(atlas_four_cascade_renders_fit_then_pages_go_back)
 	}
 	release_four(first);
 	CHECK(rnd_context_validation_messages(ctx) == 0, "%u validation messages", rnd_context_validation_messages(ctx));
+	api_scene_free(s);
+	rnd_context_destroy(ctx);
+}
+
+/* What a process held to a memory bound gives back between renders (umbrad --max-rss):
+ * the idle slots' targets and the pipeline variants, taken while another thread renders. A
+ * variant that render recorded must outlive it (retired, destroyed once it is over), and every
+ * render must give the bytes of the first: the slots' targets and the variants are made again. */
+struct trimmer {
+	struct rnd_context *ctx;
+	volatile int stop;
+	unsigned trims;
+};
+
+static void *trim_loop(void *arg)
+{
+	struct trimmer *t = arg;
+	while (!t->stop) {
+		rnd_context_trim_pipelines(t->ctx, 0);
+		rnd_context_trim_slots(t->ctx);
+		t->trims++;
+		usleep(500);
+	}
+	return NULL;
+}
+
+TEST(atlas_trims_of_slots_and_pipelines_under_a_render_change_nothing)
+{
+	const char *v = getenv("UMBRA_VALIDATION");
+	struct rnd_context_desc cd = {.slots = 2, .validation = v && strcmp(v, "1") == 0};
+	struct rnd_context *ctx;
+	struct rnd_error err;
+	REQUIRE(rnd_context_create(&cd, &ctx, &err) == RND_OK);
+	struct api_scene *s = gpu_parse(CSM_DOC);
+	if (!s) { rnd_context_destroy(ctx); return; }
+	struct job first = {.ctx = ctx, .scene = &s->scene};
+	render_job(&first);
+	CHECK(first.r == RND_OK, "first render: %s", first.err.msg);
+	struct trimmer t = {.ctx = ctx};
+	pthread_t th;
+	REQUIRE(pthread_create(&th, NULL, trim_loop, &t) == 0);
+	int same = 0;
+	for (int k = 0; k < 4 && first.r == RND_OK; k++) {
+		struct job j = {.ctx = ctx, .scene = &s->scene};
+		render_job(&j);
+		CHECK(j.r == RND_OK, "render %d beside the trims: %s", k, j.err.msg);
+		if (j.r == RND_OK && !memcmp(j.img.pixels, first.img.pixels, first.img.stride * first.img.height)) same++;
+		rnd_image_release(&j.img);
+	}
+	t.stop = 1;
+	pthread_join(th, NULL);
+	struct rnd_stats st;
+	rnd_context_stats(ctx, &st);
+	printf("  %u trims beside 4 renders; %u variants left\n", t.trims, st.pipeline_variants);
+	CHECK(first.r != RND_OK || same == 4, "%d of 4 renders beside the trims gave the first's bytes", same);
+	CHECK(t.trims > 0, "no trim ran");
+	CHECK(rnd_context_validation_messages(ctx) == 0, "%u validation messages", rnd_context_validation_messages(ctx));
+	rnd_image_release(&first.img);
 	api_scene_free(s);
 	rnd_context_destroy(ctx);
 }

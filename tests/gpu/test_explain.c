@@ -12,6 +12,8 @@
 #include "gpu_util.h"
 #include "test.h"
 #include "umbra/rnd_plan.h"
+#include "models.h"
+#include "util.h"
 
 /* A soft sun (PCSS), a hard spot (its map follows the output's size) and a point light's cube over
  * a ground, a box and a sphere (drawn by the camera as a proxy); W x W pixels; the salt moves the
@@ -73,6 +75,9 @@ static void check_counts(const struct rnd_plan_info *in, const struct rnd_timing
 	CHECK(in->camera_triangles == tm->camera_triangles, "camera triangles: plan %llu, recorded %llu",
 	      (unsigned long long)in->camera_triangles, (unsigned long long)tm->camera_triangles);
 	CHECK(in->sphere_proxies == tm->sphere_proxies, "proxies: plan %u, render %u", in->sphere_proxies, tm->sphere_proxies);
+	CHECK(in->visibility_views == tm->visibility_views && in->pixel_shaded_views == tm->pixel_shaded_views,
+	      "visibility pass: plan %u, render %u; pixel shading: plan %u, render %u", in->visibility_views,
+	      tm->visibility_views, in->pixel_shaded_views, tm->pixel_shaded_views);
 }
 
 TEST(explain_plan_counts_are_what_the_render_draws)
@@ -147,16 +152,24 @@ TEST(explain_bigger_output_bigger_hard_light_map)
 }
 
 /* The studio environment's shadow directions are the plan's: each a map the render draws (its
- * counts equal the plan's), the directions below the plane ground only weighed, and the
- * environment pass planned and run. */
+ * counts equal the plan's), the directions below the plane ground only weighed, the
+ * environment pass planned and run, and a dense model under the map shaded once per pixel. */
 TEST(explain_environment_directions_are_planned_and_drawn)
 {
 	if (!gpu_ctx()) return;
-	struct api_scene *s = gpu_parse(
-		"{'width': 96, 'height': 96, 'camera': {'position': [4, 3, 4], 'target': [0, 0.8, 0]},"
-		" 'environment': {'map': {'preset': 'studio', 'rotation': 17}, 'shadow': {'directions': 8}},"
-		" 'objects': [{'shape': 'plane', 'size': [10, 10]},"
-		" {'shape': 'box', 'size': [1, 1, 1], 'transform': {'translation': [0, 0.5, 0.03]}}]}");
+	size_t n = 0;
+	uint8_t *stl = test_bumpy_stl(64, &n);
+	char *b64 = stl ? test_b64(stl, n) : NULL, *doc = b64 ? malloc(strlen(b64) + 1024) : NULL;
+	free(stl);
+	if (!doc) { CHECK(0, "out of memory"); free(b64); return; }
+	sprintf(doc, "{'width': 96, 'height': 96, 'camera': {'position': [4, 3, 4], 'target': [0, 0.8, 0]},"
+	        " 'environment': {'map': {'preset': 'studio', 'rotation': 17}, 'shadow': {'directions': 8}},"
+	        " 'objects': [{'shape': 'plane', 'size': [10, 10]},"
+	        " {'shape': 'box', 'size': [1, 1, 1], 'transform': {'translation': [-1.2, 0.5, 0.03]}},"
+	        " {'shape': 'model', 'format': 'stl', 'data': '%s', 'transform': {'translation': [0.6, 1.2, 0]}}]}", b64);
+	struct api_scene *s = gpu_parse(doc);
+	free(b64);
+	free(doc);
 	if (!s) return;
 	struct rnd_plan_info in;
 	struct rnd_timings tm;
@@ -166,6 +179,9 @@ TEST(explain_environment_directions_are_planned_and_drawn)
 		      in.env_directions, in.env_weighed, in.env_ground);
 		CHECK(tm.env_directions == 8 && in.maps == 8 && in.maps_drawn + in.maps_cached == 8, "render %u directions, %u maps",
 		      tm.env_directions, in.maps);
+		/* dense plain draws lit by the map: shaded once per pixel (the plan's decision, the render's count) */
+		CHECK(in.pixel_shaded_views == 1 && tm.pixel_shaded_views == 1, "pixel shading: plan %u, render %u",
+		      in.pixel_shaded_views, tm.pixel_shaded_views);
 		struct rnd_plan *plan = NULL;
 		struct rnd_error err;
 		if (rnd_plan_create(gpu_ctx(), &s->scene, &plan, &err) == RND_OK) {

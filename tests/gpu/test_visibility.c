@@ -26,46 +26,14 @@
 static bool render_vis(struct rnd_image *img, const char *value, const char *doc, uint32_t *views)
 {
 	if (value) setenv("UMBRA_VISIBILITY", value, 1);
+	/* the pass's shadows as the per-fragment shading reads them: not shaded per pixel
+	 * (renderer/deferred.h, tests/gpu/test_deferred.c) */
+	setenv("UMBRA_PIXEL_SHADING", "0", 1);
 	bool ok = gpu_render(img, "%s", doc);
+	unsetenv("UMBRA_PIXEL_SHADING");
 	unsetenv("UMBRA_VISIBILITY");
 	*views = ok ? gpu_last_timings.visibility_views : 0;
 	return ok;
-}
-
-/* Largest channel difference of pixel (i, j) of a and pixel (k, l) of b (RGBA8). */
-static int px_diff(const struct rnd_image *a, int i, int j, const struct rnd_image *b, int k, int l)
-{
-	const uint8_t *pa = gpu_px8(a, i, j), *pb = gpu_px8(b, k, l);
-	int d = 0;
-	for (int c = 0; c < 4; c++) {
-		int e = abs((int)pa[c] - (int)pb[c]);
-		if (e > d) d = e;
-	}
-	return d;
-}
-
-/* Whether pixel (i, j) of img has a 4-neighbour 12 steps apart. */
-static bool contrast(const struct rnd_image *img, int i, int j)
-{
-	static const int o[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
-	for (int k = 0; k < 4; k++) {
-		int x = i + o[k][0], y = j + o[k][1];
-		if (x < 0 || y < 0 || x >= (int)img->width || y >= (int)img->height) continue;
-		if (px_diff(img, i, j, img, x, y) > 12) return true;
-	}
-	return false;
-}
-
-/* Whether pixel (i, j) of img lies on an edge of the picture: it or a pixel next to it
- * (8-neighbourhood) has a 4-neighbour 12 steps apart. A silhouette crosses pixels whose own
- * contrast can be low while the pixel beside them shows it (tessellated spheres over the
- * floor: a pixel 4 steps off, its neighbour 31 steps from the next). */
-static bool on_edge(const struct rnd_image *img, int i, int j)
-{
-	for (int y = j - 1; y <= j + 1; y++)
-		for (int x = i - 1; x <= i + 1; x++)
-			if (x >= 0 && y >= 0 && x < (int)img->width && y < (int)img->height && contrast(img, x, y)) return true;
-	return false;
 }
 
 /* Pixels of a and b that differ by more than 2 steps: *edge of them on an edge of b, *inner
@@ -76,9 +44,9 @@ static void pixels_differ(const struct rnd_image *a, const struct rnd_image *b, 
 	*worst_inner = 0;
 	for (int j = 0; j < (int)a->height; j++)
 		for (int i = 0; i < (int)a->width; i++) {
-			int d = px_diff(a, i, j, b, i, j);
+			int d = gpu_px_diff(a, i, j, b, i, j);
 			if (d <= 2) continue;
-			if (on_edge(b, i, j)) {
+			if (gpu_on_edge(b, i, j)) {
 				(*edge)++;
 			} else {
 				(*inner)++;

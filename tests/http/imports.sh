@@ -6,7 +6,8 @@
 # imports held both workers: B's render waited for A's first two time-outs and B's model for
 # the last two. The assertions are on the order of the answers, with margins of the import
 # time limit (12 s: a loaded CI machine may take seconds over its first pipelines) over a
-# 64^2 render. Prints "N passed, N failed" last.
+# 64^2 render. Then the overlap of one model's import with another's render (issue 28).
+# Prints "N passed, N failed" last.
 . tests/http/lib.sh
 
 python3 - "$T" <<'PY'
@@ -27,6 +28,13 @@ for i in range(4):
 good = b"v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n"
 json.dump(scene({"shape": "model", "data": b64(good), "format": "obj"}), open(t + "/model.json", "w"))
 json.dump(scene({"shape": "sphere", "radius": 1, "transform": {"translation": [0, 1, 0]}}), open(t + "/plain.json", "w"))
+# A model in a scene that takes seconds to render (2048^2, a soft sun and four soft spots).
+slow = scene({"shape": "model", "data": b64(good), "format": "obj"})
+slow.update({"width": 2048, "height": 2048, "output": {"msaa": 4}})
+slow["lights"] = [{"type": "directional", "direction": [-0.5, -1, -0.3], "angular_diameter": 3}] + [
+    {"type": "spot", "position": [3 * x, 4, 3 * z], "direction": [-3 * x, -4, -3 * z], "radius": 0.2}
+    for x, z in ((1, 1), (-1, 1), (1, -1), (-1, -1))]
+json.dump(slow, open(t + "/slow.json", "w"))
 PY
 
 # send NAME SCENE [CURL ARGS]: in the background; NAME.code, then NAME.done (nanoseconds).
@@ -39,6 +47,8 @@ send() {
 SENT=
 # wait_for FN VALUE: polls /metrics through FN until it says VALUE (at most 60 s).
 imports_running() { curl -s --max-time 5 "$URL/metrics" | awk '$1 == "umbra_imports_running" { print $2 }'; }
+importing_none_parked() { curl -s --max-time 5 "$URL/metrics" | awk '$1 == "umbra_imports_running" { r = $2 } $1 == "umbra_imports_parked" { p = $2 } END { print r "/" p }'; }
+renders_running() { curl -s --max-time 5 "$URL/metrics" | awk '$1 == "umbra_renders_in_flight" { print $2 }'; }
 imports_parked() { curl -s --max-time 5 "$URL/metrics" | awk '$1 == "umbra_imports_parked" { print $2 }'; }
 wait_for() {
 	i=0
@@ -66,5 +76,22 @@ if start imp --workers 2 --import-slots 2 --import-timeout-ms 12000; then
 	done
 	check "no import runs or waits afterwards" sh -c "[ \"\$(curl -s '$URL/metrics' | awk '\$1 == \"umbra_imports_running\" || \$1 == \"umbra_imports_parked\" { s += \$2 } END { print s }')\" = 0 ]"
 	stop imp "$PID"
+fi
+
+# Overlap (issue 28): one import slot, and an import thread whose import is done gives the slot
+# back before it renders. A model in a slow render, then a model whose import hangs: the second
+# import runs while the first model renders. Before, the one import thread imported and rendered,
+# and the second model waited, parked, until the first was answered.
+if start ovl --workers 2 --import-slots 1 --import-timeout-ms 5000; then
+	SENT=
+	send s-model slow
+	check "the slow model renders" wait_for renders_running 1
+	send h-model hang0
+	check "the next model's import runs, none parked" wait_for importing_none_parked 1/0
+	check "... while the first model is still rendering" [ ! -f "$T/s-model.done" ]
+	wait $SENT
+	check "the slow model: 200" [ "$(cat "$T/s-model.code")" = 200 ]
+	check "the hanging import: 422" [ "$(cat "$T/h-model.code")" = 422 ]
+	stop ovl "$PID"
 fi
 finish

@@ -124,4 +124,25 @@ check "a 57-byte PNG claiming 8192² texels under --max-memory 256M: 422 at its 
 get metrics /metrics >/dev/null
 check "... refused before any decode started" [ "$(metric 'umbra_import_jobs_started_total{job="image"}')" = "$jobs0" ]
 stop budget "$PID"
+
+# ---- the resident-memory bound (--max-rss): past it, what the daemon keeps goes after each
+# answer (maps, atlas pages, slot targets, pipeline variants but four, cached models), and the
+# next renders make it again: the same bytes ----
+start rss --max-rss 1 --workers 2 || { finish; exit 1; }
+gen image 128 128 >"$T/rss.json"
+code1=$(post rss1 "$T/rss.json"); code2=$(post rss2 "$T/rss.json"); code3=$(post rss3 "$T/rss.json")
+check "--max-rss 1: three renders of one scene, 200 and the same bytes each time" \
+	eval '[ "$code1 $code2 $code3" = "200 200 200" ] && cmp -s "$T/rss1.body" "$T/rss2.body" && cmp -s "$T/rss1.body" "$T/rss3.body"'
+# the trim follows the answer: wait for the third
+i=0
+while get metrics /metrics >/dev/null && [ "$(metric umbra_rss_trims_total)" != 3 ] && [ $i -lt 100 ]; do
+	sleep 0.1; i=$((i + 1))
+done
+check "... umbra_rss_trims_total counts a trim after each (3), umbra_rss_limit_bytes says 1" \
+	eval '[ "$(metric umbra_rss_trims_total)" = 3 ] && [ "$(metric umbra_rss_limit_bytes)" = 1 ]'
+check "... and the pipeline variants but four went" eval '[ "$(metric umbra_pipeline_variants)" -le 4 ]'
+code=$(get rssinfo /v1/info)
+check "/v1/info: limits.max_rss 1 and the resident memory now (rss)" \
+	python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(not (d["limits"]["max_rss"] == 1 and d["rss"] > 1 << 20))' "$T/rssinfo.body"
+stop rss "$PID"
 finish

@@ -105,7 +105,7 @@ TEST(info_document_is_json)
 {
 	struct api_info in = {.version = "v\"1", .device = "lavapipe", .driver = "llvmpipe", .driver_info = "x",
 	                      .vulkan_api = (1u << 22) | (3u << 12) | 238u, .cpu = true, .max_body = 67108864,
-	                      .max_dimension = 8192, .workers = 2};
+	                      .max_dimension = 8192, .workers = 2, .max_rss = 201326592, .rss = 150000000};
 	api_limits_defaults(&in.limits);
 	size_t len = 0;
 	char *s = api_info_json(&in, &len);
@@ -114,7 +114,8 @@ TEST(info_document_is_json)
 	CHECK(!strncmp(s, "{\"name\":\"umbrad\",\"version\":\"v\\\"1\",\"contract\":\"scene-v1\"", 52), "got %s", s);
 	CHECK(strstr(s, "\"vulkan_api\":\"1.3.238\",\"cpu\":true") != NULL, "got %s", s);
 	CHECK(strstr(s, "\"max_body\":67108864") != NULL && strstr(s, "\"max_dimension\":8192") != NULL);
-	CHECK(strstr(s, "\"priorities\":[\"interactive\",\"bulk\"]}") != NULL, "got %s", s);
+	CHECK(strstr(s, "\"priorities\":[\"interactive\",\"bulk\"],\"rss\":150000000}") != NULL, "got %s", s);
+	CHECK(strstr(s, "\"max_rss\":201326592") != NULL, "got %s", s);
 	free(s);
 }
 

@@ -463,11 +463,13 @@ struct rnd_timings {
 	double plan_ms;       /* the render plan (rnd_plan_create): every decision, made once */
 	double upload_ms;     /* tessellation + copy to the GPU */
 	double shadow_ms;     /* shadow passes (GPU) */
-	double main_ms;       /* main pass + resolve (GPU) */
+	double main_ms;       /* main pass + resolve (GPU), the visibility pass's included */
+	double visibility_ms; /* of main_ms: the visibility pass (renderer/visibility.c: surfaces, shadows per pixel) */
 	double readback_ms;   /* copy back to host memory */
 	uint32_t shadow_maps_rendered, shadow_maps_reused;
 	uint64_t shadow_texels;     /* texels of the shadow maps drawn (each map res x res) */
 	uint32_t visibility_views; /* views whose shadows came from the visibility pass (once per pixel) */
+	uint32_t pixel_shaded_views; /* of those, views shaded once per pixel centre (renderer/deferred.h) */
 	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
 	uint64_t shadow_triangles; /* casters' triangles the shadow maps drew */
@@ -556,6 +558,7 @@ struct rnd_stats {
 	uint32_t cached_maps;            /* shadow maps kept for reuse (spot, point, a sun's fit map) */
 	uint64_t shadow_cache_hits;      /* lights whose shadow passes were skipped */
 	uint64_t shadow_cache_misses;
+	uint32_t pipeline_variants;      /* main-pass pipeline variants compiled and kept */
 	uint32_t env_maps;               /* environment maps kept prefiltered (the studio included) */
 	uint64_t env_builds;             /* environment maps prefiltered since create (once per map kept) */
 };
@@ -565,6 +568,16 @@ void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
  * memory (lavapipe), so the atlases are resident only while tiles use them. Does nothing while
  * a render holds tiles. Returns the bytes released (0 when nothing was). Any thread. */
 uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s);
+/* What a context keeps between renders beyond rnd_context_trim()'s, for a process held to a
+ * memory bound (umbrad --max-rss): the targets and buffers of the render slots no render holds
+ * now (the next render there makes them again), and the main-pass pipeline variants but the
+ * `keep` most recently used (a variant is compiled again at its next use: lavapipe keeps ~14 MB
+ * of JIT code and state per variant, 0.1-0.4 s to make). A variant a running render may have
+ * recorded is destroyed only once that render is over. Any thread. trim_pipelines returns the
+ * variants taken out. */
+void rnd_context_trim_slots(struct rnd_context *ctx);
+uint32_t rnd_context_trim_pipelines(struct rnd_context *ctx, uint32_t keep);
+
 /* Writes the pipeline cache to desc.pipeline_cache_path (atomic rename). */
 enum rnd_result rnd_context_save_cache(struct rnd_context *ctx, struct rnd_error *err);
 

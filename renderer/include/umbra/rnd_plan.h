@@ -31,6 +31,8 @@ struct rnd_plan_info {
 	uint64_t shadow_triangles;          /* casters' triangles the maps drawn draw */
 	uint64_t camera_triangles;          /* what the cameras draw, each view counted */
 	uint32_t sphere_proxies;            /* spheres the camera draws as a proxy (renderer/proxy.h) */
+	uint32_t visibility_views;          /* views whose shadows come from the visibility pass */
+	uint32_t pixel_shaded_views;        /* views shaded once per pixel centre (deferred.h) */
 	uint64_t vertices, indices;         /* the geometry the render writes */
 	/* The environment map's shadows (env_analysis.h): the directions drawn as shadow maps (each a
 	 * directional light after the scene's: struct rnd_plan_map_info.environment), and those a
@@ -83,6 +85,8 @@ struct rnd_plan_view_info {
 	uint64_t texels_drawn, shadow_triangles, camera_triangles;
 	bool contact;                       /* a depth pass for contact shadows */
 	bool env_pass;                      /* the environment's shadows from their pass (env_pass.h) */
+	bool pixel_shading;                 /* shaded once per pixel centre (deferred.h) */
+	const char *pixel_shading_why;
 	bool visibility;                    /* shadows from the visibility pass */
 	const char *visibility_why;
 	double shadow_estimate_ms, row_ms, band_ms, main_estimate_ms;
