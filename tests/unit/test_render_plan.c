@@ -37,6 +37,15 @@ static bool cache_holds(void *user, uint64_t key, uint32_t tiles, uint32_t res)
 	return key == cached_key;
 }
 
+/* What most tests plan: thumb_scene (sc, obj, sun) at size x size on lavapipe's figures (dev). */
+#define THUMB_PLAN(size)                       \
+	struct rnd_scene sc;                   \
+	struct rnd_object obj[2];              \
+	struct rnd_light sun;                  \
+	thumb_scene(&sc, obj, &sun, (size));   \
+	struct rnd_plan_device dev;            \
+	device(&dev)
+
 /* Shadow views view v draws (not skipped). */
 static uint32_t drawn(const struct rnd_plan *p, uint32_t v)
 {
@@ -47,12 +56,7 @@ static uint32_t drawn(const struct rnd_plan *p, uint32_t v)
 
 TEST(render_plan_of_a_thumbnail)
 {
-	struct rnd_scene sc;
-	struct rnd_object obj[2];
-	struct rnd_light sun;
-	thumb_scene(&sc, obj, &sun, 256);
-	struct rnd_plan_device dev;
-	device(&dev);
+	THUMB_PLAN(256);
 	struct rnd_plan p;
 	struct rnd_error err = {0};
 	REQUIRE(rnd_plan_build(&sc, &dev, &p, &err) == RND_OK, "%s", err.msg);
@@ -116,12 +120,7 @@ TEST(render_plan_bigger_output_bigger_hard_light_maps)
  * depth bounds that let PCSS skip its search. */
 TEST(render_plan_soft_light_gets_pcss)
 {
-	struct rnd_scene sc;
-	struct rnd_object obj[2];
-	struct rnd_light sun;
-	thumb_scene(&sc, obj, &sun, 256);
-	struct rnd_plan_device dev;
-	device(&dev);
+	THUMB_PLAN(256);
 	struct rnd_plan hard, soft;
 	struct rnd_error err = {0};
 	REQUIRE(rnd_plan_build(&sc, &dev, &hard, &err) == RND_OK, "%s", err.msg);
@@ -139,12 +138,7 @@ TEST(render_plan_soft_light_gets_pcss)
 /* A map the cache holds is planned as not drawn; one it does not hold is drawn. */
 TEST(render_plan_cached_map_is_not_drawn)
 {
-	struct rnd_scene sc;
-	struct rnd_object obj[2];
-	struct rnd_light sun;
-	thumb_scene(&sc, obj, &sun, 256);
-	struct rnd_plan_device dev;
-	device(&dev);
+	THUMB_PLAN(256);
 	dev.cached = cache_holds;
 	struct rnd_plan first, again;
 	struct rnd_error err = {0};
@@ -205,12 +199,7 @@ TEST(render_plan_views_draw_fixed_maps_once)
 /* The errors the render would fail with, from the plan: the same codes and members. */
 TEST(render_plan_fails_as_the_render_would)
 {
-	struct rnd_scene sc;
-	struct rnd_object obj[2];
-	struct rnd_light sun;
-	thumb_scene(&sc, obj, &sun, 256);
-	struct rnd_plan_device dev;
-	device(&dev);
+	THUMB_PLAN(256);
 	struct rnd_plan p;
 	struct rnd_error err = {0};
 	sun.direction[0] = sun.direction[1] = sun.direction[2] = 0;
