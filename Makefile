@@ -17,11 +17,13 @@
 BUILD ?= build
 SHARED ?= ../shared
 CC ?= cc
+# C++ for api/draco.cpp alone (libdraco has no C API) and its test encoder (tests/util/).
+CXX ?= c++
 GLSLANG ?= glslangValidator
 # The packages of each module (server -> api -> renderer): each compiles with its own packages'
 # cflags only; everything links with all of them.
 PKGS_RENDERER := vulkan
-PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp libavif libdeflate
+PKGS_API := jansson libpng OpenEXR zlib assimp libjpeg libseccomp libwebp libavif libdeflate draco
 PKGS_SERVER := libmicrohttpd
 PKGS := $(PKGS_RENDERER) $(PKGS_API) $(PKGS_SERVER)
 
@@ -30,6 +32,10 @@ SAN ?=
 CFLAGS ?= $(OPT) -g
 CFLAGS += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror -Wno-missing-field-initializers \
           -fno-strict-aliasing -pthread -MMD -MP $(SAN)
+# The C++ shim: the same warnings; no vptr check (clang's C link has no C++ UBSan runtime).
+CXXFLAGS ?= $(OPT) -g
+CXXFLAGS += -std=c++17 -Wall -Wextra -Werror -fno-strict-aliasing -pthread -MMD -MP $(SAN) \
+            $(if $(SAN),-fno-sanitize=vptr)
 LDFLAGS += -pthread $(SAN)
 # Each module sees only the headers it may use (server -> api -> renderer -> shaders): an
 # include across the layering is a compile error, not a review comment. Tests see everything.
@@ -56,24 +62,27 @@ ifeq ($(UMBRA_VERSION),)
 UMBRA_VERSION := $(shell git describe --always --dirty 2>/dev/null || cat VERSION 2>/dev/null || echo unknown)
 endif
 CFLAGS += -DUMBRA_VERSION=\"$(UMBRA_VERSION)\"
-# meshoptimizer (api/model_lod.c) ships no pkg-config file in Debian 12.
-LIBS := $(PKG_LIBS) -lmeshoptimizer -lm
+# meshoptimizer (api/model_lod.c) ships no pkg-config file in Debian 12; libstdc++ for the
+# Draco shim (api/draco.cpp), linked by the C driver.
+LIBS := $(PKG_LIBS) -lmeshoptimizer -lstdc++ -lm
 
 RND_SRC := $(wildcard renderer/*.c)
 API_SRC := $(wildcard api/*.c)
+API_CXX_SRC := $(wildcard api/*.cpp)
 FARM_SRC := server/cli.c server/farm.c server/farm_remote.c server/farm_report.c server/http_client.c
 SRV_SRC := $(filter-out $(FARM_SRC),$(wildcard server/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 GPU_SRC := $(wildcard tests/gpu/*.c)
 # tests/util/: the harness (test.h, test_main.c) and helpers both test binaries share.
 UTIL_SRC := $(wildcard tests/util/*.c)
+UTIL_CXX_SRC := $(wildcard tests/util/*.cpp)
 SHADERS := $(wildcard shaders/*.vert shaders/*.frag shaders/*.comp)
 SHADER_HDRS := $(patsubst shaders/%,$(BUILD)/shaders/%.spv.h,$(SHADERS))
 
 RND_OBJ := $(RND_SRC:%.c=$(BUILD)/obj/%.o)
-API_OBJ := $(API_SRC:%.c=$(BUILD)/obj/%.o)
+API_OBJ := $(API_SRC:%.c=$(BUILD)/obj/%.o) $(API_CXX_SRC:%.cpp=$(BUILD)/obj/%.o)
 SRV_OBJ := $(SRV_SRC:%.c=$(BUILD)/obj/%.o)
-UTIL_OBJ := $(UTIL_SRC:%.c=$(BUILD)/obj/%.o)
+UTIL_OBJ := $(UTIL_SRC:%.c=$(BUILD)/obj/%.o) $(UTIL_CXX_SRC:%.cpp=$(BUILD)/obj/%.o)
 UNIT_OBJ := $(UNIT_SRC:%.c=$(BUILD)/obj/%.o) $(UTIL_OBJ)
 GPU_OBJ := $(GPU_SRC:%.c=$(BUILD)/obj/%.o) $(UTIL_OBJ)
 
@@ -107,6 +116,9 @@ $(BUILD)/shaders:
 $(BUILD)/obj/%.o: %.c | pkg-check
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(INC) -c -o $@ $<
+$(BUILD)/obj/%.o: %.cpp | pkg-check
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) $(INC) -c -o $@ $<
 $(BUILD)/obj/renderer/%.o: INC := $(INC_RENDERER)
 $(BUILD)/obj/api/%.o: INC := $(INC_API)
 $(BUILD)/obj/server/%.o: INC := $(INC_SERVER)
@@ -244,7 +256,7 @@ FUZZ_SRC := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_SAN := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_RUNS ?= 1000000
 fuzz: deps
-	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang OPT=-O1 SAN="$(FUZZ_SAN)" fuzz-targets
+	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang CXX=clang++ OPT=-O1 SAN="$(FUZZ_SAN)" fuzz-targets
 
 fuzz-long: fuzz
 	@FUZZ_BUILD=$(FUZZ_BUILD) sh tests/fuzz/long.sh $(FUZZ_RUNS)

@@ -142,6 +142,7 @@ struct api_scene {
 	/* private: the arena that owns the arrays, and the imported models the scene points into */
 	void *arena_;
 	void *models_;
+	void *env_map_;                 /* the environment map the scene points into (api/env_map.h) */
 	const uint32_t *object_source_; /* document object index of each scene.objects[i] (NULL: i) */
 	const char *views_key_;         /* "views" / "turntable" / NULL */
 	unsigned png_only_;             /* output members given that only a PNG answer uses (scene_views.c) */

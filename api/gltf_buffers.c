@@ -38,6 +38,46 @@ void api_gltf_bufs_release(struct api_gltf_bufs *b)
 	memset(b, 0, sizeof *b);
 }
 
+const char *api_gltf_json_of(const uint8_t *d, size_t len, bool glb, const char **json, size_t *jlen)
+{
+	*json = (const char *)d;
+	*jlen = len;
+	if (!glb) return NULL;
+	if (len < 20 || memcmp(d + 16, "JSON", 4)) return "the glb has no JSON chunk";
+	uint32_t n = le32(d + 12);
+	if (n > len - 20) return "the glb's JSON chunk is longer than the file";
+	*json = (const char *)d + 20;
+	*jlen = n;
+	return NULL;
+}
+
+uint8_t *api_gltf_with_json(const uint8_t *d, size_t len, bool glb, const char *js, size_t jn, size_t *out_len)
+{
+	uint8_t *out = NULL;
+	if (!glb) {
+		if ((out = malloc(jn ? jn : 1))) memcpy(out, js, jn);
+		*out_len = jn;
+		return out;
+	}
+	/* header, the new JSON chunk, then the original chunks after the JSON one */
+	size_t jpad = (jn + 3) & ~(size_t)3;
+	size_t rest_at = len >= 20 ? 20 + (size_t)le32(d + 12) : len, rest = rest_at <= len ? len - rest_at : 0;
+	size_t total = 20 + jpad + rest;
+	if (total > UINT32_MAX || !(out = malloc(total))) return NULL;
+	memcpy(out, d, 12);
+	uint32_t t32 = (uint32_t)total, j32 = (uint32_t)jpad;
+	for (int k = 0; k < 4; k++) {
+		out[8 + k] = (uint8_t)(t32 >> (8 * k));
+		out[12 + k] = (uint8_t)(j32 >> (8 * k));
+	}
+	memcpy(out + 16, "JSON", 4);
+	memcpy(out + 20, js, jn);
+	memset(out + 20 + jn, ' ', jpad - jn);
+	memcpy(out + 20 + jpad, d + rest_at, rest);
+	*out_len = total;
+	return out;
+}
+
 /* A glb's BIN chunk: the chunk after the JSON one, if its type is BIN. */
 static void glb_bin(const uint8_t *d, size_t len, struct api_gltf_bytes *out)
 {
@@ -113,7 +153,7 @@ int api_gltf_view_bytes(struct api_gltf_bufs *b, json_t *view, const char *what,
 	return 0;
 }
 
-static int type_comps(const char *t)
+int api_gltf_type_components(const char *t)
 {
 	static const char *const NAMES[] = {"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"};
 	static const int COMPS[] = {1, 2, 3, 4, 4, 9, 16};
@@ -122,7 +162,7 @@ static int type_comps(const char *t)
 	return 0;
 }
 
-static size_t comp_size(json_int_t ct)
+size_t api_gltf_component_size(json_int_t ct)
 {
 	return ct == 5126 || ct == 5125 ? 4 : ct == 5120 || ct == 5121 ? 1 : ct == 5122 || ct == 5123 ? 2 : 0;
 }
@@ -145,8 +185,8 @@ int api_gltf_accessor_floats(struct api_gltf_bufs *b, json_t *acc, const char *w
 	*out = NULL;
 	json_int_t ct = json_integer_value(json_object_get(acc, "componentType"));
 	json_int_t n = json_integer_value(json_object_get(acc, "count"));
-	int nc = type_comps(json_string_value(json_object_get(acc, "type")));
-	size_t cs = comp_size(ct);
+	int nc = api_gltf_type_components(json_string_value(json_object_get(acc, "type")));
+	size_t cs = api_gltf_component_size(ct);
 	if (!nc || !cs || n < 1 || n > (1 << 28))
 		return api_err_set(err, errsize, "%s: an accessor of an unknown type or count", what), -1;
 	json_t *views = json_object_get(b->root, "bufferViews"), *vi = json_object_get(acc, "bufferView");
@@ -182,7 +222,7 @@ long api_gltf_made_bytes(struct api_gltf_bufs *b, const void *bytes, size_t n)
 		size_t cap = b->made_cap ? b->made_cap : 4096;
 		while (cap < at + n) cap *= 2;
 		uint8_t *m = realloc(b->made, cap);
-		if (!m) return -1;
+		if (!m) return b->oom = true, -1;
 		memset(m + b->made_cap, 0, cap - b->made_cap);
 		b->made = m;
 		b->made_cap = cap;

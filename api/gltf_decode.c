@@ -1,6 +1,6 @@
 /*
  * api/gltf_decode — meshopt-compressed views and quantized attributes made readable (see the
- * header).
+ * header; Draco: api/gltf_draco.c).
  */
 #include <math.h>
 #include <stdio.h>
@@ -169,30 +169,17 @@ static long dequantize(struct api_gltf_bufs *b, char *err, size_t errsize)
 	return made;
 }
 
-static bool requires(json_t *root, const char *name)
-{
-	json_t *list = json_object_get(root, "extensionsRequired"), *e;
-	size_t i;
-	json_array_foreach(list, i, e)
-		if (json_is_string(e) && !strcmp(json_string_value(e), name)) return true;
-	return false;
-}
-
 int api_gltf_decode(struct api_gltf_bufs *b, char *err, size_t errsize)
 {
-	/* Without its uncompressed fallback (extensionsRequired) a Draco mesh has no data to draw. */
-	if (requires(b->root, "KHR_draco_mesh_compression"))
-		return api_err_set(err, errsize, "the glTF's meshes are Draco-compressed (KHR_draco_mesh_compression), which "
-		                   "umbra does not decode: convert the file, e.g. gltfpack -i in.glb -o out.glb -cc (meshopt "
-		                   "compression, which umbra reads)"), -1;
 	long a = decode_meshopt(b, err, errsize);
-	long q = a < 0 ? -1 : dequantize(b, err, errsize);
-	if (a < 0 || q < 0) return -1;
+	long d = a < 0 ? -1 : api_gltf_decode_draco(b, err, errsize);
+	long q = d < 0 ? -1 : dequantize(b, err, errsize);
+	if (q < 0) return -1;
 	api_gltf_drop_extension_name(b->root, "extensionsUsed", MESHOPT);
 	api_gltf_drop_extension_name(b->root, "extensionsRequired", MESHOPT);
 	api_gltf_drop_extension_name(b->root, "extensionsUsed", QUANT);
 	api_gltf_drop_extension_name(b->root, "extensionsRequired", QUANT);
-	return a + q > 0;
+	return a + d + q > 0;
 }
 
 void api_gltf_drop_fallbacks(json_t *root)

@@ -5,14 +5,19 @@
  *     (ATTRIBUTES, TRIANGLES, INDICES; filters OCTAHEDRAL, QUATERNION, EXPONENTIAL) into the
  *     made buffer (api/gltf_buffers.h), the view pointed at it; the fallback buffers the
  *     extension leaves without data are then dropped (api_gltf_drop_fallbacks);
+ *   - KHR_draco_mesh_compression (api/gltf_draco.c): every compressed primitive decoded with
+ *     libdraco (api/draco.h), its indices (as UNSIGNED_INT) and the attributes the extension
+ *     names written in their accessors' types into the made buffer, the accessors pointed
+ *     there, the extension removed from the primitive (Assimp 5.2's own Draco path drops
+ *     UNSIGNED_INT indices, and reads a JOINTS_0 the skins pass removed);
  *   - KHR_mesh_quantization, and any vertex attribute stored as integers (glTF core allows
- *     normalized TEXCOORD_n and COLOR_n): the accessor rewritten as floats (Assimp 5.2 read a
- *     quantized POSITION as garbage, "triangles have no area").
- * Both extensions are then removed from extensionsUsed / extensionsRequired. A file that
- * requires KHR_draco_mesh_compression is refused with what to do (Draco is not decoded).
+ *     normalized TEXCOORD_n and COLOR_n; Draco's decoded ones too): the accessor rewritten as
+ *     floats (Assimp 5.2 read a quantized POSITION as garbage, "triangles have no area").
+ * The extensions are then removed from extensionsUsed / extensionsRequired.
  *
- * Usage: n = api_gltf_decode(&bufs, err, errsize): n < 0 refused (err says why), n > 0 the
- * document changed. After api_gltf_bufs_finish: api_gltf_drop_fallbacks(root).
+ * Usage: n = api_gltf_decode(&bufs, err, errsize): n < 0 refused (err says why; bufs.oom when
+ * an allocation failed), n > 0 the document changed. After api_gltf_bufs_finish:
+ * api_gltf_drop_fallbacks(root).
  * Threading: no shared state.
  */
 #ifndef UMBRA_API_GLTF_DECODE_H
@@ -27,6 +32,8 @@
 #define API_GLTF_MAX_DECODED_VIEW ((size_t)1 << 30)
 
 int api_gltf_decode(struct api_gltf_bufs *b, char *err, size_t errsize);
+/* The Draco part of api_gltf_decode: the primitives decoded (0: none), or -1 with err. */
+long api_gltf_decode_draco(struct api_gltf_bufs *b, char *err, size_t errsize);
 /* Removes the buffers no bufferView names any more and that have no uri (meshopt's
  * fallbacks), renumbering the views' buffer indices. */
 void api_gltf_drop_fallbacks(json_t *root);

@@ -6,7 +6,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "gltf_buffers.h"
 #include "gltf_material.h"
+#include "gltf_variants.h"
 
 /* glTF sampler enums (OpenGL's) */
 #define GL_NEAREST 9728
@@ -20,13 +22,13 @@
 static const char *const SLOT_NAMES[RND_TEX_SLOTS] = {
 	"baseColorTexture", "metallicRoughnessTexture", "normalTexture", "occlusionTexture", "emissiveTexture",
 	"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture", "sheenColorTexture",
-	"sheenRoughnessTexture", "specularTexture", "specularColorTexture"};
+	"sheenRoughnessTexture", "specularTexture", "specularColorTexture", "transmissionTexture"};
 static const char *const SUPPORTED_EXT[] = {"KHR_materials_emissive_strength", "KHR_texture_transform",
                                              "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
                                              "KHR_materials_clearcoat", "KHR_materials_sheen",
                                              "KHR_materials_specular", "KHR_materials_ior",
                                              "EXT_mesh_gpu_instancing", "EXT_meshopt_compression",
-                                             "KHR_mesh_quantization", NULL};
+                                             "KHR_mesh_quantization", "KHR_draco_mesh_compression", NULL};
 /* Extensions known and not drawn (or drawn in part): what the picture lacks. */
 static const char *const LACKS[][2] = {
 	{"KHR_materials_transmission", "transmission drawn as see-through coverage (dithered), not refraction"},
@@ -34,11 +36,9 @@ static const char *const LACKS[][2] = {
 	                         "thicknessFactor x its texture's mean), no refraction"},
 	{"KHR_materials_iridescence", "iridescence not drawn"},
 	{"KHR_materials_anisotropy", "anisotropy not drawn (isotropic highlights)"},
-	{"KHR_materials_variants", "variants: the default materials drawn"},
 	{"KHR_texture_basisu", "KTX2/Basis textures not decoded: those materials drawn without their textures"},
 	{"EXT_texture_webp", "WebP textures not decoded: those materials drawn without their textures (or with a PNG/JPEG fallback)"},
 	{"KHR_lights_punctual", "the file's lights not used (the scene's lights are)"},
-	{"KHR_draco_mesh_compression", "Draco meshes not decoded: the uncompressed fallback drawn"},
 	{NULL, NULL},
 };
 
@@ -134,29 +134,6 @@ void api_gltf_read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, 
 	if (slot == RND_TEX_OCCLUSION) gm->occlusion_strength = fminf(fmaxf(num(info, "strength", 1), 0), 1);
 }
 
-/* The specular-glossiness model has no exact metallic-roughness equal; what is kept is what
- * shows most in a picture (the diffuse colour and how glossy), what is not is warned. */
-static void read_spec_gloss(struct api_gltf_info *gi, uint32_t mi, const char *mname, json_t *sg,
-                            struct api_gltf_material *gm)
-{
-	gm->spec_gloss = true;
-	json_t *d = json_object_get(sg, "diffuseFactor"), *sp = json_object_get(sg, "specularFactor");
-	for (int k = 0; k < 4; k++) {
-		json_t *e = json_array_get(d, (size_t)k);
-		double x = json_is_number(e) ? json_number_value(e) : 1;
-		gm->diffuse[k] = isfinite(x) ? fminf(fmaxf((float)x, 0), 1) : 1;
-	}
-	gm->glossiness = fminf(fmaxf(num(sg, "glossinessFactor", 1), 0), 1);
-	bool white = true;
-	for (int k = 0; k < 3; k++) {
-		json_t *e = json_array_get(sp, (size_t)k);
-		white = white && (!json_is_number(e) || json_number_value(e) == 1);
-	}
-	if (json_object_get(sg, "specularGlossinessTexture") || !white)
-		api_gltf_warn(gi, "material %u (\"%.40s\"): specular-glossiness drawn as metallic-roughness (diffuse as base "
-		              "colour, glossinessFactor as roughness; the specular colour and texture are not used)", mi, mname);
-}
-
 static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, json_t *mat, struct api_gltf_material *gm)
 {
 	memset(gm, 0, sizeof *gm);
@@ -186,9 +163,9 @@ static void read_material(struct api_gltf_info *gi, json_t *root, uint32_t mi, j
 			gm->emissive_strength = s >= 0 ? s : 1;
 		}
 		if (!strcmp(key, "KHR_materials_unlit")) gm->unlit = true;
-		if (!strcmp(key, "KHR_materials_pbrSpecularGlossiness") && !pbr) read_spec_gloss(gi, mi, name, v, gm);
 	}
-	api_gltf_read_material_ext(gi, root, mi, name, ext, gm);
+	/* Specular-glossiness where the file has no metallic-roughness fallback. */
+	api_gltf_read_material_ext(gi, root, mi, name, ext, !pbr, gm);
 }
 
 /* Extensions the renderer does not know, and parts of a scene it does not draw. */
@@ -199,6 +176,13 @@ static void scene_warnings(struct api_gltf_info *gi, json_t *root)
 	json_array_foreach(used, i, e) {
 		const char *s = json_string_value(e);
 		bool known = false;
+		if (s && !strcmp(s, "KHR_materials_variants")) {   /* a variant picked leaves no name here */
+			char names[200];
+			api_gltf_variant_names(root, names, sizeof names);
+			api_gltf_warn(gi, "KHR_materials_variants: the default materials drawn (the model object's \"variant\" "
+			              "picks one of %s)", names[0] ? names : "none");
+			continue;
+		}
 		for (int k = 0; s && SUPPORTED_EXT[k]; k++) known = known || !strcmp(s, SUPPORTED_EXT[k]);
 		for (int k = 0; s && !known && LACKS[k][0]; k++)
 			if (!strcmp(s, LACKS[k][0])) {
@@ -253,17 +237,24 @@ void api_gltf_material_shading(const struct api_gltf_info *gi, uint32_t index, s
 	if (index >= gi->material_count) return;
 	const struct api_gltf_material *gm = &gi->materials[index];
 	if (gm->spec_gloss) {
+		/* F0 is the specular colour (api_gltf_read_material_ext); the metallic-roughness
+		 * slot, when there is a specularGlossinessTexture, is made of its alpha
+		 * (api/model_material.c): roughness 1 - glossiness x A. */
 		memcpy(m->base_color, gm->diffuse, sizeof gm->diffuse);
 		m->metallic = 0;
-		m->roughness = 1 - gm->glossiness;
-		m->metal_rough_texture = NULL;
+		m->roughness = m->metal_rough_texture ? 1 : 1 - gm->glossiness;
 	}
 	if (gm->transmission > 0 && m->alpha_mode != RND_ALPHA_MASK) {
 		float t[3];
 		api_gltf_volume_transmittance(gm, t);
+		float see = 0.8f * gm->transmission * (t[0] + t[1] + t[2]) / 3;
 		m->alpha_mode = RND_ALPHA_BLEND;
-		m->base_color[3] *= 1 - 0.8f * gm->transmission * (t[0] + t[1] + t[2]) / 3;
+		/* transmissionTexture R scales the factor per pixel: the renderer's see-through slot */
+		if (m->transmission_texture) m->see_through = see;
+		else m->base_color[3] *= 1 - see;
 		for (int k = 0; k < 3; k++) m->base_color[k] *= t[k];
+	} else {
+		m->transmission_texture = NULL;
 	}
 	if (gm->unlit) {
 		for (int k = 0; k < 3; k++) {
@@ -329,31 +320,7 @@ uint8_t *api_gltf_tag_materials(json_t *root, const uint8_t *data, size_t len, b
 	}
 	char *js = json_dumps(root, JSON_COMPACT);
 	if (!js) return NULL;
-	size_t jn = strlen(js), jpad = (jn + 3) & ~(size_t)3;
-	uint8_t *out = NULL;
-	if (!glb) {
-		out = malloc(jn ? jn : 1);
-		if (out) memcpy(out, js, jn);
-		*out_len = jn;
-	} else {
-		/* header, the new JSON chunk, then the original chunks after the JSON one */
-		uint32_t old = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 | (uint32_t)data[15] << 24;
-		size_t rest_at = 20 + (size_t)old, rest = rest_at <= len ? len - rest_at : 0;
-		size_t total = 20 + jpad + rest;
-		if (total <= UINT32_MAX && (out = malloc(total))) {
-			memcpy(out, data, 12);
-			uint32_t t32 = (uint32_t)total, j32 = (uint32_t)jpad;
-			for (int k = 0; k < 4; k++) {
-				out[8 + k] = (uint8_t)(t32 >> (8 * k));
-				out[12 + k] = (uint8_t)(j32 >> (8 * k));
-			}
-			memcpy(out + 16, "JSON", 4);
-			memcpy(out + 20, js, jn);
-			memset(out + 20 + jn, ' ', jpad - jn);
-			memcpy(out + 20 + jpad, data + rest_at, rest);
-			*out_len = total;
-		}
-	}
+	uint8_t *out = api_gltf_with_json(data, len, glb, js, strlen(js), out_len);
 	free(js);
 	return out;
 }

@@ -30,9 +30,10 @@
 struct api_gltf_material {
 	float emissive_strength;           /* 1 */
 	bool unlit;                        /* KHR_materials_unlit */
-	/* KHR_materials_pbrSpecularGlossiness on a material without pbrMetallicRoughness: drawn as
-	 * a dielectric of base colour diffuseFactor (x diffuseTexture, which Assimp hands over as
-	 * the base colour's DIFFUSE texture) and roughness 1 - glossinessFactor. */
+	/* KHR_materials_pbrSpecularGlossiness on a material without pbrMetallicRoughness
+	 * (api/gltf_material_ext.c): base colour diffuseFactor (x diffuseTexture, which Assimp
+	 * hands over as the base colour's DIFFUSE texture), roughness 1 - glossinessFactor (x the
+	 * specularGlossinessTexture's A), F0 the specular colour (the specular members below). */
 	bool spec_gloss;
 	float diffuse[4], glossiness;
 	/* KHR_materials_transmission's factor (0): drawn as partial coverage, see shading; and
@@ -47,7 +48,7 @@ struct api_gltf_material {
 	uint32_t extensions;
 	struct { float factor, roughness, normal_scale; } clearcoat;
 	struct { float color[3], roughness; } sheen;
-	struct { float factor, color[3], ior; } specular;
+	struct { float factor, color[3], ior; bool spec_gloss; } specular;
 	int32_t ext_image[RND_TEX_SLOTS];
 	bool double_sided;                 /* false (glTF's default) */
 	float normal_scale, occlusion_strength;    /* 1, 1 */
@@ -90,10 +91,12 @@ void api_gltf_material_apply(const struct api_gltf_info *gi, uint32_t index, str
                              bool *single_sided);
 /* What material `index` changes once its textures are known: KHR_materials_unlit drawn as its
  * base colour alone (moved to the emissive term, which no light or shadow changes: base
- * colour black, alpha kept; normal and occlusion maps dropped); the specular-glossiness
- * stand-in (metallic 0, base colour diffuseFactor, roughness 1 - glossiness);
+ * colour black, alpha kept; normal and occlusion maps dropped); specular-glossiness (metallic
+ * 0, base colour diffuseFactor, roughness 1 - glossiness, or 1 under the metallic-roughness
+ * slot made of the glossiness);
  * KHR_materials_transmission as dithered coverage (alpha mode BLEND, alpha x (1 - 0.8 x
- * transmission x the mean of the volume's transmittance): clear glass shows a fifth of its
+ * transmission x the mean of the volume's transmittance), transmissionTexture's R a factor of
+ * the transmission per pixel (the renderer's see_through slot): clear glass shows a fifth of its
  * surface and lets four fifths of the light through to its shadow; with KHR_materials_volume
  * the shown part is tinted by the transmittance and denser glass shows more of it), not
  * refraction. */
@@ -105,9 +108,10 @@ const char *api_gltf_slot_name(uint32_t k);
 void api_gltf_read_texinfo(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, uint32_t slot,
                            json_t *info, struct api_gltf_material *gm);
 /* The PBR extensions of material mi (its "extensions" object ext) into gm
- * (api/gltf_material_ext.c), and from gm into m (what api_gltf_material_apply adds). */
+ * (api/gltf_material_ext.c; specular-glossiness only when spec_gloss: the material has no
+ * pbrMetallicRoughness), and from gm into m (what api_gltf_material_apply adds). */
 void api_gltf_read_material_ext(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, json_t *ext,
-                                struct api_gltf_material *gm);
+                                bool spec_gloss, struct api_gltf_material *gm);
 void api_gltf_material_ext_apply(const struct api_gltf_material *gm, struct rnd_material *m);
 /* KHR_materials_volume's transmittance t per channel through thickness x thickness_mean:
  * attenuationColor ^ (thickness / attenuationDistance) (Beer's law, as the sample viewer

@@ -84,6 +84,32 @@ static void read_specular(struct api_gltf_info *gi, json_t *root, uint32_t mi, c
 	ext_texture(gi, root, mi, mname, e, "specularColorTexture", RND_TEX_SPECULAR_COLOR, gm);
 }
 
+/* KHR_materials_pbrSpecularGlossiness, as the Khronos sample viewer draws it: the diffuse
+ * colour as the base colour (diffuseTexture: Assimp hands it over as the base colour's), a
+ * dielectric whose F0 is the specular colour (specularFactor x specularGlossinessTexture's
+ * RGB, read in the specular colour slot, sRGB) with specular weight 1 (F90 1), roughness 1 -
+ * glossinessFactor (x the texture's A: api/model_material.c makes the metallic-roughness
+ * slot of it). The renderer keeps 1 - max(F0) of the diffuse and reflects F0 under the ambient
+ * (rnd_material specular.spec_gloss). */
+static void read_spec_gloss(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, json_t *e,
+                            struct api_gltf_material *gm)
+{
+	gm->spec_gloss = true;
+	json_t *d = json_object_get(e, "diffuseFactor");
+	for (int k = 0; k < 4; k++) {
+		json_t *x = json_array_get(d, (size_t)k);
+		gm->diffuse[k] = json_is_number(x) && json_array_size(d) == 4 ? (float)fmin(fmax(json_number_value(x), 0), 1) : 1;
+	}
+	gm->glossiness = num(e, "glossinessFactor", 1, 0, 1);
+	gm->extensions |= RND_EXT_SPECULAR;
+	color3(e, "specularFactor", 1, gm->specular.color);
+	for (int k = 0; k < 3; k++) gm->specular.color[k] = fminf(gm->specular.color[k], 1);
+	gm->specular.factor = 1;
+	gm->specular.ior = 1e6f;   /* ((ior - 1) / (ior + 1))^2 within 4e-6 of 1: F0 = the colour */
+	gm->specular.spec_gloss = true;
+	ext_texture(gi, root, mi, mname, e, "specularGlossinessTexture", RND_TEX_SPECULAR_COLOR, gm);
+}
+
 /* KHR_materials_volume: the medium (its transmittance: api_gltf_volume_transmittance). */
 static void read_volume(struct api_gltf_info *gi, json_t *root, json_t *e, struct api_gltf_material *gm)
 {
@@ -110,18 +136,21 @@ void api_gltf_volume_transmittance(const struct api_gltf_material *gm, float t[3
 /* gm holds the defaults (api/gltf_material.c read_material): specular 1 x white, ior 1.5,
  * transmittance 1. */
 void api_gltf_read_material_ext(struct api_gltf_info *gi, json_t *root, uint32_t mi, const char *mname, json_t *ext,
-                                struct api_gltf_material *gm)
+                                bool spec_gloss, struct api_gltf_material *gm)
 {
 	json_t *v;
 	const char *key;
 	json_object_foreach(ext, key, v) {
 		if (!json_is_object(v)) continue;
+		if (!strcmp(key, "KHR_materials_pbrSpecularGlossiness") && spec_gloss) read_spec_gloss(gi, root, mi, mname, v, gm);
 		if (!strcmp(key, "KHR_materials_clearcoat")) read_clearcoat(gi, root, mi, mname, v, gm);
 		if (!strcmp(key, "KHR_materials_sheen")) read_sheen(gi, root, mi, mname, v, gm);
 		if (!strcmp(key, "KHR_materials_specular")) read_specular(gi, root, mi, mname, v, gm);
 		if (!strcmp(key, "KHR_materials_volume")) read_volume(gi, root, v, gm);
-		if (!strcmp(key, "KHR_materials_transmission"))
+		if (!strcmp(key, "KHR_materials_transmission")) {
 			gm->transmission = num(v, "transmissionFactor", 0, 0, 1);
+			ext_texture(gi, root, mi, mname, v, "transmissionTexture", RND_TEX_TRANSMISSION, gm);
+		}
 		if (!strcmp(key, "KHR_materials_ior")) {
 			gm->extensions |= RND_EXT_SPECULAR;
 			/* ior 0 is the spec's "infinite": F0 1, which ior 1e6 comes within 4e-6 of */
@@ -142,6 +171,7 @@ void api_gltf_material_ext_apply(const struct api_gltf_material *gm, struct rnd_
 	m->specular.factor = gm->specular.factor;
 	memcpy(m->specular.color, gm->specular.color, sizeof m->specular.color);
 	m->specular.ior = gm->specular.ior;
+	m->specular.spec_gloss = gm->specular.spec_gloss;
 }
 
 /* Image i's uri, or its bytes (a bufferView, a data: URI), into im. 0, or -1 with err. */

@@ -71,16 +71,10 @@ static int gltf_precheck(const uint8_t *d, size_t len, enum api_model_format f, 
                          size_t errsize)
 {
 	*root_out = NULL;
-	const char *json = (const char *)d;
-	size_t jlen = len;
-	if (f == API_MODEL_GLB) {
-		if (len < 20 || memcmp(d + 16, "JSON", 4))
-			return api_err_set(err, errsize, "the glb has no JSON chunk"), -1;
-		uint32_t n = (uint32_t)d[12] | (uint32_t)d[13] << 8 | (uint32_t)d[14] << 16 | (uint32_t)d[15] << 24;
-		if (n > len - 20) return api_err_set(err, errsize, "the glb's JSON chunk is longer than the file"), -1;
-		json = (const char *)d + 20;
-		jlen = n;
-	}
+	const char *json;
+	size_t jlen;
+	const char *bad = api_gltf_json_of(d, len, f == API_MODEL_GLB, &json, &jlen);
+	if (bad) return api_err_set(err, errsize, "%s", bad), -1;
 	json_error_t je;
 	json_t *root = json_loadb(json, jlen, 0, &je);
 	if (!json_is_object(root)) {
@@ -494,10 +488,11 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		                      &io_files, &io_nfiles, err, errsize);
 		json_decref(root);
 		if (rc != 0) {
+			bool oom = bufs.oom;   /* a decode over the memory limit, not a bad file */
 			free(tagged);
 			api_gltf_bufs_release(&bufs);
 			api_gltf_info_free(&c.gi);
-			return API_WIRE_BAD_INPUT;
+			return oom ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 		}
 		if (tagged) {
 			data = tagged;

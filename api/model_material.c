@@ -4,6 +4,7 @@
  * Assimp 5.2 does not hand over reliably comes from api/gltf_material.c), and the textures they
  * name, embedded or among the files the model refers to, decoded into the import's arena.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <assimp/cimport.h>
@@ -170,6 +171,33 @@ static int extension_textures(struct api_conv *c, int gi, struct rnd_material *m
 	return thickness_mean(c, gi);
 }
 
+/* KHR_materials_pbrSpecularGlossiness's glossiness, where it has a specularGlossinessTexture
+ * (decoded into the specular colour slot by extension_textures): the metallic-roughness slot
+ * made of its alpha, G = 1 - glossinessFactor x A, sampled the same way (the renderer
+ * multiplies roughness by G and cannot take 1 - x; roughness factor 1, api_gltf_material_shading). */
+static int spec_gloss_roughness(struct api_conv *c, int gi, struct rnd_material *m)
+{
+	const struct api_gltf_material *gm = gi >= 0 && (uint32_t)gi < c->gi.material_count ? &c->gi.materials[gi] : NULL;
+	if (!gm || !gm->spec_gloss) return 0;
+	const struct rnd_texture *sg = m->textures[RND_TEX_SPECULAR_COLOR];
+	m->metal_rough_texture = NULL;
+	if (!sg || !sg->width || !sg->height) return 0;
+	size_t n = (size_t)sg->width * sg->height;
+	struct rnd_texture *t = api_conv_alloc(c, 1, sizeof *t);
+	uint8_t *px = api_conv_alloc(c, n, 4);
+	if (!t || !px) return oom(c) ? 0 : -1;
+	for (size_t p = 0; p < n; p++) {
+		px[4 * p + 1] = (uint8_t)lrintf(255.0f - gm->glossiness * (float)sg->rgba[4 * p + 3]);
+		px[4 * p + 3] = 255;
+	}
+	t->rgba = px;
+	t->width = sg->width;
+	t->height = sg->height;
+	m->metal_rough_texture = t;
+	m->sampling[RND_TEX_METAL_ROUGH] = m->sampling[RND_TEX_SPECULAR_COLOR];
+	return 0;
+}
+
 static int material_textures(struct api_conv *c, const struct aiMaterial *am, uint32_t index, struct rnd_material *m)
 {
 	struct aiString s;
@@ -224,7 +252,9 @@ int api_conv_material(struct api_conv *c, const struct aiMaterial *am, uint32_t 
 			m->alpha_cutoff = clampf(f, 0, 1);
 	}
 	if (gi >= 0) api_gltf_material_apply(&c->gi, (uint32_t)gi, m, single_sided);
-	if (material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m) != 0 || extension_textures(c, gi, m) != 0) return -1;
+	if (material_textures(c, am, gi >= 0 ? (uint32_t)gi : index, m) != 0 || extension_textures(c, gi, m) != 0 ||
+	    spec_gloss_roughness(c, gi, m) != 0)
+		return -1;
 	if (gi >= 0) api_gltf_material_shading(&c->gi, (uint32_t)gi, m);
 	return 0;
 }

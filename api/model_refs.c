@@ -13,6 +13,7 @@
 #include <jansson.h>
 #include "asset.h"
 #include "errmsg.h"
+#include "gltf_buffers.h"
 #include "model_refs.h"
 
 enum ref_kind { REF_BUFFER, REF_IMAGE, REF_MTL, REF_TEXTURE };
@@ -189,15 +190,9 @@ static long fetch(struct ctx *c, enum ref_kind kind, const char *base, const cha
 
 static int gltf_refs(struct ctx *c, const uint8_t *d, size_t len, bool glb)
 {
-	const char *json = (const char *)d;
-	size_t jlen = len;
-	if (glb) { /* header (12), then the JSON chunk's length and type */
-		if (len < 20 || memcmp(d + 16, "JSON", 4)) return 0;
-		uint32_t n = (uint32_t)d[12] | (uint32_t)d[13] << 8 | (uint32_t)d[14] << 16 | (uint32_t)d[15] << 24;
-		if (n > len - 20) return 0;
-		json = (const char *)d + 20;
-		jlen = n;
-	}
+	const char *json;
+	size_t jlen;
+	if (api_gltf_json_of(d, len, glb, &json, &jlen)) return 0;
 	/* Malformed JSON is the importer's to report (with its own words): no references then. */
 	json_t *root = json_loadb(json, jlen, 0, NULL);
 	if (!json_is_object(root)) return json_decref(root), 0;

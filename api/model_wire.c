@@ -183,6 +183,8 @@ static enum api_result decode_extensions(struct dec *d, uint32_t i, struct rnd_m
 	uint32_t bits;
 	float e[12];
 	if (!take_u32(&d->r, &bits) || !take(&d->r, e, sizeof e)) return bad(&d->r, "material %u is cut short", i);
+	m->specular.spec_gloss = bits & API_WIRE_SPEC_GLOSS;
+	bits &= ~API_WIRE_SPEC_GLOSS;
 	bool ok = bits <= (RND_EXT_CLEARCOAT | RND_EXT_SHEEN | RND_EXT_SPECULAR) && in_range(e, 2, 0, 1) &&
 	          in_range(e + 2, 1, -1e3f, 1e3f) && in_range(e + 3, 5, 0, 1) && in_range(e + 8, 3, 0, 1e6f) &&
 	          in_range(e + 11, 1, 0, 1e6f);
@@ -211,7 +213,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 		for (uint32_t s = 0; s < RND_TEX_SLOTS; s++)
 			if (!take_u32(&d->r, &packed[s]) || !take(&d->r, tf[s], sizeof tf[s]))
 				return bad(&d->r, "material %u is cut short", i);
-		bool ok = finite_all(f, 13) && f[12] == 0;
+		bool ok = finite_all(f, 13) && f[12] >= 0 && f[12] <= 1;
 		for (int k = 0; k < 3; k++) ok = ok && f[k] >= 0 && f[k] <= 1e6f && f[6 + k] >= 0 && f[6 + k] <= 1e6f;
 		ok = ok && f[3] >= 0 && f[3] <= 1 && f[4] >= 0 && f[4] <= 1 && f[5] >= 0 && f[5] <= 1 && f[9] >= 0 &&
 		     f[9] <= 1 && fabsf(f[10]) <= 1e3f && f[11] >= 0 && f[11] <= 1;
@@ -242,6 +244,7 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 		m->alpha_cutoff = f[9];
 		m->normal_scale = f[10];
 		m->occlusion_strength = f[11];
+		m->see_through = f[12];
 		m->alpha_mode = (enum rnd_alpha_mode)mode;
 	}
 	return API_OK;

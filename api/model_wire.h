@@ -22,11 +22,12 @@
  *            zeros to a multiple of 4 bytes (every array below starts 4-byte aligned)
  *            textures:  width height, width*height*4 bytes RGBA8
  *            materials: base_color[4] roughness metallic emissive[3] alpha_cutoff normal_scale
- *                       occlusion_strength reserved (f32, reserved = 0), alpha_mode (u32),
- *                       texture[12] (i32 per rnd_texture_slot, -1 = none), then per slot the
+ *                       occlusion_strength see_through (f32), alpha_mode (u32),
+ *                       texture[13] (i32 per rnd_texture_slot, -1 = none), then per slot the
  *                       sampling: wrap_s | wrap_t << 2 | mag_nearest << 4 | min_nearest << 5 |
  *                       transformed << 6 | mip << 7 (u32, enum rnd_mip) | uv_set << 9 (0 or 1),
- *                       transform f32[6]; then the PBR extensions: bits (u32, RND_EXT_*),
+ *                       transform f32[6]; then the PBR extensions: bits (u32, RND_EXT_*, and
+ *                       1 << 16 for specular.spec_gloss),
  *                       clearcoat factor roughness normal_scale, sheen colour[3] roughness,
  *                       specular factor colour[3] ior (f32)
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
@@ -55,7 +56,9 @@
 #include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 6u
+#define API_WIRE_VERSION 7u
+/* Beside the RND_EXT_* bits of a material: its specular.spec_gloss. */
+#define API_WIRE_SPEC_GLOSS (1u << 16)
 #define API_WIRE_MAX_MESSAGE 1024u
 #define API_WIRE_MAX_TEXTURES 4096u   /* distinct textures in one reply */
 

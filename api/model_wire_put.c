@@ -90,8 +90,8 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 {
 	float f[13] = {mt->base_color[0], mt->base_color[1], mt->base_color[2], mt->base_color[3], mt->roughness,
 	               mt->metallic, mt->emissive[0], mt->emissive[1], mt->emissive[2], mt->alpha_cutoff,
-	               mt->normal_scale, mt->occlusion_strength, 0};
-	put(b, f, sizeof f); /* the last one reserved, zero */
+	               mt->normal_scale, mt->occlusion_strength, mt->see_through};
+	put(b, f, sizeof f);
 	put_u32(b, (uint32_t)mt->alpha_mode);
 	for (uint32_t s = 0; s < RND_TEX_SLOTS; s++) {
 		int32_t ti = -1;
@@ -106,7 +106,7 @@ static void put_material(struct api_wire_buf *b, const struct rnd_material *mt, 
 		           (uint32_t)(ts->uv_set == 1) << 9);
 		put(b, ts->transform, sizeof ts->transform);
 	}
-	put_u32(b, mt->extensions);
+	put_u32(b, mt->extensions | (mt->specular.spec_gloss ? API_WIRE_SPEC_GLOSS : 0));
 	float e[11] = {mt->clearcoat.factor, mt->clearcoat.roughness, mt->clearcoat.normal_scale, mt->sheen.color[0],
 	               mt->sheen.color[1], mt->sheen.color[2], mt->sheen.roughness, mt->specular.factor,
 	               mt->specular.color[0], mt->specular.color[1], mt->specular.color[2]};

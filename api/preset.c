@@ -5,20 +5,17 @@
 #include "preset.h"
 
 /* Thumbnail: 512², a three-quarter view from above fitted to the objects (planes and shadow
- * catchers left out), white background, sky and ground ambient, a soft sun (4° disk, PCSS: the
- * penumbra widens with the distance to the caster), and a ground shadow catcher three times the
- * objects' size that darkens the background (or writes alpha when the output is transparent).
- * The sun's map takes the default resolution (2048 over the whole scene, drawn only around
- * what casts): an explicit 2048 drew all of it, the same texels in a tile four times the size
- * (a model thumbnail's shadow stage 13-15 -> 5-7 ms, the same image to one step). */
+ * catchers left out), white background, lit by the built-in studio environment (renderer/
+ * env_studio.c: a small bright key high on the camera's left, fill, rim and a dim dome) with its
+ * shadows (12 directions: the soft key shadow and the contact darkening of the whole sky), and a
+ * ground shadow catcher three times the objects' size that darkens the background (or writes
+ * alpha when the output is transparent). No sun: the studio's key casts the shadow (a sun's
+ * PCSS map and lookups cost a thumbnail's main pass about what the environment's shadows do,
+ * docs/performance.md), and metals have the studio to reflect. */
 static const char THUMBNAIL[] =
 	"{\"width\": 512, \"height\": 512,"
 	" \"camera\": {\"fit\": \"objects\", \"direction\": [-1, -0.7, -1.3], \"fov_y\": 30, \"margin\": 0.08},"
-	" \"environment\": {\"background\": [1, 1, 1],"
-	"   \"ambient\": {\"sky\": [0.85, 0.9, 1], \"ground\": [0.4, 0.37, 0.33], \"intensity\": 0.6}},"
-	" \"shadows\": {\"filter\": \"pcss\"},"
-	" \"lights\": [{\"type\": \"directional\", \"direction\": [-0.35, -1, -0.45], \"intensity\": 2.5,"
-	"   \"angular_diameter\": 4}],"
+	" \"environment\": {\"background\": [1, 1, 1], \"map\": {\"preset\": \"studio\"}},"
 	" \"objects\": [{\"shape\": \"plane\", \"placement\": \"ground\", \"margin\": 3,"
 	"   \"material\": {\"shadow_catcher\": true}}],"
 	" \"output\": {\"format\": \"png\"}}";

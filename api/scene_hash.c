@@ -170,6 +170,7 @@ static uint64_t parsed(uint64_t h, const struct api_scene *s)
 	AS_SET(sc.materials);
 	AS_SET(sc.objects);
 	AS_SET(sc.lights);
+	AS_SET(sc.environment.map.rgb);   /* its pixels: map.key (their hash) */
 	sc.deadline_ns = 0;   /* how long, not what: set per request */
 	sc.cancel = NULL;
 	sc.cancel_user = NULL;

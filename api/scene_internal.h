@@ -7,7 +7,8 @@
  *   scene_objects.c   objects: shapes, mesh arrays, transforms, ground placement, model expansion
  *   scene_camera.c    one camera, and the "objects" framing sphere
  *   scene_views.c     views, turntable, output, and the size of the image or sheet
- *   scene_lights.c    lights and the environment
+ *   scene_lights.c    lights
+ *   scene_environment.c the environment: background, ambient, map (api/env_map.h), its shadows
  *   scene_shadows.c   shadow settings (root and per light)
  *   scene_parse.c     the root, model sources (data, path under the asset root, part), api_scene_*
  *
@@ -68,6 +69,10 @@ struct pctx {
 	size_t cur_object;
 	char warnings[sizeof(((struct api_scene *)0)->warnings)]; /* what is drawn other than asked ("; " between) */
 	const struct api_big_strings *big;  /* base64 members left in the document (api/big_strings.h) */
+	/* The environment map (api/env_map.h), a reference the scene keeps; whether the document
+	 * said anything of the environment's shadows (else the root's `shadows: false` turns them off). */
+	struct api_env_map *env_map;
+	bool env_shadow_given;
 	/* Members whose value the walk read into the parsed scene (the api_get_* getters of numbers,
 	 * booleans, enums and vectors record theirs): the ETag's hash takes the parsed scene for
 	 * them, so their spelling, or their being left out for the default, does not count
@@ -160,6 +165,13 @@ int api_add_material(struct pctx *c, uint32_t *index);
 /* 422 at the object that brings the scene over lim->max_textures distinct textures. */
 int api_check_textures(struct pctx *c, const struct rnd_scene *sc);
 
+/* scene_parse.c: the bytes of a file under the asset root (path checked here; *out malloc'd,
+ * the caller frees it) or of a part of the multipart request (v: its name; *out the request's);
+ * 0 or -1 (400 at the current pointer). */
+struct api_asset_stamp;
+int api_path_bytes(struct pctx *c, const char *path, unsigned char **out, size_t *len, struct api_asset_stamp *stamp);
+int api_part_bytes(struct pctx *c, json_t *v, const uint8_t **out, size_t *len);
+
 /* scene_objects.c: `objects` (an array), with models expanded and ground planes placed. */
 int api_parse_objects(struct pctx *c, json_t *objs, struct api_scene *s);
 /* scene_parse.c: a model object's source; sets c->cur_model. */
@@ -188,7 +200,10 @@ void api_check_size(struct pctx *c, json_t *root, const struct rnd_scene *sc);
 
 /* scene_lights.c */
 int api_parse_lights(struct pctx *c, json_t *root, struct rnd_scene *sc, const struct rnd_shadow *root_shadow);
+/* scene_environment.c: `environment` (j at the current pointer), and after the lights and the
+ * output, the rules that need them (the root's shadows off, a map background and transparency). */
 int api_parse_environment(struct pctx *c, json_t *j, struct rnd_environment *env);
+int api_check_environment(struct pctx *c, const struct rnd_shadow *root_shadow, struct rnd_scene *sc);
 
 /* scene_shadows.c: applies the members present in j over *s. */
 int api_parse_shadow(struct pctx *c, json_t *j, struct rnd_shadow *s, const char *what);

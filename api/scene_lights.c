@@ -1,13 +1,11 @@
 /*
  * api/scene_lights.c — `lights` (directional, spot, point; each with its shadow settings over
- * the root's) and the `environment` (background, ambient light). See scene_internal.h.
+ * the root's). See scene_internal.h.
  */
 #include <stdio.h>
 #include <string.h>
 #include "scene_internal.h"
 
-static const char *const ENV_MEMBERS[] = {"background", "ambient", NULL};
-static const char *const AMBIENT_MEMBERS[] = {"sky", "ground", "intensity", NULL};
 
 static const char *const LIGHT_COMMON[] = {"type", "name", "color", "intensity", "shadow", NULL};
 static const char *const LIGHT_TYPES[] = {"directional", "spot", "point", NULL};
@@ -72,30 +70,6 @@ static int parse_light(struct pctx *c, json_t *j, struct rnd_light *l, const str
 		         : api_fail(c, "shadow must be an object of shadow settings or a boolean, not %s", api_type_name(sh));
 		api_ptr_pop(c, old);
 		if (rc < 0) return -1;
-	}
-	return 0;
-}
-
-
-int api_parse_environment(struct pctx *c, json_t *j, struct rnd_environment *env)
-{
-	if (api_require_object(c, j, "environment") < 0 ||
-	    api_check_members(c, j, ENV_MEMBERS, NULL, "the environment") < 0)
-		return -1;
-	float bg[4] = {0, 0, 0, 1};
-	int n = api_get_vec(c, j, "background", bg, 3, 4, V_NONNEG | V_ALPHA01);
-	if (n < 0) return -1;
-	if (n) memcpy(env->background, bg, sizeof bg);
-	json_t *sub;
-	size_t old;
-	int rc = api_enter(c, j, "ambient", AMBIENT_MEMBERS, "the ambient light", &sub, &old);
-	if (rc < 0) return -1;
-	if (rc) {
-		rc = api_get_vec(c, sub, "sky", env->ambient_sky, 3, 3, V_NONNEG) < 0 ||
-		     api_get_vec(c, sub, "ground", env->ambient_ground, 3, 3, V_NONNEG) < 0 ||
-		     api_get_float(c, sub, "intensity", &R_NONNEG, &env->ambient_intensity) < 0;
-		api_ptr_pop(c, old);
-		if (rc) return -1;
 	}
 	return 0;
 }

@@ -86,13 +86,13 @@ static const char *const OBJECT_COMMON[] = {"shape", "name", "transform", "mater
                                             "receive_shadows", "double_sided", NULL};
 static const char *const SHAPES[] = {"plane", "box", "sphere", "cylinder", "mesh", "model", NULL};
 enum { SHAPE_MODEL = 5 };
-static const char *const SHAPE_MEMBERS[][6] = {
+static const char *const SHAPE_MEMBERS[][7] = {
 	{"size", "placement", "margin", NULL},
 	{"size", NULL},
 	{"radius", "segments", NULL},
 	{"radius", "height", "segments", NULL},
 	{"positions", "indices", "normals", "uvs", NULL},
-	{"data", "format", "path", "part", "up", NULL},
+	{"data", "format", "path", "part", "up", "variant", NULL},
 };
 #define MAX_SEGMENTS 1000000
 

@@ -22,6 +22,8 @@
 #include <strings.h>
 #include "big_strings.h"
 #include "asset.h"
+#include "gltf_variants.h"
+#include "env_map.h"
 #include "model.h"
 #include "model_paths.h"
 #include "model_refs.h"
@@ -71,27 +73,45 @@ static int model_bytes(struct pctx *c, const char *first, json_t *v, const char 
 		else if (!len) rc = api_fail(c, "data must not be empty");
 	} else if (!strcmp(first, "path")) {
 		const char *s = json_string_value(v);
-		char perr[200];
-		if (api_asset_check_path(s, perr, sizeof perr) != API_OK) rc = api_fail(c, "%s", perr);
-		else rc = read_asset(c, s, &b, &len, stamp);
+		rc = api_path_bytes(c, s, &b, &len, stamp);
 		if (!rc && !*given) { /* the extension says what the bytes may not (obj, ascii stl) */
 			const char *dot = strrchr(s, '.');
 			for (int i = 0; dot && formats[i]; i++)
 				if (!strcasecmp(dot + 1, formats[i])) { *f = i; *given = true; }
 		}
-	} else if (!json_string_length(v)) {
-		rc = api_fail(c, "part must name a part of the multipart request");
 	} else {
-		const char *name = json_string_value(v);
-		size_t i = 0;
-		while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
-		if (i == c->nparts) rc = api_fail(c, "part \"%.64s\" is not a part of this request", name);
-		else if (!c->parts[i].len) rc = api_fail(c, "part \"%.64s\" is empty", name);
-		else b = (unsigned char *)c->parts[i].data, len = c->parts[i].len;
+		const uint8_t *pb;
+		rc = api_part_bytes(c, v, &pb, &len);
+		b = (unsigned char *)pb;
 	}
 	*out = b;
 	*out_len = len;
 	return rc;
+}
+
+int api_path_bytes(struct pctx *c, const char *path, unsigned char **out, size_t *len, struct api_asset_stamp *stamp)
+{
+	char perr[200];
+	*out = NULL;
+	*len = 0;
+	if (api_asset_check_path(path, perr, sizeof perr) != API_OK) return api_fail(c, "%s", perr);
+	return read_asset(c, path, out, len, stamp);
+}
+
+int api_part_bytes(struct pctx *c, json_t *v, const uint8_t **out, size_t *len)
+{
+	*out = NULL;
+	*len = 0;
+	if (!json_is_string(v)) return api_fail(c, "part must be a string, not %s", api_type_name(v));
+	if (!json_string_length(v)) return api_fail(c, "part must name a part of the multipart request");
+	const char *name = json_string_value(v);
+	size_t i = 0;
+	while (i < c->nparts && (!c->parts[i].name || strcmp(c->parts[i].name, name))) i++;
+	if (i == c->nparts) return api_fail(c, "part \"%.64s\" is not a part of this request", name);
+	if (!c->parts[i].len) return api_fail(c, "part \"%.64s\" is empty", name);
+	*out = c->parts[i].data;
+	*len = c->parts[i].len;
+	return 0;
 }
 
 /* Makes m (one reference, given to the scene) the current model. */
@@ -152,6 +172,23 @@ static int model_refs(struct pctx *c, json_t *j, const char *first, json_t *v, c
 	return 0;
 }
 
+/* The model's bytes with its glTF material variant `variant` applied (api/gltf_variants.h),
+ * into *out (malloc'd); a problem at the object's "variant" (the pointer is popped to the
+ * object's: `obj`). */
+static int pick_variant(struct pctx *c, size_t obj, const char *variant, const uint8_t *b, size_t len,
+                        enum api_model_format fmt, uint8_t **out, size_t *out_len)
+{
+	char err[400];
+	bool oom;
+	if (fmt == API_MODEL_GLB || fmt == API_MODEL_GLTF)
+		*out = api_gltf_pick_variant(b, len, fmt == API_MODEL_GLB, variant, out_len, &oom, err, sizeof err);
+	else snprintf(err, sizeof err, "variant picks a glTF material variant (KHR_materials_variants); this model is %s %s "
+	              "file", fmt == API_MODEL_OBJ ? "an" : "a", api_model_format_name(fmt));
+	if (*out) return 0;
+	api_ptr_pop(c, obj);
+	return api_fail_at(c, "variant", "%s", err);
+}
+
 int api_parse_model(struct pctx *c, json_t *j)
 {
 	static const char *const sources[] = {"data", "path", "part"};
@@ -164,6 +201,8 @@ int api_parse_model(struct pctx *c, json_t *j)
 		first = sources[i];
 	}
 	if (!first) return api_fail(c, "a model needs one of data (base64 file), path or part");
+	const char *variant = NULL;
+	if (api_get_string(c, j, "variant", &variant) < 0) return -1;
 	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
 	/* A hint for the importer, not a value of the parsed scene: checked, not recorded as read
 	 * (scene_internal.h), so that it stays in the ETag's hash as written. */
@@ -180,7 +219,8 @@ int api_parse_model(struct pctx *c, json_t *j)
 	size_t old = api_ptr_push(c, first);
 	bool by_path = !strcmp(first, "path");
 	struct api_model_path_key key = {c->lim->asset_root, json_string_value(v), given ? f : -1};
-	int rc = by_path ? model_remembered(c, v, &key) : 0;
+	/* A variant is another model (api/gltf_variants.h): found in the cache by its own bytes. */
+	int rc = by_path && !variant ? model_remembered(c, v, &key) : 0;
 	if (rc != 0) {
 		api_ptr_pop(c, old);
 		return rc < 0 ? -1 : 0;
@@ -198,11 +238,14 @@ int api_parse_model(struct pctx *c, json_t *j)
 	struct api_model_refs refs = {0};
 	if (rc == 0) rc = model_refs(c, j, first, v, b, len, fmt, &refs);
 	c->import.ms[API_IMPORT_READ] += (float)(api_clock_ms() - t0);   /* the model and the files it names */
+	uint8_t *vb = NULL;
+	size_t vlen = 0;
+	if (rc == 0 && variant) rc = pick_variant(c, old, variant, b, len, fmt, &vb, &vlen);
 	struct api_model *m = NULL;
 	char err[400];
 	int status;
-	if (rc == 0 && api_model_get_timed(b, len, refs.files, refs.count, fmt, c->lim, &m, &c->import, &status, err,
-	                                   sizeof err) != API_OK) {
+	if (rc == 0 && api_model_get_timed(vb ? vb : b, vb ? vlen : len, refs.files, refs.count, fmt, c->lim, &m,
+	                                   &c->import, &status, err, sizeof err) != API_OK) {
 		/* 400 for a bad file, 422 over the import time/memory limit, 500 when the importer cannot run. */
 		const char *what = model_label(j, first, v);
 		if (what)
@@ -217,9 +260,11 @@ int api_parse_model(struct pctx *c, json_t *j)
 		if (refs.asset_hash) api_asset_hash(&h, NULL, (const uint8_t *)&refs.asset_hash, 8);
 		api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
 		/* A model remembered is attached without its bytes: only one with nothing to say is. */
-		if (!refs.warning[0] && !said[0]) api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
+		if (!refs.warning[0] && !said[0] && !variant)
+			api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
 	}
 	if (rc == 0) rc = attach_model(c, m);
+	free(vb);
 	api_model_refs_release(&refs);
 	if (by_path) free(b);
 	api_ptr_pop(c, old);
@@ -266,6 +311,7 @@ static int parse_root(struct pctx *c, json_t *root, struct api_scene *s)
 	if (api_parse_root_shadow(c, root, &root_shadow) < 0) return -1;
 	if (api_parse_lights(c, root, sc, &root_shadow) < 0) return -1;
 	if (api_parse_root_output(c, root, s) < 0) return -1;
+	if (api_check_environment(c, &root_shadow, sc) < 0) return -1;
 	api_set_pixels(s);
 	api_check_size(c, root, sc);
 	sc->materials = c->mats;
@@ -344,10 +390,12 @@ enum api_result api_scene_parse_parts(const char *json, size_t len, const struct
 	api_big_strings_free(&big);
 	if (rc < 0) {
 		model_refs_release(c.models);
+		api_env_map_release(c.env_map);
 		api_arena_destroy(c.arena);
 		return API_ERR;
 	}
 	s->models_ = c.models;
+	s->env_map_ = c.env_map;
 	s->object_source_ = c.object_source;
 	s->views_key_ = c.views_key;
 	s->asset_hash = c.asset_hash;
@@ -362,6 +410,7 @@ void api_scene_free(struct api_scene *s)
 	/* The scene itself lives in its arena; the models it points into are referenced. */
 	if (!s) return;
 	model_refs_release(s->models_);
+	api_env_map_release(s->env_map_);
 	api_arena_destroy(s->arena_);
 }
 

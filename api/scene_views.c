@@ -147,9 +147,11 @@ static int parse_output(struct pctx *c, json_t *j, struct api_scene *s)
 	                                                API_FORMAT_AVIF};
 	static const char *const tonemaps[] = {"neutral", "aces", "none", NULL};
 	static const enum rnd_tonemap tonemap_values[] = {RND_TONEMAP_NEUTRAL, RND_TONEMAP_ACES, RND_TONEMAP_NONE};
-	static const char *const debugs[] = {"none", "shadow", "cascades", "normals", "depth", "atlas", NULL};
+	static const char *const debugs[] = {"none", "shadow", "cascades", "normals", "depth", "atlas",
+	                                     "environment_shadow", NULL};
 	static const enum rnd_debug debug_values[] = {RND_DEBUG_NONE, RND_DEBUG_SHADOW, RND_DEBUG_CASCADES,
-	                                              RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS};
+	                                              RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS,
+	                                              RND_DEBUG_ENV_SHADOW};
 	int e, rc;
 	if ((rc = api_get_enum(c, j, "format", formats, &e)) < 0) return -1;
 	if (rc) {

@@ -16,7 +16,7 @@ set -eu
 PKGS="build-essential pkg-config ca-certificates curl python3
 libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
 glslang-tools libjansson-dev libmicrohttpd-dev libpng-dev zlib1g-dev
-libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev libmeshoptimizer-dev libwebp-dev libavif-dev libdeflate-dev xxd"
+libopenexr-dev libassimp-dev libjpeg-dev libseccomp-dev libmeshoptimizer-dev libwebp-dev libavif-dev libdeflate-dev libdraco-dev xxd"
 # Test tools (make test): the load balancer of the cluster test, YAML for the deploy checks,
 # chromium and node for the playground's browser test, clang + libFuzzer for the fuzz targets,
 # nginx (nginx-light) for the shared cache in front of the GET form (tests/http/cache.sh),

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "internal.h"
+#include "env.h"
 #include "moments.h"
 #include "shadow_cache.h"
 
@@ -107,10 +108,15 @@ static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityF
 	 * tiles while another render copies a new map into another tile, and one image has one
 	 * layout. The layer's performance hint that a copy into GENERAL would be faster in
 	 * TRANSFER_DST_OPTIMAL (UNASSIGNED-CoreValidation-DrawState-InvalidImageLayout) is
-	 * expected there, and only there. */
+	 * expected there, and only there. The atlas is known by its name or by its handle: with
+	 * two renders recording at once the layer has printed it nameless ("VkImage 0x...[]"). */
 	if ((type & VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT) && data->messageIdNumber == 0x4dae5635 &&
-	    data->pMessage && strstr(data->pMessage, "[shadow depth atlas]") && strstr(data->pMessage, "GENERAL"))
-		return VK_FALSE;
+	    data->pMessage && strstr(data->pMessage, "GENERAL")) {
+		char atlas[48];
+		snprintf(atlas, sizeof atlas, "VkImage 0x%llx[", (unsigned long long)(uintptr_t)ctx->atlas_depth.img);
+		if (strstr(data->pMessage, "[shadow depth atlas]") || (ctx->atlas_depth.img && strstr(data->pMessage, atlas)))
+			return VK_FALSE;
+	}
 	if (sev >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
 		__atomic_add_fetch(&ctx->validation_count, 1, __ATOMIC_RELAXED);
 		rnd_log(ctx, 0, "vulkan validation: %s", data->pMessage ? data->pMessage : "(no message)");
@@ -256,7 +262,7 @@ static enum rnd_result pick_device(struct rnd_context *ctx, struct rnd_error *er
 	 * 0's two samplers, so the device's per-stage bound limits a material, not a scene: a
 	 * scene's distinct textures are bounded by memory (the estimate and admission count
 	 * their texels) and by the descriptor sets each slot preallocates for them, which
-	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. A main-pass draw binds UMBRA_TEX_SLOTS (12,
+	 * RND_MAX_TEXTURES_CEILING keeps to a few MB. A main-pass draw binds UMBRA_TEX_SLOTS (13,
 	 * the glTF PBR extensions' textures among them) beside set 0's up to 7 samplers: more than
 	 * the 16 per stage Vulkan guarantees, fewer than any desktop driver or lavapipe offers
 	 * (lavapipe and NVIDIA: 10^6), so a device under that says so here rather than failing
@@ -434,10 +440,13 @@ enum rnd_result rnd_context_create(const struct rnd_context_desc *desc, struct r
 	if ((r = rnd_moments_init(ctx, err)) != RND_OK) goto fail_moments;
 	if ((r = rnd_slots_init(ctx, err)) != RND_OK) goto fail_slots;
 	if ((r = rnd_cache_init(ctx, err)) != RND_OK) goto fail_cache;
+	if ((r = rnd_env_init(ctx, err)) != RND_OK) goto fail_env;
 	rnd_log(ctx, 2, "device '%s' (%s %s)", ctx->props.deviceName, ctx->driver_name, ctx->driver_info);
 	*out = ctx;
 	return RND_OK;
 
+fail_env:
+	rnd_cache_release_all(ctx);
 fail_cache:
 	rnd_slots_release(ctx);
 fail_slots:
@@ -461,6 +470,7 @@ void rnd_context_destroy(struct rnd_context *ctx)
 {
 	if (!ctx) return;
 	if (ctx->device) vkDeviceWaitIdle(ctx->device); /* once, at shutdown: nothing may be in flight */
+	rnd_env_release_all(ctx);
 	rnd_cache_release_all(ctx);
 	rnd_slots_release(ctx);
 	rnd_moments_release(ctx);

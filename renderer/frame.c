@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "contact.h"
+#include "env.h"
+#include "env_pass.h"
 #include "frame.h"
 #include "material.h"
 #include "moments.h"
@@ -42,7 +44,7 @@ static VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1
 
 /* Where each region starts in the slot's parameter buffer. */
 struct params_layout {
-	VkDeviceSize off_frame, off_mat, off_light, off_view, total;
+	VkDeviceSize off_frame, off_mat, off_light, off_view, off_env, total;
 	uint32_t nmat, nlight, nview;
 };
 
@@ -58,12 +60,13 @@ static void params_layout(const struct rnd_context *ctx, const struct rnd_scene 
 	VkDeviceSize off_mat = align_up(sizeof(struct umbra_frame), al);
 	VkDeviceSize off_light = align_up(off_mat + nmat * sizeof(struct umbra_material), al);
 	VkDeviceSize off_view = align_up(off_light + nlight * sizeof(struct umbra_light), al);
-	VkDeviceSize total = off_view + nview * sizeof(struct umbra_shadow_view);
-	*lay = (struct params_layout){off_frame, off_mat, off_light, off_view, total, nmat, nlight, nview};
+	VkDeviceSize off_env = align_up(off_view + nview * sizeof(struct umbra_shadow_view), al);
+	VkDeviceSize total = off_env + sizeof(struct umbra_env);
+	*lay = (struct params_layout){off_frame, off_mat, off_light, off_view, off_env, total, nmat, nlight, nview};
 }
 
 static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const struct rnd_camera_plan *cam,
-                        float exposure)
+                        float exposure, uint32_t shaded_lights)
 {
 	memcpy(f->view_proj, cam->view_proj, sizeof f->view_proj);
 	memcpy(f->view, cam->view, sizeof f->view);
@@ -81,7 +84,7 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	f->mode[0] = record_tonemap(sc->output.tonemap);
 	f->mode[1] = record_debug(sc->output.debug);
 	f->mode[2] = sc->output.debug_light;
-	f->mode[3] = sc->light_count;
+	f->mode[3] = shaded_lights;
 	f->mode2[0] = sc->output.pixels == RND_PIXELS_RGBA32F ? 1u : 0u;
 	f->mode2[1] = sc->output.transparent ? 1u : 0u;
 	/* UMBRA_LIGHT_CULL=0: every pixel shades every light, for the test that culling
@@ -153,7 +156,8 @@ static void write_light(const struct rnd_context *ctx, struct umbra_light *l, co
 }
 
 /* Set 0 of the draw pipelines: the four regions, the depth and moment atlases, the camera depth. */
-static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay, bool contact)
+static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struct params_layout *lay, bool contact,
+                        const struct rnd_env_use *env, bool env_pass)
 {
 	VkDescriptorBufferInfo bi[4] = {
 		{s->params.buf, lay->off_frame, sizeof(struct umbra_frame)},
@@ -184,7 +188,25 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 		{ctx->pipes.shadow_sampler, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
 		{VK_NULL_HANDLE, s->visibility.view, VK_IMAGE_LAYOUT_GENERAL},
 	};
-	VkWriteDescriptorSet w[12];
+	VkWriteDescriptorSet w[UMBRA_BINDING_COUNT];
+	/* The environment: its block and images (the slot's white stand-ins without a map), the
+	 * environment pass's images (stand-ins without the pass). */
+	VkDescriptorBufferInfo ebi = {s->params.buf, lay->off_env, sizeof(struct umbra_env)};
+	VkDescriptorImageInfo ei[6];
+	rnd_env_images(ctx, env, s, ei);
+	const struct rnd_image_res *pass[3] = {&s->env_surfaces, &s->env_normals, &s->env_vis};
+	for (int i = 0; i < 3; i++)
+		ei[3 + i] = env_pass ? (VkDescriptorImageInfo){ctx->pipes.shadow_sampler, pass[i]->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}
+		                     : (VkDescriptorImageInfo){ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+	w[12] = (VkWriteDescriptorSet){
+		.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_ENV,
+		.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &ebi,
+	};
+	for (int i = 0; i < 6; i++)
+		w[13 + i] = (VkWriteDescriptorSet){
+			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_ENV_SPECULAR + i,
+			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &ei[i],
+		};
 	for (int i = 0; i < 4; i++)
 		w[8 + i] = (VkWriteDescriptorSet){
 			.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = s->set, .dstBinding = UMBRA_BINDING_SURFACES + i,
@@ -210,7 +232,7 @@ static void bind_params(struct rnd_context *ctx, struct rnd_slot *s, const struc
 			.pBufferInfo = i < 4 ? &bi[i] : NULL, .pImageInfo = i == 4 ? &ii : NULL,
 		};
 	}
-	vkUpdateDescriptorSets(ctx->device, 12, w, 0, NULL);
+	vkUpdateDescriptorSets(ctx->device, UMBRA_BINDING_COUNT, w, 0, NULL);
 }
 
 /* minmax.comp: the scratch map in, the depth bounds out. moments.frag: the depth atlas and the
@@ -253,7 +275,8 @@ static void bind_moments(struct rnd_context *ctx, struct rnd_slot *s)
 
 enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                 const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                float exposure, bool contact, struct rnd_error *err)
+                                float exposure, bool contact, const struct rnd_env_use *env, bool env_pass,
+                                struct rnd_error *err)
 {
 	struct params_layout lay;
 	params_layout(ctx, sc, &lay);
@@ -263,12 +286,20 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
 	if (r != RND_OK) return r;
 	uint8_t *base = s->params.map;
 	memset(base, 0, lay.total);
-	write_frame((struct umbra_frame *)(base + lay.off_frame), sc, cam, exposure);
+	/* The environment's directions come after the scene's lights (render.c): lights, but not
+	 * shaded as such (ibl.glsl reads their maps). */
+	uint32_t env_lights = env ? env->mapped : 0, shaded = sc->light_count - env_lights;
+	write_frame((struct umbra_frame *)(base + lay.off_frame), sc, cam, exposure, shaded);
+	float inv_vp[16];
+	if (!rnd_mat4_invert(inv_vp, cam->view_proj)) memset(inv_vp, 0, sizeof inv_vp);
+	static const struct rnd_env_use none;
+	rnd_env_write(env ? env : &none, &sc->environment, inv_vp, shaded, rnd_env_pass_scale(sc->width, sc->height),
+	              (struct umbra_env *)(base + lay.off_env));
 	write_materials((struct umbra_material *)(base + lay.off_mat), sc);
 	struct umbra_light *l = (struct umbra_light *)(base + lay.off_light);
 	for (uint32_t i = 0; i < sc->light_count; i++) write_light(ctx, &l[i], sc, sp, i);
 	memcpy(base + lay.off_view, sp->views, sp->view_count * sizeof(struct umbra_shadow_view));
-	bind_params(ctx, s, &lay, contact);
+	bind_params(ctx, s, &lay, contact, env, env_pass);
 	bind_moments(ctx, s);
 	return RND_OK;
 }

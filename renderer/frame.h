@@ -12,13 +12,19 @@
 #include "plan.h"
 #include "slot.h"
 
+struct rnd_env_use;
+
 /* Fills the uniform/storage regions (growing the slot's parameter buffer when needed) and
  * points the slot's descriptor sets at them. contact: the view draws its camera depth
  * (slot->scene_depth, bound for contact shadows). The slot's visibility-pass images are bound
  * too (visibility.c): the caller makes sure they exist. */
+/* sc: the scene with the environment's directions after its own lights (render.c); env: what
+ * the render holds of its environment (NULL: none), for the umbra_env block and its images;
+ * env_pass: the environment pass's images are bound (else the slot's white stand-ins). */
 enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
                                 const struct rnd_camera_plan *cam, const struct rnd_shadow_plan *sp,
-                                float exposure, bool contact, struct rnd_error *err);
+                                float exposure, bool contact, const struct rnd_env_use *env, bool env_pass,
+                                struct rnd_error *err);
 
 /* The 32 Poisson-disk taps of the frame block (x, y pairs; PCSS's search and filter), and the
  * longest tap's length (umbra_frame.params.w). Tests check the order the search relies on. */

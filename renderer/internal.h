@@ -86,7 +86,7 @@ struct rnd_pipelines {
 	 * world position and normal per pixel */
 	VkPipeline surfaces[2];
 	/* Main-pass variants, created on first use (rnd_pipelines_main) and kept. */
-	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs;
+	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, background_fs, env_vis_fs;
 	pthread_mutex_t mu;
 	uint32_t variant_count;
 	struct rnd_main_variant {
@@ -99,6 +99,9 @@ struct rnd_pipelines {
 			uint32_t atlas_view;         /* 1 = debug view `atlas` (fullscreen.vert + atlas.frag) */
 			uint32_t vis_pass;           /* 1 = the visibility pass (fullscreen.vert + vis.frag) */
 			uint32_t vis_read;           /* 1 = main pass reading the visibility pass (mesh_vis.frag) */
+			uint32_t background;         /* 1 = the environment map behind the scene (fullscreen.vert +
+			                                env_background.frag, where the depth is still the far plane) */
+			uint32_t env_pass;           /* 1 = the environment pass (fullscreen.vert + env_vis.frag, R16) */
 			uint32_t sc[UMBRA_SC_COUNT]; /* mesh.frag specialization constants */
 		} key;
 		VkPipeline pipeline;
@@ -121,6 +124,7 @@ struct rnd_moments {
 
 struct rnd_slot;
 struct rnd_shadow_cache;
+struct rnd_env_cache;
 
 struct rnd_context {
 	struct rnd_context_desc desc;
@@ -140,6 +144,7 @@ struct rnd_context {
 	struct rnd_pipelines pipes;
 	struct rnd_moments moments;
 	struct rnd_shadow_cache *cache;      /* shadow_cache.c */
+	struct rnd_env_cache *env;           /* env.c: environment maps prefiltered on the device */
 	struct rnd_image_res atlas_depth;    /* D32, GENERAL layout, every shadow view is a tile */
 	struct rnd_image_res atlas_moments;  /* VSM / EVSM moments, same tiles */
 	struct rnd_image_res atlas_bounds;   /* PCSS depth bounds: a texel per UMBRA_BOUNDS_BLOCK² block */
@@ -188,6 +193,10 @@ enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format
                                         uint32_t layers, uint32_t samples, uint32_t levels, VkImageUsageFlags usage,
                                         VkImageAspectFlags aspect, const char *name, struct rnd_image_res *out,
                                         struct rnd_error *err);
+/* A cube map (6 layers, cube-compatible) of `levels` mip levels; its view is a cube of them all. */
+enum rnd_result rnd_image_create_cube(struct rnd_context *ctx, VkFormat format, uint32_t side, uint32_t levels,
+                                      VkImageUsageFlags usage, const char *name, struct rnd_image_res *out,
+                                      struct rnd_error *err);
 void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im);
 
 /* pipelines.c */

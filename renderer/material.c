@@ -86,6 +86,9 @@ static void write_extensions(const struct rnd_material *in, struct umbra_materia
 	}
 	out->sheen[3] = clamp01(in->sheen.roughness);
 	out->specular[3] = bits & UMBRA_EXT_SPECULAR ? clamp01(in->specular.factor) : 1;
+	out->ext[1] = (bits & UMBRA_EXT_SPECULAR) && in->specular.spec_gloss;
+	float see = clamp01(in->see_through);
+	memcpy(&out->ext[2], &see, sizeof see);
 }
 
 void rnd_material_write(const struct rnd_material *in, struct umbra_material *out)

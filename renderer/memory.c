@@ -119,15 +119,17 @@ enum rnd_result rnd_image_create(struct rnd_context *ctx, VkFormat format, uint3
 	return rnd_image_create_levels(ctx, format, w, h, layers, samples, 1, usage, aspect, name, out, err);
 }
 
-enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h,
-                                        uint32_t layers, uint32_t samples, uint32_t levels, VkImageUsageFlags usage,
-                                        VkImageAspectFlags aspect, const char *name, struct rnd_image_res *out,
-                                        struct rnd_error *err)
+/* An image with `levels` mip levels and a view of all of it: a cube (6 layers, cube-compatible)
+ * when cube is set, else 2D or a 2D array by its layers. */
+static enum rnd_result image_create(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h, uint32_t layers,
+                                    uint32_t samples, uint32_t levels, VkImageUsageFlags usage, VkImageAspectFlags aspect,
+                                    bool cube, const char *name, struct rnd_image_res *out, struct rnd_error *err)
 {
 	VkResult vr;
 	memset(out, 0, sizeof *out);
 	VkImageCreateInfo ici = {
-		.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, .imageType = VK_IMAGE_TYPE_2D, .format = format,
+		.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, .flags = cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0,
+		.imageType = VK_IMAGE_TYPE_2D, .format = format,
 		.extent = {w, h, 1}, .mipLevels = levels, .arrayLayers = layers, .samples = (VkSampleCountFlagBits)samples,
 		.tiling = VK_IMAGE_TILING_OPTIMAL, .usage = usage, .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
 		.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
@@ -155,7 +157,7 @@ enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format
 	}
 	VkImageViewCreateInfo vci = {
 		.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = out->img,
-		.viewType = layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
+		.viewType = cube ? VK_IMAGE_VIEW_TYPE_CUBE : layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
 		.format = format, .subresourceRange = {aspect, 0, levels, 0, layers},
 	};
 	if ((vr = vkCreateImageView(ctx->device, &vci, NULL, &out->view)) != VK_SUCCESS) {
@@ -175,6 +177,21 @@ fail_image:
 	vkDestroyImage(ctx->device, out->img, NULL);
 	memset(out, 0, sizeof *out);
 	return err->code;
+}
+
+enum rnd_result rnd_image_create_levels(struct rnd_context *ctx, VkFormat format, uint32_t w, uint32_t h,
+                                        uint32_t layers, uint32_t samples, uint32_t levels, VkImageUsageFlags usage,
+                                        VkImageAspectFlags aspect, const char *name, struct rnd_image_res *out,
+                                        struct rnd_error *err)
+{
+	return image_create(ctx, format, w, h, layers, samples, levels, usage, aspect, false, name, out, err);
+}
+
+enum rnd_result rnd_image_create_cube(struct rnd_context *ctx, VkFormat format, uint32_t side, uint32_t levels,
+                                      VkImageUsageFlags usage, const char *name, struct rnd_image_res *out,
+                                      struct rnd_error *err)
+{
+	return image_create(ctx, format, side, side, 6, 1, levels, usage, VK_IMAGE_ASPECT_COLOR_BIT, true, name, out, err);
 }
 
 void rnd_image_destroy(struct rnd_context *ctx, struct rnd_image_res *im)

@@ -22,6 +22,8 @@
 #include "surface.frag.spv.h"
 #include "vis.frag.spv.h"
 #include "mesh_vis.frag.spv.h"
+#include "env_background.frag.spv.h"
+#include "env_vis.frag.spv.h"
 
 enum rnd_result rnd_shader_module(struct rnd_context *ctx, const uint32_t *code, size_t size, const char *name,
                                   VkShaderModule *out, struct rnd_error *err)
@@ -46,6 +48,13 @@ const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT] = {
 	[UMBRA_BINDING_SURFACE_NORMALS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VISIBILITY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 	[UMBRA_BINDING_VISIBILITY_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+	[UMBRA_BINDING_ENV] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+	[UMBRA_BINDING_ENV_SPECULAR] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_MAP] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_BRDF] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_SURFACES] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_NORMALS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+	[UMBRA_BINDING_ENV_VIS] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 };
 
 static enum rnd_result make_layouts(struct rnd_context *ctx, struct rnd_error *err)
@@ -135,6 +144,7 @@ struct pipe_desc {
 	VkFormat color_rest;        /* when set: the format of attachments 1.. */
 	bool no_vertices;           /* fullscreen: no vertex input, no depth test */
 	bool depth_less_ro;         /* fullscreen over a depth: test LESS (passes where it is above 0), no writes */
+	bool depth_equal_ro;        /* fullscreen over a depth: test EQUAL (passes where it is still 0), no writes */
 	const VkSpecializationInfo *spec;  /* fragment stage */
 	VkPipelineLayout layout;    /* VK_NULL_HANDLE: the main passes' (ctx->pipes.layout) */
 	const char *name;
@@ -201,9 +211,10 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 	};
 	VkPipelineDepthStencilStateCreateInfo ds = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-		.depthTestEnable = !d->no_vertices || d->depth_less_ro,
+		.depthTestEnable = !d->no_vertices || d->depth_less_ro || d->depth_equal_ro,
 		.depthWriteEnable = !d->after_prepass && !d->no_vertices,
 		.depthCompareOp = d->shadow ? VK_COMPARE_OP_LESS_OR_EQUAL : d->depth_less_ro ? VK_COMPARE_OP_LESS
+		                : d->depth_equal_ro ? VK_COMPARE_OP_EQUAL
 		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
 	};
 	VkPipelineColorBlendStateCreateInfo cb = {
@@ -269,6 +280,10 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 		goto fail;
 	if ((r = rnd_shader_module(ctx, spv_vis_frag, sizeof spv_vis_frag, "vis.frag", &p->vis_fs, err)) != RND_OK) goto fail;
 	if ((r = rnd_shader_module(ctx, spv_mesh_vis_frag, sizeof spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs, err)) != RND_OK)
+		goto fail;
+	if ((r = rnd_shader_module(ctx, spv_env_background_frag, sizeof spv_env_background_frag, "env_background.frag",
+	                           &p->background_fs, err)) != RND_OK ||
+	    (r = rnd_shader_module(ctx, spv_env_vis_frag, sizeof spv_env_vis_frag, "env_vis.frag", &p->env_vis_fs, err)) != RND_OK)
 		goto fail;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
@@ -359,11 +374,12 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
 	char name[128];
-	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
-	         key->aov ? "aov" : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)" : "main",
+	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
+	         key->aov ? "aov" : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)"
+	         : key->background ? "background" : key->env_pass ? "environment" : "main",
 	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
 	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10],
-	         key->sc[11]);
+	         key->sc[11], key->sc[12]);
 	struct pipe_desc d = {
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
@@ -398,6 +414,27 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 		d.samples = 1;
 		d.no_vertices = true;
 		d.depth_less_ro = true;
+		d.after_prepass = false;
+		d.cull_back = false;
+	}
+	if (key->background) {
+		/* The environment behind the scene: a fullscreen triangle at depth 0 (the far plane of
+		 * the reversed Z), kept where the depth is still 0: no geometry, sample by sample. */
+		d.vs = p->fullscreen_vs;
+		d.fs = p->background_fs;
+		d.no_vertices = true;
+		d.depth_equal_ro = true;
+		d.after_prepass = false;
+		d.cull_back = false;
+	}
+	if (key->env_pass) {
+		/* The environment pass: a fullscreen triangle over its grid, one R16 target. */
+		d.vs = p->fullscreen_vs;
+		d.fs = p->env_vis_fs;
+		d.color = VK_FORMAT_R16_UNORM;
+		d.depth = VK_FORMAT_UNDEFINED;
+		d.samples = 1;
+		d.no_vertices = true;
 		d.after_prepass = false;
 		d.cull_back = false;
 	}
@@ -448,6 +485,8 @@ void rnd_pipelines_release(struct rnd_context *ctx)
 	if (p->aov_fs) vkDestroyShaderModule(ctx->device, p->aov_fs, NULL);
 	if (p->vis_fs) vkDestroyShaderModule(ctx->device, p->vis_fs, NULL);
 	if (p->mesh_vis_fs) vkDestroyShaderModule(ctx->device, p->mesh_vis_fs, NULL);
+	if (p->background_fs) vkDestroyShaderModule(ctx->device, p->background_fs, NULL);
+	if (p->env_vis_fs) vkDestroyShaderModule(ctx->device, p->env_vis_fs, NULL);
 	if (p->fullscreen_vs) vkDestroyShaderModule(ctx->device, p->fullscreen_vs, NULL);
 	for (uint32_t i = 0; i < RND_TEXTURE_SAMPLERS; i++)
 		if (p->texture_samplers[i]) vkDestroySampler(ctx->device, p->texture_samplers[i], NULL);

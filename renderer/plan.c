@@ -202,7 +202,7 @@ static uint32_t hard_light_res(const struct rnd_light *L, const struct rnd_light
 static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
 {
 	if (s->dir_mode == RND_DIR_CASCADES) return true;
-	if (s->dir_mode == RND_DIR_FIT || s->dir_mode == RND_DIR_CLIPMAP) return false;
+	if (s->dir_mode == RND_DIR_FIT || s->dir_mode == RND_DIR_CLIPMAP || s->dir_mode == RND_DIR_CASTERS) return false;
 	/* auto: one fitted map when the whole scene is seen at about one scale (its size is
 	 * within a few camera distances); else cascades. */
 	float c[3], d[3], e[3];
@@ -402,9 +402,13 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		/* fit: the box (fit_box) of the scene's light-space bounds, the texels it has at
 		 * the light's resolution; then, unless the light asks for a resolution, the casters'. */
 		float cx, cy, hx, hy;
-		fit_box(view, bounds, lp->filter, &cx, &cy, &hx, &hy);
+		/* RND_DIR_CASTERS (the environment's directions): the casters' box at the light's own
+		 * resolution; as deep as the scene, which holds every receiver. */
+		bool own = s->dir_mode == RND_DIR_CASTERS && casters && !rnd_aabb_is_empty(casters);
+		fit_box(view, own ? casters : bounds, lp->filter, &cx, &cy, &hx, &hy);
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
-		if (casters && s->resolution == 0) fit_casters(s, view, casters, lp, &fres, &cx, &cy, &hx, &hy, &grow);
+		if (own) grow = 1.0f + 2.0f * ((lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : (float)lp->pcf_radius) + 3.0f) / fres;
+		else if (casters && s->resolution == 0) fit_casters(s, view, casters, lp, &fres, &cx, &cy, &hx, &hy, &grow);
 		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
 		lp->max_distance = s->max_distance;
 	} else {

@@ -10,6 +10,7 @@
 #include <string.h>
 #include "moments.h"
 #include "contact.h"
+#include "env.h"
 #include "material.h"
 #include "mesh.h"
 #include "record.h"
@@ -139,13 +140,30 @@ uint32_t record_debug(enum rnd_debug d)
 	case RND_DEBUG_CASCADES: return UMBRA_DEBUG_CASCADES;
 	case RND_DEBUG_NORMALS: return UMBRA_DEBUG_NORMALS;
 	case RND_DEBUG_DEPTH: return UMBRA_DEBUG_DEPTH;
+	case RND_DEBUG_ENV_SHADOW: return UMBRA_DEBUG_ENV_SHADOW;
 	default: return UMBRA_DEBUG_NONE;
 	}
 }
 
-void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
-                     uint32_t ndraw, struct rnd_main_key *k)
+/* UMBRA_SC_ENV: what the view takes from its environment map. */
+static uint32_t env_bits(const struct record_view *rv)
 {
+	const struct rnd_scene *sc = rv->sc;
+	if (!rv->env || !rv->env->entry) return 0;
+	uint32_t bits = UMBRA_ENV_LIGHT;
+	if (rv->env->mapped) bits |= UMBRA_ENV_SHADOWS;
+	if (rv->env->mapped && rv->env_pass) bits |= UMBRA_ENV_PASS;
+	if (sc->environment.background_map && !sc->output.transparent &&
+	    (sc->output.debug == RND_DEBUG_NONE || sc->output.debug == RND_DEBUG_CASCADES))
+		bits |= UMBRA_ENV_BACKGROUND;
+	return bits;
+}
+
+void record_main_key(const struct record_view *rv, uint32_t ndraw, struct rnd_main_key *k)
+{
+	const struct rnd_scene *sc = rv->sc;
+	const struct rnd_shadow_plan *sp = rv->sp;
+	const struct draw *draws = rv->draws;
 	memset(k, 0, sizeof *k);
 	k->format = (uint32_t)sc->output.pixels;
 	k->samples = sc->output.msaa > 1 ? 4 : 1;
@@ -176,6 +194,7 @@ void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *s
 	k->sc[UMBRA_SC_DEBUG] = record_debug(sc->output.debug);
 	k->sc[UMBRA_SC_LINEAR] = sc->output.pixels == RND_PIXELS_RGBA32F;
 	k->sc[UMBRA_SC_TONEMAP] = k->sc[UMBRA_SC_LINEAR] ? 0 : record_tonemap(sc->output.tonemap);
+	k->sc[UMBRA_SC_ENV] = env_bits(rv);
 	uint64_t dense = 0;
 	for (uint32_t i = 0; i < ndraw; i++) {
 		if (draws[i].flags & UMBRA_DRAW_SHADOW_CATCHER) k->sc[UMBRA_SC_CATCHER] = 1;
@@ -248,7 +267,8 @@ static VkClearColorValue main_clear(const struct rnd_scene *sc)
 	/* Transparent: the background is (0,0,0,0), so the MSAA resolve yields premultiplied
 	 * colour at edges (readback.c turns 8/16-bit outputs into straight alpha, as PNG wants). */
 	if (sc->output.transparent) clear.float32[0] = clear.float32[1] = clear.float32[2] = 0.0f;
-	if (sc->output.debug == RND_DEBUG_SHADOW) clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
+	if (sc->output.debug == RND_DEBUG_SHADOW || sc->output.debug == RND_DEBUG_ENV_SHADOW)
+		clear.float32[0] = clear.float32[1] = clear.float32[2] = clear.float32[3] = 1.0f;
 	return clear;
 }
 
@@ -341,7 +361,7 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 	uint32_t ndraw = rv->ndraw;
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
-	record_main_key(sc, rv->sp, rv->draws, ndraw, &key);
+	record_main_key(rv, ndraw, &key);
 	key.vis_read = rv->vis;
 	/* Reading the visibility pass, a fragment no longer filters: shading a hidden one costs about
 	 * what drawing every triangle twice does, or less on real models. Measured (main pass, 512²,
@@ -369,6 +389,21 @@ enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const s
 		vkCmdDraw(cmd, 3, 1, 0, 0);
 	}
 	draw_main(ctx, s, rv, ndraw, key.prepass, pipes, ms);
+	if (!atlas_pipe && (key.sc[UMBRA_SC_ENV] & UMBRA_ENV_BACKGROUND)) {
+		/* The map behind the scene: a fullscreen triangle at the far plane (depth 0 of the
+		 * reversed Z) where nothing was drawn (env_background.frag). */
+		struct rnd_main_key bk = key;
+		bk.background = 1;
+		bk.cull_back = 0;
+		bk.prepass = 0;
+		VkPipeline bg;
+		if ((r = rnd_pipelines_main(ctx, &bk, &bg, err)) != RND_OK) {
+			vkCmdEndRendering(cmd);
+			return r;
+		}
+		vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, bg);
+		vkCmdDraw(cmd, 3, 1, 0, 0);
+	}
 	vkCmdEndRendering(cmd);
 	return RND_OK;
 }
@@ -442,12 +477,13 @@ enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const st
 	VkRect2D area = record_band_area(rv);
 	struct rnd_main_key key;
 	VkPipeline pipes[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
-	record_main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
+	record_main_key(rv, rv->ndraw, &key);
 	memset(&key.sc[UMBRA_SC_DEBUG], 0, sizeof key.sc[0]);
 	key.sc[UMBRA_SC_DEBUG] = 0;
 	key.sc[UMBRA_SC_LINEAR] = 1;
 	key.sc[UMBRA_SC_TONEMAP] = 0;
 	key.sc[UMBRA_SC_CATCHER] = 0;
+	key.sc[UMBRA_SC_ENV] = 0;
 	key.sc[UMBRA_SC_MATERIAL_EXT] = 0;   /* the AOVs hold no lobe */
 	key.format = RND_PIXELS_RGBA32F;
 	key.samples = 1;

@@ -9,6 +9,8 @@
 #include "plan.h"
 #include "slot.h"
 
+struct rnd_env_use;
+
 /* One object's draw, made by render.c's upload. */
 struct draw {
 	uint32_t first_index, index_count;
@@ -52,6 +54,11 @@ struct record_view {
 	uint32_t band_y, band_h;       /* band_h 0 = every row */
 	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
 	bool vis;                      /* shadows from the visibility pass (visibility.c), drawn per band */
+	/* Every light the shadow passes draw for: the scene's, then the environment's directions
+	 * (render.c, env_shadow.h); NULL: the scene's. */
+	const struct rnd_light *shadow_lights;
+	const struct rnd_env_use *env;  /* the view's environment (NULL: none) */
+	bool env_pass;                 /* its shadows from the environment pass (env_pass.c), drawn once */
 };
 
 /* The rows of the view that this submit draws (band_y, band_h). */
@@ -90,9 +97,8 @@ void record_shadow_part(struct rnd_context *ctx, struct rnd_slot *s, const struc
 /* Whether shadow view v draws draw i (a caster inside its frustum) and, if so, with back faces
  * culled (*cull). */
 bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, int *cull);
-/* The specialization key of this scene's main pass (see mesh.frag). */
-void record_main_key(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, const struct draw *draws,
-                     uint32_t ndraw, struct rnd_main_key *k);
+/* The specialization key of the view's main pass (see mesh.frag) over its first ndraw draws. */
+void record_main_key(const struct record_view *rv, uint32_t ndraw, struct rnd_main_key *k);
 enum rnd_result record_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,
                             struct rnd_error *err);
 enum rnd_result record_aov(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *v,

@@ -21,7 +21,7 @@ bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, i
 	const struct draw *d = &rv->draws[i];
 	if (!d->cast || !d->index_count) return false;
 	if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) return false;
-	const struct rnd_light *L = &rv->sc->lights[sp->view_light[v]];
+	const struct rnd_light *L = &(rv->shadow_lights ? rv->shadow_lights : rv->sc->lights)[sp->view_light[v]];
 	*cull = d->single_sided ||
 	        (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
 	return true;

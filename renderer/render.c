@@ -16,6 +16,8 @@
 #include <string.h>
 #include <time.h>
 #include "contact.h"
+#include "env_pass.h"
+#include "env_shadow.h"
 #include "proxy.h"
 #include "visibility.h"
 #include "estimate.h"
@@ -71,6 +73,11 @@ static enum rnd_result validate(const struct rnd_context *ctx, const struct rnd_
 struct render {
 	struct rnd_context *ctx;
 	const struct rnd_scene *sc;
+	/* The scene as the shadow passes see it: its lights, then the environment's shadow
+	 * directions (env_shadow.h), which only those passes and ibl.glsl's lookups use. */
+	struct rnd_scene esc;
+	struct rnd_light lights[UMBRA_MAX_LIGHTS];
+	struct rnd_env_use env;
 	struct rnd_slot *s;
 	struct rnd_sheet sheet;
 	void *arena;                  /* one block: draws, shadow plan, levels of detail, texture list */
@@ -172,15 +179,19 @@ static void plane_casters(struct render *rq)
 	bool fill_only[RND_PLANES_JUDGED_MAX] = {false};
 	for (uint32_t i = 0; i < sc->object_count && rnd_planes_judged(sc); i++) {
 		if (!draws[i].cast || sc->objects[i].shape != RND_SHAPE_PLANE) continue;
-		bool other = false, seen = false;
+		/* seen: for the scene's lights; seen_env: for the environment's directions too (the
+		 * plane then casts into their maps, but the box that sizes a sun's map stays the same) */
+		bool other = false, seen = false, seen_env = false;
 		for (uint32_t j = 0; j < sc->object_count && !seen; j++) {
 			if (j == i) continue;
 			rnd_object_bounds(sc, j, &draws[j].bounds, &b);
 			if (rnd_aabb_is_empty(&b)) continue;
 			other = true;
 			seen = rnd_plane_may_shadow_seen(sc, &sc->objects[i], &b, cams, ncam);
+			if (!seen_env && rq->esc.light_count > sc->light_count)
+				seen_env = rnd_plane_may_shadow_seen(&rq->esc, &sc->objects[i], &b, cams, ncam);
 		}
-		draws[i].cast = seen || (other && moments);
+		draws[i].cast = seen || seen_env || (other && moments);
 		fill_only[i] = draws[i].cast && !seen;
 	}
 	rnd_aabb_empty(&rq->casters);
@@ -219,6 +230,24 @@ static uint64_t caster_key(const struct render *rq)
 	return geo;
 }
 
+/* The scene the shadow passes see (rq->esc): its lights, then the environment's directions
+ * that get maps, as many as fit in UMBRA_MAX_LIGHTS. */
+static void env_lights(struct render *rq)
+{
+	const struct rnd_scene *sc = rq->sc;
+	float ground[3];
+	bool has_ground = rnd_env_ground(sc, rq->draws, ground);
+	rnd_env_shadow_dirs(&rq->env, &sc->environment, has_ground ? ground : NULL);
+	rq->esc = *sc;
+	uint32_t n = sc->light_count < UMBRA_MAX_LIGHTS ? sc->light_count : UMBRA_MAX_LIGHTS;
+	if (!rq->env.mapped) return;
+	memcpy(rq->lights, sc->lights, n * sizeof *rq->lights);
+	rq->env.mapped = rnd_env_lights(&rq->env, &sc->environment, UMBRA_MAX_LIGHTS - n, rq->lights + n);
+	rq->esc.lights = rq->lights;
+	rq->esc.light_count = n + rq->env.mapped;
+	rq->tm.env_directions = rq->env.mapped;
+}
+
 /* Everything before the first view: geometry, textures, targets, the readback buffer. */
 static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 {
@@ -229,8 +258,13 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	double t0 = now_ms();
 	rnd_pacer_init(&rq->pacer, sc);
 	if ((r = rnd_pacer_check(&rq->pacer, err)) != RND_OK) return r;
+	double wait_until = sc->deadline_ns ? (double)sc->deadline_ns * 1e-9 : 0.0;
+	if ((r = rnd_env_acquire(ctx, &sc->environment, wait_until, &rq->env, err)) != RND_OK) return r;
+	rq->pacer.ctx = ctx;
+	rq->pacer.env = &rq->env;
 	if ((r = rnd_upload_scene(ctx, s, sc, &rq->pacer, rq->lod, rq->proxies, rq->draws, &rq->bounds, err)) != RND_OK) return r;
 	frame_bounds(rq);
+	env_lights(rq);
 	if ((r = rnd_material_textures(ctx, s, sc, rq->draws, rq->tex, &rq->ntex, err)) != RND_OK) return r;
 	rq->tm.upload_ms = now_ms() - t0;
 	rq->pacer.tex = rq->tex;
@@ -300,10 +334,11 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		draws[i].cull_back = !(draws[i].flags & UMBRA_DRAW_SPHERE) &&
 		                     (draws[i].single_sided || (draws[i].closed && record_camera_outside(cam, &draws[i].bounds)));
-	if ((r = rnd_shadow_plan_with(sc, &rq->bounds, &rq->casters, cam, v ? rq->cascades : NULL, sp, err)) != RND_OK)
+	const struct rnd_scene *esc = &rq->esc;
+	if ((r = rnd_shadow_plan_with(esc, &rq->bounds, &rq->casters, cam, v ? rq->cascades : NULL, sp, err)) != RND_OK)
 		return r;
 	if (v == 0)
-		for (uint32_t i = 0; i < sc->light_count && i < UMBRA_MAX_LIGHTS; i++)
+		for (uint32_t i = 0; i < esc->light_count && i < UMBRA_MAX_LIGHTS; i++)
 			rq->cascades[i] = sp->lights[i].follows_camera && !sp->lights[i].clipmap;
 	bool any_moments = false;
 	for (uint32_t i = 0; i < sc->light_count; i++)
@@ -327,7 +362,7 @@ static enum rnd_result plan_view(struct render *rq, uint32_t v, struct rnd_camer
 static enum rnd_result grant_tiles(struct render *rq, struct rnd_error *err)
 {
 	struct rnd_context *ctx = rq->ctx;
-	const struct rnd_scene *sc = rq->sc;
+	const struct rnd_scene *sc = &rq->esc;
 	const struct rnd_shadow_plan *sp = rq->sp;
 	struct rnd_cache_request req[UMBRA_MAX_LIGHTS];
 	uint32_t ngrant = 0;
@@ -421,7 +456,10 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	        : s->surfaces.img && s->visibility.img ? RND_OK : rnd_slot_visibility(ctx, s, 1, 1, 1, err);
 	if (r != RND_OK) return r;
 	if (vis) rq->tm.visibility_views++;
-	if ((r = rnd_frame_write(ctx, s, sc, &cam, rq->sp, camera->exposure, contact, err)) != RND_OK) return r;
+	bool env_pass = rnd_env_pass_wanted(sc, &rq->env, rq->draws, sc->object_count);
+	if (env_pass && (r = rnd_slot_env_pass(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
+	if ((r = rnd_frame_write(ctx, s, &rq->esc, &cam, rq->sp, camera->exposure, contact, &rq->env, env_pass, err)) != RND_OK)
+		return r;
 
 	uint32_t col = v % sh->cols, row = v / sh->cols;
 	VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sh->width + (VkDeviceSize)col * sc->width);
@@ -429,7 +467,7 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.sc = sc, .cam = &cam, .sp = rq->sp, .draws = rq->draws, .ndraw = sc->object_count, .aov_passes = sh->passes,
 		.color_offset = cell * sh->px, .aov_offset = sh->color_bytes + cell * 16, .aov_stride = sh->att_bytes,
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = contact,
-		.vis = vis,
+		.vis = vis, .shadow_lights = rq->esc.lights, .env = &rq->env, .env_pass = env_pass,
 	};
 	return rnd_submit_view(ctx, s, &rv, &rq->pacer, &rq->tm, &rq->gpu_busy, err);
 }
@@ -453,6 +491,8 @@ static void finish(struct render *rq, enum rnd_result r, struct rnd_error *err)
 		rnd_slot_drop_textures(ctx, rq->s);
 		rnd_slot_trim(ctx, rq->s);
 	}
+	rq->tm.env_ms = rq->env.ms;
+	rnd_env_done(ctx, &rq->env, r == RND_OK, rq->gpu_busy);
 	rnd_slot_release(ctx, rq->s);
 	free(rq->arena);
 }

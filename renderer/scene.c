@@ -41,6 +41,9 @@ void rnd_scene_defaults(struct rnd_scene *scene)
 	set3(e->ambient_sky, 0.6f, 0.7f, 0.9f);
 	set3(e->ambient_ground, 0.3f, 0.25f, 0.2f);
 	e->ambient_intensity = 0.3f;
+	e->source = RND_ENV_AMBIENT;
+	e->intensity = 1.0f;
+	e->shadow_directions = RND_DEFAULT_ENV_DIRECTIONS;
 
 	scene->output.pixels = RND_PIXELS_RGBA8;
 	scene->output.transparent = false;

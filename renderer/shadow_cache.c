@@ -11,6 +11,7 @@
 #include <unistd.h>
 #include "moments.h"
 #include "shadow_cache.h"
+#include "env.h"
 #include "slot.h"
 
 #define MAX_ENTRIES 1024
@@ -385,6 +386,7 @@ void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st)
 	pthread_mutex_unlock(&c->mu);
 	st->shadow_cache_hits = __atomic_load_n(&ctx->stats_hits, __ATOMIC_RELAXED);
 	st->shadow_cache_misses = __atomic_load_n(&ctx->stats_misses, __ATOMIC_RELAXED);
+	rnd_env_stats(ctx, &st->env_maps, &st->env_builds);
 }
 
 void rnd_cache_wake(struct rnd_context *ctx)
@@ -444,5 +446,5 @@ uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s)
 		}
 	}
 	pthread_mutex_unlock(&c->mu);
-	return released;
+	return released + rnd_env_trim(ctx, idle_s);
 }

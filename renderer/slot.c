@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "slot.h"
+#include "env_pass.h"
 #include "material.h"
 
 /* A descriptor pool (named "slot N <what> descriptor pool") holding exactly `count` sets, one
@@ -88,9 +89,9 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		RND_NAME(ctx, VK_OBJECT_TYPE_QUERY_POOL, s->queries, "slot %u timestamps", index);
 	}
 	VkDescriptorPoolSize sizes[4] = {
-		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
+		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 4},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 7},
+		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 13},
 		{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
 	};
 	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
@@ -105,6 +106,10 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, 1, 1, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
 	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->white, err)) != RND_OK)
 		goto fail_texture_pool;
+	snprintf(name, sizeof name, "slot %u white cube", index);
+	if ((r = rnd_image_create_cube(ctx, VK_FORMAT_R8G8B8A8_UNORM, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+	                               name, &s->white_cube, err)) != RND_OK)
+		goto fail_white;
 	VkDescriptorImageInfo wi = {ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
 	VkWriteDescriptorSet ww[UMBRA_TEX_SLOTS];
 	for (uint32_t b = 0; b < UMBRA_TEX_SLOTS; b++)
@@ -127,6 +132,7 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 	return RND_OK;
 
 fail_white:
+	rnd_image_destroy(ctx, &s->white_cube);
 	rnd_image_destroy(ctx, &s->white);
 
 fail_texture_pool:
@@ -152,6 +158,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	if (!s) return;
 	rnd_slot_drop_textures(ctx, s);
 	rnd_image_destroy(ctx, &s->white);
+	rnd_image_destroy(ctx, &s->white_cube);
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
 	rnd_image_destroy(ctx, &s->moments_tmp);
 	rnd_image_destroy(ctx, &s->shadow_scratch);
@@ -164,6 +171,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_image_destroy(ctx, &s->normals);
 	rnd_image_destroy(ctx, &s->surfaces_depth);
 	rnd_image_destroy(ctx, &s->visibility);
+	rnd_env_pass_release(ctx, s);
 	rnd_buffer_destroy(ctx, &s->staging);
 	rnd_image_destroy(ctx, &s->resolve);
 	rnd_image_destroy(ctx, &s->depth);
@@ -359,6 +367,9 @@ void rnd_slot_trim(struct rnd_context *ctx, struct rnd_slot *s)
 		rnd_image_destroy(ctx, &s->surfaces_depth);
 		rnd_image_destroy(ctx, &s->visibility);
 	}
+	if (image_bytes(ctx, &s->env_surfaces) + image_bytes(ctx, &s->env_normals) + image_bytes(ctx, &s->env_depth) +
+	        image_bytes(ctx, &s->env_vis) > keep)
+		rnd_env_pass_release(ctx, s);
 	if (image_bytes(ctx, &s->shadow_scratch) + s->scratch_buf.size > keep) {
 		rnd_image_destroy(ctx, &s->shadow_scratch);
 		rnd_buffer_destroy(ctx, &s->scratch_buf);

@@ -36,7 +36,8 @@ struct rnd_slot {
 	VkDescriptorPool texture_pool;
 	VkDescriptorSet *texture_sets;    /* 1 + rnd_texture_sets(ctx->max_textures) */
 	struct rnd_image_res white;
-	bool white_ready;             /* cleared to white and in SHADER_READ_ONLY layout */
+	struct rnd_image_res white_cube;  /* 1x1 cube: the environment's stand-in in renders without a map */
+	bool white_ready;             /* both cleared to white and in SHADER_READ_ONLY layout */
 	/* AOV pass targets: UMBRA_AOV_ATTACHMENTS x RGBA32F + a single-sample depth */
 	struct rnd_image_res aov[UMBRA_AOV_ATTACHMENTS], aov_depth;
 	/* moment maps (VSM / EVSM) are blurred through this tile-sized temporary (GENERAL layout) */
@@ -54,6 +55,8 @@ struct rnd_slot {
 	/* the visibility pass (visibility.c): the view's surface positions and normals, their
 	 * depth, the visibility image */
 	struct rnd_image_res surfaces, normals, surfaces_depth, visibility;
+	/* the environment pass (env_pass.c): the surfaces at its scale, their depth, its visibility */
+	struct rnd_image_res env_surfaces, env_normals, env_depth, env_vis;
 };
 
 /* Makes the colour/depth targets match (format, w, h, samples). */

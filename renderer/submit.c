@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 #include "visibility.h"
+#include "env_pass.h"
 #include "submit.h"
 #include "contact.h"
 #include "cost.h"
@@ -190,6 +191,7 @@ static enum rnd_result cmd_open(struct rnd_slot *s, struct rnd_pacer *p, struct 
 	st->ts = RND_TS_START + 1;
 	if (p->prologue) {
 		record_textures(s, p->tex, p->ntex);
+		if (p->env) rnd_env_record(p->ctx, s->cmd, p->env);
 		p->prologue = false;
 		st->prologue = true;
 	}
@@ -363,10 +365,15 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 	struct cmd_state st = {0};
 	const struct rnd_scene *sc = rv->sc;
 	if ((r = submit_shadows(ctx, s, rv, p, &st, tm, gpu_busy, err)) != RND_OK) goto fail;
-	/* Contact shadows march against the whole view's depth: drawn once, before any band. */
+	/* Contact shadows march against the whole view's depth: drawn once, before any band; so is
+	 * the environment pass. */
 	if (rv->contact) {
 		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
 		record_scene_depth(ctx, s, rv);
+	}
+	if (rv->env_pass) {
+		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
+		if ((r = record_env_pass(ctx, s, rv, err)) != RND_OK) goto fail;
 	}
 
 	bool split = p->slice_ms > 0 || sc->band_rows;

@@ -18,6 +18,7 @@
 #ifndef UMBRA_RENDERER_SUBMIT_H
 #define UMBRA_RENDERER_SUBMIT_H
 
+#include "env.h"
 #include "record.h"
 
 struct rnd_pacer {
@@ -28,6 +29,8 @@ struct rnd_pacer {
 	const struct rnd_texture *const *tex; /* staged textures, recorded into the first submit */
 	uint32_t ntex;
 	bool prologue;              /* textures (and the slot's white texture) not yet recorded */
+	struct rnd_context *ctx;    /* for the environment's build, recorded with the prologue */
+	const struct rnd_env_use *env; /* env.h: what the render builds of its environment (NULL: nothing) */
 	/* The last two bands: rows and wall milliseconds (the next band's height comes from them). */
 	uint32_t rows[2];
 	double ms[2];

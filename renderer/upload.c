@@ -120,10 +120,18 @@ void record_textures(struct rnd_slot *s, const struct rnd_texture *const *tex, u
 		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
 		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
 		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+		record_image_barrier(cmd, s->white_cube.img, VK_IMAGE_ASPECT_COLOR_BIT, 6, VK_IMAGE_LAYOUT_UNDEFINED,
+		                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+		                     VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
 		VkClearColorValue white = {{1.0f, 1.0f, 1.0f, 1.0f}};
-		VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+		VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1}, cube = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 6};
 		vkCmdClearColorImage(cmd, s->white.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &white, 1, &range);
+		vkCmdClearColorImage(cmd, s->white_cube.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &white, 1, &cube);
 		record_image_barrier(cmd, s->white.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+		                     VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+		record_image_barrier(cmd, s->white_cube.img, VK_IMAGE_ASPECT_COLOR_BIT, 6, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
 		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
 		                     VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);

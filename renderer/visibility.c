@@ -103,11 +103,12 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
 
 /* Pass 1: the surfaces of the band's rows, cleared to 0 (nothing drawn); their depth stays an
  * attachment for pass 2's test. */
-static void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, VkRect2D area)
+void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, VkRect2D area,
+                     const struct rnd_surface_targets *t)
 {
 	VkCommandBuffer cmd = s->cmd;
-	const struct rnd_scene *sc = rv->sc;
-	const struct rnd_image_res *img[2] = {&s->surfaces, &s->normals};
+	const struct rnd_image_res *img[2] = {t->positions, t->normals};
+	const struct rnd_image_res *depth = t->depth;
 	VkRenderingAttachmentInfo ca[2];
 	for (int i = 0; i < 2; i++) {
 		record_image_barrier(cmd, img[i]->img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
@@ -119,13 +120,13 @@ static void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const s
 			.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}},
 		};
 	}
-	record_image_barrier(cmd, s->surfaces_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+	record_image_barrier(cmd, depth->img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
 	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
 	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
 	                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 	VkRenderingAttachmentInfo da = {
-		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = s->surfaces_depth.view,
+		.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO, .imageView = depth->view,
 		.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
 		.storeOp = VK_ATTACHMENT_STORE_OP_STORE, .clearValue.depthStencil = {0.0f, 0}, /* reversed Z */
 	};
@@ -134,8 +135,9 @@ static void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const s
 		.colorAttachmentCount = 2, .pColorAttachments = ca, .pDepthAttachment = &da,
 	};
 	vkCmdBeginRendering(cmd, &ri);
-	/* The main pass's viewport (the whole view) and the band's rows: the same pixels. */
-	VkViewport vp = {0, 0, (float)sc->width, (float)sc->height, 0, 1};
+	/* The main pass's viewport (the whole view, at the targets' scale) and the band's rows: the
+	 * same pixels. */
+	VkViewport vp = {0, 0, t->width, t->height, 0, 1};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
 	vkCmdSetScissor(cmd, 0, 1, &area);
 	record_bind_geometry(ctx, s);
@@ -157,7 +159,7 @@ static void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const s
 		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
 		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-	record_image_barrier(cmd, s->surfaces_depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+	record_image_barrier(cmd, depth->img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
 	                     VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
 	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
@@ -169,11 +171,12 @@ enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, c
 	const struct rnd_scene *sc = rv->sc;
 	VkCommandBuffer cmd = s->cmd;
 	struct rnd_main_key key;
-	record_main_key(sc, rv->sp, rv->draws, rv->ndraw, &key);
+	record_main_key(rv, rv->ndraw, &key);
 	/* Only the shadow constants shape vis.frag: the rest are zeroed so that scenes differing in
 	 * output, tone map or materials share one variant. */
 	key.sc[UMBRA_SC_LINEAR] = key.sc[UMBRA_SC_TONEMAP] = key.sc[UMBRA_SC_CATCHER] = 0;
-	key.sc[UMBRA_SC_TEXTURES] = key.sc[UMBRA_SC_MASKED] = key.sc[UMBRA_SC_DEBUG] = key.sc[UMBRA_SC_MATERIAL_EXT] = 0;
+	key.sc[UMBRA_SC_TEXTURES] = key.sc[UMBRA_SC_MASKED] = key.sc[UMBRA_SC_DEBUG] = key.sc[UMBRA_SC_ENV] = 0;
+	key.sc[UMBRA_SC_MATERIAL_EXT] = 0;
 	key.format = 0;
 	key.samples = 1;
 	key.cull_back = key.prepass = key.aov = key.atlas_view = 0;
@@ -189,7 +192,8 @@ enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, c
 	if (y1 > sc->height) y1 = sc->height;
 	area.offset.y = (int32_t)y0;
 	area.extent.height = y1 - y0;
-	record_surfaces(ctx, s, rv, area);
+	struct rnd_surface_targets t = {&s->surfaces, &s->normals, &s->surfaces_depth, (float)sc->width, (float)sc->height};
+	record_surfaces(ctx, s, rv, area, &t);
 
 	record_image_barrier(cmd, s->visibility.img, VK_IMAGE_ASPECT_COLOR_BIT, s->visibility.layers,
 	                     VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,

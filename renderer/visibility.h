@@ -23,6 +23,18 @@ bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene
  * at all (no shadowed light, a debug view, a view too large): what a render may need beyond
  * its targets (estimate.c counts it, before the plan says whether the pass runs). */
 uint64_t rnd_visibility_bytes(const struct rnd_scene *sc);
+/* Where the surfaces pass draws: world positions (RND_SURFACES_FORMAT, w 1 where drawn, 0 else)
+ * and geometric normals (RND_SURFACE_NORMALS_FORMAT) of what each pixel centre of the targets
+ * shows, and their depth; the view fills a viewport of width x height of them (the view's own
+ * size, or a coarser grid: env_pass.c). */
+struct rnd_surface_targets {
+	const struct rnd_image_res *positions, *normals, *depth;
+	float width, height;
+};
+/* Draws rv's surfaces over area (rows of the targets) into t, left ready for sampling (the depth
+ * as a read-only attachment). */
+void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, VkRect2D area,
+                     const struct rnd_surface_targets *t);
 /* The surfaces and visibility passes over rv's band (record_band_area), leaving both images
  * ready for sampling by the main pass. */
 enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,

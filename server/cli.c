@@ -175,8 +175,9 @@ static int render_one(const char *in, const char *out, const char *device, const
 	}
 	if (timings)
 		fprintf(stderr, "parse %.2f ms, device %.2f ms, upload %.2f ms, shadow %.2f ms, main %.2f ms, readback %.2f ms, "
-		        "encode %.2f ms, total %.2f ms, %u shadow maps\n", t_parse, t_ctx, tm.upload_ms, tm.shadow_ms, tm.main_ms,
-		        tm.readback_ms, t_enc, farm_now_ms() - t0, tm.shadow_maps_rendered);
+		        "encode %.2f ms, total %.2f ms, %u shadow maps, environment %.2f ms and %u directions\n", t_parse, t_ctx,
+		        tm.upload_ms, tm.shadow_ms, tm.main_ms, tm.readback_ms, t_enc, farm_now_ms() - t0, tm.shadow_maps_rendered,
+		        tm.env_ms, tm.env_directions);
 	rc = 0;
 out_bytes:
 	free(bytes);

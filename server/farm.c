@@ -259,6 +259,7 @@ static enum job_status local_job(struct farm *f, size_t i, const struct job_inpu
 	if (st != JOB_OK) return st;
 	r->parse_ms = farm_now_ms() - t0;
 	r->imp = s->import;
+	r->env = s->scene.environment.source != RND_ENV_AMBIENT;
 	struct rnd_image img = {0};
 	struct rnd_timings tm;
 	struct rnd_error err;

@@ -35,6 +35,7 @@ struct job_result {
 	struct api_import_times imp;
 	struct rnd_timings tm;
 	double parse_ms, encode_ms;
+	bool env;                 /* the scene had an environment map (its stage in the report) */
 };
 
 /* A job's bytes as read once: the scene document (or thumbnail document) and the parts. */

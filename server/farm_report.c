@@ -30,6 +30,7 @@ static void write_stages(FILE *fp, const struct job_result *r)
 	fprintf(fp, ",\"stages\":{\"parse\":%.2f", r->parse_ms > in_models ? r->parse_ms - in_models : 0.0);
 	if (r->imp.imports || r->imp.ms[API_IMPORT_READ] > 0)
 		for (int k = 0; k < API_IMPORT_STAGES; k++) fprintf(fp, ",\"%s\":%.2f", API_IMPORT_STAGE_NAMES[k], (double)r->imp.ms[k]);
+	if (r->env) fprintf(fp, ",\"environment\":%.2f", r->tm.env_ms);   /* as umbrad's Server-Timing */
 	fprintf(fp, ",\"upload\":%.2f,\"shadow\":%.2f,\"main\":%.2f,\"readback\":%.2f,\"encode\":%.2f}", r->tm.upload_ms,
 	        r->tm.shadow_ms, r->tm.main_ms, r->tm.readback_ms, r->encode_ms);
 }

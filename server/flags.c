@@ -46,7 +46,7 @@ static const struct opt_def opts[] = {
 	{ "import-timeout-ms", OPT_UINT, "MS", "wall-clock and CPU limit of one sandboxed model import (10000)", LIM(import_timeout_ms), 1, 3600000 },
 	{ "import-memory", OPT_SIZE, "BYTES", "memory limit of one sandboxed model import, 0 = none (2G)", LIM(import_memory), 0, UINT64_MAX },
 	{ "max-textures", OPT_UINT, "N", "distinct textures in one scene, at most 4096; materials sharing textures are not counted twice (256)", LIM(max_textures), 1, 1000000 },
-	{ "warm-up", OPT_STR, "defaults|all", "pipelines compiled before ready: the contract's defaults (MSAA 4, PNG; sun, cascades, spot, point; pcf, pcss), or also MSAA 1, EXR and VSM/EVSM (~14 MB each on lavapipe; otherwise compiled at first use) (defaults)", CFG(warm_up), 0, 0 },
+	{ "warm-up", OPT_STR, "defaults|all", "pipelines compiled before ready: the contract's defaults (MSAA 4, PNG; sun, cascades, spot, point; pcf, pcss; the thumbnail preset's studio environment), or also MSAA 1, EXR and VSM/EVSM (~14 MB each on lavapipe; otherwise compiled at first use) (defaults)", CFG(warm_up), 0, 0 },
 	{ "pipeline-cache", OPT_STR, "PATH", "Vulkan pipeline cache, loaded at start, saved at exit", CFG(pipeline_cache), 0, 0 },
 	{ "log-format", OPT_LOGFMT, "text|json", "stderr log lines (text)", CFG(log_format), 0, 0 },
 	{ "atlas-size", OPT_UINT, "N", "texels per side of the shadow atlases, power of two (8192)", CFG(atlas_size), 0, 16384 },

@@ -19,8 +19,9 @@
  * must succeed; the others only warn (a renderer without some feature still serves the rest).
  * Each variant lavapipe keeps costs ~14 MB of resident memory (its JIT's code and state), so by
  * default only the contract's defaults are warmed (MSAA 4, PNG: what a request that names no
- * output gets, and every bench scene); MSAA 1, EXR and VSM/EVSM compile at first use, in
- * 0.1-0.4 s on the 2-core machine (`--warm-up all` warms them too). */
+ * output gets, and every bench scene; and the thumbnail preset, the farms' request); MSAA 1,
+ * EXR and VSM/EVSM compile at first use, in 0.1-0.4 s on the 2-core machine (`--warm-up all`
+ * warms them too). */
 #define WARM_SCENE(lights, output) \
 	"{\"width\":32,\"height\":32," \
 	"\"camera\":{\"type\":\"perspective\",\"position\":[3,2,3],\"target\":[0,0.5,0],\"fov_y\":45}," \
@@ -43,6 +44,12 @@
 #define PNG1 "{\"format\":\"png\",\"msaa\":1}"
 #define PNG4 "{\"format\":\"png\",\"msaa\":4}"
 #define EXR4 "{\"format\":\"exr\",\"msaa\":4}"
+/* The thumbnail preset: the studio environment (its maps, built once per process, and the
+ * environment's compute, shadow and pass pipelines) with its 12 shadow directions. */
+#define WARM_THUMBNAIL \
+	"{\"preset\":\"thumbnail\",\"width\":32,\"height\":32,\"objects\":[" \
+	"{\"shape\":\"box\",\"size\":[1,1,1],\"transform\":{\"translation\":[0,0.5,0]}}," \
+	"{\"shape\":\"sphere\",\"radius\":0.4,\"segments\":8,\"transform\":{\"translation\":[1,0.4,0]}}]}"
 
 /* The contract's defaults first (WARM_DEFAULTS of them), then what `--warm-up all` adds. */
 static const struct { const char *name, *json; } warm_scenes[] = {
@@ -50,6 +57,7 @@ static const struct { const char *name, *json; } warm_scenes[] = {
 	{ "msaa 4, directional pcss", WARM_SCENE(WARM_SUN, PNG4) },
 	{ "msaa 4, cascades pcss", WARM_SCENE(WARM_CSM, PNG4) },
 	{ "msaa 4, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG4) },
+	{ "thumbnail preset, studio environment", WARM_THUMBNAIL },
 	{ "msaa 1, directional pcf", WARM_SCENE(WARM_DIR, PNG1) },
 	{ "msaa 1, directional pcss", WARM_SCENE(WARM_SUN, PNG1) },
 	{ "msaa 1, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG1) },
@@ -57,7 +65,7 @@ static const struct { const char *name, *json; } warm_scenes[] = {
 	{ "msaa 4, vsm+evsm", WARM_SCENE(WARM_VSM "," WARM_EVSM "," WARM_EVSM_SUN "," WARM_VSM_SPOT, PNG4) },
 };
 
-#define WARM_DEFAULTS 4u
+#define WARM_DEFAULTS 5u
 #define WARM_ALL (unsigned)(sizeof warm_scenes / sizeof warm_scenes[0])
 
 static int warm_one(struct srv_server *s, size_t i)

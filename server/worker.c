@@ -337,10 +337,15 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 			                 (double)sc->import.ms[k]);
 			if (w > 0) n += (size_t)w;
 		}
+	/* The environment map: the CPU's share of preparing it (0 once it is kept) and the shadow
+	 * directions drawn (their maps and the environment pass are in `shadow`). */
+	char env[80] = "";
+	if (sc->scene.environment.source != RND_ENV_AMBIENT)
+		snprintf(env, sizeof env, ", environment;dur=%.3f;desc=\"%u directions\"", t->env_ms, t->env_directions);
 	snprintf(req->server_timing, sizeof req->server_timing,
-	         "queue;dur=%.3f, parse;dur=%.3f%s, device-wait;dur=%.3f, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
+	         "queue;dur=%.3f, parse;dur=%.3f%s, device-wait;dur=%.3f%s, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
 	         "readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
-	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, gate_ms, t->upload_ms, t->shadow_ms,
+	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, gate_ms, env, t->upload_ms, t->shadow_ms,
 	         t->main_ms, t->readback_ms, encode_ms, total_ms);
 }
 

@@ -51,6 +51,13 @@ vec4 material_texture(sampler2D s, umbra_material m, uint slot, vec2 uv, vec2 uv
 	                   t * (one ? material_dy1 : material_dy));
 }
 
+// What of the coverage a see-through texture (UMBRA_TEX_TRANSMISSION, its R) leaves: 1 - the
+// material's see-through share (the float bits `share`, umbra_material.ext.z) x R.
+float see_through_keep(sampler2D s, umbra_material m, uint share, vec2 uv, vec2 uv1)
+{
+	return 1.0 - uintBitsToFloat(share) * material_texture(s, m, UMBRA_TEX_TRANSMISSION, uv, uv1).r;
+}
+
 // Alpha mode BLEND, dithered: an ordered 4x4 (Bayer) threshold per pixel, so a surface of
 // alpha a keeps about a of its pixels (of its shadow-map texels in the depth passes) and the
 // same request always gives the same pixels. True when the fragment is kept.

@@ -40,6 +40,8 @@ struct ext_surface {
 	float cc_rough;    // coat roughness, 0.03..1
 	float cc_f0;       // coat F0 (from the ior)
 	float cc_keep;     // 1 - cc x F_coat(N_coat.V): what of the layers under the coat shows
+	float spec_gloss;  // 1: the specular-glossiness model (F0 the specular colour: c_diff x (1 - max(F0)),
+	                   // the ambient reflects F0)
 };
 ext_surface ext_s;
 
@@ -73,6 +75,7 @@ vec3 ext_surface_at(umbra_material m, vec3 N, vec3 n_geo, vec3 V, vec3 base, flo
 	ext_s.cc_rough = 1.0;
 	ext_s.cc_f0 = 0.04;
 	ext_s.cc_keep = 1.0;
+	ext_s.spec_gloss = 0.0;
 	float ndv = max(dot(N, V), 1e-4);
 	if (EXT_SPECULAR) {
 		vec3 col = m.specular.rgb;
@@ -82,6 +85,7 @@ vec3 ext_surface_at(umbra_material m, vec3 N, vec3 n_geo, vec3 V, vec3 base, flo
 		if (has_tex(m, UMBRA_TEX_SPECULAR)) w *= material_texture(specular_texture, m, UMBRA_TEX_SPECULAR, v_uv, v_uv1).a;
 		f0 = mix(min(col, vec3(1.0)) * w, base, metal);
 		ext_s.f90 = mix(vec3(w), vec3(1.0), metal);
+		ext_s.spec_gloss = m.ext.y != 0u ? 1.0 : 0.0;
 	}
 	if (EXT_SHEEN) {
 		vec3 col = m.sheen.rgb;

@@ -2,6 +2,7 @@
 // reading its shadows from the visibility pass, renderer/visibility.c).
 #define UMBRA_PUSH_MAIN   // the draw's material head arrives in the push constants
 #include "shading.glsl"
+#include "ibl.glsl"
 
 layout(location = 0) out vec4 o_color;
 
@@ -19,6 +20,7 @@ umbra_material draw_material()
 		m.clearcoat = materials[pc.info.x].clearcoat;
 		m.sheen = materials[pc.info.x].sheen;
 		m.specular = materials[pc.info.x].specular;
+		m.ext = materials[pc.info.x].ext;
 	}
 	return m;
 }
@@ -44,7 +46,13 @@ void main()
 	metal = clamp(metal, 0.0, 1.0);
 	vec3 f0 = mix(vec3(0.04), base, metal);
 	vec3 c_diff = base * (1.0 - metal);
-	if (SC_MATERIAL_EXT != 0u) f0 = ext_surface_at(m, N, n_geo, V, base, metal, f0);
+	float f0_ambient = metal;   // the ambient reflects a metal's F0 ...
+	if (SC_MATERIAL_EXT != 0u) {
+		f0 = ext_surface_at(m, N, n_geo, V, base, metal, f0);
+		// ... and a specular-glossiness surface's, whose diffuse keeps 1 - max(F0) (the sample viewer's)
+		c_diff *= 1.0 - ext_s.spec_gloss * ext_max3(f0);
+		f0_ambient = max(metal, ext_s.spec_gloss);
+	}
 	bool receive = (flags & UMBRA_DRAW_RECEIVE_SHADOWS) != 0u;
 	vec3 lit, unshadowed;
 	float debug_vis;
@@ -55,8 +63,15 @@ void main()
 	float ao = 1.0;
 	if (has_tex(m, UMBRA_TEX_OCCLUSION))
 		ao = 1.0 + m.params.w * (material_texture(occlusion_texture, m, UMBRA_TEX_OCCLUSION, v_uv, v_uv1).r - 1.0);
-	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * metal) * ao;
+	vec3 ambient = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * (c_diff + f0 * f0_ambient) * ao;
 	if (SC_MATERIAL_EXT != 0u) ambient = ext_ambient(ambient, mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * ao, N, V);
+	// The environment map's light and its shadows (ibl.glsl; folded away without a map).
+	float env_vis = 1.0;
+	vec3 env_open = vec3(0.0);
+	if (SC_ENV != 0u) {
+		if (receive) env_vis = env_shadow(p_shadow, n_shadow, N);
+		ambient += env_light(N, V, c_diff, f0, rough, ao, env_vis, env_open);
+	}
 	vec3 emissive = m.emissive.rgb;
 	if (has_tex(m, UMBRA_TEX_EMISSIVE))
 		emissive *= material_texture(emissive_texture, m, UMBRA_TEX_EMISSIVE, v_uv, v_uv1).rgb;
@@ -64,6 +79,7 @@ void main()
 
 	const uint debug = SC_DEBUG;
 	if (debug == UMBRA_DEBUG_SHADOW) { o_color = vec4(vec3(debug_vis), 1.0); return; }
+	if (debug == UMBRA_DEBUG_ENV_SHADOW) { o_color = vec4(vec3(env_vis), 1.0); return; }
 	if (debug == UMBRA_DEBUG_NORMALS) { o_color = vec4(N * 0.5 + 0.5, 1.0); return; }
 	if (debug == UMBRA_DEBUG_DEPTH) {
 		float z = dot(v_pos - frame.camera_pos.xyz, frame.camera_fwd.xyz);
@@ -78,10 +94,14 @@ void main()
 	if (SC_CATCHER != 0u && (flags & UMBRA_DRAW_SHADOW_CATCHER) != 0u) {
 		// Not drawn itself: the share of light removed by shadows darkens the background.
 		vec3 amb_c = mix(frame.ambient_ground.rgb, frame.ambient_sky.rgb, hemi) * c_diff;
-		float full = dot(unshadowed + amb_c, vec3(0.2126, 0.7152, 0.0722));
-		float kept = dot(lit + amb_c, vec3(0.2126, 0.7152, 0.0722));
+		float full = dot(unshadowed + amb_c + env_open, vec3(0.2126, 0.7152, 0.0722));
+		float kept = dot(lit + amb_c + env_open * env_vis, vec3(0.2126, 0.7152, 0.0722));
 		float ratio = full > 1e-6 ? clamp(kept / full, 0.0, 1.0) : 1.0;
 		if (frame.mode2.y != 0u) { o_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio); return; }
+		if ((SC_ENV & UMBRA_ENV_BACKGROUND) != 0u) {   // the map behind it, tone mapped like the scene
+			o_color = vec4(display(env_background(-V) * frame.params.x * ratio), 1.0);
+			return;
+		}
 		vec3 bg = frame.background.rgb * ratio;
 		o_color = vec4(SC_LINEAR != 0u ? bg : srgb_encode(bg), 1.0);
 		return;

@@ -34,6 +34,7 @@ layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_VISIBILITY) uniform sample
 layout(set = UMBRA_SET_FRAME, binding = UMBRA_BINDING_VISIBILITY_OUT, r16) uniform writeonly image2DArray vis_out;
 #endif
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_BASE_TEXTURE) uniform sampler2D base_texture;
+layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_TEX_TRANSMISSION) uniform sampler2D transmission_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_METAL_ROUGH_TEXTURE) uniform sampler2D metal_rough_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
 layout(set = UMBRA_SET_MATERIAL, binding = UMBRA_BINDING_OCCLUSION_TEXTURE) uniform sampler2D occlusion_texture;
@@ -61,8 +62,8 @@ layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + 
 layout(constant_id = UMBRA_SC_SAMPLES) const uint SC_SAMPLES = 1u;      // samples the pass rasterises
 layout(constant_id = UMBRA_SC_MATERIAL_EXT) const uint SC_MATERIAL_EXT = 0u; // UMBRA_EXT_* lobes (material_ext.glsl)
 
-#ifdef UMBRA_VIS_PASS
-// vis.frag: the surface comes from the surfaces image, not from a triangle.
+#if defined(UMBRA_VIS_PASS) || defined(UMBRA_ENV_PASS_FRAG)
+// vis.frag, env_vis.frag: the surface comes from a surfaces image, not from a triangle.
 vec3 v_pos;
 vec3 v_nrm;
 vec2 v_uv;
@@ -474,12 +475,15 @@ vec3 light_dir(umbra_light L, vec3 pos, out float atten)
 #include "visibility.glsl"
 
 // Base colour times its texture (sRGB texels decode to linear in the sampler) times the
-// vertex colour; alpha MASK discards below the cutoff, BLEND by the dither (material.glsl).
+// vertex colour, alpha times what the see-through texture leaves (material.glsl); alpha MASK
+// discards below the cutoff, BLEND by the dither (material.glsl).
 vec4 base_color(umbra_material m)
 {
 	vec4 c = m.base_color;
 	if (has_tex(m, UMBRA_TEX_BASE)) c *= material_texture(base_texture, m, UMBRA_TEX_BASE, v_uv, v_uv1);
 	if ((SC_TEXTURES & UMBRA_TEXBIT_VERTEX_COLOR) != 0u) c *= v_color;
+	if (has_tex(m, UMBRA_TEX_TRANSMISSION))
+		c.a *= see_through_keep(transmission_texture, m, materials[pc.info.x].ext.z, v_uv, v_uv1);
 	if (SC_MASKED != 0u && m.tex.y != UMBRA_ALPHA_OPAQUE && !alpha_keep(m, c.a, gl_FragCoord.xy)) discard;
 	return c;
 }

@@ -26,7 +26,30 @@
 #define UMBRA_BINDING_VISIBILITY     10 /* sampler2DArray (R16 unorm, texelFetch): layer i = light i's
                                            visibility of that surface (1 where it does not reach) */
 #define UMBRA_BINDING_VISIBILITY_OUT 11 /* the same image as vis.frag's storage image */
-#define UMBRA_BINDING_COUNT          12
+/* The environment's light (renderer/env.c, shaders/ibl.glsl): bound in every render (a 1x1 stand-in
+ * where the scene has no map), read by the pipelines whose UMBRA_SC_ENV says so. */
+#define UMBRA_BINDING_ENV            12 /* uniform  umbra_env */
+#define UMBRA_BINDING_ENV_SPECULAR   13 /* samplerCube: the map prefiltered for GGX, a mip level per roughness step */
+#define UMBRA_BINDING_ENV_MAP        14 /* sampler2D: the equirectangular map with its mip chain (background) */
+#define UMBRA_BINDING_ENV_BRDF       15 /* sampler2D (RG16F): the split-sum table, x n.v, y roughness */
+/* The environment pass (renderer/env_pass.c): the view's surfaces at 1 / UMBRA_ENV_PASS_SCALE of
+ * its pixels a side (as the visibility pass's), and the environment's visibility there (R16). */
+#define UMBRA_BINDING_ENV_SURFACES   16 /* sampler2D (RGBA32F, texelFetch): world position, w 1 (0 = nothing) */
+#define UMBRA_BINDING_ENV_NORMALS    17 /* sampler2D (RGBA16 snorm, texelFetch): geometric normal */
+#define UMBRA_BINDING_ENV_VIS        18 /* sampler2D (R16 unorm, texelFetch): occluded / unoccluded */
+#define UMBRA_BINDING_COUNT          19
+#define UMBRA_ENV_PASS_SCALE         2  /* the view's pixels per environment-pass texel, a side, at least
+                                           (larger views take more: env_pass.c rnd_env_pass_scale) */
+/* env_prefilter.comp's and env_brdf.comp's own set 0 */
+#define UMBRA_ENVC_BINDING_SOURCE    0  /* sampler2D: the equirectangular map (prefilter) */
+#define UMBRA_ENVC_BINDING_OUT       1  /* storage image: a cube level as a 2D array (rgba16f) / the table (rg16f) */
+#define UMBRA_ENV_BRDF_SIZE          64 /* texels a side of the split-sum table */
+#define UMBRA_MAX_ENV_DIRECTIONS     32 /* environment shadow directions (rnd.h RND_MAX_ENV_DIRECTIONS) */
+/* umbra_env.flags / UMBRA_SC_ENV bits */
+#define UMBRA_ENV_LIGHT              1u /* the map lights the scene (split-sum specular, SH diffuse) */
+#define UMBRA_ENV_SHADOWS            2u /* ... with its shadow directions */
+#define UMBRA_ENV_BACKGROUND         4u /* the map is the background (shadow catchers darken it) */
+#define UMBRA_ENV_PASS               8u /* its shadows come from the environment pass (env_pass.c) */
 /* moments.frag's own set 0 (renderer/moments.c) */
 #define UMBRA_MOMENTS_BINDING_DEPTH  0  /* sampler2D: the depth atlas (pass 0 reads the view's tile) */
 #define UMBRA_MOMENTS_BINDING_BLUR   1  /* sampler2D: the slot's blur temporary (pass 1 reads it) */
@@ -68,7 +91,10 @@
 #define UMBRA_TEX_SHEEN_ROUGHNESS    9  /* A sheen roughness (sRGB class) */
 #define UMBRA_TEX_SPECULAR           10 /* A specular factor (sRGB class) */
 #define UMBRA_TEX_SPECULAR_COLOR     11 /* sRGB: rgb specular colour */
-#define UMBRA_TEX_SLOTS              12
+/* R: the see-through share of the coverage (umbra_material.ext.z): alpha x (1 - ext.z x R),
+ * main pass and alpha-tested depth passes alike. */
+#define UMBRA_TEX_TRANSMISSION       12 /* linear */
+#define UMBRA_TEX_SLOTS              13
 #define UMBRA_BINDING_BASE_TEXTURE       UMBRA_TEX_BASE
 #define UMBRA_BINDING_METAL_ROUGH_TEXTURE UMBRA_TEX_METAL_ROUGH
 #define UMBRA_BINDING_NORMAL_TEXTURE     UMBRA_TEX_NORMAL
@@ -133,6 +159,7 @@
 #define UMBRA_DEBUG_CASCADES 2
 #define UMBRA_DEBUG_NORMALS  3
 #define UMBRA_DEBUG_DEPTH    4
+#define UMBRA_DEBUG_ENV_SHADOW 5   /* the environment's visibility (ibl.glsl env_visibility) */
 
 /* umbra_frame.mode.x: tone map */
 #define UMBRA_TONEMAP_NEUTRAL 0
@@ -156,11 +183,12 @@
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
 #define UMBRA_SC_PCF_RADIUS  10   /* 2 when every PCF-filtered light has the default radius 1; 0: read per light */
-#define UMBRA_SC_MATERIAL_EXT 11  /* UMBRA_EXT_* bits of the drawn materials: the extension lobes compiled in */
-#define UMBRA_SC_COUNT       12
+#define UMBRA_SC_ENV         11   /* UMBRA_ENV_* bits: the environment map's light, shadows, background */
+#define UMBRA_SC_MATERIAL_EXT 12  /* UMBRA_EXT_* bits of the drawn materials: the extension lobes compiled in */
+#define UMBRA_SC_COUNT       13
 /* Not in the key's sc[]: pipelines.c sets it from the pipeline's own sample count (the key
  * has that already, so it makes no variant of its own). */
-#define UMBRA_SC_SAMPLES     12   /* rasterization samples: 1 or 4 */
+#define UMBRA_SC_SAMPLES     13   /* rasterization samples: 1 or 4 */
 
 /* umbra_material.ext.x and UMBRA_SC_MATERIAL_EXT: the glTF PBR extensions a material uses
  * (shaders/material_ext.glsl draws them; a scene without any compiles none of their code). */
@@ -211,7 +239,9 @@ struct umbra_material {
 	U_VEC4 clearcoat;        /* x factor, y roughness, z normal scale, w the coat's F0 (from the ior) */
 	U_VEC4 sheen;            /* rgb colour, w roughness */
 	U_VEC4 specular;         /* rgb the dielectric F0 (from the ior) x specular colour, w specular factor */
-	U_UVEC4 ext;             /* x UMBRA_EXT_* bits */
+	U_UVEC4 ext;             /* x UMBRA_EXT_* bits, y 1 = the specular-glossiness model (the
+	                            diffuse x (1 - max(F0)), the ambient reflects F0), z the float bits of
+	                            the see-through share (UMBRA_TEX_TRANSMISSION) */
 	/* per texture slot, the uv transform (KHR_texture_transform) as two rows:
 	 * uv' = (dot(uvx[2s].xy, uv) + uvx[2s].z, dot(uvx[2s+1].xy, uv) + uvx[2s+1].z) */
 	U_VEC4 uvx[2 * UMBRA_TEX_SLOTS];
@@ -239,6 +269,24 @@ struct umbra_shadow_view {
 	U_VEC4 params;           /* x world size of one texel (ortho) or at distance 1 (perspective),
 	                            y 1 = perspective, z near, w far */
 	U_VEC4 rect;             /* this view's tile in the shadow atlases: x, y, size, atlas size (texels) */
+};
+
+/* The environment of one view (renderer/env.c writes it, shaders/ibl.glsl reads it). Directions
+ * are in the scene's frame; the map's textures in the map's own (rot turns one into the other). */
+struct umbra_env {
+	U_VEC4 sh[9];            /* rgb: irradiance / pi by spherical harmonics (order 2) of the map's
+	                            direction, intensity applied: sum_i sh[i] Y_i(d_map) */
+	U_VEC4 rot;              /* x cos, y sin of the rotation about +Y; z intensity; w the specular
+	                            chain's last level (roughness 1) */
+	U_VEC4 params;           /* x, y the map's width and height (texels); z the first light that is an
+	                            environment direction (umbra_light: its shadow views), w those lights */
+	U_VEC4 ground;           /* xyz the normal of a ground plane that hides every direction below it
+	                            (those come after the mapped ones, with no map), w all directions */
+	U_MAT4 inv_view_proj;    /* the camera's clip -> world (the background's rays) */
+	U_VEC4 pass;             /* x the environment pass's view pixels per texel, a side (env_pass.c) */
+	U_VEC4 dirs[UMBRA_MAX_ENV_DIRECTIONS];      /* xyz unit direction towards the sky, w its share of the
+	                                               map's light (energy; the shares sum to 1) */
+	U_VEC4 sizes[UMBRA_MAX_ENV_DIRECTIONS / 4]; /* sin of each direction's angular radius, four a vec4 */
 };
 
 /* One push-constant block for every pipeline (80 bytes). */

@@ -114,18 +114,24 @@ j += b" " * (-len(j) % 4)
 qbuf += b"\0" * (-len(qbuf) % 4)
 put("fuzz_model_glb", "quantized.glb", b"glTF" + struct.pack("<II", 2, 12 + 8 + len(j) + 8 + len(qbuf)) +
     struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(qbuf)) + b"BIN\0" + qbuf)
+# draco.glb (KHR_draco_mesh_compression, a quad) is not written here: Python has no Draco
+# encoder. It is tests/util/models.c's test_draco_glb() of the quad (0,0,0)..(1,1,0) with
+# normals +z and uvs, edgebreaker, 11-bit positions, UNSIGNED_SHORT indices, written by a
+# three-line C main linked with tests/util/models.o and draco_encode.o; committed as is.
 # replies of the importer (api/model_wire.h)
 def header(kind, status, msg=b""):
-    return b"UMBRAIMP" + struct.pack("<IIII", 5, kind, status, len(msg)) + msg
+    return b"UMBRAIMP" + struct.pack("<IIII", 7, kind, status, len(msg)) + msg
 tex = struct.pack("<II", 2, 1) + bytes([255, 0, 0, 255, 0, 255, 0, 255])
-# material: 13 floats, alpha mode, a texture per slot (base, metal-rough, normal, occlusion,
-# emissive, clearcoat, its roughness and normal, sheen colour and roughness, specular and its
-# colour), per slot the sampling (packed modes + a 2x3 uv transform; bit 9: the second uv set,
-# here on the occlusion slot), then the PBR extensions (bits: clearcoat and sheen; 11 floats
-# and the ior)
-mat = struct.pack("<13f", 1, 1, 1, 1, 0.5, 0, 1, 1, 1, 0.5, 1, 1, 0) + struct.pack("<I12i", 2, 0, -1, 0, -1, 0, 0, -1, -1, 0, -1, -1, -1) + \
-      b"".join(struct.pack("<I6f", 0x45 | (0x200 if s == 3 else 0), 1, 0, 0.5, 0, 1, 0) for s in range(12)) + \
-      struct.pack("<I12f", 3, 1, 0.1, 1, 0.5, 0.5, 0.5, 0.8, 1, 1, 1, 1, 1.5)
+# material: 13 floats (the last the see-through share, 0.5 here), alpha mode, a texture per
+# slot (base, metal-rough, normal, occlusion, emissive, clearcoat, its roughness and normal,
+# sheen colour and roughness, specular and its colour, transmission), per slot the sampling
+# (packed modes + a 2x3 uv transform; bit 9: the second uv set, here on the occlusion slot),
+# then the PBR extensions (bits: clearcoat, sheen and 1 << 16, the specular-glossiness model; 11
+# floats and the ior)
+mat = struct.pack("<13f", 1, 1, 1, 1, 0.5, 0, 1, 1, 1, 0.5, 1, 1, 0.5) + \
+      struct.pack("<I13i", 2, 0, -1, 0, -1, 0, 0, -1, -1, 0, -1, -1, -1, 0) + \
+      b"".join(struct.pack("<I6f", 0x45 | (0x200 if s == 3 else 0), 1, 0, 0.5, 0, 1, 0) for s in range(13)) + \
+      struct.pack("<I12f", 3 | 1 << 16, 1, 0.1, 1, 0.5, 0.5, 0.5, 0.8, 1, 1, 1, 1, 1.5)
 # mesh: normals, uvs, colours, tangents, single-sided, a second uv set (flag 128, after the uvs)
 mesh = struct.pack("<4I", 3, 3, 0, 31 | 128) + pos + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1) + \
        struct.pack("<6f", 0, 0, 1, 0, 0, 1) + struct.pack("<6f", 0.5, 0.5, 1, 0.5, 0.5, 1) + \
@@ -134,7 +140,8 @@ inst = struct.pack("<I", 0) + struct.pack("<16f", 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 
 warn = b"skins are not applied (drawn in the bind pose)"
 # the importer's stage times f32[4], texture_side texture_max, then the counts
 times = struct.pack("<4f", 1, 2, 0, 0) + struct.pack("<II", 0, 2)
-put("fuzz_import_reply", "model.bin", header(1, 0) + times + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn + tex + mat + mesh +
-    inst)
+# the warnings padded with zeros to a multiple of 4 bytes
+put("fuzz_import_reply", "model.bin", header(1, 0) + times + struct.pack("<5I", 1, 1, 1, 1, len(warn)) + warn +
+    b"\0" * (-len(warn) % 4) + tex + mat + mesh + inst)
 put("fuzz_import_reply", "image.bin", header(2, 0) + tex)
 put("fuzz_import_reply", "error.bin", header(1, 1, b"PLY: bad header"))

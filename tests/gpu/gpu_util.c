@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "api.h"
+#include "model.h"
 #include "gpu_util.h"
 #include "test.h"
 #include "util.h"
@@ -39,6 +40,22 @@ struct rnd_context *gpu_ctx(void)
 }
 
 struct rnd_timings gpu_last_timings;
+const char *gpu_asset_root;
+
+float *gpu_read_grey(const char *path, uint32_t w, uint32_t h)
+{
+	size_t len;
+	uint8_t *png = test_read_file(path, &len), *rgba = NULL;
+	uint32_t pw = 0, ph = 0;
+	char err[200];
+	float *out = NULL;
+	if (png && api_image_decode(png, len, 0, &rgba, &pw, &ph, err, sizeof err) == API_OK && pw == w && ph == h &&
+	    (out = malloc(sizeof *out * w * h)))
+		for (uint32_t i = 0; i < w * h; i++) out[i] = rgba[4 * i] / 255.0f;
+	free(png);
+	free(rgba);
+	return out;
+}
 
 struct api_scene *gpu_parse(const char *json)
 {
@@ -48,6 +65,7 @@ struct api_scene *gpu_parse(const char *json)
 		if (*p == '\'') *p = '"';
 	struct api_limits lim;
 	api_limits_defaults(&lim);
+	lim.asset_root = gpu_asset_root;
 	struct api_scene *s = NULL;
 	struct api_problem prob = {0};
 	if (api_scene_parse(doc, strlen(doc), &lim, &s, &prob) != API_OK) {
@@ -72,6 +90,7 @@ bool gpu_render_at(const char *file, int line, struct rnd_image *img, const char
 
 	struct api_limits lim;
 	api_limits_defaults(&lim);
+	lim.asset_root = gpu_asset_root;
 	struct api_scene *s = NULL;
 	struct api_problem prob;
 	memset(&prob, 0, sizeof prob);

@@ -80,6 +80,12 @@ enum { GPU_CLS_BG = 0, GPU_CLS_OBJ = 1, GPU_CLS_LIT = 2, GPU_CLS_SHADOW = 3, GPU
  * distance `band`. */
 bool gpu_near_edge(const uint8_t *cls, int w, int h, int i, int j, int band);
 
+/* A grey (or RGBA: its red) PNG as 0..1 floats, w x h (malloc'd); NULL when missing or of
+ * another size. */
+float *gpu_read_grey(const char *path, uint32_t w, uint32_t h);
+/* The asset root of gpu_render and gpu_parse (NULL: none, the default). */
+extern const char *gpu_asset_root;
+
 /* Bytes of a and b that differ (-1 when their sizes differ); *first (may be NULL): the first. */
 long gpu_bytes_differ(const struct rnd_image *a, const struct rnd_image *b, size_t *first);
 

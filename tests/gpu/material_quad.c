@@ -108,7 +108,7 @@ char *quad_data(const struct mglb *g)
 }
 
 /* Renders the quad model: `light` "none" or a directional light straight down of intensity pi
- * (so a white Lambert surface facing it has radiance 1); no ambient; no tone map. */
+ * (so a white Lambert surface facing it has radiance 1); g->ambient's ambient; no tone map. */
 bool render_quad(int line, struct rnd_image *img, const struct mglb *g, bool light, bool below)
 {
 	char *enc = quad_data(g);
@@ -116,10 +116,10 @@ bool render_quad(int line, struct rnd_image *img, const struct mglb *g, bool lig
 	                        "{'width':%d,'height':%d,"
 	                        "'camera':{'type':'orthographic','position':[0,%d,0],'target':[0,0,0],'up':[0,0,-1],"
 	                        "'height':%.9g},"
-	                        "'environment':{'background':[0,0,0],'ambient':{'intensity':0}},"
+	                        "'environment':{'background':[0,0,0],'ambient':{'intensity':%.9g}},"
 	                        "'objects':[{'shape':'model','format':'glb','data':'%s'}],"
 	                        "'lights':[%s],'output':{%s}}",
-	                        MW, MH, below ? -5 : 5, MORTHO, enc,
+	                        MW, MH, below ? -5 : 5, MORTHO, g->ambient, enc,
 	                        !light ? "" : g->light ? g->light : "{'type':'directional','direction':[0,-1,0],'intensity':3.14159265}",
 	                        g->output ? g->output : "'tonemap':'none','msaa':1");
 	free(enc);

@@ -31,6 +31,7 @@ struct mglb {
 	const float *uv0;            /* TEXCOORD_0 uv per vertex instead of the one above, or NULL */
 	const float *uv1;            /* TEXCOORD_1 uv per vertex, or NULL: none */
 	const char *light;           /* render_quad's lit light (JSON), or NULL: straight down, intensity pi */
+	float ambient;               /* render_quad's ambient intensity (0: none) */
 };
 
 #define MW 64
@@ -48,7 +49,8 @@ char *quad_data(const struct mglb *g);
 /* The orthographic camera straight down on the quad (from below: `below`). */
 void cam_of(struct gpu_cam *cam, bool below);
 /* Renders the quad model: `light` none or a directional light straight down of intensity pi
- * (so a white Lambert surface facing it has radiance 1); no ambient; no tone map. */
+ * (so a white Lambert surface facing it has radiance 1); the ambient of g->ambient (none by
+ * default); no tone map. */
 bool render_quad(int line, struct rnd_image *img, const struct mglb *g, bool light, bool below);
 /* Linear radiance of channel c at world point (x, 0, z) seen from the camera. */
 double lin_at(const struct rnd_image *img, bool below, double x, double z, int c);

@@ -108,6 +108,37 @@ TEST(materials_transmission_as_partial_coverage)
 	CHECK(share > 0.1 && share < 0.3, "transmission 1 takes %.2f of the light, want ~0.2", share);
 }
 
+/* transmissionTexture (R) times transmissionFactor 1, per pixel: a 1x2 texture, R 255 over
+ * the quad's z < 0 half (coverage 0.2, 0.2 of the light stopped) and R 0 over the z > 0 half
+ * (no transmission: opaque, a full shadow). Before, the texture was not read: both halves 0.2. */
+TEST(materials_transmission_texture_per_pixel)
+{
+	static const uint8_t tex[8] = {255, 0, 0, 255, 0, 0, 0, 255};
+	struct mglb g = {.material = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1],\"metallicFactor\":0,"
+	                             "\"roughnessFactor\":1},\"extensions\":{\"KHR_materials_transmission\":{"
+	                             "\"transmissionFactor\":1,\"transmissionTexture\":{\"index\":0}}}}",
+	                 .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP,
+	                 .extensions_used = "[\"KHR_materials_transmission\"]", .y = 1};
+	add_png(&g, tex, 1, 2);
+	struct rnd_image op, q;
+	bool ok = blend_render(__LINE__, &op, false);
+	ok = ok && quad_over_ground(__LINE__, &q, &g);
+	free_pngs(&g);
+	if (!ok) return;
+	double lit = mean_rect(&op, 2.0, 2.35, -0.6, 0.6, 0, 2);
+	for (int half = 0; half < 2; half++) {
+		double z0 = half ? 0.2 : -0.8, z1 = half ? 0.8 : -0.2;
+		double red = mean_rect(&q, -0.8, 0.8, z0, z1, 1, 0) / mean_rect(&op, -0.8, 0.8, z0, z1, 1, 0);
+		double share = (lit - mean_rect(&q, 1.1, 1.7, z0, z1, 0, 2)) / (lit - mean_rect(&op, 1.1, 1.7, z0, z1, 0, 2));
+		double want = half ? 1 : 0.2;
+		printf("    R %d: coverage %.2f, shadow share %.2f (want %.1f)\n", half ? 0 : 255, red, share, want);
+		CHECK(fabs(red - want) < 0.1, "R %d: coverage %.2f, want %.1f", half ? 0 : 255, red, want);
+		CHECK(fabs(share - want) < 0.1, "R %d: shadow share %.2f, want %.1f", half ? 0 : 255, share, want);
+	}
+	rnd_image_release(&op);
+	rnd_image_release(&q);
+}
+
 /* ---- mipmaps ---- */
 
 /* A 256^2 black/white checker of single texels (sRGB 0 and 255: linear 0 and 1) as the

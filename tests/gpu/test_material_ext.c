@@ -199,3 +199,63 @@ TEST(material_ext_sheen)
 	rnd_image_release(&fi);
 	rnd_image_release(&ti);
 }
+
+/* ---- KHR_materials_pbrSpecularGlossiness ---- */
+
+/* Drawn as the sample viewer draws it: F0 the specular colour, roughness 1 - glossiness, the
+ * diffuse colour as the base. Straight down (N = V = L = H) a black diffuse gives the GGX lobe
+ * alone, pi x F0 x D x vis. Factors: specular (1, 0.5, 0.25), glossiness 0.2 (roughness 0.8:
+ * 0.61 F0). Texture (specularGlossinessTexture: RGB specular in sRGB, A glossiness 0.2, 0,
+ * 0.3, 0.1): per texel. Under the ambient alone, a specular-glossiness metal (black diffuse,
+ * that specular) is the metallic-roughness metal of that base colour: the ambient reflects
+ * F0 as it does a metal's. Before, the specular colour and texture were ignored: the quad
+ * drew the 0.04 dielectric's lobe, and the ambient none of it. */
+#define SG_MAT(extra) "{\"extensions\":{\"KHR_materials_pbrSpecularGlossiness\":{\"diffuseFactor\":[0,0,0,1]," extra "}}}"
+#define SG_USED "[\"KHR_materials_pbrSpecularGlossiness\"]"
+
+static double sg_lobe(double f0, double rough)
+{
+	double a = rough * rough;
+	return M_PI * f0 * ggx(a * a, 1, 1, 1);
+}
+
+TEST(material_ext_specular_glossiness)
+{
+	static const uint8_t tex[16] = {255, 255, 255, 51, 255, 128, 0, 0, 0, 200, 0, 77, 128, 128, 128, 26};
+	struct mglb f = {.material = SG_MAT("\"specularFactor\":[1,0.5,0.25],\"glossinessFactor\":0.2"),
+	                 .extensions_used = SG_USED};
+	struct mglb t = {.material = SG_MAT("\"specularGlossinessTexture\":{\"index\":0}"),
+	                 .textures = "[{\"source\":0,\"sampler\":0}]", .samplers = NEAREST_CLAMP, .extensions_used = SG_USED};
+	add_png(&t, tex, 2, 2);
+	struct mglb sa = f, ma = {.material = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0.5,0.25,1],"
+	                                      "\"metallicFactor\":1,\"roughnessFactor\":0.8}}"};
+	sa.ambient = ma.ambient = 1;
+	struct rnd_image fi, ti, si, mi;
+	bool ok = render_quad(__LINE__, &fi, &f, true, false);
+	ok = ok && render_quad(__LINE__, &ti, &t, true, false);
+	ok = ok && render_quad(__LINE__, &si, &sa, false, false) && render_quad(__LINE__, &mi, &ma, false, false);
+	free_pngs(&t);
+	if (!ok) return;
+	static const double col[3] = {1, 0.5, 0.25};
+	for (int c = 0; c < 3; c++) {
+		double want = sg_lobe(col[c], 0.8), got = lin_at(&fi, false, 0.3, -0.4, c);
+		double amb_sg = lin_at(&si, false, 0.3, -0.4, c), amb_mr = lin_at(&mi, false, 0.3, -0.4, c);
+		printf("    factors, channel %d: %.4f (want %.4f); ambient alone: %.4f (metal %.4f)\n", c, got, want, amb_sg, amb_mr);
+		CHECK(fabs(got - want) < 0.012 + 0.02 * want, "factors: channel %d %.4f, want %.4f", c, got, want);
+		CHECK(amb_mr > 0.05 && fabs(amb_sg - amb_mr) < 0.01, "ambient: channel %d %.4f, the metal's %.4f", c, amb_sg, amb_mr);
+	}
+	for (int k = 0; k < 4; k++) {
+		double x, z;
+		texel_xz(k, &x, &z);
+		double rough = fmax(1 - tex[4 * k + 3] / 255.0, 0.03);
+		for (int c = 0; c < 3; c++) {
+			double want = sg_lobe(gpu_srgb_decode(tex[4 * k + c] / 255.0), rough), got = lin_at(&ti, false, x, z, c);
+			printf("    texel %d channel %d: %.4f (want %.4f)\n", k, c, got, want);
+			CHECK(fabs(got - want) < 0.012 + 0.03 * want, "texel %d channel %d: %.4f, want %.4f", k, c, got, want);
+		}
+	}
+	rnd_image_release(&fi);
+	rnd_image_release(&ti);
+	rnd_image_release(&si);
+	rnd_image_release(&mi);
+}

@@ -33,90 +33,6 @@ static uint8_t *checker_png(size_t *len)
 	return test_png_rgba(px, CHK, CHK, len);
 }
 
-/* A .glb with one mesh (positions, optional normals and uvs, uint32 indices) in one node
- * translated by `node_t`; with `png`, a material with that base-colour texture and alphaMode
- * MASK (cutoff 0.5) when `mask`, else OPAQUE. */
-struct glb_in {
-	const float *pos, *nrm, *uv;
-	uint32_t nv;
-	const uint32_t *idx;
-	uint32_t ni;
-	float node_t[3];
-	const uint8_t *png;
-	size_t png_len;
-	bool mask;
-};
-
-static uint8_t *glb_build(const struct glb_in *in, size_t *len)
-{
-	size_t off_pos = 0, n_pos = (size_t)in->nv * 12;
-	size_t off_nrm = off_pos + n_pos, n_nrm = in->nrm ? (size_t)in->nv * 12 : 0;
-	size_t off_uv = off_nrm + n_nrm, n_uv = in->uv ? (size_t)in->nv * 8 : 0;
-	size_t off_idx = off_uv + n_uv, n_idx = (size_t)in->ni * 4;
-	size_t off_png = off_idx + n_idx, n_png = in->png ? in->png_len : 0;
-	size_t binlen = off_png + n_png, binpad = (binlen + 3) & ~(size_t)3;
-	float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
-	for (uint32_t v = 0; v < in->nv; v++)
-		for (int k = 0; k < 3; k++) {
-			lo[k] = fminf(lo[k], in->pos[3 * v + k]);
-			hi[k] = fmaxf(hi[k], in->pos[3 * v + k]);
-		}
-
-	/* bufferViews / accessors in order: pos, [nrm], [uv], idx, [png view] */
-	char views[1024], accs[1024], attrs[256], mat[512] = "", imgs[256] = "";
-	int nview = 0, nacc = 0;
-	int vl = 0, al = 0, tl = 0;
-	vl += snprintf(views + vl, sizeof views - vl, "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_pos, n_pos);
-	al += snprintf(accs + al, sizeof accs - al,
-	               "{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\","
-	               "\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]}",
-	               nview++, in->nv, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
-	tl += snprintf(attrs + tl, sizeof attrs - tl, "\"POSITION\":%d", nacc++);
-	if (in->nrm) {
-		vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_nrm, n_nrm);
-		al += snprintf(accs + al, sizeof accs - al,
-		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"}", nview++, in->nv);
-		tl += snprintf(attrs + tl, sizeof attrs - tl, ",\"NORMAL\":%d", nacc++);
-	}
-	if (in->uv) {
-		vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_uv, n_uv);
-		al += snprintf(accs + al, sizeof accs - al,
-		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", nview++, in->nv);
-		tl += snprintf(attrs + tl, sizeof attrs - tl, ",\"TEXCOORD_0\":%d", nacc++);
-	}
-	vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_idx, n_idx);
-	al += snprintf(accs + al, sizeof accs - al,
-	               ",{\"bufferView\":%d,\"componentType\":5125,\"count\":%u,\"type\":\"SCALAR\"}", nview++, in->ni);
-	int idx_acc = nacc++;
-	if (in->png) {
-		vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_png, n_png);
-		snprintf(imgs, sizeof imgs,
-		         ",\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":%d,\"mimeType\":\"image/png\"}]", nview++);
-		snprintf(mat, sizeof mat,
-		         ",\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],\"metallicFactor\":0,"
-		         "\"roughnessFactor\":0.8,\"baseColorTexture\":{\"index\":0}},\"alphaMode\":\"%s\"%s}]",
-		         in->mask ? "MASK" : "OPAQUE", in->mask ? ",\"alphaCutoff\":0.5" : "");
-	}
-	char json[4096];
-	int jn = snprintf(json, sizeof json,
-		"{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-		"\"nodes\":[{\"mesh\":0,\"translation\":[%.9g,%.9g,%.9g]}],"
-		"\"meshes\":[{\"primitives\":[{\"attributes\":{%s},\"indices\":%d%s}]}]%s%s,"
-		"\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[%s],\"accessors\":[%s]}",
-		in->node_t[0], in->node_t[1], in->node_t[2], attrs, idx_acc, in->png ? ",\"material\":0" : "", mat, imgs,
-		binpad, views, accs);
-	uint8_t *b = calloc(1, binpad ? binpad : 1);
-	if (!b) return NULL;
-	memcpy(b + off_pos, in->pos, n_pos);
-	if (in->nrm) memcpy(b + off_nrm, in->nrm, n_nrm);
-	if (in->uv) memcpy(b + off_uv, in->uv, n_uv);
-	memcpy(b + off_idx, in->idx, n_idx);
-	if (in->png) memcpy(b + off_png, in->png, n_png);
-	uint8_t *g = test_glb_pack(json, (size_t)jn, b, binpad, binpad, len);
-	free(b);
-	return g;
-}
-
 /* A box [lo, hi] as 24 vertices (flat normals, outward, counter-clockwise) and 36 indices. */
 static void box_mesh(const float lo[3], const float hi[3], float pos[72], float nrm[72], uint32_t idx[36])
 {
@@ -320,9 +236,9 @@ TEST(models_fit_glb_box)
 	float lo[3] = {-1, -0.5f, -0.25f}, hi[3] = {1, 0.5f, 0.25f}, pos[72], nrm[72];
 	uint32_t idx[36];
 	box_mesh(lo, hi, pos, nrm, idx);
-	struct glb_in in = {.pos = pos, .nrm = nrm, .nv = 24, .idx = idx, .ni = 36, .node_t = {1.5f, 1, -2}};
+	struct test_glb_mesh in = {.pos = pos, .nrm = nrm, .nv = 24, .idx = idx, .ni = 36, .node_t = {1.5f, 1, -2}};
 	size_t n;
-	uint8_t *glb = glb_build(&in, &n);
+	uint8_t *glb = test_glb_mesh(&in, &n);
 	char *enc = test_b64(glb, n);
 	free(glb);
 	size_t cap = strlen(enc) + 256;
@@ -568,10 +484,10 @@ static char *glb_quad_json(bool masked)
 	size_t pl;
 	uint8_t *png = checker_png(&pl);
 	if (!png) return NULL;
-	struct glb_in in = {.pos = QPOS, .nrm = QNRM, .uv = QUV, .nv = 4, .idx = QIDX, .ni = 6,
+	struct test_glb_mesh in = {.pos = QPOS, .nrm = QNRM, .uv = QUV, .nv = 4, .idx = QIDX, .ni = 6,
 	                    .node_t = {0, (float)QY, 0}, .png = png, .png_len = pl, .mask = masked};
 	size_t n;
-	uint8_t *glb = glb_build(&in, &n);
+	uint8_t *glb = test_glb_mesh(&in, &n);
 	free(png);
 	char *enc = test_b64(glb, n);
 	free(glb);
@@ -612,4 +528,76 @@ TEST(models_opaque_quad_shadow_glb)
 	REQUIRE(q);
 	quad_check(__LINE__, "glb quad, OPAQUE", q, false);
 	free(q);
+}
+
+/* KHR_draco_mesh_compression (api/gltf_draco.c): a uv sphere as a plain glb and as a Draco one
+ * (libdraco's encoder, tests/util/draco_encode.h) under the thumbnail preset. Sequential
+ * encoding without quantization keeps every float and the vertex order: the same picture to
+ * the byte. Edgebreaker with 11-bit positions (reordered, moved up to 1/4096 of the size):
+ * within a few steps on the outline. Before, a file requiring Draco was a 400. */
+#define SPH_U 32
+#define SPH_V 16
+static void draco_sphere(float *pos, float *nrm, float *uv, uint32_t *idx)
+{
+	for (int v = 0; v <= SPH_V; v++)
+		for (int u = 0; u <= SPH_U; u++) {
+			int i = v * (SPH_U + 1) + u;
+			double th = M_PI * v / SPH_V, ph = 2 * M_PI * u / SPH_U;
+			float n[3] = {(float)(sin(th) * cos(ph)), (float)cos(th), (float)(sin(th) * sin(ph))};
+			memcpy(nrm + 3 * i, n, sizeof n);
+			memcpy(pos + 3 * i, n, sizeof n);
+			uv[2 * i] = (float)u / SPH_U, uv[2 * i + 1] = (float)v / SPH_V;
+		}
+	int t = 0;
+	for (int v = 0; v < SPH_V; v++)
+		for (int u = 0; u < SPH_U; u++) {
+			uint32_t a = (uint32_t)(v * (SPH_U + 1) + u), b = a + 1, c = a + SPH_U + 1, d = c + 1;
+			uint32_t q[6] = {a, b, d, a, d, c};
+			memcpy(idx + 6 * t++, q, sizeof q);
+		}
+}
+
+static bool render_glb(int line, struct rnd_image *img, const uint8_t *glb, size_t n)
+{
+	char *enc = test_b64(glb, n);
+	bool ok = enc && gpu_render_at(__FILE__, line, img, "{'preset':'thumbnail','width':192,'height':192,'objects':["
+	                               "{'shape':'model','data':'%s','material':{'base_color':[0.8,0.3,0.1]}}]}", enc);
+	free(enc);
+	return ok;
+}
+
+TEST(models_draco_sphere_same_picture)
+{
+	enum { NV = (SPH_U + 1) * (SPH_V + 1), NT = 2 * SPH_U * SPH_V };
+	static float pos[3 * NV], nrm[3 * NV], uv[2 * NV];
+	static uint32_t idx[3 * NT];
+	draco_sphere(pos, nrm, uv, idx);
+	struct test_glb_mesh plain = {.pos = pos, .nrm = nrm, .uv = uv, .nv = NV, .idx = idx, .ni = 3 * NT};
+	struct test_draco_mesh seq = {.pos = pos, .nrm = nrm, .uv = uv, .nv = NV, .idx = idx, .ntri = NT};
+	struct test_draco_mesh eb = seq;
+	eb.edgebreaker = 1, eb.position_bits = 11;
+	size_t n[3];
+	uint8_t *g[3] = {test_glb_mesh(&plain, &n[0]), test_draco_glb(&seq, &n[1]), test_draco_glb(&eb, &n[2])};
+	struct rnd_image img[3] = {{0}};
+	bool ok = g[0] && g[1] && g[2];
+	for (int k = 0; ok && k < 3; k++) ok = render_glb(__LINE__, &img[k], g[k], n[k]);
+	for (int k = 0; k < 3; k++) free(g[k]);
+	REQUIRE(ok, "the glbs were not built or rendered");
+	long same = gpu_bytes_differ(&img[0], &img[1], NULL);
+	int lit = 0, worst = 0, changed = 0;
+	for (int j = 0; j < 192; j++)
+		for (int i = 0; i < 192; i++) {
+			const uint8_t *a = gpu_px8(&img[0], i, j), *b = gpu_px8(&img[2], i, j);
+			lit += a[0] > a[2] + 60;   /* the orange sphere */
+			int d = 0;
+			for (int c = 0; c < 3; c++) d = abs(a[c] - b[c]) > d ? abs(a[c] - b[c]) : d;
+			worst = d > worst ? d : worst;
+			changed += d > 4;
+		}
+	printf("  draco sphere: %d sphere pixels; sequential %ld bytes differ; edgebreaker 11-bit: %d pixels > 4 steps "
+	       "(largest %d)\n", lit, same, changed, worst);
+	CHECK(lit > 4000, "the sphere covers %d pixels", lit);
+	CHECK(same == 0, "sequential Draco: %ld bytes differ from the plain glb", same);
+	CHECK(changed < 150, "edgebreaker Draco: %d pixels differ by more than 4 steps", changed);
+	for (int k = 0; k < 3; k++) rnd_image_release(&img[k]);
 }

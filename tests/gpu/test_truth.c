@@ -19,22 +19,6 @@
 
 #define TRUTH_DIR "tests/gpu/truth/"
 
-/* A grey PNG of the reference as 0..1 floats (w x h); NULL when missing. */
-static float *read_grey(const char *path, uint32_t w, uint32_t h)
-{
-	size_t len;
-	uint8_t *png = test_read_file(path, &len), *rgba = NULL;
-	uint32_t pw = 0, ph = 0;
-	char err[200];
-	float *out = NULL;
-	if (png && api_image_decode(png, len, 0, &rgba, &pw, &ph, err, sizeof err) == API_OK && pw == w && ph == h &&
-	    (out = malloc(sizeof *out * w * h)))
-		for (uint32_t i = 0; i < w * h; i++) out[i] = rgba[4 * i] / 255.0f;
-	free(png);
-	free(rgba);
-	return out;
-}
-
 struct truth_score {
 	double rmse, iou, disagree_core, hf_cand, hf_truth;
 	double missing_contact;   /* truth-shadowed px within 8 px of a geometry edge left lit */
@@ -122,11 +106,11 @@ static void check_scene(const char *name, double max_rmse, double min_iou, doubl
 	REQUIRE(doc, "cannot read %s", path);
 	const int w = 128, h = 128;
 	snprintf(path, sizeof path, TRUTH_DIR "%s.vis.png", name);
-	float *truth = read_grey(path, w, h);
+	float *truth = gpu_read_grey(path, w, h);
 	snprintf(path, sizeof path, TRUTH_DIR "%s.mask.png", name);
-	float *mask = read_grey(path, w, h);
+	float *mask = gpu_read_grey(path, w, h);
 	snprintf(path, sizeof path, TRUTH_DIR "%s.edge.png", name);
-	float *edge = read_grey(path, w, h);
+	float *edge = gpu_read_grey(path, w, h);
 	float *cand = malloc(sizeof *cand * w * h);
 	struct rnd_image img;
 	if (truth && mask && edge && cand && gpu_render(&img, "%s", doc)) {
@@ -248,9 +232,9 @@ TEST(truth_contact_shadows_sun_low_res_map)
 	size_t len;
 	char *doc = (char *)test_read_file(TRUTH_DIR "contact_sun.json", &len);
 	REQUIRE(doc, "cannot read " TRUTH_DIR "contact_sun.json");
-	float *truth = read_grey(TRUTH_DIR "contact_sun.vis.png", w, h);
-	float *mask = read_grey(TRUTH_DIR "contact_sun.mask.png", w, h);
-	float *edge = read_grey(TRUTH_DIR "contact_sun.edge.png", w, h);
+	float *truth = gpu_read_grey(TRUTH_DIR "contact_sun.vis.png", w, h);
+	float *mask = gpu_read_grey(TRUTH_DIR "contact_sun.mask.png", w, h);
+	float *edge = gpu_read_grey(TRUTH_DIR "contact_sun.edge.png", w, h);
 	char *off = replaced(doc, "\"contact\": {\"enabled\": true}", "\"contact\": {\"enabled\": false}");
 	char *exr = replaced(doc, "\"output\": {\"debug\": \"shadow\", \"msaa\": 1}",
 	                     "\"output\": {\"format\": \"exr\", \"aovs\": [\"shadow\"], \"msaa\": 1}");
@@ -308,9 +292,9 @@ TEST(truth_soft_spot_contact_on_meets_missing_contact)
 	size_t len;
 	char *doc = (char *)test_read_file(TRUTH_DIR "spot_pcss.json", &len);
 	REQUIRE(doc, "cannot read " TRUTH_DIR "spot_pcss.json");
-	float *truth = read_grey(TRUTH_DIR "spot_pcss.vis.png", w, h);
-	float *mask = read_grey(TRUTH_DIR "spot_pcss.mask.png", w, h);
-	float *edge = read_grey(TRUTH_DIR "spot_pcss.edge.png", w, h);
+	float *truth = gpu_read_grey(TRUTH_DIR "spot_pcss.vis.png", w, h);
+	float *mask = gpu_read_grey(TRUTH_DIR "spot_pcss.mask.png", w, h);
+	float *edge = gpu_read_grey(TRUTH_DIR "spot_pcss.edge.png", w, h);
 	char *on = replaced(doc, "\"shadow\": {\"filter\": \"pcss\"}",
 	                    "\"shadow\": {\"filter\": \"pcss\", \"contact\": {\"enabled\": true}}");
 	CHECK(truth && mask && edge, "missing reference images for spot_pcss in " TRUTH_DIR);

@@ -73,8 +73,8 @@ if [ "$FIRST_READY" = 503 ]; then
 	check "readyz 503 with Retry-After before ready" grep -qi '^Retry-After:' "$T/main.first-ready.hdr"
 fi
 grep -q "listening on http://127.0.0.1:$(cat "$T/main.port")" "$T/main.log" && ok "start-up log names the bound port" || nok "start-up log names the bound port"
-check "--warm-up defaults: the MSAA 4 variants are warmed, MSAA 1 ones left to first use" \
-	sh -c "grep -q \"warm-up 'msaa 4, directional pcf'\" '$T/main.log' && ! grep -q \"warm-up 'msaa 1\" '$T/main.log'"
+check "--warm-up defaults: the MSAA 4 variants and the thumbnail preset are warmed, MSAA 1 ones left to first use" \
+	sh -c "grep -q \"warm-up 'msaa 4, directional pcf'\" '$T/main.log' && grep -q \"warm-up 'thumbnail preset\" '$T/main.log' && ! grep -q \"warm-up 'msaa 1\" '$T/main.log'"
 
 # -- GET routes
 c=$(get h /healthz); check "GET /healthz 200" [ "$c" = 200 ]

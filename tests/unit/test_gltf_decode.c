@@ -4,7 +4,11 @@
  * with meshoptimizer in the BIN chunk, an empty fallback buffer) give the quad the plain file
  * gives; a corrupt meshopt stream is refused, naming the extension. Before, Assimp 5.2 read
  * the quantized positions as garbage ("triangles have no area") and could not read meshopt
- * views at all. */
+ * views at all. KHR_draco_mesh_compression (api/gltf_draco.c), streams made by libdraco's
+ * encoder here (tests/util/draco_encode.h): a 67,600-vertex grid with UNSIGNED_INT indices
+ * (Assimp 5.2's own Draco path: "Invalid accessor without data"), a skinned quad with
+ * quantized positions (Assimp's: "Invalid draco attribute ... JOINTS_0"), a corrupt stream
+ * and a wrong count refused naming the extension. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -12,6 +16,7 @@
 #include <string.h>
 #include <meshoptimizer.h>
 #include "api.h"
+#include "draco_encode.h"
 #include "models.h"
 #include "test.h"
 #include "util.h"
@@ -148,20 +153,129 @@ TEST(gltf_meshopt_corrupt_stream_is_refused)
 	CHECK(p.status >= 400 && p.status < 500 && strstr(p.detail, "EXT_meshopt_compression"), "%d: %s", p.status, p.detail);
 }
 
-TEST(gltf_draco_required_is_refused_with_what_to_do)
+/* A grid of GRID x GRID (67,600) vertices over [0, 1]^2 (z 0, normals +z), edgebreaker with positions
+ * quantized to 14 bits, as gltf-pipeline and Blender write it: more than 65,536 vertices, so
+ * UNSIGNED_INT indices. */
+#define GRID 260
+TEST(gltf_draco_grid_with_uint32_indices_decoded)
 {
-	uint8_t bin[60] = {0};
+	uint32_t nv = GRID * GRID, ntri = 2 * (GRID - 1) * (GRID - 1);
+	float *pos = malloc(nv * 12), *nrm = malloc(nv * 12), *uv = malloc(nv * 8);
+	uint32_t *idx = malloc(ntri * 12);
+	REQUIRE(pos && nrm && uv && idx);
+	for (uint32_t y = 0; y < GRID; y++)
+		for (uint32_t x = 0; x < GRID; x++) {
+			uint32_t v = y * GRID + x;
+			pos[3 * v] = (float)x / (GRID - 1), pos[3 * v + 1] = (float)y / (GRID - 1), pos[3 * v + 2] = 0;
+			nrm[3 * v] = nrm[3 * v + 1] = 0, nrm[3 * v + 2] = 1;
+			uv[2 * v] = pos[3 * v], uv[2 * v + 1] = pos[3 * v + 1];
+		}
+	uint32_t t = 0;
+	for (uint32_t y = 0; y + 1 < GRID; y++)
+		for (uint32_t x = 0; x + 1 < GRID; x++) {
+			uint32_t a = y * GRID + x, b = a + 1, c = a + GRID, d = c + 1;
+			uint32_t q[6] = {a, b, d, a, d, c};
+			memcpy(idx + 3 * t, q, sizeof q);
+			t += 2;
+		}
+	struct test_draco_mesh dm = {.pos = pos, .nrm = nrm, .uv = uv, .nv = nv, .idx = idx, .ntri = ntri,
+	                             .edgebreaker = 1, .position_bits = 14};
 	size_t n;
-	uint8_t *g = glb(QUANT_JSON "\"buffers\":[{\"byteLength\":60}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,"
-	                 "\"byteLength\":32,\"byteStride\":8},{\"buffer\":0,\"byteOffset\":32,\"byteLength\":16,\"byteStride\":4},"
-	                 "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}]}",
-	                 bin, sizeof bin, &n, ",\"KHR_draco_mesh_compression\"", ",\"KHR_draco_mesh_compression\"");
-	REQUIRE(g);
+	uint8_t *g = test_draco_glb(&dm, &n);
+	free(pos), free(nrm), free(uv), free(idx);
+	REQUIRE(g, "encoding failed");
 	struct api_problem p;
 	struct api_scene *s = test_parse_model(g, n, "glb", &p);
 	free(g);
-	CHECK(!s, "a file requiring Draco was accepted");
-	if (s) api_scene_free(s);
-	CHECK(p.status >= 400 && p.status < 500 && strstr(p.detail, "Draco") && strstr(p.detail, "gltfpack"), "%d: %s",
-	      p.status, p.detail);
+	REQUIRE(s, "%d %s: %s", p.status, p.pointer, p.detail);
+	REQUIRE(s->scene.object_count == 1, "%u objects", s->scene.object_count);
+	const struct rnd_object *o = &s->scene.objects[0];
+	CHECK(o->index_count == 3 * ntri, "%u indices, want %u", o->index_count, 3 * ntri);
+	CHECK(o->vertex_count >= nv, "%u vertices", o->vertex_count);
+	float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
+	double area = 0;
+	for (uint32_t v = 0; v < o->vertex_count; v++)
+		for (int k = 0; k < 3; k++) lo[k] = fminf(lo[k], o->positions[3 * v + k]), hi[k] = fmaxf(hi[k], o->positions[3 * v + k]);
+	for (uint32_t i = 0; i + 2 < o->index_count; i += 3) {
+		const float *a = o->positions + 3 * o->indices[i], *b = o->positions + 3 * o->indices[i + 1],
+		            *c = o->positions + 3 * o->indices[i + 2];
+		area += 0.5 * fabs((double)(b[0] - a[0]) * (c[1] - a[1]) - (double)(b[1] - a[1]) * (c[0] - a[0]));
+	}
+	CHECK(fabsf(lo[0]) < 1e-3f && fabsf(lo[1]) < 1e-3f && fabsf(hi[0] - 1) < 1e-3f && fabsf(hi[1] - 1) < 1e-3f &&
+	      fabsf(lo[2]) < 1e-3f && fabsf(hi[2]) < 1e-3f, "bounds %.4f..%.4f %.4f..%.4f %.4f..%.4f", lo[0], hi[0], lo[1],
+	      hi[1], lo[2], hi[2]);
+	/* every index right: the triangles tile the square once (wrong indices overlap or leave holes) */
+	CHECK(fabs(area - 1) < 1e-3, "the triangles cover %.5f of the unit square", area);
+	api_scene_free(s);
+}
+
+/* The quantized quad (QPOS under the node's 0.001 scale, normals +z) with a skin: POSITION as
+ * a Draco int16 attribute (KHR_mesh_quantization), JOINTS_0 (uint16) and WEIGHTS_0 compressed
+ * too, sequential encoding, UNSIGNED_SHORT indices as the Khronos samples have them. corrupt:
+ * the stream's magic overwritten; bad_count: the POSITION accessor's count one too many. */
+static uint8_t *draco_skinned_glb(bool corrupt, bool bad_count, size_t *len)
+{
+	int16_t qp[12];
+	float nrm[12], w[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+	uint16_t j[16] = {0};
+	uint32_t idx[6];
+	for (int v = 0; v < 4; v++) {
+		memcpy(qp + 3 * v, QPOS + 4 * v, 6);
+		nrm[3 * v] = nrm[3 * v + 1] = 0, nrm[3 * v + 2] = 1;
+	}
+	for (int i = 0; i < 6; i++) idx[i] = QIDX[i];
+	struct test_draco_attr at[4] = {{TEST_DRACO_POSITION, TEST_DRACO_INT16, 3, qp, 0},
+	                                {TEST_DRACO_NORMAL, TEST_DRACO_FLOAT32, 3, nrm, 0},
+	                                {TEST_DRACO_GENERIC, TEST_DRACO_UINT16, 4, j, 0},
+	                                {TEST_DRACO_GENERIC, TEST_DRACO_FLOAT32, 4, w, 0}};
+	size_t n;
+	uint32_t np, nf;
+	uint8_t *drc = test_draco_encode(at, 4, 4, idx, 2, 0, 0, &n, &np, &nf);
+	if (!drc) return NULL;
+	if (corrupt) memset(drc, 'x', 5);
+	uint8_t *g = glb(
+		"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_draco_mesh_compression\",\"KHR_mesh_quantization\"],"
+		"\"extensionsRequired\":[\"KHR_draco_mesh_compression\",\"KHR_mesh_quantization\"],\"scene\":0,"
+		"\"scenes\":[{\"nodes\":[0,1]}],\"nodes\":[{\"mesh\":0,\"skin\":0,\"scale\":[0.001,0.001,0.001]},{\"name\":\"bone\"}],"
+		"\"skins\":[{\"joints\":[1]}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":1,\"NORMAL\":2,"
+		"\"JOINTS_0\":3,\"WEIGHTS_0\":4},\"indices\":0,\"extensions\":{\"KHR_draco_mesh_compression\":{\"bufferView\":0,"
+		"\"attributes\":{\"POSITION\":%u,\"NORMAL\":%u,\"JOINTS_0\":%u,\"WEIGHTS_0\":%u}}}}]}],\"accessors\":["
+		"{\"componentType\":5123,\"count\":%u,\"type\":\"SCALAR\"},{\"componentType\":5122,\"count\":%u,\"type\":\"VEC3\","
+		"\"min\":[0,0,0],\"max\":[1000,1000,0]},{\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"},"
+		"{\"componentType\":5123,\"count\":%u,\"type\":\"VEC4\"},{\"componentType\":5126,\"count\":%u,\"type\":\"VEC4\"}],"
+		"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%zu}],\"buffers\":[{\"byteLength\":%zu}]}",
+		drc, n, len, at[0].unique_id, at[1].unique_id, at[2].unique_id, at[3].unique_id, 3 * nf, np + bad_count, np, np,
+		np, n, (n + 3) & ~(size_t)3);
+	free(drc);
+	return g;
+}
+
+TEST(gltf_draco_skinned_quantized_decoded)
+{
+	size_t n;
+	uint8_t *g = draco_skinned_glb(false, false, &n);
+	REQUIRE(g, "encoding failed");
+	struct api_problem p;
+	struct api_scene *s = test_parse_model(g, n, "glb", &p);
+	free(g);
+	REQUIRE(s, "%d %s: %s", p.status, p.pointer, p.detail);
+	check_quad(s);
+	CHECK(!strstr(s->warnings, "Draco"), "warned: %s", s->warnings);
+	api_scene_free(s);
+}
+
+TEST(gltf_draco_corrupt_or_miscounted_is_refused)
+{
+	for (int bad = 0; bad < 2; bad++) {
+		size_t n;
+		uint8_t *g = draco_skinned_glb(bad == 0, bad == 1, &n);
+		REQUIRE(g, "encoding failed");
+		struct api_problem p;
+		struct api_scene *s = test_parse_model(g, n, "glb", &p);
+		free(g);
+		CHECK(!s, "case %d accepted", bad);
+		if (s) api_scene_free(s);
+		CHECK(p.status == 400 && strstr(p.detail, "KHR_draco_mesh_compression mesh 0 primitive 0") &&
+		      strstr(p.detail, bad ? "count" : "does not decode"), "case %d: %d: %s", bad, p.status, p.detail);
+	}
 }

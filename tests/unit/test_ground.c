@@ -156,7 +156,7 @@ TEST(ground_placement_problems_name_the_member)
 	               400, "/objects/0/placement");
 }
 
-TEST(preset_thumbnail_gives_camera_sun_and_ground)
+TEST(preset_thumbnail_gives_camera_studio_and_ground)
 {
 	const char *doc = "{\"preset\":\"thumbnail\",\"objects\":[{\"shape\":\"box\",\"transform\":{\"translation\":[0,5,0]}}]}";
 	struct api_problem p;
@@ -165,20 +165,20 @@ TEST(preset_thumbnail_gives_camera_sun_and_ground)
 	const struct rnd_scene *sc = &s->scene;
 	CHECK(sc->width == 512 && sc->height == 512, "%ux%u", sc->width, sc->height);
 	CHECK(sc->camera.fit == RND_FIT_OBJECTS, "the camera is fitted to the objects");
-	REQUIRE(sc->light_count == 1, "one sun, got %u lights", sc->light_count);
-	CHECK(sc->lights[0].type == RND_LIGHT_DIRECTIONAL && sc->lights[0].angular_diameter > 0 &&
-	      sc->lights[0].shadow.filter == RND_FILTER_PCSS, "a soft sun with PCSS");
+	CHECK(sc->light_count == 0, "no sun: the studio's key casts the shadow, got %u lights", sc->light_count);
+	CHECK(sc->environment.source == RND_ENV_STUDIO && sc->environment.shadow_directions == RND_DEFAULT_ENV_DIRECTIONS,
+	      "the built-in studio with its shadows");
 	REQUIRE(sc->object_count == 2, "the box and the preset's ground, got %u", sc->object_count);
 	const struct rnd_object *g = &sc->objects[1];
 	CHECK(g->shape == RND_SHAPE_PLANE && sc->materials[g->material].shadow_catcher, "a shadow-catcher ground");
 	CHECK(near_d(g->model[13], 4.5), "the ground under the box (y 4.5), got %g", g->model[13]);
-	CHECK(sc->environment.ambient_intensity > 0, "sky light");
+	CHECK(sc->environment.ambient_intensity == 0, "no hemisphere ambient: the studio is the ambient");
 	api_scene_free(s);
 }
 
 TEST(preset_members_are_overridden_by_the_scene)
 {
-	const char *doc = "{\"preset\":\"thumbnail\",\"width\":96,\"height\":64,\"shadows\":null,"
+	const char *doc = "{\"preset\":\"thumbnail\",\"width\":96,\"height\":64,\"shadows\":null,\"environment\":{\"map\":null},"
 	                  "\"camera\":{\"fov_y\":50},"
 	                  "\"lights\":[{\"type\":\"point\",\"position\":[0,3,0]},{\"type\":\"point\",\"position\":[1,3,0]}],"
 	                  "\"output\":{\"transparent\":true},"
@@ -189,7 +189,8 @@ TEST(preset_members_are_overridden_by_the_scene)
 	const struct rnd_scene *sc = &s->scene;
 	CHECK(sc->width == 96 && sc->height == 64, "size from the scene: %ux%u", sc->width, sc->height);
 	CHECK(sc->light_count == 2 && sc->lights[0].type == RND_LIGHT_POINT, "the scene's lights replace the sun");
-	CHECK(sc->lights[0].shadow.filter != RND_FILTER_PCSS, "shadows: null drops the preset's pcss");
+	CHECK(sc->lights[0].shadow.filter != RND_FILTER_PCSS, "shadows: null: the renderer's defaults");
+	CHECK(sc->environment.source == RND_ENV_AMBIENT, "environment.map: null drops the preset's studio");
 	CHECK(sc->camera.fit == RND_FIT_OBJECTS && near_d(sc->camera.fov_y, 50 * M_PI / 180),
 	      "camera merged: fit kept, fov_y %g", sc->camera.fov_y);
 	CHECK(sc->output.transparent, "output merged");

@@ -1,9 +1,11 @@
 /* tests/util/models.c — see models.h. */
 #include <math.h>
 #include <png.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "draco_encode.h"
 #include "models.h"
 
 void test_put32(uint8_t *p, uint32_t v)
@@ -172,3 +174,115 @@ uint8_t *test_bumpy_stl(int seg, size_t *len)
 	return d;
 }
 
+
+uint8_t *test_glb_mesh(const struct test_glb_mesh *in, size_t *len)
+{
+	size_t off_pos = 0, n_pos = (size_t)in->nv * 12;
+	size_t off_nrm = off_pos + n_pos, n_nrm = in->nrm ? (size_t)in->nv * 12 : 0;
+	size_t off_uv = off_nrm + n_nrm, n_uv = in->uv ? (size_t)in->nv * 8 : 0;
+	size_t off_idx = off_uv + n_uv, n_idx = (size_t)in->ni * 4;
+	size_t off_png = off_idx + n_idx, n_png = in->png ? in->png_len : 0;
+	size_t binlen = off_png + n_png, binpad = (binlen + 3) & ~(size_t)3;
+	float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+	for (uint32_t v = 0; v < in->nv; v++)
+		for (int k = 0; k < 3; k++) {
+			lo[k] = fminf(lo[k], in->pos[3 * v + k]);
+			hi[k] = fmaxf(hi[k], in->pos[3 * v + k]);
+		}
+
+	/* bufferViews / accessors in order: pos, [nrm], [uv], idx, [png view] */
+	char views[1024], accs[1024], attrs[256], mat[512] = "", imgs[256] = "";
+	int nview = 0, nacc = 0;
+	int vl = 0, al = 0, tl = 0;
+	vl += snprintf(views + vl, sizeof views - vl, "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_pos, n_pos);
+	al += snprintf(accs + al, sizeof accs - al,
+	               "{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\","
+	               "\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]}",
+	               nview++, in->nv, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+	tl += snprintf(attrs + tl, sizeof attrs - tl, "\"POSITION\":%d", nacc++);
+	if (in->nrm) {
+		vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_nrm, n_nrm);
+		al += snprintf(accs + al, sizeof accs - al,
+		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"}", nview++, in->nv);
+		tl += snprintf(attrs + tl, sizeof attrs - tl, ",\"NORMAL\":%d", nacc++);
+	}
+	if (in->uv) {
+		vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_uv, n_uv);
+		al += snprintf(accs + al, sizeof accs - al,
+		               ",{\"bufferView\":%d,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", nview++, in->nv);
+		tl += snprintf(attrs + tl, sizeof attrs - tl, ",\"TEXCOORD_0\":%d", nacc++);
+	}
+	vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_idx, n_idx);
+	al += snprintf(accs + al, sizeof accs - al,
+	               ",{\"bufferView\":%d,\"componentType\":5125,\"count\":%u,\"type\":\"SCALAR\"}", nview++, in->ni);
+	int idx_acc = nacc++;
+	if (in->png) {
+		vl += snprintf(views + vl, sizeof views - vl, ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", off_png, n_png);
+		snprintf(imgs, sizeof imgs,
+		         ",\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":%d,\"mimeType\":\"image/png\"}]", nview++);
+		snprintf(mat, sizeof mat,
+		         ",\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],\"metallicFactor\":0,"
+		         "\"roughnessFactor\":0.8,\"baseColorTexture\":{\"index\":0}},\"alphaMode\":\"%s\"%s}]",
+		         in->mask ? "MASK" : "OPAQUE", in->mask ? ",\"alphaCutoff\":0.5" : "");
+	}
+	char json[4096];
+	int jn = snprintf(json, sizeof json,
+		"{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+		"\"nodes\":[{\"mesh\":0,\"translation\":[%.9g,%.9g,%.9g]}],"
+		"\"meshes\":[{\"primitives\":[{\"attributes\":{%s},\"indices\":%d%s}]}]%s%s,"
+		"\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[%s],\"accessors\":[%s]}",
+		in->node_t[0], in->node_t[1], in->node_t[2], attrs, idx_acc, in->png ? ",\"material\":0" : "", mat, imgs,
+		binpad, views, accs);
+	uint8_t *b = calloc(1, binpad ? binpad : 1);
+	if (!b) return NULL;
+	memcpy(b + off_pos, in->pos, n_pos);
+	if (in->nrm) memcpy(b + off_nrm, in->nrm, n_nrm);
+	if (in->uv) memcpy(b + off_uv, in->uv, n_uv);
+	memcpy(b + off_idx, in->idx, n_idx);
+	if (in->png) memcpy(b + off_png, in->png, n_png);
+	uint8_t *g = test_glb_pack(json, (size_t)jn, b, binpad, binpad, len);
+	free(b);
+	return g;
+}
+
+uint8_t *test_draco_glb(const struct test_draco_mesh *m, size_t *len)
+{
+	struct test_draco_attr at[3] = {{TEST_DRACO_POSITION, TEST_DRACO_FLOAT32, 3, m->pos, 0}};
+	int na = 1;
+	if (m->nrm) at[na++] = (struct test_draco_attr){TEST_DRACO_NORMAL, TEST_DRACO_FLOAT32, 3, m->nrm, 0};
+	if (m->uv) at[na++] = (struct test_draco_attr){TEST_DRACO_TEX_COORD, TEST_DRACO_FLOAT32, 2, m->uv, 0};
+	size_t n;
+	uint32_t np, nf;
+	uint8_t *drc = test_draco_encode(at, na, m->nv, m->idx, m->ntri, m->edgebreaker, m->position_bits, &n, &np, &nf);
+	if (!drc) return NULL;
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (uint32_t v = 0; v < m->nv; v++)
+		for (int k = 0; k < 3; k++) lo[k] = fminf(lo[k], m->pos[3 * v + k]), hi[k] = fmaxf(hi[k], m->pos[3 * v + k]);
+	char attrs[160], ids[160], accs[640];
+	int al = snprintf(attrs, sizeof attrs, "\"POSITION\":1"), il = snprintf(ids, sizeof ids, "\"POSITION\":%u", at[0].unique_id);
+	int cl = snprintf(accs, sizeof accs, "{\"componentType\":%d,\"count\":%u,\"type\":\"SCALAR\"},"
+	                  "{\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\",\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]}",
+	                  m->short_indices ? 5123 : 5125, 3 * nf, np, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+	static const char *const names[3] = {"POSITION", "NORMAL", "TEXCOORD_0"};
+	for (int a = 1; a < na; a++) {
+		const char *nm = names[at[a].type == TEST_DRACO_NORMAL ? 1 : 2];
+		al += snprintf(attrs + al, sizeof attrs - (size_t)al, ",\"%s\":%d", nm, a + 1);
+		il += snprintf(ids + il, sizeof ids - (size_t)il, ",\"%s\":%u", nm, at[a].unique_id);
+		cl += snprintf(accs + cl, sizeof accs - (size_t)cl, ",{\"componentType\":5126,\"count\":%u,\"type\":\"VEC%d\"}", np,
+		               at[a].comps);
+	}
+	char json[2048];
+	size_t pad = (n + 3) & ~(size_t)3;
+	int jn = snprintf(json, sizeof json,
+		"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
+		"\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+		"\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{%s},\"indices\":0,\"extensions\":"
+		"{\"KHR_draco_mesh_compression\":{\"bufferView\":0,\"attributes\":{%s}}}}]}],\"accessors\":[%s],"
+		"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%zu}],\"buffers\":[{\"byteLength\":%zu}]}",
+		attrs, ids, accs, n, pad);
+	uint8_t *bin = calloc(1, pad ? pad : 4);
+	uint8_t *g = bin ? test_glb_pack(json, (size_t)jn, (memcpy(bin, drc, n), bin), pad, pad, len) : NULL;
+	free(bin);
+	free(drc);
+	return g;
+}

@@ -1,7 +1,7 @@
 /*
  * tests/util/models.h — model and image files built in memory for the tests (unit and GPU),
  * one copy of each builder: a PNG from RGBA8 texels (libpng), a binary STL tetrahedron, the
- * GLB container around a glTF JSON chunk and a binary chunk. Every result is malloc'd (the
+ * GLB container around a glTF JSON chunk and a binary chunk, a Draco-compressed glb. Every result is malloc'd (the
  * caller frees it) except where the caller passes the buffer.
  */
 #ifndef UMBRA_TEST_MODELS_H
@@ -9,6 +9,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "umbra/rnd.h"
@@ -38,5 +39,34 @@ uint8_t *test_bumpy_stl(int seg, size_t *len);
  * zeros to binpad, which the JSON's buffer byteLength must state). NULL when out of memory. */
 uint8_t *test_glb_pack(const char *json, size_t json_len, const uint8_t *bin, size_t binlen, size_t binpad,
                        size_t *len);
+
+/* A .glb (NULL when out of memory) with one mesh (positions, optional normals and uvs, uint32
+ * indices) in one node translated by `node_t`; with `png`, a material with that base-colour texture and alphaMode
+ * MASK (cutoff 0.5) when `mask`, else OPAQUE. */
+struct test_glb_mesh {
+	const float *pos, *nrm, *uv;
+	uint32_t nv;
+	const uint32_t *idx;
+	uint32_t ni;
+	float node_t[3];
+	const uint8_t *png;
+	size_t png_len;
+	bool mask;
+};
+uint8_t *test_glb_mesh(const struct test_glb_mesh *in, size_t *len);
+
+/* A .glb of one mesh compressed with KHR_draco_mesh_compression as exporters write it
+ * (extensionsRequired, no fallback: the accessors have counts and no bufferView), encoded by
+ * libdraco (tests/util/draco_encode.h): pos, optional nrm and uv, ntri triangles; indices
+ * UNSIGNED_INT (UNSIGNED_SHORT when short_indices). NULL on failure. */
+struct test_draco_mesh {
+	const float *pos, *nrm, *uv;
+	uint32_t nv;
+	const uint32_t *idx;
+	uint32_t ntri;
+	int edgebreaker, position_bits;   /* test_draco_encode's */
+	int short_indices;
+};
+uint8_t *test_draco_glb(const struct test_draco_mesh *m, size_t *len);
 
 #endif

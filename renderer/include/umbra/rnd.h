@@ -76,11 +76,12 @@ enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYL
 enum rnd_alpha_mode { RND_ALPHA_OPAQUE, RND_ALPHA_MASK, RND_ALPHA_BLEND };
 
 /* Texture slots of a material (the order of rnd_material.textures): glTF's core five, then
- * those of the PBR extensions (read only where the material has that extension). */
+ * those of the PBR extensions (read only where the material has that extension), then the
+ * see-through share of the coverage (rnd_material.see_through). */
 enum rnd_texture_slot { RND_TEX_BASE, RND_TEX_METAL_ROUGH, RND_TEX_NORMAL, RND_TEX_OCCLUSION, RND_TEX_EMISSIVE,
                         RND_TEX_CLEARCOAT, RND_TEX_CLEARCOAT_ROUGHNESS, RND_TEX_CLEARCOAT_NORMAL,
                         RND_TEX_SHEEN_COLOR, RND_TEX_SHEEN_ROUGHNESS, RND_TEX_SPECULAR, RND_TEX_SPECULAR_COLOR,
-                        RND_TEX_SLOTS };
+                        RND_TEX_TRANSMISSION, RND_TEX_SLOTS };
 /* rnd_material.extensions: the glTF 2.0 PBR extensions a material has (0: none; the members
  * of the others are not read). */
 enum rnd_material_ext {
@@ -143,12 +144,16 @@ struct rnd_material {
 			                         *occlusion_texture, *emissive_texture;
 			const struct rnd_texture *clearcoat_texture, *clearcoat_roughness_texture, *clearcoat_normal_texture,
 			                         *sheen_color_texture, *sheen_roughness_texture, *specular_texture,
-			                         *specular_color_texture;
+			                         *specular_color_texture, *transmission_texture;
 		};
 		const struct rnd_texture *textures[RND_TEX_SLOTS];
 	};
 	float normal_scale;        /* 1 */
 	float occlusion_strength;  /* 1 */
+	/* With transmission_texture: the coverage (alpha, as MASK or BLEND draw it, shadows too) is
+	 * alpha x (1 - see_through x the texture's R), per pixel (0..1; 0 default: none). api/
+	 * draws KHR_materials_transmission's texture so (api_gltf_material_shading). */
+	float see_through;
 	/* How each slot's texture is sampled (zero = repeat, linear, untransformed). */
 	struct rnd_texture_sampling {
 		uint8_t wrap_s, wrap_t;             /* enum rnd_wrap */
@@ -177,6 +182,11 @@ struct rnd_material {
 		float factor;          /* 0..1 the specular weight (x specular_texture A); glTF default 1 */
 		float color[3];        /* linear, multiplies the dielectric F0 (x specular_color_texture); default 1 */
 		float ior;             /* >= 1 (KHR_materials_ior; 1.5 gives F0 0.04) */
+		/* The specular-glossiness model (KHR_materials_pbrSpecularGlossiness, as the sample
+		 * viewer draws it): F0 is the whole specular (the colour, ior ~infinite), the diffuse
+		 * keeps 1 - max(F0) of the base colour, and the ambient light reflects F0 as it does a
+		 * metal's base colour. false (default): a dielectric's F0, no ambient term (the core's). */
+		bool spec_gloss;
 	} specular;
 };
 
@@ -225,7 +235,9 @@ struct rnd_object {
 enum rnd_light_type { RND_LIGHT_DIRECTIONAL, RND_LIGHT_SPOT, RND_LIGHT_POINT };
 
 enum rnd_filter { RND_FILTER_AUTO, RND_FILTER_HARD, RND_FILTER_PCF, RND_FILTER_PCSS, RND_FILTER_VSM, RND_FILTER_EVSM };
-enum rnd_dir_mode { RND_DIR_AUTO, RND_DIR_FIT, RND_DIR_CASCADES, RND_DIR_CLIPMAP };
+/* RND_DIR_CASTERS: one map fitted to what casts shadows (not the whole scene), the light's
+ * resolution across it: the environment's shadow directions (renderer/env_shadow.c). */
+enum rnd_dir_mode { RND_DIR_AUTO, RND_DIR_FIT, RND_DIR_CASCADES, RND_DIR_CLIPMAP, RND_DIR_CASTERS };
 enum rnd_vsm_precision { RND_VSM_AUTO, RND_VSM_FP32, RND_VSM_FP16 };
 
 /* Resolved shadow settings of one light (api/ merges root `shadows` and the light's `shadow`).
@@ -283,7 +295,10 @@ struct rnd_camera {
 };
 
 enum rnd_tonemap { RND_TONEMAP_NEUTRAL, RND_TONEMAP_ACES, RND_TONEMAP_NONE };
-enum rnd_debug { RND_DEBUG_NONE, RND_DEBUG_SHADOW, RND_DEBUG_CASCADES, RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS };
+/* RND_DEBUG_ENV_SHADOW: the share of the environment's cosine-weighted diffuse light that
+ * reaches each pixel (occluded / unoccluded), written as `shadow` writes a light's. */
+enum rnd_debug { RND_DEBUG_NONE, RND_DEBUG_SHADOW, RND_DEBUG_CASCADES, RND_DEBUG_NORMALS, RND_DEBUG_DEPTH, RND_DEBUG_ATLAS,
+                 RND_DEBUG_ENV_SHADOW };
 
 /* What the renderer writes into rnd_image.pixels. */
 enum rnd_pixel_format {
@@ -311,11 +326,40 @@ struct rnd_output {
 	uint32_t debug_light;
 };
 
+/* Where the environment's light comes from: the hemisphere ambient alone (sky and ground
+ * colours), an equirectangular map, or the built-in studio (renderer/env_studio.c, generated). */
+enum rnd_env_source { RND_ENV_AMBIENT, RND_ENV_MAP, RND_ENV_STUDIO };
+
+/* An equirectangular map: linear RGB floats, width x height texels, rows from the zenith (top)
+ * to the nadir; the scene direction d = (x, y, z) reads it at u = 0.5 + atan2(z, x) / 2pi (from
+ * the left edge), v = 0.5 - asin(y) / pi (from the top): the centre column is +X, the column at
+ * width/4 is -Z (three.js' equirectUv, ../shared/truth-cycles/envmap.py). */
+struct rnd_env_map {
+	const float *rgb;     /* width * height * 3 */
+	uint32_t width, height;
+	/* The caller's hash of the pixels (the prefiltered copy on the device is kept under it:
+	 * renderer/env.c), 0 = the renderer hashes them. */
+	uint64_t key;
+};
+
 struct rnd_environment {
 	float background[4];  /* linear RGBA, default 0.5 0.5 0.5 1 */
 	float ambient_sky[3], ambient_ground[3];
 	float ambient_intensity;
+	enum rnd_env_source source;   /* AMBIENT */
+	struct rnd_env_map map;       /* source MAP */
+	float rotation;               /* radians about +Y (right hand): the map's d appears at R_y d */
+	float intensity;              /* multiplies the map's radiance, default 1 */
+	bool background_map;          /* the map (tone mapped like the scene) behind the scene */
+	/* Shadows of the map's light: directions drawn as shadow maps, each over the map's brightest
+	 * region of equal energy (0 = no environment shadows; at most RND_MAX_ENV_DIRECTIONS), and
+	 * the side of their maps (0 = renderer: RND_DEFAULT_ENV_SHADOW_RESOLUTION). */
+	uint32_t shadow_directions;   /* RND_DEFAULT_ENV_DIRECTIONS */
+	uint32_t shadow_resolution;
 };
+#define RND_MAX_ENV_DIRECTIONS 32u
+#define RND_DEFAULT_ENV_DIRECTIONS 12u
+#define RND_DEFAULT_ENV_SHADOW_RESOLUTION 512u
 
 struct rnd_scene {
 	uint32_t width, height;   /* of one view */
@@ -427,6 +471,9 @@ struct rnd_timings {
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
 	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
 	uint32_t shadow_parts;     /* submits of shadow maps drawn in parts (too costly for one) */
+	uint32_t env_directions;   /* environment shadow directions drawn (maps rendered or reused) */
+	double env_ms;             /* this render's share of preparing the environment (CPU analysis and
+	                              the device's prefiltering, once per map: 0 when it was ready) */
 };
 
 /* ---- context ---- */
@@ -511,6 +558,8 @@ struct rnd_stats {
 	uint32_t cached_maps;            /* shadow maps kept for reuse (spot, point, a sun's fit map) */
 	uint64_t shadow_cache_hits;      /* lights whose shadow passes were skipped */
 	uint64_t shadow_cache_misses;
+	uint32_t env_maps;               /* environment maps kept prefiltered (the studio included) */
+	uint64_t env_builds;             /* environment maps prefiltered since create (once per map kept) */
 };
 void rnd_context_stats(struct rnd_context *ctx, struct rnd_stats *st);
 /* Idle trim: drops cached shadow maps not used for idle_s seconds (0: all), and once no map

@@ -1,0 +1,36 @@
+/*
+ * renderer/env_pass.h — the environment pass: the environment map's shadows computed once per
+ * texel of a grid coarser than the view (rnd_env_pass_scale; env_pass.c says why), which
+ * the main pass reads back with a bilateral upsample (shaders/ibl.glsl env_pass_read).
+ *
+ * Usage: render.c asks rnd_env_pass_wanted() per view and sizes the slot's images
+ * (rnd_slot_env_pass); rnd_frame_write binds them (or the slot's white stand-ins); submit.c
+ * records record_env_pass() once per view, after the shadow maps and before the first band.
+ * The images belong to the slot, the pipeline to the context.
+ */
+#ifndef UMBRA_RENDERER_ENV_PASS_H
+#define UMBRA_RENDERER_ENV_PASS_H
+
+#include "record.h"
+
+/* Whether view rv's environment shadows come from the pass: it has mapped directions, no
+ * alpha-tested draw (the surfaces pass does not cut texels out) and no debug view but
+ * environment_shadow's. UMBRA_ENV_PASS=0 computes them per fragment instead (tests). */
+bool rnd_env_pass_wanted(const struct rnd_scene *sc, const struct rnd_env_use *env, const struct draw *draws,
+                         uint32_t ndraw);
+/* The view's pixels per texel of the pass's grid, a side: UMBRA_ENV_PASS_SCALE (2), more for
+ * views larger than RND_ENV_PASS_GRID texels a side at that scale, at most RND_ENV_PASS_MAX_SCALE. */
+#define RND_ENV_PASS_GRID 192u
+#define RND_ENV_PASS_MAX_SCALE 4u
+uint32_t rnd_env_pass_scale(uint32_t w, uint32_t h);
+/* The pass's grid for a w x h view: ceil(w / scale) x ceil(h / scale). */
+void rnd_env_pass_size(uint32_t w, uint32_t h, uint32_t *pw, uint32_t *ph);
+/* Makes the slot's pass images match a w x h view. */
+enum rnd_result rnd_slot_env_pass(struct rnd_context *ctx, struct rnd_slot *s, uint32_t w, uint32_t h,
+                                  struct rnd_error *err);
+void rnd_env_pass_release(struct rnd_context *ctx, struct rnd_slot *s);
+/* The surfaces at the pass's scale, then the visibility pass over them, left ready for sampling. */
+enum rnd_result record_env_pass(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                                struct rnd_error *err);
+
+#endif
