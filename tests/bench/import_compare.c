@@ -24,30 +24,17 @@
 #include "ply_import.h"
 #include "util.h"
 
-static double now_ms(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
-static int cmp(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return x < y ? -1 : x > y;
-}
-
 /* One import (own: readers first, as the importer does; else Assimp alone), finished as the
  * importer finishes it for side 0. Its status; *ms its time. */
 static int import(const uint8_t *d, size_t len, const struct api_model_refs *r, int fmt, int own, struct api_arena *a,
                   struct api_model *m, double *ms, char *err, size_t errsize)
 {
 	size_t bytes = 0;
-	double t0 = now_ms();
+	double t0 = test_now_ms();
 	int st = own ? api_model_import_files(d, len, r->files, r->count, fmt, 0, a, m, &bytes, err, errsize)
 	             : api_model_import_assimp(d, len, r->files, r->count, fmt, 0, a, m, &bytes, err, errsize);
 	if (st == API_WIRE_OK) api_model_finish_import(m, 0, a, &bytes);
-	*ms = now_ms() - t0;
+	*ms = test_now_ms() - t0;
 	return st;
 }
 
@@ -94,9 +81,7 @@ static int one_file(const char *path, int n)
 			if (i + 1 == n) keep[w] = a;
 			else api_arena_destroy(a);
 		}
-	qsort(t[0], (size_t)n, sizeof t[0][0], cmp);
-	qsort(t[1], (size_t)n, sizeof t[1][0], cmp);
-	printf("%-40.40s own %8.1f ms  assimp %8.1f ms  ", src.path, t[0][n / 2], t[1][n / 2]);
+	printf("%-40.40s own %8.1f ms  assimp %8.1f ms  ", src.path, test_median(t[0], n), test_median(t[1], n));
 	char why[300];
 	if (!own_takes(d, len, &r, fmt)) printf("assimp\n");
 	else if (st[0] != API_WIRE_OK || st[1] != API_WIRE_OK) {
