@@ -194,7 +194,7 @@ bench-farm: bench-deps
 
 # The floor (../shared/floor, read-only) builds out of tree into $(BUILD)/floor.
 bench-tools:
-	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench \
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench $(BUILD)/tests/import_compare \
 		$(BUILD)/tests/edge_error
 	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor
 
@@ -203,6 +203,10 @@ $(BUILD)/tests/bench: $(BUILD)/obj/tests/bench/bench.o $(BUILD)/obj/tests/util/u
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/import_bench: $(BUILD)/obj/tests/bench/import_bench.o $(BUILD)/obj/tests/util/util.o $(BUILD)/libapi.a \
 		$(BUILD)/librenderer.a
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/tests/import_compare: $(BUILD)/obj/tests/bench/import_compare.o $(BUILD)/obj/tests/util/util.o \
+		$(BUILD)/obj/tests/util/model_compare.o $(BUILD)/libapi.a $(BUILD)/librenderer.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/tests/edge_error: $(BUILD)/obj/tests/bench/edge_error.o

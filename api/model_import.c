@@ -40,7 +40,9 @@
 #include "model_import.h"
 #include "model_io.h"
 #include "model_lod.h"
+#include "obj_import.h"
 #include "ply_colors.h"
+#include "ply_import.h"
 #include "ply_strips.h"
 #include "stl_import.h"
 #include "umbra/rnd_math.h"
@@ -117,9 +119,7 @@ static void mat_from_ai(float out[16], const struct aiMatrix4x4 *a)
 		for (int col = 0; col < 4; col++) out[col * 4 + row] = r[row * 4 + col];
 }
 
-/* True when some triangle of the meshes has an area (a model of only degenerate triangles
- * imports "fine" and renders nothing: it is refused instead). */
-static bool any_area(const struct api_model_mesh *m, uint32_t n)
+bool api_model_meshes_have_area(const struct api_model_mesh *m, uint32_t n)
 {
 	for (uint32_t i = 0; i < n; i++)
 		for (uint32_t t = 0; t + 2 < m[i].index_count; t += 3) {
@@ -324,7 +324,7 @@ static int convert(struct api_conv *c)
 		c->mesh_map[i] = (int32_t)nmesh++;
 	}
 	if (!nmesh) return api_err_set(c->err, c->errsize, "the model has no triangles"), -1;
-	if (!any_area(meshes, nmesh))
+	if (!api_model_meshes_have_area(meshes, nmesh))
 		return api_err_set(c->err, c->errsize, "the model's triangles have no area (every one's corners lie on a line "
 		               "or a point): nothing would be drawn"), -1;
 
@@ -389,8 +389,12 @@ enum api_wire_status api_model_import_files(const uint8_t *data, size_t len, con
 	double t0 = api_clock_ms();
 	memset(out, 0, sizeof *out);
 	*bytes = 0;
+	/* Our own readers first (their NOT_MINE values are all -1): what they leave goes to Assimp */
 	int st = API_STL_NOT_MINE;
 	if (format == API_MODEL_STL && data) st = api_stl_import_binary(data, len, arena, out, bytes, err, errsize);
+	if (format == API_MODEL_OBJ && data)
+		st = api_obj_import(data, len, files, nfiles, output_side, arena, out, bytes, err, errsize);
+	if (format == API_MODEL_PLY && data) st = api_ply_import(data, len, arena, out, bytes, err, errsize);
 	if (st == API_STL_NOT_MINE)
 		st = api_model_import_assimp(data, len, files, nfiles, format, output_side, arena, out, bytes, err, errsize);
 	out->times.ms[API_IMPORT_PARSE] = (float)(api_clock_ms() - t0) - out->times.ms[API_IMPORT_TEXTURES];

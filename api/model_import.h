@@ -37,4 +37,8 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
                                              struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
                                              size_t errsize);
 
+/* True when some triangle of the meshes has an area (a model of only degenerate triangles
+ * imports "fine" and renders nothing: it is refused instead). */
+bool api_model_meshes_have_area(const struct api_model_mesh *m, uint32_t n);
+
 #endif

@@ -5,13 +5,14 @@
  *   if (api_preset_apply(&root, p) < 0) { json_decref(root); return API_ERR; }  // p: 400 at /preset
  *
  * "preset": "thumbnail" (the only one so far) gives a framed model on a self-placing shadow-
- * catcher ground under a soft sun and sky light. The document's own members override the
- * preset's as an RFC 7396 merge patch: objects merge member by member, arrays and values replace,
- * null removes a preset member ("shadows": null). Three exceptions: `objects` are the document's
- * own followed by the preset's ground (left out when the document has its own plane with
- * placement "ground"); `lights` replace the preset's sun as a whole; a `camera` with `position`
- * or `target` replaces the preset's fitted camera as a whole. The document's own members keep
- * their JSON Pointers (its objects stay first), so problems still point at what the user wrote.
+ * catcher ground lit by the studio environment and its shadows (preset.c). The document's own
+ * members override the preset's as an RFC 7396 merge patch: objects merge member by member,
+ * arrays and values replace, null removes a preset member ("environment": {"map": null} drops
+ * the studio). Two exceptions: `objects` are the document's own followed by the preset's ground
+ * (left out when the document has its own plane with placement "ground"); a `camera` with
+ * `position` or `target` replaces the preset's fitted camera as a whole. The document's `lights`
+ * are its own (the preset has none). The document's own members keep their JSON Pointers (its
+ * objects stay first), so problems still point at what the user wrote.
  *
  * Ownership: *root is replaced by the merged document (the old one released). Thread-safe.
  * This header is internal to api/ (it exposes jansson).

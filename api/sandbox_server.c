@@ -77,7 +77,7 @@ static void stop_server(void)
 
 char **api_sbx_helper_env(char *const *env, char **own)
 {
-	static const char tunable[] = "glibc.malloc.hugetlb=1";
+	static const char tunable[] = API_SBX_TUNABLES;
 	size_t n = 0;
 	const char *old = NULL;
 	for (; env[n]; n++)

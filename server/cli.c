@@ -60,7 +60,7 @@ static int usage(FILE *f, int code)
 	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n"
 	           "  --asset-root DIR  models' \"path\" is relative to DIR and never leaves it (default: none, a 400)\n"
 	           "  thumb        MODEL files (.glb .gltf .obj .stl .ply) as thumbnails: \"preset\": \"thumbnail\"\n"
-	           "               (framed, soft sun and sky light, a ground shadow catcher under the model)\n"
+	           "               (framed, lit by the studio environment and its shadows, a ground shadow catcher)\n"
 	           "  --size N     thumbnail width and height (default 512)\n"
 	           "  --transparent  thumbnails on a transparent background (the ground shadow in alpha)\n"
 	           "  --up AXIS    thumbnails: the models' up axis, z y x -z -y -x (default y; z for most STL and\n"

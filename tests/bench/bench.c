@@ -16,25 +16,6 @@
 #include "util.h"
 #include "umbra/rnd.h"
 
-static double now_ms(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
-static int cmp(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-	qsort(v, (size_t)n, sizeof *v, cmp);
-	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 enum { S_PARSE, S_UPLOAD, S_SHADOW, S_MAIN, S_READBACK, S_ENCODE, S_TOTAL, S_VIS, S_COUNT };
 static const char *names[S_COUNT] = {"parse", "upload", "shadow", "main", "readback", "encode", "total", "vis"};
 
@@ -84,24 +65,24 @@ int main(int argc, char **argv)
 		api_model_cache_set_limit(cold_models ? 0 : 256u << 20);
 		lim.asset_root = asset_root;
 		for (int i = -1; i < n && rc == 0; i++) {
-			double t0 = now_ms();
+			double t0 = test_now_ms();
 			struct api_scene *s;
 			struct api_problem p;
 			if (api_scene_parse(json, len, &lim, &s, &p) != API_OK) {
 				fprintf(stderr, "bench: %s: %s %s\n", argv[a], p.pointer, p.detail); rc = 1; break;
 			}
-			double t1 = now_ms();
+			double t1 = test_now_ms();
 			struct rnd_image img;
 			struct rnd_timings tm;
 			if (deadline_ms > 0) s->scene.deadline_ns = (uint64_t)((t0 + deadline_ms) * 1e6);
 			if (rnd_render(ctx, &s->scene, &img, &tm, &err) != RND_OK) {
 				fprintf(stderr, "bench: %s: %s\n", argv[a], err.msg); api_scene_free(s); rc = 1; break;
 			}
-			double t2 = now_ms();
+			double t2 = test_now_ms();
 			uint8_t *out; size_t olen;
 			if (api_encode(s, &img, &out, &olen, &p) != API_OK) { fprintf(stderr, "bench: encode: %s\n", p.detail); rc = 1; }
 			else free(out);
-			double t3 = now_ms();
+			double t3 = test_now_ms();
 			bytes_out = olen;
 			last = tm;
 			rnd_image_release(&img);
@@ -121,7 +102,7 @@ int main(int argc, char **argv)
 				double v[1024];
 				int m = n < 1024 ? n : 1024;
 				for (int i = 0; i < m; i++) v[i] = t[(size_t)i * S_COUNT + s];
-				col[s] = median(v, m);
+				col[s] = test_median(v, m);
 				if (s <= S_TOTAL) printf(" %8.2f", col[s]);
 			}
 			printf(" %8.1f %8zu %4u/%-4u %6.2f %8.1f %3u %3u %7.2f\n", 1000.0 / col[S_TOTAL], bytes_out / 1024,

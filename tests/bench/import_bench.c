@@ -20,19 +20,6 @@
 #include "sandbox.h"
 #include "util.h"
 
-static double now_ms(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
-static int cmp(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return x < y ? -1 : x > y;
-}
-
 /* A binary STL of about `tris` triangles: a k x k grid of quads (shared vertices). */
 static uint8_t *grid_stl(uint32_t tris, size_t *len)
 {
@@ -57,12 +44,6 @@ static uint8_t *grid_stl(uint32_t tris, size_t *len)
 	return d;
 }
 
-static double median(double *t, int n)
-{
-	qsort(t, (size_t)n, sizeof *t, cmp);
-	return n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
-}
-
 /* One cold import of d as fmt (sandboxed, or in-process without isolation), its ms; *m gets
  * its triangles and stage times. Exits on failure. */
 static double import_once(const uint8_t *d, size_t len, int fmt, const struct api_limits *lim, int sandboxed,
@@ -72,12 +53,12 @@ static double import_once(const uint8_t *d, size_t len, int fmt, const struct ap
 	size_t bytes;
 	char err[400];
 	int st;
-	double t0 = now_ms();
+	double t0 = test_now_ms();
 	int ok = sandboxed ? api_sandbox_import_model(d, len, (enum api_model_format)fmt, lim, a, m, &bytes, &st, err,
 	                                              sizeof err) == API_OK
 	                   : api_model_import_local(d, len, (enum api_model_format)fmt, a, m, &bytes, err, sizeof err) ==
 	                         API_WIRE_OK;
-	double ms = now_ms() - t0;
+	double ms = test_now_ms() - t0;
 	if (!ok) {
 		fprintf(stderr, "import_bench: %s: %s\n", name, err);
 		exit(1);
@@ -95,7 +76,7 @@ static double run(const uint8_t *d, size_t len, int sandboxed, int n, uint64_t *
 		*tris = m.triangles;
 		if (i >= 0) t[i] = ms;   /* run -1 starts the fork server / warms caches */
 	}
-	double med = median(t, n);
+	double med = test_median(t, n);
 	free(t);
 	return med;
 }
@@ -136,8 +117,8 @@ static int stages(int argc, char **argv)
 		}
 		const char *base = strrchr(argv[i], '/');
 		printf("%-32.32s", base ? base + 1 : argv[i]);
-		for (int k = API_IMPORT_PARSE; k <= API_IMPORT_VALIDATE; k++) printf(" %9.1f", median(t[k], runs));
-		printf(" %9.1f\n", median(t[API_IMPORT_STAGES], runs));
+		for (int k = API_IMPORT_PARSE; k <= API_IMPORT_VALIDATE; k++) printf(" %9.1f", test_median(t[k], runs));
+		printf(" %9.1f\n", test_median(t[API_IMPORT_STAGES], runs));
 		free(d);
 	}
 	return 0;

@@ -20,6 +20,14 @@ put("fuzz_model_obj", "tri.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1.5 0\nf 1 2 3\n")
 put("fuzz_model_obj", "quad-uv-normals.obj",
     "o quad\n" + "".join("v %g %g %g\n" % v for v in QUAD_V) + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
     "usemtl none\ns 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n")
+# obj for the own reader (api/obj_import.c): negative indices, quads, objects and groups,
+# materials (the .mtl is not sent: Assimp's named empty materials), a pentagon (left to Assimp)
+GRID = "".join("v %d %g %d\nvt %g %g\nvn 0 1 %g\n" % (i, 0.1 * ((i * j) % 3), j, i / 2, j / 2, 0.1 * i)
+               for j in range(3) for i in range(3))
+put("fuzz_model_obj", "grid-groups-materials.obj",
+    "mtllib grid.mtl\n" + GRID + "o sheet\nusemtl red\nf -9/-9/-9 -6/-6/-6 -5/-5/-5 -8/-8/-8\ng row 2\n"
+    "f 2/2/2 5/5/5 6/6/6\nusemtl wood\nf 2//2 6//6 3//3\ng\nf 4/4 7/7 8/8 5/5\nf 5 8 9 6\n")
+put("fuzz_model_obj", "pentagon.obj", "v 0 0 0\nv 1 0 0\nv 1.5 1 0\nv 0.5 1.5 0\nv -0.5 1 0\nf 1 2 3 4 5\n")
 # stl
 put("fuzz_model_stl", "tetra-ascii.stl",
     "solid t\n" + "".join("facet normal 0 0 0\nouter loop\n" + "".join("vertex %g %g %g\n" % p for p in tri) +
@@ -36,6 +44,20 @@ put("fuzz_model_ply", "quad-ascii.ply", hdr % "ascii" + "".join("%g %g %g\n" % v
     "".join("3 %d %d %d\n" % f for f in QUAD_F))
 put("fuzz_model_ply", "quad-binary.ply", (hdr % "binary_little_endian").encode() +
     b"".join(struct.pack("<3f", *v) for v in QUAD_V) + b"".join(struct.pack("<B3i", 3, *f) for f in QUAD_F))
+# ply for the own reader (api/ply_import.c): big-endian with normals, uvs and ushort colours;
+# face colours; a quad
+qhdr = ("ply\nformat %s 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+        "property float nx\nproperty float ny\nproperty float nz\nproperty float s\nproperty float t\n"
+        "property ushort red\nproperty ushort green\nproperty ushort blue\n"
+        "element face 1\nproperty list uchar uint vertex_indices\nend_header\n")
+put("fuzz_model_ply", "quad-be-attributes.ply", (qhdr % "binary_big_endian").encode() +
+    b"".join(struct.pack(">3d3f2f3H", *v, 0, 0, 1, v[0], v[1], 60000, 3000, 100) for v in QUAD_V) +
+    struct.pack(">B4I", 4, 0, 1, 2, 3))
+fhdr = ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 2\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nend_header\n")
+put("fuzz_model_ply", "face-colours.ply", fhdr + "".join("%g %g %g\n" % v for v in QUAD_V) +
+    "3 0 1 2 255 0 0\n3 0 2 3 0 0 255\n")
 # gltf / glb: one triangle, positions + indices in one buffer
 pos = b"".join(struct.pack("<3f", *v) for v in [(0, 0, 0), (1, 0, 0), (0, 1, 0)])
 idx = struct.pack("<3H", 0, 1, 2) + b"\0\0"

@@ -1,6 +1,7 @@
 /* tests/util/util.c — see util.h. */
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
 #include <string.h>
 
 #include "api.h"
@@ -87,4 +88,23 @@ uint8_t *test_read_file(const char *path, size_t *len)
 	fclose(f);
 	if (b) { b[n] = 0; *len = (size_t)n; }
 	return b;
+}
+
+double test_now_ms(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return x < y ? -1 : x > y;
+}
+
+double test_median(double *t, int n)
+{
+	qsort(t, (size_t)n, sizeof *t, cmp_double);
+	return n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
 }

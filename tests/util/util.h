@@ -33,4 +33,9 @@ struct api_scene *test_parse_model(const uint8_t *d, size_t n, const char *forma
  * problem (*p zeroed first). */
 struct api_scene *test_parse_scene(const char *doc, struct api_problem *p);
 
+/* The monotonic clock in ms (the benchmarks' timer). */
+double test_now_ms(void);
+/* The median of t[0..n) (n > 0; t is sorted in place). */
+double test_median(double *t, int n);
+
 #endif
