@@ -261,6 +261,17 @@ struct api_info {
  * length. NULL when out of memory. api/info.c. */
 char *api_info_json(const struct api_info *in, size_t *len);
 
+/* What a caller measured around a render, for `explain` (milliseconds; < 0: not measured). */
+struct api_plan_times {
+	double parse_ms, encode_ms, total_ms;
+};
+/* The render plan of s (rnd_plan_create, umbra/rnd_plan.h) as the JSON document `explain`
+ * answers (api/explain.schema.json): the image, the memory estimate, the views, every shadow
+ * map, every object, the passes in order; after rnd_render_plan(), "analyzed" and what each step
+ * measured (EXPLAIN ANALYZE; t: the caller's stages, or NULL). Compact JSON, malloc'd (the caller
+ * frees it), *len its length (len may be NULL); NULL when out of memory. api/plan_json.c. */
+char *api_plan_json(const struct api_scene *s, const struct rnd_plan *plan, const struct api_plan_times *t, size_t *len);
+
 /* One line of a JSON-lines render manifest (umbra-render --manifest), api/manifest.c:
  * {"scene": "path.json" | {document}, "output": "name.png"}; output optional, a bare file name.
  * On API_OK exactly one of scene_path / scene_json is set (malloc'd, as is output); release with

@@ -103,3 +103,20 @@ double rnd_atlas_occupancy(const struct rnd_atlas *a)
 {
 	return a->size ? (double)a->used_texels / ((double)a->size * a->size) : 0.0;
 }
+
+bool rnd_atlas_fit(const uint32_t *tiles, const uint32_t *want, uint32_t n, uint32_t atlas, uint32_t min_tile,
+                   uint32_t *res)
+{
+	for (uint32_t k = 0; k < n; k++) res[k] = want[k] < min_tile ? min_tile : want[k] > atlas ? atlas : want[k];
+	for (;;) {
+		uint64_t need = 0;
+		uint32_t big = n;
+		for (uint32_t k = 0; k < n; k++) {
+			need += (uint64_t)tiles[k] * res[k] * res[k];
+			if (res[k] > min_tile && (big == n || res[k] > res[big])) big = k;
+		}
+		if (need <= (uint64_t)atlas * atlas) return true;
+		if (big == n) return false;
+		res[big] /= 2;
+	}
+}

@@ -13,6 +13,7 @@
  */
 #include <string.h>
 #include "contact.h"
+#include "record.h"
 
 bool rnd_contact_on(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, uint32_t i)
 {

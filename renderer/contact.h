@@ -1,13 +1,17 @@
 /*
  * renderer/contact.h — contact shadows: which lights march them, their parameters, and the
- * camera-view depth pass they march against (see contact.c). Used by render.c and record.c;
+ * camera-view depth pass they march against (see contact.c). The first two are the render
+ * plan's (render_plan.c: whether a view draws its depth for them); no Vulkan in this header,
  * no state of its own.
  */
 #ifndef UMBRA_RENDERER_CONTACT_H
 #define UMBRA_RENDERER_CONTACT_H
 
-#include <math.h>
-#include "record.h"
+#include "plan.h"
+
+struct rnd_context;
+struct rnd_slot;
+struct record_view;
 
 /* Light i marches contact shadows (asked for, shadows on, and the light has shadow views). */
 bool rnd_contact_on(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, uint32_t i);

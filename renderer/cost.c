@@ -1,9 +1,29 @@
 /*
- * renderer/cost.c — fragments a draw may cover in a view (see cost.h).
+ * renderer/cost.c — the deadline's cost model and the fragments a draw may cover in a view
+ * (see cost.h).
  */
 #include <math.h>
+#include "casters.h"
+#include "contact.h"
 #include "cost.h"
-#include "plan.h"
+
+/* Cost model for the first band and for grouping shadow views, in lavapipe milliseconds (a
+ * GPU is faster: the model then only makes the first band smaller than needed, and measured
+ * times take over from the second band on). On the high side: an underestimate lets one submit
+ * run past a deadline. But not far: every band redraws every triangle (and repeats the
+ * visibility pass's), and the measured rows are never trusted below a quarter of the estimate
+ * (rnd_pacer_band_rows). Calibrated on 26 bench scenes (ninth landing): the main pass's
+ * estimate is 0.6x (five stacked layers of small two-sided triangles) to 4.5x (16 soft lights)
+ * of its time, mostly 1-2.5x. It had been 20-200x since the filters got cheaper, and under
+ * umbrad's default 30 s deadline (slices of 1 s) a render of 0.02-0.3 s was cut into bands: the
+ * ogre OBJ under three soft lights took 262 ms instead of 140, 16 soft lights 166 instead of
+ * 141. */
+#define EST_MS_PER_PIXEL_UNIT 1.5e-5 /* one pixel, one unit of shading (rnd_cost_pixel_units) */
+#define EST_MS_PER_BAND 3.0          /* a band's clears, resolve and copy */
+#define EST_MS_PER_TRIANGLE 3e-4     /* main pass: vertex work, repeated in every band */
+#define EST_MS_PER_TEXEL 5e-6        /* shadow map clear, raster, copy into the atlas */
+#define EST_MS_PER_CASTER 1e-4       /* depth-only triangle */
+#define EST_MS_PER_DEPTH_FRAG 2e-6   /* depth-only fragment beyond the map's first layer (cost.h) */
 
 /* Row r (0..3) of a column-major 4x4 matrix, xyz part and w part. */
 static void row(const float m[16], int r, double out[4])
@@ -62,4 +82,61 @@ double rnd_cost_layer_factor(double fill, double w, double h)
 	if (!(px > 0)) return 1.0;
 	double layers = fill / px;
 	return layers > RND_COST_LAYERS_CALIBRATED ? layers / RND_COST_LAYERS_CALIBRATED : 1.0;
+}
+
+/* Shadow view v: its triangles (*tris) and their fill beyond one layer over the map, in
+ * milliseconds. The first layer is in the per-texel term (clear, raster, copy). */
+double rnd_cost_shadow_view_ms(const struct rnd_shadow_plan *sp, const struct rnd_light *lights,
+                               const struct draw *draws, uint32_t ndraw, uint32_t v, uint64_t *tris)
+{
+	const struct umbra_shadow_view *sv = &sp->views[v];
+	double res = sv->rect[2], fill = 0;
+	int cull;
+	*tris = 0;
+	for (uint32_t i = 0; i < ndraw; i++) {
+		if (!rnd_shadow_view_draws(sp, lights, draws, v, i, &cull)) continue;
+		const struct draw *d = &draws[i];
+		*tris += d->index_count / 3;
+		fill += rnd_cost_fill(sv->view_proj, res, res, &d->bounds, d->area, d->index_count / 3, d->closed);
+	}
+	double beyond = fill > res * res ? fill - res * res : 0;
+	return res * res * EST_MS_PER_TEXEL + (double)*tris * EST_MS_PER_CASTER + beyond * EST_MS_PER_DEPTH_FRAG;
+}
+
+/* Shading work per pixel, in units of a hard-shadowed light's. */
+double rnd_cost_pixel_units(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, bool vis, uint32_t aov_passes)
+{
+	double u = 1;
+	for (uint32_t i = 0; i < sc->light_count; i++) {
+		const struct rnd_light_plan *lp = &sp->lights[i];
+		if (!lp->view_count) { u += 0.5; continue; }
+		switch (lp->filter) {
+		case UMBRA_FILTER_PCF: u += 1 + 0.5 * lp->pcf_radius; break;
+		case UMBRA_FILTER_PCSS: u += 4; break;
+		case UMBRA_FILTER_MOMENTS: u += 1.5; break;
+		default: u += 1; break;
+		}
+		if (lp->view_count > 1 && sc->lights[i].type == RND_LIGHT_DIRECTIONAL) u += 2;   /* cascades, levels */
+		if (rnd_contact_on(sc, sp, i)) u += 4;                                           /* the march */
+	}
+	if (vis) u += 4;   /* the visibility pass's own passes */
+	if (sc->output.msaa > 1) u *= 1.5;
+	if (sc->output.pixels == RND_PIXELS_RGBA32F) u *= 1.5;   /* float targets, resolve and copy */
+	return u * (1 + 3 * aov_passes);
+}
+
+void rnd_cost_main(const struct rnd_scene *sc, const float view_proj[16], const struct draw *draws, uint32_t ndraw,
+                   double units, double *row_ms, double *fixed_ms)
+{
+	uint64_t tris = 0;
+	for (uint32_t i = 0; i < ndraw; i++) tris += draws[i].cam_index_count / 3;
+	/* Geometry stacked many layers deep costs per layer (cost.h): a band of rows sized as if
+	 * each pixel were covered once had run a 10 s submit past a 3 s deadline. */
+	double fill = 0;
+	for (uint32_t i = 0; i < ndraw; i++)
+		fill += rnd_cost_fill(view_proj, sc->width, sc->height, &draws[i].bounds, draws[i].area,
+		                      draws[i].cam_index_count / 3, draws[i].closed);
+	*row_ms = sc->width * units * EST_MS_PER_PIXEL_UNIT * rnd_cost_layer_factor(fill, sc->width, sc->height);
+	/* lavapipe shades each triangle's 4x4 blocks: a triangle costs more where a pixel does */
+	*fixed_ms = EST_MS_PER_BAND + (double)tris * EST_MS_PER_TRIANGLE * (1 + units / 4);
 }

@@ -1,6 +1,9 @@
 /*
- * renderer/cost — how many fragments a draw may rasterise into a view: the part of the cost
- * model (renderer/submit.c) that depends on how much of the image the geometry covers.
+ * renderer/cost — the cost model of the deadline's bands: how many milliseconds a shadow map
+ * and a row of the main pass are estimated to take, which the render plan holds for each view
+ * (render_plan.c) and the submit pacer sizes its first band and its shadow submits by
+ * (renderer/submit.c); and how many fragments a draw may rasterise into a view, the part of
+ * the model that depends on how much of the image the geometry covers.
  *
  * Why: the submit pacer sized its first band and its shadow submits from pixels and triangle
  * counts alone, as if every pixel were covered once. A scene of 400 boxes stacked in one place
@@ -15,6 +18,8 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include "draw.h"
+#include "plan.h"
 #include "umbra/rnd_math.h"
 
 /* About how many fragments `tris` triangles of world-space area `area` inside bounds b
@@ -32,5 +37,18 @@ double rnd_cost_fill(const float view_proj[16], double vp_w, double vp_h, const 
 
 /* The factor a view's per-pixel estimate takes for `fill` fragments over w x h pixels. */
 double rnd_cost_layer_factor(double fill, double w, double h);
+
+/* Shadow view v of sp (drawn at its rect[2] texels a side) for the casters rnd_shadow_view_draws
+ * says it draws of draws[ndraw] (lights: sp's): its triangles (*tris) and its milliseconds. */
+double rnd_cost_shadow_view_ms(const struct rnd_shadow_plan *sp, const struct rnd_light *lights,
+                               const struct draw *draws, uint32_t ndraw, uint32_t v, uint64_t *tris);
+/* Shading work per pixel of a view of sc (sp its shadow plan; vis: its shadows from the
+ * visibility pass; aov_passes its AOV passes), in units of a hard-shadowed light's. */
+double rnd_cost_pixel_units(const struct rnd_scene *sc, const struct rnd_shadow_plan *sp, bool vis, uint32_t aov_passes);
+/* The main pass of a view (view_proj its camera's; draws as the camera draws them; units its
+ * rnd_cost_pixel_units): milliseconds per row (*row_ms) and per band whatever its rows
+ * (*fixed_ms: the vertex work every band repeats). */
+void rnd_cost_main(const struct rnd_scene *sc, const float view_proj[16], const struct draw *draws, uint32_t ndraw,
+                   double units, double *row_ms, double *fixed_ms);
 
 #endif

@@ -21,54 +21,6 @@ bool rnd_deferred_supported(struct rnd_context *ctx)
 	       (dp.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT);
 }
 
-/* A draw shade.glsl can shade from the surfaces pass alone: no texture (the fullscreen pass has
- * no uv derivatives and binds no material's set), no material extension's lobe (their textures
- * and coat normal), opaque (no alpha test or dither: the surfaces pass cuts no texel out), not a
- * sphere's proxy (it shades the true sphere, not the mesh the surfaces pass keeps). */
-static bool plain(const struct rnd_scene *sc, const struct draw *d)
-{
-	return !d->masked && !(d->tex_bits & ((1u << UMBRA_TEX_SLOTS) - 1u)) && !(d->flags & UMBRA_DRAW_SPHERE) &&
-	       !(sc->material_count && rnd_material_ext_bits(&sc->materials[d->material]));
-}
-
-/* Without the visibility pass (no light with a wide shadow filter), pixel shading runs the
- * surfaces pass for itself where an environment map lights the view: its shading (the map's
- * light and the environment pass's bilateral read, ibl.glsl) is what lavapipe would otherwise run
- * per triangle per 4x4 block. It pays over dense meshes, as the visibility pass does for one wide
- * light: at least one face towards the camera per RND_DEFERRED_PIXELS_PER_FACE pixels. */
-#define RND_DEFERRED_PIXELS_PER_FACE 16u
-
-bool rnd_deferred_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct draw *draws,
-                         uint32_t ndraw, bool vis, bool env_lit)
-{
-	if (!ctx->pixel_shading || sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return false;
-	/* An environment map behind the scene is drawn where the main pass left the far plane
-	 * (record.c, env_background.frag); the resolve writes the clear colour there. */
-	if (sc->environment.source != RND_ENV_AMBIENT && sc->environment.background_map && !sc->output.transparent)
-		return false;
-	for (uint32_t i = 0; i < ndraw; i++)
-		if (draws[i].index_count && !plain(sc, &draws[i])) return false;
-	if (!vis) {
-		if (!ctx->visibility_pass || !env_lit || !rnd_surfaces_bytes(sc, 0)) return false;
-		if (rnd_camera_faces(draws, ndraw) * RND_DEFERRED_PIXELS_PER_FACE < (uint64_t)sc->width * sc->height)
-			return false;
-	}
-	const char *env = getenv("UMBRA_PIXEL_SHADING");
-	return !(env && strcmp(env, "0") == 0);
-}
-
-uint64_t rnd_deferred_bytes(const struct rnd_scene *sc)
-{
-	if (sc->output.msaa != 4 || sc->output.debug != RND_DEBUG_NONE) return 0;
-	/* the surfaces pass's images where the visibility pass has none (an environment map's view) */
-	uint64_t surfaces = 0;
-	if (!rnd_visibility_bytes(sc)) {
-		if (sc->environment.source == RND_ENV_AMBIENT || !(surfaces = rnd_surfaces_bytes(sc, 0))) return 0;
-	}
-	/* the shading inputs (RGBA32UI) and the shaded colour (at most RGBA32F) */
-	return surfaces + (uint64_t)sc->width * sc->height * (16 + 16);
-}
-
 /* The view's depth, every sample, of the band's rows: every draw with the depth pre-pass's
  * pipelines (no fragment shader), kept for the resolve. */
 static void draw_depth(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv, VkRect2D area)
@@ -98,6 +50,7 @@ static void draw_depth(struct rnd_context *ctx, struct rnd_slot *s, const struct
 	for (uint32_t i = 0; i < rv->ndraw; i++) {
 		const struct draw *d = &rv->draws[i];
 		if (!d->index_count) continue;
+		if (rv->drawn_camera && rv->band_y == 0) *rv->drawn_camera += d->cam_index_count / 3;   /* record.h */
 		VkPipeline p = ctx->pipes.prepass[1][d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
 		record_draw_camera(cmd, d);

@@ -20,7 +20,7 @@
  *     and, along silhouettes, the colour of the surface each sample shows, shaded at the nearest
  *     pixel centre that shows it.
  *
- * When (rnd_deferred_wanted): the view runs the visibility pass (dense triangles, wide shadow
+ * When (visibility_plan.c rnd_pixel_shading_wanted, the render plan's decision): the view runs the visibility pass (dense triangles, wide shadow
  * filters) or is lit by an environment map over dense triangles (one face per 16 pixels: the
  * thumbnail preset's studio), MSAA 4, no debug view, no environment map as the background, and
  * every draw is plain: opaque, no texture (vertex colours are fine), no glTF material extension
@@ -37,13 +37,6 @@
 /* Whether the device can: standard sample locations (resolve.frag assumes them), a sampled
  * 4-sample depth image, RGBA32UI colour attachments that can be sampled. Once, at create. */
 bool rnd_deferred_supported(struct rnd_context *ctx);
-/* Whether a view of sc is shaded per pixel: vis, it runs the visibility pass; env_lit, an
- * environment map lights it (then pixel shading may run the surfaces pass for itself: the
- * caller runs the visibility pass's passes wherever this says yes). */
-bool rnd_deferred_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct draw *draws,
-                         uint32_t ndraw, bool vis, bool env_lit);
-/* The bytes of pixel shading's images for a view of sc (estimate.c: beside the visibility pass's). */
-uint64_t rnd_deferred_bytes(const struct rnd_scene *sc);
 /* The main pass of a pixel-shaded band (after record_visibility): depth only, MSAA 4, then the
  * resolve into the slot's colour target, left as record_main leaves it for the readback. */
 enum rnd_result record_deferred_main(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,

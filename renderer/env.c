@@ -195,6 +195,17 @@ static enum rnd_result claim_brdf(struct rnd_env_cache *c, double deadline, stru
 	return RND_OK;
 }
 
+/* The cache's key of env's map: its own key or its pixels, and its size. */
+static uint64_t env_key(const struct rnd_environment *env)
+{
+	if (env->source != RND_ENV_MAP) return STUDIO_KEY;
+	uint32_t dims[2] = {env->map.width, env->map.height};
+	uint64_t key = env->map.key ? env->map.key
+	                            : rnd_hash(0x656e76ull, env->map.rgb, (size_t)env->map.width * env->map.height * 3 * sizeof(float));
+	key = rnd_hash(key, dims, sizeof dims);
+	return key == STUDIO_KEY ? key + 1 : key;
+}
+
 enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_environment *env, double deadline,
                                 struct rnd_env_use *use, struct rnd_error *err)
 {
@@ -204,14 +215,7 @@ enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_enviro
 		return rnd_fail(err, RND_ERR_INVALID, "the environment map has no pixels (%ux%u)", env->map.width, env->map.height);
 	double t0 = mono_now();
 	struct rnd_env_cache *c = ctx->env;
-	uint64_t key = STUDIO_KEY;
-	if (env->source == RND_ENV_MAP) {
-		uint32_t dims[2] = {env->map.width, env->map.height};
-		key = env->map.key ? env->map.key
-		                   : rnd_hash(0x656e76ull, env->map.rgb, (size_t)env->map.width * env->map.height * 3 * sizeof(float));
-		key = rnd_hash(key, dims, sizeof dims);
-		if (key == STUDIO_KEY) key++;
-	}
+	uint64_t key = env_key(env);
 	pthread_mutex_lock(&c->mu);
 	enum rnd_result r = rnd_env_gpu_init(ctx, &c->gpu, err);
 	if (r == RND_OK) r = find_entry(ctx, c, key, deadline, use, err);
@@ -224,23 +228,67 @@ enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_enviro
 	return r;
 }
 
-void rnd_env_shadow_dirs(struct rnd_env_use *use, const struct rnd_environment *env, const float *ground_n)
+void rnd_env_shadow_dirs(struct rnd_env_use *use, const struct rnd_env_plan *plan)
 {
 	use->ndirs = use->mapped = 0;
-	use->ground = ground_n != NULL;
-	if (ground_n) memcpy(use->ground_n, ground_n, sizeof use->ground_n);
-	if (!use->entry || !env->shadow_directions) return;
-	struct rnd_env_dir d[RND_MAX_ENV_DIRECTIONS + RND_ENV_GROUND_DIRS];
-	uint32_t count = env->shadow_directions < RND_MAX_ENV_DIRECTIONS ? env->shadow_directions : RND_MAX_ENV_DIRECTIONS;
-	uint32_t n = rnd_env_directions(&use->entry->bins, count, use->ground, d, &use->mapped);
-	float c = cosf(env->rotation), s = sinf(env->rotation);
-	for (uint32_t i = 0; i < n; i++) {   /* the map's frame to the scene's: R_y(rotation) */
-		float x = d[i].dir[0], z = d[i].dir[2];
-		d[i].dir[0] = c * x + s * z;
-		d[i].dir[2] = -s * x + c * z;
+	use->ground = plan->ground;
+	memcpy(use->ground_n, plan->ground_n, sizeof use->ground_n);
+	if (!use->entry) return;
+	use->ndirs = plan->ndirs;
+	use->mapped = plan->mapped;
+	memcpy(use->dirs, plan->dirs, plan->ndirs * sizeof plan->dirs[0]);
+}
+
+/* The built-in studio's bins, made once per process (its pixels never change within a build):
+ * a plan made before the studio's entry is ready (the first render, every --explain of a
+ * one-shot CLI) would otherwise generate it (~40-90 ms on lavapipe's machine) twice. */
+static struct rnd_env_bins studio_bins;
+static pthread_once_t studio_once = PTHREAD_ONCE_INIT;
+static bool studio_binned;
+
+static void bin_studio(void)
+{
+	float *rgb = malloc((size_t)RND_ENV_STUDIO_W * RND_ENV_STUDIO_H * 3 * sizeof(float));
+	if (!rgb) return;   /* studio_binned stays false: the plan fails out of memory */
+	rnd_env_studio(rgb, RND_ENV_STUDIO_W, RND_ENV_STUDIO_H);
+	rnd_env_bin(rgb, RND_ENV_STUDIO_W, RND_ENV_STUDIO_H, &studio_bins);
+	free(rgb);
+	studio_binned = true;
+}
+
+/* A map's bins: the entry's when the cache holds it ready, else binned here (the studio's once
+ * per process). */
+enum rnd_result rnd_env_plan_bins(struct rnd_context *ctx, const struct rnd_environment *env, struct rnd_env_bins **out,
+                                  struct rnd_error *err)
+{
+	*out = NULL;
+	if (env->source == RND_ENV_AMBIENT || !env->shadow_directions) return RND_OK;
+	if (env->source == RND_ENV_MAP && (!env->map.rgb || env->map.width < 2 || env->map.height < 2))
+		return rnd_fail(err, RND_ERR_INVALID, "the environment map has no pixels (%ux%u)", env->map.width, env->map.height);
+	struct rnd_env_bins *b = malloc(sizeof *b);
+	if (!b) return rnd_fail(err, RND_ERR_OOM, "out of memory for the environment's bins");
+	struct rnd_env_cache *c = ctx->env;
+	uint64_t key = env_key(env);
+	bool found = false;
+	pthread_mutex_lock(&c->mu);
+	for (uint32_t i = 0; i < RND_ENV_ENTRIES && !found; i++)
+		if (c->entries[i].state == ENTRY_READY && c->entries[i].key == key) {
+			memcpy(b, &c->entries[i].bins, sizeof *b);
+			found = true;
+		}
+	pthread_mutex_unlock(&c->mu);
+	if (!found && env->source == RND_ENV_STUDIO) {
+		pthread_once(&studio_once, bin_studio);
+		if (!studio_binned) {
+			free(b);
+			return rnd_fail(err, RND_ERR_OOM, "out of memory for the studio environment");
+		}
+		memcpy(b, &studio_bins, sizeof *b);
+	} else if (!found) {
+		rnd_env_bin(env->map.rgb, env->map.width, env->map.height, b);
 	}
-	memcpy(use->dirs, d, n * sizeof d[0]);
-	use->ndirs = n;
+	*out = b;
+	return RND_OK;
 }
 
 void rnd_env_record(struct rnd_context *ctx, VkCommandBuffer cmd, const struct rnd_env_use *use)

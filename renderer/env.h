@@ -61,10 +61,14 @@ void rnd_env_release_all(struct rnd_context *ctx);
  * seconds, 0 = none: RND_ERR_TIMEOUT). */
 enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_environment *env, double deadline,
                                 struct rnd_env_use *use, struct rnd_error *err);
-/* The shadow directions for this render: env->shadow_directions regions of the map's light,
- * turned by the rotation; with a ground (its unit normal, NULL = none) only those above it get
- * maps. Pure once acquired. */
-void rnd_env_shadow_dirs(struct rnd_env_use *use, const struct rnd_environment *env, const float *ground_n);
+/* The shadow directions for this render: the render plan's (rnd_env_plan_dirs, from the bins
+ * rnd_env_plan_bins gave it: the same as the entry's). Pure once acquired. */
+void rnd_env_shadow_dirs(struct rnd_env_use *use, const struct rnd_env_plan *plan);
+/* For a render plan (render_plan.h): the bins of env's map (*out malloc'd; NULL: no map, or no
+ * shadow directions asked), the cache's when it holds the map, else binned now. RND_ERR_INVALID
+ * for a map without pixels (as rnd_env_acquire). */
+enum rnd_result rnd_env_plan_bins(struct rnd_context *ctx, const struct rnd_environment *env, struct rnd_env_bins **out,
+                                  struct rnd_error *err);
 /* Records the build (map upload, prefilter, table) when use->build: into the render's first
  * command buffer, before anything samples it. */
 void rnd_env_record(struct rnd_context *ctx, VkCommandBuffer cmd, const struct rnd_env_use *use);

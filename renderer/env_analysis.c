@@ -273,3 +273,23 @@ uint32_t rnd_env_directions(const struct rnd_env_bins *b, uint32_t count, bool g
 	free(rest);
 	return n + s;
 }
+
+void rnd_env_plan_dirs(const struct rnd_env_bins *b, const struct rnd_environment *env, const float *ground_n,
+                       struct rnd_env_plan *out)
+{
+	memset(out, 0, sizeof *out);
+	out->ground = ground_n != NULL;
+	if (ground_n) memcpy(out->ground_n, ground_n, sizeof out->ground_n);
+	if (!b || !env->shadow_directions) return;
+	struct rnd_env_dir d[RND_MAX_ENV_DIRECTIONS + RND_ENV_GROUND_DIRS];
+	uint32_t count = env->shadow_directions < RND_MAX_ENV_DIRECTIONS ? env->shadow_directions : RND_MAX_ENV_DIRECTIONS;
+	uint32_t n = rnd_env_directions(b, count, out->ground, d, &out->mapped);
+	float c = cosf(env->rotation), s = sinf(env->rotation);
+	for (uint32_t i = 0; i < n; i++) {   /* the map's frame to the scene's: R_y(rotation) */
+		float x = d[i].dir[0], z = d[i].dir[2];
+		d[i].dir[0] = c * x + s * z;
+		d[i].dir[2] = -s * x + c * z;
+	}
+	memcpy(out->dirs, d, n * sizeof d[0]);
+	out->ndirs = n;
+}

@@ -12,6 +12,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include "umbra/rnd.h"
 
 /* The map averaged into RND_ENV_BINS_W x RND_ENV_BINS_H bins (equal steps of longitude and
  * latitude, rows from the zenith), linear RGB. */
@@ -52,6 +53,20 @@ void rnd_env_sh_basis(const float n[3], float y[9]);
 #define RND_ENV_GROUND_DIRS 4u
 uint32_t rnd_env_directions(const struct rnd_env_bins *b, uint32_t count, bool ground, struct rnd_env_dir *out,
                             uint32_t *upper);
+
+/* The shadow directions of one render, in the scene's frame (the render plan's, render_plan.h;
+ * env.h's rnd_env_use takes them): the first `mapped` get shadow maps, the rest (below a
+ * ground) are only weighed. */
+struct rnd_env_plan {
+	uint32_t ndirs, mapped;
+	struct rnd_env_dir dirs[RND_MAX_ENV_DIRECTIONS + RND_ENV_GROUND_DIRS];
+	bool ground;
+	float ground_n[3];
+};
+/* env->shadow_directions regions of the light of a map binned as b, turned by env->rotation;
+ * with a ground (its unit normal, NULL = none) only those above it get maps. b NULL: none. */
+void rnd_env_plan_dirs(const struct rnd_env_bins *b, const struct rnd_environment *env, const float *ground_n,
+                       struct rnd_env_plan *out);
 
 /* Rec. 709 luminance. */
 static inline float rnd_env_luminance(const float c[3])

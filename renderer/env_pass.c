@@ -19,19 +19,6 @@
 
 #define ENV_VIS_FORMAT VK_FORMAT_R16_UNORM
 
-bool rnd_env_pass_wanted(const struct rnd_scene *sc, const struct rnd_env_use *env, const struct draw *draws,
-                         uint32_t ndraw)
-{
-	if (!env || !env->entry || !env->mapped) return false;
-	if (sc->output.debug != RND_DEBUG_NONE && sc->output.debug != RND_DEBUG_ENV_SHADOW &&
-	    sc->output.debug != RND_DEBUG_CASCADES)
-		return false;
-	for (uint32_t i = 0; i < ndraw; i++)
-		if (draws[i].index_count && draws[i].masked) return false;
-	const char *force = getenv("UMBRA_ENV_PASS");
-	return !(force && strcmp(force, "0") == 0);
-}
-
 uint32_t rnd_env_pass_scale(uint32_t w, uint32_t h)
 {
 	uint32_t side = w > h ? w : h, s = (side + RND_ENV_PASS_GRID - 1) / RND_ENV_PASS_GRID;

@@ -3,7 +3,7 @@
  * texel of a grid coarser than the view (rnd_env_pass_scale; env_pass.c says why), which
  * the main pass reads back with a bilateral upsample (shaders/ibl.glsl env_pass_read).
  *
- * Usage: render.c asks rnd_env_pass_wanted() per view and sizes the slot's images
+ * Usage: the render plan asks rnd_env_pass_wanted() (env_shadow.h) per view; render.c sizes the slot's images
  * (rnd_slot_env_pass); rnd_frame_write binds them (or the slot's white stand-ins); submit.c
  * records record_env_pass() once per view, after the shadow maps and before the first band.
  * The images belong to the slot, the pipeline to the context.
@@ -13,11 +13,6 @@
 
 #include "record.h"
 
-/* Whether view rv's environment shadows come from the pass: it has mapped directions, no
- * alpha-tested draw (the surfaces pass does not cut texels out) and no debug view but
- * environment_shadow's. UMBRA_ENV_PASS=0 computes them per fragment instead (tests). */
-bool rnd_env_pass_wanted(const struct rnd_scene *sc, const struct rnd_env_use *env, const struct draw *draws,
-                         uint32_t ndraw);
 /* The view's pixels per texel of the pass's grid, a side: UMBRA_ENV_PASS_SCALE (2), more for
  * views larger than RND_ENV_PASS_GRID texels a side at that scale, at most RND_ENV_PASS_MAX_SCALE. */
 #define RND_ENV_PASS_GRID 192u

@@ -1,6 +1,6 @@
 /*
  * renderer/env_shadow.c — the environment's shadows as lights the shadow machinery already
- * knows: each shadow direction of the map (env.h rnd_env_shadow_dirs, a median-cut region of
+ * knows: each shadow direction of the map (env_analysis.h rnd_env_plan_dirs, a median-cut region of
  * its light) becomes a directional light appended after the scene's own, whose one map is
  * fitted to what casts (RND_DIR_CASTERS) and drawn, cached and reused like any sun's. They are
  * never shaded as lights: shaders/ibl.glsl env_visibility() reads their maps and weighs each by
@@ -48,7 +48,19 @@ bool rnd_env_ground(const struct rnd_scene *sc, const struct draw *draws, float 
 	return false;
 }
 
-uint32_t rnd_env_lights(const struct rnd_env_use *use, const struct rnd_environment *env, uint32_t room,
+bool rnd_env_pass_wanted(const struct rnd_scene *sc, uint32_t mapped, const struct draw *draws, uint32_t ndraw,
+                         int force)
+{
+	if (!mapped || force == 0) return false;
+	if (sc->output.debug != RND_DEBUG_NONE && sc->output.debug != RND_DEBUG_ENV_SHADOW &&
+	    sc->output.debug != RND_DEBUG_CASCADES)
+		return false;
+	for (uint32_t i = 0; i < ndraw; i++)
+		if (draws[i].index_count && draws[i].masked) return false;
+	return true;
+}
+
+uint32_t rnd_env_lights(const struct rnd_env_plan *use, const struct rnd_environment *env, uint32_t room,
                         struct rnd_light *out)
 {
 	uint32_t n = use->mapped < room ? use->mapped : room;

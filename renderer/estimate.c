@@ -3,13 +3,15 @@
  * of several views, the AOV passes, and the bytes of every target, buffer and host copy a
  * render of a scene needs. rnd_render() refuses a scene whose largest single allocation is over
  * the device's limit (a 422 naming the member, not an out-of-memory 503 that no retry cures);
- * the daemon admits renders by the estimate (--max-memory).
+ * the render plan carries the estimate (render_plan.c makes it once), and the daemon admits
+ * renders by it (--max-memory).
  */
-#include "deferred.h"
+#include <string.h>
+#include "error.h"
 #include "estimate.h"
 #include "mesh.h"
-#include "texture.h"
-#include "visibility.h"
+#include "umbra_shared.h"
+#include "visibility_plan.h"
 
 void rnd_sheet_layout(uint32_t view_count, uint32_t *cols, uint32_t *rows)
 {
@@ -17,6 +19,20 @@ void rnd_sheet_layout(uint32_t view_count, uint32_t *cols, uint32_t *rows)
 	while (c * c < n) c++;
 	*cols = c;
 	*rows = (n + c - 1) / c;
+}
+
+void rnd_sheet_init(struct rnd_sheet *sh, const struct rnd_scene *sc)
+{
+	memset(sh, 0, sizeof *sh);
+	sh->views = sc->view_count ? sc->view_count : 1;
+	rnd_sheet_layout(sh->views, &sh->cols, &sh->rows);
+	sh->width = (uint64_t)sh->cols * sc->width;
+	sh->height = (uint64_t)sh->rows * sc->height;
+	sh->px = (size_t)rnd_pixel_bytes(sc->output.pixels);
+	sh->passes = rnd_aov_passes(sc);
+	sh->color_bytes = sh->width * sh->height * sh->px;
+	sh->att_bytes = sh->width * sh->height * 16;
+	sh->readback_bytes = sh->color_bytes + (uint64_t)sh->passes * UMBRA_AOV_ATTACHMENTS * sh->att_bytes;
 }
 
 uint32_t rnd_aov_passes(const struct rnd_scene *sc)
@@ -96,17 +112,9 @@ void rnd_estimate_scene(const struct rnd_scene *sc, uint32_t atlas_size, struct 
 	e->readback_bytes = readback;
 }
 
-enum rnd_result rnd_render_estimate(const struct rnd_context *ctx, const struct rnd_scene *sc, struct rnd_estimate *e,
-                                    struct rnd_error *err)
+enum rnd_result rnd_check_allocation(uint64_t max, const struct rnd_scene *sc, const struct rnd_estimate *e,
+                                     struct rnd_error *err)
 {
-	rnd_estimate_scene(sc, ctx->desc.atlas_size, e);
-	return rnd_check_allocation(ctx, sc, e, err);
-}
-
-enum rnd_result rnd_check_allocation(const struct rnd_context *ctx, const struct rnd_scene *sc,
-                                     const struct rnd_estimate *e, struct rnd_error *err)
-{
-	uint64_t max = ctx->max_allocation;
 	if (!max || e->largest_allocation <= max) return RND_OK;
 	if (sc->output.aovs)
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_AOVS, 0,

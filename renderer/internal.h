@@ -31,9 +31,6 @@
 /* Pixel shading (deferred.c): what shading a pixel centre's surface needs (umbra_shared.h
  * UMBRA_SHADING_*); the colour shaded there has the output's colour format. */
 #define RND_SURFACE_SHADING_FORMAT VK_FORMAT_R32G32B32A32_UINT
-/* Layers of the visibility image: at least 2, so that its view is an array (layers beyond a
- * render's lights are not read). */
-#define RND_VIS_MIN_LAYERS 2u
 #define RND_MAX_VARIANTS 1024
 
 /* Map a VkResult to a result + message "what: VK_ERROR_..." */

@@ -8,11 +8,12 @@
  * whole sagitta, which measurably blurs it (tests/bench/edge_error.c). That error is compared
  * with the world size of a pixel at the point of the object nearest each camera, and of a texel
  * at the point nearest each shadow view; the object gets the segments the tightest of them
- * needs, never more than asked for. Also which planes cast shadows (rnd_plane_may_shadow*).
+ * needs, never more than asked for. (Which planes cast shadows is casters.c's.)
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "casters.h"
 #include "lod.h"
 #include "mesh.h"
 #include "proxy.h"
@@ -284,138 +285,4 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 	}
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		if (is_round(&sc->objects[i]) && segments[i] < 3) segments[i] = 3;
-}
-
-/* The corners of the part of box b behind the plane (n through p0) from side `side` (the sign
- * along n of the light's side): b's corners behind it and where b's edges cross it. Returns
- * how many (at most 8 + 12). */
-static int part_behind(const struct rnd_aabb *b, const float n[3], const float p0[3], float side, float x[20][3])
-{
-	float c[8][3], sd[8];
-	for (int k = 0; k < 8; k++) {
-		float d[3];
-		for (int a = 0; a < 3; a++) c[k][a] = k >> a & 1 ? b->max[a] : b->min[a];
-		rnd_v3_sub(d, c[k], p0);
-		sd[k] = side * rnd_v3_dot(n, d);
-	}
-	int nx = 0;
-	for (int k = 0; k < 8; k++) {
-		if (sd[k] < 0.0f) memcpy(x[nx++], c[k], sizeof x[0]);
-		for (int a = 0; a < 3; a++) {
-			int j = k | 1 << a;
-			if (j == k || (sd[k] < 0.0f) == (sd[j] < 0.0f)) continue;
-			float t = sd[k] / (sd[k] - sd[j]);
-			for (int m = 0; m < 3; m++) x[nx][m] = c[k][m] + t * (c[j][m] - c[k][m]);
-			nx++;
-		}
-	}
-	return nx;
-}
-
-/* Whether the points x[nx] behind `plane` (part_behind) are all hidden from a camera by the
- * plane's own quad (opaque): every line of sight to them crosses the plane inside the quad.
- * The part of a box behind the plane is convex and so is its central (or, orthographic,
- * parallel) projection onto the plane, so its corners decide. False unless the camera's whole
- * near rectangle is strictly on the plane's side `side`: a camera whose near plane cuts the
- * ground sees under it. inv: the inverse of the plane's model matrix. */
-static bool quad_hides(const struct rnd_object *plane, const float inv[16], const float n[3], const float p0[3],
-                       float side, float x[][3], int nx, const struct rnd_camera_plan *cam)
-{
-	float right[3];
-	if (cam->ortho && side * rnd_v3_dot(n, cam->fwd) >= 0.0f) return false;   /* looking away from it */
-	rnd_v3_cross(right, cam->fwd, cam->up);
-	if (!rnd_v3_normalize(right, right)) return false;
-	float hh = cam->ortho ? 0.5f * (cam->ortho_height > 0 ? cam->ortho_height : 1.0f) : cam->znear * tanf(0.5f * cam->fov_y);
-	float hw = hh * cam->aspect;
-	for (int k = 0; k < 4; k++) {
-		float q[3];
-		for (int a = 0; a < 3; a++)
-			q[a] = cam->pos[a] + cam->fwd[a] * cam->znear + right[a] * (k & 1 ? hw : -hw) + cam->up[a] * (k & 2 ? hh : -hh) -
-			       p0[a];
-		if (side * rnd_v3_dot(n, q) <= 0.0f) return false;
-	}
-	/* the quad's edge shrunk by 1e-4 of its size */
-	float hx = 0.5f * plane->size[0] * (1.0f - 1e-4f), hz = 0.5f * plane->size[2] * (1.0f - 1e-4f);
-	for (int k = 0; k < nx; k++) {
-		/* along the line of sight to x, onto the plane */
-		float dir[3], q[3], lq[3], dx[3];
-		if (cam->ortho) memcpy(dir, cam->fwd, sizeof dir);
-		else rnd_v3_sub(dir, x[k], cam->pos);
-		float dn = rnd_v3_dot(n, dir);
-		if (fabsf(dn) < 1e-12f) return false;
-		rnd_v3_sub(dx, p0, x[k]);
-		float t = rnd_v3_dot(n, dx) / dn;
-		for (int m = 0; m < 3; m++) q[m] = x[k][m] + t * dir[m];
-		rnd_mat4_mul_point(lq, inv, q);
-		if (fabsf(lq[0]) > hx || fabsf(lq[2]) > hz) return false;
-	}
-	return true;
-}
-
-/* rnd_plane_may_shadow (ncam 0) and rnd_plane_may_shadow_seen in one: for each shadowed light,
- * whether part of b lies behind the plane from it, and then whether a camera may see that part.
- * A one-sided plane hides nothing (culled from behind, and a mirroring transform turns its
- * front). */
-static bool plane_shadows(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
-                          const struct rnd_camera_plan *cams, uint32_t ncam)
-{
-	float inv[16];
-	if (ncam && (!plane->double_sided || !rnd_mat4_invert(inv, plane->model))) ncam = 0;
-	float nm[16], n[3], up[3] = {0.0f, 1.0f, 0.0f}, p0[3] = {plane->model[12], plane->model[13], plane->model[14]};
-	if (!rnd_mat4_normal_matrix(nm, plane->model)) return true;
-	rnd_mat4_mul_dir(n, nm, up);
-	if (!rnd_v3_normalize(n, n)) return true;
-	/* Signed distances of the box from the plane: the corner farthest on each side. */
-	float lo = 0.0f, hi = 0.0f;
-	for (int k = 0; k < 3; k++) {
-		float a = n[k] * (b->min[k] - p0[k]), c = n[k] * (b->max[k] - p0[k]);
-		lo += a < c ? a : c;
-		hi += a < c ? c : a;
-	}
-	const float eps = 1e-4f;
-	for (uint32_t i = 0; i < sc->light_count; i++) {
-		const struct rnd_light *L = &sc->lights[i];
-		if (!L->shadow.enabled) continue;
-		float side; /* > 0: the light is on the normal's side */
-		if (L->type == RND_LIGHT_DIRECTIONAL) side = -rnd_v3_dot(n, L->direction);
-		else {
-			float d[3];
-			rnd_v3_sub(d, L->position, p0);
-			side = rnd_v3_dot(n, d);
-		}
-		if (fabsf(side) <= eps) return true;        /* grazing: keep it simple, it casts */
-		if (side > 0.0f ? lo >= -eps : hi <= eps) continue;  /* nothing of the box behind it */
-		if (!ncam) return true;
-		float x[20][3], sgn = side > 0.0f ? 1.0f : -1.0f;
-		int nx = part_behind(b, n, p0, sgn, x);
-		for (uint32_t v = 0; v < ncam; v++)
-			if (!quad_hides(plane, inv, n, p0, sgn, x, nx, &cams[v])) return true;
-	}
-	return false;
-}
-
-bool rnd_planes_judged(const struct rnd_scene *sc)
-{
-	return sc->object_count <= RND_PLANES_JUDGED_MAX;
-}
-
-bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b)
-{
-	return plane_shadows(sc, plane, b, NULL, 0);
-}
-
-bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
-                               const struct rnd_camera_plan *cams, uint32_t ncam)
-{
-	bool opaque = !sc->material_count || sc->materials[plane->material].alpha_mode == RND_ALPHA_OPAQUE;
-	return plane_shadows(sc, plane, b, cams, opaque ? ncam : 0);
-}
-
-bool rnd_moments_need_ground(const struct rnd_scene *sc)
-{
-	for (uint32_t k = 0; k < sc->light_count; k++)
-		if (sc->lights[k].shadow.enabled &&
-		    (sc->lights[k].shadow.filter == RND_FILTER_VSM || sc->lights[k].shadow.filter == RND_FILTER_EVSM))
-			return true;
-	return false;
 }

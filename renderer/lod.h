@@ -89,39 +89,10 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 struct rnd_proxy;
 void rnd_lod_proxies(const struct rnd_scene *sc, uint32_t nviews, const uint32_t *segments, struct rnd_proxy *proxies);
 
-/* Whether plane object `plane` may cast a shadow of any shadowed light of sc onto the box b (an
- * object's world bounds): false when b lies wholly on the lit side of the plane for every such
- * light (a flat plane never shadows itself). render.c leaves a plane that shadows none of the
- * other objects out of the shadow pass: the ground under a thumbnail costs no depth fill. */
-bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b);
-
-/* Planes are judged one against another (rnd_plane_may_shadow*, each plane against every other
- * object) only in scenes of at most this many objects: the test is quadratic (16,000 planes
- * took 107 s of planning before the first submit). In a bigger scene every plane that asks to
- * cast shadows casts: the estimate (rnd_lod_choose) and render.c's shadow passes both follow
- * rnd_planes_judged(). */
-#define RND_PLANES_JUDGED_MAX 256u
-bool rnd_planes_judged(const struct rnd_scene *sc);
-
 /* World bounds of object i as asked: an analytic shape's own (a sphere of its radius, not the
  * radius a coarser tessellation raises, rnd_lod_radius), a mesh's `drawn` bounds (its levels
  * keep a subset of its vertices, so they reach no further) or, when drawn is NULL, those of
  * its vertices (one pass over them). */
 void rnd_object_bounds(const struct rnd_scene *sc, uint32_t i, const struct rnd_aabb *drawn, struct rnd_aabb *out);
-
-/* rnd_plane_may_shadow, less the shadows no camera of the render sees: where the part of b
- * behind an opaque plane (from a light) is hidden from every camera of cams[ncam] by the
- * plane's own quad, the plane's shadow on it cannot show (objects sunk into the ground: their
- * buried parts). Cameras: the render's views; none = rnd_plane_may_shadow. render.c passes
- * each other object's bounds as asked (rnd_object_bounds): a sphere resting on the ground
- * whose segments the level of detail lowered dips a fraction of a millimetre below the ground
- * as drawn, and had made the ground a caster (thumb-256: a 2048^2 map drawn for that). */
-bool rnd_plane_may_shadow_seen(const struct rnd_scene *sc, const struct rnd_object *plane, const struct rnd_aabb *b,
-                               const struct rnd_camera_plan *cams, uint32_t ncam);
-
-/* Whether a light of sc filters with moments (VSM / EVSM): their blurred moments need what lies
- * behind a caster's edge, the ground, in the map (against the empty map's far depth light bled
- * into the penumbrae), so render.c keeps every plane in the shadow pass. */
-bool rnd_moments_need_ground(const struct rnd_scene *sc);
 
 #endif

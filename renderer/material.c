@@ -37,30 +37,9 @@ void rnd_material_record(const struct rnd_scene *sc, uint32_t index, struct umbr
 	out->emissive[3] = d.roughness;
 }
 
-/* The extension lobe (RND_EXT_*) a texture slot belongs to; 0 for the core slots. */
-static uint32_t slot_extension(uint32_t k)
-{
-	if (k >= RND_TEX_CLEARCOAT && k <= RND_TEX_CLEARCOAT_NORMAL) return RND_EXT_CLEARCOAT;
-	if (k == RND_TEX_SHEEN_COLOR || k == RND_TEX_SHEEN_ROUGHNESS) return RND_EXT_SHEEN;
-	if (k == RND_TEX_SPECULAR || k == RND_TEX_SPECULAR_COLOR) return RND_EXT_SPECULAR;
-	return 0;
-}
-
-/* Slot k's texture as drawn: NULL where the material lacks the slot's extension. */
 static const struct rnd_texture *slot_texture(const struct rnd_material *m, uint32_t k)
 {
-	uint32_t e = slot_extension(k);
-	return e && !(m->extensions & e) ? NULL : m->textures[k];
-}
-
-uint32_t rnd_material_ext_bits(const struct rnd_material *m)
-{
-	uint32_t bits = 0;
-	if ((m->extensions & RND_EXT_CLEARCOAT) && m->clearcoat.factor > 0) bits |= UMBRA_EXT_CLEARCOAT;
-	if ((m->extensions & RND_EXT_SHEEN) && (m->sheen.color[0] > 0 || m->sheen.color[1] > 0 || m->sheen.color[2] > 0))
-		bits |= UMBRA_EXT_SHEEN;
-	if (m->extensions & RND_EXT_SPECULAR) bits |= UMBRA_EXT_SPECULAR;
-	return bits;
+	return rnd_material_slot_texture(m, k);
 }
 
 static float clamp01(float v)

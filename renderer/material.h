@@ -11,11 +11,8 @@
 #ifndef UMBRA_RENDERER_MATERIAL_H
 #define UMBRA_RENDERER_MATERIAL_H
 
+#include "material_bits.h"
 #include "record.h"
-
-/* The UMBRA_EXT_* lobes material m draws (a coat of factor 0 or a black sheen: none); their
- * union over the drawn materials is UMBRA_SC_MATERIAL_EXT. */
-uint32_t rnd_material_ext_bits(const struct rnd_material *m);
 
 /* The GPU record of one material (umbra_shared.h). */
 void rnd_material_write(const struct rnd_material *in, struct umbra_material *out);

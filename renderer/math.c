@@ -57,22 +57,6 @@ uint64_t rnd_hash(uint64_t h, const void *data, size_t len)
 	return h;
 }
 
-float rnd_v3_length(const float a[3])
-{
-	return sqrtf(rnd_v3_dot(a, a));
-}
-
-bool rnd_v3_normalize(float out[3], const float a[3])
-{
-	float len = rnd_v3_length(a);
-	if (!(len > 0.0f) || !isfinite(len)) {
-		if (out != a) memcpy(out, a, 3 * sizeof *out);
-		return false;
-	}
-	rnd_v3_scale(out, a, 1.0f / len);
-	return true;
-}
-
 void rnd_mat4_identity(float m[16])
 {
 	memset(m, 0, 16 * sizeof *m);
@@ -201,23 +185,6 @@ float rnd_mat4_det3(const float m[16])
 	return (float)(a0 * (b1 * c2 - b2 * c1) + a1 * (b2 * c0 - b0 * c2) + a2 * (b0 * c1 - b1 * c0));
 }
 
-void rnd_mat4_mul_point(float out[3], const float m[16], const float p[3])
-{
-	float r[4];
-	for (int row = 0; row < 4; row++)
-		r[row] = m[row] * p[0] + m[4 + row] * p[1] + m[8 + row] * p[2] + m[12 + row];
-	float iw = (r[3] != 0.0f) ? 1.0f / r[3] : 1.0f;
-	out[0] = r[0] * iw; out[1] = r[1] * iw; out[2] = r[2] * iw;
-}
-
-void rnd_mat4_mul_dir(float out[3], const float m[16], const float d[3])
-{
-	float r[3];
-	for (int row = 0; row < 3; row++)
-		r[row] = m[row] * d[0] + m[4 + row] * d[1] + m[8 + row] * d[2];
-	memcpy(out, r, sizeof r);
-}
-
 bool rnd_mat4_normal_matrix(float out[16], const float m[16])
 {
 	/* inverse-transpose of the 3x3 = cofactor matrix / det. The cofactor matrix's columns
@@ -249,14 +216,6 @@ void rnd_aabb_empty(struct rnd_aabb *b)
 bool rnd_aabb_is_empty(const struct rnd_aabb *b)
 {
 	return !(b->min[0] <= b->max[0] && b->min[1] <= b->max[1] && b->min[2] <= b->max[2]);
-}
-
-void rnd_aabb_add_point(struct rnd_aabb *b, const float p[3])
-{
-	for (int i = 0; i < 3; i++) {
-		if (p[i] < b->min[i]) b->min[i] = p[i];
-		if (p[i] > b->max[i]) b->max[i] = p[i];
-	}
 }
 
 void rnd_aabb_union(struct rnd_aabb *b, const struct rnd_aabb *o)

@@ -17,6 +17,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "mesh.h"
 
@@ -289,8 +290,12 @@ void rnd_mesh_write_uv1(const struct rnd_object *o, const struct rnd_vertex *ver
 	}
 }
 
-enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
-                               uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err)
+/* rnd_mesh_write(); with shape_only, positions and indices alone (no normal or tangent is
+ * transformed: rnd_mesh_measure wants the shape); with checked, a mesh's arrays are not
+ * checked again (rnd_mesh_measure did). */
+static enum rnd_result write_shape(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
+                                   uint32_t base_vertex, struct rnd_aabb *bounds, bool shape_only, bool checked,
+                                   struct rnd_error *err)
 {
 	uint64_t vc, ic;
 	float nm[16];
@@ -310,7 +315,7 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
 	case RND_SHAPE_SPHERE: gen_sphere(o, vertices, indices); break;
 	case RND_SHAPE_CYLINDER: gen_cylinder(o, vertices, indices); break;
 	case RND_SHAPE_MESH: {
-		enum rnd_result r = check_mesh(o, err);
+		enum rnd_result r = checked ? RND_OK : check_mesh(o, err);
 		if (r != RND_OK) return r;
 		gen_mesh(o, vertices, indices);
 		break;
@@ -324,6 +329,8 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
 	for (uint32_t i = 0; i < (uint32_t)vc; i++) {
 		struct rnd_vertex *v = &vertices[i];
 		rnd_mat4_mul_point(v->pos, o->model, v->pos);
+		if (bounds) rnd_aabb_add_point(bounds, v->pos);
+		if (shape_only) continue;
 		rnd_mat4_mul_dir(v->nrm, nm, v->nrm);
 		if (!rnd_v3_normalize(v->nrm, v->nrm)) { v->nrm[0] = 0.0f; v->nrm[1] = 1.0f; v->nrm[2] = 0.0f; }
 		if (tangents) {
@@ -335,7 +342,6 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
 			for (int k = 0; k < 3; k++) v->tangent[k] = snorm8(t[k]);
 			v->tangent[3] = (v->tangent[3] < 0) != flip ? -127 : 127;
 		}
-		if (bounds) rnd_aabb_add_point(bounds, v->pos);
 	}
 	for (uint32_t i = 0; i < (uint32_t)ic; i += 3) {
 		if (flip) { uint32_t t = indices[i + 1]; indices[i + 1] = indices[i + 2]; indices[i + 2] = t; }
@@ -344,17 +350,32 @@ enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *ve
 	return RND_OK;
 }
 
-double rnd_mesh_area(const struct rnd_vertex *vertices, const uint32_t *indices, uint32_t index_count)
+enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
+                               uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err)
 {
-	/* An estimate's input (renderer/cost.h): at most RND_MESH_AREA_SAMPLES triangles, evenly
-	 * strided, scaled up; every upload calls it, and a pass over a 1M-triangle mesh in mapped
-	 * memory would cost a few ms of a 25 ms render. */
-	uint32_t tris = index_count / 3, stride = tris > RND_MESH_AREA_SAMPLES ? tris / RND_MESH_AREA_SAMPLES : 1;
+	return write_shape(o, vertices, indices, base_vertex, bounds, false, false, err);
+}
+
+enum rnd_result rnd_mesh_write_measured(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
+                                        uint32_t base_vertex, struct rnd_error *err)
+{
+	return write_shape(o, vertices, indices, base_vertex, NULL, false, true, err);
+}
+
+/* Corner k of triangle t: its world position (in buf, or where it is stored). */
+typedef const float *corner_fn(const void *user, uint32_t t, int k, float buf[3]);
+
+/* An estimate's input (renderer/cost.h): at most RND_MESH_AREA_SAMPLES triangles, evenly
+ * strided, scaled up; every plan measures it, and a pass over a 1M-triangle mesh would cost a
+ * few ms of a 25 ms render. Inlined where it is called, with the corner function it is given. */
+static inline __attribute__((always_inline)) double sampled_area(uint32_t tris, corner_fn *corner, const void *user)
+{
+	uint32_t stride = tris > RND_MESH_AREA_SAMPLES ? tris / RND_MESH_AREA_SAMPLES : 1;
 	double sum = 0.0;
 	uint32_t taken = 0;
 	for (uint32_t t = 0; t < tris; t += stride, taken++) {
-		uint32_t i = 3 * t;
-		const float *a = vertices[indices[i]].pos, *b = vertices[indices[i + 1]].pos, *c = vertices[indices[i + 2]].pos;
+		float ab[3], bb[3], cb[3];
+		const float *a = corner(user, t, 0, ab), *b = corner(user, t, 1, bb), *c = corner(user, t, 2, cb);
 		float e1[3], e2[3], n[3];
 		rnd_v3_sub(e1, b, a);
 		rnd_v3_sub(e2, c, a);
@@ -362,6 +383,94 @@ double rnd_mesh_area(const struct rnd_vertex *vertices, const uint32_t *indices,
 		sum += 0.5 * sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
 	}
 	return taken ? sum * ((double)tris / taken) : 0.0;
+}
+
+struct written { const struct rnd_vertex *vertices; const uint32_t *indices; };
+
+static const float *written_corner(const void *user, uint32_t t, int k, float buf[3])
+{
+	const struct written *w = user;
+	(void)buf;
+	return w->vertices[w->indices[3 * t + (uint32_t)k]].pos;
+}
+
+double rnd_mesh_area(const struct rnd_vertex *vertices, const uint32_t *indices, uint32_t index_count)
+{
+	struct written w = {vertices, indices};
+	return sampled_area(index_count / 3, written_corner, &w);
+}
+
+/* A mesh's corner as rnd_mesh_write() writes it: its source position through the model matrix,
+ * the last two corners swapped by a mirroring one. */
+struct source { const struct rnd_object *o; bool flip; };
+
+static const float *source_corner(const void *user, uint32_t t, int k, float buf[3])
+{
+	const struct source *s = user;
+	uint32_t c = 3 * t + (uint32_t)(s->flip && k ? 3 - k : k);
+	uint32_t src = s->o->indices ? s->o->indices[c] : c;
+	rnd_mat4_mul_point(buf, s->o->model, s->o->positions + 3 * (size_t)src);
+	return buf;
+}
+
+/* A mesh's bounds as rnd_mesh_write() grows them: every vertex it writes through the model
+ * matrix (with normals and indices, every given vertex; else each triangle's corners, which
+ * are the vertices the indices name). */
+static enum rnd_result mesh_bounds(const struct rnd_object *o, struct rnd_aabb *bounds, struct rnd_error *err)
+{
+	bool all = (o->normals && o->indices) || !o->indices;
+	uint8_t *used = all ? NULL : calloc(o->vertex_count ? o->vertex_count : 1, 1);
+	if (!all && !used) return mesh_error(err, RND_ERR_OOM, "out of memory measuring a mesh of %u vertices", o->vertex_count);
+	uint32_t n = o->indices || !all ? o->vertex_count : o->vertex_count / 3 * 3;
+	if (used)
+		for (uint32_t i = 0; i < o->index_count / 3 * 3; i++) used[o->indices[i]] = 1;
+	for (uint32_t i = 0; i < n; i++) {
+		if (used && !used[i]) continue;
+		float p[3];
+		rnd_mat4_mul_point(p, o->model, o->positions + 3 * (size_t)i);
+		rnd_aabb_add_point(bounds, p);
+	}
+	free(used);
+	return RND_OK;
+}
+
+enum rnd_result rnd_mesh_measure(const struct rnd_object *o, struct rnd_vertex *keep_vertices, uint32_t *keep_indices,
+                                 struct rnd_aabb *bounds, double *area, struct rnd_error *err)
+{
+	uint64_t vc, ic;
+	counts64(o, &vc, &ic);
+	*area = 0.0;
+	if (vc > UINT32_MAX || ic > UINT32_MAX)
+		return mesh_error(err, RND_ERR_LIMIT, "object needs %llu vertices and %llu indices: over 32-bit indexing",
+		                  (unsigned long long)vc, (unsigned long long)ic);
+	if (o->shape != RND_SHAPE_MESH) {
+		/* Analytic shapes are small (their level of detail bounds them): written as
+		 * rnd_mesh_write writes them, so that their bounds and area are its own; into the
+		 * caller's memory (whole, to be copied instead of written again) or scratch (the
+		 * shape alone). */
+		bool keep = keep_vertices && keep_indices;
+		struct rnd_vertex *v = keep ? keep_vertices : malloc((vc ? vc : 1) * sizeof *v);
+		uint32_t *x = keep ? keep_indices : malloc((ic ? ic : 1) * sizeof *x);
+		enum rnd_result r = v && x ? write_shape(o, v, x, 0, bounds, !keep, false, err)
+		                           : mesh_error(err, RND_ERR_OOM, "out of memory measuring an object of %llu vertices",
+		                                        (unsigned long long)vc);
+		if (r == RND_OK) *area = rnd_mesh_area(v, x, (uint32_t)ic);
+		if (!keep) {
+			free(v);
+			free(x);
+		}
+		return r;
+	}
+	float nm[16];
+	if (!rnd_mat4_normal_matrix(nm, o->model)) return mesh_error(err, RND_ERR_INVALID, "object model matrix is singular (scale 0?)");
+	for (int i = 0; i < 16; i++)
+		if (!isfinite(o->model[i])) return mesh_error(err, RND_ERR_INVALID, "object model matrix is not finite");
+	enum rnd_result r = check_mesh(o, err);
+	if (r == RND_OK) r = mesh_bounds(o, bounds, err);
+	if (r != RND_OK) return r;
+	struct source src = {o, rnd_mat4_det3(o->model) < 0.0f};
+	*area = sampled_area((uint32_t)(ic / 3), source_corner, &src);
+	return RND_OK;
 }
 
 void rnd_mesh_local_bounds(const struct rnd_object *o, struct rnd_aabb *out)

@@ -42,6 +42,12 @@ void rnd_mesh_counts(const struct rnd_object *o, uint32_t *vertex_count, uint32_
 enum rnd_result rnd_mesh_write(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
                                uint32_t base_vertex, struct rnd_aabb *bounds, struct rnd_error *err);
 
+/* rnd_mesh_write() of an object rnd_mesh_measure() accepted: a mesh's arrays are not checked
+ * again, and no bounds are grown (the measure has them: tests/unit/test_render_plan.c checks
+ * that they are the write's). */
+enum rnd_result rnd_mesh_write_measured(const struct rnd_object *o, struct rnd_vertex *vertices, uint32_t *indices,
+                                        uint32_t base_vertex, struct rnd_error *err);
+
 /* The second uv set of the count vertices rnd_mesh_write() wrote for o at vertices (the same
  * order), into out (2 floats each): o->uvs1 where it has them, else each vertex's own uv, so
  * a slot that asks for set 1 on an object without it reads set 0. */
@@ -52,6 +58,16 @@ void rnd_mesh_write_uv1(const struct rnd_object *o, const struct rnd_vertex *ver
  * to RND_MESH_AREA_SAMPLES triangles, past it estimated from that many, evenly strided. */
 #define RND_MESH_AREA_SAMPLES 16384u
 double rnd_mesh_area(const struct rnd_vertex *vertices, const uint32_t *indices, uint32_t index_count);
+
+/* What rnd_mesh_write() would write for o (the render plan's measure of each draw, made before
+ * anything is written): the world bounds it would grow *bounds by (the same floats: the same
+ * transform of the same positions), the world area rnd_mesh_area() would find there, and the
+ * same errors. A mesh is measured from its arrays, without writing; an analytic shape (small:
+ * its level of detail bounds them) is written, with base vertex 0, into keep_vertices and
+ * keep_indices (rnd_mesh_counts() of each) where the caller gives them, so that the upload
+ * copies it instead of writing it again, else its shape alone into scratch memory. */
+enum rnd_result rnd_mesh_measure(const struct rnd_object *o, struct rnd_vertex *keep_vertices, uint32_t *keep_indices,
+                                 struct rnd_aabb *bounds, double *area, struct rnd_error *err);
 
 /* Object-space bounds before any tessellation (cheap; for culling and camera derivation). */
 void rnd_mesh_local_bounds(const struct rnd_object *o, struct rnd_aabb *out);

@@ -379,6 +379,7 @@ static void fit_casters(const struct rnd_shadow *s, const float view[16], const 
 		}
 	}
 	lp->resolution = res < (uint32_t)*fres ? res : (uint32_t)*fres;
+	if (res < (uint32_t)*fres) lp->size_rule = RND_SIZE_CASTERS;
 	*fres = (float)lp->resolution;
 }
 
@@ -472,11 +473,16 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
 		uint32_t want = s->resolution ? s->resolution
 		              : L->type == RND_LIGHT_DIRECTIONAL ? RND_DEFAULT_SHADOW_RESOLUTION : light_importance_res(L, bounds, cam);
+		lp->size_rule = s->resolution ? RND_SIZE_ASKED : L->type == RND_LIGHT_DIRECTIONAL ? RND_SIZE_DEFAULT : RND_SIZE_IMPORTANCE;
 		if (!s->resolution && L->type != RND_LIGHT_DIRECTIONAL) {
 			uint32_t hard = hard_light_res(L, lp, bounds, cam, scene->height, rnd_shadow_map_side(want, true, 0));
-			if (hard > want) want = hard;
+			if (hard > want) {
+				want = hard;
+				lp->size_rule = RND_SIZE_HARD_EDGE;
+			}
 		}
 		lp->resolution = rnd_shadow_map_side(want, s->resolution != 0, scene->max_shadow_resolution);
+		if (lp->resolution < rnd_shadow_map_side(want, s->resolution != 0, 0)) lp->size_rule = RND_SIZE_CAPPED;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;
 		bool cascades = false, clipmap = false;
 		uint32_t ncasc = 1;

@@ -45,6 +45,18 @@ struct rnd_light_plan {
 	                                              moment map fitted to the casters (plan.c) */
 	bool fp16;                                 /* vsm.precision fp16 asked for */
 	uint32_t resolution;                       /* tile size asked for (power of two) */
+	uint8_t size_rule;                         /* enum rnd_size_rule: what chose the resolution */
+};
+
+/* What chose a light's map size (rnd_light_plan.size_rule; the render plan shows it). */
+enum rnd_size_rule {
+	RND_SIZE_ASKED,        /* the light's shadow.resolution (a power of two at or above it) */
+	RND_SIZE_DEFAULT,      /* a sun's default (RND_DEFAULT_SHADOW_RESOLUTION) */
+	RND_SIZE_IMPORTANCE,   /* a spot or point light's share of the view (light_importance_res) */
+	RND_SIZE_HARD_EDGE,    /* a hard light's kernel within a pixel (hard_light_res) */
+	RND_SIZE_CASTERS,      /* a `fit` sun map cut to the casters' box, same texels (fit_casters) */
+	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
+	RND_SIZE_RULE_COUNT
 };
 
 struct rnd_shadow_plan {

@@ -1,6 +1,6 @@
 /*
- * renderer/readback.c — the sheet layout and the copy of a finished render out of the slot's
- * readback buffer (see readback.h): colour pixels (un-premultiplied where PNG expects straight
+ * renderer/readback.c — the copy of a finished render out of the slot's readback buffer (see
+ * readback.h): colour pixels (un-premultiplied where PNG expects straight
  * alpha) and the AOV attachments split into named float planes; and the recorded copy of a
  * band's resolved colour into that buffer (record_readback).
  */
@@ -10,20 +10,6 @@
 #include "estimate.h"
 #include "readback.h"
 #include "record.h"
-
-void rnd_sheet_init(struct rnd_sheet *sh, const struct rnd_scene *sc)
-{
-	memset(sh, 0, sizeof *sh);
-	sh->views = sc->view_count ? sc->view_count : 1;
-	rnd_sheet_layout(sh->views, &sh->cols, &sh->rows);
-	sh->width = (uint64_t)sh->cols * sc->width;
-	sh->height = (uint64_t)sh->rows * sc->height;
-	sh->px = (size_t)rnd_pixel_bytes(sc->output.pixels);
-	sh->passes = rnd_aov_passes(sc);
-	sh->color_bytes = sh->width * sh->height * sh->px;
-	sh->att_bytes = sh->width * sh->height * 16;
-	sh->readback_bytes = sh->color_bytes + (VkDeviceSize)sh->passes * UMBRA_AOV_ATTACHMENTS * sh->att_bytes;
-}
 
 /* Turns the AOV attachments in the readback buffer (RGBA32F, sheet-sized each) into named
  * float planes. */

@@ -15,20 +15,6 @@
 #include "mesh.h"
 #include "record.h"
 
-/* Culling back faces of a closed primitive changes nothing in the picture as long as the
- * viewer is outside it and it lies wholly beyond the near plane; it halves the triangles
- * lavapipe rasterises and shades. */
-bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b)
-{
-	for (int i = 0; i < 8; i++) {
-		float p[3] = {i & 1 ? b->max[0] : b->min[0], i & 2 ? b->max[1] : b->min[1], i & 4 ? b->max[2] : b->min[2]};
-		float d[3];
-		rnd_v3_sub(d, p, cam->pos);
-		if (rnd_v3_dot(d, cam->fwd) <= cam->znear * 1.01f) return false;
-	}
-	return true;
-}
-
 void record_image_barrier(VkCommandBuffer cmd, VkImage img, VkImageAspectFlags aspect, uint32_t layers,
                           VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)
@@ -363,6 +349,7 @@ static void draw_main(struct rnd_context *ctx, struct rnd_slot *s, const struct 
 		uint32_t i = k % ndraw;
 		const struct draw *d = &draws[i];
 		if (!d->index_count || d->closed != (k < ndraw)) continue;
+		if (rv->drawn_camera && rv->band_y == 0) *rv->drawn_camera += d->cam_index_count / 3;
 		VkPipeline p = pipes[d->cull_back];
 		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
 		record_cull(cmd, d);

@@ -6,29 +6,11 @@
 #ifndef UMBRA_RENDERER_RECORD_H
 #define UMBRA_RENDERER_RECORD_H
 
+#include "draw.h"
 #include "plan.h"
 #include "slot.h"
 
 struct rnd_env_use;
-
-/* One object's draw, made by render.c's upload. */
-struct draw {
-	uint32_t first_index, index_count;
-	uint32_t cam_first_index, cam_index_count;   /* what the camera passes draw: the same, or a
-	                                                sphere's proxy (UMBRA_DRAW_SPHERE, proxy.h) */
-	uint32_t cam_first_vertex;                   /* the proxy's first vertex */
-	uint32_t first_vertex, vertex_count;
-	struct rnd_aabb bounds;
-	double area;         /* world-space area of its triangles (renderer/cost.h) */
-	uint32_t material;
-	uint32_t flags;      /* UMBRA_DRAW_* */
-	bool cast, cull_back;
-	bool closed;         /* sphere / box / cylinder: back faces never show from outside */
-	bool single_sided;   /* double_sided: false */
-	bool masked;         /* alpha_mode MASK or BLEND (dithered): alpha-tested depth passes */
-	uint32_t texture_set; /* slot->texture_sets index: 0 = white, 1 + i = textured material i */
-	uint32_t tex_bits;    /* (1 << UMBRA_TEX_*) its material samples | UMBRA_TEXBIT_VERTEX_COLOR */
-};
 
 /* Draws what the camera passes draw of d (cam_first_index, cam_index_count). */
 static inline void record_draw_camera(VkCommandBuffer cmd, const struct draw *d)
@@ -54,6 +36,15 @@ struct record_view {
 	uint32_t band_y, band_h;       /* band_h 0 = every row */
 	bool contact;                  /* draw the view's depth for contact shadows first (contact.c) */
 	bool vis;                      /* shadows from the visibility pass (visibility.c), drawn per band */
+	/* The plan's estimates (cost.c): each shadow view's milliseconds and casters' triangles,
+	 * the main pass's per row and per band. */
+	const double *map_ms;
+	const uint64_t *map_tris;
+	double row_ms, band_ms;
+	/* What the recorders drew, counted as they record (struct rnd_timings; NULL: not counted):
+	 * the camera's triangles in the main pass (pixel shading's: its depth pass) of the view's
+	 * first band, the casters' triangles of every shadow map drawn. */
+	uint64_t *drawn_camera, *drawn_shadow;
 	bool deferred;                 /* with vis: shaded once per pixel centre (deferred.c) */
 	/* Every light the shadow passes draw for: the scene's, then the environment's directions
 	 * (render.c, env_shadow.h); NULL: the scene's. */
@@ -122,7 +113,5 @@ void record_clear_color(const struct rnd_scene *sc, float out[4]);
 uint32_t record_tonemap(enum rnd_tonemap t);
 uint32_t record_debug(enum rnd_debug d);
 
-/* Culling helpers shared with render.c. */
-bool record_camera_outside(const struct rnd_camera_plan *cam, const struct rnd_aabb *b);
 
 #endif

@@ -5,26 +5,13 @@
  * drawn in parts, one submit each (record_shadow_part, sized by renderer/submit.c).
  */
 #include <string.h>
+#include "casters.h"
 #include "moments.h"
 #include "record.h"
 
-static bool point_outside(const float p[3], const struct rnd_aabb *b, float pad)
-{
-	for (int k = 0; k < 3; k++)
-		if (p[k] < b->min[k] - pad || p[k] > b->max[k] + pad) return true;
-	return false;
-}
-
 bool record_shadow_draws(const struct record_view *rv, uint32_t v, uint32_t i, int *cull)
 {
-	const struct rnd_shadow_plan *sp = rv->sp;
-	const struct draw *d = &rv->draws[i];
-	if (!d->cast || !d->index_count) return false;
-	if (!rnd_aabb_in_frustum(&d->bounds, sp->views[v].view_proj, sp->view_ortho[v])) return false;
-	const struct rnd_light *L = &(rv->shadow_lights ? rv->shadow_lights : rv->sc->lights)[sp->view_light[v]];
-	*cull = d->single_sided ||
-	        (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
-	return true;
+	return rnd_shadow_view_draws(rv->sp, rv->shadow_lights ? rv->shadow_lights : rv->sc->lights, rv->draws, v, i, cull);
 }
 
 /* Begins a later part of a map: the earlier part's depth (an earlier submit) loaded. */
@@ -72,6 +59,7 @@ static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const s
 		uint64_t n = d.index_count / 3, a = lo > at ? lo - at : 0, b = hi - at < n ? hi - at : n;
 		at += n;
 		if (a >= b) continue;
+		if (rv->drawn_shadow) *rv->drawn_shadow += b - a;
 		d.first_index += (uint32_t)(3 * a);
 		d.index_count = (uint32_t)(3 * (b - a));
 		record_depth_draw(ctx, s, &d, cull, &push, &bound);

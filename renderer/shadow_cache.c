@@ -191,26 +191,6 @@ static uint32_t free_slot(struct rnd_shadow_cache *c)
 	return MAX_ENTRIES;
 }
 
-/* The resolution of every request's tiles, a function of the request alone (not of what the
- * cache holds or what other renders use), so the same request always draws the same maps:
- * each clamped to 64..atlas size, then the largest (the first of equals) halved until all
- * tiles together fit in the atlas. False when even 64² tiles do not fit. */
-static bool plan_resolutions(const struct rnd_cache_request *req, uint32_t n, uint32_t atlas, uint32_t res[])
-{
-	for (uint32_t k = 0; k < n; k++) res[k] = req[k].res < MIN_TILE ? MIN_TILE : req[k].res > atlas ? atlas : req[k].res;
-	for (;;) {
-		uint64_t need = 0;
-		uint32_t big = n;
-		for (uint32_t k = 0; k < n; k++) {
-			need += (uint64_t)req[k].tiles * res[k] * res[k];
-			if (res[k] > MIN_TILE && (big == n || res[k] > res[big])) big = k;
-		}
-		if (need <= (uint64_t)atlas * atlas) return true;
-		if (big == n) return false;
-		res[big] /= 2;
-	}
-}
-
 /* Gives back what one attempt took (hits referenced, new entries allocated). */
 static void undo_attempt(struct rnd_shadow_cache *c, struct rnd_cache_grant *out, const bool *granted, uint32_t n)
 {
@@ -286,17 +266,19 @@ enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cach
 	uint32_t res[UMBRA_MAX_LIGHTS];
 	if (n > UMBRA_MAX_LIGHTS)
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0, "%u shadowed lights: at most %d", n, UMBRA_MAX_LIGHTS);
-	uint64_t min_texels = 0;
+	uint64_t need = 0;
 	for (uint32_t k = 0; k < n; k++) {
 		if (req[k].tiles == 0 || req[k].tiles > 8)
 			return rnd_fail(err, RND_ERR_INVALID, "%u shadow tiles for one light", req[k].tiles);
-		min_texels += (uint64_t)req[k].tiles * 64 * 64;
+		res[k] = req[k].res;
+		if (res[k] < MIN_TILE || res[k] > c->atlas.size || (res[k] & (res[k] - 1)))
+			return rnd_fail(err, RND_ERR_INVALID, "a shadow tile of %u texels in a %u atlas", res[k], c->atlas.size);
+		need += (uint64_t)req[k].tiles * res[k] * res[k];
 	}
-	if (!plan_resolutions(req, n, c->atlas.size, res))
-		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0,
-		                   "the lights need %llu shadow tiles; even at 64x64 texels they do not fit in the "
-		                   "%ux%u shadow atlas (raise --atlas-size or use fewer shadowed lights)",
-		                   (unsigned long long)(min_texels / 4096), c->atlas.size, c->atlas.size);
+	/* The plan sized the maps to fit (rnd_atlas_fit): this holds unless it was made for another atlas. */
+	if (need > (uint64_t)c->atlas.size * c->atlas.size)
+		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_LIGHTS, 0, "the shadow maps need %llu texels, more than the %ux%u atlas",
+		                   (unsigned long long)need, c->atlas.size, c->atlas.size);
 	pthread_mutex_lock(&c->mu);
 	c->clock++;
 	enum rnd_result r = RND_OK;
@@ -338,6 +320,20 @@ enum rnd_result rnd_cache_acquire(struct rnd_context *ctx, const struct rnd_cach
 		}
 	pthread_mutex_unlock(&c->mu);
 	return r;
+}
+
+bool rnd_cache_probe(struct rnd_context *ctx, uint64_t key, uint32_t tiles, uint32_t res)
+{
+	struct rnd_shadow_cache *c = ctx->cache;
+	bool hit = false;
+	if (!c || !key) return false;
+	pthread_mutex_lock(&c->mu);
+	for (uint32_t i = 0; i < MAX_ENTRIES && !hit; i++) {
+		const struct rnd_cache_entry *e = &c->entries[i];
+		hit = e->live && e->valid && e->key == key && e->ntiles == tiles && e->res == res;
+	}
+	pthread_mutex_unlock(&c->mu);
+	return hit;
 }
 
 /* Texels of the completed maps the cache keeps. */

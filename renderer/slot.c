@@ -6,6 +6,7 @@
 #include "slot.h"
 #include "env_pass.h"
 #include "material.h"
+#include "visibility_plan.h"
 
 /* A descriptor pool (named "slot N <what> descriptor pool") holding exactly `count` sets, one
  * per layouts[i], all allocated into sets[]. On failure nothing is left. Descriptor sets stay

@@ -10,25 +10,7 @@
 #include "env_pass.h"
 #include "submit.h"
 #include "contact.h"
-#include "cost.h"
 
-/* Cost model for the first band and for grouping shadow views, in lavapipe milliseconds (a
- * GPU is faster: the model then only makes the first band smaller than needed, and measured
- * times take over from the second band on). On the high side: an underestimate lets one submit
- * run past a deadline. But not far: every band redraws every triangle (and repeats the
- * visibility pass's), and the measured rows are never trusted below a quarter of the estimate
- * (rnd_pacer_band_rows). Calibrated on 26 bench scenes (ninth landing): the main pass's
- * estimate is 0.6x (five stacked layers of small two-sided triangles) to 4.5x (16 soft lights)
- * of its time, mostly 1-2.5x. It had been 20-200x since the filters got cheaper, and under
- * umbrad's default 30 s deadline (slices of 1 s) a render of 0.02-0.3 s was cut into bands: the
- * ogre OBJ under three soft lights took 262 ms instead of 140, 16 soft lights 166 instead of
- * 141. */
-#define EST_MS_PER_PIXEL_UNIT 1.5e-5 /* one pixel, one unit of shading (see px_units) */
-#define EST_MS_PER_BAND 3.0          /* a band's clears, resolve and copy */
-#define EST_MS_PER_TRIANGLE 3e-4     /* main pass: vertex work, repeated in every band */
-#define EST_MS_PER_TEXEL 5e-6        /* shadow map clear, raster, copy into the atlas */
-#define EST_MS_PER_CASTER 1e-4       /* depth-only triangle */
-#define EST_MS_PER_DEPTH_FRAG 2e-6   /* depth-only fragment beyond the map's first layer (cost.h) */
 /* A fence is waited on in slices this long; between slices a long wait is logged. */
 #define WAIT_SLICE_NS (1000ull * 1000 * 1000)
 
@@ -238,49 +220,6 @@ static enum rnd_result cmd_flush(struct rnd_context *ctx, struct rnd_slot *s, st
 	return RND_OK;
 }
 
-/* ---- estimates ---- */
-
-/* Shadow view v: its triangles (*tris) and their fill beyond one layer over the map, in
- * milliseconds. The first layer is in the per-texel term (clear, raster, copy). */
-static double est_shadow_view_ms(const struct record_view *rv, uint32_t v, uint64_t *tris)
-{
-	const struct umbra_shadow_view *sv = &rv->sp->views[v];
-	double res = sv->rect[2], fill = 0;
-	int cull;
-	*tris = 0;
-	for (uint32_t i = 0; i < rv->ndraw; i++) {
-		if (!record_shadow_draws(rv, v, i, &cull)) continue;
-		const struct draw *d = &rv->draws[i];
-		*tris += d->index_count / 3;
-		fill += rnd_cost_fill(sv->view_proj, res, res, &d->bounds, d->area, d->index_count / 3, d->closed);
-	}
-	double beyond = fill > res * res ? fill - res * res : 0;
-	return res * res * EST_MS_PER_TEXEL + (double)*tris * EST_MS_PER_CASTER + beyond * EST_MS_PER_DEPTH_FRAG;
-}
-
-/* Shading work per pixel, in units of a hard-shadowed light's. */
-static double px_units(const struct record_view *rv)
-{
-	const struct rnd_scene *sc = rv->sc;
-	double u = 1;
-	for (uint32_t i = 0; i < sc->light_count; i++) {
-		const struct rnd_light_plan *lp = &rv->sp->lights[i];
-		if (!lp->view_count) { u += 0.5; continue; }
-		switch (lp->filter) {
-		case UMBRA_FILTER_PCF: u += 1 + 0.5 * lp->pcf_radius; break;
-		case UMBRA_FILTER_PCSS: u += 4; break;
-		case UMBRA_FILTER_MOMENTS: u += 1.5; break;
-		default: u += 1; break;
-		}
-		if (lp->view_count > 1 && sc->lights[i].type == RND_LIGHT_DIRECTIONAL) u += 2;   /* cascades, levels */
-		if (rnd_contact_on(sc, rv->sp, i)) u += 4;                                       /* the march */
-	}
-	if (rv->vis) u += 4;   /* the visibility pass's own passes */
-	if (sc->output.msaa > 1) u *= 1.5;
-	if (sc->output.pixels == RND_PIXELS_RGBA32F) u *= 1.5;   /* float targets, resolve and copy */
-	return u * (1 + 3 * rv->aov_passes);
-}
-
 /* ---- one view ---- */
 
 /* The blur temporary's contents never carry over: take it from UNDEFINED each time. */
@@ -329,10 +268,8 @@ static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *
 	enum rnd_result r;
 	const struct rnd_shadow_plan *sp = rv->sp;
 	bool paced = p->slice_ms > 0;
-	double est[UMBRA_MAX_SHADOW_VIEWS];
-	uint64_t tris[UMBRA_MAX_SHADOW_VIEWS];
-	for (uint32_t v = 0; v < sp->view_count; v++)
-		est[v] = sp->view_skip[v] ? 0 : est_shadow_view_ms(rv, v, &tris[v]);
+	const double *est = rv->map_ms;
+	const uint64_t *tris = rv->map_tris;
 	uint32_t v = 0;
 	while (v < sp->view_count) {
 		if (sp->view_skip[v]) { v++; continue; }
@@ -379,18 +316,7 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 	}
 
 	bool split = p->slice_ms > 0 || sc->band_rows;
-	uint64_t tris = 0;
-	for (uint32_t i = 0; i < rv->ndraw; i++) tris += rv->draws[i].cam_index_count / 3;
-	double units = px_units(rv);
-	/* Geometry stacked many layers deep costs per layer (cost.h): a band of rows sized as if
-	 * each pixel were covered once had run a 10 s submit past a 3 s deadline. */
-	double fill = 0;
-	for (uint32_t i = 0; i < rv->ndraw; i++)
-		fill += rnd_cost_fill(rv->cam->view_proj, sc->width, sc->height, &rv->draws[i].bounds, rv->draws[i].area,
-		                      rv->draws[i].cam_index_count / 3, rv->draws[i].closed);
-	double est_row = sc->width * units * EST_MS_PER_PIXEL_UNIT * rnd_cost_layer_factor(fill, sc->width, sc->height);
-	/* lavapipe shades each triangle's 4x4 blocks: a triangle costs more where a pixel does */
-	double est_fixed = EST_MS_PER_BAND + (double)tris * EST_MS_PER_TRIANGLE * (1 + units / 4);
+	double est_row = rv->row_ms, est_fixed = rv->band_ms;
 	/* Down to single rows: with many soft-shadowed lights and AOVs one row of a large image
 	 * can take a second on lavapipe. */
 	uint32_t min_rows = 1;

@@ -1,8 +1,9 @@
 /*
  * renderer/upload.c — the scene's geometry into the slot (see upload.h): every object
  * tessellated (at its level of detail) straight into the slot's mapped vertex and index
- * buffers, with its draw: ranges, bounds, material, flags, culling; and the recorded copy of
- * the staged textures into their images (record_textures).
+ * buffers, where the plan's draws say (render_plan.c made them: ranges, bounds, material,
+ * flags, culling); and the recorded copy of the staged textures into their images
+ * (record_textures).
  */
 #include <stdio.h>
 #include <string.h>
@@ -24,23 +25,35 @@ static enum rnd_result reserve_uv1(struct rnd_context *ctx, struct rnd_slot *s, 
 	return rnd_buffer_reserve(ctx, &s->uvs1, (nv ? nv : 1) * 8, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "slot uvs1", err);
 }
 
-enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_scene *sc,
-                                 const struct rnd_pacer *pacer, const uint32_t *lod, const struct rnd_proxy *proxies,
-                                 struct draw *draws, struct rnd_aabb *bounds, struct rnd_error *err)
+/* Object i at its draw's place: copied where the plan kept it, else written (the plan checked
+ * its arrays and measured its bounds: rnd_mesh_write_measured). */
+static enum rnd_result write_object(const struct rnd_plan *plan, uint32_t i, struct rnd_vertex *vtx, uint32_t *idx,
+                                    float *uv1, struct rnd_error *err)
 {
-	uint64_t nv = 0, ni = 0;
-	for (uint32_t i = 0; i < sc->object_count; i++) {
-		uint32_t v, x;
-		struct rnd_object o = sc->objects[i];
-		rnd_lod_apply(&o, lod[i]); /* renderer/lod.h: no finer than the output can show */
-		rnd_mesh_counts(&o, &v, &x);
-		nv += v; ni += x;
-		rnd_proxy_counts(&proxies[i], &v, &x);
-		nv += v; ni += x;
+	struct rnd_object o = plan->sc->objects[i];
+	const struct draw *d = &plan->draws[i];
+	rnd_lod_apply(&o, plan->lod[i]); /* renderer/lod.h: no finer than the output can show */
+	if (plan->kept_vertices[i]) {
+		/* written by the plan as rnd_mesh_write writes it at base 0: its indices moved to base */
+		memcpy(vtx + d->first_vertex, plan->kept_vertices[i], (size_t)d->vertex_count * sizeof *vtx);
+		for (uint32_t k = 0; k < d->index_count; k++) idx[d->first_index + k] = plan->kept_indices[i][k] + d->first_vertex;
+	} else {
+		enum rnd_result r = rnd_mesh_write_measured(&o, vtx + d->first_vertex, idx + d->first_index, d->first_vertex, err);
+		if (r != RND_OK) {
+			char m[sizeof err->msg];
+			snprintf(m, sizeof m, "%s", err->msg);
+			return rnd_fail(err, r, "object %u: %s", i, m);
+		}
 	}
-	if (nv > UINT32_MAX || ni > UINT32_MAX)
-		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECTS, 0, "scene too large: %llu vertices, %llu indices",
-		                (unsigned long long)nv, (unsigned long long)ni);
+	if (uv1) rnd_mesh_write_uv1(&o, vtx + d->first_vertex, d->vertex_count, uv1 + 2 * (size_t)d->first_vertex);
+	return RND_OK;
+}
+
+enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_plan *plan,
+                                 const struct rnd_pacer *pacer, struct rnd_error *err)
+{
+	const struct rnd_scene *sc = plan->sc;
+	uint64_t nv = plan->vertices, ni = plan->indices;
 	enum rnd_result r;
 	VkDeviceSize vbytes = (nv ? nv : 1) * sizeof(struct rnd_vertex), ibytes = (ni ? ni : 1) * sizeof(uint32_t);
 	if ((r = rnd_buffer_reserve(ctx, &s->vertices, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "slot vertices", err)) != RND_OK)
@@ -52,62 +65,24 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 	float *uv1 = s->has_uv1 ? s->uvs1.cpu : NULL;
 	struct rnd_vertex *vtx = s->vertices.cpu;
 	uint32_t *idx = s->indices.cpu;
-	uint32_t vbase = 0, ibase = 0;
-	rnd_aabb_empty(bounds);
 	for (uint32_t i = 0; i < sc->object_count; i++) {
-		struct rnd_object lo = sc->objects[i];
-		rnd_lod_apply(&lo, lod[i]);
-		const struct rnd_object *o = &lo;
-		struct draw *d = &draws[i];
-		uint32_t v, x;
-		rnd_mesh_counts(o, &v, &x);
 		/* Tessellating millions of triangles takes seconds: the deadline holds here too. */
-		if (((i & 15) == 0 || x > (1u << 20)) && (r = rnd_pacer_check(pacer, err)) != RND_OK) return r;
-		rnd_aabb_empty(&d->bounds);
-		if ((r = rnd_mesh_write(o, vtx + vbase, idx + ibase, vbase, &d->bounds, err)) != RND_OK) {
-			char m[sizeof err->msg];
-			snprintf(m, sizeof m, "%s", err->msg);
-			return rnd_fail(err, r, "object %u: %s", i, m);
-		}
-		if (uv1) rnd_mesh_write_uv1(o, vtx + vbase, v, uv1 + 2 * (size_t)vbase);
-		d->area = rnd_mesh_area(vtx, idx + ibase, x);
-		d->first_index = d->cam_first_index = ibase;
-		d->index_count = d->cam_index_count = x;
-		d->first_vertex = vbase;
-		d->vertex_count = v;
-		vbase += v; ibase += x;
-		bool proxy = proxies[i].outline > 0;
-		d->material = sc->material_count ? o->material : 0;
-		bool catcher = sc->material_count && sc->materials[o->material].shadow_catcher;
-		d->flags = (o->receive_shadows ? UMBRA_DRAW_RECEIVE_SHADOWS : 0) | (catcher ? UMBRA_DRAW_SHADOW_CATCHER : 0) |
-		           (proxy ? UMBRA_DRAW_SPHERE : 0);
-		/* A shadow catcher receives shadows and casts none (contract §7). */
-		d->cast = o->cast_shadows && !catcher;
-		/* MASK and dithered BLEND both take the alpha-tested depth passes. */
-		d->masked = sc->material_count && sc->materials[o->material].alpha_mode != RND_ALPHA_OPAQUE;
-		d->texture_set = 0; /* set by rnd_material_textures() */
-		d->single_sided = !o->double_sided;
-		d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
-		            (o->shape == RND_SHAPE_MESH && o->closed);
-		d->cull_back = d->single_sided;
-		rnd_aabb_union(bounds, &d->bounds);
+		if (((i & 15) == 0 || plan->draws[i].index_count > (1u << 20)) && (r = rnd_pacer_check(pacer, err)) != RND_OK)
+			return r;
+		if ((r = write_object(plan, i, vtx, idx, uv1, err)) != RND_OK) return r;
 	}
-	/* The camera's proxies of spheres after every mesh: where the meshes lie in the buffers (which
-	 * the shadow cache's keys hash, render.c caster_key) does not depend on the camera. */
+	/* The camera's proxies of spheres, after every mesh (plan_layout). */
 	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct draw *d = &plan->draws[i];
 		uint32_t v, x;
-		rnd_proxy_counts(&proxies[i], &v, &x);
+		rnd_proxy_counts(&plan->proxies[i], &v, &x);
 		if (!x) continue;
-		rnd_proxy_write(&proxies[i], vtx + vbase, idx + ibase, vbase);
-		if (uv1) memset(uv1 + 2 * (size_t)vbase, 0, (size_t)v * 8);   /* a sphere's proxy: no texture uvs */
-		draws[i].cam_first_index = ibase;
-		draws[i].cam_index_count = x;
-		draws[i].cam_first_vertex = vbase;
-		vbase += v; ibase += x;
+		rnd_proxy_write(&plan->proxies[i], vtx + d->cam_first_vertex, idx + d->cam_first_index, d->cam_first_vertex);
+		if (uv1) memset(uv1 + 2 * (size_t)d->cam_first_vertex, 0, (size_t)v * 8);   /* a sphere's proxy: no texture uvs */
 	}
-	rnd_buffer_publish(&s->vertices, 0, (VkDeviceSize)vbase * sizeof(struct rnd_vertex));
-	rnd_buffer_publish(&s->indices, 0, (VkDeviceSize)ibase * sizeof(uint32_t));
-	if (uv1) rnd_buffer_publish(&s->uvs1, 0, (VkDeviceSize)vbase * 8);
+	rnd_buffer_publish(&s->vertices, 0, (VkDeviceSize)nv * sizeof(struct rnd_vertex));
+	rnd_buffer_publish(&s->indices, 0, (VkDeviceSize)ni * sizeof(uint32_t));
+	if (uv1) rnd_buffer_publish(&s->uvs1, 0, (VkDeviceSize)nv * 8);
 	return RND_OK;
 }
 

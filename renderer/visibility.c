@@ -20,97 +20,13 @@
  * that no centre shows takes its neighbour's shadow: it covers part of a pixel.
  *
  * When: scenes with lights with wide filters (PCSS, PCF of radius 4 or more) and enough small
- * triangles to pay for the passes (rnd_visibility_wanted: more for one such light than for
- * several), no debug view (the views show the filters' own work) and no alpha-tested material
+ * triangles to pay for the passes (visibility_plan.c rnd_visibility_wanted: more for one such
+ * light than for several; the render plan decides), no debug view (the views show the filters' own work) and no alpha-tested material
  * (the surfaces pass does not cut out texels, so what shows through them would take the
  * cut-out surface's shadow).
  * UMBRA_VISIBILITY=0 turns it off, =1 on where the device and the scene allow it.
  */
-#include <stdlib.h>
-#include <string.h>
 #include "visibility.h"
-
-/* When the pass pays (measured on lavapipe, studio-spots' objects under its seven lights, 768 x
- * 512): it runs the filters once per block of 4x4 pixels where the main pass ran them once per
- * block per triangle touching it, and costs a surfaces pass and a main pass of its own. A floor
- * alone: 15 % slower; spheres of 16 segments (~600 triangles facing the camera): 4 % faster; of
- * 32 (~2,200): 11 %; of 64 (~8,300): 20 % (4 and 16 spot lights: 23 %, 18 %). So: at least one
- * such triangle per 512 pixels. One wide light: one per 16 pixels (below).
- * Only wide filters pay for it: studio-spots' seven lights all hard made the main pass 49 ms
- * without the pass and 65 with it; PCF radius 1: 57 / 68, 2: 81 / 84, 3: 97 / 97, 5: 143 /
- * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
-#define RND_VIS_MIN_PCF_RADIUS 4u
-#define RND_VIS_PIXELS_PER_FACE 512u
-/* One wide light pays for the passes only over dense meshes. Measured, the thumbnail preset
- * with its one PCSS sun, 512², whole render without / with the pass: the 124k-triangle ogre
- * OBJ's 49k level 115 / 101 ms, nefertiti 113 / 86, beast 88 / 73, a 100k-triangle STL sphere's
- * level 60 / 55 (main pass alone: ogre 97 / 80, nefertiti 95 / 69); about even: a sphere of
- * 128 segments (one face towards the camera per 32 pixels) 49.1 / 48.6, a 10k-triangle STL
- * (one per 52) 46.7 / 44.6 and 43.6 / 44.0, 64 segments (one per 130) 39.7 / 39.5; worse: 16
- * segments (one per 500) 31.9 / 35.1, thumb-512's tessellated sphere (one per 47) main pass
- * 17.3 / 19.4. So one per 16 pixels, where it clearly pays; and only with MSAA, which shades
- * a pixel once per triangle touching it: at MSAA 1 one triangle shades each pixel, and the
- * ogre's thumbnail took 53-57 ms without the pass, 59-60 with it. */
-#define RND_VIS_PIXELS_PER_FACE_ONE_LIGHT 16u
-/* The largest visibility image (bytes) a render may take: 16 lights of a 1024² view. */
-#define RND_VIS_MAX_BYTES (32ull << 20)
-
-/* A filter costly enough per pixel that running it once per pixel pays for the passes. */
-static bool wide_filter(const struct rnd_light_plan *lp)
-{
-	return lp->filter == UMBRA_FILTER_PCSS || (lp->filter == UMBRA_FILTER_PCF && lp->pcf_radius >= RND_VIS_MIN_PCF_RADIUS);
-}
-
-uint64_t rnd_surfaces_bytes(const struct rnd_scene *sc, uint32_t lights)
-{
-	uint64_t px = (uint64_t)sc->width * sc->height;
-	if (px * lights * 2 > RND_VIS_MAX_BYTES) return 0;
-	/* rnd_slot_visibility's images: surfaces RGBA32F, normals RGBA16 SNORM, their depth D32,
-	 * an R16 layer per light, at least RND_VIS_MIN_LAYERS (internal.h) */
-	uint32_t layers = lights < RND_VIS_MIN_LAYERS ? RND_VIS_MIN_LAYERS : lights;
-	return px * (16 + 8 + 4 + 2ull * layers);
-}
-
-uint64_t rnd_visibility_bytes(const struct rnd_scene *sc)
-{
-	if (sc->output.debug != RND_DEBUG_NONE) return 0;
-	bool shadowed = false;
-	for (uint32_t i = 0; i < sc->light_count; i++) shadowed |= sc->lights[i].shadow.enabled;
-	return shadowed ? rnd_surfaces_bytes(sc, sc->light_count) : 0;
-}
-
-uint64_t rnd_camera_faces(const struct draw *draws, uint32_t ndraw)
-{
-	/* a back-face culled closed shape shows about half its triangles, a sphere's proxy all of
-	 * its own */
-	uint64_t faces = 0;
-	for (uint32_t i = 0; i < ndraw; i++)
-		faces += draws[i].cam_index_count / 3 / (draws[i].cull_back ? 2 : 1);
-	return faces;
-}
-
-bool rnd_visibility_wanted(const struct rnd_context *ctx, const struct rnd_scene *sc, const struct rnd_shadow_plan *sp,
-                           const struct draw *draws, uint32_t ndraw)
-{
-	if (!ctx->visibility_pass || sc->output.debug != RND_DEBUG_NONE) return false;
-	uint32_t shadowed = 0, wide = 0;
-	for (uint32_t i = 0; i < sc->light_count; i++)
-		if (sp->lights[i].view_count) {
-			shadowed++;
-			if (wide_filter(&sp->lights[i])) wide++;
-		}
-	if (!shadowed) return false;
-	for (uint32_t i = 0; i < ndraw; i++)
-		if (draws[i].index_count && draws[i].masked) return false;
-	if (!rnd_visibility_bytes(sc)) return false;   /* over the size cap */
-	const char *env = getenv("UMBRA_VISIBILITY");
-	if (env && strcmp(env, "0") == 0) return false;
-	if (env && strcmp(env, "1") == 0) return true;
-	uint64_t faces = rnd_camera_faces(draws, ndraw);
-	uint64_t px = (uint64_t)sc->width * sc->height;
-	if (wide >= 2) return faces * RND_VIS_PIXELS_PER_FACE >= px;
-	return wide == 1 && sc->output.msaa > 1 && faces * RND_VIS_PIXELS_PER_FACE_ONE_LIGHT >= px;
-}
 
 /* Pass 1: the surfaces of the band's rows, cleared to 0 (nothing drawn); their depth stays an
  * attachment for pass 2's test. */

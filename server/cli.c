@@ -2,6 +2,7 @@
  * server/cli.c — umbra-render: renders scenes with the renderer library, no server.
  *
  *   umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp|OUT.avif] [--timings] [--device NAME]
+ *   umbra-render --explain[=analyze] [--json] SCENE.json [-o OUT]  the render plan (render_explain.c)
  *   umbra-render SCENE.json... -o DIR/ [batch options]            many scenes, one process
  *   umbra-render --manifest LIST.jsonl -o DIR/ [batch options]    {"scene": ..., "output": ...} per line
  *   umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]
@@ -30,13 +31,19 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 #include "api.h"
+#include "explain_text.h"
 #include "farm.h"
 #include "umbra/rnd.h"
+
+/* --explain: none, the plan alone (no render), or the plan rendered with what it measured. */
+enum cli_explain { CLI_EXPLAIN_NONE, CLI_EXPLAIN_PLAN, CLI_EXPLAIN_ANALYZE };
 
 static int usage(FILE *f, int code)
 {
 	fprintf(f, "usage: umbra-render SCENE.json|- [-o OUT.png|OUT.exr|OUT.webp|OUT.avif] [--timings] [--device NAME]\n"
+	           "       umbra-render --explain[=analyze] [--json] SCENE.json|- [-o OUT]\n"
 	           "       umbra-render SCENE.json... -o DIR/ [batch options]\n"
 	           "       umbra-render --manifest LIST.jsonl -o DIR/ [batch options]\n"
 	           "       umbra-render thumb MODEL... -o DIR/ [--size N] [--transparent] [--up AXIS] [--format F [--quality Q]]\n"
@@ -45,6 +52,11 @@ static int usage(FILE *f, int code)
 	           "  -o FILE      output file; .png, .exr, .webp or .avif picks the format (default: stdout, output.format)\n"
 	           "  -o DIR/      batch: one image per input in DIR (name of the input, extension of the format)\n"
 	           "  --timings    print per-stage milliseconds to stderr (one scene)\n"
+	           "  --explain    print the render plan instead of rendering: every decision (views, shadow maps,\n"
+	           "               levels of detail, what casts, passes, memory) as JSON (api/explain.schema.json),\n"
+	           "               or as a table when stdout is a terminal; =analyze renders it too and adds what\n"
+	           "               each step measured (the image into -o's file, or nowhere)\n"
+	           "  --json       --explain: JSON on a terminal too\n"
 	           "  --device S   use the Vulkan device whose name contains S (also $UMBRA_DEVICE)\n"
 	           "  --asset-root DIR  models' \"path\" is relative to DIR and never leaves it (default: none, a 400)\n"
 	           "  thumb        MODEL files (.glb .gltf .obj .stl .ply) as thumbnails: \"preset\": \"thumbnail\"\n"
@@ -115,80 +127,123 @@ static int load_scene(const char *in, const char *out, const char *asset_root, s
 	return 2;
 }
 
-/* One scene, as before the batch runner: stdout or one file, --timings. */
-static int render_one(const char *in, const char *out, const char *device, const char *asset_root, int timings)
+static struct rnd_context *open_context(const char *device)
 {
-	double t0 = farm_now_ms();
-	struct api_scene *scene = NULL;
-	struct api_problem prob;
-	char line[1024];
-	int rc = load_scene(in, out, asset_root, &scene);
-	if (rc) return rc;
-	rc = 1;
-	double t_parse = farm_now_ms() - t0;
-
 	const char *v = getenv("UMBRA_VALIDATION");
 	struct rnd_context_desc cd = {
 		.device_name = device, .validation = v && *v == '1', .slots = 1, .log = log_cb,
 	};
 	struct rnd_context *ctx = NULL;
 	struct rnd_error err;
-	double t_ctx = farm_now_ms();
 	if (rnd_context_create(&cd, &ctx, &err) != RND_OK) {
 		fprintf(stderr, "umbra-render: %s\n", err.msg);
+		return NULL;
+	}
+	return ctx;
+}
+
+/* A failed plan or render on stderr; the exit status (2: the scene's fault). */
+static int render_failed(const struct api_scene *scene, enum rnd_result r, const struct rnd_error *err)
+{
+	bool scene_fault = r == RND_ERR_INVALID || r == RND_ERR_LIMIT;
+	if (scene_fault) {
+		struct api_problem prob;
+		char line[1024];
+		api_problem_from_render(&prob, scene, err, r == RND_ERR_LIMIT ? 422 : 400);
+		api_problem_format(&prob, line, sizeof line);
+		fprintf(stderr, "umbra-render: %s\n", line);
+	} else {
+		fprintf(stderr, "umbra-render: render failed: %s\n", err->msg);
+	}
+	return scene_fault ? 2 : 1;
+}
+
+/* The encoded image into out (stdout without one): 0, or 1 with the reason on stderr.
+ * *enc_ms: the encoding's time. */
+static int write_image(const struct api_scene *scene, const struct rnd_image *img, const char *out, double *enc_ms)
+{
+	struct api_problem prob;
+	char line[1024];
+	double t0 = farm_now_ms();
+	uint8_t *bytes = NULL;
+	size_t nbytes = 0;
+	if (api_encode(scene, img, &bytes, &nbytes, &prob) != API_OK) {
+		api_problem_format(&prob, line, sizeof line);
+		fprintf(stderr, "umbra-render: %s\n", line);
+		return 1;
+	}
+	*enc_ms = farm_now_ms() - t0;
+	FILE *f = out ? fopen(out, "wb") : stdout;
+	int rc = 1;
+	if (!f) {
+		fprintf(stderr, "umbra-render: cannot write '%s': %s\n", out, strerror(errno));
+	} else {
+		size_t w = fwrite(bytes, 1, nbytes, f);
+		if ((f != stdout ? fclose(f) : fflush(f)) != 0 || w != nbytes)
+			fprintf(stderr, "umbra-render: cannot write '%s': %s\n", out ? out : "(stdout)", strerror(errno));
+		else
+			rc = 0;
+	}
+	free(bytes);
+	return rc;
+}
+
+/* The plan on stdout: JSON, or on a terminal (unless json) the text table. */
+static int print_plan(const struct api_scene *scene, const struct rnd_plan *plan, const struct api_plan_times *t,
+                      bool json)
+{
+	if (!json && isatty(STDOUT_FILENO)) {
+		srv_explain_text(stdout, plan);
+		return fflush(stdout) ? 1 : 0;
+	}
+	size_t len = 0;
+	char *doc = api_plan_json(scene, plan, t, &len);
+	int rc = doc && fwrite(doc, 1, len, stdout) == len && fputc('\n', stdout) != EOF && !fflush(stdout) ? 0 : 1;
+	if (rc) fprintf(stderr, "umbra-render: cannot write the plan\n");
+	free(doc);
+	return rc;
+}
+
+/* One scene, as before the batch runner: stdout or one file, --timings; with --explain its
+ * plan on stdout instead of the image, and with --explain=analyze the plan rendered, with
+ * what each step measured (the image into -o's file, or nowhere). */
+static int render_one(const char *in, const char *out, const char *device, const char *asset_root, int timings,
+                      enum cli_explain explain, bool json)
+{
+	double t0 = farm_now_ms();
+	struct api_scene *scene = NULL;
+	int rc = load_scene(in, out, asset_root, &scene);
+	if (rc) return rc;
+	double t_parse = farm_now_ms() - t0, t_ctx = farm_now_ms(), t_enc = 0;
+	struct rnd_context *ctx = open_context(device);
+	if (!ctx) {
 		api_scene_free(scene);
 		return 1;
 	}
 	t_ctx = farm_now_ms() - t_ctx;
-	struct rnd_image img;
-	struct rnd_timings tm;
-	enum rnd_result r = rnd_render(ctx, &scene->scene, &img, &tm, &err);
-	if (r != RND_OK) {
-		bool scene_fault = r == RND_ERR_INVALID || r == RND_ERR_LIMIT;
-		if (scene_fault) {
-			api_problem_from_render(&prob, scene, &err, r == RND_ERR_LIMIT ? 422 : 400);
-			api_problem_format(&prob, line, sizeof line);
-			fprintf(stderr, "umbra-render: %s\n", line);
-		} else {
-			fprintf(stderr, "umbra-render: render failed: %s\n", err.msg);
-		}
-		rc = scene_fault ? 2 : 1;
-		goto out_ctx;
+	struct rnd_image img = {0};
+	struct rnd_timings tm = {0};
+	struct rnd_error err;
+	struct rnd_plan *plan = NULL;
+	enum rnd_result r = rnd_plan_create(ctx, &scene->scene, &plan, &err);
+	if (r == RND_OK && explain != CLI_EXPLAIN_PLAN) r = rnd_render_plan(ctx, plan, &img, &tm, &err);
+	if (r != RND_OK) rc = render_failed(scene, r, &err);
+	else if (explain != CLI_EXPLAIN_PLAN && (out || !explain)) rc = write_image(scene, &img, out, &t_enc);
+	if (!rc && explain) {
+		struct api_plan_times t = {t_parse, explain == CLI_EXPLAIN_ANALYZE && out ? t_enc : -1, farm_now_ms() - t0};
+		rc = print_plan(scene, plan, &t, json);
 	}
-	double t_enc = farm_now_ms();
-	uint8_t *bytes = NULL;
-	size_t nbytes = 0;
-	if (api_encode(scene, &img, &bytes, &nbytes, &prob) != API_OK) {
-		api_problem_format(&prob, line, sizeof line);
-		fprintf(stderr, "umbra-render: %s\n", line);
-		goto out_img;
-	}
-	t_enc = farm_now_ms() - t_enc;
-	FILE *f = out ? fopen(out, "wb") : stdout;
-	if (!f) {
-		fprintf(stderr, "umbra-render: cannot write '%s': %s\n", out, strerror(errno));
-		goto out_bytes;
-	}
-	size_t w = fwrite(bytes, 1, nbytes, f);
-	if ((f != stdout ? fclose(f) : fflush(f)) != 0 || w != nbytes) {
-		fprintf(stderr, "umbra-render: cannot write '%s': %s\n", out ? out : "(stdout)", strerror(errno));
-		goto out_bytes;
-	}
-	if (timings)
-		fprintf(stderr, "parse %.2f ms, device %.2f ms, upload %.2f ms, shadow %.2f ms, main %.2f ms, readback %.2f ms, "
-		        "encode %.2f ms, total %.2f ms, %u shadow maps, environment %.2f ms and %u directions\n", t_parse, t_ctx,
-		        tm.upload_ms, tm.shadow_ms, tm.main_ms, tm.readback_ms, t_enc, farm_now_ms() - t0, tm.shadow_maps_rendered,
-		        tm.env_ms, tm.env_directions);
-	rc = 0;
-out_bytes:
-	free(bytes);
-out_img:
-	rnd_image_release(&img);
-out_ctx:
+	if (!rc && timings && explain != CLI_EXPLAIN_PLAN)
+		fprintf(stderr, "parse %.2f ms, device %.2f ms, plan %.2f ms, upload %.2f ms, shadow %.2f ms, main %.2f ms, "
+		        "readback %.2f ms, encode %.2f ms, total %.2f ms, %u shadow maps, environment %.2f ms and %u directions\n",
+		        t_parse, t_ctx, tm.plan_ms, tm.upload_ms, tm.shadow_ms, tm.main_ms, tm.readback_ms, t_enc,
+		        farm_now_ms() - t0, tm.shadow_maps_rendered, tm.env_ms, tm.env_directions);
 	if (rnd_context_validation_messages(ctx)) {
 		fprintf(stderr, "umbra-render: %u Vulkan validation messages\n", rnd_context_validation_messages(ctx));
 		rc = 1;
 	}
+	rnd_image_release(&img);
+	rnd_plan_destroy(plan);
 	rnd_context_destroy(ctx);
 	api_scene_free(scene);
 	return rc;
@@ -202,6 +257,8 @@ struct args {
 	size_t ninputs;
 	bool thumb;
 	int timings;
+	enum cli_explain explain;   /* --explain[=analyze] */
+	bool json;                  /* --json: the plan as JSON on a terminal too */
 	enum api_format format;   /* thumb --format (PNG by default) */
 	struct farm_opts farm;
 };
@@ -255,26 +312,29 @@ static bool shard_arg(const char *s, struct farm_opts *o)
 }
 
 /* getopt_long, as umbrad's flags.c: options and inputs in any order ("-" is an input: stdin). */
+/* The long options (getopt_long). */
+enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
+       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY, O_SERVER, O_RESUME, O_SHARD, O_EXPLAIN, O_JSON };
+static const struct option cli_options[] = {
+	{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
+	{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
+	{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
+	{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
+	{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
+	{"up", required_argument, NULL, O_UP}, {"format", required_argument, NULL, O_FORMAT},
+	{"quality", required_argument, NULL, O_QUALITY}, {"server", required_argument, NULL, O_SERVER},
+	{"resume", no_argument, NULL, O_RESUME}, {"shard", required_argument, NULL, O_SHARD},
+	{"explain", optional_argument, NULL, O_EXPLAIN}, {"json", no_argument, NULL, O_JSON}, {0},
+};
+
 static int parse_args(int argc, char **argv, struct args *a)
 {
-	enum { O_TIMINGS = 1000, O_TRANSPARENT, O_PROGRESS, O_NO_PROGRESS, O_DEVICE, O_ASSET_ROOT, O_MANIFEST,
-	       O_REPORT, O_SIZE, O_UP, O_FORMAT, O_QUALITY, O_SERVER, O_RESUME, O_SHARD };
-	static const struct option lopts[] = {
-		{"help", no_argument, NULL, 'h'}, {"timings", no_argument, NULL, O_TIMINGS},
-		{"transparent", no_argument, NULL, O_TRANSPARENT}, {"progress", no_argument, NULL, O_PROGRESS},
-		{"no-progress", no_argument, NULL, O_NO_PROGRESS}, {"device", required_argument, NULL, O_DEVICE},
-		{"asset-root", required_argument, NULL, O_ASSET_ROOT}, {"manifest", required_argument, NULL, O_MANIFEST},
-		{"report", required_argument, NULL, O_REPORT}, {"size", required_argument, NULL, O_SIZE},
-		{"up", required_argument, NULL, O_UP}, {"format", required_argument, NULL, O_FORMAT},
-		{"quality", required_argument, NULL, O_QUALITY}, {"server", required_argument, NULL, O_SERVER},
-		{"resume", no_argument, NULL, O_RESUME}, {"shard", required_argument, NULL, O_SHARD}, {0},
-	};
 	a->farm.progress = -1;
 	a->inputs = calloc((size_t)argc, sizeof *a->inputs);
 	if (!a->inputs) return 1;
 	optind = 1;
 	if (argc > 1 && !strcmp(argv[1], "thumb")) a->thumb = true, optind = 2;
-	for (int c; (c = getopt_long(argc, argv, "ho:j:", lopts, NULL)) != -1;) {
+	for (int c; (c = getopt_long(argc, argv, "ho:j:", cli_options, NULL)) != -1;) {
 		switch (c) {
 		case 'h': return usage(stdout, 0) - 1;
 		case 'o': a->out = optarg; break;
@@ -287,6 +347,14 @@ static int parse_args(int argc, char **argv, struct args *a)
 		case O_REPORT: a->report = optarg; break;
 		case O_SERVER: a->farm.server = optarg; break;
 		case O_RESUME: a->farm.resume = true; break;
+		case O_JSON: a->json = true; break;
+		case O_EXPLAIN:
+			a->explain = !optarg || !strcmp(optarg, "plan") ? CLI_EXPLAIN_PLAN
+			             : !strcmp(optarg, "analyze")      ? CLI_EXPLAIN_ANALYZE
+			                                               : CLI_EXPLAIN_NONE;
+			if (a->explain) break;
+			fprintf(stderr, "umbra-render: bad option --explain=%s (plan or analyze)\n", optarg);
+			return usage(stderr, 1);
 		case O_SHARD:
 			if (shard_arg(optarg, &a->farm)) break;
 			fprintf(stderr, "umbra-render: bad option --shard %s (K/N with 0 <= K < N, e.g. 0/4)\n", optarg);
@@ -405,8 +473,13 @@ int main(int argc, char **argv)
 		free(a.inputs);
 		return 1;
 	}
+	if (batch && a.explain) {
+		fprintf(stderr, "umbra-render: --explain is for one scene\n");
+		free(a.inputs);
+		return 1;
+	}
 	if (!batch) {
-		rc = render_one(a.inputs[0], a.out, a.device, a.farm.asset_root, a.timings);
+		rc = render_one(a.inputs[0], a.out, a.device, a.farm.asset_root, a.timings, a.explain, a.json);
 		free(a.inputs);
 		return rc;
 	}

@@ -1,8 +1,8 @@
 /*
  * umbrad's renderer context (see srv.h): the shared rnd_context — created from the flags,
  * recovered after a lost device (the first worker to see the loss recreates it and warms it up
- * again, server/warmup.c), its pipeline cache saved at exit — and srv_render(), the one way a
- * worker renders on it.
+ * again, server/warmup.c), its pipeline cache saved at exit — and srv_plan() and srv_render(),
+ * the one way a worker plans and renders on it.
  */
 #include <malloc.h>
 #include <pthread.h>
@@ -116,11 +116,30 @@ void srv_context_recover(struct srv_server *s, unsigned gen)
 	srv_log(SRV_LOG_ERROR, "the renderer could not be brought back after a device loss: staying not ready");
 }
 
+enum rnd_result srv_plan(struct srv_server *s, const struct rnd_scene *scene, struct srv_plan *out,
+                         struct rnd_error *err)
+{
+	enum rnd_result r = RND_ERR_DEVICE_LOST;
+	memset(err, 0, sizeof *err);
+	out->plan = NULL;
+	pthread_rwlock_rdlock(&s->ctx_lock);
+	out->gen = s->ctx_gen;
+	if (s->ctx) r = rnd_plan_create(s->ctx, scene, &out->plan, err);
+	pthread_rwlock_unlock(&s->ctx_lock);
+	return r;
+}
+
+void srv_plan_release(struct srv_plan *p)
+{
+	rnd_plan_destroy(p->plan);
+	p->plan = NULL;
+}
+
 /* Renders on the shared context. On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the lost
  * context's generation + 1 for context_recover(), and the daemon is marked not ready before
  * the lock is let go (so a recovery cannot finish before this mark). */
-enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
-                           struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen)
+enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct srv_plan *plan,
+                           struct rnd_image *img, struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen)
 {
 	pthread_rwlock_rdlock(&s->ctx_lock);
 	unsigned gen = s->ctx_gen;
@@ -131,7 +150,16 @@ enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, 
 		snprintf(err->msg, sizeof err->msg, "the renderer context could not be recreated after a lost device");
 	} else {
 		atomic_fetch_add(&s->in_flight, 1);
-		r = rnd_render(s->ctx, scene, img, t, err);
+		if (plan && (!plan->plan || plan->gen != gen)) {
+			/* made on a context lost since (or never): made again on this one */
+			srv_plan_release(plan);
+			plan->gen = gen;
+			r = rnd_plan_create(s->ctx, scene, &plan->plan, err);
+		} else {
+			r = RND_OK;
+		}
+		if (r == RND_OK)
+			r = plan ? rnd_render_plan(s->ctx, plan->plan, img, t, err) : rnd_render(s->ctx, scene, img, t, err);
 		atomic_fetch_sub(&s->in_flight, 1);
 		if (r == RND_ERR_DEVICE_LOST) {
 			atomic_store(&s->ready, false);

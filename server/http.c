@@ -41,8 +41,13 @@
 const char *srv_route_name(enum srv_route r)
 {
 	static const char *const names[SRV_ROUTE_COUNT] = { "/v1/render", "/healthz", "/readyz",
-		"/metrics", "/v1/info", "/playground", "/v1/renders", "/v1/renders/{hash}", "other" };
+		"/metrics", "/v1/info", "/playground", "/v1/renders", "/v1/renders/{hash}", "/v1/explain", "other" };
 	return (unsigned)r < SRV_ROUTE_COUNT ? names[r] : "other";
+}
+
+bool srv_route_posts(enum srv_route r)
+{
+	return r == SRV_ROUTE_RENDER || r == SRV_ROUTE_RENDERS || r == SRV_ROUTE_EXPLAIN;
 }
 
 const char *srv_stage_name(enum srv_stage st)
@@ -58,6 +63,7 @@ static enum srv_route route_of(const char *url)
 		{ "/v1/render", SRV_ROUTE_RENDER }, { "/healthz", SRV_ROUTE_HEALTHZ },
 		{ "/readyz", SRV_ROUTE_READYZ }, { "/metrics", SRV_ROUTE_METRICS },
 		{ "/v1/info", SRV_ROUTE_INFO }, { "/v1/renders", SRV_ROUTE_RENDERS },
+		{ "/v1/explain", SRV_ROUTE_EXPLAIN },
 	};
 	for (size_t i = 0; i < sizeof routes / sizeof routes[0]; i++)
 		if (!strcmp(url, routes[i].path))
@@ -99,17 +105,21 @@ static void request_free(struct srv_request *req)
 
 const char *srv_allow_of(enum srv_route r)
 {
-	return r == SRV_ROUTE_RENDER || r == SRV_ROUTE_RENDERS ? "POST" : "GET, HEAD";
+	return srv_route_posts(r) ? "POST" : "GET, HEAD";
 }
 
-/* The headers of a render answer (POST /v1/render, POST /v1/renders, GET /v1/renders/{hash}):
- * ETag, Location, Server-Timing, Umbra-Warnings and Cache-Control; no-store for the rest. */
+/* The headers of a render answer (POST /v1/render, POST /v1/renders, GET /v1/renders/{hash},
+ * POST /v1/explain): ETag, Location, Server-Timing, Umbra-Warnings and Cache-Control; no-store
+ * for the rest. A plan (explain) is no image: no ETag, and no-store (it says what the cache
+ * held). */
 static void render_headers(struct srv_request *req, struct MHD_Response *resp, int status)
 {
 	const struct srv_server *s = req->srv;
-	bool render = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS || req->route == SRV_ROUTE_RESULT;
+	bool explain = req->explain || req->route == SRV_ROUTE_EXPLAIN;
+	bool render = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS || req->route == SRV_ROUTE_RESULT ||
+	              req->route == SRV_ROUTE_EXPLAIN;
 	bool fresh = status == 200 || status == 303 || status == 304;
-	if (render && (fresh || status == 412) && req->etag[0])
+	if (render && !explain && (fresh || status == 412) && req->etag[0])
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, req->etag);
 	if (render && status == 303)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_LOCATION, req->location);
@@ -121,7 +131,7 @@ static void render_headers(struct srv_request *req, struct MHD_Response *resp, i
 	const char *cc = "no-store";
 	if (req->route == SRV_ROUTE_RESULT && (status == 200 || status == 304))
 		cc = SRV_RESULT_CACHE_CONTROL;
-	else if (render && (status == 200 || status == 303))
+	else if (render && !explain && (status == 200 || status == 303))
 		cc = s->cfg.cache_control ? s->cfg.cache_control : SRV_RENDER_CACHE_CONTROL;
 	MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, cc);
 }
@@ -262,8 +272,7 @@ enum MHD_Result srv_answer_not_ready(struct srv_request *req)
  * the Access-Control-Allow-* headers too (srv_origin_headers). */
 static enum MHD_Result answer_options(struct srv_request *req)
 {
-	bool post = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS;
-	return srv_respond(req, 204, NULL, NULL, 0, post ? "POST, OPTIONS" : "GET, HEAD, OPTIONS");
+	return srv_respond(req, 204, NULL, NULL, 0, srv_route_posts(req->route) ? "POST, OPTIONS" : "GET, HEAD, OPTIONS");
 }
 
 static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection *conn, const char *version)
@@ -283,7 +292,7 @@ static enum MHD_Result first_call(struct srv_request *req, struct MHD_Connection
 		req->state = SRV_REQ_HEADERS; /* answered on the next call, as a GET */
 		return MHD_YES;
 	}
-	bool post = req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS;
+	bool post = srv_route_posts(req->route);
 	if (post ? strcmp(req->method, "POST") != 0 : !get)
 		return srv_respond_problem(req, 405, srv_allow_of(req->route), "", "%s is not allowed on %s; allowed: %s",
 		                       req->method, srv_route_name(req->route), srv_allow_of(req->route));

@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "explain.h"
 #include "http.h"
 #include "metrics.h"
 #include "negotiate.h"
@@ -124,7 +125,15 @@ enum MHD_Result srv_render_begin(struct srv_request *req, struct MHD_Connection 
 			return srv_respond_problem(req, 400, NULL, "", "multipart/form-data without a usable boundary");
 	}
 	const char *accept = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
+	enum MHD_Result refused;
+	if (srv_explain_begin(req, conn, accept, &refused))
+		return refused;
 	enum srv_accept choice = srv_accept_choice(accept);
+	/* POST /v1/explain answers JSON (srv_explain_begin checked its Accept); a render with its
+	 * plan answers multipart/mixed, whose image part is negotiated as ever (PNG when Accept
+	 * names none: multipart/mixed alone). */
+	if (req->route == SRV_ROUTE_EXPLAIN || (req->explain && choice == SRV_ACCEPT_NONE))
+		choice = SRV_ACCEPT_PNG;
 	if (choice == SRV_ACCEPT_NONE)
 		return srv_respond_problem(req, 406, NULL, "", "this server answers image/png, image/webp, image/avif or image/x-exr (or a "
 		                       "problem+json document); Accept: %.200s names none of them", accept);

@@ -108,10 +108,13 @@ enum srv_route {
 	SRV_ROUTE_PLAYGROUND,          /* GET / and /playground (server/playground.c) */
 	SRV_ROUTE_RENDERS,             /* POST /v1/renders: render, store, 303 to the GET form */
 	SRV_ROUTE_RESULT,              /* GET /v1/renders/{hash}.{ext} (server/renders_route.c) */
+	SRV_ROUTE_EXPLAIN,             /* POST /v1/explain: the render plan, nothing rendered (explain.c) */
 	SRV_ROUTE_OTHER,
 	SRV_ROUTE_COUNT
 };
 const char *srv_route_name(enum srv_route r);
+/* The routes that take a scene by POST: /v1/render, /v1/renders, /v1/explain. */
+bool srv_route_posts(enum srv_route r);
 
 enum srv_priority { SRV_PRIO_INTERACTIVE, SRV_PRIO_BULK, SRV_PRIO_COUNT };
 
@@ -206,6 +209,8 @@ struct srv_request {
 	struct srv_kept_scene kept;    /* POST /v1/renders: the scene for the result cache (results.h) */
 	char location[64];             /* the Location of a 303 */
 	int want;                      /* Accept's choice (enum srv_accept: PNG, EXR or WebP) */
+	bool explain;                  /* POST /v1/render?explain=1: the image and its plan (explain.c) */
+	char mime[128];                 /* content_type when it is made per answer (multipart/mixed) */
 	bool close_after;              /* answer with Connection: close (framing error) */
 	char cors_origin[SRV_ORIGIN_MAX]; /* an allowed cross-origin caller's Origin, echoed; "" = none */
 	bool cors_private_network;     /* its preflight asked Access-Control-Request-Private-Network */
@@ -241,10 +246,23 @@ int srv_context_open(struct srv_server *s);         /* create + info; 0 or -1 (l
 /* After RND_ERR_DEVICE_LOST from the context of generation gen: recreates and warms it up once. */
 void srv_context_recover(struct srv_server *s, unsigned gen);
 int srv_warmup(struct srv_server *s);               /* 0 or -1 (logged); server/warmup.c */
-/* Renders on the shared context (context.c). On RND_ERR_DEVICE_LOST, *lost_gen (if given) is the
- * lost context's generation + 1, and the daemon is marked not ready. */
-enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct rnd_image *img,
-                           struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
+/* A render plan made on the shared context (context.c), and that context's generation: a
+ * render after a recovery makes its plan again on the new context. */
+struct srv_plan {
+	struct rnd_plan *plan;
+	unsigned gen;
+};
+/* The plan of scene on the shared context (rnd_plan_create): RND_OK, the plan's own error, or
+ * RND_ERR_DEVICE_LOST when there is no context (the render reports it). */
+enum rnd_result srv_plan(struct srv_server *s, const struct rnd_scene *scene, struct srv_plan *out,
+                         struct rnd_error *err);
+void srv_plan_release(struct srv_plan *p);
+/* Renders scene by its plan on the shared context (context.c): plan->plan made before (admission
+ * reads its estimate), or made here when it is NULL or of an older context. On
+ * RND_ERR_DEVICE_LOST, *lost_gen (if given) is the lost context's generation + 1, and the daemon
+ * is marked not ready. */
+enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, struct srv_plan *plan,
+                           struct rnd_image *img, struct rnd_timings *t, struct rnd_error *err, unsigned *lost_gen);
 /* Memory back to the system: shadow maps unused for idle_s seconds, the atlases' pages once no
  * map is left (rnd_context_trim), then malloc's free pages. Returns the atlas bytes released. */
 uint64_t srv_context_trim(struct srv_server *s, double idle_s);

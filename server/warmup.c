@@ -84,7 +84,7 @@ static int warm_one(struct srv_server *s, size_t i)
 		char msg[700];
 		api_problem_format(&p, msg, sizeof msg);
 		srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, msg);
-	} else if (srv_render(s, &sc->scene, &img, &t, &err, NULL) != RND_OK) {
+	} else if (srv_render(s, &sc->scene, NULL, &img, &t, &err, NULL) != RND_OK) {
 		srv_log(SRV_LOG_WARN, "warm-up '%s': %s", warm_scenes[i].name, err.msg);
 	} else if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
 		srv_log(SRV_LOG_WARN, "warm-up '%s': encode: %s", warm_scenes[i].name, p.detail);

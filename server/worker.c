@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "explain.h"
 #include "imports.h"
 #include "log.h"
 #include "metrics.h"
@@ -65,34 +66,6 @@ static uint64_t input_bytes(const struct srv_request *req)
 	return n;
 }
 
-/* Admission by memory: the renderer's estimate of what the scene allocates, against
- * --max-memory (admit.h). Limits no retry can cure (one allocation over the device's limit)
- * answer 422 here, before the render. held: what its parse holds already (api_memory_gate).
- * 0 admitted (*need, held included, to release), else p is filled (held still to release). */
-static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t held,
-                 uint64_t *need, struct api_problem *p)
-{
-	struct rnd_estimate est;
-	struct rnd_error err = {0};
-	enum rnd_result r = RND_ERR_DEVICE_LOST;
-	pthread_rwlock_rdlock(&s->ctx_lock);
-	if (s->ctx) r = rnd_render_estimate(s->ctx, &sc->scene, &est, &err);
-	pthread_rwlock_unlock(&s->ctx_lock);
-	if (r == RND_ERR_DEVICE_LOST) return 0; /* the render itself reports it */
-	if (r != RND_OK) {
-		api_problem_from_render(p, sc, &err, r == RND_ERR_LIMIT ? 422 : 400);
-		return -1;
-	}
-	uint64_t n = est.device_bytes + est.host_bytes;
-	double deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0;
-	if (srv_admit_grow(&s->admit, sc, held, n, deadline, p) != 0) {
-		if (p->status == 504) srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
-		return -1;
-	}
-	*need = held + n;
-	return 0;
-}
-
 static int render_status(enum rnd_result r)
 {
 	switch (r) {
@@ -103,6 +76,29 @@ static int render_status(enum rnd_result r)
 	case RND_ERR_DEVICE_LOST: return 503;   /* the context is recreated: a retry can succeed */
 	default: return 500;
 	}
+}
+
+/* Admission by memory: the render plan's estimate of what the scene allocates (the plan the
+ * render then executes: made once, here), against --max-memory (admit.h). held: what its
+ * parse holds already (api_memory_gate). 0 admitted (*need, held included, to release); -1
+ * refused (p is filled; held still to release); -2 no plan (*r, *err: the render's error, a
+ * limit no retry can cure among them: one allocation over the device's). */
+static int admit(struct srv_server *s, const struct srv_request *req, const struct api_scene *sc, uint64_t held,
+                 struct srv_plan *plan, uint64_t *need, enum rnd_result *r, struct rnd_error *err, struct api_problem *p)
+{
+	struct rnd_estimate est;
+	*r = srv_plan(s, &sc->scene, plan, err);
+	if (*r == RND_ERR_DEVICE_LOST) return 0; /* the render itself reports it */
+	if (*r != RND_OK) return -2;
+	rnd_plan_estimate(plan->plan, &est);
+	uint64_t n = est.device_bytes + est.host_bytes;
+	double deadline = s->cfg.deadline_ms ? req->t_queued + s->cfg.deadline_ms / 1000.0 : 0;
+	if (srv_admit_grow(&s->admit, sc, held, n, deadline, p) != 0) {
+		if (p->status == 504) srv_metrics_add(s->metrics, SRV_CTR_DEADLINE, 1);
+		return -1;
+	}
+	*need = held + n;
+	return 0;
 }
 
 /* The renderer's cancel callback: yield to a request that has waited half its deadline. */
@@ -172,6 +168,8 @@ static int job_identity(struct srv_server *s, struct srv_request *req, const str
 {
 	struct api_problem p = { 0 };
 	const char *mime = api_format_mime(sc->format);
+	if (req->route == SRV_ROUTE_EXPLAIN)
+		return 0;   /* a plan is no image: no ETag, no condition, nothing stored */
 	pthread_rwlock_rdlock(&s->ctx_lock);
 	req->etag_hash = srv_etag_of(sc->scene_hash, sc->asset_hash, mime, s->info.device_name, s->info.driver_info);
 	pthread_rwlock_unlock(&s->ctx_lock);
@@ -323,7 +321,7 @@ static void job_render_stages(struct srv_server *s, const struct rnd_timings *t)
  * api_import_stage: only with a model read or imported), `parse` what is left of parsing (the
  * JSON, the checks, the cache look-ups), `device-wait` the wait for the device (one render at a
  * time on a CPU device: server/gate.h), so that the stages add up to all but the gaps between
- * them. */
+ * them. `plan` is the render plan's (made at admission, before the device wait). */
 static void format_timing(struct srv_request *req, const struct api_scene *sc, const struct rnd_timings *t,
                           double queue_ms, double parse_ms, double gate_ms, double encode_ms, double total_ms)
 {
@@ -343,16 +341,49 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 	if (sc->scene.environment.source != RND_ENV_AMBIENT)
 		snprintf(env, sizeof env, ", environment;dur=%.3f;desc=\"%u directions\"", t->env_ms, t->env_directions);
 	snprintf(req->server_timing, sizeof req->server_timing,
-	         "queue;dur=%.3f, parse;dur=%.3f%s, device-wait;dur=%.3f%s, upload;dur=%.3f, shadow;dur=%.3f, main;dur=%.3f, "
-	         "readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
-	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, gate_ms, env, t->upload_ms, t->shadow_ms,
-	         t->main_ms, t->readback_ms, encode_ms, total_ms);
+	         "queue;dur=%.3f, parse;dur=%.3f%s, plan;dur=%.3f, device-wait;dur=%.3f%s, upload;dur=%.3f, shadow;dur=%.3f, "
+	         "main;dur=%.3f, readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
+	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, t->plan_ms, gate_ms, env, t->upload_ms,
+	         t->shadow_ms, t->main_ms, t->readback_ms, encode_ms, total_ms);
 }
 
-/* One request from the queue: parse, admit by memory, render, encode, answer. Returns the
- * lost context's generation + 1 when its render lost the device (the caller recovers after
- * answering), else 0. */
-/* Answers req (or, on a worker, parks it for an import thread: *parked). Returns the lost
+/* After a render: the image encoded and answered (with its plan for ?explain=1: explain.c),
+ * unless the deadline passed meanwhile; Server-Timing. ms: queue, parse and device-wait. */
+static void job_encode(struct srv_server *s, struct srv_request *req, const struct api_scene *sc,
+                       const struct srv_plan *plan, const struct rnd_image *img, const struct rnd_timings *t,
+                       const double ms[3])
+{
+	struct api_problem p = { 0 };
+	uint8_t *bytes = NULL;
+	size_t len = 0;
+	double t2 = srv_now();
+	if (api_encode(sc, img, &bytes, &len, &p) != API_OK) {
+		job_problem(req, &p);
+		return;
+	}
+	double encode_s = srv_now() - t2;
+	srv_metrics_stage(s->metrics, SRV_STAGE_ENCODE, encode_s);
+	double t3 = srv_now();
+	if (past_deadline(s, req, t3)) {
+		free(bytes);
+		job_deadline(s, req, "while rendering", t3);
+		return;
+	}
+	if (!req->explain) {
+		job_answer(s, req, sc, bytes, len);
+	} else {
+		struct api_plan_times pt = { ms[1], encode_s * 1000.0, (t3 - req->t_queued) * 1000.0 };
+		if (!srv_explain_multipart(req, sc, plan->plan, &pt, bytes, len)) {
+			api_problem_set(&p, 503, "", "out of memory for the render's plan; retry, or ask without explain");
+			job_problem(req, &p);
+			return;
+		}
+	}
+	format_timing(req, sc, t, ms[0], ms[1], ms[2], encode_s * 1000.0, (t3 - req->t_queued) * 1000.0);
+}
+
+/* One request from the queue: parse, admit by memory, render, encode, answer (POST
+ * /v1/explain: parse and plan, explain.c). Answers req (or, on a worker, parks it for an import thread: *parked). Returns the lost
  * context's generation + 1 after a device loss, else 0. */
 static unsigned job_run(struct srv_server *s, struct srv_request *req, bool importer, bool *parked)
 {
@@ -369,8 +400,7 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	struct rnd_image img = { 0 };
 	struct rnd_timings t = { 0 };
 	struct rnd_error err = { 0 };
-	uint8_t *bytes = NULL;
-	size_t len = 0;
+	struct srv_plan plan = { 0 };
 	uint64_t admitted = 0;        /* bytes admitted by memory, released when the answer is ready */
 	double parse_s = 0;
 	uint64_t sent = input_bytes(req);
@@ -382,16 +412,21 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 	admitted = ticket.reserved;
 	*parked = pr == 2;
 	if (pr) goto out;
+	if (req->route == SRV_ROUTE_EXPLAIN) {
+		srv_explain_answer(s, req, sc, parse_s * 1000.0);
+		goto out;
+	}
 
 	double t1 = srv_now();
 	if (past_deadline(s, req, t1)) {
 		job_deadline(s, req, "before rendering", t1);
 		goto out;
 	}
-	if (admit(s, req, sc, admitted, &admitted, &p) != 0) {
-		job_problem(req, &p);
-		goto out;
-	}
+	enum rnd_result r = RND_OK;
+	int ar = admit(s, req, sc, admitted, &plan, &admitted, &r, &err, &p);
+	if (ar == -2) job_render_failed(s, req, sc, r, &err, false);
+	else if (ar != 0) job_problem(req, &p);
+	if (ar != 0) goto out;
 	struct render_watch watch = { .srv = s };
 	if (s->cfg.deadline_ms) {
 		sc->scene.deadline_ns = (uint64_t)((req->t_queued + s->cfg.deadline_ms / 1000.0) * 1e9);
@@ -407,33 +442,17 @@ static unsigned job_run(struct srv_server *s, struct srv_request *req, bool impo
 		goto out;
 	}
 	double gate_ms = (srv_now() - t_gate) * 1000.0;
-	enum rnd_result r = srv_render(s, &sc->scene, &img, &t, &err, &lost_gen);
+	r = srv_render(s, &sc->scene, &plan, &img, &t, &err, &lost_gen);
 	srv_gate_leave(&s->gate);
 	if (r != RND_OK) {
 		job_render_failed(s, req, sc, r, &err, watch.yielded);
 		goto out;
 	}
 	job_render_stages(s, &t);
-
-	double t2 = srv_now();
-	if (api_encode(sc, &img, &bytes, &len, &p) != API_OK) {
-		job_problem(req, &p);
-		goto out;
-	}
-	double encode_s = srv_now() - t2;
-	srv_metrics_stage(s->metrics, SRV_STAGE_ENCODE, encode_s);
-
-	double t3 = srv_now();
-	if (past_deadline(s, req, t3)) {
-		free(bytes);
-		job_deadline(s, req, "while rendering", t3);
-		goto out;
-	}
-	job_answer(s, req, sc, bytes, len);
-	format_timing(req, sc, &t, (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, gate_ms, encode_s * 1000.0,
-	              (t3 - req->t_queued) * 1000.0);
+	job_encode(s, req, sc, &plan, &img, &t, (double[]){ (t_pop - req->t_queued) * 1000.0, parse_s * 1000.0, gate_ms });
 out:
 	rnd_image_release(&img);
+	srv_plan_release(&plan);
 	api_scene_free(sc);
 	srv_admit_release(&s->admit, admitted);
 	/* After an enormous request, its memory back to the system now: its freed heap, and its

@@ -64,6 +64,7 @@ command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && run_suite cluster env
 command -v haproxy >/dev/null && [ -x "$BUILD/umbrad" ] && [ -x "$BUILD/umbra-render" ] &&
 	run_suite farm-remote env DAEMON_PRELOAD="$PRELOAD" python3 tests/cluster/test_farm.py
 [ -x "$BUILD/umbrad" ] && run_suite http-thumbnail sh tests/http/thumbnail.sh
+[ -x "$BUILD/umbrad" ] && run_suite http-explain sh tests/http/explain.sh
 # Cacheable renders (POST /v1/renders, GET /v1/renders/{hash}), and nginx in front when installed.
 [ -x "$BUILD/umbrad" ] && run_suite http-cache sh tests/http/cache.sh
 [ -x "$BUILD/umbra-render" ] && run_suite cli sh tests/cli/run.sh

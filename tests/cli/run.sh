@@ -376,5 +376,18 @@ check "Ctrl-C: every ok line has its complete PNG, nothing else" \
 	sh -c "[ \$(ls '$T/intr' | grep -c '\\.png\$') = $okn ] && ! ls '$T/intr' | grep -q tmp"
 check "Ctrl-C: report lists all 40" [ "$(wc -l <"$T/intr/report.jsonl")" = 40 ]
 
+# ---- --explain: the plan without rendering, and with =analyze the render's measures ----
+printf '{"width": 48, "height": 48, "camera": {"position": [4, 3, 4], "target": [0, 0.8, 0]}, "objects": [{"shape": "plane", "size": [10, 10]}, {"shape": "sphere", "radius": 1, "transform": {"translation": [0, 1, 0]}}], "lights": [{"type": "directional", "direction": [-0.5, -1, -0.3]}]}' >"$T/ex.json"
+cli --explain "$T/ex.json" >"$T/ex.plan" 2>"$T/ex.err"; rc=$?
+check "--explain: exit 0, a plan valid under api/explain.schema.json" sh -c \
+	"[ $rc = 0 ] && python3 tests/http/explain_check.py plan '$T/ex.plan'"
+cli --explain=analyze "$T/ex.json" -o "$T/ex.png" >"$T/exa.plan" 2>"$T/exa.err"; rc=$?
+check "--explain=analyze: the image written, the plan analyzed with the render's counts" sh -c \
+	"[ $rc = 0 ] && [ -s '$T/ex.png' ] && python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); t=d[\"totals\"]; a=d[\"actual\"]; sys.exit(not (d[\"analyzed\"] and all(t[k] == a[k] for k in (\"shadow_maps_drawn\", \"shadow_texels\", \"shadow_triangles\", \"camera_triangles\"))))' '$T/exa.plan'"
+cli --explain=maybe "$T/ex.json" >/dev/null 2>&1; rc=$?
+check "--explain=maybe: exit 1" [ $rc = 1 ]
+cli --explain "$T/ex.json" "$T/ex.json" -o "$T/exdir/" >/dev/null 2>"$T/exb.err"; rc=$?
+check "--explain with several scenes: exit 1, said why" sh -c "[ $rc = 1 ] && grep -q 'one scene' '$T/exb.err'"
+
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "api.h"
+#include "estimate.h"
 #include "gpu_util.h"
 #include "test.h"
 
@@ -204,14 +205,17 @@ TEST(limits_allocation_over_device_limit_names_aovs)
 	REQUIRE(api_scene_parse(doc, strlen(doc), &lim, &s, &prob) == API_OK, "%s %s", prob.pointer, prob.detail);
 	struct rnd_estimate est;
 	struct rnd_error err = {0};
-	enum rnd_result re = rnd_render_estimate(ctx, &s->scene, &est, &err);
+	rnd_estimate_scene(&s->scene, 4096, &est);
+	struct rnd_plan *plan = NULL;
+	enum rnd_result re = rnd_plan_create(ctx, &s->scene, &plan, &err);
+	rnd_plan_destroy(plan);
 	printf("    [4096², 40 AOV planes] readback %.2f GB, largest allocation %.2f GB, device allows %.2f GB; "
 	       "estimate %.2f GB device + %.2f GB host\n", est.readback_bytes / 1e9, est.largest_allocation / 1e9,
 	       info.max_allocation / 1e9, est.device_bytes / 1e9, est.host_bytes / 1e9);
 	/* readback: 16 B colour + 3 passes x 4 x 16 B per pixel */
 	CHECK(est.readback_bytes == 4096ull * 4096 * (16 + 3 * 4 * 16), "readback %llu", (unsigned long long)est.readback_bytes);
 	if (est.largest_allocation > info.max_allocation) {
-		CHECK(re == RND_ERR_LIMIT && err.at == RND_AT_AOVS, "estimate: %s at %d", rnd_result_str(re), (int)err.at);
+		CHECK(re == RND_ERR_LIMIT && err.at == RND_AT_AOVS, "plan: %s at %d", rnd_result_str(re), (int)err.at);
 		struct rnd_image img = {0};
 		memset(&err, 0, sizeof err);
 		enum rnd_result r = rnd_render(ctx, &s->scene, &img, NULL, &err);

@@ -4,7 +4,7 @@
 #include <string.h>
 #include "estimate.h"
 #include "test.h"
-#include "visibility.h"
+#include "visibility_plan.h"
 
 TEST(estimate_counts_the_visibility_pass)
 {

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "test.h"
 #include "thumb_scene.h"
+#include "casters.h"
 #include "lod.h"
 
 #define PI_D 3.14159265358979323846

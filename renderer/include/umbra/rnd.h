@@ -460,6 +460,7 @@ void rnd_image_release(struct rnd_image *img);
 
 /* Milliseconds per stage of one render. */
 struct rnd_timings {
+	double plan_ms;       /* the render plan (rnd_plan_create): every decision, made once */
 	double upload_ms;     /* tessellation + copy to the GPU */
 	double shadow_ms;     /* shadow passes (GPU) */
 	double main_ms;       /* main pass + resolve (GPU), the visibility pass's included */
@@ -471,6 +472,7 @@ struct rnd_timings {
 	uint32_t pixel_shaded_views; /* of those, views shaded once per pixel centre (renderer/deferred.h) */
 	uint32_t sphere_proxies;   /* spheres the camera drew as a proxy shading the true sphere (proxy.h) */
 	uint64_t camera_triangles; /* triangles the camera's passes drew, each view counted once */
+	uint64_t shadow_triangles; /* casters' triangles the shadow maps drew */
 	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
 	uint32_t shadow_parts;     /* submits of shadow maps drawn in parts (too costly for one) */
 	uint32_t env_directions;   /* environment shadow directions drawn (maps rendered or reused) */
@@ -538,7 +540,8 @@ uint32_t rnd_context_validation_messages(const struct rnd_context *ctx);
 
 /* What a render of a scene will allocate, from the scene alone (before any allocation): for
  * admission by memory (umbrad --max-memory) and for limits that no retry can cure. Bytes are
- * upper estimates of what the render holds at its peak. */
+ * upper estimates of what the render holds at its peak. A render plan carries it
+ * (rnd_plan_estimate). */
 struct rnd_estimate {
 	uint64_t device_bytes;        /* targets, AOV images, readback buffer, geometry, shadow scratch,
 	                                 material textures with their mip chains (image + staging)
@@ -547,11 +550,6 @@ struct rnd_estimate {
 	uint64_t largest_allocation;  /* the largest single buffer or image */
 	uint64_t readback_bytes;      /* the readback buffer (colour + AOV attachments of the sheet) */
 };
-/* Fills *est; RND_ERR_LIMIT (err->at names the AOVs, views or size) when a single allocation
- * would be over the device's limit, which rnd_render() would refuse the same way. Thread-safe. */
-enum rnd_result rnd_render_estimate(const struct rnd_context *ctx, const struct rnd_scene *scene,
-                                    struct rnd_estimate *est, struct rnd_error *err);
-
 /* Counters for metrics; thread-safe. */
 struct rnd_stats {
 	uint32_t atlas_size;
@@ -592,9 +590,39 @@ enum rnd_fault { RND_FAULT_NONE, RND_FAULT_DEVICE_LOST, RND_FAULT_OUT_OF_MEMORY 
 void rnd_context_inject_fault(struct rnd_context *ctx, enum rnd_fault kind, uint32_t nth_submit);
 
 /* Renders one scene. Blocks until done (or until scene->deadline_ns / cancel stop it:
- * RND_ERR_TIMEOUT). See the threading note at the top. */
+ * RND_ERR_TIMEOUT). See the threading note at the top. The same as rnd_plan_create(),
+ * rnd_render_plan() and rnd_plan_destroy(). */
 enum rnd_result rnd_render(struct rnd_context *ctx, const struct rnd_scene *scene,
                            struct rnd_image *out, struct rnd_timings *timings, struct rnd_error *err);
+
+/* ---- render plans ----
+ * Every decision of a render — views, shadow maps (kind, size, filter, cached or drawn), each
+ * object's level of detail, what each pass leaves out, the passes, the deadline's estimates,
+ * the memory estimate — is made once, as a plan, before anything is allocated; the render
+ * executes the plan and nothing else. A caller that wants to admit a render by its memory, or
+ * show its plan (umbra/rnd_plan.h, `explain`), makes the plan first:
+ *   struct rnd_plan *plan;
+ *   if (rnd_plan_create(ctx, &scene, &plan, &err) == RND_OK) {
+ *       struct rnd_estimate est; rnd_plan_estimate(plan, &est);      // admit by est ...
+ *       r = rnd_render_plan(ctx, plan, &img, &t, &err);               // ... then render it
+ *       rnd_plan_destroy(plan);
+ *   }
+ * Ownership: the plan points into the scene, which must outlive it; rnd_plan_destroy frees it
+ * (NULL-safe). A plan is rendered at most once, on the context it was made on (its cache's
+ * maps, its limits). Threading: plans are independent; a plan is used by one thread at a time. */
+struct rnd_plan;
+/* Makes the plan of scene on ctx: RND_OK, or the error rnd_render would fail with before
+ * drawing anything (invalid, over a limit, RND_ERR_LIMIT at a member when one allocation would
+ * be over the device's limit). */
+enum rnd_result rnd_plan_create(struct rnd_context *ctx, const struct rnd_scene *scene, struct rnd_plan **out,
+                                struct rnd_error *err);
+void rnd_plan_destroy(struct rnd_plan *plan);
+/* What the plan's render will allocate (see struct rnd_estimate). */
+void rnd_plan_estimate(const struct rnd_plan *plan, struct rnd_estimate *est);
+/* Executes the plan: as rnd_render. Fills the plan's measured side (rnd_plan.h: EXPLAIN
+ * ANALYZE) whatever the result. */
+enum rnd_result rnd_render_plan(struct rnd_context *ctx, struct rnd_plan *plan, struct rnd_image *out,
+                                struct rnd_timings *timings, struct rnd_error *err);
 
 const char *rnd_result_str(enum rnd_result r);
 

@@ -11,9 +11,11 @@
 #ifndef UMBRA_RND_MATH_H
 #define UMBRA_RND_MATH_H
 
+#include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -63,9 +65,22 @@ static inline void rnd_v3_scale(float out[3], const float a[3], float s)
 	for (int i = 0; i < 3; i++) out[i] = a[i] * s;
 }
 
-float rnd_v3_length(const float a[3]);
+static inline float rnd_v3_length(const float a[3])
+{
+	return sqrtf(rnd_v3_dot(a, a));
+}
+
 /* Returns false (and leaves out = a) when |a| is 0 or not finite. */
-bool rnd_v3_normalize(float out[3], const float a[3]);
+static inline bool rnd_v3_normalize(float out[3], const float a[3])
+{
+	float len = rnd_v3_length(a);
+	if (!(len > 0.0f) || !isfinite(len)) {
+		if (out != a) memcpy(out, a, 3 * sizeof *out);
+		return false;
+	}
+	rnd_v3_scale(out, a, 1.0f / len);
+	return true;
+}
 
 void rnd_mat4_identity(float m[16]);
 /* out = a * b; out may not alias a or b. */
@@ -83,14 +98,37 @@ void rnd_mat4_ortho(float out[16], float l, float r, float b, float t, float zne
 bool rnd_mat4_invert(float out[16], const float m[16]);
 /* Determinant of the upper-left 3x3 block (negative = mirroring transform). */
 float rnd_mat4_det3(const float m[16]);
-void rnd_mat4_mul_point(float out[3], const float m[16], const float p[3]);   /* w = 1, divides by w */
-void rnd_mat4_mul_dir(float out[3], const float m[16], const float d[3]);     /* w = 0 */
+/* w = 1, divides by w. Inline, as the rest below: the renderer's tessellation and the render
+ * plan's measure of each mesh run them once or twice per vertex. */
+static inline void rnd_mat4_mul_point(float out[3], const float m[16], const float p[3])
+{
+	float r[4];
+	for (int row = 0; row < 4; row++)
+		r[row] = m[row] * p[0] + m[4 + row] * p[1] + m[8 + row] * p[2] + m[12 + row];
+	float iw = (r[3] != 0.0f) ? 1.0f / r[3] : 1.0f;
+	out[0] = r[0] * iw; out[1] = r[1] * iw; out[2] = r[2] * iw;
+}
+
+/* w = 0 */
+static inline void rnd_mat4_mul_dir(float out[3], const float m[16], const float d[3])
+{
+	float r[3];
+	for (int row = 0; row < 3; row++)
+		r[row] = m[row] * d[0] + m[4 + row] * d[1] + m[8 + row] * d[2];
+	memcpy(out, r, sizeof r);
+}
 /* Inverse-transpose of the upper 3x3, as a 4x4 (for normals). False when singular. */
 bool rnd_mat4_normal_matrix(float out[16], const float m[16]);
 
 void rnd_aabb_empty(struct rnd_aabb *b);
 bool rnd_aabb_is_empty(const struct rnd_aabb *b);
-void rnd_aabb_add_point(struct rnd_aabb *b, const float p[3]);
+static inline void rnd_aabb_add_point(struct rnd_aabb *b, const float p[3])
+{
+	for (int i = 0; i < 3; i++) {
+		if (p[i] < b->min[i]) b->min[i] = p[i];
+		if (p[i] > b->max[i]) b->max[i] = p[i];
+	}
+}
 void rnd_aabb_union(struct rnd_aabb *b, const struct rnd_aabb *o);
 /* Bounds of the 8 transformed corners of b. */
 void rnd_aabb_transform(struct rnd_aabb *out, const struct rnd_aabb *b, const float m[16]);
