@@ -163,7 +163,7 @@ TEST(obj_own_reader_leaves_the_rest_to_assimp)
 		"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 3 3\n",
 	};
 	for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-		char what[32];
+		char what[64];
 		snprintf(what, sizeof what, "obj case %zu", i);
 		same_both_ways(what, API_MODEL_OBJ, (const uint8_t *)files[i], strlen(files[i]), NULL, 0, false);
 	}
@@ -257,7 +257,7 @@ TEST(ply_own_reader_matches_assimp)
 	for (int kind = 0; kind < PLY_KINDS; kind++)
 		for (int fmt = 0; fmt < 3; fmt++) {
 			size_t len;
-			char *s = grid_ply((enum ply_kind)kind, fmt, &len), what[32];
+			char *s = grid_ply((enum ply_kind)kind, fmt, &len), what[64];
 			snprintf(what, sizeof what, "ply kind %d format %d", kind, fmt);
 			/* (big-endian strips: api/ply_strips.c leaves them to Assimp, and so does the reader) */
 			same_both_ways(what, API_MODEL_PLY, (const uint8_t *)s, len, NULL, 0, !(kind == PLY_STRIPS && fmt == 2));
@@ -289,7 +289,7 @@ TEST(ply_own_reader_leaves_the_rest_to_assimp)
 		"0 1 0\n3 0 1 2 7\n",
 	};
 	for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-		char what[32];
+		char what[64];
 		snprintf(what, sizeof what, "ply case %zu", i);
 		same_both_ways(what, API_MODEL_PLY, (const uint8_t *)files[i], strlen(files[i]), NULL, 0, false);
 	}
