@@ -74,6 +74,13 @@ enum rnd_result rnd_fail_vk(struct rnd_error *err, VkResult vr, const char *what
 
 const char *rnd_result_str(enum rnd_result r);
 
+double rnd_now_ms(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
+
 void rnd_log(const struct rnd_context *ctx, int level, const char *fmt, ...)
 {
 	char buf[1024];

@@ -36,13 +36,6 @@ struct rnd_env_cache {
 	struct rnd_env_entry entries[RND_ENV_ENTRIES];
 };
 
-static double mono_now(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
 enum rnd_result rnd_env_init(struct rnd_context *ctx, struct rnd_error *err)
 {
 	struct rnd_env_cache *c = calloc(1, sizeof *c);
@@ -164,7 +157,7 @@ static enum rnd_result find_entry(struct rnd_context *ctx, struct rnd_env_cache 
 			if (c->entries[i].state != ENTRY_FREE && c->entries[i].key == key) found = &c->entries[i];
 		if (found && found->state == ENTRY_READY) {
 			found->refs++;
-			found->used = mono_now();
+			found->used = (rnd_now_ms() * 1e-3);
 			use->entry = found;
 			return RND_OK;
 		}
@@ -213,7 +206,7 @@ enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_enviro
 	if (env->source == RND_ENV_AMBIENT) return RND_OK;
 	if (env->source == RND_ENV_MAP && (!env->map.rgb || env->map.width < 2 || env->map.height < 2))
 		return rnd_fail(err, RND_ERR_INVALID, "the environment map has no pixels (%ux%u)", env->map.width, env->map.height);
-	double t0 = mono_now();
+	double t0 = (rnd_now_ms() * 1e-3);
 	struct rnd_env_cache *c = ctx->env;
 	uint64_t key = env_key(env);
 	pthread_mutex_lock(&c->mu);
@@ -224,7 +217,7 @@ enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_enviro
 	if (r == RND_OK && use->build) r = stage_entry(ctx, use->entry, env, err);
 	if (r != RND_OK && use->entry) rnd_env_done(ctx, use, false, false);
 	if (r != RND_OK) memset(use, 0, sizeof *use);
-	use->ms = (mono_now() - t0) * 1e3;
+	use->ms = ((rnd_now_ms() * 1e-3) - t0) * 1e3;
 	return r;
 }
 
@@ -359,7 +352,7 @@ void rnd_env_done(struct rnd_context *ctx, struct rnd_env_use *use, bool ok, boo
 		e->state = ok ? ENTRY_READY : ENTRY_FREE;
 	}
 	e->refs--;
-	e->used = mono_now();
+	e->used = (rnd_now_ms() * 1e-3);
 	pthread_cond_broadcast(&c->cv);
 	pthread_mutex_unlock(&c->mu);
 	use->entry = NULL;
@@ -384,7 +377,7 @@ uint64_t rnd_env_trim(struct rnd_context *ctx, double idle_s)
 	uint64_t bytes = 0;
 	if (!c) return 0;
 	pthread_mutex_lock(&c->mu);
-	double now = mono_now();
+	double now = (rnd_now_ms() * 1e-3);
 	for (uint32_t i = 0; i < RND_ENV_ENTRIES; i++) {
 		struct rnd_env_entry *e = &c->entries[i];
 		if (e->state != ENTRY_READY || e->refs || e->key == STUDIO_KEY || now - e->used < idle_s) continue;

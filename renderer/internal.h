@@ -32,6 +32,8 @@
  * UMBRA_SHADING_*); the colour shaded there has the output's colour format. */
 #define RND_SURFACE_SHADING_FORMAT VK_FORMAT_R32G32B32A32_UINT
 #define RND_MAX_VARIANTS 1024
+/* variants compiled at once on one context (more wait their turn: a few per core is plenty) */
+#define RND_COMPILING_MAX 32
 
 /* Map a VkResult to a result + message "what: VK_ERROR_..." */
 enum rnd_result rnd_fail_vk(struct rnd_error *err, VkResult vr, const char *what);
@@ -91,6 +93,9 @@ struct rnd_pipelines {
 	VkShaderModule mesh_vs, mesh_fs, mesh_vis_fs, aov_fs, fullscreen_vs, vis_fs, vis_shade_fs, resolve_fs, background_fs,
 	               env_vis_fs;
 	pthread_mutex_t mu;
+	pthread_cond_t compiled;             /* broadcast when a variant in `compiling` is done */
+	struct rnd_main_key *compiling[RND_COMPILING_MAX]; /* keys being compiled now (outside mu) */
+	uint32_t compiling_count;
 	uint32_t variant_count;
 	struct rnd_main_variant {
 		struct rnd_main_key {
@@ -186,6 +191,10 @@ struct rnd_context {
 };
 
 void rnd_log(const struct rnd_context *ctx, int level, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* CLOCK_MONOTONIC in milliseconds: every stage time of the renderer. */
+double rnd_now_ms(void);
+/* pipelines.c: milliseconds this thread has spent compiling pipeline variants (rnd_timings.compile_ms). */
+extern _Thread_local double rnd_compile_ms_tls;
 /* Debug name for any Vulkan object (no-op without VK_EXT_debug_utils). */
 void rnd_name(const struct rnd_context *ctx, VkObjectType type, uint64_t handle, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
@@ -230,11 +239,16 @@ enum rnd_result rnd_pipeline_fullscreen(struct rnd_context *ctx, VkShaderModule 
 /* The descriptor type of each binding of the main set (UMBRA_BINDING_* of umbra_shared.h): one
  * table for the set layout and for the descriptor writes (render.c). */
 extern const VkDescriptorType rnd_binding_type[UMBRA_BINDING_COUNT];
-/* The main-pass pipeline for key, compiled on first use (thread-safe). */
+/* Compiles main-pass variant key (pipelines.c; the caller keeps it: pipeline_variants.c). */
+enum rnd_result rnd_pipeline_variant_compile(struct rnd_context *ctx, const struct rnd_main_key *key, const char *name,
+                                             VkPipeline *out, struct rnd_error *err);
+
+/* pipeline_variants.c */
+/* The main-pass pipeline for key, compiled on first use (thread-safe; a render that needs a
+ * variant another is compiling waits for it instead of compiling it again). */
 enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
                                    struct rnd_error *err);
-
-/* Destroys the retired pipeline variants no running render may use (pipelines.c). */
+/* Destroys the retired pipeline variants no running render may use. */
 void rnd_pipelines_reap(struct rnd_context *ctx);
 uint32_t rnd_pipelines_count(struct rnd_context *ctx);
 

@@ -2,8 +2,8 @@
  * renderer/pipelines.c — shader modules (SPIR-V embedded at build time), the one descriptor
  * set layout and pipeline layout, the shadow sampler, and the graphics pipelines. The fixed
  * ones are created with the context; a main-pass variant (specialization constants of a
- * scene's lights and filters) is compiled on its first use, outside the lock, and kept (at most
- * RND_MAX_VARIANTS); the daemon's warm-up and the pipeline cache make that first use cheap.
+ * scene's lights and filters) is compiled here on its first use and kept by
+ * pipeline_variants.c; the daemon's warm-up and the pipeline cache make that first use cheap.
  *
  * Pipelines use dynamic rendering (Vulkan 1.3): no render pass or framebuffer objects.
  * Variants: shadow depth-only [cull none/back]; main [output format][MSAA 1/4][cull none/back].
@@ -278,6 +278,7 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 	VkShaderModule shadow_vs = VK_NULL_HANDLE, masked_vs = VK_NULL_HANDLE, masked_fs = VK_NULL_HANDLE;
 	VkShaderModule surface_fs = VK_NULL_HANDLE, surface_shade_fs = VK_NULL_HANDLE;
 	pthread_mutex_init(&p->mu, NULL);
+	pthread_cond_init(&p->compiled, NULL);
 	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
 	/* The modules: those of the pipelines made here (destroyed below) and those the context
 	 * keeps for the variants. */
@@ -421,25 +422,13 @@ static void pass_desc(const struct rnd_context *ctx, const struct rnd_main_key *
 	}
 }
 
-enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_main_key *key, VkPipeline *out,
-                                   struct rnd_error *err)
+/* Compiles main-pass variant key into *out (rnd_pipelines_main: pipeline_variants.c, which
+ * keeps it); name: its debug name. */
+enum rnd_result rnd_pipeline_variant_compile(struct rnd_context *ctx, const struct rnd_main_key *key, const char *name,
+                                             VkPipeline *out, struct rnd_error *err)
 {
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r = RND_OK;
-	/* Look up under the lock; compile outside it (lavapipe compiles for 0.1 s or more, and
-	 * other renders' look-ups must not wait behind that); insert under the lock again. */
-	pthread_mutex_lock(&p->mu);
-	for (uint32_t i = 0; i < p->variant_count; i++) {
-		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
-			*out = p->variants[i].pipeline;
-			p->variants[i].used = ++p->tick;
-			pthread_mutex_unlock(&p->mu);
-			return RND_OK;
-		}
-	}
-	bool full = p->variant_count == RND_MAX_VARIANTS;
-	pthread_mutex_unlock(&p->mu);
-	if (full) return rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
 	/* the key's constants, then UMBRA_SC_SAMPLES: the samples this pipeline rasterises (d's,
 	 * set below once the pass is known) */
 	uint32_t values[UMBRA_SC_COUNT + 1];
@@ -448,14 +437,6 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	for (uint32_t i = 0; i <= UMBRA_SC_COUNT; i++)
 		entries[i] = (VkSpecializationMapEntry){i, (uint32_t)(i * sizeof(uint32_t)), sizeof(uint32_t)};
 	VkSpecializationInfo spec = {UMBRA_SC_COUNT + 1, entries, sizeof values, values};
-	char name[128];
-	snprintf(name, sizeof name, "%s fmt%u msaa%u%s%s sc %u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u/%u",
-	         key->aov ? "aov" : key->resolve ? "resolve" : key->vis_shade ? "pixel shading"
-	         : key->vis_pass ? "visibility" : key->vis_read ? "main (visibility)"
-	         : key->background ? "background" : key->env_pass ? "environment" : "main",
-	         key->format, key->samples, key->cull_back ? " cull" : "", key->prepass ? " eq" : "", key->sc[0], key->sc[1],
-	         key->sc[2], key->sc[3], key->sc[4], key->sc[5], key->sc[6], key->sc[7], key->sc[8], key->sc[9], key->sc[10],
-	         key->sc[11], key->sc[12]);
 	struct pipe_desc d = {
 		.vs = p->mesh_vs, .fs = p->mesh_fs, .color = ctx->color_formats[key->format], .depth = RND_DEPTH_FORMAT,
 		.samples = key->samples, .cull_back = key->cull_back, .spec = &spec, .after_prepass = key->prepass, .name = name,
@@ -465,81 +446,15 @@ enum rnd_result rnd_pipelines_main(struct rnd_context *ctx, const struct rnd_mai
 	if (key->atlas_view) {
 		/* Debug view of the depth atlas: a fullscreen triangle. */
 		if ((r = rnd_shader_module(ctx, spv_atlas_frag, sizeof spv_atlas_frag, "atlas.frag", &fs_fs, err)) != RND_OK)
-			goto out_modules;
+			return r;
 		fullscreen(&d, p, fs_fs);
 		d.spec = NULL;
 	}
 	pass_desc(ctx, key, &d);
 	values[UMBRA_SC_SAMPLES] = d.samples;
-	VkPipeline pipe;
-	r = make_pipeline(ctx, &d, &pipe, err);
-out_modules:
+	r = make_pipeline(ctx, &d, out, err);
 	if (fs_fs) vkDestroyShaderModule(ctx->device, fs_fs, NULL);
-	if (r != RND_OK) return r;
-	pthread_mutex_lock(&p->mu);
-	/* Another render may have made the same variant meanwhile: keep the first. */
-	for (uint32_t i = 0; i < p->variant_count; i++) {
-		if (!memcmp(&p->variants[i].key, key, sizeof *key)) {
-			*out = p->variants[i].pipeline;
-			pthread_mutex_unlock(&p->mu);
-			vkDestroyPipeline(ctx->device, pipe, NULL);
-			return RND_OK;
-		}
-	}
-	if (p->variant_count == RND_MAX_VARIANTS) {
-		pthread_mutex_unlock(&p->mu);
-		vkDestroyPipeline(ctx->device, pipe, NULL);
-		return rnd_fail(err, RND_ERR_LIMIT, "more than %d pipeline variants", RND_MAX_VARIANTS);
-	}
-	p->variants[p->variant_count].key = *key;
-	p->variants[p->variant_count].pipeline = pipe;
-	p->variants[p->variant_count].used = ++p->tick;
-	p->variant_count++;
-	*out = pipe;
-	pthread_mutex_unlock(&p->mu);
-	return RND_OK;
-}
-
-uint32_t rnd_context_trim_pipelines(struct rnd_context *ctx, uint32_t keep)
-{
-	struct rnd_pipelines *p = &ctx->pipes;
-	uint32_t n = 0;
-	pthread_mutex_lock(&p->mu);
-	while (p->variant_count > keep && p->retired_count < RND_MAX_VARIANTS) {
-		uint32_t lru = 0;
-		for (uint32_t i = 1; i < p->variant_count; i++)
-			if (p->variants[i].used < p->variants[lru].used) lru = i;
-		/* out of the table first: a render that takes a slot from the epoch on cannot find it */
-		VkPipeline pipe = p->variants[lru].pipeline;
-		p->variants[lru] = p->variants[--p->variant_count];
-		p->retired[p->retired_count++] = (struct rnd_retired){pipe, rnd_slot_epoch_advance(ctx)};
-		n++;
-	}
-	pthread_mutex_unlock(&p->mu);
-	rnd_pipelines_reap(ctx);
-	return n;
-}
-
-void rnd_pipelines_reap(struct rnd_context *ctx)
-{
-	struct rnd_pipelines *p = &ctx->pipes;
-	if (!__atomic_load_n(&p->retired_count, __ATOMIC_RELAXED)) return;
-	uint64_t oldest = rnd_slot_oldest_busy_epoch(ctx);
-	pthread_mutex_lock(&p->mu);
-	for (uint32_t i = 0; i < p->retired_count;) {
-		if (p->retired[i].epoch > oldest) { i++; continue; }
-		vkDestroyPipeline(ctx->device, p->retired[i].pipeline, NULL);
-		p->retired[i] = p->retired[--p->retired_count];
-	}
-	pthread_mutex_unlock(&p->mu);
-}
-
-uint32_t rnd_pipelines_count(struct rnd_context *ctx)
-{
-	pthread_mutex_lock(&ctx->pipes.mu);
-	uint32_t n = ctx->pipes.variant_count;
-	pthread_mutex_unlock(&ctx->pipes.mu);
-	return n;
+	return r;
 }
 
 void rnd_pipelines_release(struct rnd_context *ctx)

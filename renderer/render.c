@@ -34,13 +34,6 @@
 #include "submit.h"
 #include "upload.h"
 
-static double now_ms(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
 /* ---- plans on a context ---- */
 
 static bool cache_probe(void *user, uint64_t key, uint32_t tiles, uint32_t res)
@@ -89,7 +82,7 @@ enum rnd_result rnd_plan_create(struct rnd_context *ctx, const struct rnd_scene 
 	struct rnd_plan *p = calloc(1, sizeof *p);
 	if (!p) return rnd_fail(err, RND_ERR_OOM, "out of memory for a render plan");
 	struct rnd_plan_device dev;
-	double t0 = now_ms();
+	double t0 = rnd_now_ms();
 	plan_device(ctx, &dev);
 	struct rnd_env_bins *bins = NULL;
 	enum rnd_result r = rnd_env_plan_bins(ctx, &sc->environment, &bins, err);
@@ -104,7 +97,7 @@ enum rnd_result rnd_plan_create(struct rnd_context *ctx, const struct rnd_scene 
 	p->dev.cached = NULL;   /* the plan outlives no context it was made on */
 	p->dev.cache_user = NULL;
 	p->context = ctx;
-	p->plan_ms = now_ms() - t0;
+	p->plan_ms = rnd_now_ms() - t0;
 	*out = p;
 	return RND_OK;
 }
@@ -173,7 +166,7 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	const struct rnd_sheet *sh = &rq->plan->sheet;
 	struct rnd_slot *s = rq->s;
 	enum rnd_result r;
-	double t0 = now_ms();
+	double t0 = rnd_now_ms();
 	rnd_pacer_init(&rq->pacer, sc);
 	if ((r = rnd_pacer_check(&rq->pacer, err)) != RND_OK) return r;
 	/* The environment's map before any shadow tile is granted (a render never waits for a map
@@ -186,11 +179,12 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	rq->pacer.env = &rq->env;
 	if ((r = rnd_upload_scene(ctx, s, rq->plan, &rq->pacer, err)) != RND_OK) return r;
 	if ((r = rnd_material_textures(ctx, s, sc, rq->draws, rq->tex, &rq->ntex, err)) != RND_OK) return r;
-	rq->tm.upload_ms = now_ms() - t0;
+	rq->tm.upload_ms = rnd_now_ms() - t0;
 	rq->pacer.tex = rq->tex;
 	rq->pacer.ntex = rq->ntex;
 	rq->pacer.prologue = true;
 
+	double t1 = rnd_now_ms();
 	VkFormat fmt = ctx->color_formats[sc->output.pixels];
 	if ((r = rnd_slot_targets(ctx, s, fmt, sc->width, sc->height, sc->output.msaa, err)) != RND_OK) return r;
 	if (sh->passes && (r = rnd_slot_aov(ctx, s, sc->width, sc->height, err)) != RND_OK) return r;
@@ -198,6 +192,7 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	if ((r = rnd_buffer_reserve(ctx, &s->readback, rb, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "slot readback", err)) != RND_OK)
 		return r;
 	if (sh->views > 1) memset(s->readback.map, 0, rb); /* unused cells of the sheet (colour and AOVs) */
+	rq->tm.targets_ms = rnd_now_ms() - t1;
 	return RND_OK;
 }
 
@@ -352,19 +347,21 @@ enum rnd_result rnd_render_plan(struct rnd_context *ctx, struct rnd_plan *plan, 
 	rq.tm.plan_ms = plan->plan_ms;
 	if ((r = arena_init(&rq, err)) != RND_OK) return r;
 
+	double compiled = rnd_compile_ms_tls;
 	rq.s = rnd_slot_acquire(ctx);
 	if ((r = prepare(&rq, err)) != RND_OK) goto done;
 	for (uint32_t v = 0; v < plan->nviews; v++)
 		if ((r = render_view(&rq, v, err)) != RND_OK) goto done;
 
-	double t_copy = now_ms();
+	double t_copy = rnd_now_ms();
 	if ((r = rnd_readback_image(rq.s, rq.sc, &plan->sheet, out, err)) != RND_OK) goto done;
-	rq.tm.readback_ms += now_ms() - t_copy;
+	rq.tm.readback_ms += rnd_now_ms() - t_copy;
 
 done:
 	finish(&rq, r, err);
 	rq.tm.submits = rq.pacer.submits;
 	rq.tm.shadow_parts = rq.pacer.shadow_parts;
+	rq.tm.compile_ms = rnd_compile_ms_tls - compiled;
 	plan->actual.tm = rq.tm;
 	plan->actual.done = r == RND_OK;
 	if (timings) *timings = rq.tm;

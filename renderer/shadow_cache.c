@@ -38,13 +38,6 @@ struct rnd_shadow_cache {
 	bool touched;             /* a tile was drawn since the atlases' pages were last released */
 };
 
-static double mono_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 /* One-time set-up of both atlases on slot 0's command buffer: both in GENERAL layout for good.
  * Not cleared: every map is copied whole into its tile before anything samples it, and the
  * filters never read outside a tile. Where device memory is host memory (lavapipe), pages
@@ -218,7 +211,7 @@ static bool attempt(struct rnd_shadow_cache *c, const struct rnd_cache_request *
 			if (e->live && e->valid && e->key == req[k].key && e->ntiles == req[k].tiles && e->res == res[k]) {
 				e->refs++;
 				e->last_use = c->clock;
-				e->used_at = mono_now();
+				e->used_at = (rnd_now_ms() * 1e-3);
 				g->entry = i; g->res = e->res; g->hit = true;
 				memcpy(g->tile, e->tile, sizeof e->tile);
 				granted[k] = true;
@@ -243,7 +236,7 @@ static bool attempt(struct rnd_shadow_cache *c, const struct rnd_cache_request *
 			return false;
 		}
 		e->live = true; e->valid = false; e->key = req[k].key; e->refs = 1; e->last_use = c->clock;
-		e->used_at = mono_now();
+		e->used_at = (rnd_now_ms() * 1e-3);
 		c->touched = true;
 		out[k].entry = slot; out[k].res = e->res; out[k].hit = false;
 		memcpy(out[k].tile, e->tile, sizeof e->tile);
@@ -427,7 +420,7 @@ uint64_t rnd_context_trim(struct rnd_context *ctx, double idle_s)
 	/* A render that holds tiles may be drawing into the atlas: then nothing is released. One
 	 * that holds none never reads a texel (maps are sampled only inside granted tiles). */
 	if (!others_hold_tiles(c)) {
-		double now = mono_now();
+		double now = (rnd_now_ms() * 1e-3);
 		for (uint32_t i = 0; i < MAX_ENTRIES; i++) {
 			struct rnd_cache_entry *e = &c->entries[i];
 			if (e->live && now - e->used_at >= idle_s) entry_free(c, e);

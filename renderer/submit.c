@@ -14,13 +14,6 @@
 /* A fence is waited on in slices this long; between slices a long wait is logged. */
 #define WAIT_SLICE_NS (1000ull * 1000 * 1000)
 
-static double now_ms(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
 static uint64_t now_ns(void)
 {
 	struct timespec t;
@@ -200,9 +193,9 @@ static enum rnd_result cmd_flush(struct rnd_context *ctx, struct rnd_slot *s, st
 	st->open = false;
 	if ((vr = vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return rnd_fail_vk(err, vr, "vkEndCommandBuffer");
 	if ((r = rnd_pacer_check(p, err)) != RND_OK) return r;
-	double t0 = now_ms();
+	double t0 = rnd_now_ms();
 	if ((r = submit_wait(ctx, s, gpu_busy, err)) != RND_OK) return r;
-	double t1 = now_ms();
+	double t1 = rnd_now_ms();
 	p->submits++;
 	if (st->prologue) s->white_ready = true;   /* its clear (recorded while false) has run */
 	*wall_ms = t1 - t0;

@@ -234,9 +234,11 @@ static int render_one(const char *in, const char *out, const char *device, const
 		rc = print_plan(scene, plan, &t, json);
 	}
 	if (!rc && timings && explain != CLI_EXPLAIN_PLAN)
-		fprintf(stderr, "parse %.2f ms, device %.2f ms, plan %.2f ms, upload %.2f ms, shadow %.2f ms, main %.2f ms, "
-		        "readback %.2f ms, encode %.2f ms, total %.2f ms, %u shadow maps, environment %.2f ms and %u directions\n",
-		        t_parse, t_ctx, tm.plan_ms, tm.upload_ms, tm.shadow_ms, tm.main_ms, tm.readback_ms, t_enc,
+		fprintf(stderr, "parse %.2f ms, device %.2f ms, plan %.2f ms, upload %.2f ms, targets %.2f ms, compile %.2f ms, "
+		        "shadow %.2f ms, main %.2f ms, readback %.2f ms, encode %.2f ms, total %.2f ms, %u shadow maps, "
+		        "environment %.2f ms and %u directions\n",
+		        t_parse, t_ctx, tm.plan_ms, tm.upload_ms, tm.targets_ms, tm.compile_ms, tm.shadow_ms, tm.main_ms,
+		        tm.readback_ms, t_enc,
 		        farm_now_ms() - t0, tm.shadow_maps_rendered, tm.env_ms, tm.env_directions);
 	if (rnd_context_validation_messages(ctx)) {
 		fprintf(stderr, "umbra-render: %u Vulkan validation messages\n", rnd_context_validation_messages(ctx));

@@ -198,7 +198,8 @@ uint64_t srv_rss_bytes(void)
 /* issue 28: a warm daemon under 200 MB after any mix of requests (lavapipe: ~150 MB ready) */
 #define RSS_DEFAULT_BOUND (192ull << 20)
 
-/* The main-pass variants a trim keeps: the warm-up's defaults (server/warmup.c) are four. */
+/* The main-pass variants a trim keeps (the most recently used): what a thumbnail farm's model
+ * request uses (main, pixel shading, resolve, environment pass; server/warmup.c warms eight). */
 #define RSS_KEEP_VARIANTS 4u
 
 /* One step of srv_context_fit_rss: what the renderer keeps, by how dear it is to make again. */

@@ -31,8 +31,10 @@ static void write_stages(FILE *fp, const struct job_result *r)
 	if (r->imp.imports || r->imp.ms[API_IMPORT_READ] > 0)
 		for (int k = 0; k < API_IMPORT_STAGES; k++) fprintf(fp, ",\"%s\":%.2f", API_IMPORT_STAGE_NAMES[k], (double)r->imp.ms[k]);
 	if (r->env) fprintf(fp, ",\"environment\":%.2f", r->tm.env_ms);   /* as umbrad's Server-Timing */
-	fprintf(fp, ",\"upload\":%.2f,\"shadow\":%.2f,\"main\":%.2f,\"readback\":%.2f,\"encode\":%.2f}", r->tm.upload_ms,
-	        r->tm.shadow_ms, r->tm.main_ms, r->tm.readback_ms, r->encode_ms);
+	fprintf(fp, ",\"upload\":%.2f,\"targets\":%.2f", r->tm.upload_ms, r->tm.targets_ms);
+	if (r->tm.compile_ms > 0) fprintf(fp, ",\"compile\":%.2f", r->tm.compile_ms);
+	fprintf(fp, ",\"shadow\":%.2f,\"main\":%.2f,\"readback\":%.2f,\"encode\":%.2f}", r->tm.shadow_ms, r->tm.main_ms,
+	        r->tm.readback_ms, r->encode_ms);
 }
 
 /* A remote job's stages: the daemon's Server-Timing ("parse;dur=0.4, upload;dur=1.2, ...")

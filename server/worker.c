@@ -14,6 +14,7 @@
  * 503 answer goes out; its worker then recreates the context (srv_context_recover) and runs
  * the warm-up again, and only then is the daemon ready again.
  */
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -322,29 +323,42 @@ static void job_render_stages(struct srv_server *s, const struct rnd_timings *t)
  * JSON, the checks, the cache look-ups), `device-wait` the wait for the device (one render at a
  * time on a CPU device: server/gate.h), so that the stages add up to all but the gaps between
  * them. `plan` is the render plan's (made at admission, before the device wait). */
+/* Appends to a Server-Timing header of cap bytes at *n; past the end it is cut (and stays terminated). */
+__attribute__((format(printf, 4, 5)))
+static void timing_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
+{
+	if (*n >= cap) return;
+	va_list ap;
+	va_start(ap, fmt);
+	int w = vsnprintf(buf + *n, cap - *n, fmt, ap);
+	va_end(ap);
+	if (w > 0) *n = (size_t)w < cap - *n ? *n + (size_t)w : cap;
+}
+
 static void format_timing(struct srv_request *req, const struct api_scene *sc, const struct rnd_timings *t,
                           double queue_ms, double parse_ms, double gate_ms, double encode_ms, double total_ms)
 {
-	char models[400] = "";
-	size_t n = 0;
+	char *h = req->server_timing;
+	size_t cap = sizeof req->server_timing, n = 0;
 	double in_models = 0;
-	if (sc->import.imports || sc->import.ms[API_IMPORT_READ] > 0)
-		for (int k = 0; k < API_IMPORT_STAGES && n < sizeof models; k++) {
-			in_models += sc->import.ms[k];
-			int w = snprintf(models + n, sizeof models - n, ", %s;dur=%.3f", API_IMPORT_STAGE_NAMES[k],
-			                 (double)sc->import.ms[k]);
-			if (w > 0) n += (size_t)w;
-		}
+	bool models = sc->import.imports || sc->import.ms[API_IMPORT_READ] > 0;
+	if (models)
+		for (int k = 0; k < API_IMPORT_STAGES; k++) in_models += sc->import.ms[k];
+	timing_append(h, cap, &n, "queue;dur=%.3f, parse;dur=%.3f", queue_ms,
+	              parse_ms > in_models ? parse_ms - in_models : 0.0);
+	if (models)
+		for (int k = 0; k < API_IMPORT_STAGES; k++)
+			timing_append(h, cap, &n, ", %s;dur=%.3f", API_IMPORT_STAGE_NAMES[k], (double)sc->import.ms[k]);
+	timing_append(h, cap, &n, ", plan;dur=%.3f, device-wait;dur=%.3f", t->plan_ms, gate_ms);
 	/* The environment map: the CPU's share of preparing it (0 once it is kept) and the shadow
 	 * directions drawn (their maps and the environment pass are in `shadow`). */
-	char env[80] = "";
 	if (sc->scene.environment.source != RND_ENV_AMBIENT)
-		snprintf(env, sizeof env, ", environment;dur=%.3f;desc=\"%u directions\"", t->env_ms, t->env_directions);
-	snprintf(req->server_timing, sizeof req->server_timing,
-	         "queue;dur=%.3f, parse;dur=%.3f%s, plan;dur=%.3f, device-wait;dur=%.3f%s, upload;dur=%.3f, shadow;dur=%.3f, "
-	         "main;dur=%.3f, readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
-	         queue_ms, parse_ms > in_models ? parse_ms - in_models : 0.0, models, t->plan_ms, gate_ms, env, t->upload_ms,
-	         t->shadow_ms, t->main_ms, t->readback_ms, encode_ms, total_ms);
+		timing_append(h, cap, &n, ", environment;dur=%.3f;desc=\"%u directions\"", t->env_ms, t->env_directions);
+	timing_append(h, cap, &n, ", upload;dur=%.3f, targets;dur=%.3f", t->upload_ms, t->targets_ms);
+	/* compiling a pipeline variant at its first use (the warm-up's are compiled before ready) */
+	if (t->compile_ms > 0) timing_append(h, cap, &n, ", compile;dur=%.3f", t->compile_ms);
+	timing_append(h, cap, &n, ", shadow;dur=%.3f, main;dur=%.3f, readback;dur=%.3f, encode;dur=%.3f, total;dur=%.3f",
+	              t->shadow_ms, t->main_ms, t->readback_ms, encode_ms, total_ms);
 }
 
 /* After a render: the image encoded and answered (with its plan for ?explain=1: explain.c),

@@ -26,7 +26,8 @@ void main()
 	for (uint i = 0u; i < n; i++) {
 		vec2 xi = vec2(float(i) / float(n), float(bitfieldReverse(i)) * 2.3283064365386963e-10);
 		float phi = 2.0 * PI * xi.x;
-		float ct = sqrt((1.0 - xi.y) / (1.0 + (a2 - 1.0) * xi.y)), st = sqrt(1.0 - ct * ct);
+		// clamped: an inexact divide (a GPU's) can put ct a rounding above 1, and st at NaN
+		float ct = min(sqrt((1.0 - xi.y) / (1.0 + (a2 - 1.0) * xi.y)), 1.0), st = sqrt(max(1.0 - ct * ct, 0.0));
 		vec3 H = vec3(st * cos(phi), st * sin(phi), ct);
 		vec3 L = 2.0 * dot(V, H) * H - V;
 		float ndl = L.z, vdh = max(dot(V, H), 0.0);

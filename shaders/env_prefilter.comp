@@ -54,7 +54,8 @@ void main()
 		for (uint i = 0u; i < n; i++) {
 			vec2 xi = hammersley(i, n);
 			float phi = 2.0 * ENV_PI * xi.x;
-			float ct = sqrt((1.0 - xi.y) / (1.0 + (a2 - 1.0) * xi.y)), st = sqrt(1.0 - ct * ct);
+			// clamped: an inexact divide (a GPU's) can put ct a rounding above 1, and st at NaN
+			float ct = min(sqrt((1.0 - xi.y) / (1.0 + (a2 - 1.0) * xi.y)), 1.0), st = sqrt(max(1.0 - ct * ct, 0.0));
 			vec3 H = t * (st * cos(phi)) + b * (st * sin(phi)) + N * ct;
 			vec3 L = 2.0 * dot(N, H) * H - N;
 			float ndl = dot(N, L);

@@ -360,6 +360,9 @@ struct rnd_timings {
 	uint32_t env_directions;   /* environment shadow directions drawn (maps rendered or reused) */
 	double env_ms;             /* this render's share of preparing the environment (CPU analysis and
 	                              the device's prefiltering, once per map: 0 when it was ready) */
+	double targets_ms;         /* the slot's colour/depth targets, AOV images and readback buffer:
+	                              made on a slot's first render of a size, else ~0 */
+	double compile_ms;         /* pipeline variants this render compiled (first use of a variant) */
 };
 
 /* ---- context ---- */
