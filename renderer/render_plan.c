@@ -191,7 +191,7 @@ static void plan_env(struct rnd_plan *p)
 	p->esc = *sc;
 	uint32_t n = sc->light_count < UMBRA_MAX_LIGHTS ? sc->light_count : UMBRA_MAX_LIGHTS;
 	if (!p->env.mapped) return;
-	memcpy(p->lights, sc->lights, n * sizeof *p->lights);
+	if (n) memcpy(p->lights, sc->lights, n * sizeof *p->lights);   /* lights NULL when n is 0 */
 	p->env.mapped = rnd_env_lights(&p->env, &sc->environment, UMBRA_MAX_LIGHTS - n, p->lights + n);
 	p->esc.lights = p->lights;
 	p->esc.light_count = n + p->env.mapped;

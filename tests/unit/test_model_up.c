@@ -60,7 +60,7 @@ TEST(model_up_auto_without_a_flat_bottom_keeps_y)
 	static const float pos[12] = {0, 0, 0, 1, 0, 1, -1, 0.5f, 1, 0, -1, 1};
 	static const uint32_t idx[12] = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
 	struct api_model_mesh me = {.positions = pos, .indices = idx, .vertex_count = 4, .index_count = 12};
-	struct api_model_instance in;
+	struct api_model_instance in = {.mesh = 0};
 	for (int k = 0; k < 16; k++) in.model[k] = k % 5 == 0;
 	struct api_model m = {.meshes = &me, .mesh_count = 1, .instances = &in, .instance_count = 1, .format = API_MODEL_STL};
 	double cy, cz;

@@ -81,6 +81,49 @@ TEST(ply_strips_ascii_import_every_triangle)
 	api_model_release(m);
 }
 
+/* Big endian too: the faces written in the file's byte order (Assimp 5.2's own strip reader
+ * drew one sliver and leaked each triangle's indices). */
+TEST(ply_strips_big_endian_import_every_triangle)
+{
+	static const char hdr[] = "ply\nformat binary_big_endian 1.0\nelement vertex 4\nproperty float x\n"
+	                          "property float y\nproperty float z\nelement tristrips 1\n"
+	                          "property list int int vertex_indices\nend_header\n";
+	static const float v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+	static const int32_t strip[5] = {4, 0, 1, 2, 3};
+	uint8_t d[sizeof hdr - 1 + sizeof v + sizeof strip];
+	size_t at = sizeof hdr - 1;
+	memcpy(d, hdr, at);
+	for (int k = 0; k < 12; k++, at += 4) {
+		uint32_t b;
+		memcpy(&b, &v[k], 4);
+		b = __builtin_bswap32(b);
+		memcpy(d + at, &b, 4);
+	}
+	for (int k = 0; k < 5; k++, at += 4) {
+		uint32_t b = __builtin_bswap32((uint32_t)strip[k]);
+		memcpy(d + at, &b, 4);
+	}
+	size_t n = 0;
+	uint8_t *out = api_ply_strips_to_faces(d, sizeof d, &n);
+	REQUIRE(out, "rewritten");
+	/* the second face record (2 1 3, flipped on the odd step), big endian after its count byte */
+	const uint8_t *f = memmem(out, n, "end_header\n", 11) + 11 + sizeof v + 13;
+	static const uint8_t want[13] = {3, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 3};
+	CHECK(!memcmp(f, want, 13) && (size_t)(f + 13 - out) == n, "face records in big endian");
+	free(out);
+	struct api_limits l;
+	api_limits_defaults(&l);
+	struct api_model *m = NULL;
+	char err[300];
+	int st;
+	REQUIRE(api_model_get(d, sizeof d, API_MODEL_PLY, &l, &m, &st, err, sizeof err) == API_OK && m, "%s", err);
+	CHECK(m->triangles == 2, "%llu triangles (a quad strip has 2)", (unsigned long long)m->triangles);
+	int up = 0;
+	for (uint32_t i = 0; i < m->meshes[0].vertex_count; i++) up += m->meshes[0].normals[3 * i + 2] > 0.99f;
+	CHECK(up == (int)m->meshes[0].vertex_count, "%d of %u normals +z", up, m->meshes[0].vertex_count);
+	api_model_release(m);
+}
+
 /* A model whose every triangle is degenerate imports "fine" in Assimp and draws nothing: a 400
  * with the reason, never a silently empty image. */
 TEST(model_of_degenerate_triangles_is_refused)
