@@ -45,16 +45,7 @@ static void draw_depth(struct rnd_context *ctx, struct rnd_slot *s, const struct
 	VkViewport vp = {0, 0, (float)rv->sc->width, (float)rv->sc->height, 0, 1};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
 	vkCmdSetScissor(cmd, 0, 1, &area);
-	record_bind_geometry(ctx, s);
-	VkPipeline bound = VK_NULL_HANDLE;
-	for (uint32_t i = 0; i < rv->ndraw; i++) {
-		const struct draw *d = &rv->draws[i];
-		if (!d->index_count) continue;
-		if (rv->drawn_camera && rv->band_y == 0) *rv->drawn_camera += d->cam_index_count / 3;   /* record.h */
-		VkPipeline p = ctx->pipes.prepass[1][d->cull_back];
-		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		record_draw_camera(cmd, d);
-	}
+	record_camera_draws(ctx, s, rv, ctx->pipes.prepass[1], false, true);
 	vkCmdEndRendering(cmd);
 	record_image_barrier(cmd, s->depth.img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
 	                     VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,

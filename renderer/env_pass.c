@@ -84,10 +84,7 @@ static void record_vis(struct rnd_context *ctx, struct rnd_slot *s, VkPipeline p
 	vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
 	vkCmdDraw(cmd, 3, 1, 0, 0);
 	vkCmdEndRendering(cmd);
-	record_image_barrier(cmd, s->env_vis.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-	                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-	                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-	                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+	record_color_to_sampled(cmd, s->env_vis.img);
 }
 
 enum rnd_result record_env_pass(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,

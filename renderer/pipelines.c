@@ -158,53 +158,46 @@ struct pipe_desc {
 	const char *name;
 };
 
-/* One graphics pipeline from d. Longer than most functions here on purpose: one create-info
- * per fixed-function state, read top to bottom in the order Vulkan's struct takes them. */
-static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_desc *d, VkPipeline *out,
-                                     struct rnd_error *err)
+/* The vertex layout (struct rnd_vertex; binding 1: the second uv set, umbra_shared.h); both
+ * strides are dynamic (record.c). Alpha-tested depth passes read position, uvs and colour (its
+ * alpha scales coverage); shadow passes the position only. */
+static const VkVertexInputBindingDescription VERTEX_BINDINGS[2] = {
+	{0, sizeof(struct rnd_vertex), VK_VERTEX_INPUT_RATE_VERTEX},
+	{UMBRA_VERTEX_BINDING_UV1, 8, VK_VERTEX_INPUT_RATE_VERTEX},
+};
+static const VkVertexInputAttributeDescription VERTEX_ATTRIBUTES[6] = {
+	{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, pos)},
+	{1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, nrm)},
+	{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
+	{3, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(struct rnd_vertex, color)},
+	{4, 0, VK_FORMAT_R8G8B8A8_SNORM, offsetof(struct rnd_vertex, tangent)},
+	{UMBRA_LOCATION_UV1, UMBRA_VERTEX_BINDING_UV1, VK_FORMAT_R32G32_SFLOAT, 0},
+};
+static const VkVertexInputAttributeDescription VERTEX_ATTRIBUTES_UV[4] = {
+	{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, pos)},
+	{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
+	{3, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(struct rnd_vertex, color)},
+	{UMBRA_LOCATION_UV1, UMBRA_VERTEX_BINDING_UV1, VK_FORMAT_R32G32_SFLOAT, 0},
+};
+
+/* d's colour attachments: their formats and (no blending) write masks; returns how many. */
+static uint32_t color_attachments(const struct pipe_desc *d, VkFormat formats[UMBRA_AOV_ATTACHMENTS],
+                                  VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS])
 {
-	VkPipelineShaderStageCreateInfo stages[2] = {
-		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = d->vs, .pName = "main"},
-		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = d->fs, .pName = "main",
-		 .pSpecializationInfo = d->spec},
-	};
-	/* binding 1: the second uv set (umbra_shared.h); both strides are dynamic (record.c) */
-	VkVertexInputBindingDescription vb[2] = {{0, sizeof(struct rnd_vertex), VK_VERTEX_INPUT_RATE_VERTEX},
-	                                         {UMBRA_VERTEX_BINDING_UV1, 8, VK_VERTEX_INPUT_RATE_VERTEX}};
-	VkVertexInputAttributeDescription va[6] = {
-		{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, pos)},
-		{1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(struct rnd_vertex, nrm)},
-		{2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(struct rnd_vertex, uv)},
-		{3, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(struct rnd_vertex, color)},
-		{4, 0, VK_FORMAT_R8G8B8A8_SNORM, offsetof(struct rnd_vertex, tangent)},
-		{UMBRA_LOCATION_UV1, UMBRA_VERTEX_BINDING_UV1, VK_FORMAT_R32G32_SFLOAT, 0},
-	};
-	/* alpha-tested depth passes: position, uvs and colour (its alpha scales coverage) */
-	VkVertexInputAttributeDescription va_uv[4] = {va[0], va[2], va[3], va[5]};
 	uint32_t ncolor = d->color == VK_FORMAT_UNDEFINED ? 0 : d->color_count ? d->color_count : 1;
-	VkFormat formats[UMBRA_AOV_ATTACHMENTS];
-	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
 	for (uint32_t i = 0; i < UMBRA_AOV_ATTACHMENTS; i++) {
 		formats[i] = i > 0 && d->color_rest ? d->color_rest : d->color;
 		if (d->color_last && i + 1 == ncolor) formats[i] = d->color_last;
 		cbas[i] = (VkPipelineColorBlendAttachmentState){.colorWriteMask = 0xf};
 	}
-	VkPipelineVertexInputStateCreateInfo vi = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-		.pVertexBindingDescriptions = vb,
-		.vertexBindingDescriptionCount = d->no_vertices ? 0 : 2,
-		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 4 : d->shadow ? 1 : 6,
-		.pVertexAttributeDescriptions = d->uv_only ? va_uv : va,
-	};
-	VkPipelineInputAssemblyStateCreateInfo ia = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO, .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
-	};
-	VkPipelineViewportStateCreateInfo vp = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO, .viewportCount = 1, .scissorCount = 1,
-	};
+	return ncolor;
+}
+
+static VkPipelineRasterizationStateCreateInfo rasterization_state(const struct rnd_context *ctx, const struct pipe_desc *d)
+{
 	VkPhysicalDeviceFeatures feats;
 	vkGetPhysicalDeviceFeatures(ctx->phys, &feats);
-	VkPipelineRasterizationStateCreateInfo rs = {
+	return (VkPipelineRasterizationStateCreateInfo){
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
 		.depthClampEnable = d->shadow && feats.depthClamp,
 		.polygonMode = VK_POLYGON_MODE_FILL,
@@ -215,10 +208,13 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		.depthBiasEnable = d->shadow,
 		.lineWidth = 1.0f,
 	};
-	VkPipelineMultisampleStateCreateInfo ms = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO, .rasterizationSamples = (VkSampleCountFlagBits)d->samples,
-	};
-	VkPipelineDepthStencilStateCreateInfo ds = {
+}
+
+/* Shadow maps: LESS_OR_EQUAL; the main view: reversed-Z (GREATER_OR_EQUAL), EQUAL after its
+ * pre-pass without writes; fullscreen passes test a depth only when asked. */
+static VkPipelineDepthStencilStateCreateInfo depth_state(const struct pipe_desc *d)
+{
+	return (VkPipelineDepthStencilStateCreateInfo){
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
 		.depthTestEnable = !d->no_vertices || d->depth_less_ro || d->depth_equal_ro,
 		.depthWriteEnable = !d->after_prepass && !d->no_vertices,
@@ -226,17 +222,58 @@ static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_
 		                : d->depth_equal_ro ? VK_COMPARE_OP_EQUAL
 		                : d->after_prepass ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
 	};
+}
+
+/* The states d sets while recording; returns how many of dyn[5] it filled. */
+static uint32_t dynamic_states(const struct pipe_desc *d, VkDynamicState dyn[5])
+{
+	uint32_t n = 0;
+	dyn[n++] = VK_DYNAMIC_STATE_VIEWPORT;
+	dyn[n++] = VK_DYNAMIC_STATE_SCISSOR;
+	if (d->shadow) dyn[n++] = VK_DYNAMIC_STATE_DEPTH_BIAS;
+	if (!d->no_vertices) dyn[n++] = VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE;
+	if (d->dynamic_cull) dyn[n++] = VK_DYNAMIC_STATE_CULL_MODE;   /* core in Vulkan 1.3 */
+	return n;
+}
+
+/* One graphics pipeline from d: one create-info per fixed-function state, in the order
+ * Vulkan's struct takes them (the larger ones built by the helpers above). */
+static enum rnd_result make_pipeline(struct rnd_context *ctx, const struct pipe_desc *d, VkPipeline *out,
+                                     struct rnd_error *err)
+{
+	VkPipelineShaderStageCreateInfo stages[2] = {
+		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = d->vs, .pName = "main"},
+		{.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = d->fs, .pName = "main",
+		 .pSpecializationInfo = d->spec},
+	};
+	VkFormat formats[UMBRA_AOV_ATTACHMENTS];
+	VkPipelineColorBlendAttachmentState cbas[UMBRA_AOV_ATTACHMENTS];
+	uint32_t ncolor = color_attachments(d, formats, cbas);
+	VkPipelineVertexInputStateCreateInfo vi = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+		.pVertexBindingDescriptions = VERTEX_BINDINGS,
+		.vertexBindingDescriptionCount = d->no_vertices ? 0 : 2,
+		.vertexAttributeDescriptionCount = d->no_vertices ? 0 : d->uv_only ? 4 : d->shadow ? 1 : 6,
+		.pVertexAttributeDescriptions = d->uv_only ? VERTEX_ATTRIBUTES_UV : VERTEX_ATTRIBUTES,
+	};
+	VkPipelineInputAssemblyStateCreateInfo ia = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO, .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+	};
+	VkPipelineViewportStateCreateInfo vp = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO, .viewportCount = 1, .scissorCount = 1,
+	};
+	VkPipelineRasterizationStateCreateInfo rs = rasterization_state(ctx, d);
+	VkPipelineMultisampleStateCreateInfo ms = {
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO, .rasterizationSamples = (VkSampleCountFlagBits)d->samples,
+	};
+	VkPipelineDepthStencilStateCreateInfo ds = depth_state(d);
 	VkPipelineColorBlendStateCreateInfo cb = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
 		.attachmentCount = ncolor, .pAttachments = cbas,
 	};
-	VkDynamicState dyn[5] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-	uint32_t ndyn = 2;
-	if (d->shadow) dyn[ndyn++] = VK_DYNAMIC_STATE_DEPTH_BIAS;
-	if (!d->no_vertices) dyn[ndyn++] = VK_DYNAMIC_STATE_VERTEX_INPUT_BINDING_STRIDE;
-	if (d->dynamic_cull) dyn[ndyn++] = VK_DYNAMIC_STATE_CULL_MODE;   /* core in Vulkan 1.3 */
+	VkDynamicState dyn[5];
 	VkPipelineDynamicStateCreateInfo dy = {
-		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, .dynamicStateCount = ndyn, .pDynamicStates = dyn,
+		.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, .dynamicStateCount = dynamic_states(d, dyn), .pDynamicStates = dyn,
 	};
 	VkPipelineRenderingCreateInfo rci = {
 		.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
@@ -271,22 +308,33 @@ enum rnd_result rnd_pipeline_fullscreen(struct rnd_context *ctx, VkShaderModule 
 	return make_pipeline(ctx, &d, out, err);
 }
 
-enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err)
+/* The shader modules only rnd_pipelines_init()'s own pipelines use: destroyed once those exist
+ * (a pipeline keeps what it needs of its modules). */
+struct init_modules {
+	VkShaderModule shadow_vs, masked_vs, masked_fs, surface_fs, surface_shade_fs;
+};
+
+static void init_modules_release(struct rnd_context *ctx, struct init_modules *m)
+{
+	if (m->surface_shade_fs) vkDestroyShaderModule(ctx->device, m->surface_shade_fs, NULL);
+	if (m->surface_fs) vkDestroyShaderModule(ctx->device, m->surface_fs, NULL);
+	if (m->masked_fs) vkDestroyShaderModule(ctx->device, m->masked_fs, NULL);
+	if (m->masked_vs) vkDestroyShaderModule(ctx->device, m->masked_vs, NULL);
+	if (m->shadow_vs) vkDestroyShaderModule(ctx->device, m->shadow_vs, NULL);
+	*m = (struct init_modules){0};
+}
+
+/* Every module: those of the pipelines made at start (into m) and those the context keeps for
+ * the variants (into ctx->pipes). On failure the caller releases both. */
+static enum rnd_result make_modules(struct rnd_context *ctx, struct init_modules *m, struct rnd_error *err)
 {
 	struct rnd_pipelines *p = &ctx->pipes;
 	enum rnd_result r;
-	VkShaderModule shadow_vs = VK_NULL_HANDLE, masked_vs = VK_NULL_HANDLE, masked_fs = VK_NULL_HANDLE;
-	VkShaderModule surface_fs = VK_NULL_HANDLE, surface_shade_fs = VK_NULL_HANDLE;
-	pthread_mutex_init(&p->mu, NULL);
-	pthread_cond_init(&p->compiled, NULL);
-	if ((r = make_layouts(ctx, err)) != RND_OK) goto fail;
-	/* The modules: those of the pipelines made here (destroyed below) and those the context
-	 * keeps for the variants. */
 	const struct { const uint32_t *code; size_t size; const char *name; VkShaderModule *out; } mods[] = {
 #define MOD(spv, file, out) {spv, sizeof spv, file, out}
-		MOD(spv_shadow_vert, "shadow.vert", &shadow_vs), MOD(spv_masked_vert, "masked.vert", &masked_vs),
-		MOD(spv_masked_frag, "masked.frag", &masked_fs), MOD(spv_surface_frag, "surface.frag", &surface_fs),
-		MOD(spv_surface_shade_frag, "surface_shade.frag", &surface_shade_fs),
+		MOD(spv_shadow_vert, "shadow.vert", &m->shadow_vs), MOD(spv_masked_vert, "masked.vert", &m->masked_vs),
+		MOD(spv_masked_frag, "masked.frag", &m->masked_fs), MOD(spv_surface_frag, "surface.frag", &m->surface_fs),
+		MOD(spv_surface_shade_frag, "surface_shade.frag", &m->surface_shade_fs),
 		MOD(spv_mesh_vert, "mesh.vert", &p->mesh_vs), MOD(spv_mesh_frag, "mesh.frag", &p->mesh_fs),
 		MOD(spv_aov_frag, "aov.frag", &p->aov_fs), MOD(spv_fullscreen_vert, "fullscreen.vert", &p->fullscreen_vs),
 		MOD(spv_vis_frag, "vis.frag", &p->vis_fs), MOD(spv_mesh_vis_frag, "mesh_vis.frag", &p->mesh_vis_fs),
@@ -296,28 +344,37 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 #undef MOD
 	};
 	for (size_t i = 0; i < sizeof mods / sizeof mods[0]; i++)
-		if ((r = rnd_shader_module(ctx, mods[i].code, mods[i].size, mods[i].name, mods[i].out, err)) != RND_OK) goto fail;
+		if ((r = rnd_shader_module(ctx, mods[i].code, mods[i].size, mods[i].name, mods[i].out, err)) != RND_OK) return r;
+	return RND_OK;
+}
+
+/* The depth-only pipelines: shadow maps (alpha-tested and plain) and the main view's depth
+ * pre-pass (alpha-tested and plain, 1 and 4 samples), each with and without back-face culling. */
+static enum rnd_result make_depth_pipelines(struct rnd_context *ctx, const struct init_modules *mod, struct rnd_error *err)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	enum rnd_result r;
 	/* Alpha-tested depth pipelines for alpha_mode MASK: shadow maps and the camera pre-pass. */
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
-			.vs = masked_vs, .fs = masked_fs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
+			.vs = mod->masked_vs, .fs = mod->masked_fs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
 			.cull_back = cull, .shadow = true, .uv_only = true, .name = "shadow depth (alpha mask)",
 		};
-		if ((r = make_pipeline(ctx, &d, &p->shadow_masked[cull], err)) != RND_OK) goto fail;
+		if ((r = make_pipeline(ctx, &d, &p->shadow_masked[cull], err)) != RND_OK) return r;
 		for (int m = 0; m < 2; m++) {
 			struct pipe_desc dp = {
-				.vs = masked_vs, .fs = masked_fs, .color = VK_FORMAT_UNDEFINED, .depth = RND_DEPTH_FORMAT,
+				.vs = mod->masked_vs, .fs = mod->masked_fs, .color = VK_FORMAT_UNDEFINED, .depth = RND_DEPTH_FORMAT,
 				.samples = m ? 4 : 1, .cull_back = cull, .uv_only = true, .name = "depth prepass (alpha mask)",
 			};
-			if ((r = make_pipeline(ctx, &dp, &p->prepass_masked[m][cull], err)) != RND_OK) goto fail;
+			if ((r = make_pipeline(ctx, &dp, &p->prepass_masked[m][cull], err)) != RND_OK) return r;
 		}
 	}
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
-			.vs = shadow_vs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
+			.vs = mod->shadow_vs, .color = VK_FORMAT_UNDEFINED, .depth = RND_SHADOW_FORMAT, .samples = 1,
 			.cull_back = cull, .shadow = true, .name = cull ? "shadow depth (cull back)" : "shadow depth",
 		};
-		if ((r = make_pipeline(ctx, &d, &p->shadow[cull], err)) != RND_OK) goto fail;
+		if ((r = make_pipeline(ctx, &d, &p->shadow[cull], err)) != RND_OK) return r;
 	}
 	/* Depth pre-pass of the main view: the main pass then tests EQUAL, so every pixel is shaded
 	 * by its visible surface only (lavapipe shades whole 4x4 blocks per triangle, and two-sided
@@ -330,40 +387,50 @@ enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *er
 				.vs = p->mesh_vs, .color = VK_FORMAT_UNDEFINED, .depth = RND_DEPTH_FORMAT, .samples = m ? 4 : 1,
 				.cull_back = cull, .name = name,
 			};
-			if ((r = make_pipeline(ctx, &d, &p->prepass[m][cull], err)) != RND_OK) goto fail;
+			if ((r = make_pipeline(ctx, &d, &p->prepass[m][cull], err)) != RND_OK) return r;
 		}
 	}
-	/* The visibility pass's surfaces (renderer/visibility.c): what the main pass will shade at
-	 * each pixel centre, single-sample, the main pass's reversed-Z depth test. */
+	return RND_OK;
+}
+
+/* The visibility pass's surfaces (renderer/visibility.c): what the main pass will shade at each
+ * pixel centre, single-sample, the main pass's reversed-Z depth test; with and without the
+ * shading attachment (pixel shading: deferred.c). */
+static enum rnd_result make_surface_pipelines(struct rnd_context *ctx, const struct init_modules *mod, struct rnd_error *err)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	enum rnd_result r;
 	for (int cull = 0; cull < 2; cull++) {
 		struct pipe_desc d = {
-			.vs = p->mesh_vs, .fs = surface_fs, .color = RND_SURFACES_FORMAT, .color_count = 2,
+			.vs = p->mesh_vs, .fs = mod->surface_fs, .color = RND_SURFACES_FORMAT, .color_count = 2,
 			.color_rest = RND_SURFACE_NORMALS_FORMAT,
 			.depth = RND_DEPTH_FORMAT, .samples = 1, .cull_back = cull, .name = cull ? "surfaces (cull back)" : "surfaces",
 		};
-		if ((r = make_pipeline(ctx, &d, &p->surfaces[cull], err)) != RND_OK) goto fail;
-		d.fs = surface_shade_fs;
+		if ((r = make_pipeline(ctx, &d, &p->surfaces[cull], err)) != RND_OK) return r;
+		d.fs = mod->surface_shade_fs;
 		d.color_count = 3;
 		d.color_last = RND_SURFACE_SHADING_FORMAT;
 		d.name = cull ? "surfaces + shading (cull back)" : "surfaces + shading";
-		if ((r = make_pipeline(ctx, &d, &p->surfaces_shade[cull], err)) != RND_OK) goto fail;
+		if ((r = make_pipeline(ctx, &d, &p->surfaces_shade[cull], err)) != RND_OK) return r;
 	}
-	/* These pipelines keep what they need from their modules. */
-	vkDestroyShaderModule(ctx->device, surface_shade_fs, NULL);
-	vkDestroyShaderModule(ctx->device, surface_fs, NULL);
-	vkDestroyShaderModule(ctx->device, masked_fs, NULL);
-	vkDestroyShaderModule(ctx->device, masked_vs, NULL);
-	vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
 	return RND_OK;
+}
 
-fail:
-	if (surface_shade_fs) vkDestroyShaderModule(ctx->device, surface_shade_fs, NULL);
-	if (surface_fs) vkDestroyShaderModule(ctx->device, surface_fs, NULL);
-	if (masked_fs) vkDestroyShaderModule(ctx->device, masked_fs, NULL);
-	if (masked_vs) vkDestroyShaderModule(ctx->device, masked_vs, NULL);
-	if (shadow_vs) vkDestroyShaderModule(ctx->device, shadow_vs, NULL);
-	rnd_pipelines_release(ctx);
-	return r;
+enum rnd_result rnd_pipelines_init(struct rnd_context *ctx, struct rnd_error *err)
+{
+	struct rnd_pipelines *p = &ctx->pipes;
+	struct init_modules mod = {0};
+	enum rnd_result r;
+	pthread_mutex_init(&p->mu, NULL);
+	pthread_cond_init(&p->compiled, NULL);
+	if ((r = make_layouts(ctx, err)) != RND_OK || (r = make_modules(ctx, &mod, err)) != RND_OK ||
+	    (r = make_depth_pipelines(ctx, &mod, err)) != RND_OK || (r = make_surface_pipelines(ctx, &mod, err)) != RND_OK) {
+		init_modules_release(ctx, &mod);
+		rnd_pipelines_release(ctx);
+		return r;
+	}
+	init_modules_release(ctx, &mod);
+	return RND_OK;
 }
 
 /* A fullscreen triangle's pipeline (fullscreen.vert, no vertices) with fragment shader fs:

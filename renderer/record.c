@@ -102,6 +102,35 @@ void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s)
 	vkCmdBindDescriptorSets(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, ctx->pipes.layout, 0, 1, &s->set, 0, NULL);
 }
 
+void record_camera_draws(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                         const VkPipeline pipes[2], bool push, bool count)
+{
+	VkCommandBuffer cmd = s->cmd;
+	record_bind_geometry(ctx, s);
+	VkPipeline bound = VK_NULL_HANDLE;
+	for (uint32_t i = 0; i < rv->ndraw; i++) {
+		const struct draw *d = &rv->draws[i];
+		if (!d->index_count) continue;
+		if (count && rv->drawn_camera && rv->band_y == 0) *rv->drawn_camera += d->cam_index_count / 3;   /* record.h */
+		VkPipeline p = pipes[d->cull_back];
+		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
+		if (push) {
+			struct umbra_push pc = {.info = {d->material, d->flags, 0, 0}};
+			vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+			                   sizeof pc, &pc);
+		}
+		record_draw_camera(cmd, d);
+	}
+}
+
+void record_color_to_sampled(VkCommandBuffer cmd, VkImage img)
+{
+	record_image_barrier(cmd, img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+	                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+	                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+	                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
 void record_depth_draw(struct rnd_context *ctx, struct rnd_slot *s, const struct draw *d, int cull,
                        struct umbra_push *push, VkPipeline *bound)
 {

@@ -72,6 +72,15 @@ void record_begin_depth(VkCommandBuffer cmd, VkImage img, VkImageView view, uint
 void record_depth_rendering(VkCommandBuffer cmd, VkImageView view, uint32_t w, uint32_t h, bool load);
 /* Binds the slot's vertex and index buffers and its set 0 (frame constants, atlases). */
 void record_bind_geometry(struct rnd_context *ctx, struct rnd_slot *s);
+/* The band's camera draws, inside a rendering the caller began: record_bind_geometry, then each
+ * draw with pipes[its cull_back], bound when it changes. push: each draw's material and flags as
+ * push constants (the surfaces passes' shaders read them); count: its camera triangles added to
+ * rv->drawn_camera (by the one pass per view that stands for the main pass). */
+void record_camera_draws(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
+                         const VkPipeline pipes[2], bool push, bool count);
+/* A colour attachment just written (COLOR_ATTACHMENT_OPTIMAL), made readable by the next
+ * pass's fragment shaders (SHADER_READ_ONLY_OPTIMAL). */
+void record_color_to_sampled(VkCommandBuffer cmd, VkImage img);
 /* One draw with the shadow (depth-only) pipelines, culling back faces when cull is set; masked
  * draws get their material index in push->info.x and their texture set. *bound is the
  * pipeline bound last (VK_NULL_HANDLE at the start of a pass). */

@@ -38,31 +38,19 @@ static enum rnd_result pool_with_sets(struct rnd_context *ctx, const VkDescripto
 	return RND_OK;
 }
 
-/* One render slot: every object in creation order, unwound in reverse by the goto chain at the
- * end (kept in one function so that the chain stays next to what it undoes). */
-static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, struct rnd_slot **out, struct rnd_error *err)
+/* A slot's command pool, its one command buffer, its fence and (with timestamps) its query
+ * pool. On failure nothing of them is left. */
+static enum rnd_result slot_commands(struct rnd_context *ctx, struct rnd_slot *s, struct rnd_error *err)
 {
 	VkResult vr;
 	enum rnd_result r;
-	struct rnd_slot *s = calloc(1, sizeof *s);
-	if (!s) return rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
-	s->index = index;
-	uint32_t ntex = ctx->max_textures, nsets = rnd_texture_sets(ntex);
-	s->textures = calloc(ntex, sizeof *s->textures);
-	s->texture_sets = calloc(1 + nsets, sizeof *s->texture_sets);
-	VkDescriptorSetLayout *layouts = calloc(1 + nsets, sizeof *layouts);
-	if (!s->textures || !s->texture_sets || !layouts) {
-		r = rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
-		goto fail_pool;
-	}
+	uint32_t index = s->index;
 	VkCommandPoolCreateInfo pci = {
 		.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
 		.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, .queueFamilyIndex = ctx->queue_family,
 	};
-	if ((vr = vkCreateCommandPool(ctx->device, &pci, NULL, &s->pool)) != VK_SUCCESS) {
-		r = rnd_fail_vk(err, vr, "vkCreateCommandPool");
-		goto fail_pool;
-	}
+	if ((vr = vkCreateCommandPool(ctx->device, &pci, NULL, &s->pool)) != VK_SUCCESS)
+		return rnd_fail_vk(err, vr, "vkCreateCommandPool");
 	RND_NAME(ctx, VK_OBJECT_TYPE_COMMAND_POOL, s->pool, "slot %u command pool", index);
 	VkCommandBufferAllocateInfo cai = {
 		.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, .commandPool = s->pool,
@@ -85,32 +73,75 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		};
 		if ((vr = vkCreateQueryPool(ctx->device, &qci, NULL, &s->queries)) != VK_SUCCESS) {
 			r = rnd_fail_vk(err, vr, "vkCreateQueryPool");
-			goto fail_queries;
+			goto fail_fence;
 		}
 		RND_NAME(ctx, VK_OBJECT_TYPE_QUERY_POOL, s->queries, "slot %u timestamps", index);
 	}
+	return RND_OK;
+
+fail_fence:
+	vkDestroyFence(ctx->device, s->fence, NULL);
+	s->fence = VK_NULL_HANDLE;
+fail_cmd:
+	vkDestroyCommandPool(ctx->device, s->pool, NULL); /* frees the command buffer */
+	s->pool = VK_NULL_HANDLE;
+	s->cmd = VK_NULL_HANDLE;
+	return r;
+}
+
+/* Undoes slot_commands(). */
+static void slot_commands_release(struct rnd_context *ctx, struct rnd_slot *s)
+{
+	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
+	vkDestroyFence(ctx->device, s->fence, NULL);
+	vkDestroyCommandPool(ctx->device, s->pool, NULL); /* frees the command buffer */
+}
+
+/* The slot's frame descriptor set and its texture sets (set 0: every binding the white texture,
+ * then one per texture set the context allows), each in its own pool. On failure neither is left. */
+static enum rnd_result slot_descriptor_pools(struct rnd_context *ctx, struct rnd_slot *s, uint32_t nsets,
+                                             struct rnd_error *err)
+{
+	enum rnd_result r;
+	VkDescriptorSetLayout *layouts = calloc(1 + nsets, sizeof *layouts);
+	if (!layouts) return rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", s->index);
 	VkDescriptorPoolSize sizes[4] = {
 		{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 4},
 		{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
 		{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16},
 		{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
 	};
-	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", index, &s->desc_pool, &s->set, err)) != RND_OK)
-		goto fail_desc_pool;
+	if ((r = pool_with_sets(ctx, sizes, 4, 1, &ctx->pipes.set_layout, "", s->index, &s->desc_pool, &s->set, err)) != RND_OK)
+		goto done;
 	VkDescriptorPoolSize tsize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (1 + nsets) * UMBRA_TEX_SLOTS};
 	for (uint32_t i = 0; i < 1 + nsets; i++) layouts[i] = ctx->pipes.texture_layout;
-	if ((r = pool_with_sets(ctx, &tsize, 1, 1 + nsets, layouts, "texture", index, &s->texture_pool, s->texture_sets,
-	                        err)) != RND_OK)
-		goto fail_set;
+	if ((r = pool_with_sets(ctx, &tsize, 1, 1 + nsets, layouts, "texture", s->index, &s->texture_pool, s->texture_sets,
+	                        err)) != RND_OK) {
+		vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
+		s->desc_pool = VK_NULL_HANDLE;
+	}
+done:
+	free(layouts);
+	return r;
+}
+
+/* The slot's 1x1 white texture and white cube (what an absent texture or environment samples),
+ * the white texture written into every binding of texture set 0. On failure neither is left. */
+static enum rnd_result slot_white(struct rnd_context *ctx, struct rnd_slot *s, struct rnd_error *err)
+{
+	enum rnd_result r;
 	char name[48];
-	snprintf(name, sizeof name, "slot %u white texture", index);
+	snprintf(name, sizeof name, "slot %u white texture", s->index);
 	if ((r = rnd_image_create(ctx, VK_FORMAT_R8G8B8A8_SRGB, 1, 1, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
 	                          VK_IMAGE_ASPECT_COLOR_BIT, name, &s->white, err)) != RND_OK)
-		goto fail_texture_pool;
-	snprintf(name, sizeof name, "slot %u white cube", index);
+		return r;
+	snprintf(name, sizeof name, "slot %u white cube", s->index);
 	if ((r = rnd_image_create_cube(ctx, VK_FORMAT_R8G8B8A8_UNORM, 1, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-	                               name, &s->white_cube, err)) != RND_OK)
-		goto fail_white;
+	                               name, &s->white_cube, err)) != RND_OK) {
+		rnd_image_destroy(ctx, &s->white_cube);
+		rnd_image_destroy(ctx, &s->white);
+		return r;
+	}
 	VkDescriptorImageInfo wi = {ctx->pipes.texture_samplers[0], s->white.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
 	VkWriteDescriptorSet ww[UMBRA_TEX_SLOTS];
 	for (uint32_t b = 0; b < UMBRA_TEX_SLOTS; b++)
@@ -119,6 +150,30 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 			.descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &wi,
 		};
 	vkUpdateDescriptorSets(ctx->device, UMBRA_TEX_SLOTS, ww, 0, NULL);
+	return RND_OK;
+}
+
+/* One render slot: its parts in creation order (each part unwinds itself when it fails), the
+ * parts made so far unwound in reverse by the goto chain at the end. */
+static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, struct rnd_slot **out, struct rnd_error *err)
+{
+	enum rnd_result r;
+	struct rnd_slot *s = calloc(1, sizeof *s);
+	if (!s) return rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
+	s->index = index;
+	uint32_t ntex = ctx->max_textures, nsets = rnd_texture_sets(ntex);
+	s->textures = calloc(ntex, sizeof *s->textures);
+	s->texture_sets = calloc(1 + nsets, sizeof *s->texture_sets);
+	if (!s->textures || !s->texture_sets) {
+		r = rnd_fail(err, RND_ERR_OOM, "out of memory for render slot %u", index);
+		goto fail_alloc;
+	}
+	if ((r = slot_commands(ctx, s, err)) != RND_OK)
+		goto fail_alloc;
+	if ((r = slot_descriptor_pools(ctx, s, nsets, err)) != RND_OK)
+		goto fail_commands;
+	if ((r = slot_white(ctx, s, err)) != RND_OK)
+		goto fail_pools;
 	VkDescriptorPoolSize msizes[3] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
 	                                  {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2}};
 	VkDescriptorSetLayout mlayouts[2] = {ctx->moments.set_layout, ctx->moments.blur_set_layout};
@@ -128,26 +183,18 @@ static enum rnd_result slot_create(struct rnd_context *ctx, uint32_t index, stru
 		goto fail_white;
 	s->moments_set = msets[0];
 	s->blur_set = msets[1];
-	free(layouts);
 	*out = s;
 	return RND_OK;
 
 fail_white:
 	rnd_image_destroy(ctx, &s->white_cube);
 	rnd_image_destroy(ctx, &s->white);
-
-fail_texture_pool:
+fail_pools:
 	vkDestroyDescriptorPool(ctx->device, s->texture_pool, NULL);
-fail_set:
 	vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
-fail_desc_pool:
-	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
-fail_queries:
-	vkDestroyFence(ctx->device, s->fence, NULL);
-fail_cmd:
-	vkDestroyCommandPool(ctx->device, s->pool, NULL); /* frees the command buffer */
-fail_pool:
-	free(layouts);
+fail_commands:
+	slot_commands_release(ctx, s);
+fail_alloc:
 	free(s->texture_sets);
 	free(s->textures);
 	free(s);
@@ -185,9 +232,7 @@ static void slot_destroy(struct rnd_context *ctx, struct rnd_slot *s)
 	rnd_buffer_destroy(ctx, &s->uvs1);
 	rnd_buffer_destroy(ctx, &s->vertices);
 	vkDestroyDescriptorPool(ctx->device, s->desc_pool, NULL);
-	if (s->queries) vkDestroyQueryPool(ctx->device, s->queries, NULL);
-	vkDestroyFence(ctx->device, s->fence, NULL);
-	vkDestroyCommandPool(ctx->device, s->pool, NULL);
+	slot_commands_release(ctx, s);
 	free(s->texture_sets);
 	free(s->textures);
 	free(s);

@@ -69,25 +69,10 @@ void record_surfaces(struct rnd_context *ctx, struct rnd_slot *s, const struct r
 	VkViewport vp = {0, 0, t->width, t->height, 0, 1};
 	vkCmdSetViewport(cmd, 0, 1, &vp);
 	vkCmdSetScissor(cmd, 0, 1, &area);
-	record_bind_geometry(ctx, s);
-	VkPipeline bound = VK_NULL_HANDLE;
-	for (uint32_t i = 0; i < rv->ndraw; i++) {
-		const struct draw *d = &rv->draws[i];
-		if (!d->index_count) continue;
-		VkPipeline p = t->shading ? ctx->pipes.surfaces_shade[d->cull_back] : ctx->pipes.surfaces[d->cull_back];
-		if (p != bound) { vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p); bound = p; }
-		/* surface.frag reads the draw's flags (a sphere's proxy), surface_shade.frag its material */
-		struct umbra_push push = {.info = {d->material, d->flags, 0, 0}};
-		vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-		                   sizeof push, &push);
-		record_draw_camera(cmd, d);
-	}
+	/* surface.frag reads each draw's flags (a sphere's proxy), surface_shade.frag its material */
+	record_camera_draws(ctx, s, rv, t->shading ? ctx->pipes.surfaces_shade : ctx->pipes.surfaces, true, false);
 	vkCmdEndRendering(cmd);
-	for (uint32_t i = 0; i < nimg; i++)
-		record_image_barrier(cmd, img[i]->img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+	for (uint32_t i = 0; i < nimg; i++) record_color_to_sampled(cmd, img[i]->img);
 	record_image_barrier(cmd, depth->img, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
 	                     VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
 	                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
@@ -169,10 +154,6 @@ enum rnd_result record_visibility(struct rnd_context *ctx, struct rnd_slot *s, c
 	                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 	                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
 	                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-	if (rv->deferred)
-		record_image_barrier(cmd, s->shaded.img, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-		                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-		                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-		                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+	if (rv->deferred) record_color_to_sampled(cmd, s->shaded.img);
 	return RND_OK;
 }

@@ -9,6 +9,15 @@
  * image in base64 would grow it by a third and hide it from image tools; a header cannot hold
  * a plan. The answer is not cacheable (Cache-Control: no-store, no ETag): it says what the
  * shadow cache held and how long each step took.
+ *
+ * Why `Prefer: explain` as the header form (RFC 7240): asking for more of an answer without
+ * changing what the resource is, is what Prefer is for (`return=representation`,
+ * `respond-async`); a preference a server or a cache in between does not know is ignored, not
+ * refused, and the answer says which it honoured (`Preference-Applied: explain`), so a client
+ * checks that header rather than guessing from the Content-Type; render answers say
+ * `Vary: Accept, Prefer`. A private `Umbra-Explain: 1` would need all three conventions made
+ * up again. Being a preference, it is lenient where `?explain=` is strict: elsewhere than
+ * POST /v1/render, or with a value it does not know, it is ignored.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +26,36 @@
 #include "explain.h"
 #include "http.h"
 #include "log.h"
+
+/* One Prefer header's preferences (comma-separated, each `token[=value][;param...]`): is one of
+ * them `explain` (no value, or 1, true, analyze; quoted or not)? */
+static enum MHD_Result prefer_header(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+	(void)kind;
+	bool *found = cls;
+	if (strcasecmp(key, "Prefer") != 0 || !value) return MHD_YES;
+	for (const char *p = value; *p;) {
+		p += strspn(p, " \t,");
+		size_t n = strcspn(p, "=;, \t");
+		if (n == 7 && !strncasecmp(p, "explain", 7)) {
+			const char *v = p + n;
+			v += strspn(v, " \t");
+			if (*v != '=') {
+				*found = true;
+				break;
+			}
+			v++;
+			v += strspn(v, " \t\"");
+			size_t vn = strcspn(v, "\";, \t");
+			if ((vn == 1 && *v == '1') || (vn == 4 && !strncasecmp(v, "true", 4)) || (vn == 7 && !strncasecmp(v, "analyze", 7))) {
+				*found = true;
+				break;
+			}
+		}
+		p += strcspn(p, ",");
+	}
+	return MHD_YES;
+}
 
 bool srv_explain_begin(struct srv_request *req, struct MHD_Connection *conn, const char *accept,
                        enum MHD_Result *refused)
@@ -34,6 +73,14 @@ bool srv_explain_begin(struct srv_request *req, struct MHD_Connection *conn, con
 			return true;
 		}
 		req->explain = true;
+	}
+	/* The header form, every Prefer header read (a preference may come in any of them). */
+	bool preferred = false;
+	if (req->route == SRV_ROUTE_RENDER)
+		MHD_get_connection_values(conn, MHD_HEADER_KIND, prefer_header, &preferred);
+	if (preferred) {
+		req->explain = true;
+		req->explain_preferred = true;
 	}
 	/* The plan is JSON: an Accept that excludes it is a 406 (none, any JSON type, or a wildcard is fine). */
 	if (req->route == SRV_ROUTE_EXPLAIN && accept && *accept && !strcasestr(accept, "json") &&

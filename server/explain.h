@@ -3,7 +3,8 @@
  *   POST /v1/explain                the plan of a scene, as JSON (api/explain.schema.json);
  *                                   nothing rendered
  *   POST /v1/render?explain=1       the render, answered as multipart/mixed: the image, then
- *                                   the plan with what each step measured (EXPLAIN ANALYZE)
+ *                                   the plan with what each step measured (EXPLAIN ANALYZE);
+ *                                   the same with the header `Prefer: explain` (RFC 7240)
  * srv_explain_begin() runs on the polling thread (render_route.c), the rest in a worker.
  */
 #ifndef UMBRA_SRV_EXPLAIN_H
@@ -14,7 +15,8 @@
 #include "api.h"
 #include "srv.h"
 
-/* The `explain` query parameter and, for POST /v1/explain, its Accept: sets req->explain.
+/* The `explain` query parameter, `Prefer: explain` (req->explain_preferred too: the answer
+ * carries Preference-Applied) and, for POST /v1/explain, its Accept: sets req->explain.
  * true when the request is answered already (400, 406: *refused is what the access handler
  * returns). */
 bool srv_explain_begin(struct srv_request *req, struct MHD_Connection *conn, const char *accept,

@@ -128,6 +128,8 @@ static void render_headers(struct srv_request *req, struct MHD_Response *resp, i
 	/* What the image leaves out of what the scene asked for (never silent). */
 	if (render && (status == 200 || status == 303) && req->warnings[0])
 		MHD_add_response_header(resp, "Umbra-Warnings", req->warnings);
+	if (req->explain_preferred && status == 200)
+		MHD_add_response_header(resp, "Preference-Applied", "explain");
 	const char *cc = "no-store";
 	if (req->route == SRV_ROUTE_RESULT && (status == 200 || status == 304))
 		cc = SRV_RESULT_CACHE_CONTROL;

@@ -39,8 +39,8 @@
  * balancer's X-Umbra-Affinity); the answer headers it may read (beyond the CORS-safelisted
  * Content-Type and Content-Length); how long a browser may keep a preflight's answer
  * (seconds; Chromium caps it at 7200). */
-#define SRV_CORS_ALLOW_HEADERS "Content-Type, Accept, If-None-Match, X-Priority, X-Request-Id, X-Umbra-Affinity"
-#define SRV_CORS_EXPOSE_HEADERS "ETag, Server-Timing, Retry-After, X-Request-Id, Umbra-Warnings"
+#define SRV_CORS_ALLOW_HEADERS "Content-Type, Accept, If-None-Match, Prefer, X-Priority, X-Request-Id, X-Umbra-Affinity"
+#define SRV_CORS_EXPOSE_HEADERS "ETag, Server-Timing, Retry-After, X-Request-Id, Umbra-Warnings, Preference-Applied"
 #define SRV_CORS_MAX_AGE "7200"
 /* Content-Security-Policy of every answer but the playground page (which has its own, built
  * with the page: server/www/embed.sh): nothing in an answer may run or be framed. */

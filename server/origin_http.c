@@ -86,7 +86,7 @@ void srv_origin_headers(struct srv_request *req, struct MHD_Response *resp, int 
 	MHD_add_response_header(resp, "Content-Security-Policy", page ? srv_playground_csp() : SRV_CSP_API);
 	/* With --cors-origin, whether an answer may be read depends on the Origin it was asked with. */
 	if (by_accept || cors)
-		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, by_accept && cors ? "Accept, Origin" : by_accept ? "Accept" : "Origin");
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, by_accept && cors ? "Accept, Prefer, Origin" : by_accept ? "Accept, Prefer" : "Origin");
 	if (!req->cors_origin[0])
 		return;
 	MHD_add_response_header(resp, "Access-Control-Allow-Origin", req->cors_origin);

@@ -210,6 +210,7 @@ struct srv_request {
 	char location[64];             /* the Location of a 303 */
 	int want;                      /* Accept's choice (enum srv_accept: PNG, EXR or WebP) */
 	bool explain;                  /* POST /v1/render?explain=1: the image and its plan (explain.c) */
+	bool explain_preferred;        /* ... asked by `Prefer: explain`: answered with Preference-Applied */
 	char mime[128];                 /* content_type when it is made per answer (multipart/mixed) */
 	bool close_after;              /* answer with Connection: close (framing error) */
 	char cors_origin[SRV_ORIGIN_MAX]; /* an allowed cross-origin caller's Origin, echoed; "" = none */

@@ -2,7 +2,7 @@
 # server/www/embed.sh SRC_DIR OUT_DIR SCHEMA [BENCH.json...] — the playground as one page, that page as
 # a C array (xxd -i) for server/playground.c, and the page's Content-Security-Policy. The page's
 # marker lines are replaced in place: <style>/*@css*/</style> by playground.css,
-# <script>/*@js*/</script> by playground.js, <script>/*@bench*/</script> by
+# <script>/*@js*/</script> by playground.js, <script>/*@plan*/</script> by plan.js, <script>/*@bench*/</script> by
 # `window.UMBRA_BENCH = {"name": scene, ...}` from the bench scenes given (none: an empty
 # object), <script>/*@schema*/</script> by `window.UMBRA_SCHEMA = ` SCHEMA (api/scene.schema.json:
 # the editor's completion and help). Each inline block is exactly its file between the tags, so the policy allows it by
@@ -31,6 +31,7 @@ while IFS= read -r l; do
 	case "$l" in
 	'<style>/*@css*/</style>') printf '<style>'; cat "$src/playground.css"; printf '</style>\n' ;;
 	'<script>/*@js*/</script>') printf '<script>'; cat "$src/playground.js"; printf '</script>\n' ;;
+	'<script>/*@plan*/</script>') printf '<script>'; cat "$src/plan.js"; printf '</script>\n' ;;
 	'<script>/*@bench*/</script>') printf '<script>'; cat "$out/bench.js"; printf '</script>\n' ;;
 	'<script>/*@schema*/</script>') printf '<script>'; cat "$out/schema.js"; printf '</script>\n' ;;
 	*) printf '%s\n' "$l" ;;
@@ -38,7 +39,7 @@ while IFS= read -r l; do
 done <"$src/playground.html" >"$page.tmp"
 mv "$page.tmp" "$page"
 # Images are the renders' blob: URLs; fetches go to this daemon only; nothing may frame the page, and no form or <base> may point elsewhere.
-csp="default-src 'self'; script-src $(hash "$out/bench.js") $(hash "$out/schema.js") $(hash "$src/playground.js"); style-src $(hash "$src/playground.css"); img-src 'self' blob:; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"
+csp="default-src 'self'; script-src $(hash "$out/bench.js") $(hash "$out/schema.js") $(hash "$src/plan.js") $(hash "$src/playground.js"); style-src $(hash "$src/playground.css"); img-src 'self' blob:; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"
 {
 	(cd "$out" && xxd -i playground.html)
 	printf 'static const char playground_csp[] = "%s";\n' "$csp"

@@ -487,20 +487,30 @@ function body(doc) {
   fd.append('model', model.file, model.name);
   return { body: fd, headers: {} };
 }
-async function send(doc, img, cap) {
+// The render; with `explain` it is asked with its plan (`Prefer: explain`): the answer is then
+// multipart/mixed, the image's own bytes and the plan (api/explain.schema.json), measured.
+async function send(doc, img, cap, explain) {
   const t0 = performance.now();
-  const r = await fetch('/v1/render', Object.assign({ method: 'POST', headers: { Accept: 'image/png' } }, body(doc)));
+  const b = body(doc);
+  const headers = Object.assign(explain ? { Prefer: 'explain' } : {}, b.headers);
+  const r = await fetch('/v1/render', { method: 'POST', headers, body: b.body });
   const rtt = performance.now() - t0;
-  const blob = await r.blob();
+  let blob = await r.blob(), plan = null;
   if (!r.ok) {
     let p = {};
     try { p = JSON.parse(await blob.text()); } catch (e) { p = { detail: 'HTTP ' + r.status }; }
     return { ok: false, status: r.status, problem: p, rtt };
   }
+  if (r.headers.get('Preference-Applied') === 'explain') {
+    const ps = parts(new Uint8Array(await blob.arrayBuffer()), r.headers.get('Content-Type'));
+    const im = ps.find((x) => x.type.startsWith('image/')), pj = ps.find((x) => x.type === 'application/json');
+    if (im) blob = new Blob([im.bytes], { type: im.type });
+    try { plan = pj ? JSON.parse(new TextDecoder().decode(pj.bytes)) : null; } catch (e) { plan = null; }
+  }
   if (img.src) URL.revokeObjectURL(img.src);
   await new Promise((res) => { img.onload = res; img.onerror = res; img.src = URL.createObjectURL(blob); });
   cap.textContent = img.naturalWidth + '×' + img.naturalHeight;
-  return { ok: true, status: r.status, size: blob.size, etag: r.headers.get('ETag'), timing: r.headers.get('Server-Timing'), rtt };
+  return { ok: true, status: r.status, size: blob.size, etag: r.headers.get('ETag'), timing: r.headers.get('Server-Timing'), rtt, plan };
 }
 function showTiming(header) {
   const dur = {};
@@ -560,8 +570,9 @@ async function renderNow() {
   $('images').classList.toggle('two', compare);
   $('fig-b').hidden = !compare;
   try {
-    const jobs = [send(withView(parsed.value, compare ? $('filter-a').value : null), $('image'), $('cap-a'))];
-    if (compare) jobs.push(send(withView(parsed.value, $('filter-b').value), $('image2'), $('cap-b')));
+    const explain = $('explain').checked;
+    const jobs = [send(withView(parsed.value, compare ? $('filter-a').value : null), $('image'), $('cap-a'), explain)];
+    if (compare) jobs.push(send(withView(parsed.value, $('filter-b').value), $('image2'), $('cap-b'), false));
     const res = await Promise.all(jobs);
     const bad = res.find((x) => !x.ok);
     const a = res[0];
@@ -575,6 +586,7 @@ async function renderNow() {
       $('size').textContent = $('etag').textContent = '—';
       $('timing').innerHTML = $('timing-legend').innerHTML = '';
       $('download').hidden = true;
+      showPlan(null);
       $('status').textContent = again ? 'rendering…' : 'error ' + bad.status;
       return;
     }
@@ -584,8 +596,10 @@ async function renderNow() {
     }
     $('images').classList.remove('stale');
     $('size').textContent = res.map((x) => x.size.toLocaleString('en') + ' bytes').join(', ');
-    $('etag').textContent = res.map((x) => x.etag || '').join(', ');
+    // An answer with its plan is no cacheable image: it has no ETag.
+    $('etag').textContent = res.map((x) => x.etag || (x.plan ? 'none (answered with its plan)' : '')).join(', ');
     showTiming(a.timing);
+    showPlan(a.plan, compare ? 'of the first image' : '');
     const dl = $('download');
     dl.href = $('image').src;
     dl.download = imageName(compare, $('image').naturalWidth, $('image').naturalHeight);
@@ -703,6 +717,7 @@ function lightsChanged() {
 }
 $('debug').addEventListener('change', () => { lightsChanged(); $('light-label').hidden = $('debug').value !== 'shadow'; render(); });
 $('debug-light').addEventListener('change', render);
+$('explain').addEventListener('change', render);
 $('compare').addEventListener('change', () => {
   $('filter-a').disabled = $('filter-b').disabled = !$('compare').checked;
   render();

@@ -110,6 +110,18 @@ async function copied(page, button) {
   return page.evaluate(() => navigator.clipboard.readText());
 }
 
+// The plan shown beside the image: its facts by name and its steps' estimate and measure.
+function planShown(page) {
+  return page.evaluate(() => {
+    const box = document.getElementById('plan'), facts = {}, steps = {};
+    document.querySelectorAll('#plan-facts tr').forEach((tr) => { facts[tr.dataset.fact] = { value: tr.querySelector('.v').textContent, why: tr.querySelector('.why').textContent }; });
+    document.querySelectorAll('#plan-steps tbody tr').forEach((tr) => {
+      steps[tr.dataset.step] = { est: parseFloat(tr.cells[1].textContent), measured: parseFloat(tr.cells[2].textContent) };
+    });
+    return { shown: !box.hidden && box.getBoundingClientRect().height > 0, facts, steps };
+  });
+}
+
 const pngSize = (buf) => buf.length > 24 && buf.toString('latin1', 1, 4) === 'PNG' ? buf.readUInt32BE(16) + 'x' + buf.readUInt32BE(20) : 'not a PNG';
 
 async function main() {
@@ -206,9 +218,42 @@ async function main() {
     check('render: status done', st === 'done', st);
     check('render: image is 512x384', a.w === 512 && a.h === 384, a.w + 'x' + a.h);
     check('render: non-trivial content', a.colours > 100, a.colours + ' colours');
+    // The plan beside the image: asked with Prefer: explain, shown as what was decided and why,
+    // then each step's estimate beside its measure.
+    let plan = await planShown(page);
+    const pf = plan.facts;
+    check('plan: asked with Prefer: explain', (sent[sent.length - 1].headers().prefer || '') === 'explain');
+    check('plan: shown with views, shadow maps, triangles, pixel shading, visibility pass', plan.shown &&
+      ['views', 'shadow maps', 'triangles', 'pixel shading', 'visibility pass', 'memory'].every((k) => pf[k]), JSON.stringify(pf).slice(0, 400));
+    check('plan: one view of 512×384', pf.views && pf.views.value === '1 × 512×384 png', pf.views && pf.views.value);
+    check('plan: the PCSS light\'s map, drawn or cached, and why', pf['map 0'] && / pcss: (drawn|cached)$/.test(pf['map 0'].value) &&
+      pf['map 0'].why.length > 10, JSON.stringify(pf['map 0']));
+    check('plan: triangles for the camera and the shadows', pf.triangles && /^[1-9][\d,]* camera, [1-9][\d,]* shadow$/.test(pf.triangles.value),
+      pf.triangles && pf.triangles.value);
+    check('plan: pixel shading on or off, with why', pf['pixel shading'] && /^(on|off)$/.test(pf['pixel shading'].value) && pf['pixel shading'].why.length > 10,
+      JSON.stringify(pf['pixel shading']));
+    check('plan: each step estimated and measured', plan.steps.main && plan.steps.main.est > 0 && plan.steps.main.measured > 0 &&
+      plan.steps.shadow && plan.steps.shadow.est >= 0 && plan.steps.shadow.measured >= 0 && plan.steps.total.measured > 0, JSON.stringify(plan.steps));
+    const etagPlan = await page.$eval('#etag', (e) => e.textContent);
+    check('plan: an answer with its plan has no ETag, and says so', etagPlan === 'none (answered with its plan)', etagPlan);
+    if (process.env.SHOT) {
+      // Wide enough for the plan beside the image.
+      await page.setViewport({ width: 1720, height: 900 });
+      await page.screenshot({ path: process.env.SHOT.replace(/\.png$/, '-plan.png') });
+      await page.setViewport({ width: 1280, height: 820 });
+    }
+    // Without the plan: the plain image, its ETag; with it again, the maps the plain render drew are cached.
+    st = await rendered(page, () => page.click('#explain'));
     const etag = await page.$eval('#etag', (e) => e.textContent);
     const size = await page.$eval('#size', (e) => e.textContent);
-    check('render: ETag and size shown', /^"/.test(etag) && /^\d[\d,]* bytes$/.test(size), etag + ' / ' + size);
+    check('render: ETag and size shown', st === 'done' && /^"/.test(etag) && /^\d[\d,]* bytes$/.test(size), etag + ' / ' + size);
+    check('plan off: no plan shown, no Prefer sent', !(await planShown(page)).shown && !sent[sent.length - 1].headers().prefer);
+    const plainHash = (await imageFacts(page, 'image')).hash;
+    st = await rendered(page, () => page.click('#explain'));
+    plan = await planShown(page);
+    check('plan again: every map cached, none drawn; the same image', st === 'done' && plan.facts['shadow maps'] &&
+      /^0 drawn, [1-9]\d* cached$/.test(plan.facts['shadow maps'].value) && (await imageFacts(page, 'image')).hash === plainHash &&
+      (await page.$eval('#size', (e) => e.textContent)) === size, JSON.stringify(plan.facts['shadow maps']));
     const bars = await page.$$eval('#timing div', (d) => d.map((x) => parseFloat(x.style.width)));
     check('render: Server-Timing bar has its stages', bars.length === 7 && bars.some((w) => w > 10), bars.join(','));
     check('line numbers in the gutter', (await page.$eval('#gutter', (g) => g.textContent.split('\n').length)) > 20);

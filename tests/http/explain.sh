@@ -50,6 +50,19 @@ c=$(post plain "$T/s64.json")
 check "plain render 200" [ "$c" = 200 ]
 check "?explain=1: the image part is the plain render's bytes; the plan analyzed, valid, its counts the render's" \
 	$CHECK multipart "$T/ex.body" "$(hdr ex Content-Type)" "$T/plain.body"
+# The header form: Prefer: explain (RFC 7240), among other preferences; honoured, and said so.
+c=$(curl -s --max-time 120 -o "$T/pf.body" -D "$T/pf.hdr" -w '%{http_code}' -H 'Content-Type: application/json' \
+	-H 'Prefer: respond-async, explain' --data-binary "@$T/s64.json" "$URL/v1/render")
+check "Prefer: explain: 200 multipart, Preference-Applied: explain, no-store" sh -c "[ '$c' = 200 ] && \
+	[ '$(hdr pf Preference-Applied)' = explain ] && [ '$(hdr pf Cache-Control)' = no-store ] && [ -z '$(hdr pf ETag)' ]"
+check "Prefer: explain: the same answer as ?explain=1 (the plain image, the plan analyzed, its counts the render's)" \
+	$CHECK multipart "$T/pf.body" "$(hdr pf Content-Type)" "$T/plain.body"
+check "a plain render: Vary: Accept, Prefer; no Preference-Applied" sh -c \
+	"[ '$(hdr plain Vary)' = 'Accept, Prefer' ] && [ -z '$(hdr plain Preference-Applied)' ]"
+c=$(curl -s --max-time 120 -o "$T/pu.body" -D "$T/pu.hdr" -w '%{http_code}' -H 'Content-Type: application/json' \
+	-H 'Prefer: explain=sometimes' --data-binary "@$T/s64.json" "$URL/v1/render")
+check "Prefer: explain=sometimes (unknown value): ignored as preferences are, the plain image" sh -c \
+	"[ '$c' = 200 ] && [ -z '$(hdr pu Preference-Applied)' ] && cmp -s '$T/pu.body' '$T/plain.body'"
 c=$(explain e2 "$T/s64.json")
 check "explained again after the render: its map cached, none drawn" sh -c \
 	"[ '$($CHECK get "$T/e2.body" shadow_maps.0.state)' = cached ] && [ '$($CHECK get "$T/e2.body" totals.shadow_maps_drawn)' = 0 ]"

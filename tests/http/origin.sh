@@ -40,7 +40,7 @@ DEF=$PID
 PORT=$(cat "$T/def.port")
 c=$(post plain "$T/s.json"); check "no Origin (curl): 200" [ "$c" = 200 ]
 check "no Origin: no Access-Control-Allow-Origin, no Vary: Origin" \
-	sh -c "[ -z '$(hdr plain Access-Control-Allow-Origin)' ] && [ '$(hdr plain Vary)' = Accept ]"
+	sh -c "[ -z '$(hdr plain Access-Control-Allow-Origin)' ] && [ '$(hdr plain Vary)' = 'Accept, Prefer' ]"
 n200=$(renders 200)
 c=$(post foreign "$T/s.json" -H 'Origin: https://evil.example' -H 'Sec-Fetch-Site: cross-site' -H 'Sec-Fetch-Mode: cors')
 check "foreign Origin: 403" [ "$c" = 403 ]
@@ -115,7 +115,7 @@ CORS=$PID
 c=$(post app "$T/s.json" -H 'Origin: https://app.example.com' -H 'Sec-Fetch-Site: cross-site' -H 'Sec-Fetch-Mode: cors')
 check "allowed origin: 200" [ "$c" = 200 ]
 check "allowed origin: Access-Control-Allow-Origin echoes it" [ "$(hdr app Access-Control-Allow-Origin)" = https://app.example.com ]
-check "allowed origin: Vary: Accept, Origin" [ "$(hdr app Vary)" = "Accept, Origin" ]
+check "allowed origin: Vary: Accept, Prefer, Origin" [ "$(hdr app Vary)" = "Accept, Prefer, Origin" ]
 eh=$(hdr app Access-Control-Expose-Headers)
 check "allowed origin: ETag, Server-Timing, Retry-After, X-Request-Id, Umbra-Warnings exposed ($eh)" sh -c '
 	for h in ETag Server-Timing Retry-After X-Request-Id Umbra-Warnings; do
@@ -130,7 +130,7 @@ check "unlisted origin: 403 naming --cors-origin" sh -c "[ $c = 403 ] && [ -z '$
 check "unlisted origin: the detail names the flag" has other '--cors-origin https://other.example'
 c=$(post xs "$T/s.json" -H 'Sec-Fetch-Site: cross-site')
 check "cross-site without Origin, a list set: 403" [ "$c" = 403 ]
-c=$(post none "$T/s.json"); check "no Origin: 200, Vary: Accept, Origin" sh -c "[ $c = 200 ] && [ '$(hdr none Vary)' = 'Accept, Origin' ]"
+c=$(post none "$T/s.json"); check "no Origin: 200, Vary: Accept, Prefer, Origin" sh -c "[ $c = 200 ] && [ '$(hdr none Vary)' = 'Accept, Prefer, Origin' ]"
 c=$(preflight pfa /v1/render https://app.example.com -H 'Access-Control-Request-Private-Network: true')
 check "preflight from an allowed origin: 204" [ "$c" = 204 ]
 check "preflight: Access-Control-Allow-Origin" [ "$(hdr pfa Access-Control-Allow-Origin)" = https://app.example.com ]
