@@ -72,7 +72,7 @@ static void *worker_main(void *arg)
 	struct srv_request *req;
 	while ((req = srv_queue_pop(srv.queue)) != NULL) {
 		CHECK(req->state == SRV_REQ_QUEUED && (req->route == SRV_ROUTE_RENDER || req->route == SRV_ROUTE_RENDERS ||
-		                                       req->route == SRV_ROUTE_RESULT));
+		                                       req->route == SRV_ROUTE_RESULT || req->route == SRV_ROUTE_EXPLAIN));
 		CHECK(req->body && req->body_len > 0 && req->body_len < req->body_cap && !req->body[req->body_len]);
 		CHECK(req->body_len <= srv.cfg.max_body);
 		for (size_t i = 0; i < req->part_count; i++) {
