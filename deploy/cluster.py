@@ -128,6 +128,11 @@ class Cluster:
                  deadline_ms=30000, workdir=None, haproxy="haproxy", env=None):
         self.umbrad = os.path.join(build, "umbrad")
         self.flags = list(flags or [])
+        # At SIGTERM a daemon first fails /readyz while it still renders, for as long as HAProxy
+        # takes to mark it DOWN (2 failed checks a second apart, haproxy.cfg.in), then drains:
+        # a request the balancer sent just before it noticed is answered, not refused.
+        if "--drain-grace-ms" not in self.flags:
+            self.flags += ["--drain-grace-ms", "2500"]
         self.port, self.stats_port = port, stats_port
         # The balancer's timeouts follow the daemons' deadline, also when given as a flag.
         fl = self.flags

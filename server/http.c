@@ -320,6 +320,8 @@ static enum MHD_Result answer_get(struct srv_request *req)
 	case SRV_ROUTE_HEALTHZ:
 		return respond_text(req, 200, "text/plain; charset=utf-8", "ok\n");
 	case SRV_ROUTE_READYZ:
+		if (atomic_load(&s->leaving) && !atomic_load(&s->draining))
+			return srv_respond_problem(req, 503, NULL, "", "the server is shutting down (it still answers renders for --drain-grace-ms)");
 		if (!srv_is_ready(s))
 			return srv_answer_not_ready(req);
 		return respond_text(req, 200, "text/plain; charset=utf-8", "ready\n");

@@ -7,6 +7,7 @@
  * in-flight renders finish and are answered, the pipeline cache is saved, exit 0.
  * Exit codes: 0 clean, 1 start-up failure, 2 bad flags, 3 validation-layer messages seen.
  */
+#include <errno.h>
 #include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
@@ -37,6 +38,22 @@ static void wait_pending(struct srv_server *s, double timeout_s)
 }
 
 /* Signals, the context lock and the request-id seed, before any thread starts. */
+/* --drain-grace-ms: /readyz says 503 while renders are still taken, so a balancer that checks
+ * it (deploy/haproxy.cfg.in: 2 failed checks a second apart) stops sending before the drain
+ * refuses anything; a second signal ends the grace. */
+static void grace(struct srv_server *s, const sigset_t *sigs, int sig)
+{
+	atomic_store(&s->leaving, true);
+	unsigned ms = s->cfg.drain_grace_ms;
+	if (!ms) return;
+	srv_log(SRV_LOG_INFO, "%s: /readyz 503, still answering for %u ms before the drain", sig == SIGINT ? "SIGINT" : "SIGTERM",
+	        ms);
+	struct timespec t = { (time_t)(ms / 1000), (long)(ms % 1000) * 1000000L };
+	siginfo_t info;
+	while (sigtimedwait(sigs, &info, &t) < 0 && errno == EINTR)
+		;
+}
+
 static void process_init(struct srv_server *s, sigset_t *sigs)
 {
 	/* Every thread (libmicrohttpd's, the workers', the driver's) inherits this mask; the
@@ -107,6 +124,7 @@ int main(int argc, char **argv)
 	int sig = 0;
 	while (sigwait(&sigs, &sig) != 0)
 		;
+	grace(s, &sigs, sig);
 	srv_log(SRV_LOG_INFO, "%s: draining (%u queued, %u rendering)", sig == SIGINT ? "SIGINT" : "SIGTERM",
 	        srv_queue_depth(s->queue), atomic_load(&s->in_flight));
 	exit_code = 0;

@@ -274,7 +274,7 @@ static void write_queue(struct srv_buf *b, struct srv_server *s)
 	write_gauge(b, "umbra_workers", "Render worker threads (context render slots).",
 	            s->cfg.workers);
 	write_gauge(b, "umbra_ready", "1 when /readyz answers 200.",
-	            atomic_load(&s->ready) && !atomic_load(&s->draining));
+	            atomic_load(&s->ready) && !atomic_load(&s->leaving) && !atomic_load(&s->draining));
 	write_gauge(b, "umbra_draining", "1 after SIGTERM/SIGINT.", atomic_load(&s->draining));
 	unsigned running = 0, parked = 0;
 	if (s->imports) srv_imports_counts(s->imports, &running, &parked);

@@ -87,6 +87,7 @@ struct srv_config {
 	unsigned idle_timeout_s;       /* idle connection timeout, default 60 */
 	unsigned header_timeout_s;     /* a new connection's first request head, 0 = idle, default 10 */
 	unsigned drain_timeout_s;      /* longest wait for queued/in-flight work at exit, default 60 */
+	unsigned drain_grace_ms;       /* at SIGTERM, /readyz 503 this long while renders are still taken */
 	uint64_t model_cache_bytes;    /* api_model_cache_set_limit() at start, default 256 MiB */
 	unsigned idle_trim_s;          /* idle this long: drop unused cached maps, give memory back; 0 = never, default 30 */
 	uint64_t max_rss;              /* resident-memory bound kept after each request (srv_context_fit_rss), 0 = none */
@@ -148,7 +149,8 @@ struct srv_server {
 	unsigned thread_count;
 
 	atomic_bool ready;             /* context created and warm-up done */
-	atomic_bool draining;          /* SIGTERM/SIGINT seen: no new work */
+	atomic_bool leaving;           /* SIGTERM/SIGINT seen: /readyz 503 (renders still taken for --drain-grace-ms) */
+	atomic_bool draining;          /* after the grace: no new work */
 	atomic_uint pending;           /* requests begun and not yet completed by libmicrohttpd */
 	atomic_uint in_flight;         /* renders running now */
 	atomic_uint_fast64_t next_id;  /* request id counter */

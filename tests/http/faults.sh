@@ -4,7 +4,8 @@
 # /readyz turns 503 and comes back only after the warm-up ran again, and the next request gets
 # the same bytes as the CLI; an injected out-of-memory submit gives the atlas its tiles back;
 # a render far longer than --deadline-ms is stopped (504) and a small request queued behind it
-# is served (200). Prints "ok - x" / "FAIL - x" and, last, "N passed, N failed".
+# is served (200); with --drain-grace-ms a SIGTERM fails /readyz first while renders are still
+# answered. Prints "ok - x" / "FAIL - x" and, last, "N passed, N failed".
 # Env: BUILD, UMBRA_VALIDATION (tests/run.sh sets 1), START_TIMEOUT (s).
 SUITE=faults . tests/util/suite.sh
 
@@ -153,6 +154,26 @@ if start dl --workers 1 --deadline-ms 8000; then
 		"small after $(awk -v a="$t_small" -v b="$t0" 'BEGIN { printf "%.1f", a - b }') s (deadline 8 s)"
 	echo "# heavy: $(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["detail"])' "$T/heavy.body" 2>/dev/null)"
 	stop dl "$PID"
+fi
+
+# ---- (d) --drain-grace-ms: at SIGTERM /readyz fails first while renders are still answered ----
+# (a balancer's health checks take the daemon out before it refuses anything); a second signal
+# ends the grace, and the daemon drains and exits 0.
+if start grace --workers 1 --drain-grace-ms 60000; then
+	kill -TERM "$PID"
+	i=0
+	while [ "$(curl -s -o /dev/null -w '%{http_code}' --max-time 5 "$URL/readyz")" != 503 ] && [ $i -lt 300 ]; do
+		i=$((i + 1)); sleep 0.1
+	done
+	check "grace: /readyz answers 503 after SIGTERM" \
+		[ "$(curl -s -o /dev/null -w '%{http_code}' --max-time 5 "$URL/readyz")" = 503 ]
+	check "grace: umbra_ready is 0" [ "$(metric umbra_ready)" = 0 ]
+	check "grace: umbra_draining is still 0" [ "$(metric umbra_draining)" = 0 ]
+	c=$(post grace1 "$T/scene.json")
+	check "grace: a render sent meanwhile is answered 200" [ "$c" = 200 ]
+	check "grace: its answer is a PNG" is_png "$T/grace1.body"
+	check "grace: the log says so" grep -q 'still answering for 60000 ms' "$T/grace.log"
+	stop grace "$PID"   # the second SIGTERM ends the grace
 fi
 
 echo "$pass passed, $fail failed"
