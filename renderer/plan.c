@@ -361,18 +361,34 @@ static float camera_pixel_at(const struct rnd_camera_plan *cam, uint32_t height,
 }
 
 /* What a `fit` sun map's texel must resolve: a camera pixel's world size at the casters'
- * nearest point (0: no camera), and the light's widest penumbra (tan of its angular radius;
- * zmax: the scene's far light depth). */
+ * nearest point (0: no camera), and the half-width of the light's widest penumbra on the
+ * scene's receivers (world units). */
 struct fit_need {
-	float pixel, tan_half, zmax;
+	float pixel, penumbra;
 };
 
+/* The longest way light passes from a corner of the casters' box along d before it leaves the
+ * scene's box: where their shadows can fall at the farthest. */
+static float shadow_reach(const float d[3], const struct rnd_aabb *casters, const struct rnd_aabb *bounds)
+{
+	float far = 0;
+	for (int i = 0; i < 8 && !rnd_aabb_is_empty(casters); i++) {
+		float t = 1e30f;
+		for (int k = 0; k < 3; k++) {
+			float p = i >> k & 1 ? casters->max[k] : casters->min[k];
+			if (fabsf(d[k]) > 1e-6f) t = fminf(t, ((d[k] > 0 ? bounds->max[k] : bounds->min[k]) - p) / d[k]);
+		}
+		far = fmaxf(far, fmaxf(t, 0.0f));
+	}
+	return far;
+}
+
 /* Width in texels of the smallest footprint the light's filter blurs an edge over: PCF's
- * (2r+1) kernel, PCSS's narrowest disk (radius 1) and its bilinear taps, a moment blur's. */
-static float filter_kernel_texels(const struct rnd_shadow *s, const struct rnd_light_plan *lp)
+ * (2r+1) kernel, PCSS's narrowest disk (radius 1) and its bilinear taps; a moment map's blur
+ * is the softness asked for, in texels (test_moments): one texel. */
+static float filter_kernel_texels(const struct rnd_light_plan *lp)
 {
 	if (lp->filter == UMBRA_FILTER_PCSS) return 3.0f;
-	if (lp->moments) return 2.0f * ceilf(fmaxf(s->vsm_blur, 0.0f)) + 1.0f;
 	return lp->filter == UMBRA_FILTER_PCF ? 2.0f * (float)lp->pcf_radius + 1.0f : 1.0f;
 }
 
@@ -383,7 +399,10 @@ static float filter_kernel_texels(const struct rnd_shadow *s, const struct rnd_l
  * casters' nearest point): the filter's narrowest kernel within a pixel, as hard_light_res
  * asks of a hard spot, and at most one doubling of the tile the scene's texels need (the
  * shadow pass grows at most 4x); then the tile filled (the texel shrunk until the box and the
- * filter's reach span it: the same texels, finer). Issue 31: a masked checker 0.7 m over a
+ * filter's reach span it: the same texels, finer), except that PCSS's texels stay wide enough
+ * for its 24-texel search to reach the light's widest penumbra on the scene's receivers
+ * (`penumbra`), in the tile they need. A light asking for a resolution (at or above the
+ * default: the caller decides) gets that tile. Issue 31: a masked checker 0.7 m over a
  * 14 m ground had the ground's 9 mm texels in a half-empty 256 tile, about three to a pixel:
  * PCSS's narrowest disk blurred its cells' edges over a pixel (IoU 0.948 against Cycles).
  * The grid: whole texels from the light basis' origin. A moment blur clamps at the tile's edge
@@ -406,14 +425,16 @@ static void fit_casters(const struct rnd_shadow *s, const float view[16], const 
 		float span = fmaxf((lc.max[0] - lc.min[0]) / tx, (lc.max[1] - lc.min[1]) / ty);  /* in those texels */
 		while ((float)res < span + 2.0f * reach + 2.0f && (float)res < *fres) res *= 2;
 		if (s->resolution) res = (uint32_t)*fres;
-		float want = need->pixel / filter_kernel_texels(s, lp), finer = want > 0 ? fminf(want / fmaxf(tx, ty), 1.0f) : 1.0f;
+		float want = need->pixel / filter_kernel_texels(lp), finer = want > 0 ? fminf(want / fmaxf(tx, ty), 1.0f) : 1.0f;
 		if (span / finer + 2.0f * reach + 2.0f > (float)res && 2.0f * (float)res <= *fres) res *= 2;
-		float fill = ((float)res - 2.0f * reach - 2.0f) / fmaxf(span, 1e-6f);   /* texels per scene texel */
-		/* PCSS searches and filters within search_texels: no finer than the widest penumbra
-		 * (a blocker at the casters' top, a receiver at the scene's bottom) within that */
-		if (lp->filter == UMBRA_FILTER_PCSS)
-			fill = fminf(fill, fmaxf(tx, ty) * lp->search_texels / fmaxf(need->tan_half * (need->zmax + lc.max[2]), 1e-9f));
-		if (fill >= 1.0f) {
+		float fit = ((float)res - 2.0f * reach - 2.0f) / fmaxf(span, 1e-6f);   /* texels per scene texel */
+		/* PCSS searches and filters within search_texels: texels no finer than its widest
+		 * penumbra there, never coarser than the scene's; the tile no larger than they need */
+		float fill = fit;
+		if (lp->filter == UMBRA_FILTER_PCSS && need->penumbra > 0)
+			fill = fminf(fit, fmaxf(fmaxf(tx, ty) * lp->search_texels / need->penumbra, 1.0f));
+		while (!s->resolution && res > 64 && (float)res / 2.0f >= span * fill + 2.0f * reach + 2.0f) res /= 2;
+		if (fit >= 1.0f) {
 			cut = true;
 			tx /= fill; ty /= fill;
 			*hx = 0.5f * (float)res * tx; *hy = 0.5f * (float)res * ty;
@@ -456,7 +477,7 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
 		if (own) grow = 1.0f + 2.0f * ((lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : (float)lp->pcf_radius) + 3.0f) / fres;
 		else if (casters && (!s->resolution || s->resolution >= RND_DEFAULT_SHADOW_RESOLUTION)) {
-			struct fit_need need = {cam_pixel, tanf(0.5f * L->angular_diameter), zmax};
+			struct fit_need need = {cam_pixel, tanf(0.5f * L->angular_diameter) * shadow_reach(d, casters, bounds)};
 			fit_casters(s, view, casters, &need, lp, &fres, &cx, &cy, &hx, &hy, &grow);
 		}
 		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
