@@ -2,7 +2,8 @@
  * renderer/plan.c — shadow-view planning (see plan.h; the camera's is in camera.c). Pure math.
  *
  * Directional lights: `fit` is one orthographic map around what casts shadows, as deep as the
- * scene, with the texels of the default map around the whole scene; `cascades` are camera-
+ * scene, with texels no coarser than the default map's around the whole scene and finer where
+ * the camera sees the casters close (fit_casters); `cascades` are camera-
  * centred bounding spheres of the practical split scheme's slices (rotating the camera in place
  * moves no cascade), snapped to whole texels in a light basis that does not depend on the
  * camera (translating it moves shadows by whole texels: no shimmer); their depth range covers
@@ -345,47 +346,113 @@ static void fit_box(const float view[16], const struct rnd_aabb *b, uint32_t fil
 	*hx = fmaxf(*hx, hmax / 32.0f); *hy = fmaxf(*hy, hmax / 32.0f);
 }
 
+/* World size of one camera pixel at the point of box b nearest the camera (an orthographic
+ * camera: the same everywhere); 0 = no camera, no image height or an empty box. */
+static float camera_pixel_at(const struct rnd_camera_plan *cam, uint32_t height, const struct rnd_aabb *b)
+{
+	if (!cam || !height || rnd_aabb_is_empty(b)) return 0.0f;
+	if (cam->ortho) return cam->ortho_height / (float)height;
+	float d2 = 0;
+	for (int k = 0; k < 3; k++) {
+		float e = fmaxf(fmaxf(b->min[k] - cam->pos[k], cam->pos[k] - b->max[k]), 0.0f);
+		d2 += e * e;
+	}
+	return 2.0f * tanf(0.5f * cam->fov_y) * fmaxf(sqrtf(d2), cam->znear) / (float)height;
+}
+
+/* What a `fit` sun map's texel must resolve: a camera pixel's world size at the casters'
+ * nearest point (0: no camera), and the half-width of the light's widest penumbra on the
+ * scene's receivers (world units). */
+struct fit_need {
+	float pixel, penumbra;
+};
+
+/* The longest way light passes from a corner of the casters' box along d before it leaves the
+ * scene's box: where their shadows can fall at the farthest. */
+static float shadow_reach(const float d[3], const struct rnd_aabb *casters, const struct rnd_aabb *bounds)
+{
+	float far = 0;
+	for (int i = 0; i < 8 && !rnd_aabb_is_empty(casters); i++) {
+		float t = 1e30f;
+		for (int k = 0; k < 3; k++) {
+			float p = i >> k & 1 ? casters->max[k] : casters->min[k];
+			if (fabsf(d[k]) > 1e-6f) t = fminf(t, ((d[k] > 0 ? bounds->max[k] : bounds->min[k]) - p) / d[k]);
+		}
+		far = fmaxf(far, fmaxf(t, 0.0f));
+	}
+	return far;
+}
+
+/* Width in texels of the smallest footprint the light's filter blurs an edge over: PCF's
+ * (2r+1) kernel, PCSS's narrowest disk (radius 1) and its bilinear taps; a moment map's blur
+ * is the softness asked for, in texels (test_moments): one texel. */
+static float filter_kernel_texels(const struct rnd_light_plan *lp)
+{
+	if (lp->filter == UMBRA_FILTER_PCSS) return 3.0f;
+	return lp->filter == UMBRA_FILTER_PCF ? 2.0f * (float)lp->pcf_radius + 1.0f : 1.0f;
+}
+
 /* A `fit` map (centre cx, cy; half sizes hx, hy; margin grow; fres texels) cut down to the
  * casters' box, as deep as before: a receiver outside it has nothing between it and the sun.
- * (thumb-256 drew a 2048^2 map and used a 400^2 corner.) Same texels, on the same grid (a
- * shifted grid moved the truth test's PCSS score), in the smallest tile holding the box and
- * the filter's reach. A moment blur clamps at the tile's edge and a lit ground read dark within
- * a blur of it: that band reads as lit (moment_edge), the casters keep a blur away from it. */
+ * (thumb-256 drew a 2048^2 map and used a 400^2 corner.) The texel: the whole scene's map's,
+ * finer where the camera sees the casters close (`pixel`, a camera pixel's world size at the
+ * casters' nearest point): the filter's narrowest kernel within a pixel, as hard_light_res
+ * asks of a hard spot, and at most one doubling of the tile the scene's texels need (the
+ * shadow pass grows at most 4x); then the tile filled (the texel shrunk until the box and the
+ * filter's reach span it: the same texels, finer), except that PCSS's texels stay wide enough
+ * for its 24-texel search to reach the light's widest penumbra on the scene's receivers
+ * (`penumbra`), in the tile they need. A light asking for a resolution (at or above the
+ * default: the caller decides) gets that tile. Issue 31: a masked checker 0.7 m over a
+ * 14 m ground had the ground's 9 mm texels in a half-empty 256 tile, about three to a pixel:
+ * PCSS's narrowest disk blurred its cells' edges over a pixel (IoU 0.948 against Cycles).
+ * The grid: whole texels from the light basis' origin. A moment blur clamps at the tile's edge
+ * and a lit ground read dark within a blur of it: that band reads as lit (moment_edge), the
+ * casters keep a blur away from it. */
 static void fit_casters(const struct rnd_shadow *s, const float view[16], const struct rnd_aabb *casters,
-                        struct rnd_light_plan *lp, float *fres, float *cx, float *cy, float *hx, float *hy, float *grow)
+                        const struct fit_need *need, struct rnd_light_plan *lp, float *fres, float *cx, float *cy,
+                        float *hx, float *hy, float *grow)
 {
 	float blur = ceilf(fmaxf(s->vsm_blur, 0.0f));
 	float reach = (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels
 	               : lp->moments ? 2.0f * blur + 1.0f : (float)lp->pcf_radius) + 2.0f;
-	/* the whole scene's map: its texels and its texel grid's origin */
+	/* the whole scene's map's texels */
 	float tx = 2.0f * *hx * *grow / *fres, ty = 2.0f * *hy * *grow / *fres;
-	float ox = *cx - *hx * *grow, oy = *cy - *hy * *grow;
 	uint32_t res = 64;
-	if (!rnd_aabb_is_empty(casters)) {
-		/* the casters' box and margin in whole texels of that grid */
+	bool cut = rnd_aabb_is_empty(casters);   /* nothing casts: the smallest tile */
+	if (!cut) {
 		struct rnd_aabb lc;
 		rnd_aabb_transform(&lc, casters, view);
-		float x0 = floorf((lc.min[0] - ox) / tx - reach), x1 = ceilf((lc.max[0] - ox) / tx + reach);
-		float y0 = floorf((lc.min[1] - oy) / ty - reach), y1 = ceilf((lc.max[1] - oy) / ty + reach);
-		float need = fmaxf(x1 - x0, y1 - y0);
-		while ((float)res < need && (float)res < *fres) res *= 2;
-		if ((float)res < *fres) {
-			/* centred on the casters, whole texels from the grid's origin */
-			float sx = floorf(0.5f * (x0 + x1 - (float)res)), sy = floorf(0.5f * (y0 + y1 - (float)res));
+		float span = fmaxf((lc.max[0] - lc.min[0]) / tx, (lc.max[1] - lc.min[1]) / ty);  /* in those texels */
+		while ((float)res < span + 2.0f * reach + 2.0f && (float)res < *fres) res *= 2;
+		if (s->resolution) res = (uint32_t)*fres;
+		float want = need->pixel / filter_kernel_texels(lp), finer = want > 0 ? fminf(want / fmaxf(tx, ty), 1.0f) : 1.0f;
+		if (span / finer + 2.0f * reach + 2.0f > (float)res && 2.0f * (float)res <= *fres) res *= 2;
+		float fit = ((float)res - 2.0f * reach - 2.0f) / fmaxf(span, 1e-6f);   /* texels per scene texel */
+		/* PCSS searches and filters within search_texels: texels no finer than its widest
+		 * penumbra there, never coarser than the scene's; the tile no larger than they need */
+		float fill = fit;
+		if (lp->filter == UMBRA_FILTER_PCSS && need->penumbra > 0)
+			fill = fminf(fit, fmaxf(fmaxf(tx, ty) * lp->search_texels / need->penumbra, 1.0f));
+		while (!s->resolution && res > 64 && (float)res / 2.0f >= span * fill + 2.0f * reach + 2.0f) res /= 2;
+		if (fit >= 1.0f) {
+			cut = true;
+			tx /= fill; ty /= fill;
 			*hx = 0.5f * (float)res * tx; *hy = 0.5f * (float)res * ty;
-			*cx = ox + sx * tx + *hx; *cy = oy + sy * ty + *hy;
+			*cx = tx * roundf(0.5f * (lc.min[0] + lc.max[0]) / tx);
+			*cy = ty * roundf(0.5f * (lc.min[1] + lc.max[1]) / ty);
 			*grow = 1.0f;
 			if (lp->moments) lp->moment_edge = blur + 1.0f;
 		}
 	}
-	lp->resolution = res < (uint32_t)*fres ? res : (uint32_t)*fres;
-	if (res < (uint32_t)*fres) lp->size_rule = RND_SIZE_CASTERS;
+	if (!cut) res = (uint32_t)*fres;
+	lp->resolution = res;
+	if (cut) lp->size_rule = RND_SIZE_CASTERS;
 	*fres = (float)lp->resolution;
 }
 
 /* A directional light's views: clipmap levels, one fitted map, or cascades. */
 static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, const struct rnd_aabb *bounds,
-                                        const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
+                                        const struct rnd_aabb *casters, float cam_pixel, const struct rnd_camera_plan *cam,
                                         bool clipmap, bool cascades, uint32_t ncasc, struct rnd_light_plan *lp,
                                         struct rnd_shadow_plan *out, struct rnd_error *err)
 {
@@ -409,7 +476,10 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		fit_box(view, own ? casters : bounds, lp->filter, &cx, &cy, &hx, &hy);
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
 		if (own) grow = 1.0f + 2.0f * ((lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : (float)lp->pcf_radius) + 3.0f) / fres;
-		else if (casters && s->resolution == 0) fit_casters(s, view, casters, lp, &fres, &cx, &cy, &hx, &hy, &grow);
+		else if (casters && (!s->resolution || s->resolution >= RND_DEFAULT_SHADOW_RESOLUTION)) {
+			struct fit_need need = {cam_pixel, tanf(0.5f * L->angular_diameter) * shadow_reach(d, casters, bounds)};
+			fit_casters(s, view, casters, &need, lp, &fres, &cx, &cy, &hx, &hy, &grow);
+		}
 		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
 		lp->max_distance = s->max_distance;
 	} else {
@@ -461,6 +531,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		                   scene->light_count, UMBRA_MAX_LIGHTS);
 	bool empty = rnd_aabb_is_empty(bounds);
 	out->resolution = 0;
+	float cam_pixel = casters ? camera_pixel_at(cam, scene->height, casters) : 0.0f;
 
 	for (uint32_t i = 0; i < scene->light_count && !empty; i++) {
 		const struct rnd_light *L = &scene->lights[i];
@@ -503,7 +574,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		lp->first_view = out->view_count;
 		lp->view_count = need;
 		lp->follows_camera = cascades || clipmap;
-		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, casters, cam, clipmap, cascades, ncasc, lp, out, err)
+		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, casters, cam_pixel, cam, clipmap, cascades, ncasc, lp, out, err)
 		                                     : plan_local(L, i, bounds, lp, out, err);
 		if (r != RND_OK) return r;
 		if (lp->resolution > out->resolution) out->resolution = lp->resolution;

@@ -54,7 +54,7 @@ enum rnd_size_rule {
 	RND_SIZE_DEFAULT,      /* a sun's default (RND_DEFAULT_SHADOW_RESOLUTION) */
 	RND_SIZE_IMPORTANCE,   /* a spot or point light's share of the view (light_importance_res) */
 	RND_SIZE_HARD_EDGE,    /* a hard light's kernel within a pixel (hard_light_res) */
-	RND_SIZE_CASTERS,      /* a `fit` sun map cut to the casters' box, same texels (fit_casters) */
+	RND_SIZE_CASTERS,      /* a `fit` sun map cut to the casters' box, texels for the camera (fit_casters) */
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
 	RND_SIZE_RULE_COUNT
 };
@@ -76,8 +76,10 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 /* The same, with the `auto` directional choice made by the caller: cascades[i] 1 = cascades,
  * 0 = fit (later views of a request keep view 0's choice, so they need the same tiles); and
  * with the bounds of what casts shadows (casters, within bounds; empty: nothing casts), which
- * a `fit` sun map covers instead of the whole scene, at the same texel size, in a smaller
- * tile (NULL: the whole scene, as rnd_shadow_plan). */
+ * a `fit` sun map covers instead of the whole scene, in a smaller tile, with texels no coarser
+ * than the whole scene's and finer where cam sees the casters close (plan.c fit_casters; a
+ * light asking for a resolution under the default keeps the whole scene) (NULL: the whole
+ * scene, as rnd_shadow_plan). */
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                      const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
                                      const uint8_t *cascades,

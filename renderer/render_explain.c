@@ -28,7 +28,7 @@ static const char *const size_why[RND_SIZE_RULE_COUNT] = {
 	[RND_SIZE_DEFAULT] = "a sun's default",
 	[RND_SIZE_IMPORTANCE] = "the share of the view the light's reach covers",
 	[RND_SIZE_HARD_EDGE] = "a hard light: its filter kernel within a pixel of the output",
-	[RND_SIZE_CASTERS] = "the default map's texels, cut to the casters' box",
+	[RND_SIZE_CASTERS] = "the casters' box: texels finer than the default map's where the camera sees them close",
 	[RND_SIZE_CAPPED] = "the server's largest shadow resolution",
 };
 

@@ -306,6 +306,18 @@ static enum rnd_result plan_shadows(const struct rnd_plan *p, uint32_t v, const 
 	if (v == 0)
 		for (uint32_t i = 0; i < esc->light_count && i < UMBRA_MAX_LIGHTS; i++)
 			cascades[i] = sp->lights[i].follows_camera && !sp->lights[i].clipmap;
+	/* Later views read view 0's maps that do not follow the camera (plan_view_work skips
+	 * drawing them): they read them through view 0's projection, which a `fit` sun's texel
+	 * chosen for view 0's camera (plan.c fit_casters) makes their own. */
+	for (uint32_t i = 0; v > 0 && i < esc->light_count && i < UMBRA_MAX_LIGHTS; i++) {
+		struct rnd_light_plan *lp = &sp->lights[i];
+		const struct rnd_light_plan *l0 = &p->views[0].lights[i];
+		if (!lp->view_count || lp->follows_camera || lp->view_count != l0->view_count) continue;
+		memcpy(&sp->views[lp->first_view], &p->views[0].views[l0->first_view], lp->view_count * sizeof *sp->views);
+		lp->resolution = l0->resolution;
+		lp->size_rule = l0->size_rule;
+		if (lp->resolution > sp->resolution) sp->resolution = lp->resolution;
+	}
 	bool any_moments = false;
 	for (uint32_t i = 0; i < sc->light_count; i++)
 		if (sp->lights[i].moments && sp->lights[i].view_count) any_moments = true;

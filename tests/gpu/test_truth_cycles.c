@@ -88,8 +88,12 @@ TEST(cycles_low_poly_shapes_sun)
 }
 
 /* An 8x8 checker of alpha-masked cells on a tilted quad 0.7 m above the ground, under a sun of
- * 0.5 degrees: the cells' shadows, corners touching. */
+ * 0.5 degrees: the cells' shadows, corners touching. Before the sun map's texel followed the
+ * camera (plan.c fit_casters: the 14 m ground's 9 mm texels in a half-empty 256 tile, PCSS's
+ * narrowest disk over a pixel): default rmse 0.0386, iou 0.948; at 4096 (the whole scene)
+ * 0.0163, 0.9825. After (a 512 tile filled, 2.6 mm): 0.0113, 0.976; at 4096 (on the casters)
+ * 0.0060, 0.995. The bounds are the issue's targets. */
 TEST(cycles_masked_checker_sun)
 {
-	check_cycles(&(struct cycles_case){"masked_sun", 0.045, 0.94, 0.05});
+	check_cycles(&(struct cycles_case){"masked_sun", 0.02, 0.97, 0.02});
 }

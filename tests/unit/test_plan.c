@@ -307,12 +307,13 @@ TEST(plan_fit_covers_scene_bounds)
 }
 
 /* A sun over a 2 m object on a 40 m ground that casts nothing (rnd_shadow_plan_with's
- * casters): the fitted map is a smaller tile around the casters (a quarter the side, half under
- * a sun 8 degrees up, whose map is a long box) with the texels of the default
- * map around the whole scene, on that map's very texel grid (an integer number of its texels
- * from its origin), with the filter's reach as margin; a light that asks for a resolution keeps
- * the whole scene; no caster at all gives the smallest tile. */
-TEST(plan_fit_covers_the_casters_on_the_whole_scenes_grid)
+ * casters): the fitted map is a smaller tile around the casters (at most 1024, 2048 under a
+ * sun 8 degrees up, whose map is a long box) with texels no coarser than the default map's
+ * around the whole scene, on whole texels from the light basis' origin, with the filter's
+ * reach as margin; a light that asks for less than the default resolution keeps the whole
+ * scene, one that asks for more spends it on the casters (finer than the default's); no
+ * caster at all gives the smallest tile. */
+TEST(plan_fit_covers_the_casters_on_whole_texels)
 {
 	static const float dirs[][3] = {{-0.5f, -1, -0.3f}, {0.2f, -1, 0.1f}, {1, -0.15f, 0.3f}};
 	static const enum rnd_filter filters[] = {RND_FILTER_PCF, RND_FILTER_PCSS};
@@ -335,47 +336,72 @@ TEST(plan_fit_covers_the_casters_on_the_whole_scenes_grid)
 			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &empty, &cp, NULL, &none, &err) == RND_OK, "none: %s",
 			        err.msg);
 			const struct umbra_shadow_view *w = &whole.views[0], *v = &part.views[0];
-			CHECK(w->rect[2] == 2048.0f && v->rect[2] <= (di == 2 ? 1024.0f : 512.0f) && part.lights[0].resolution == (uint32_t)v->rect[2],
+			CHECK(w->rect[2] == 2048.0f && v->rect[2] <= (di == 2 ? 2048.0f : 1024.0f) &&
+			      part.lights[0].resolution == (uint32_t)v->rect[2],
 			      "dir %d filter %d: tiles %g (whole scene) and %g (casters)", di, fi, w->rect[2], v->rect[2]);
 			CHECK(none.views[0].rect[2] == 64.0f, "no caster: tile %g", none.views[0].rect[2]);
-			/* texel size and grid: light-space x, y of a world point in texels of each map */
+			CHECK(v->params[0] <= w->params[0] * (1.0f + 1e-5f), "dir %d filter %d: texel %g, the whole scene's %g", di,
+			      fi, v->params[0], w->params[0]);
 			double reach = (filters[fi] == RND_FILTER_PCSS ? 24.0 : (double)part.lights[0].pcf_radius) + 2.0;
-			for (int i = 0; i < 9; i++) {
-				double p[3], nw[3], nv[3];
-				if (i < 8) corner(&casters, i, p);
-				else { p[0] = 4; p[1] = 1; p[2] = 0; }
-				ndc3(w->view_proj, p, nw);
+			double origin[3] = {0, 0, 0}, no[3];
+			ndc3(v->view_proj, origin, no);
+			for (int a = 0; a < 2; a++)
+				CHECK(frac_dist((no[a] * 0.5 + 0.5) * v->rect[2], 0.0) < 1e-3,
+				      "dir %d filter %d axis %d: the light basis' origin at texel %.4f, not on the grid", di, fi, a,
+				      (no[a] * 0.5 + 0.5) * v->rect[2]);
+			for (int i = 0; i < 8; i++) {
+				double p[3], nv[3];
+				corner(&casters, i, p);
 				ndc3(v->view_proj, p, nv);
 				for (int a = 0; a < 2; a++) {
-					double tw = (nw[a] * 0.5 + 0.5) * w->rect[2], tv = (nv[a] * 0.5 + 0.5) * v->rect[2];
-					CHECK(frac_dist(tw, tv) < 1e-3, "dir %d filter %d point %d axis %d: texel %.4f in the whole map, %.4f "
-					      "in the casters' one: not the same grid", di, fi, i, a, tw, tv);
-					if (i == 8) {
-						/* one texel further along this axis moves one texel in both maps */
-						double q[3] = {p[0], p[1], p[2]}, mw[3], mv[3];
-						double step = 1e-3;
-						q[0] += step;
-						ndc3(w->view_proj, q, mw);
-						ndc3(v->view_proj, q, mv);
-						double dw = (mw[a] - nw[a]) * w->rect[2], dv = (mv[a] - nv[a]) * v->rect[2];
-						CHECK(fabs(dw - dv) <= 1e-3 * fabs(dw) + 1e-9, "dir %d axis %d: texel sizes differ (%g vs %g)", di,
-						      a, dw, dv);
-					}
-					if (i < 8)
-						CHECK(tv >= reach - 1e-3 && tv <= v->rect[2] - reach + 1e-3,
-						      "dir %d filter %d corner %d axis %d at texel %.2f of %g: less than %g texels of margin", di,
-						      fi, i, a, tv, v->rect[2], reach);
+					double tv = (nv[a] * 0.5 + 0.5) * v->rect[2];
+					CHECK(tv >= reach - 1e-3 && tv <= v->rect[2] - reach + 1e-3,
+					      "dir %d filter %d corner %d axis %d at texel %.2f of %g: less than %g texels of margin", di, fi,
+					      i, a, tv, v->rect[2], reach);
 				}
 			}
-			CHECK(fabs(v->params[0] - w->params[0]) <= 1e-5f * w->params[0], "texel world size %g vs %g", v->params[0],
-			      w->params[0]);
 			f.light.shadow.resolution = 1024;
 			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &asked, &err) == RND_OK, "asked: %s",
 			        err.msg);
 			REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
 			CHECK(!memcmp(&asked.views[0], &whole.views[0], sizeof asked.views[0]),
-			      "dir %d: an asked-for resolution must keep the whole scene's map", di);
+			      "dir %d: an asked-for resolution under the default must keep the whole scene's map", di);
+			f.light.shadow.resolution = 4096;
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &asked, &err) == RND_OK, "4096: %s",
+			        err.msg);
+			CHECK(asked.views[0].rect[2] == 4096.0f && asked.views[0].params[0] < v->params[0],
+			      "dir %d filter %d: asked 4096: tile %g, texel %g, the default's %g", di, fi, asked.views[0].rect[2],
+			      asked.views[0].params[0], v->params[0]);
 		}
+}
+
+/* The casters' texel follows the camera: a 128-texel-high image of a 0.3 m object 20 cm over a
+ * 14 m ground seen from 40 m keeps the whole scene's texels, seen from 1.5 m gets finer ones
+ * (PCF's 3-texel kernel within a pixel) but at most one doubling of the tile. */
+TEST(plan_fit_texels_finer_where_the_camera_sees_the_casters)
+{
+	static const float dir[3] = {-0.2f, -0.8f, 0.6f};
+	struct rnd_aabb scene, casters;
+	set_box(&scene, -7, 0, -7, 7, 0.5f, 7);
+	set_box(&casters, -0.15f, 0.2f, -0.15f, 0.15f, 0.5f, 0.15f);
+	static struct rnd_shadow_plan plan[2];
+	for (int c = 0; c < 2; c++) {
+		struct fixture f;
+		fixture_fit_sun(&f, 14.0f, dir);
+		f.light.shadow.filter = RND_FILTER_PCF;
+		f.scene.width = f.scene.height = 128;
+		float d = c ? 1.5f : 40.0f;
+		camera_at(&f.scene.camera, 0, d * 0.6f, d * 0.8f, 0, 0.3f, 0, 0, 0);
+		struct rnd_camera_plan cp;
+		struct rnd_error err = {0};
+		REQUIRE(rnd_camera_plan(&f.scene.camera, 128, 128, &scene, &cp, &err) == RND_OK, "camera: %s", err.msg);
+		REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &plan[c], &err) == RND_OK, "plan: %s",
+		        err.msg);
+	}
+	const struct umbra_shadow_view *far = &plan[0].views[0], *near = &plan[1].views[0];
+	CHECK(near->params[0] < 0.6f * far->params[0], "texel %g from 1.5 m, %g from 40 m", near->params[0], far->params[0]);
+	CHECK(near->rect[2] <= 2.0f * far->rect[2], "tile %g from 1.5 m, %g from 40 m", near->rect[2], far->rect[2]);
+	CHECK(plan[1].lights[0].size_rule == RND_SIZE_CASTERS, "size rule %u", plan[1].lights[0].size_rule);
 }
 
 /* A sun 7 degrees above a 30 m plane: the bounds' light-space box is ~8:1, and the fitted map
