@@ -277,14 +277,9 @@ static void set_defaults(struct srv_config *cfg)
 	cfg->no_playground = v && *v && strcmp(v, "0") != 0;
 }
 
-int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+/* Every UMBRA_<FLAG> variable of the environment into cfg (flags win: they come after). */
+static int load_env(struct srv_config *cfg)
 {
-	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
-	set_defaults(cfg);
-	early_format = peek_log_format(argc, argv);
-	srv_log_init(early_format);
-
-	/* Environment first. */
 	for (size_t i = 0; i < OPT_COUNT; i++) {
 		char env[64] = "UMBRA_";
 		size_t n = strlen(env);
@@ -295,8 +290,12 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		if (val && apply(cfg, &opts[i], val, env) != 0)
 			return -1;
 	}
+	return 0;
+}
 
-	/* Then flags. */
+/* The command line's flags into cfg: 0, 1 after --help, -1 on a bad one. */
+static int load_flags(struct srv_config *cfg, int argc, char **argv)
+{
 	struct option lopts[OPT_COUNT + 3];
 	for (size_t i = 0; i < OPT_COUNT; i++)
 		lopts[i] = (struct option){ opts[i].name, required_argument, NULL, (int)(i + 1000) };
@@ -331,6 +330,12 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		usage(stderr);
 		return -1;
 	}
+	return 0;
+}
+
+/* What no single flag can check alone, and what follows from several; -1 on a bad value. */
+static int check_and_derive(struct srv_config *cfg)
+{
 	if (cfg->limits.max_shadow_resolution && cfg->limits.max_shadow_resolution < RND_MIN_SHADOW_RESOLUTION) {
 		config_error("--max-shadow-resolution: %u is under the smallest map, %u (0: no limit)",
 		        cfg->limits.max_shadow_resolution, RND_MIN_SHADOW_RESOLUTION);
@@ -372,4 +377,18 @@ int srv_config_load(struct srv_config *cfg, int argc, char **argv)
 		cfg->import_slots = fit < 1 ? 1 : fit < cfg->workers ? (unsigned)fit : cfg->workers;
 	}
 	return 0;
+}
+
+int srv_config_load(struct srv_config *cfg, int argc, char **argv)
+{
+	_Static_assert(sizeof(unsigned) == sizeof(uint32_t), "unsigned members are set as uint32_t");
+	set_defaults(cfg);
+	early_format = peek_log_format(argc, argv);
+	srv_log_init(early_format);
+	if (load_env(cfg) != 0)
+		return -1;
+	int rc = load_flags(cfg, argc, argv);
+	if (rc != 0)
+		return rc;
+	return check_and_derive(cfg);
 }

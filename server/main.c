@@ -73,6 +73,46 @@ static void process_init(struct srv_server *s, sigset_t *sigs)
 		s->id_seed = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32);
 }
 
+/* The daemon's parts that need no device: metrics, queue, admission, gate, import slots and
+ * the results cache (parts_destroy gives back what was made). */
+static int parts_create(struct srv_server *s)
+{
+	s->metrics = srv_metrics_create();
+	s->queue = srv_queue_create(s->cfg.queue);
+	srv_admit_init(&s->admit, s->cfg.max_memory);
+	srv_gate_init(&s->gate, s->cfg.workers);
+	s->imports = srv_imports_create(s->cfg.import_slots);
+	s->results = srv_results_create((uint64_t)s->cfg.result_cache_mb << 20);
+	if (!s->metrics || !s->queue || !s->imports || (s->cfg.result_cache_mb && !s->results)) {
+		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
+		return -1;
+	}
+	return 0;
+}
+
+static void parts_destroy(struct srv_server *s)
+{
+	api_model_cache_clear();
+	srv_queue_destroy(s->queue);
+	srv_imports_destroy(s->imports);
+	srv_results_destroy(s->results);
+	srv_metrics_destroy(s->metrics);
+	srv_admit_destroy(&s->admit);
+	pthread_rwlock_destroy(&s->ctx_lock);
+	srv_gate_destroy(&s->gate);
+}
+
+/* Ready: until SIGTERM or SIGINT, then the grace (--drain-grace-ms). */
+static void wait_for_signal(struct srv_server *s, sigset_t *sigs)
+{
+	int sig = 0;
+	while (sigwait(sigs, &sig) != 0)
+		;
+	grace(s, sigs, sig);
+	srv_log(SRV_LOG_INFO, "%s: draining (%u queued, %u rendering)", sig == SIGINT ? "SIGINT" : "SIGTERM",
+	        srv_queue_depth(s->queue), atomic_load(&s->in_flight));
+}
+
 int main(int argc, char **argv)
 {
 	static struct srv_server srv;
@@ -94,16 +134,8 @@ int main(int argc, char **argv)
 	sigset_t sigs;
 	process_init(s, &sigs);
 
-	s->metrics = srv_metrics_create();
-	s->queue = srv_queue_create(s->cfg.queue);
-	srv_admit_init(&s->admit, s->cfg.max_memory);
-	srv_gate_init(&s->gate, s->cfg.workers);
-	s->imports = srv_imports_create(s->cfg.import_slots);
-	s->results = srv_results_create((uint64_t)s->cfg.result_cache_mb << 20);
-	if (!s->metrics || !s->queue || !s->imports || (s->cfg.result_cache_mb && !s->results)) {
-		srv_log(SRV_LOG_ERROR, "out of memory at start-up");
+	if (parts_create(s) != 0)
 		goto out_free;
-	}
 	srv_log(SRV_LOG_INFO, "umbrad %s starting: %u workers, queue %u, max body %llu, deadline %u ms",
 	        UMBRA_VERSION, s->cfg.workers, s->cfg.queue, (unsigned long long)s->cfg.max_body, s->cfg.deadline_ms);
 	if (srv_http_start(s) != 0)
@@ -121,12 +153,7 @@ int main(int argc, char **argv)
 	atomic_store(&s->ready, true);
 	srv_log(SRV_LOG_INFO, "ready");
 
-	int sig = 0;
-	while (sigwait(&sigs, &sig) != 0)
-		;
-	grace(s, &sigs, sig);
-	srv_log(SRV_LOG_INFO, "%s: draining (%u queued, %u rendering)", sig == SIGINT ? "SIGINT" : "SIGTERM",
-	        srv_queue_depth(s->queue), atomic_load(&s->in_flight));
+	wait_for_signal(s, &sigs);
 	exit_code = 0;
 
 out_workers:
@@ -150,14 +177,7 @@ out_context:
 out_http:
 	srv_http_stop(s);
 out_free:
-	api_model_cache_clear();
-	srv_queue_destroy(s->queue);
-	srv_imports_destroy(s->imports);
-	srv_results_destroy(s->results);
-	srv_metrics_destroy(s->metrics);
-	srv_admit_destroy(&s->admit);
-	pthread_rwlock_destroy(&s->ctx_lock);
-	srv_gate_destroy(&s->gate);
+	parts_destroy(s);
 	if (exit_code == 0)
 		srv_log(SRV_LOG_INFO, "stopped");
 	return exit_code;
