@@ -131,31 +131,55 @@ static bool grid_build(struct grid *g, const struct welded *w, const float lo[3]
 	return true;
 }
 
+/* The nearest of the vertices in cells lo..hi to p, into *best (squared; stays when none is
+ * nearer) and *bv: rows in z, y order, each row's cells one run of items, the first of equals. */
+static void nearest_in(const struct grid *g, const float p[3], const uint32_t lo[3], const uint32_t hi[3],
+                       float *best, uint32_t *bv)
+{
+	for (uint32_t z = lo[2]; z <= hi[2]; z++)
+		for (uint32_t y = lo[1]; y <= hi[1]; y++) {
+			size_t row = ((size_t)z * g->dim[1] + y) * g->dim[0];
+			for (uint32_t i = g->start[row + lo[0]], e = g->start[row + hi[0] + 1]; i < e; i++) {
+				const float *q = g->ipos + 3 * (size_t)i;
+				float d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
+				float dd = d0 * d0 + d1 * d1 + d2 * d2;
+				if (dd < *best) { *best = dd; *bv = g->items[i]; }
+			}
+		}
+}
+
 /* Distance of p from the full mesh, estimated as its distance from the tangent plane (the
  * full mesh's vertex normal) of the nearest full-mesh vertex in the cells around it (searched up to 4
- * cells out; none that near counts as 4 cells, which marks the level as coarse). */
+ * cells out; none that near counts as 4 cells, which marks the level as coarse). The nearest in
+ * p's own cell first: a neighbour cell whose side is farther from p than that one cannot hold
+ * a nearer vertex, so the 27 cells around p shrink to those that can (often p's own alone),
+ * searched in the same order: the same vertex as the 27 would give, in a fraction of the time
+ * (the level's measure makes this search for four points of every level triangle). */
 static float surface_distance(const struct grid *g, const struct welded *w, const float p[3])
 {
 	uint32_t c[3] = {cell_of(g, p, 0), cell_of(g, p, 1), cell_of(g, p, 2)};
 	float best = INFINITY;
 	uint32_t bv = 0;
+	nearest_in(g, p, c, c, &best, &bv);
+	if (best < INFINITY) {
+		/* (a margin for the rounding of cell_of's division at a cell's side) */
+		float reach = sqrtf(best) * 1.01f + 1e-4f * g->cell;
+		uint32_t lo[3], hi[3];
+		for (int k = 0; k < 3; k++) {
+			float side = g->lo[k] + (float)c[k] * g->cell;
+			lo[k] = c[k] > 0 && p[k] - side <= reach ? c[k] - 1 : c[k];
+			hi[k] = c[k] + 1 < g->dim[k] && side + g->cell - p[k] <= reach ? c[k] + 1 : c[k];
+		}
+		best = INFINITY;
+		nearest_in(g, p, lo, hi, &best, &bv);
+	}
 	for (uint32_t r = 1; r <= 4 && best == INFINITY; r++) {
 		uint32_t lo[3], hi[3];
 		for (int k = 0; k < 3; k++) {
 			lo[k] = c[k] > r ? c[k] - r : 0;
 			hi[k] = c[k] + r < g->dim[k] ? c[k] + r : g->dim[k] - 1;
 		}
-		for (uint32_t z = lo[2]; z <= hi[2]; z++)
-			for (uint32_t y = lo[1]; y <= hi[1]; y++) {
-				/* cells lo[0]..hi[0] of this row: one run of items */
-				size_t row = ((size_t)z * g->dim[1] + y) * g->dim[0];
-				for (uint32_t i = g->start[row + lo[0]], e = g->start[row + hi[0] + 1]; i < e; i++) {
-					const float *q = g->ipos + 3 * (size_t)i;
-					float d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
-					float dd = d0 * d0 + d1 * d1 + d2 * d2;
-					if (dd < best) { best = dd; bv = g->items[i]; }
-				}
-			}
+		nearest_in(g, p, lo, hi, &best, &bv);
 	}
 	if (best == INFINITY) return 4.0f * g->cell; /* far from every vertex: at least this coarse */
 	float d[3];
@@ -255,89 +279,186 @@ static float point_triangle_d2(const float p[3], const float a[3], const float b
 	return rnd_v3_dot(ap, ap);
 }
 
-/* How far a level (idx: ni indices into w) is from the full mesh: the largest distance of its
- * triangles' centroids and edge midpoints (its vertices are the full mesh's own) from the full
- * mesh's faces met walking out from the triangle's corners without leaving the ball around it
- * (its circumscribing sphere, widened by half): exact, where the faces nearest a point are among
- * those (else more, never less). That walk covers thousands of faces for a coarse level's
- * triangle, so it runs only for triangles where the cheap estimate (surface_distance) comes
- * within half the level's worst so far, and stops as soon as no sample of the triangle can
- * raise it; where the cheap estimate is far below the truth, a triangle is missed (two of the
- * ogre OBJ's levels come out 16 and 19 % under the figure of the walk run everywhere). The
- * cheap estimate alone had been the measure: a nearest vertex found in space can belong to
- * another part close by (an eyeball in its socket) or sit on a crease of the triangle's own
- * face, and every level of the 124k-triangle ogre OBJ measured 0.29 of its 12-unit height that
- * way, so none was ever drawn. meshoptimizer's own error measures the kept vertices against
- * the removed faces' planes and says nothing of the new triangles' insides: on a sphere it
- * claims 6x less than this. */
-static float level_error(const struct grid *g, struct walk *k, const struct welded *w, const uint32_t *idx, size_t ni)
+/* A level triangle's samples: s[0] its centroid, s[1..3] its edges' midpoints (its corners are
+ * the full mesh's own vertices); v[] its corners. */
+static void tri_samples(const struct welded *w, const uint32_t *tri, const float *v[3], float s[4][3])
 {
-	float worst2 = 0.0f;
-	for (size_t t = 0; t + 2 < ni; t += 3) {
-		const float *v[3] = {w->pos + 3 * (size_t)idx[t], w->pos + 3 * (size_t)idx[t + 1], w->pos + 3 * (size_t)idx[t + 2]};
-		float s[4][3], r2 = 0.0f;
-		for (int a = 0; a < 3; a++) {
-			s[0][a] = (v[0][a] + v[1][a] + v[2][a]) / 3.0f;
-			s[1][a] = 0.5f * (v[0][a] + v[1][a]);
-			s[2][a] = 0.5f * (v[1][a] + v[2][a]);
-			s[3][a] = 0.5f * (v[2][a] + v[0][a]);
-		}
-		/* The walk is dear (a coarse level's triangle covers thousands of faces): only where the
-		 * cheap estimate (surface_distance), which can understate (another part close by, a
-		 * crease), comes within half the level's worst. From the worst itself levels came out
-		 * up to ~25 % low (the beast OBJ's third: 0.61 against 0.79); from half of it they match
-		 * the walk run everywhere but for two of the ogre's, for 10-25 % more import time (the
-		 * walk everywhere: +50-90 %). */
-		bool any = false;
-		for (int q = 0; q < 4; q++) {
-			float e = surface_distance(g, w, s[q]);
-			any |= 4.0f * e * e > worst2;
-		}
-		if (!any) continue;
+	for (int c = 0; c < 3; c++) v[c] = w->pos + 3 * (size_t)tri[c];
+	for (int a = 0; a < 3; a++) {
+		s[0][a] = (v[0][a] + v[1][a] + v[2][a]) / 3.0f;
+		s[1][a] = 0.5f * (v[0][a] + v[1][a]);
+		s[2][a] = 0.5f * (v[1][a] + v[2][a]);
+		s[3][a] = 0.5f * (v[2][a] + v[0][a]);
+	}
+}
+
+/* The squared distance of the level triangle tri's samples from the full mesh's faces met
+ * walking out from its corners without leaving the ball around it (its circumscribing sphere,
+ * widened by half), the largest of the four; or at most worst2 (the walk stops early) when
+ * every sample comes within sqrt(worst2) of a face: then the triangle cannot raise the level's
+ * worst. The walk's order does not change the answer: it is the exact figure over the faces
+ * of the ball's connected part, or one not above worst2. */
+/* Whether each of a level triangle's samples s (corners v, ball r2 around s[0]) comes within
+ * sqrt(worst2) of a full-mesh face met going downhill from its nearest corner: from a vertex to
+ * its faces' vertex nearest the sample, inside the ball, until none is nearer. Those faces are
+ * among walk_triangle's (each vertex on the way is one its walk queues), so when this is true
+ * the walk would stop early too, and the triangle cannot raise the level's worst; a few dozen
+ * faces a sample where the walk meets thousands before its early stop. */
+static bool downhill_within(const struct walk *k, const struct welded *w, const uint32_t *tri, const float *v[3],
+                            const float s[4][3], float r2, float worst2)
+{
+	for (int q = 0; q < 4; q++) {
+		uint32_t u = tri[0];
+		float du = INFINITY, best = INFINITY;
 		for (int c = 0; c < 3; c++) {
 			float d[3];
-			rnd_v3_sub(d, v[c], s[0]);
-			r2 = max_f(r2, rnd_v3_dot(d, d));
+			rnd_v3_sub(d, v[c], s[q]);
+			if (rnd_v3_dot(d, d) < du) du = rnd_v3_dot(d, d), u = tri[c];
 		}
-		r2 *= 2.25f;
-		float best[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
-		if (++k->stamp == 0) {
-			memset(k->vseen, 0, w->count * sizeof *k->vseen);
-			memset(k->fseen, 0, (k->start[w->count] / 3) * sizeof *k->fseen);
-			k->stamp = 1;
-		}
-		uint32_t head = 0, tail = 0;
-		for (int c = 0; c < 3; c++)
-			if (k->vseen[idx[t + (size_t)c]] != k->stamp) {
-				k->vseen[idx[t + (size_t)c]] = k->stamp;
-				k->queue[tail++] = idx[t + (size_t)c];
-			}
-		while (head < tail) {
-			uint32_t u = k->queue[head++];
+		for (int step = 0; step < 256 && best > worst2; step++) {
+			uint32_t next = u;
 			for (uint32_t i = k->start[u]; i < k->start[u + 1]; i++) {
-				uint32_t f = k->faces[i];
-				if (k->fseen[f] == k->stamp) continue;
-				k->fseen[f] = k->stamp;
-				const uint32_t *fi = k->idx + 3 * (size_t)f;
-				const float *a = w->pos + 3 * (size_t)fi[0], *b = w->pos + 3 * (size_t)fi[1], *c = w->pos + 3 * (size_t)fi[2];
-				float most = 0.0f;
-				for (int q = 0; q < 4; q++) most = max_f(most, best[q] = min_f(best[q], point_triangle_d2(s[q], a, b, c)));
-				/* Every sample already this near a face: the rest of the walk can only find
-				 * nearer ones, and this triangle cannot raise the level's worst. */
-				if (most <= worst2) { head = tail; break; }
+				const uint32_t *fi = k->idx + 3 * (size_t)k->faces[i];
+				best = min_f(best, point_triangle_d2(s[q], w->pos + 3 * (size_t)fi[0], w->pos + 3 * (size_t)fi[1],
+				                                     w->pos + 3 * (size_t)fi[2]));
 				for (int j = 0; j < 3; j++) {
-					uint32_t x = fi[j];
-					if (k->vseen[x] == k->stamp) continue;
-					k->vseen[x] = k->stamp;
-					float d[3];
-					rnd_v3_sub(d, w->pos + 3 * (size_t)x, s[0]);
-					if (rnd_v3_dot(d, d) <= r2) k->queue[tail++] = x;
+					const float *x = w->pos + 3 * (size_t)fi[j];
+					float d[3], e[3];
+					rnd_v3_sub(d, x, s[q]);
+					rnd_v3_sub(e, x, s[0]);
+					if (rnd_v3_dot(d, d) < du && rnd_v3_dot(e, e) <= r2) du = rnd_v3_dot(d, d), next = fi[j];
 				}
 			}
+			if (next == u) break;
+			u = next;
 		}
-		for (int q = 0; q < 4; q++) worst2 = max_f(worst2, best[q]);
+		if (best > worst2) return false;
 	}
+	return true;
+}
+
+static float walk_triangle(struct walk *k, const struct welded *w, const uint32_t *tri, float worst2)
+{
+	const float *v[3];
+	float s[4][3], r2 = 0.0f;
+	tri_samples(w, tri, v, s);
+	for (int c = 0; c < 3; c++) {
+		float d[3];
+		rnd_v3_sub(d, v[c], s[0]);
+		r2 = max_f(r2, rnd_v3_dot(d, d));
+	}
+	r2 *= 2.25f;
+	if (worst2 > 0.0f && downhill_within(k, w, tri, v, s, r2, worst2)) return worst2;
+	float best[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+	if (++k->stamp == 0) {
+		memset(k->vseen, 0, w->count * sizeof *k->vseen);
+		memset(k->fseen, 0, (k->start[w->count] / 3) * sizeof *k->fseen);
+		k->stamp = 1;
+	}
+	uint32_t head = 0, tail = 0;
+	for (int c = 0; c < 3; c++)
+		if (k->vseen[tri[c]] != k->stamp) {
+			k->vseen[tri[c]] = k->stamp;
+			k->queue[tail++] = tri[c];
+		}
+	while (head < tail) {
+		uint32_t u = k->queue[head++];
+		for (uint32_t i = k->start[u]; i < k->start[u + 1]; i++) {
+			uint32_t f = k->faces[i];
+			if (k->fseen[f] == k->stamp) continue;
+			k->fseen[f] = k->stamp;
+			const uint32_t *fi = k->idx + 3 * (size_t)f;
+			const float *a = w->pos + 3 * (size_t)fi[0], *b = w->pos + 3 * (size_t)fi[1], *c = w->pos + 3 * (size_t)fi[2];
+			float most = 0.0f;
+			for (int q = 0; q < 4; q++) most = max_f(most, best[q] = min_f(best[q], point_triangle_d2(s[q], a, b, c)));
+			/* Every sample already this near a face: the rest of the walk can only find
+			 * nearer ones, and this triangle cannot raise the level's worst. */
+			if (most <= worst2) return most;
+			for (int j = 0; j < 3; j++) {
+				uint32_t x = fi[j];
+				if (k->vseen[x] == k->stamp) continue;
+				k->vseen[x] = k->stamp;
+				float d[3];
+				rnd_v3_sub(d, w->pos + 3 * (size_t)x, s[0]);
+				if (rnd_v3_dot(d, d) <= r2) k->queue[tail++] = x;
+			}
+		}
+	}
+	float most = 0.0f;
+	for (int q = 0; q < 4; q++) most = max_f(most, best[q]);
+	return most;
+}
+
+/* How far a level (idx: ni indices into w) is from the full mesh: the largest distance of its
+ * triangles' centroids and edge midpoints (its vertices are the full mesh's own) from the full
+ * mesh's faces around them (walk_triangle): exact, where the faces nearest a point are among
+ * those (else more, never less). That walk covers thousands of faces for a coarse level's
+ * triangle, so it runs only for triangles whose cheap estimate (surface_distance, the largest
+ * of the four samples') comes within half the level's worst; where the cheap estimate is far
+ * below the truth, a triangle is missed. The cheap estimate alone had been the measure: a
+ * nearest vertex found in space can belong to another part close by (an eyeball in its socket)
+ * or sit on a crease of the triangle's own face, and every level of the 124k-triangle ogre OBJ
+ * measured 0.29 of its 12-unit height that way, so none was ever drawn. meshoptimizer's own
+ * error measures the kept vertices against the removed faces' planes and says nothing of the
+ * new triangles' insides: on a sphere it claims 6x less than this.
+ *
+ * The triangles are walked in descending order of their cheap estimates (ties: index order),
+ * so that the worst rises at once, and the first triangle whose estimate is under half the
+ * worst ends the measure (every later one's is too); a triangle that cannot raise the worst is
+ * mostly told by a few faces downhill from its corners (downhill_within) instead of its walk.
+ * The figure is the same as walking in index order, where the worst rose slowly and each walk
+ * met ~2,200 faces before its early stop: the same errors, bit for bit, on the 1M, 100k and
+ * real-mesh levels measured (docs/performance.md); the 1M-triangle blob STL's level at 256
+ * pixels 270-530 ms -> 60-70 ms. */
+static float level_error(const struct grid *g, struct walk *k, const struct welded *w, const uint32_t *idx, size_t ni)
+{
+	size_t nt = ni / 3;
+	uint64_t *key = malloc((nt ? nt : 1) * 2 * sizeof *key);
+	if (!key) return INFINITY;   /* out of memory: no level (the full mesh is always correct) */
+	for (size_t t = 0; t < nt; t++) {
+		const float *v[3];
+		float s[4][3], e = 0.0f;
+		tri_samples(w, idx + 3 * t, v, s);
+		for (int q = 0; q < 4; q++) e = max_f(e, surface_distance(g, w, s[q]));
+		uint32_t bits;
+		memcpy(&bits, &e, sizeof bits);   /* e >= 0: its bits order as it does */
+		key[t] = (uint64_t)~bits << 32 | (uint64_t)t;
+	}
+	const uint64_t *order = api_radix_sort(key, key + nt, NULL, NULL, nt);
+	float worst2 = 0.0f;
+	for (size_t i = 0; i < nt; i++) {
+		uint32_t bits = ~(uint32_t)(order[i] >> 32);
+		float e;
+		memcpy(&e, &bits, sizeof e);
+		if (4.0f * e * e <= worst2) break;   /* this one's and every later one's estimate */
+		worst2 = max_f(worst2, walk_triangle(k, w, idx + 3 * (uint32_t)order[i], worst2));
+	}
+	free(key);
 	return sqrtf(worst2);
+}
+
+/* The figure level_error stands for: every triangle of the level walked to the end. */
+static float level_error_everywhere(struct walk *k, const struct welded *w, const uint32_t *idx, size_t ni)
+{
+	float worst2 = 0.0f;
+	for (size_t t = 0; t + 2 < ni; t += 3) worst2 = max_f(worst2, walk_triangle(k, w, idx + t, 0.0f));
+	return sqrtf(worst2);
+}
+
+float api_lod_level_error(const float *pos, const float *nrm, size_t nv, const uint32_t *full, size_t nfull,
+                          const uint32_t *level, size_t nlevel, bool everywhere)
+{
+	struct welded w = {(float *)pos, (float *)nrm, NULL, nv};
+	struct grid g = {0};
+	struct walk k = {0};
+	float lo[3], hi[3], ext = points_box(pos, nv, lo, hi), e = INFINITY;
+	if (ext > 0.0f && grid_build(&g, &w, lo, hi, ext) && walk_build(&k, &w, full, nfull))
+		e = everywhere ? level_error_everywhere(&k, &w, level, nlevel) : level_error(&g, &k, &w, level, nlevel);
+	walk_free(&k);
+	free(g.start);
+	free(g.items);
+	free(g.ipos);
+	return e;
 }
 
 /* Crease-angle normals of a level (idx: ni indices into w), one per corner: the area-weighted
