@@ -53,13 +53,6 @@ void api_mesh_bounds(struct api_model_mesh *me);
  * with a repeated index are left out. */
 bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos);
 
-/* The error a level is measured with (object units): level[0..nlevel) and full[0..nfull),
- * triangles of the same welded vertices pos (with their normals nrm, unit), nv of them; or,
- * everywhere, the figure it stands for: every level triangle walked to the end over the full
- * mesh's faces around it (dear). For tests and benchmarks; INFINITY when out of memory. */
-float api_lod_level_error(const float *pos, const float *nrm, size_t nv, const uint32_t *full, size_t nfull,
-                          const uint32_t *level, size_t nlevel, bool everywhere);
-
 /* Levels of one mesh on the wire (api/model_wire.h): one per size. */
 #define API_LOD_LEVELS 1u
 
