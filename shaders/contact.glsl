@@ -17,6 +17,31 @@ vec4 scene_view_depth(vec4 d)
 	return -(l.y - ndc * l.w) / (ndc * l.z - l.x);
 }
 
+// Whether the scene's depth at uv (tsz: the depth image's size) occludes a ray whose view depth
+// runs over [lo, hi] since the previous step: a depth texel stands for a slab `thick` deep behind
+// the surface it saw. Where the four texels around uv lie on one smooth surface (their range
+// within `smooth_range`, what a planar receiver spans over two pixels), all four must be in front
+// of the ray: a ray just above a planar receiver, whose depth they bracket, stays lit. Across a
+// silhouette (a wider range), the texel nearest uv decides: a caster covers the pixels its raster
+// covered. Requiring all four there too dropped a caster narrower than two pixels and a pixel of
+// every wider one (issue 31: a thin pole's contact shadow lost at its edges); a blend of the four
+// would widen it (rays beside a silhouette darkened). Far texels (the background, infinitely deep
+// with an infinite far plane) are clamped so that no range is infinite.
+bool contact_occludes(vec2 uv, vec2 tsz, float smooth_range, float lo, float hi, float thick)
+{
+	vec4 z = min(scene_view_depth(textureGather(scene_depth, uv)), vec4(1e20));
+	float range = max(max(z.x, z.y), max(z.z, z.w)) - min(min(z.x, z.y), min(z.z, z.w));
+	if (range <= smooth_range) return all(lessThan(z, vec4(hi))) && any(greaterThan(z, vec4(lo - thick)));
+	// textureGather's order: x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0)
+	vec2 f = fract(uv * tsz - 0.5);
+	vec2 col = f.x < 0.5 ? z.wx : z.zy;   // (j0, j1) of the nearer column
+	float zn = f.y < 0.5 ? col.x : col.y;
+	// ... and the texels of its surface (within smooth_range of it) must all be in front: on a
+	// receiver's edge, the nearest texel alone lies half a pixel off the ray and can be behind it.
+	vec4 surf = mix(z, vec4(-1e30), greaterThan(abs(z - zn), vec4(smooth_range)));
+	return all(lessThan(surf, vec4(hi))) && zn > lo - thick;
+}
+
 // Contact shadows: march from pos towards the light through the view's depth buffer, over
 // L.contact.x world units (0: CONTACT_TEXELS texels of the light's map at pos, the zone next
 // to a caster that the map's bias and filter cannot resolve, and at least CONTACT_PX pixels).
@@ -66,6 +91,10 @@ float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
 	int steps = clamp(int(ceil(span)), 1, int(L.contact.y));
 	float dt = (len - t0) / float(steps);
 	float jitter = ign(frag_xy());
+	vec2 tsz = vec2(textureSize(scene_depth, 0));
+	// The receiver's plane spans px * tan(angle to the view ray) of view depth per pixel.
+	float cos_v = max(abs(dot(n, normalize(pos - cam))), 0.05);
+	float smooth_range = 2.0 * px * sqrt(1.0 - cos_v * cos_v) / cos_v;
 	float z_prev = zs0 + dz * t0;
 	float eps = 1e-3 * px;
 	for (int i = 0; i < steps; i++) {
@@ -73,10 +102,9 @@ float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
 		vec4 c = c0 + dc * t;
 		vec2 uv = c.xy / c.w * 0.5 + 0.5;
 		if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) break;
-		vec4 zs = scene_view_depth(textureGather(scene_depth, uv));
 		float zp = zs0 + dz * t;
 		float lo = min(z_prev, zp), hi = max(z_prev, zp);
-		if (all(lessThan(zs, vec4(hi - eps))) && any(greaterThan(zs, vec4(lo - thick)))) return 0.0;
+		if (contact_occludes(uv, tsz, smooth_range, lo, hi - eps, thick)) return 0.0;
 		z_prev = zp;
 	}
 	return 1.0;
