@@ -361,6 +361,7 @@ done:
 	finish(&rq, r, err);
 	rq.tm.submits = rq.pacer.submits;
 	rq.tm.shadow_parts = rq.pacer.shadow_parts;
+	rq.tm.shadow_submits = rq.pacer.shadow_submits;
 	rq.tm.compile_ms = rnd_compile_ms_tls - compiled;
 	plan->actual.tm = rq.tm;
 	plan->actual.done = r == RND_OK;
