@@ -30,6 +30,8 @@ enum rnd_cast_why {
 	                            in their maps, left out of the casters' box */
 	RND_CAST_WHY_COUNT
 };
+/* A reason in words ("" for none). */
+const char *rnd_cast_why_text(unsigned why);
 
 /* Whether plane object `plane` may cast a shadow of any shadowed light of sc onto the box b (an
  * object's world bounds): false when b lies wholly on the lit side of the plane for every such

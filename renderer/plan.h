@@ -58,6 +58,10 @@ enum rnd_size_rule {
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
 	RND_SIZE_RULE_COUNT
 };
+/* A rule in words ("" for none). */
+const char *rnd_size_rule_text(unsigned rule);
+/* What kind of map light L's plan lp draws: "casters", "spot", "cube", "clipmap", "cascades", "fit". */
+const char *rnd_light_plan_kind(const struct rnd_light *L, const struct rnd_light_plan *lp);
 
 struct rnd_shadow_plan {
 	uint32_t resolution;                       /* the largest tile any light asks for */

@@ -163,6 +163,11 @@ enum rnd_result rnd_plan_build(const struct rnd_scene *sc, const struct rnd_plan
                                struct rnd_error *err);
 void rnd_plan_release(struct rnd_plan *p);
 
+/* plan_maps' decisions about map m, in words: why its side is under the one asked for ("" when
+ * it is not); whether it is drawn ("drawn", "cached", "every view"), and why (*why). */
+const char *rnd_map_plan_fitted(const struct rnd_plan *p, const struct rnd_map_plan *m);
+const char *rnd_map_plan_state(const struct rnd_map_plan *m, const char **why);
+
 /* View v's shadow plan as the recorders read it (out: views' skip from the plan's prediction;
  * the executor replaces it with the grant's answer). */
 void rnd_plan_view_shadows(const struct rnd_plan *p, uint32_t v, struct rnd_shadow_plan *out);
