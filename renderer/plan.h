@@ -3,7 +3,7 @@
  * derived near/far) and the shadow views of every light (plan.c: fit, cascades, spot cone,
  * point cube faces).
  *
- * Pure math: no Vulkan calls, no allocation; unit-tested in tests/unit/test_plan.c.
+ * Pure math: no Vulkan calls, no allocation; unit-tested in tests/unit/test_plan_*.c.
  */
 #ifndef UMBRA_RENDERER_PLAN_H
 #define UMBRA_RENDERER_PLAN_H
