@@ -261,7 +261,8 @@ const char *rnd_cast_why_text(unsigned why)
 		[RND_CAST_LIT_SIDE] = "a plane with every other object on its lit side",
 		[RND_CAST_UNSEEN] = "a plane whose shadow falls only where no camera sees it (on parts of objects sunk into it)",
 		[RND_CAST_FOR_MOMENTS] = "a plane drawn into the maps for the VSM/EVSM blur, left out of the casters' box",
-		[RND_CAST_UNJUDGED] = "a plane in a scene of more than 256 objects: planes are not judged, it casts",
+		[RND_CAST_UNJUDGED] = "a plane in a scene of more than " RND_NUMBER_WORDS(RND_PLANES_JUDGED_MAX)
+		                       " objects: planes are not judged, it casts",
 		[RND_CAST_FOR_ENV] = ("a plane that shadows others only from the environment's directions: in their maps, "
 		                      "left out of the casters' box"),
 	};

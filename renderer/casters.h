@@ -44,7 +44,7 @@ bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *p
  * took 107 s of planning before the first submit). In a bigger scene every plane that asks to
  * cast shadows casts: the level of detail's estimate (lod.c) and rnd_casters_plan both follow
  * rnd_planes_judged(). */
-#define RND_PLANES_JUDGED_MAX 256u
+#define RND_PLANES_JUDGED_MAX 256
 bool rnd_planes_judged(const struct rnd_scene *sc);
 
 /* rnd_plane_may_shadow, less the shadows no camera of the render sees: where the part of b

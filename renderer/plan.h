@@ -60,6 +60,10 @@ enum rnd_size_rule {
 };
 /* A rule in words ("" for none). */
 const char *rnd_size_rule_text(unsigned rule);
+/* A limit written once, as a plain integer (no suffix), in the words that show it: "more than "
+ * RND_NUMBER_WORDS(RND_PLANES_JUDGED_MAX) " objects" is "more than 256 objects". */
+#define RND_NUMBER_WORDS(x) RND_NUMBER_WORDS_(x)
+#define RND_NUMBER_WORDS_(x) #x
 /* What kind of map light L's plan lp draws: "casters", "spot", "cube", "clipmap", "cascades", "fit". */
 const char *rnd_light_plan_kind(const struct rnd_light *L, const struct rnd_light_plan *lp);
 

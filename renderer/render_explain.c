@@ -1,8 +1,9 @@
 /*
  * renderer/render_explain.c — the render plan in words and figures (umbra/rnd_plan.h): what
  * `explain` shows, read from the plan the render executes (render_plan.h), and after the render
- * what it measured. Nothing here decides anything: every reason is the name of a decision made
- * in its own module (casters.c, plan.c, visibility_plan.c, lod.c, shadow_cache.c).
+ * what it measured. Nothing here decides anything: every reason is in the words of the module
+ * that makes the decision (casters.c, plan_words.c, visibility_plan.c, lod.c, env_shadow.c,
+ * render_plan.c), and the limits in them are written once, where they are set.
  */
 #include <string.h>
 #include "env_shadow.h"

@@ -16,7 +16,7 @@
  * Only wide filters pay for it: studio-spots' seven lights all hard made the main pass 49 ms
  * without the pass and 65 with it; PCF radius 1: 57 / 68, 2: 81 / 84, 3: 97 / 97, 5: 143 /
  * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
-#define RND_VIS_MIN_PCF_RADIUS 4u
+#define RND_VIS_MIN_PCF_RADIUS 4
 #define RND_VIS_PIXELS_PER_FACE 512u
 /* One wide light pays for the passes only over dense meshes. Measured, the thumbnail preset
  * with its one PCSS sun, 512², whole render without / with the pass: the 124k-triangle ogre
@@ -167,7 +167,8 @@ const char *rnd_vis_why_text(unsigned why)
 		[RND_VIS_MASKED] = "an alpha-tested material",
 		[RND_VIS_TOO_LARGE] = "its images would be too large",
 		[RND_VIS_FORCED_OFF] = "UMBRA_VISIBILITY=0",
-		[RND_VIS_NARROW] = "no light filters widely enough (PCSS, PCF radius 4 or more)",
+		[RND_VIS_NARROW] = ("no light filters widely enough (PCSS, PCF radius " RND_NUMBER_WORDS(RND_VIS_MIN_PCF_RADIUS)
+		                    " or more)"),
 		[RND_VIS_SPARSE] = "too few triangles for its passes to pay",
 	};
 	return why < RND_VIS_WHY_COUNT ? text[why] : "";
