@@ -1,0 +1,39 @@
+/*
+ * renderer/plan_local.h — the shadow views of spot and point lights (plan_local.c), for plan.c:
+ * their tile size by importance or a hard edge's need, then the spot's cone cut down to where
+ * its casters are and both sized for where the camera sees them. Pure math, as plan.c.
+ */
+#ifndef UMBRA_RENDERER_PLAN_LOCAL_H
+#define UMBRA_RENDERER_PLAN_LOCAL_H
+
+#include "plan.h"
+
+/* Farthest distance from p to the box. */
+float rnd_plan_max_dist(const float p[3], const struct rnd_aabb *b);
+
+/* Width in texels of the narrowest footprint lp's filter blurs an edge over (plan.c). */
+float rnd_plan_kernel_texels(const struct rnd_light_plan *lp);
+
+/* The next shadow view of light i in out (plan.c). */
+struct umbra_shadow_view *rnd_plan_next_view(struct rnd_shadow_plan *out, uint32_t i, bool ortho);
+
+/* Tile size a spot or point light without a resolution of its own asks for before its casters
+ * are known: its share of the view, or what a hard edge needs; *rule says which. */
+uint32_t rnd_plan_local_want(const struct rnd_light *L, const struct rnd_light_plan *lp, const struct rnd_aabb *bounds,
+                             const struct rnd_camera_plan *cam, uint32_t height, uint8_t *rule);
+
+/* Where the camera and the casters are, for rnd_plan_local (casters NULL or cam NULL: the
+ * light's whole cone or cube at lp->resolution, as before). */
+struct rnd_local_need {
+	const struct rnd_aabb *bounds, *casters;
+	const struct rnd_camera_plan *cam;
+	uint32_t height;     /* output image height (0: no camera need) */
+	uint32_t cap;        /* the scene's max_shadow_resolution (0: none) */
+};
+
+/* Light i's views: a spot's one perspective map, a point light's six cube faces; may change
+ * lp->resolution and lp->size_rule (see plan_local.c). */
+enum rnd_result rnd_plan_local(const struct rnd_light *L, uint32_t i, const struct rnd_local_need *need,
+                               struct rnd_light_plan *lp, struct rnd_shadow_plan *out, struct rnd_error *err);
+
+#endif
