@@ -415,7 +415,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 	bool empty = rnd_aabb_is_empty(bounds);
 	out->resolution = 0;
 	float cam_pixel = casters ? camera_pixel_at(cam, scene->height, casters) : 0.0f;
-	struct rnd_local_need local = {bounds, casters, cam, scene->height, scene->max_shadow_resolution};
+	struct rnd_local_need local = {bounds, casters, cam, scene->height, scene->max_shadow_resolution, 0};
 
 	for (uint32_t i = 0; i < scene->light_count && !empty; i++) {
 		const struct rnd_light *L = &scene->lights[i];
@@ -428,8 +428,12 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
 		uint32_t want = s->resolution ? s->resolution : RND_DEFAULT_SHADOW_RESOLUTION;
 		lp->size_rule = s->resolution ? RND_SIZE_ASKED : RND_SIZE_DEFAULT;
-		if (!s->resolution && L->type != RND_LIGHT_DIRECTIONAL)
-			want = rnd_plan_local_want(L, lp, bounds, cam, scene->height, &lp->size_rule);
+		if (L->type != RND_LIGHT_DIRECTIONAL) {
+			uint8_t rule;
+			uint32_t def = rnd_plan_local_want(L, lp, bounds, cam, scene->height, &rule);
+			local.default_res = rnd_shadow_map_side(def, false, scene->max_shadow_resolution);
+			if (!s->resolution) want = def, lp->size_rule = rule;
+		}
 		lp->resolution = rnd_shadow_map_side(want, s->resolution != 0, scene->max_shadow_resolution);
 		if (lp->resolution < rnd_shadow_map_side(want, s->resolution != 0, 0)) lp->size_rule = RND_SIZE_CAPPED;
 		uint32_t need = L->type == RND_LIGHT_POINT ? 6 : 1;

@@ -182,36 +182,59 @@ static struct local_texels local_need(const struct rnd_light *L, const float *d,
 	return t;
 }
 
-/* A spot's cone cut down to its casters: in the tan plane of the light's view (NDC of a
- * 90-degree frustum, y down), the casters' box within the cone [-tc, tc]^2, in a square tile
- * of texels t, from today's (the whole widened cone over lp->resolution) down to the camera's
- * need (the tile at most doubled), then filling the tile, never finer than PCSS's search
- * reaches (the tile shrunk to what that needs, at most to texels 4x today's). Writes the view's
- * centre and half extent (tan units) and lp->resolution / size_rule; false: the whole cone
- * (a light among its casters, or no gain), at lp->resolution (64 when none of the casters is
- * in the cone). */
-static bool fit_spot(const struct rnd_light *L, const float d[3], const float view[16], float tc,
-                     const struct rnd_local_need *need, struct rnd_light_plan *lp, float *cx, float *cy, float *h)
+/* The casters' box in the tan plane of a light's view (NDC of a 90-degree frustum, y down),
+ * clipped to [-lim, lim]^2 (the view's widened extent: a caster outside it shades no receiver
+ * this view serves). 1: r = {u0, u1, v0, v1}; 0: nothing inside; -1: a corner not in front
+ * of the light (the box's image is unbounded: the whole view). */
+static int casters_rect(const float view[16], const struct rnd_aabb *c, float lim, float r[4])
 {
-	const struct rnd_aabb *c = need->casters;
-	float u0 = 1e30f, u1 = -1e30f, v0 = 1e30f, v1 = -1e30f;
+	r[0] = r[2] = 1e30f; r[1] = r[3] = -1e30f;
 	for (int i = 0; i < 8; i++) {
 		float p[3], q[3];
 		for (int k = 0; k < 3; k++) p[k] = i >> k & 1 ? c->max[k] : c->min[k];
 		rnd_mat4_mul_point(q, view, p);
-		if (-q[2] < 1e-3f) return false;
-		u0 = fminf(u0, q[0] / -q[2]); u1 = fmaxf(u1, q[0] / -q[2]);
-		v0 = fminf(v0, q[1] / q[2]); v1 = fmaxf(v1, q[1] / q[2]);
+		if (-q[2] < 1e-3f) return -1;
+		r[0] = fminf(r[0], q[0] / -q[2]); r[1] = fmaxf(r[1], q[0] / -q[2]);
+		r[2] = fminf(r[2], q[1] / q[2]); r[3] = fmaxf(r[3], q[1] / q[2]);
 	}
-	u0 = fmaxf(u0, -tc); u1 = fminf(u1, tc); v0 = fmaxf(v0, -tc); v1 = fminf(v1, tc);
-	if (u0 >= u1 || v0 >= v1) {
+	r[0] = fmaxf(r[0], -lim); r[1] = fminf(r[1], lim); r[2] = fmaxf(r[2], -lim); r[3] = fminf(r[3], lim);
+	return r[0] < r[1] && r[2] < r[3];
+}
+
+/* A rectangle of a view's tan plane: centre cx, cy, half extent h (a square tile). */
+struct tan_rect {
+	float cx, cy, h;
+};
+
+/* The texel (tan units) a tile of res texels gives rect r with the filter's margin m: the
+ * span filling it, never finer than `floor_t`. */
+static float fill_texel(const float r[4], float res, float m, float floor_t)
+{
+	float span = fmaxf(r[1] - r[0], r[3] - r[2]);
+	return fmaxf(span / fmaxf(res - 2.0f * m - 2.0f, 1.0f), floor_t);
+}
+
+/* A spot's cone cut down to its casters (casters_rect within the widened cone): a square tile
+ * of texels t, from today's (the whole widened cone over lp->resolution) down to the camera's
+ * need (the tile at most doubled), then filling the tile, never finer than PCSS's search
+ * reaches unless the default size's texels are (the tile, an asked one too, shrunk to what it
+ * needs: texels the search cannot reach cost accuracy, Spot and the duck at 4096). Writes the view's rectangle
+ * and lp->resolution / size_rule; false: the whole cone (a light among its casters, or no
+ * gain), at lp->resolution (64 when none of the casters is in the cone). */
+static bool fit_spot(const struct rnd_light *L, const float d[3], const float view[16], float tc,
+                     const struct rnd_local_need *need, struct rnd_light_plan *lp, struct tan_rect *out)
+{
+	bool asked = lp->size_rule == RND_SIZE_ASKED;
+	float m = local_margin(lp), res0 = (float)lp->resolution, r[4];
+	float t0 = 2.0f * tc * (1.0f + 2.0f * m / res0) / res0;
+	int in = casters_rect(view, need->casters, tc + m * t0, r);
+	if (in < 0) return false;
+	if (in == 0) {
 		lp->resolution = RND_MIN_SHADOW_RESOLUTION;   /* nothing in the cone casts */
 		lp->size_rule = RND_SIZE_CASTERS;
 		return false;
 	}
-	bool asked = lp->size_rule == RND_SIZE_ASKED;
-	float m = local_margin(lp), res0 = (float)lp->resolution;
-	float t0 = 2.0f * tc * (1.0f + 2.0f * m / res0) / res0, span = fmaxf(u1 - u0, v1 - v0);
+	float span = fmaxf(r[1] - r[0], r[3] - r[2]);
 	struct local_texels need_t = local_need(L, d, need, lp);
 	float top = asked ? res0 : fmaxf(res0, fminf(2.0f * res0, 2048.0f));
 	if (need->cap) top = fminf(top, fmaxf((float)need->cap, res0));
@@ -220,65 +243,84 @@ static bool fit_spot(const struct rnd_light *L, const float d[3], const float vi
 	if (asked) res = res0;
 	if (need_t.camera > 0)
 		while (!asked && res < span / need_t.camera + 2.0f * m + 2.0f && 2.0f * res <= top) res *= 2.0f;
-	float t = span / fmaxf(res - 2.0f * m - 2.0f, 1.0f), reach = fminf(need_t.search, t0);
+	/* the search's floor: no finer than it reaches, unless the default size's texels are */
+	float def = (float)need->default_res, reach = fminf(need_t.search, 2.0f * tc * (1.0f + 2.0f * m / def) / def);
+	float t = fill_texel(r, res, m, 0.0f);
 	bool search = reach > t;
-	if (search) {
-		t = reach;
-		while (!asked && res > RND_MIN_SHADOW_RESOLUTION && res / 2.0f >= span / t + 2.0f * m + 2.0f) res /= 2.0f;
-		t = fmaxf(t, span / fmaxf(res - 2.0f * m - 2.0f, 1.0f));
-	}
+	if (search)
+		while (res > RND_MIN_SHADOW_RESOLUTION && res / 2.0f >= span / reach + 2.0f * m + 2.0f) res /= 2.0f;
+	t = fill_texel(r, res, m, reach);
 	if (!search && t >= t0) return false;
-	*cx = 0.5f * (u0 + u1);
-	*cy = 0.5f * (v0 + v1);
-	*h = 0.5f * res * t;
+	*out = (struct tan_rect){0.5f * (r[0] + r[1]), 0.5f * (r[2] + r[3]), 0.5f * res * t};
 	lp->resolution = (uint32_t)res;
 	lp->size_rule = search ? RND_SIZE_SEARCH : RND_SIZE_CASTERS;
 	return true;
 }
 
-/* A perspective view through the rectangle centre (cx, cy), half extent h, of the tan plane of
- * `view` (off-axis: the spot's axis and depth stay, so a texel is 2h/res per unit of depth). */
-static void persp_rect_view(struct umbra_shadow_view *v, const float view[16], float cx, float cy, float h,
+/* A perspective view through rectangle q of the tan plane of `view` (off-axis: the light's
+ * axis and depth stay, so a texel is 2 q.h / res per unit of depth). */
+static void persp_rect_view(struct umbra_shadow_view *v, const float view[16], struct tan_rect q,
                             float znear, float zfar, float res)
 {
 	float proj[16];
 	rnd_mat4_perspective(proj, 0.5f * (float)M_PI, 1.0f, znear, zfar);
 	for (int col = 0; col < 4; col++) {
-		proj[col * 4 + 0] = (proj[col * 4 + 0] - cx * proj[col * 4 + 3]) / h;
-		proj[col * 4 + 1] = (proj[col * 4 + 1] - cy * proj[col * 4 + 3]) / h;
+		proj[col * 4 + 0] = (proj[col * 4 + 0] - q.cx * proj[col * 4 + 3]) / q.h;
+		proj[col * 4 + 1] = (proj[col * 4 + 1] - q.cy * proj[col * 4 + 3]) / q.h;
 	}
 	rnd_mat4_mul(v->view_proj, proj, view);
-	v->params[0] = 2.0f * h / res;
+	v->params[0] = 2.0f * q.h / res;
 	v->params[1] = 1.0f;
 	v->params[2] = znear;
 	v->params[3] = zfar;
 	v->rect[2] = res;
 }
 
-/* A point light's cube faces sized for its casters as fit_spot sizes a spot's tile (the faces
- * keep their 90-degree frustums): finer for the camera up to twice today's side (at most 1024,
- * never for an asked resolution), then never finer than PCSS's search reaches (halved at most
- * twice). */
-static void size_point(const struct rnd_light *L, const struct rnd_local_need *need, struct rnd_light_plan *lp)
+/* Texels (tan units) of a whole cube face of res texels widened by m on each side. */
+static float face_texel(float res, float m)
+{
+	return 2.0f * (1.0f + 2.0f * m / res) / res;
+}
+
+/* A point light's faces sized for its casters as fit_spot sizes a spot's tile: finer for the
+ * camera up to twice today's side (at most 1024, never for an asked resolution), no finer
+ * than PCSS's search reaches unless the default size's are (an asked size is shrunk to that). Each face is then cut to the casters in it
+ * (point_face): a receiver's face is its direction's major axis, and so is that of every
+ * caster between it and the light. Returns the search's floor on the texel. */
+static float size_point(const struct rnd_light *L, const struct rnd_local_need *need, struct rnd_light_plan *lp)
 {
 	bool asked = lp->size_rule == RND_SIZE_ASKED;
 	float m = local_margin(lp), res0 = (float)lp->resolution, res = res0;
 	struct local_texels t = local_need(L, NULL, need, lp);
 	float top = asked ? res0 : fmaxf(res0, fminf(2.0f * res0, 1024.0f));
 	if (need->cap) top = fminf(top, fmaxf((float)need->cap, res0));
-#define FACE_TEXEL(r) (2.0f * (1.0f + 2.0f * m / (r)) / (r))
-	while (t.camera > 0 && FACE_TEXEL(res) > t.camera && 2.0f * res <= top) res *= 2.0f;
+	while (t.camera > 0 && face_texel(res, m) > t.camera && 2.0f * res <= top) res *= 2.0f;
 	if (res > res0) lp->size_rule = RND_SIZE_CASTERS;
-	while (FACE_TEXEL(res) < t.search && res > res0) {
+	float def = (float)need->default_res, floor_t = fminf(t.search, face_texel(def, m));
+	while (face_texel(res, m) < floor_t && res > def) {
 		res /= 2.0f;
 		lp->size_rule = RND_SIZE_SEARCH;
 	}
-#undef FACE_TEXEL
 	lp->resolution = (uint32_t)res;
+	return floor_t;
+}
+
+/* Face f of a point light's cube (view): the whole widened face, or the casters' part of it
+ * filling the tile, never finer than floor_t. */
+static void point_face(struct umbra_shadow_view *v, const float view[16], const struct rnd_local_need *need,
+                       const struct rnd_light_plan *lp, float floor_t, float znear, float zfar)
+{
+	float m = local_margin(lp), res = (float)lp->resolution, whole = face_texel(res, m), r[4];
+	struct tan_rect q = {0, 0, 0.5f * res * whole};
+	if (need->casters && !rnd_aabb_is_empty(need->casters) && casters_rect(view, need->casters, 1.0f + m * whole, r) > 0) {
+		float t = fill_texel(r, res, m, floor_t);
+		if (t < whole) q = (struct tan_rect){0.5f * (r[0] + r[1]), 0.5f * (r[2] + r[3]), 0.5f * res * t};
+	}
+	persp_rect_view(v, view, q, znear, zfar, res);
 }
 
 /* A spot light's cone (or the part of it its casters cover), or a point light's six cube
- * faces. */
+ * faces (each cut to the casters in it). */
 enum rnd_result rnd_plan_local(const struct rnd_light *L, uint32_t i, const struct rnd_local_need *need,
                                struct rnd_light_plan *lp, struct rnd_shadow_plan *out, struct rnd_error *err)
 {
@@ -298,11 +340,12 @@ enum rnd_result rnd_plan_local(const struct rnd_light *L, uint32_t i, const stru
 		float up[3] = {0, 1, 0};
 		if (fabsf(d[1]) > 0.99f) { up[1] = 0; up[2] = 1; }
 		float half = fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f);
-		float view[16], target[3], cx, cy, h;
+		float view[16], target[3];
+		struct tan_rect q;
 		rnd_v3_add(target, L->position, d);
 		rnd_mat4_look_at(view, L->position, target, up);
-		if (fits && fit_spot(L, d, view, tanf(half), need, lp, &cx, &cy, &h)) {
-			persp_rect_view(rnd_plan_next_view(out, i, false), view, cx, cy, h, znear, zfar, (float)lp->resolution);
+		if (fits && fit_spot(L, d, view, tanf(half), need, lp, &q)) {
+			persp_rect_view(rnd_plan_next_view(out, i, false), view, q, znear, zfar, (float)lp->resolution);
 			return RND_OK;
 		}
 		float fres = (float)lp->resolution;
@@ -310,12 +353,32 @@ enum rnd_result rnd_plan_local(const struct rnd_light *L, uint32_t i, const stru
 		persp_view(rnd_plan_next_view(out, i, false), L->position, d, up, fov, znear, zfar, fres);
 		return RND_OK;
 	}
-	if (fits) size_point(L, need, lp);
 	static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 	static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+	float floor_t = fits ? size_point(L, need, lp) : 0.0f;
 	float fres = (float)lp->resolution;
 	float fov = 2.0f * atanf(1.0f + 2.0f * local_margin(lp) / fres);
-	for (int f6 = 0; f6 < 6; f6++)
-		persp_view(rnd_plan_next_view(out, i, false), L->position, dirs[f6], ups[f6], fov, znear, zfar, fres);
+	for (int f6 = 0; f6 < 6; f6++) {
+		if (!fits) {
+			persp_view(rnd_plan_next_view(out, i, false), L->position, dirs[f6], ups[f6], fov, znear, zfar, fres);
+			continue;
+		}
+		float view[16], target[3];
+		rnd_v3_add(target, L->position, dirs[f6]);
+		rnd_mat4_look_at(view, L->position, target, ups[f6]);
+		point_face(rnd_plan_next_view(out, i, false), view, need, lp, floor_t, znear, zfar);
+	}
 	return RND_OK;
+}
+
+void rnd_plan_local_regrant(struct umbra_shadow_view *v, const struct rnd_light_plan *lp, float granted)
+{
+	float planned = v->rect[2], m = local_margin(lp);
+	if (granted >= planned || granted <= 2.0f * m + 2.0f) return;
+	float k = (planned - 2.0f * m - 2.0f) / planned * granted / (granted - 2.0f * m - 2.0f);   /* >= 1 */
+	for (int col = 0; col < 4; col++) {
+		v->view_proj[col * 4 + 0] /= k;
+		v->view_proj[col * 4 + 1] /= k;
+	}
+	v->params[0] *= k;
 }

@@ -29,11 +29,19 @@ struct rnd_local_need {
 	const struct rnd_camera_plan *cam;
 	uint32_t height;     /* output image height (0: no camera need) */
 	uint32_t cap;        /* the scene's max_shadow_resolution (0: none) */
+	uint32_t default_res; /* this light's tile without an asked resolution (rnd_plan_local_want) */
 };
 
 /* Light i's views: a spot's one perspective map, a point light's six cube faces; may change
  * lp->resolution and lp->size_rule (see plan_local.c). */
 enum rnd_result rnd_plan_local(const struct rnd_light *L, uint32_t i, const struct rnd_local_need *need,
                                struct rnd_light_plan *lp, struct rnd_shadow_plan *out, struct rnd_error *err);
+
+/* A perspective view v (a spot's, a cube face's; planned at v->rect[2] texels) drawn into a
+ * smaller tile than planned (rnd_atlas_fit: the atlas full): widened about its centre so that
+ * what it covered still lies the filter's margin of *granted* texels inside (six 4096 faces
+ * granted 1024 kept a quarter of PCSS's 27-texel margin). Call before the texel's world size
+ * is scaled to the grant (render_plan.c). */
+void rnd_plan_local_regrant(struct umbra_shadow_view *v, const struct rnd_light_plan *lp, float granted);
 
 #endif
