@@ -415,7 +415,11 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 	bool empty = rnd_aabb_is_empty(bounds);
 	out->resolution = 0;
 	float cam_pixel = casters ? camera_pixel_at(cam, scene->height, casters) : 0.0f;
-	struct rnd_local_need local = {bounds, casters, cam, scene->height, scene->max_shadow_resolution, 0};
+	uint32_t local_lights = 0;
+	for (uint32_t i = 0; i < scene->light_count; i++)
+		local_lights += scene->lights[i].shadow.enabled && scene->lights[i].type != RND_LIGHT_DIRECTIONAL;
+	const struct rnd_aabb *fit = local_lights <= RND_LOCAL_FIT_LIGHTS_MAX ? casters : NULL;
+	struct rnd_local_need local = {bounds, fit, cam, scene->height, scene->max_shadow_resolution, 0};
 
 	for (uint32_t i = 0; i < scene->light_count && !empty; i++) {
 		const struct rnd_light *L = &scene->lights[i];

@@ -24,8 +24,15 @@ uint32_t rnd_plan_local_want(const struct rnd_light *L, const struct rnd_light_p
 
 /* Where the camera and the casters are, for rnd_plan_local (casters NULL or cam NULL: the
  * light's whole cone or cube at lp->resolution, as before). */
+/* With more shadowed spot and point lights than this, their maps keep the whole cone / cube
+ * face at the importance size (no fit to the casters): finer texels on many lights cost the
+ * main pass (16 shadowed lights 405 -> 627 ms on lavapipe) and their growth over-filled the
+ * atlas, which then cut another light's map (studio-spots: its sun 2048 -> 512). The fit is for
+ * the one or two lights a picture's shadows come from. */
+#define RND_LOCAL_FIT_LIGHTS_MAX 2u
+
 struct rnd_local_need {
-	const struct rnd_aabb *bounds, *casters;
+	const struct rnd_aabb *bounds, *casters; /* casters NULL: no fit (RND_LOCAL_FIT_LIGHTS_MAX) */
 	const struct rnd_camera_plan *cam;
 	uint32_t height;     /* output image height (0: no camera need) */
 	uint32_t cap;        /* the scene's max_shadow_resolution (0: none) */
