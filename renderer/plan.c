@@ -13,6 +13,7 @@
 #include <string.h>
 #include "error.h"
 #include "plan.h"
+#include "plan_local.h"
 
 uint32_t rnd_shadow_map_side(uint32_t want, bool asked, uint32_t cap)
 {
@@ -113,93 +114,6 @@ static void ortho_view(struct umbra_shadow_view *v, const float view[16], float 
 	v->rect[2] = res;   /* x, y and the atlas size are filled in when the tile is granted */
 }
 
-static void persp_view(struct umbra_shadow_view *v, const float eye[3], const float dir[3], const float up[3],
-                       float fov, float znear, float zfar, float res)
-{
-	float view[16], proj[16], target[3];
-	rnd_v3_add(target, eye, dir);
-	rnd_mat4_look_at(view, eye, target, up);
-	rnd_mat4_perspective(proj, fov, 1.0f, znear, zfar);
-	rnd_mat4_mul(v->view_proj, proj, view);
-	v->params[0] = 2.0f * tanf(fov * 0.5f) / res;
-	v->params[1] = 1.0f;
-	v->params[2] = znear;
-	v->params[3] = zfar;
-	v->rect[2] = res;   /* x, y and the atlas size are filled in when the tile is granted */
-}
-
-/* Farthest distance from p to the box (for spot/point far planes). */
-static float max_dist(const float p[3], const struct rnd_aabb *b)
-{
-	float d2 = 0;
-	for (int k = 0; k < 3; k++) {
-		float a = fmaxf(fabsf(p[k] - b->min[k]), fabsf(p[k] - b->max[k]));
-		d2 += a * a;
-	}
-	return sqrtf(d2);
-}
-
-/* Tile size of a spot or point light with no resolution of its own: by importance, here the
- * share of the view its lit region covers (range, else the scene's extent from the light).
- * A light filling the view gets 1024 (spot) or 512 per cube face (six of them), a small one
- * down to 256 (an explicit `resolution` asks for more),
- * so many small lights share the atlas and a large one gets resolution. */
-static uint32_t light_importance_res(const struct rnd_light *L, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
-{
-	float reach = max_dist(L->position, b);
-	if (L->range > 0 && L->range < reach) reach = L->range;
-	if (L->type == RND_LIGHT_SPOT) reach *= fminf(sinf(fminf(L->outer_angle, 1.5f)) + 0.25f, 1.0f);
-	float d[3];
-	rnd_v3_sub(d, L->position, cam->pos);
-	float dist = rnd_v3_length(d);
-	float frac;
-	if (cam->ortho) frac = reach / fmaxf(0.5f * cam->ortho_height, 1e-6f);
-	else frac = dist <= reach ? 1.0f : tanf(asinf(reach / dist)) / tanf(0.5f * cam->fov_y);
-	frac = fminf(fmaxf(frac, 0.0f), 1.0f);
-	float top = L->type == RND_LIGHT_SPOT ? 1024.0f : 512.0f;
-	float want = fmaxf(top * frac, 256.0f);
-	return (uint32_t)want;
-}
-
-/* Tile size a hard spot or point light (no radius, PCF or hard filter) needs so that its
- * filter kernel, (2r+1) texels, spans at most one pixel where the camera may see what the
- * light reaches (the corners and centre of the scene bounds, pulled in to the light's reach):
- * such a light's edge is a step, and a kernel wider than a pixel is blur the light does not
- * have. The 512-texel cube faces importance gives a full-view point light 3 m above a 12 m
- * floor made a 3-texel ramp up to ~2 pixels wide on a 128² image; against the traced answer
- * rmse 0.025, at 1024 0.017. Kept cheap: at most one doubling of the importance choice `base`
- * (a light keeps its share of the atlas, its shadow pass grows at most 4x), and at most 2048
- * for a spot, 1024 for a cube face (six of them). 0 = no need. */
-static uint32_t hard_light_res(const struct rnd_light *L, const struct rnd_light_plan *lp, const struct rnd_aabb *b,
-                               const struct rnd_camera_plan *cam, uint32_t height, uint32_t base)
-{
-	if (L->radius > 0 || (lp->filter != UMBRA_FILTER_PCF && lp->filter != UMBRA_FILTER_HARD) || height == 0)
-		return 0;
-	float reach = max_dist(L->position, b);
-	if (L->range > 0 && L->range < reach) reach = L->range;
-	float tan_half = L->type == RND_LIGHT_SPOT ? tanf(fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f)) : 1.0f;
-	float kernel = (float)(lp->filter == UMBRA_FILTER_PCF ? 2 * lp->pcf_radius + 1 : 1);
-	float pix = cam->ortho ? cam->ortho_height / (float)height : 2.0f * tanf(0.5f * cam->fov_y) / (float)height;
-	float want = 0;
-	for (int i = 0; i < 9; i++) {
-		float p[3], d[3];
-		for (int k = 0; k < 3; k++)
-			p[k] = i == 8 ? 0.5f * (b->min[k] + b->max[k]) : (i >> k & 1 ? b->max[k] : b->min[k]);
-		rnd_v3_sub(d, p, L->position);
-		float to_light = rnd_v3_length(d);
-		if (to_light > reach) {
-			for (int k = 0; k < 3; k++) p[k] = L->position[k] + d[k] * (reach / to_light);
-			to_light = reach;
-		}
-		rnd_v3_sub(d, p, cam->pos);
-		float footprint = cam->ortho ? pix : pix * fmaxf(rnd_v3_length(d), cam->znear);
-		/* texel at p: 2 tan_half |p - L| / res <= footprint / kernel */
-		want = fmaxf(want, kernel * 2.0f * tan_half * to_light / footprint);
-	}
-	float cap = fminf(2.0f * (float)base, L->type == RND_LIGHT_SPOT ? 2048.0f : 1024.0f);
-	return (uint32_t)fminf(want, cap);
-}
-
 static bool use_cascades(const struct rnd_shadow *s, const struct rnd_aabb *b, const struct rnd_camera_plan *cam)
 {
 	if (s->dir_mode == RND_DIR_CASCADES) return true;
@@ -221,7 +135,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
 }
 
 /* The next shadow view, of light i (ortho: depth clamp instead of near-plane culling). */
-static struct umbra_shadow_view *next_view(struct rnd_shadow_plan *out, uint32_t i, bool ortho)
+struct umbra_shadow_view *rnd_plan_next_view(struct rnd_shadow_plan *out, uint32_t i, bool ortho)
 {
 	out->view_light[out->view_count] = i;
 	out->view_ortho[out->view_count] = ortho;
@@ -265,7 +179,7 @@ static void plan_clipmap(const struct rnd_shadow *s, uint32_t i, const float vie
                          struct rnd_light_plan *lp, struct rnd_shadow_plan *out)
 {
 	float fres = (float)lp->resolution;
-	float maxd = s->max_distance > 0 ? s->max_distance : fminf(cam->zfar, max_dist(cam->pos, bounds));
+	float maxd = s->max_distance > 0 ? s->max_distance : fminf(cam->zfar, rnd_plan_max_dist(cam->pos, bounds));
 	float extent = s->clipmap_extent > 0 ? s->clipmap_extent : 2.0f * maxd / (float)(1u << (ncasc - 1));
 	float eye_ls[3];
 	rnd_mat4_mul_point(eye_ls, view, cam->pos);
@@ -274,7 +188,7 @@ static void plan_clipmap(const struct rnd_shadow *s, uint32_t i, const float vie
 		float texel = 2.0f * half / fres;
 		float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
 		float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
-		ortho_view(next_view(out, i, true), view, cx, cy, half, zmin, zmax, fres, d);
+		ortho_view(rnd_plan_next_view(out, i, true), view, cx, cy, half, zmin, zmax, fres, d);
 	}
 	lp->clipmap = true;
 	lp->max_distance = s->max_distance > 0 ? s->max_distance : 0.5f * extent * (float)(1u << (ncasc - 1));
@@ -321,7 +235,7 @@ static void plan_cascades(const struct rnd_shadow *s, uint32_t i, const float vi
 		float texel = 2.0f * r / fres;
 		float cx = floorf(eye_ls[0] / texel + 0.5f) * texel;
 		float cy = floorf(eye_ls[1] / texel + 0.5f) * texel;
-		ortho_view(next_view(out, i, true), view, cx, cy, r, zmin, zmax, fres, d);
+		ortho_view(rnd_plan_next_view(out, i, true), view, cx, cy, r, zmin, zmax, fres, d);
 	}
 }
 
@@ -386,7 +300,7 @@ static float shadow_reach(const float d[3], const struct rnd_aabb *casters, cons
 /* Width in texels of the smallest footprint the light's filter blurs an edge over: PCF's
  * (2r+1) kernel, PCSS's narrowest disk (radius 1) and its bilinear taps; a moment map's blur
  * is the softness asked for, in texels (test_moments): one texel. */
-static float filter_kernel_texels(const struct rnd_light_plan *lp)
+float rnd_plan_kernel_texels(const struct rnd_light_plan *lp)
 {
 	if (lp->filter == UMBRA_FILTER_PCSS) return 3.0f;
 	return lp->filter == UMBRA_FILTER_PCF ? 2.0f * (float)lp->pcf_radius + 1.0f : 1.0f;
@@ -425,7 +339,7 @@ static void fit_casters(const struct rnd_shadow *s, const float view[16], const 
 		float span = fmaxf((lc.max[0] - lc.min[0]) / tx, (lc.max[1] - lc.min[1]) / ty);  /* in those texels */
 		while ((float)res < span + 2.0f * reach + 2.0f && (float)res < *fres) res *= 2;
 		if (s->resolution) res = (uint32_t)*fres;
-		float want = need->pixel / filter_kernel_texels(lp), finer = want > 0 ? fminf(want / fmaxf(tx, ty), 1.0f) : 1.0f;
+		float want = need->pixel / rnd_plan_kernel_texels(lp), finer = want > 0 ? fminf(want / fmaxf(tx, ty), 1.0f) : 1.0f;
 		if (span / finer + 2.0f * reach + 2.0f > (float)res && 2.0f * (float)res <= *fres) res *= 2;
 		float fit = ((float)res - 2.0f * reach - 2.0f) / fmaxf(span, 1e-6f);   /* texels per scene texel */
 		/* PCSS searches and filters within search_texels: texels no finer than its widest
@@ -480,43 +394,12 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 			struct fit_need need = {cam_pixel, tanf(0.5f * L->angular_diameter) * shadow_reach(d, casters, bounds)};
 			fit_casters(s, view, casters, &need, lp, &fres, &cx, &cy, &hx, &hy, &grow);
 		}
-		ortho_view_rect(next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
+		ortho_view_rect(rnd_plan_next_view(out, i, true), view, cx, cy, hx * grow, hy * grow, zmin, zmax, fres);
 		lp->max_distance = s->max_distance;
 	} else {
 		plan_cascades(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
 	}
 	lp->fade_start = lp->max_distance * (1.0f - fminf(fmaxf(s->fade, 0.0f), 1.0f));
-	return RND_OK;
-}
-
-/* A spot light's cone, or a point light's six cube faces. */
-static enum rnd_result plan_local(const struct rnd_light *L, uint32_t i, const struct rnd_aabb *bounds,
-                                  struct rnd_light_plan *lp, struct rnd_shadow_plan *out, struct rnd_error *err)
-{
-	float fres = (float)lp->resolution;
-	float reach = L->range > 0 ? L->range : max_dist(L->position, bounds);
-	float zfar = fmaxf(reach, 0.1f) * 1.01f;
-	float znear = fmaxf(zfar * 1e-3f, 0.01f);
-	/* Widen the frustum by the filter footprint so taps near an edge stay inside this view:
-	 * no seams between cube faces, no clipped cones. */
-	float margin = (float)(lp->pcf_radius + 2) + (lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : 0.0f);
-	float grow = 1.0f + 2.0f * margin / fres;
-	if (L->type == RND_LIGHT_SPOT) {
-		float d[3];
-		if (!rnd_v3_normalize(d, L->direction))
-			return rnd_fail(err, RND_ERR_INVALID, "light %u: direction is zero", i);
-		float up[3] = {0, 1, 0};
-		if (fabsf(d[1]) > 0.99f) { up[1] = 0; up[2] = 1; }
-		float half = fminf(L->outer_angle, 85.0f * (float)M_PI / 180.0f);
-		float fov = 2.0f * atanf(tanf(half) * grow);
-		persp_view(next_view(out, i, false), L->position, d, up, fov, znear, zfar, fres);
-		return RND_OK;
-	}
-	static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-	static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-	float fov = 2.0f * atanf(grow);
-	for (int f6 = 0; f6 < 6; f6++)
-		persp_view(next_view(out, i, false), L->position, dirs[f6], ups[f6], fov, znear, zfar, fres);
 	return RND_OK;
 }
 
@@ -532,6 +415,11 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 	bool empty = rnd_aabb_is_empty(bounds);
 	out->resolution = 0;
 	float cam_pixel = casters ? camera_pixel_at(cam, scene->height, casters) : 0.0f;
+	uint32_t local_lights = 0;
+	for (uint32_t i = 0; i < scene->light_count; i++)
+		local_lights += scene->lights[i].shadow.enabled && scene->lights[i].type != RND_LIGHT_DIRECTIONAL;
+	const struct rnd_aabb *fit = local_lights <= RND_LOCAL_FIT_LIGHTS_MAX ? casters : NULL;
+	struct rnd_local_need local = {bounds, fit, cam, scene->height, scene->max_shadow_resolution, 0};
 
 	for (uint32_t i = 0; i < scene->light_count && !empty; i++) {
 		const struct rnd_light *L = &scene->lights[i];
@@ -542,15 +430,13 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		/* Tile size: the light's resolution rounded up to a power of two (atlas tiles), else
 		 * by type: a sun map covers the whole view, a spot cone less, a cube face a sixth. */
 		if ((r = plan_filter(L, i, lp, err)) != RND_OK) return r;
-		uint32_t want = s->resolution ? s->resolution
-		              : L->type == RND_LIGHT_DIRECTIONAL ? RND_DEFAULT_SHADOW_RESOLUTION : light_importance_res(L, bounds, cam);
-		lp->size_rule = s->resolution ? RND_SIZE_ASKED : L->type == RND_LIGHT_DIRECTIONAL ? RND_SIZE_DEFAULT : RND_SIZE_IMPORTANCE;
-		if (!s->resolution && L->type != RND_LIGHT_DIRECTIONAL) {
-			uint32_t hard = hard_light_res(L, lp, bounds, cam, scene->height, rnd_shadow_map_side(want, true, 0));
-			if (hard > want) {
-				want = hard;
-				lp->size_rule = RND_SIZE_HARD_EDGE;
-			}
+		uint32_t want = s->resolution ? s->resolution : RND_DEFAULT_SHADOW_RESOLUTION;
+		lp->size_rule = s->resolution ? RND_SIZE_ASKED : RND_SIZE_DEFAULT;
+		if (L->type != RND_LIGHT_DIRECTIONAL) {
+			uint8_t rule;
+			uint32_t def = rnd_plan_local_want(L, lp, bounds, cam, scene->height, &rule);
+			local.default_res = rnd_shadow_map_side(def, false, scene->max_shadow_resolution);
+			if (!s->resolution) want = def, lp->size_rule = rule;
 		}
 		lp->resolution = rnd_shadow_map_side(want, s->resolution != 0, scene->max_shadow_resolution);
 		if (lp->resolution < rnd_shadow_map_side(want, s->resolution != 0, 0)) lp->size_rule = RND_SIZE_CAPPED;
@@ -575,7 +461,7 @@ enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct
 		lp->view_count = need;
 		lp->follows_camera = cascades || clipmap;
 		r = L->type == RND_LIGHT_DIRECTIONAL ? plan_directional(L, i, bounds, casters, cam_pixel, cam, clipmap, cascades, ncasc, lp, out, err)
-		                                     : plan_local(L, i, bounds, lp, out, err);
+		                                     : rnd_plan_local(L, i, &local, lp, out, err);
 		if (r != RND_OK) return r;
 		if (lp->resolution > out->resolution) out->resolution = lp->resolution;
 	}

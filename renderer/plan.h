@@ -54,8 +54,11 @@ enum rnd_size_rule {
 	RND_SIZE_DEFAULT,      /* a sun's default (RND_DEFAULT_SHADOW_RESOLUTION) */
 	RND_SIZE_IMPORTANCE,   /* a spot or point light's share of the view (light_importance_res) */
 	RND_SIZE_HARD_EDGE,    /* a hard light's kernel within a pixel (hard_light_res) */
-	RND_SIZE_CASTERS,      /* a `fit` sun map cut to the casters' box, texels for the camera (fit_casters) */
+	RND_SIZE_CASTERS,      /* a `fit` sun map or a spot's cone cut to the casters' box, or a point light's
+	                          faces, texels for where the camera sees the casters (fit_casters, plan_local.c) */
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
+	RND_SIZE_SEARCH,       /* a PCSS spot / point map: texels no finer than its blocker search reaches
+	                          the widest penumbra its casters cast (plan_local.c) */
 	RND_SIZE_RULE_COUNT
 };
 /* A rule in words ("" for none). */

@@ -13,6 +13,7 @@ const char *rnd_size_rule_text(unsigned why)
 		[RND_SIZE_IMPORTANCE] = "the share of the view the light's reach covers",
 		[RND_SIZE_HARD_EDGE] = "a hard light: its filter kernel within a pixel of the output",
 		[RND_SIZE_CASTERS] = "the casters' box: texels finer than the default map's where the camera sees them close",
+		[RND_SIZE_SEARCH] = "the casters' box: texels no finer than the PCSS blocker search reaches for their widest penumbra",
 		[RND_SIZE_CAPPED] = "the server's largest shadow resolution",
 	};
 	return why < RND_SIZE_RULE_COUNT ? text[why] : "";

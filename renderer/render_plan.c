@@ -20,6 +20,7 @@
 #include "material_bits.h"
 #include "mesh.h"
 #include "render_plan.h"
+#include "plan_local.h"
 #include "shadow_keys.h"
 #include "visibility_plan.h"
 
@@ -450,6 +451,8 @@ static enum rnd_result plan_view_work(struct rnd_plan *p, uint32_t v, struct rnd
 			 * at rect[2]) grows with it, or PCSS, the contact march and the normal offset measure
 			 * in texels 2-4x too small (issue 31: a point light at resolution 4096, fitted to
 			 * 1024, had a 4x over-wide penumbra). */
+			if (!sp->view_ortho[lp->first_view + t])
+				rnd_plan_local_regrant(&sp->views[lp->first_view + t], lp, (float)m->res);
 			sp->views[lp->first_view + t].params[0] *= rect[2] / (float)m->res;
 			rect[2] = (float)m->res;
 			rect[3] = (float)p->dev.atlas_size;
