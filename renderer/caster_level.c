@@ -39,7 +39,7 @@ struct draw rnd_caster_view_draw(const struct rnd_shadow_plan *sp, const struct 
 	out.first_index = d->env_first_index;
 	out.index_count = d->env_index_count;
 	*cull = 0;
-	*raise = d->env_error;
+	*raise = d->env_raise;
 	return out;
 }
 

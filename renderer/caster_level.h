@@ -41,8 +41,8 @@ float rnd_caster_world_error(const struct rnd_object *o);
 
 /* Draw d as shadow view v draws it: its caster level (its range, no culling: a coarse level's
  * winding is not to be trusted) when the view is one of the environment's and its texel
- * allows the level, with *raise its error (world units; the view's depth bias raise); else d
- * and *raise 0. */
+ * allows the level, with *raise its d->env_raise (its error, world units: the view's depth
+ * bias raise); else d and *raise 0. */
 struct draw rnd_caster_view_draw(const struct rnd_shadow_plan *sp, const struct rnd_light *lights, uint32_t v,
                                  const struct draw *d, int *cull, float *raise);
 

@@ -65,6 +65,8 @@ static void plan_device(struct rnd_context *ctx, struct rnd_plan_device *d)
 	/* UMBRA_CASTER_LEVEL=0: the environment's maps draw what the camera draws (comparisons) */
 	const char *cl = getenv("UMBRA_CASTER_LEVEL");
 	d->caster_levels_off = cl && strcmp(cl, "0") == 0;
+	const char *cb = getenv("UMBRA_CASTER_BIAS");   /* 0: without their bias (tests: the acne it prevents) */
+	d->caster_bias_off = cb && strcmp(cb, "0") == 0;
 	d->pixel_shading = ctx->pixel_shading;
 	const char *ps = getenv("UMBRA_PIXEL_SHADING");   /* 0: shaded per fragment (tests, comparisons) */
 	d->pixel_shading_force = ps && strcmp(ps, "0") == 0 ? 0 : -1;

@@ -140,6 +140,7 @@ static enum rnd_result plan_layout(struct rnd_plan *p, struct rnd_error *err)
 		d->env_first_index = (uint32_t)ni;
 		d->env_index_count = o->caster->index_count;
 		d->env_error = rnd_caster_world_error(o);
+		d->env_raise = p->dev.caster_bias_off ? 0.0f : d->env_error;
 		nv += o->caster->vertex_count;
 		ni += o->caster->index_count;
 	}
