@@ -26,16 +26,19 @@ float rnd_caster_world_error(const struct rnd_object *o)
 	return o->caster ? o->caster->error * s : 0.0f;
 }
 
+bool rnd_caster_level_used(const struct rnd_light *L, const struct umbra_shadow_view *sv, bool ortho,
+                           const struct draw *d)
+{
+	return d->env_index_count && L->shadow.dir_mode == RND_DIR_CASTERS && ortho &&
+	       d->env_error <= RND_CASTER_MAX_TEXELS * sv->params[0];
+}
+
 struct draw rnd_caster_view_draw(const struct rnd_shadow_plan *sp, const struct rnd_light *lights, uint32_t v,
                                  const struct draw *d, int *cull, float *raise)
 {
 	struct draw out = *d;
 	*raise = 0.0f;
-	const struct rnd_light *L = &lights[sp->view_light[v]];
-	float texel = sp->views[v].params[0];
-	if (!d->env_index_count || L->shadow.dir_mode != RND_DIR_CASTERS || !sp->view_ortho[v] ||
-	    !(d->env_error <= RND_CASTER_MAX_TEXELS * texel))
-		return out;
+	if (!rnd_caster_level_used(&lights[sp->view_light[v]], &sp->views[v], sp->view_ortho[v], d)) return out;
 	out.first_index = d->env_first_index;
 	out.index_count = d->env_index_count;
 	*cull = 0;

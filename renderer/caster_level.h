@@ -39,6 +39,12 @@ bool rnd_caster_level_wanted(const struct rnd_scene *sc, const struct rnd_object
 /* The level's error in world units: its object-space error times o->model's largest scale. */
 float rnd_caster_world_error(const struct rnd_object *o);
 
+/* Whether a shadow view (of light L, sv, orthographic or not) draws d's caster level: L is one
+ * of the environment's (RND_DIR_CASTERS), the view orthographic, and the level's error within
+ * RND_CASTER_MAX_TEXELS of its texel (sv->params[0]). */
+bool rnd_caster_level_used(const struct rnd_light *L, const struct umbra_shadow_view *sv, bool ortho,
+                           const struct draw *d);
+
 /* Draw d as shadow view v draws it: its caster level (its range, no culling: a coarse level's
  * winding is not to be trusted) when the view is one of the environment's and its texel
  * allows the level, with *raise its d->env_raise (its error, world units: the view's depth

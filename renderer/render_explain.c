@@ -5,6 +5,7 @@
  * in its own module (casters.c, plan.c, visibility_plan.c, lod.c, shadow_cache.c).
  */
 #include <string.h>
+#include "caster_level.h"
 #include "lod.h"
 #include "render_plan.h"
 #include "visibility_plan.h"
@@ -237,6 +238,11 @@ void rnd_plan_object(const struct rnd_plan *p, uint32_t i, struct rnd_plan_objec
 	object_detail(p, i, out);
 	out->triangles = d->index_count / 3;
 	out->camera_triangles = d->cam_index_count / 3;
+	out->caster_triangles = d->env_index_count / 3;
+	out->caster_error = d->env_error;
+	const struct rnd_view_plan *vp = &p->views[0];
+	for (uint32_t k = 0; k < vp->shadow_views && d->env_index_count; k++)
+		out->caster_maps += rnd_caster_level_used(&p->esc.lights[vp->view_light[k]], &vp->views[k], vp->view_ortho[k], d);
 	out->proxy = (d->flags & UMBRA_DRAW_SPHERE) != 0;
 	out->casts = d->cast && d->index_count;
 	out->cast_why = cast_why[p->cast_why[i] % RND_CAST_WHY_COUNT];
