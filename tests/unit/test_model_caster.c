@@ -38,6 +38,25 @@ static void sphere(int seg, float **pos, float **nrm, uint32_t **idx, uint32_t *
 		}
 }
 
+/* Model m of one mesh me, the 80k-triangle sphere, its material mat (opaque). */
+static bool sphere_model(struct api_model *m, struct api_model_mesh *me, struct rnd_material *mat)
+{
+	float *pos, *nrm;
+	uint32_t *idx, nv, ni;
+	sphere(200, &pos, &nrm, &idx, &nv, &ni);
+	rnd_material_defaults(mat);
+	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
+	*m = (struct api_model){.meshes = me, .mesh_count = 1, .materials = mat, .material_count = 1};
+	return pos && nrm && idx;
+}
+
+static void sphere_free(struct api_model_mesh *me)
+{
+	free((void *)me->positions);
+	free((void *)me->normals);
+	free((void *)me->indices);
+}
+
 /* A flat n x n grid of squares over [0,1]^2 at height y (x, z in the plane). */
 static void grid(int n, float y, float *pos, uint32_t *idx)
 {
@@ -78,14 +97,10 @@ TEST(caster_error_of_parallel_grids_is_their_distance)
  * beyond the lattice's term (within a hundredth of the radius). */
 TEST(caster_level_error_bound_holds_on_a_sphere)
 {
-	float *pos, *nrm;
-	uint32_t *idx, nv, ni;
-	sphere(200, &pos, &nrm, &idx, &nv, &ni);
-	REQUIRE(pos && nrm && idx);
 	struct rnd_material mat;
-	rnd_material_defaults(&mat);
-	struct api_model_mesh me = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
-	struct api_model m = {.meshes = &me, .mesh_count = 1, .materials = &mat, .material_count = 1};
+	struct api_model_mesh me;
+	struct api_model m;
+	REQUIRE(sphere_model(&m, &me, &mat));
 	struct api_arena *a = api_arena_create();
 	size_t bytes = 0;
 	api_model_finish_import(&m, 0, a, &bytes);
@@ -112,21 +127,17 @@ TEST(caster_level_error_bound_holds_on_a_sphere)
 	CHECK(c->error >= worst, "claimed %g, found %g", (double)c->error, worst);
 	CHECK(c->error <= worst + 2.0 / 96.0 / sqrt(3.0) + 0.01, "claimed %g is loose (found %g)", (double)c->error, worst);
 	api_arena_destroy(a);
-	free(pos); free(nrm); free(idx);
+	sphere_free(&me);
 }
 
 /* No level where the depth pass needs more than positions (a masked or blended material) or
  * the mesh is too small to gain from one. */
 TEST(caster_level_none_for_masked_or_small_meshes)
 {
-	float *pos, *nrm;
-	uint32_t *idx, nv, ni;
-	sphere(200, &pos, &nrm, &idx, &nv, &ni);
-	REQUIRE(pos && nrm && idx);
 	struct rnd_material mat;
-	rnd_material_defaults(&mat);
-	struct api_model_mesh me = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
-	struct api_model m = {.meshes = &me, .mesh_count = 1, .materials = &mat, .material_count = 1};
+	struct api_model_mesh me;
+	struct api_model m;
+	REQUIRE(sphere_model(&m, &me, &mat));
 	CHECK(api_mesh_wants_caster(&m, &me), "opaque and dense: wanted");
 	static const enum rnd_alpha_mode modes[2] = {RND_ALPHA_MASK, RND_ALPHA_BLEND};
 	for (int k = 0; k < 2; k++) {
@@ -144,5 +155,5 @@ TEST(caster_level_none_for_masked_or_small_meshes)
 	api_model_finish_import(&m, 0, a, &bytes);
 	CHECK(me.caster == NULL && !api_mesh_wants_caster(&m, &me), "%u triangles: no level", me.index_count / 3);
 	api_arena_destroy(a);
-	free(pos); free(nrm); free(idx);
+	sphere_free(&me);
 }
