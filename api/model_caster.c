@@ -26,6 +26,8 @@ struct tgrid {
 	float lo[3], cell;
 	int n[3];
 	uint32_t *start, *items;   /* cell c's triangles: items[start[c] .. start[c + 1]) */
+	float *sphere;             /* per triangle (index offset / 3): centroid xyz and the radius
+	                              reaching its corners, to pass over most candidates cheaply */
 };
 
 static int cell_of(const struct tgrid *g, float x, int k)
@@ -54,8 +56,10 @@ static bool tgrid_build(struct tgrid *g, const uint32_t *idx, size_t ni, const f
 	g->pos = pos;
 	g->idx = idx;
 	float side = fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-	/* a surface crosses ~6 n^2 of n^3 cells: about half a triangle a cell, at most 160 a side */
-	float per_axis = fminf(fmaxf(sqrtf((float)(ni / 3) / 3.0f), 1.0f), 160.0f);
+	/* ~8 cells a triangle in all (a surface crosses ~6 n^2 of the n^3: a few triangles each of
+	 * those), at most 128 a side: a grid of 160 a side for a 100k mesh spent more on its 4M
+	 * empty cells than the searches saved */
+	float per_axis = fminf(fmaxf(cbrtf(8.0f * (float)(ni / 3)), 1.0f), 128.0f);
 	g->cell = side > 0.0f ? side / per_axis * 1.001f : 1.0f;
 	size_t cells = 1;
 	for (int k = 0; k < 3; k++) {
@@ -64,7 +68,19 @@ static bool tgrid_build(struct tgrid *g, const uint32_t *idx, size_t ni, const f
 		cells *= (size_t)g->n[k];
 	}
 	g->start = calloc(cells + 1, sizeof *g->start);
-	if (!g->start) return false;
+	g->sphere = malloc((ni / 3 ? ni / 3 : 1) * 4 * sizeof *g->sphere);
+	if (!g->start || !g->sphere) return false;
+	for (size_t t = 0; t + 2 < ni; t += 3) {
+		float *sp = g->sphere + 4 * (t / 3), r2 = 0.0f;
+		for (int k = 0; k < 3; k++)
+			sp[k] = (pos[3 * (size_t)idx[t] + k] + pos[3 * (size_t)idx[t + 1] + k] + pos[3 * (size_t)idx[t + 2] + k]) / 3.0f;
+		for (int c = 0; c < 3; c++) {
+			float d[3];
+			rnd_v3_sub(d, pos + 3 * (size_t)idx[t + (size_t)c], sp);
+			r2 = fmaxf(r2, rnd_v3_dot(d, d));
+		}
+		sp[3] = sqrtf(r2);
+	}
 	size_t total = 0;
 	for (int pass = 0; pass < 2; pass++) {
 		for (size_t t = 0; t + 2 < ni; t += 3) {
@@ -92,6 +108,7 @@ static bool tgrid_build(struct tgrid *g, const uint32_t *idx, size_t ni, const f
 
 static void tgrid_free(struct tgrid *g)
 {
+	free(g->sphere);
 	free(g->start);
 	free(g->items);
 }
@@ -182,6 +199,10 @@ static float tgrid_dist(const struct tgrid *g, const float p[3], uint32_t *hint)
 					if (cell_dist2(g, p, x, y, z) > best) continue;   /* nothing in it can be nearer */
 					size_t cell = ((size_t)z * (size_t)g->n[1] + (size_t)y) * (size_t)g->n[0] + (size_t)x;
 					for (uint32_t k = g->start[cell]; k < g->start[cell + 1]; k++) {
+						const float *sp = g->sphere + 4 * (g->items[k] / 3);
+						float e[3], reach = sqrtf(best) + sp[3];
+						rnd_v3_sub(e, p, sp);
+						if (rnd_v3_dot(e, e) > reach * reach) continue;   /* its sphere is farther */
 						float d = tri_dist2(g, p, g->items[k]);
 						if (d < best) best = d, *hint = g->items[k];
 					}
@@ -197,6 +218,11 @@ static float tgrid_dist(const struct tgrid *g, const float p[3], uint32_t *hint)
  * divides it (the covering radius of a triangle of longest side l is at most l / sqrt(3)), row
  * by row, each search seeded with its neighbour's nearest triangle (the first's with its
  * corner's). */
+static inline float max2(float a, float b)
+{
+	return a > b ? a : b;   /* (not fmaxf: a call into libm per sample, for its NaN rules) */
+}
+
 static float one_way(const uint32_t *ia, size_t na, const float *pa, size_t nva, const struct tgrid *g, float spacing)
 {
 	float worst = 0.0f, *vd = malloc((nva ? nva : 1) * sizeof *vd);
@@ -215,7 +241,7 @@ static float one_way(const uint32_t *ia, size_t na, const float *pa, size_t nva,
 		float ab[3], ac[3], bc[3];
 		rnd_v3_sub(ab, b, a); rnd_v3_sub(ac, c, a); rnd_v3_sub(bc, c, b);
 		float longest = sqrtf(fmaxf(rnd_v3_dot(ab, ab), fmaxf(rnd_v3_dot(ac, ac), rnd_v3_dot(bc, bc))));
-		float found = fmaxf(vd[ia[t]], fmaxf(vd[ia[t + 1]], vd[ia[t + 2]]));
+		float found = max2(vd[ia[t]], max2(vd[ia[t + 1]], vd[ia[t + 2]]));
 		float steps = ceilf(longest / spacing);
 		int m = steps > 1.0f ? steps < 64.0f ? (int)steps : 64 : 1;
 		uint32_t row = near[ia[t]];
@@ -224,11 +250,11 @@ static float one_way(const uint32_t *ia, size_t na, const float *pa, size_t nva,
 			for (int j = 0; i + j <= m; j++) {
 				float u = (float)i / (float)m, w = (float)j / (float)m, q[3];
 				for (int k = 0; k < 3; k++) q[k] = a[k] + u * ab[k] + w * ac[k];
-				found = fmaxf(found, tgrid_dist(g, q, &hint));
+				found = max2(found, tgrid_dist(g, q, &hint));
 				if (j == 0) row = hint;
 			}
 		}
-		worst = fmaxf(worst, found + longest / (float)m / sqrtf(3.0f));
+		worst = max2(worst, found + longest / (float)m / sqrtf(3.0f));
 	}
 	free(near);
 	free(vd);
