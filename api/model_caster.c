@@ -276,18 +276,18 @@ static void box2(const float *pa, size_t na, const float *pb, size_t nb, float l
 	}
 }
 
-/* Vertices named by idx[0..ni) (each below nv). */
-static size_t named_vertices(const uint32_t *idx, size_t ni, size_t nv)
+/* Vertices idx[0..ni) reaches: its largest index + 1. */
+static size_t named_vertices(const uint32_t *idx, size_t ni)
 {
 	size_t top = 0;
 	for (size_t i = 0; i < ni; i++) top = idx[i] + 1u > top ? idx[i] + 1u : top;
-	return top < nv ? top : nv;
+	return top;
 }
 
 float api_caster_error(const uint32_t *ia, size_t na, const float *pa, const uint32_t *ib, size_t nb, const float *pb,
                        float spacing)
 {
-	size_t nva = named_vertices(ia, na, SIZE_MAX), nvb = named_vertices(ib, nb, SIZE_MAX);
+	size_t nva = named_vertices(ia, na), nvb = named_vertices(ib, nb);
 	float lo[3], hi[3];
 	box2(pa, nva, pb, nvb, lo, hi);
 	if (!(spacing > 0.0f) || na < 3 || nb < 3) return INFINITY;

@@ -52,9 +52,10 @@ void api_caster_build(struct api_model_mesh *me, const uint32_t *idx, size_t ni,
                       struct api_arena *arena, size_t *bytes);
 
 /* A bound on the distance between the surfaces of triangles a (na indices into pa) and b (nb
- * into pb), both ways: every point of either lies within it of the other. spacing: the
- * lattice's step (the bound adds spacing / sqrt(3), the lattice's covering radius); INFINITY
- * when a point has no triangle of the other within a few grid cells, or memory runs out. */
+ * into pb), both ways: every point of either lies within it of the other. Each side's vertices
+ * must all be named by its indices (a welded or compacted mesh). spacing: the lattice's step on
+ * triangles longer than it (each triangle adds how far its points can be from its samples, at
+ * most its lattice step / sqrt(3)); INFINITY when memory runs out or a side has no triangle. */
 float api_caster_error(const uint32_t *ia, size_t na, const float *pa, const uint32_t *ib, size_t nb, const float *pb,
                        float spacing);
 
