@@ -13,6 +13,7 @@
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
 #   make bench-farm-remote  the local farm against --server on 3 daemons, 300 models
 #   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
+#   make sizes      files over ~600 lines and functions over ~80 in api/ renderer/ server/ (a list)
 #   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
 BUILD ?= build
 SHARED ?= ../shared
@@ -94,7 +95,7 @@ ifneq ($(GPU_SRC),)
 BINS += $(BUILD)/tests/gpu_tests
 endif
 
-.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster test-farm bench-cluster bench-farm-remote check-deploy print-version
+.PHONY: pkg-check all deps run test test-asan bench bench-quick bench-tools fuzz fuzz-long fuzz-targets soak clean cluster test-cluster test-farm bench-cluster bench-farm-remote check-deploy sizes print-version
 all: $(BINS)
 
 deps:
@@ -241,6 +242,9 @@ bench-farm-remote: deps
 
 check-deploy:
 	@sh deploy/check.sh
+
+sizes:
+	@python3 tests/sizes.py
 
 print-version:
 	@echo $(UMBRA_VERSION)

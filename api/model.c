@@ -328,17 +328,11 @@ static void release_list(struct model_priv *list)
 	}
 }
 
-/* The cache's entry for `data` (the model's model_len bytes, then nfiles files as the sandbox's
- * bundle lays them out: the key covers the files too), importing it on a miss. */
-static enum api_result get(const uint8_t *data, size_t len, size_t model_len, size_t nfiles,
-                           enum api_model_format format, const struct api_limits *lim, struct api_model **out,
-                           bool *was_hit, int *status, char *err, size_t errsize)
+/* The listed model of data[0..len) (hash h) for images of side, a reference taken and moved to
+ * the list's front; NULL on a miss. Counts the hit or miss. */
+static struct model_priv *cache_take(uint64_t h, const uint8_t *data, size_t len, size_t model_len,
+                                     enum api_model_format format, uint32_t side)
 {
-	/* Word at a time: a cached 50 MB model is hashed on every request that names it (byte at a
-	 * time that alone took ~50 ms); the whole buffer is at hand, so no need to stream. */
-	uint64_t h = rnd_hash(RND_FNV_SEED ^ (uint64_t)format, data, len);
-
-	uint32_t side = lim ? lim->output_side : 0;
 	pthread_mutex_lock(&cache_mu);
 	struct model_priv *hit = lru_find(h, data, len, model_len, format, side);
 	if (hit) {
@@ -350,6 +344,50 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 		cache_misses++;
 	}
 	pthread_mutex_unlock(&cache_mu);
+	return hit;
+}
+
+/* Lists m, just imported from data[0..len) (the cache's reference taken; the models it covers,
+ * and those it pushes over the cache's limit, released), and returns NULL; or, when another
+ * request listed the same bytes meanwhile, returns that one with a reference taken (m is then
+ * not listed: the caller's to release). */
+static struct model_priv *cache_list(struct model_priv *m, const uint8_t *data, size_t len, size_t model_len,
+                                     enum api_model_format format, uint32_t side)
+{
+	struct model_priv *evicted = NULL;
+	pthread_mutex_lock(&cache_mu);
+	struct model_priv *dup = lru_find(m->hash, data, len, model_len, format, side);
+	if (dup) {
+		atomic_fetch_add(&dup->refs, 1);
+	} else {
+		struct model_priv *older = unlist_covered(m);
+		lru_push_front(m);
+		atomic_fetch_add(&m->refs, 1); /* the cache's reference */
+		evicted = evict_over_limit(m);
+		if (older) {   /* both lists end in NULL: join them for one release */
+			struct model_priv *t = older;
+			while (t->next) t = t->next;
+			t->next = evicted;
+			evicted = older;
+		}
+	}
+	pthread_mutex_unlock(&cache_mu);
+	release_list(evicted);
+	return dup;
+}
+
+/* The cache's entry for `data` (the model's model_len bytes, then nfiles files as the sandbox's
+ * bundle lays them out: the key covers the files too), importing it on a miss. */
+static enum api_result get(const uint8_t *data, size_t len, size_t model_len, size_t nfiles,
+                           enum api_model_format format, const struct api_limits *lim, struct api_model **out,
+                           bool *was_hit, int *status, char *err, size_t errsize)
+{
+	/* Word at a time: a cached 50 MB model is hashed on every request that names it (byte at a
+	 * time that alone took ~50 ms); the whole buffer is at hand, so no need to stream. */
+	uint64_t h = rnd_hash(RND_FNV_SEED ^ (uint64_t)format, data, len);
+
+	uint32_t side = lim ? lim->output_side : 0;
+	struct model_priv *hit = cache_take(h, data, len, model_len, format, side);
 	if (hit) {
 		api_levels_on_hit(&hit->pub, lim);
 		*was_hit = true;
@@ -380,26 +418,8 @@ static enum api_result get(const uint8_t *data, size_t len, size_t model_len, si
 	m->hash = h;
 	m->pub.bytes_ = cost;
 
-	struct model_priv *evicted = NULL;
-	pthread_mutex_lock(&cache_mu);
 	/* Another request may have imported the same bytes meanwhile: use the listed one. */
-	struct model_priv *dup = lru_find(h, data, len, model_len, format, side);
-	if (dup) {
-		atomic_fetch_add(&dup->refs, 1);
-	} else {
-		struct model_priv *older = unlist_covered(m);
-		lru_push_front(m);
-		atomic_fetch_add(&m->refs, 1); /* the cache's reference */
-		evicted = evict_over_limit(m);
-		if (older) {   /* both lists end in NULL: join them for one release */
-			struct model_priv *t = older;
-			while (t->next) t = t->next;
-			t->next = evicted;
-			evicted = older;
-		}
-	}
-	pthread_mutex_unlock(&cache_mu);
-	release_list(evicted);
+	struct model_priv *dup = cache_list(m, data, len, model_len, format, side);
 	if (dup) {
 		/* Imported for another image size of the same texture class, maybe: this request's
 		 * level as on any hit, or it would render at full detail here and with its level

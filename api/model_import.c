@@ -462,6 +462,28 @@ static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb,
 	return 0;
 }
 
+/* Assimp's scene of data[0..len), a file of format beside io_files (what it opens: the model's
+ * own file and those it names), or NULL with *st and err saying why. The caller releases the
+ * scene (aiReleaseImport, under import_mu). */
+static const struct aiScene *assimp_read(const uint8_t *data, size_t len, const struct api_model_file *io_files,
+                                         size_t io_nfiles, enum api_model_format format, bool face_colors,
+                                         enum api_wire_status *st, char *err, size_t errsize)
+{
+	struct api_mem_io mi = {.data = data, .len = len, .files = io_files, .nfiles = io_nfiles};
+	snprintf(mi.name, sizeof mi.name, MEM_NAME ".%s", FORMAT_NAMES[format]);
+	struct aiFileIO io;
+	api_mem_io_init(&mi, &io);
+	struct aiPropertyStore *props = aiCreatePropertyStore();
+	/* SortByPType puts points and lines in meshes of their own: drawn as thin geometry (convert). */
+	aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
+	pthread_mutex_lock(&import_mu);   /* Assimp's error string is global: read under the lock */
+	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, import_flags(format, face_colors), &io, props);
+	if (!sc) *st = import_error(format, err, errsize);
+	pthread_mutex_unlock(&import_mu);
+	aiReleasePropertyStore(props);
+	return sc;
+}
+
 enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, const struct api_model_file *files,
                                              size_t nfiles, enum api_model_format format, uint32_t output_side,
                                              struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
@@ -508,23 +530,11 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		data = strips;
 		len = strips_len;
 	}
-	struct api_mem_io mi = {.data = data, .len = len, .files = io_files, .nfiles = io_nfiles};
-	snprintf(mi.name, sizeof mi.name, MEM_NAME ".%s", FORMAT_NAMES[format]);
-	struct aiFileIO io;
-	api_mem_io_init(&mi, &io);
-	struct aiPropertyStore *props = aiCreatePropertyStore();
-	/* SortByPType puts points and lines in meshes of their own: drawn as thin geometry (convert). */
-	aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
-	unsigned flags = import_flags(format, face_colors);
 	/* Assimp 5.2's join of identical vertices ignores their colours (import_flags leaves it
 	 * out): convert_mesh joins them by position, normal and colour. */
 	if (face_colors) c.join = true;
 	enum api_wire_status st = API_WIRE_OK;
-	pthread_mutex_lock(&import_mu);   /* Assimp's error string is global: read under the lock */
-	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, flags, &io, props);
-	if (!sc) st = import_error(format, err, errsize);
-	pthread_mutex_unlock(&import_mu);
-	aiReleasePropertyStore(props);
+	const struct aiScene *sc = assimp_read(data, len, io_files, io_nfiles, format, face_colors, &st, err, errsize);
 	free(strips);   /* Assimp copied what it needed */
 	free(tagged);
 	api_gltf_bufs_release(&bufs);

@@ -28,8 +28,11 @@
  * (its triangulation of polygons is its own), points and lines, vertices with colours or a
  * w, curves, line continuations, an `o` naming an earlier object, numbers not written plainly
  * (no digit first, a comma, nan, inf, no exponent digits), values past 1e18, out-of-range
- * vertex indices, more than 4M runs of faces, a skeleton Assimp refuses (the whole file then
- * gets its message), a file of no triangle with an area, and anything else odd.
+ * vertex indices, more than 4M runs of faces, a file of no triangle with an area, and anything
+ * else odd. A skeleton Assimp refuses is the file's refusal, with Assimp's message: it holds the
+ * file's o, g, usemtl and mtllib lines as they are, and every other line was read here (what
+ * Assimp refuses in it is a material's, such as a texture it cannot decode); Assimp is not run a
+ * second time on the whole file only to refuse it again.
  */
 #include <math.h>
 #include <stdbool.h>
@@ -535,7 +538,7 @@ static int build_with_materials(const struct parse *p, const struct obj_files *o
 	int rc = api_model_import_assimp((const uint8_t *)text, n, of->files, of->nfiles, API_MODEL_OBJ, of->output_side,
 	                                 arena, &sk, &skb, err, errsize);
 	free(text);
-	if (rc != API_WIRE_OK) return rc == API_WIRE_OVER_MEMORY ? rc : NOT_MINE;   /* Assimp says why */
+	if (rc != API_WIRE_OK) return rc;   /* the file's refusal: Assimp said why (see the top) */
 	size_t *start = malloc((sk.mesh_count + 1) * sizeof *start);
 	struct span *sp = malloc(k->nrun * sizeof *sp);
 	uint8_t *seen = calloc(k->nrun, 1);

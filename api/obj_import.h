@@ -16,8 +16,9 @@
 
 /* d[0..len) as an OBJ into *out (arena memory; *bytes what it holds), with the files it names
  * (its .mtl and textures, as api_model_import_files takes them) for images of output_side:
- * API_WIRE_OK, API_WIRE_OVER_MEMORY with a sentence in err, or API_OBJ_NOT_MINE (err then
- * holds nothing of use). */
+ * API_WIRE_OK, API_WIRE_OVER_MEMORY with a sentence in err, the status and message Assimp
+ * refused the file's materials with (API_WIRE_BAD_INPUT: a texture it cannot decode, ...), or
+ * API_OBJ_NOT_MINE (err then holds nothing of use). */
 int api_obj_import(const uint8_t *d, size_t len, const struct api_model_file *files, size_t nfiles,
                    uint32_t output_side, struct api_arena *arena, struct api_model *out, size_t *bytes, char *err,
                    size_t errsize);

@@ -189,32 +189,57 @@ static int pick_variant(struct pctx *c, size_t obj, const char *variant, const u
 	return api_fail_at(c, "variant", "%s", err);
 }
 
-int api_parse_model(struct pctx *c, json_t *j)
+/* A model object's members that say what to import: its one source (data, path or part:
+ * *first), the glTF material variant (*variant, NULL: none) and the format hint (*f, an index of
+ * formats; -1: none). 0, or -1 with the problem set. */
+static int model_source(struct pctx *c, json_t *j, const char *const *formats, const char **first,
+                        const char **variant, int *f)
 {
 	static const char *const sources[] = {"data", "path", "part"};
-	const char *first = NULL;
+	*first = NULL;
 	for (int i = 0; i < 3; i++) {
 		if (!json_object_get(j, sources[i])) continue;
-		if (first)
+		if (*first)
 			return api_fail_at(c, sources[i], "%s cannot be combined with %s: a model has one source", sources[i],
-			               first);
-		first = sources[i];
+			                   *first);
+		*first = sources[i];
 	}
-	if (!first) return api_fail(c, "a model needs one of data (base64 file), path or part");
-	const char *variant = NULL;
-	if (api_get_string(c, j, "variant", &variant) < 0) return -1;
-	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
+	if (!*first) return api_fail(c, "a model needs one of data (base64 file), path or part");
+	*variant = NULL;
+	if (api_get_string(c, j, "variant", variant) < 0) return -1;
 	/* A hint for the importer, not a value of the parsed scene: checked, not recorded as read
 	 * (scene_internal.h), so that it stays in the ETag's hash as written. */
-	int f = -1;
+	*f = -1;
 	json_t *fv = json_object_get(j, "format");
-	bool given = fv != NULL;
-	if (given) {
-		size_t o2 = api_ptr_push(c, "format");
-		int frc = api_check_enum(c, "format", fv, formats, &f);
-		api_ptr_pop(c, o2);
-		if (frc < 0) return -1;
-	}
+	if (!fv) return 0;
+	size_t o2 = api_ptr_push(c, "format");
+	int frc = api_check_enum(c, "format", fv, formats, f);
+	api_ptr_pop(c, o2);
+	return frc < 0 ? -1 : 0;
+}
+
+/* A model imported by path (its bytes b[0..len), the files it names in refs): the answer
+ * depends on the files, not only on the request, so the ETag's hash takes them; a model with
+ * nothing to say (quiet: no warning about its files or its format, no variant) is remembered
+ * for later requests (api/model_paths.h), which attach it without its bytes. */
+static void model_by_path(struct pctx *c, const struct api_model_path_key *key, const struct api_asset_stamp *stamp,
+                          const uint8_t *b, size_t len, const struct api_model_refs *refs, bool quiet,
+                          struct api_model *m)
+{
+	uint64_t h = 0;
+	api_asset_hash(&h, key->path, b, len);
+	if (refs->asset_hash) api_asset_hash(&h, NULL, (const uint8_t *)&refs->asset_hash, 8);
+	api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
+	if (quiet && !refs->warning[0]) api_model_paths_remember(key, stamp, refs->origins, refs->norigins, m, h);
+}
+
+int api_parse_model(struct pctx *c, json_t *j)
+{
+	static const char *const formats[] = {"glb", "gltf", "obj", "stl", "ply", NULL};
+	const char *first, *variant;
+	int f;
+	if (model_source(c, j, formats, &first, &variant, &f) < 0) return -1;
+	bool given = f >= 0;
 	json_t *v = json_object_get(j, first);
 	size_t old = api_ptr_push(c, first);
 	bool by_path = !strcmp(first, "path");
@@ -253,16 +278,7 @@ int api_parse_model(struct pctx *c, json_t *j)
 		else api_problem_set(c->p, status, c->ptr, "the model in %s could not be imported: %s", first, err);
 		rc = -1;
 	}
-	if (rc == 0 && by_path) {
-		/* The answer depends on the files, not only on the request: the ETag must change when they do. */
-		uint64_t h = 0;
-		api_asset_hash(&h, key.path, b, len);
-		if (refs.asset_hash) api_asset_hash(&h, NULL, (const uint8_t *)&refs.asset_hash, 8);
-		api_asset_hash(&c->asset_hash, NULL, (const uint8_t *)&h, 8);
-		/* A model remembered is attached without its bytes: only one with nothing to say is. */
-		if (!refs.warning[0] && !said[0] && !variant)
-			api_model_paths_remember(&key, &stamp, refs.origins, refs.norigins, m, h);
-	}
+	if (rc == 0 && by_path) model_by_path(c, &key, &stamp, b, len, &refs, !said[0] && !variant, m);
 	if (rc == 0) rc = attach_model(c, m);
 	free(vb);
 	api_model_refs_release(&refs);

@@ -1,7 +1,7 @@
 /*
  * renderer/camera.c — camera planning (plan.h rnd_camera_plan): the view, the reversed-Z
  * projection, near and far derived from the scene bounds where the request gives none, and
- * `fit` framing. Pure math; unit-tested in tests/unit/test_plan.c.
+ * `fit` framing. Pure math; unit-tested in tests/unit/test_camera.c.
  */
 #include <math.h>
 #include <string.h>

@@ -249,3 +249,22 @@ bool rnd_shadow_view_draws(const struct rnd_shadow_plan *sp, const struct rnd_li
 	        (d->closed && (L->type == RND_LIGHT_DIRECTIONAL || point_outside(L->position, &d->bounds, 0.05f)));
 	return true;
 }
+
+/* Each reason above in words (the plan shows them). */
+const char *rnd_cast_why_text(unsigned why)
+{
+	static const char *const text[RND_CAST_WHY_COUNT] = {
+		[RND_CAST_YES] = "casts",
+		[RND_CAST_NOT_ASKED] = "cast_shadows is false",
+		[RND_CAST_CATCHER] = "a shadow catcher receives shadows and casts none",
+		[RND_CAST_ALONE] = "a plane with no other object to shadow",
+		[RND_CAST_LIT_SIDE] = "a plane with every other object on its lit side",
+		[RND_CAST_UNSEEN] = "a plane whose shadow falls only where no camera sees it (on parts of objects sunk into it)",
+		[RND_CAST_FOR_MOMENTS] = "a plane drawn into the maps for the VSM/EVSM blur, left out of the casters' box",
+		[RND_CAST_UNJUDGED] = "a plane in a scene of more than " RND_NUMBER_WORDS(RND_PLANES_JUDGED_MAX)
+		                       " objects: planes are not judged, it casts",
+		[RND_CAST_FOR_ENV] = ("a plane that shadows others only from the environment's directions: in their maps, "
+		                      "left out of the casters' box"),
+	};
+	return why < RND_CAST_WHY_COUNT ? text[why] : "";
+}

@@ -30,6 +30,8 @@ enum rnd_cast_why {
 	                            in their maps, left out of the casters' box */
 	RND_CAST_WHY_COUNT
 };
+/* A reason in words ("" for none). */
+const char *rnd_cast_why_text(unsigned why);
 
 /* Whether plane object `plane` may cast a shadow of any shadowed light of sc onto the box b (an
  * object's world bounds): false when b lies wholly on the lit side of the plane for every such
@@ -42,7 +44,7 @@ bool rnd_plane_may_shadow(const struct rnd_scene *sc, const struct rnd_object *p
  * took 107 s of planning before the first submit). In a bigger scene every plane that asks to
  * cast shadows casts: the level of detail's estimate (lod.c) and rnd_casters_plan both follow
  * rnd_planes_judged(). */
-#define RND_PLANES_JUDGED_MAX 256u
+#define RND_PLANES_JUDGED_MAX 256
 bool rnd_planes_judged(const struct rnd_scene *sc);
 
 /* rnd_plane_may_shadow, less the shadows no camera of the render sees: where the part of b

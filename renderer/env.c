@@ -104,10 +104,11 @@ static bool fit_width(const float *rgb, uint32_t *w, uint32_t *h, float **out)
 	return true;
 }
 
-/* The CPU's part of a build, without the lock: the pixels (the studio generated), their bins and
- * harmonics, the device objects with the staged chain. */
+/* The CPU's part of a build, without the lock: the pixels (the studio generated), their bins
+ * (the plan's when it made them: a map is read for its bins once) and harmonics, the device
+ * objects with the staged chain. */
 static enum rnd_result stage_entry(struct rnd_context *ctx, struct rnd_env_entry *e, const struct rnd_environment *env,
-                                   struct rnd_error *err)
+                                   const struct rnd_env_bins *bins, struct rnd_error *err)
 {
 	bool studio = env->source == RND_ENV_STUDIO;
 	uint32_t w = studio ? RND_ENV_STUDIO_W : env->map.width, h = studio ? RND_ENV_STUDIO_H : env->map.height;
@@ -119,7 +120,8 @@ static enum rnd_result stage_entry(struct rnd_context *ctx, struct rnd_env_entry
 		rnd_env_studio(own, w, h);
 		rgb = own;
 	}
-	rnd_env_bin(rgb, w, h, &e->bins);
+	if (bins) memcpy(&e->bins, bins, sizeof e->bins);
+	else rnd_env_bin(rgb, w, h, &e->bins);
 	rnd_env_sh(&e->bins, e->sh);
 	enum rnd_result r;
 	if (!fit_width(rgb, &w, &h, &fitted)) r = rnd_fail(err, RND_ERR_OOM, "out of memory reducing the environment map");
@@ -199,8 +201,9 @@ static uint64_t env_key(const struct rnd_environment *env)
 	return key == STUDIO_KEY ? key + 1 : key;
 }
 
-enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_environment *env, double deadline,
-                                struct rnd_env_use *use, struct rnd_error *err)
+enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_environment *env,
+                                const struct rnd_env_bins *bins, double deadline, struct rnd_env_use *use,
+                                struct rnd_error *err)
 {
 	memset(use, 0, sizeof *use);
 	if (env->source == RND_ENV_AMBIENT) return RND_OK;
@@ -214,7 +217,7 @@ enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_enviro
 	if (r == RND_OK) r = find_entry(ctx, c, key, deadline, use, err);
 	if (r == RND_OK) r = claim_brdf(c, deadline, use, err);
 	pthread_mutex_unlock(&c->mu);
-	if (r == RND_OK && use->build) r = stage_entry(ctx, use->entry, env, err);
+	if (r == RND_OK && use->build) r = stage_entry(ctx, use->entry, env, bins, err);
 	if (r != RND_OK && use->entry) rnd_env_done(ctx, use, false, false);
 	if (r != RND_OK) memset(use, 0, sizeof *use);
 	use->ms = ((rnd_now_ms() * 1e-3) - t0) * 1e3;

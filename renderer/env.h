@@ -56,11 +56,13 @@ struct rnd_env_use {
 enum rnd_result rnd_env_init(struct rnd_context *ctx, struct rnd_error *err);
 void rnd_env_release_all(struct rnd_context *ctx);
 /* The map of env (source MAP or STUDIO; AMBIENT: use->entry NULL, RND_OK) found ready, or
- * claimed for this render to build (its pixels analysed and staged here). Waits for another
- * render building the same map, or for a free entry, until `deadline` (CLOCK_MONOTONIC
- * seconds, 0 = none: RND_ERR_TIMEOUT). */
-enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_environment *env, double deadline,
-                                struct rnd_env_use *use, struct rnd_error *err);
+ * claimed for this render to build (its pixels analysed and staged here; bins: the plan's bins
+ * of the same map (rnd_env_plan_bins), which the build keeps instead of reading every texel
+ * again; NULL: it bins the map). Waits for another render building the same map, or for a free
+ * entry, until `deadline` (CLOCK_MONOTONIC seconds, 0 = none: RND_ERR_TIMEOUT). */
+enum rnd_result rnd_env_acquire(struct rnd_context *ctx, const struct rnd_environment *env,
+                                const struct rnd_env_bins *bins, double deadline, struct rnd_env_use *use,
+                                struct rnd_error *err);
 /* The shadow directions for this render: the render plan's (rnd_env_plan_dirs, from the bins
  * rnd_env_plan_bins gave it: the same as the entry's). Pure once acquired. */
 void rnd_env_shadow_dirs(struct rnd_env_use *use, const struct rnd_env_plan *plan);

@@ -86,3 +86,8 @@ uint32_t rnd_env_lights(const struct rnd_env_plan *use, const struct rnd_environ
 	}
 	return n;
 }
+
+const char *rnd_env_lights_size_text(void)
+{
+	return "the environment's shadow_resolution, coarser for a wider region (env_shadow.c)";
+}

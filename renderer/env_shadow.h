@@ -15,6 +15,8 @@ bool rnd_env_ground(const struct rnd_scene *sc, const struct draw *draws, float 
  * light of its own (intensity 0). */
 uint32_t rnd_env_lights(const struct rnd_env_plan *dirs, const struct rnd_environment *env, uint32_t room,
                         struct rnd_light *out);
+/* How rnd_env_lights sizes their maps, in words (the plan shows it). */
+const char *rnd_env_lights_size_text(void);
 /* Whether a view's environment shadows come from the environment pass (env_pass.h): it has
  * mapped directions, no alpha-tested draw (the surfaces pass does not cut texels out) and no
  * debug view but environment_shadow's (or cascades'). force: UMBRA_ENV_PASS, 0 computes them

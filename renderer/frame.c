@@ -20,7 +20,7 @@
  * little outside it, the longest at 1.216: umbra_frame.params.w, how far the taps reach). The
  * even ones, the search's wide ring (shaders/shading.glsl pcss), come in ascending length: the
  * search takes only those that can reach a blocker (pcss_bounds' bound), a prefix
- * (tests/unit/test_plan.c checks the order). The filter takes all 32. */
+ * (tests/unit/test_plan_lights.c checks the order). The filter takes all 32. */
 static const float POISSON[64] = {
 	-0.146336f, -0.259194f, -0.920347f, -0.41142f, 0.0116886f, 0.326395f, -0.884518f, 0.568041f,
 	0.0625935f, -0.50853f, -0.792474f, -0.779962f, 0.56859f, 0.11655f, -0.580859f, -0.208777f,

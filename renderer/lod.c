@@ -286,3 +286,14 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 	for (uint32_t i = 0; i < sc->object_count; i++)
 		if (is_round(&sc->objects[i]) && segments[i] < 3) segments[i] = 3;
 }
+
+const char *rnd_lod_detail(const struct rnd_object *o, uint32_t lod)
+{
+	if (o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_CYLINDER)
+		return lod < o->segments ? "fewer segments: the output shows no more (1/32 pixel, 1/8 shadow texel)"
+		                         : "the segments asked for";
+	if (o->shape == RND_SHAPE_MESH && o->lod_count)
+		return lod ? "a simplified level: its error within half a pixel of every camera"
+		           : "the full mesh: no level's error fits the output";
+	return "as given";
+}

@@ -77,6 +77,8 @@ uint32_t rnd_lod_mesh_level(const struct rnd_object *o, float pixel_world, float
 /* Makes o the object rnd_lod_choose()'s entry `lod` for it says: a sphere / cylinder with lod
  * segments (and rnd_lod_radius), a mesh with level lod (0: unchanged). */
 void rnd_lod_apply(struct rnd_object *o, uint32_t lod);
+/* The level rnd_lod_choose gave object o (lod: segments, or a mesh's level), in words. */
+const char *rnd_lod_detail(const struct rnd_object *o, uint32_t lod);
 
 /* Fills segments[i] for every object of the scene (nviews views of width x height, scratch for
  * the shadow plans): segments for spheres and cylinders, the level for meshes with levels

@@ -242,9 +242,14 @@ uint32_t rnd_moments_max_res(const struct rnd_context *ctx)
 	return r;
 }
 
+bool rnd_bounds_rule(const struct rnd_light_plan *lp, bool bounds_atlas, uint32_t max_res, uint32_t res)
+{
+	return lp->filter == UMBRA_FILTER_PCSS && bounds_atlas && res <= max_res;
+}
+
 bool rnd_bounds_wanted(const struct rnd_context *ctx, const struct rnd_light_plan *lp, uint32_t res)
 {
-	return lp->filter == UMBRA_FILTER_PCSS && ctx->atlas_bounds.img && res <= rnd_moments_max_res(ctx);
+	return rnd_bounds_rule(lp, ctx->atlas_bounds.img != VK_NULL_HANDLE, rnd_moments_max_res(ctx), res);
 }
 
 void rnd_bounds_record_view(struct rnd_context *ctx, struct rnd_slot *s, const struct rnd_shadow_plan *sp, uint32_t v)

@@ -36,6 +36,9 @@ void rnd_moments_record_view(struct rnd_context *ctx, struct rnd_slot *s, const 
  * res: only PCSS lights get them, and only maps the scratch buffer's storage-buffer range can
  * hold (the same cap as moment maps). record.c draws them, frame.c tells the shader. */
 bool rnd_bounds_wanted(const struct rnd_context *ctx, const struct rnd_light_plan *lp, uint32_t res);
+/* The same rule from what the plan knows of the context (struct rnd_plan_device: whether the
+ * bounds' atlas exists, rnd_moments_max_res): what `explain` shows. */
+bool rnd_bounds_rule(const struct rnd_light_plan *lp, bool bounds_atlas, uint32_t max_res, uint32_t res);
 /* After shadow view v was drawn and copied to s->scratch_buf: its tile's
  * depth bounds into ctx->atlas_bounds. s->moments_set must point at both. Tiles are
  * UMBRA_BOUNDS_BLOCK-aligned (at least 64 texels, aligned to their size). */

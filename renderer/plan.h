@@ -3,7 +3,7 @@
  * derived near/far) and the shadow views of every light (plan.c: fit, cascades, spot cone,
  * point cube faces).
  *
- * Pure math: no Vulkan calls, no allocation; unit-tested in tests/unit/test_plan.c.
+ * Pure math: no Vulkan calls, no allocation; unit-tested in tests/unit/test_plan_*.c.
  */
 #ifndef UMBRA_RENDERER_PLAN_H
 #define UMBRA_RENDERER_PLAN_H
@@ -58,6 +58,14 @@ enum rnd_size_rule {
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
 	RND_SIZE_RULE_COUNT
 };
+/* A rule in words ("" for none). */
+const char *rnd_size_rule_text(unsigned rule);
+/* A limit written once, as a plain integer (no suffix), in the words that show it: "more than "
+ * RND_NUMBER_WORDS(RND_PLANES_JUDGED_MAX) " objects" is "more than 256 objects". */
+#define RND_NUMBER_WORDS(x) RND_NUMBER_WORDS_(x)
+#define RND_NUMBER_WORDS_(x) #x
+/* What kind of map light L's plan lp draws: "casters", "spot", "cube", "clipmap", "cascades", "fit". */
+const char *rnd_light_plan_kind(const struct rnd_light *L, const struct rnd_light_plan *lp);
 
 struct rnd_shadow_plan {
 	uint32_t resolution;                       /* the largest tile any light asks for */

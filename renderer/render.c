@@ -93,12 +93,12 @@ enum rnd_result rnd_plan_create(struct rnd_context *ctx, const struct rnd_scene 
 	enum rnd_result r = rnd_env_plan_bins(ctx, &sc->environment, &bins, err);
 	dev.env_bins = bins;
 	if (r == RND_OK) r = rnd_plan_build(sc, &dev, p, err);
-	free(bins);
-	p->dev.env_bins = NULL;
 	if (r != RND_OK) {
+		free(bins);
 		free(p);
 		return r;
 	}
+	p->env_bins = bins;
 	p->dev.cached = NULL;   /* the plan outlives no context it was made on */
 	p->dev.cache_user = NULL;
 	p->context = ctx;
@@ -110,6 +110,7 @@ enum rnd_result rnd_plan_create(struct rnd_context *ctx, const struct rnd_scene 
 void rnd_plan_destroy(struct rnd_plan *p)
 {
 	if (!p) return;
+	free(p->env_bins);
 	rnd_plan_release(p);
 	free(p);
 }
@@ -177,7 +178,8 @@ static enum rnd_result prepare(struct render *rq, struct rnd_error *err)
 	/* The environment's map before any shadow tile is granted (a render never waits for a map
 	 * while it holds tiles); its shadow directions are the plan's. */
 	double wait_until = sc->deadline_ns ? (double)sc->deadline_ns * 1e-9 : 0.0;
-	if ((r = rnd_env_acquire(ctx, &sc->environment, wait_until, &rq->env, err)) != RND_OK) return r;
+	if ((r = rnd_env_acquire(ctx, &sc->environment, rq->plan->env_bins, wait_until, &rq->env, err)) != RND_OK)
+		return r;
 	rnd_env_shadow_dirs(&rq->env, &rq->plan->env);
 	rq->tm.env_directions = rq->env.mapped;
 	rq->pacer.ctx = ctx;
@@ -366,6 +368,7 @@ done:
 	finish(&rq, r, err);
 	rq.tm.submits = rq.pacer.submits;
 	rq.tm.shadow_parts = rq.pacer.shadow_parts;
+	rq.tm.shadow_submits = rq.pacer.shadow_submits;
 	rq.tm.compile_ms = rnd_compile_ms_tls - compiled;
 	plan->actual.tm = rq.tm;
 	plan->actual.done = r == RND_OK;

@@ -1,63 +1,18 @@
 /*
  * renderer/render_explain.c — the render plan in words and figures (umbra/rnd_plan.h): what
  * `explain` shows, read from the plan the render executes (render_plan.h), and after the render
- * what it measured. Nothing here decides anything: every reason is the name of a decision made
- * in its own module (casters.c, plan.c, visibility_plan.c, lod.c, shadow_cache.c).
+ * what it measured. Nothing here decides anything: every reason is in the words of the module
+ * that makes the decision (casters.c, plan_words.c, visibility_plan.c, lod.c, env_shadow.c,
+ * render_plan.c), and the limits in them are written once, where they are set.
  */
 #include <string.h>
 #include "caster_level.h"
+#include "env_shadow.h"
 #include "lod.h"
+#include "moments.h"
 #include "render_plan.h"
 #include "visibility_plan.h"
 #include "umbra/rnd_plan.h"
-
-static const char *const cast_why[RND_CAST_WHY_COUNT] = {
-	[RND_CAST_YES] = "casts",
-	[RND_CAST_NOT_ASKED] = "cast_shadows is false",
-	[RND_CAST_CATCHER] = "a shadow catcher receives shadows and casts none",
-	[RND_CAST_ALONE] = "a plane with no other object to shadow",
-	[RND_CAST_LIT_SIDE] = "a plane with every other object on its lit side",
-	[RND_CAST_UNSEEN] = "a plane whose shadow falls only where no camera sees it (on parts of objects sunk into it)",
-	[RND_CAST_FOR_MOMENTS] = "a plane drawn into the maps for the VSM/EVSM blur, left out of the casters' box",
-	[RND_CAST_UNJUDGED] = "a plane in a scene of more than 256 objects: planes are not judged, it casts",
-	[RND_CAST_FOR_ENV] = ("a plane that shadows others only from the environment's directions: in their maps, "
-	                      "left out of the casters' box"),
-};
-
-static const char *const size_why[RND_SIZE_RULE_COUNT] = {
-	[RND_SIZE_ASKED] = "the light's shadow.resolution",
-	[RND_SIZE_DEFAULT] = "a sun's default",
-	[RND_SIZE_IMPORTANCE] = "the share of the view the light's reach covers",
-	[RND_SIZE_HARD_EDGE] = "a hard light: its filter kernel within a pixel of the output",
-	[RND_SIZE_CASTERS] = "the casters' box: texels finer than the default map's where the camera sees them close",
-	[RND_SIZE_CAPPED] = "the server's largest shadow resolution",
-};
-
-static const char *const vis_why[RND_VIS_WHY_COUNT] = {
-	[RND_VIS_DENSE] = "enough small triangles under wide filters for the pass to pay",
-	[RND_VIS_FORCED_ON] = "UMBRA_VISIBILITY=1",
-	[RND_VIS_NO_DEVICE] = "the device cannot run it",
-	[RND_VIS_DEBUG] = "a debug view shows the filters' own work",
-	[RND_VIS_NO_SHADOWS] = "no light has shadow maps",
-	[RND_VIS_MASKED] = "an alpha-tested material",
-	[RND_VIS_TOO_LARGE] = "its images would be too large",
-	[RND_VIS_FORCED_OFF] = "UMBRA_VISIBILITY=0",
-	[RND_VIS_NARROW] = "no light filters widely enough (PCSS, PCF radius 4 or more)",
-	[RND_VIS_SPARSE] = "too few triangles for its passes to pay",
-};
-
-static const char *const pixel_why[RND_PIXEL_WHY_COUNT] = {
-	[RND_PIXEL_VISIBILITY] = "plain draws: the visibility pass's surfaces shaded once per pixel centre",
-	[RND_PIXEL_ENVIRONMENT] = "an environment map over dense plain draws: its own surfaces pass, shaded once per pixel",
-	[RND_PIXEL_NO_DEVICE] = "the device cannot",
-	[RND_PIXEL_OUTPUT] = "not MSAA 4, or a debug view",
-	[RND_PIXEL_BACKGROUND] = "the environment map is the background",
-	[RND_PIXEL_NOT_PLAIN] = "a textured, alpha-tested or extension material, or a sphere's proxy",
-	[RND_PIXEL_NO_PASS] = "no visibility pass and no environment map",
-	[RND_PIXEL_TOO_LARGE] = "its images would be too large",
-	[RND_PIXEL_SPARSE] = "too few triangles for its passes to pay",
-	[RND_PIXEL_FORCED_OFF] = "UMBRA_PIXEL_SHADING=0",
-};
 
 static const char *const shapes[] = {"plane", "box", "sphere", "cylinder", "mesh"};
 static const char *const light_types[] = {"directional", "spot", "point"};
@@ -72,10 +27,16 @@ static const char *filter_name(const struct rnd_light_plan *lp)
 	}
 }
 
-/* What PCSS's depth bounds need (moments.c rnd_bounds_wanted, from the plan's device). */
+/* Whether a map draws PCSS's depth bounds: the render's rule (moments.c), from the plan's device. */
 static bool pcss_bounds(const struct rnd_plan *p, const struct rnd_light_plan *lp, uint32_t res)
 {
-	return lp->filter == UMBRA_FILTER_PCSS && p->dev.pcss_bounds && res <= p->dev.moments_max_res;
+	return rnd_bounds_rule(lp, p->dev.pcss_bounds, p->dev.moments_max_res, res);
+}
+
+/* The main pass's estimate for view vp: its rows' and its bands' (cost.c). */
+static double main_estimate_ms(const struct rnd_plan *p, const struct rnd_view_plan *vp)
+{
+	return vp->row_ms * p->sc->height + vp->band_ms;
 }
 
 void rnd_plan_info(const struct rnd_plan *p, struct rnd_plan_info *out)
@@ -117,14 +78,6 @@ void rnd_plan_info(const struct rnd_plan *p, struct rnd_plan_info *out)
 	out->actual = p->actual.tm;
 }
 
-static const char *map_kind(const struct rnd_scene *sc, const struct rnd_light_plan *lp, uint32_t light)
-{
-	if (sc->lights[light].shadow.dir_mode == RND_DIR_CASTERS) return "casters";
-	if (sc->lights[light].type == RND_LIGHT_SPOT) return "spot";
-	if (sc->lights[light].type == RND_LIGHT_POINT) return "cube";
-	return lp->clipmap ? "clipmap" : lp->follows_camera ? "cascades" : "fit";
-}
-
 void rnd_plan_map(const struct rnd_plan *p, uint32_t k, struct rnd_plan_map_info *out)
 {
 	memset(out, 0, sizeof *out);
@@ -140,23 +93,17 @@ void rnd_plan_map(const struct rnd_plan *p, uint32_t k, struct rnd_plan_map_info
 		memcpy(out->direction, d->dir, sizeof out->direction);
 		out->share = d->share;
 	}
-	out->kind = map_kind(sc, lp, m->light);
+	out->kind = rnd_light_plan_kind(&sc->lights[m->light], lp);
 	out->tiles = m->tiles;
 	out->resolution = m->res;
 	out->asked = m->want;
-	out->size = env ? "the environment's shadow_resolution, coarser for a wider region (env_shadow.c)"
-	                : size_why[lp->size_rule % RND_SIZE_RULE_COUNT];
-	out->fitted = m->res == m->want ? "" : m->moments_capped && m->res == p->dev.moments_max_res
-	                                       ? "moment maps are capped at what the device reads as one buffer"
-	                                       : "halved, the largest first, until every map fits in the atlas";
+	out->size = env ? rnd_env_lights_size_text() : rnd_size_rule_text(lp->size_rule);
+	out->fitted = rnd_map_plan_fitted(p, m);
 	out->filter = filter_name(lp);
 	out->pcf_radius = lp->pcf_radius;
 	out->pcss_bounds = pcss_bounds(p, lp, m->res);
 	out->key = m->key;
-	out->state = !m->key ? "every view" : m->cached ? "cached" : "drawn";
-	out->why = !m->key ? "cascades and clipmap levels follow the camera: drawn by every view, never kept"
-	           : m->cached ? "the atlas holds a completed map of this key (drawn by an earlier request)"
-	                       : "no map of this key in the atlas: drawn, then kept for later requests";
+	out->state = rnd_map_plan_state(m, &out->why);
 	for (uint32_t v = 0; v < p->nviews; v++) {
 		const struct rnd_view_plan *vp = &p->views[v];
 		const struct rnd_light_plan *l = &vp->lights[m->light];
@@ -198,19 +145,19 @@ void rnd_plan_view(const struct rnd_plan *p, uint32_t v, struct rnd_plan_view_in
 	out->contact = vp->contact;
 	out->env_pass = vp->env_pass;
 	out->pixel_shading = vp->deferred;
-	out->pixel_shading_why = pixel_why[vp->deferred_why % RND_PIXEL_WHY_COUNT];
+	out->pixel_shading_why = rnd_pixel_why_text(vp->deferred_why);
 	out->visibility = vp->vis;
-	out->visibility_why = vis_why[vp->vis_why % RND_VIS_WHY_COUNT];
+	out->visibility_why = rnd_vis_why_text(vp->vis_why);
 	out->row_ms = vp->row_ms;
 	out->band_ms = vp->band_ms;
-	out->main_estimate_ms = vp->row_ms * p->sc->height + vp->band_ms;
+	out->main_estimate_ms = main_estimate_ms(p, vp);
 	out->analyzed = p->actual.done;
 	out->shadow_ms = p->actual.shadow_ms[v];
 	out->main_ms = p->actual.main_ms[v];
 	out->bands = p->actual.bands[v];
 }
 
-/* A level of detail in words. */
+/* An object's level of detail (lod.c chose it). */
 static void object_detail(const struct rnd_plan *p, uint32_t i, struct rnd_plan_object_info *out)
 {
 	const struct rnd_object *o = &p->sc->objects[i];
@@ -218,16 +165,11 @@ static void object_detail(const struct rnd_plan *p, uint32_t i, struct rnd_plan_
 	if (o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_CYLINDER) {
 		out->asked = o->segments;
 		out->segments = lod;
-		out->detail = lod < o->segments ? "fewer segments: the output shows no more (1/32 pixel, 1/8 shadow texel)"
-		                                : "the segments asked for";
 	} else if (o->shape == RND_SHAPE_MESH && o->lod_count) {
 		out->levels = o->lod_count;
 		out->level = lod;
-		out->detail = lod ? "a simplified level: its error within half a pixel of every camera"
-		                  : "the full mesh: no level's error fits the output";
-	} else {
-		out->detail = "as given";
 	}
+	out->detail = rnd_lod_detail(o, lod);
 }
 
 void rnd_plan_object(const struct rnd_plan *p, uint32_t i, struct rnd_plan_object_info *out)
@@ -245,7 +187,7 @@ void rnd_plan_object(const struct rnd_plan *p, uint32_t i, struct rnd_plan_objec
 		out->caster_maps += rnd_caster_level_used(&p->esc.lights[vp->view_light[k]], &vp->views[k], vp->view_ortho[k], d);
 	out->proxy = (d->flags & UMBRA_DRAW_SPHERE) != 0;
 	out->casts = d->cast && d->index_count;
-	out->cast_why = cast_why[p->cast_why[i] % RND_CAST_WHY_COUNT];
+	out->cast_why = rnd_cast_why_text(p->cast_why[i]);
 	out->in_casters_box = out->casts && p->cast_why[i] != RND_CAST_FOR_MOMENTS;
 }
 
@@ -312,7 +254,7 @@ uint32_t rnd_plan_passes(const struct rnd_plan *p, struct rnd_plan_pass_info *ou
 		}
 		pass.pass = "main";
 		pass.triangles = vp->camera_triangles;
-		pass.estimate_ms = vp->row_ms * sc->height + vp->band_ms;
+		pass.estimate_ms = main_estimate_ms(p, vp);
 		pass.note = vp->deferred         ? "depth only, MSAA 4; each sample takes a pixel centre's colour (the resolve)"
 		            : sc->output.msaa > 1 ? "MSAA 4, resolved and copied into the readback buffer"
 		                                  : "copied into the readback buffer";

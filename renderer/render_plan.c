@@ -426,6 +426,22 @@ static enum rnd_result plan_maps(struct rnd_plan *p, const struct rnd_shadow_pla
 	return RND_OK;
 }
 
+const char *rnd_map_plan_fitted(const struct rnd_plan *p, const struct rnd_map_plan *m)
+{
+	if (m->res == m->want) return "";
+	return m->moments_capped && m->res == p->dev.moments_max_res
+	       ? "moment maps are capped at what the device reads as one buffer"
+	       : "halved, the largest first, until every map fits in the atlas";
+}
+
+const char *rnd_map_plan_state(const struct rnd_map_plan *m, const char **why)
+{
+	*why = !m->key ? "cascades and clipmap levels follow the camera: drawn by every view, never kept"
+	       : m->cached ? "the atlas holds a completed map of this key (drawn by an earlier request)"
+	                   : "no map of this key in the atlas: drawn, then kept for later requests";
+	return !m->key ? "every view" : m->cached ? "cached" : "drawn";
+}
+
 /* View v's maps in their tiles (the side granted, the atlas's size; where comes with the grant),
  * which it draws and what they are estimated to cost; its passes and its bands' estimates. */
 static enum rnd_result plan_view_work(struct rnd_plan *p, uint32_t v, struct rnd_shadow_plan *sp, struct draw *draws,

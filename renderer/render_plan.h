@@ -62,7 +62,7 @@ struct rnd_plan_device {
 	bool pixel_shading;                    /* the device can shade per pixel (deferred.c) */
 	int pixel_shading_force;               /* UMBRA_PIXEL_SHADING: -1 unset, 0 off */
 	/* The environment map's bins (env.c rnd_env_plan_bins; NULL: no map, or no shadow directions
-	 * asked), read while the plan is built. */
+	 * asked), read while the plan is built (rnd_plan_create keeps them: struct rnd_plan.env_bins). */
 	const struct rnd_env_bins *env_bins;
 	/* Whether the cache holds a completed map of key (shadow_cache.c rnd_cache_probe); NULL:
 	 * it holds none. */
@@ -154,6 +154,10 @@ struct rnd_plan {
 	struct rnd_map_plan maps[UMBRA_MAX_LIGHTS];
 	struct rnd_plan_actual actual;
 	struct rnd_context *context;           /* the context it was made on (render.c) */
+	/* rnd_plan_create's: the environment map's bins it was built from (dev.env_bins; NULL:
+	 * none), freed by rnd_plan_destroy. The render's build of the map keeps them (env.c
+	 * rnd_env_acquire): a map's texels are read for its bins once. */
+	struct rnd_env_bins *env_bins;
 	double plan_ms;                        /* how long rnd_plan_create took */
 	void *mem;                             /* what the plan allocated (render_plan.c) */
 };
@@ -164,6 +168,11 @@ struct rnd_plan {
 enum rnd_result rnd_plan_build(const struct rnd_scene *sc, const struct rnd_plan_device *dev, struct rnd_plan *p,
                                struct rnd_error *err);
 void rnd_plan_release(struct rnd_plan *p);
+
+/* plan_maps' decisions about map m, in words: why its side is under the one asked for ("" when
+ * it is not); whether it is drawn ("drawn", "cached", "every view"), and why (*why). */
+const char *rnd_map_plan_fitted(const struct rnd_plan *p, const struct rnd_map_plan *m);
+const char *rnd_map_plan_state(const struct rnd_map_plan *m, const char **why);
 
 /* View v's shadow plan as the recorders read it (out: views' skip from the plan's prediction;
  * the executor replaces it with the grant's answer). */

@@ -3,7 +3,7 @@
  *
  * With a deadline or a cancel callback in the scene, the work of a view is cut into several
  * submits, each waited on before the next is recorded: shadow views in groups of about half
- * a slice by estimate, then the main (+ AOV) pass in horizontal bands (render area + scissor)
+ * a slice by estimate (an eighth until a group was measured, then scaled by what it measured), then the main (+ AOV) pass in horizontal bands (render area + scissor)
  * whose height comes from the measured time of the bands before. Between submits the deadline
  * and the callback are checked; past them the view stops with RND_ERR_TIMEOUT. Without
  * either, a view is one submit (the normal path costs nothing extra).
@@ -26,6 +26,11 @@ struct rnd_pacer {
 	double slice_ms;            /* target wall time of one submit; 0 = as few submits as possible */
 	uint32_t submits;           /* submitted by this render so far */
 	uint32_t shadow_parts;      /* of them, parts of shadow maps (submit.c) */
+	uint32_t shadow_submits;    /* of them, those of shadow maps alone (whole or in parts; paced only) */
+	/* Shadow groups: measured wall time over the estimate of the last group measured (at
+	 * least 1), and whether one was (submit.c: the first group is kept small until then). */
+	double shadow_scale;
+	bool shadow_measured;
 	const struct rnd_texture *const *tex; /* staged textures, recorded into the first submit */
 	uint32_t ntex;
 	bool prologue;              /* textures (and the slot's white texture) not yet recorded */

@@ -16,7 +16,7 @@
  * Only wide filters pay for it: studio-spots' seven lights all hard made the main pass 49 ms
  * without the pass and 65 with it; PCF radius 1: 57 / 68, 2: 81 / 84, 3: 97 / 97, 5: 143 /
  * 134; PCSS: 136 / 119. A hard or moment-map lookup is one fetch, cheaper than the passes. */
-#define RND_VIS_MIN_PCF_RADIUS 4u
+#define RND_VIS_MIN_PCF_RADIUS 4
 #define RND_VIS_PIXELS_PER_FACE 512u
 /* One wide light pays for the passes only over dense meshes. Measured, the thumbnail preset
  * with its one PCSS sun, 512², whole render without / with the pass: the 124k-triangle ogre
@@ -153,4 +153,41 @@ uint64_t rnd_deferred_bytes(const struct rnd_scene *sc)
 	}
 	/* the shading inputs (RGBA32UI) and the shaded colour (at most RGBA32F) */
 	return surfaces + (uint64_t)sc->width * sc->height * (16 + 16);
+}
+
+/* rnd_visibility_wanted's reasons in words (the plan shows them). */
+const char *rnd_vis_why_text(unsigned why)
+{
+	static const char *const text[RND_VIS_WHY_COUNT] = {
+		[RND_VIS_DENSE] = "enough small triangles under wide filters for the pass to pay",
+		[RND_VIS_FORCED_ON] = "UMBRA_VISIBILITY=1",
+		[RND_VIS_NO_DEVICE] = "the device cannot run it",
+		[RND_VIS_DEBUG] = "a debug view shows the filters' own work",
+		[RND_VIS_NO_SHADOWS] = "no light has shadow maps",
+		[RND_VIS_MASKED] = "an alpha-tested material",
+		[RND_VIS_TOO_LARGE] = "its images would be too large",
+		[RND_VIS_FORCED_OFF] = "UMBRA_VISIBILITY=0",
+		[RND_VIS_NARROW] = ("no light filters widely enough (PCSS, PCF radius " RND_NUMBER_WORDS(RND_VIS_MIN_PCF_RADIUS)
+		                    " or more)"),
+		[RND_VIS_SPARSE] = "too few triangles for its passes to pay",
+	};
+	return why < RND_VIS_WHY_COUNT ? text[why] : "";
+}
+
+/* rnd_pixel_shading_wanted's reasons in words. */
+const char *rnd_pixel_why_text(unsigned why)
+{
+	static const char *const text[RND_PIXEL_WHY_COUNT] = {
+		[RND_PIXEL_VISIBILITY] = "plain draws: the visibility pass's surfaces shaded once per pixel centre",
+		[RND_PIXEL_ENVIRONMENT] = "an environment map over dense plain draws: its own surfaces pass, shaded once per pixel",
+		[RND_PIXEL_NO_DEVICE] = "the device cannot",
+		[RND_PIXEL_OUTPUT] = "not MSAA 4, or a debug view",
+		[RND_PIXEL_BACKGROUND] = "the environment map is the background",
+		[RND_PIXEL_NOT_PLAIN] = "a textured, alpha-tested or extension material, or a sphere's proxy",
+		[RND_PIXEL_NO_PASS] = "no visibility pass and no environment map",
+		[RND_PIXEL_TOO_LARGE] = "its images would be too large",
+		[RND_PIXEL_SPARSE] = "too few triangles for its passes to pay",
+		[RND_PIXEL_FORCED_OFF] = "UMBRA_PIXEL_SHADING=0",
+	};
+	return why < RND_PIXEL_WHY_COUNT ? text[why] : "";
 }

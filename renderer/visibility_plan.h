@@ -33,6 +33,8 @@ enum rnd_vis_why {
 	RND_VIS_SPARSE,         /* off: too few triangles for its passes to pay */
 	RND_VIS_WHY_COUNT
 };
+/* A reason in words ("" for none). */
+const char *rnd_vis_why_text(unsigned why);
 /* The bytes of the slot's images the pass would take for a view of sc, 0 where it cannot run
  * at all (no shadowed light, a debug view, a view too large): what a render may need beyond
  * its targets (estimate.c counts it, before the plan says whether the pass runs). */
@@ -66,6 +68,8 @@ enum rnd_pixel_why {
 	RND_PIXEL_FORCED_OFF,   /* off: UMBRA_PIXEL_SHADING=0 */
 	RND_PIXEL_WHY_COUNT
 };
+/* A reason in words ("" for none). */
+const char *rnd_pixel_why_text(unsigned why);
 /* The bytes of pixel shading's images for a view of sc (estimate.c: beside the visibility pass's). */
 uint64_t rnd_deferred_bytes(const struct rnd_scene *sc);
 

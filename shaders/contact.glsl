@@ -17,6 +17,38 @@ vec4 scene_view_depth(vec4 d)
 	return -(l.y - ndc * l.w) / (ndc * l.z - l.x);
 }
 
+// Whether the scene's depth at uv (tsz: the depth image's size) occludes a ray whose view depth
+// runs over [lo, hi] since the previous step: a depth texel stands for a slab `thick` deep behind
+// the surface it saw. Where the four texels around uv lie on one smooth surface (their range
+// within `smooth_range`, what a planar receiver spans over two pixels), all four must be in front
+// of the ray: a ray just above a planar receiver, whose depth they bracket, stays lit. Across a
+// silhouette (a wider range), the texel nearest uv decides: a caster covers the pixels its raster
+// covered. Requiring all four there too dropped a caster narrower than two pixels and a pixel of
+// every wider one (issue 31: a thin pole's contact shadow lost at its edges); a blend of the four
+// would widen it (rays beside a silhouette darkened). Background texels (the clear value, 1) are
+// 1e20 deep, not at the far plane: a finite far plane made them a wall that rays from the
+// farthest ground, marching the far cascade's texels, went behind (a band of false shadow at the
+// horizon); infinite depths (an infinite far plane) are clamped so that no range is infinite. z_recv: the view depth
+// of the receiver's plane under the ray's point.
+bool contact_occludes(vec2 uv, vec2 tsz, float smooth_range, float lo, float hi, float thick, float z_recv)
+{
+	vec4 d = textureGather(scene_depth, uv);
+	vec4 z = mix(min(scene_view_depth(d), vec4(1e20)), vec4(1e20), greaterThanEqual(d, vec4(1.0)));
+	float range = max(max(z.x, z.y), max(z.z, z.w)) - min(min(z.x, z.y), min(z.z, z.w));
+	if (range <= smooth_range) return all(lessThan(z, vec4(hi))) && any(greaterThan(z, vec4(lo - thick)));
+	// textureGather's order: x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0)
+	vec2 f = fract(uv * tsz - 0.5);
+	vec2 col = f.x < 0.5 ? z.wx : z.zy;   // (j0, j1) of the nearer column
+	float zn = f.y < 0.5 ? col.x : col.y;
+	// ... and the texels of its surface (within smooth_range of it) must all be in front: on a
+	// receiver's edge, the nearest texel alone lies half a pixel off the ray and can be behind it.
+	vec4 surf = mix(z, vec4(-1e30), greaterThan(abs(z - zn), vec4(smooth_range)));
+	// The receiver's own plane never shadows it: a nearest texel within a pixel's slope of that
+	// plane's depth under the ray (z_recv) is the receiver itself, seen half a pixel off (at a
+	// grazing view, towards the horizon, that is far in front of the ray).
+	return all(lessThan(surf, vec4(hi))) && zn > lo - thick && zn < z_recv - 0.5 * smooth_range;
+}
+
 // Contact shadows: march from pos towards the light through the view's depth buffer, over
 // L.contact.x world units (0: CONTACT_TEXELS texels of the light's map at pos, the zone next
 // to a caster that the map's bias and filter cannot resolve, and at least CONTACT_PX pixels).
@@ -35,18 +67,21 @@ vec4 scene_view_depth(vec4 d)
 // 12 texels, not 8 (issue 31): a 4 cm pole under a sun with a 256 map lost 53 % of the shadow
 // within 8 px of its foot with 8 and a one-pixel slab, 6 % with 12 and a one-texel slab; 16
 // hardened the duck's soft self-shadow near contact (rmse 0.016 -> 0.022 against Cycles).
+// `view`: the map's view that lit pos (the cascade or clipmap level map_visibility chose): its
+// texel sets the default length and thickness. The first cascade's (the finest) made the march
+// a few centimetres long in the farther cascades, whose texels lose a thin pole (issue 31).
 const float CONTACT_TEXELS = 12.0;
 const float CONTACT_PX = 4;
 const float CONTACT_THICK_PX = 1.0;
 const float CONTACT_THICK_TEXELS = 1.0;
-float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
+float contact_visibility(umbra_light L, uint view, vec3 pos, vec3 n, vec3 to_light)
 {
 	vec3 cam = frame.camera_pos.xyz, fwd = frame.camera_fwd.xyz;
 	float z0 = max(dot(pos - cam, fwd), 1e-4);
 	float px = frame.target.z * (frame.target.w > 0.5 ? 1.0 : z0);   // world size of a pixel at pos
 	bool local = uint(L.color.w) != UMBRA_LIGHT_DIRECTIONAL;
 	float to_l = local ? length(L.position.xyz - pos) : 1e30;
-	umbra_shadow_view v = views[L.shadow.x];
+	umbra_shadow_view v = views[view];
 	float texel = is_persp(v) ? v.params.x * to_l : v.params.x;
 	float len = L.contact.x > 0.0 ? L.contact.x : max(CONTACT_TEXELS * texel, CONTACT_PX * px);
 	len = min(len, to_l);
@@ -66,17 +101,25 @@ float contact_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light)
 	int steps = clamp(int(ceil(span)), 1, int(L.contact.y));
 	float dt = (len - t0) / float(steps);
 	float jitter = ign(frag_xy());
+	vec2 tsz = vec2(textureSize(scene_depth, 0));
+	// The receiver's plane spans px * tan(angle to the view ray) of view depth per pixel.
+	float cos_v = max(abs(dot(n, normalize(pos - cam))), 0.05);
+	float smooth_range = 2.0 * px * sqrt(1.0 - cos_v * cos_v) / cos_v;
 	float z_prev = zs0 + dz * t0;
 	float eps = 1e-3 * px;
+	// The receiver's plane (pos, n) under the ray's point p(t): the camera ray through p meets it
+	// at view depth z(t) * recv_num / (recv0 + t recv_dt); no receiver there when that ratio is <= 0.
+	float recv_num = dot(pos - cam, n), recv0 = dot(start - cam, n), recv_dt = dot(to_light, n);
 	for (int i = 0; i < steps; i++) {
 		float t = t0 + dt * (float(i) + jitter);
 		vec4 c = c0 + dc * t;
 		vec2 uv = c.xy / c.w * 0.5 + 0.5;
 		if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) break;
-		vec4 zs = scene_view_depth(textureGather(scene_depth, uv));
 		float zp = zs0 + dz * t;
 		float lo = min(z_prev, zp), hi = max(z_prev, zp);
-		if (all(lessThan(zs, vec4(hi - eps))) && any(greaterThan(zs, vec4(lo - thick)))) return 0.0;
+		float ratio = recv_num / (recv0 + recv_dt * t);
+		float z_recv = ratio > 0.0 ? zp * ratio : 1e20;
+		if (contact_occludes(uv, tsz, smooth_range, lo, hi - eps, thick, z_recv)) return 0.0;
 		z_prev = zp;
 	}
 	return 1.0;

@@ -428,7 +428,7 @@ float map_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, uint filter
 float shadow_visibility(umbra_light L, vec3 pos, vec3 n, vec3 to_light, uint filters, out uint view_out)
 {
 	float vis = map_visibility(L, pos, n, to_light, filters, view_out);
-	if (SC_CONTACT != 0u && L.contact.w > 0.5 && vis > 0.0) vis = min(vis, contact_visibility(L, pos, n, to_light));
+	if (SC_CONTACT != 0u && L.contact.w > 0.5 && vis > 0.0) vis = min(vis, contact_visibility(L, L.shadow.x + view_out, pos, n, to_light));
 	return vis;
 }
 

@@ -1,7 +1,7 @@
 // umbra playground — the render's plan (explain) shown beside the image: the multipart/mixed
 // answer of `Prefer: explain` split into the image and the plan (api/explain.schema.json), and
-// the plan as two short tables. Inlined before playground.js (server/www/embed.sh), which calls
-// parts() and showPlan(); uses its $().
+// the plan as two short tables. Inlined before request.js (server/www/embed.sh), which calls
+// parts() and showPlan(); uses editor.js's $().
 'use strict';
 
 // The parts of a multipart/mixed body (RFC 2046): [{type, bytes}], in order.

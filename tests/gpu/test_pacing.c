@@ -113,6 +113,50 @@ TEST(pacing_stacked_layers_are_cut_into_submits)
 	api_scene_free(s);
 }
 
+/* Eight spot lights over 30 boxes stacked in one place: ~280 ms of maps by the cost model (30
+ * layers of fill each), under half a slice (0.5 s of a deadline ten minutes away). They went in
+ * one submit, and a group runs whole before the deadline is checked: 32 spot maps estimated at
+ * 0.4 s ran 11 s in one submit on a machine at load 15. Now the first group is an eighth of a
+ * slice by estimate and the next ones are sized by what it measured: at least two submits of
+ * maps, the same bytes. */
+TEST(pacing_first_shadow_group_is_small)
+{
+	struct rnd_context *ctx = gpu_ctx();
+	REQUIRE(ctx);
+	char json[8192];
+	int at = snprintf(json, sizeof json, "{'width':48,'height':48,'camera':{'position':[0,5,14],'target':[0,4,0]},'lights':[");
+	for (int i = 0; i < 8; i++)
+		at += snprintf(json + at, sizeof json - (size_t)at,
+		               "%s{'type':'spot','position':[%d,12,4],'direction':[%d,-8,-4],'outer_angle':60,'intensity':5,"
+		               "'shadow':{'filter':'pcf','resolution':1024}}",
+		               i ? "," : "", i - 4, 4 - i);
+	at += snprintf(json + at, sizeof json - (size_t)at, "],'objects':[{'shape':'plane','size':[40,40]}");
+	for (int i = 0; i < 30; i++)
+		at += snprintf(json + at, sizeof json - (size_t)at,
+		               ",{'shape':'box','size':[8,8,8],'transform':{'translation':[%.3f,%.3f,0]}}", 0.001 * i,
+		               4 + 0.001 * i);
+	REQUIRE(at > 0 && (size_t)at + 3 < sizeof json);
+	memcpy(json + at, "]}", 3);
+	struct api_scene *s = gpu_parse(json);
+	REQUIRE(s);
+	uint32_t before = rnd_context_validation_messages(ctx);
+	struct rnd_image whole = {0}, paced = {0};
+	struct rnd_timings t0 = {0}, t = {0};
+	struct rnd_error err = {0};
+	CHECK(render_uncached(ctx, s, &whole, &t0, &err) == RND_OK, "unpaced: %s", err.msg);
+	CHECK(t0.shadow_submits == 0 && t0.submits == 1, "unpaced: %u submits, %u of maps", t0.submits, t0.shadow_submits);
+	s->scene.deadline_ns = mono_ns() + 600ull * 1000000000ull;
+	CHECK(render_uncached(ctx, s, &paced, &t, &err) == RND_OK, "paced: %s", err.msg);
+	CHECK(t.shadow_maps_rendered == 8, "%u maps drawn", t.shadow_maps_rendered);
+	CHECK(t.shadow_submits >= 2, "8 maps in %u submit(s): the first group is not kept small", t.shadow_submits);
+	CHECK(t.submits > t.shadow_submits, "%u submits, %u of maps", t.submits, t.shadow_submits);
+	CHECK(same_pixels(&whole, &paced), "the maps in groups changed the image");
+	CHECK(rnd_context_validation_messages(ctx) == before, "validation messages");
+	rnd_image_release(&whole);
+	rnd_image_release(&paced);
+	api_scene_free(s);
+}
+
 /* 16,000 planes side by side with a sphere above them: judging each plane against every other
  * (does it shadow it?) was quadratic and ran before the first submit, where no deadline is
  * checked: 107 s of planning on lavapipe (issue 29). Past RND_PLANES_JUDGED_MAX objects every

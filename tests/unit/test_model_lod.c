@@ -10,6 +10,7 @@
 #include "arena.h"
 #include <meshoptimizer.h>
 #include "lod.h"
+#include "lod_error.h"
 #include "lod_simplify.h"
 #include "model_lod.h"
 
@@ -284,6 +285,20 @@ TEST(model_mesh_closed_needs_watertight_outward_winding)
 	free(p); free(n); free(idx);
 }
 
+/* The triangles of a (seg + 1)^2-vertex latitude-longitude grid (vertex i * (seg + 1) + j),
+ * two a quad, 6 seg^2 indices into idx. */
+static void grid_sphere_indices(uint32_t seg, uint32_t *idx)
+{
+	uint32_t k = 0;
+	for (uint32_t i = 0; i < seg; i++)
+		for (uint32_t j = 0; j < seg; j++) {
+			uint32_t q[4] = {i * (seg + 1) + j, i * (seg + 1) + j + 1, (i + 1) * (seg + 1) + j, (i + 1) * (seg + 1) + j + 1};
+			uint32_t t[6] = {q[0], q[2], q[1], q[1], q[2], q[3]};
+			memcpy(idx + k, t, sizeof t);
+			k += 6;
+		}
+}
+
 /* The centroid of each triangle idx[0..ni) over pos: its largest distance from the unit sphere. */
 static double worst_centroid(const float *pos, const uint32_t *idx, size_t ni)
 {
@@ -314,14 +329,7 @@ TEST(model_lod_large_mesh_simplified_in_pieces)
 			float *p = pos + 3 * (i * (SEG + 1) + j);
 			p[0] = (float)(sin(th) * cos(ph)), p[1] = (float)cos(th), p[2] = (float)(sin(th) * sin(ph));
 		}
-	uint32_t k = 0;
-	for (uint32_t i = 0; i < SEG; i++)
-		for (uint32_t j = 0; j < SEG; j++) {
-			uint32_t q[4] = {i * (SEG + 1) + j, i * (SEG + 1) + j + 1, (i + 1) * (SEG + 1) + j, (i + 1) * (SEG + 1) + j + 1};
-			uint32_t t[6] = {q[0], q[2], q[1], q[1], q[2], q[3]};
-			memcpy(idx + k, t, sizeof t);
-			k += 6;
-		}
+	grid_sphere_indices(SEG, idx);
 	REQUIRE(ni / 3 >= 8 * API_LOD_PIECE_TRIANGLES);
 	float target = 0.25f * api_lod_import_error(256);
 	size_t na = api_lod_simplify(a, idx, ni, pos, nv, 2.0f, target);
@@ -337,4 +345,54 @@ TEST(model_lod_large_mesh_simplified_in_pieces)
 	free(idx);
 	free(a);
 	free(b);
+}
+
+/* A level's measured error (api/lod_error.h): walking its triangles in order of their cheap
+ * estimates, skipping those whose few faces downhill already prove them within the worst, and
+ * the nearest-vertex search narrowed to the cells that can hold a nearer one, comes out as the
+ * figure it stands for (every triangle walked to the end), bit for bit, on a bumpy sphere of
+ * shared vertices (radius 1 + 0.04 sin 6 theta sin 5 phi) and its levels at three aims; and the
+ * figure is not a hair above the distance of the level's centroids from the surface (a
+ * lower bound of it: the full mesh's chords sit within `input` of the sphere). */
+TEST(model_lod_level_error_ordered_equals_every_walk)
+{
+	enum { SEG = 200 };   /* 2 x 200^2 = 80,000 triangles */
+	uint32_t nv = (SEG + 1) * (SEG + 1), ni = 6 * SEG * SEG;
+	float *pos = malloc(nv * 12ull), *nrm = malloc(nv * 12ull);
+	uint32_t *idx = malloc(ni * 4ull), *lv = malloc(ni * 4ull);
+	REQUIRE(pos && nrm && idx && lv);
+	for (uint32_t i = 0; i <= SEG; i++)
+		for (uint32_t j = 0; j <= SEG; j++) {
+			double th = PI_D * i / SEG, ph = 2 * PI_D * j / SEG, r = 1 + 0.04 * sin(6 * th) * sin(5 * ph);
+			float *p = pos + 3 * (i * (SEG + 1) + j), *n = nrm + 3 * (i * (SEG + 1) + j);
+			n[0] = (float)(sin(th) * cos(ph)), n[1] = (float)cos(th), n[2] = (float)(sin(th) * sin(ph));
+			for (int k = 0; k < 3; k++) p[k] = (float)(r * n[k]);
+		}
+	grid_sphere_indices(SEG, idx);
+	float lo[3], hi[3], ext = api_points_box(pos, nv, lo, hi);
+	struct api_lod_measure *m = api_lod_measure_create(pos, nrm, nv, idx, ni, lo, hi, ext);
+	REQUIRE(m);
+	const float aims[3] = {0.0005f, 0.002f, 0.008f};
+	for (int a = 0; a < 3; a++) {
+		size_t nl = api_lod_simplify(lv, idx, ni, pos, nv, 2.08f, aims[a]);
+		REQUIRE(nl >= 3 && nl < ni, "aim %g: %zu indices", aims[a], nl);
+		float fast = api_lod_measure_level(m, lv, nl, false), all = api_lod_measure_level(m, lv, nl, true);
+		printf("    aim %g: %zu triangles, error %g, every triangle walked %g\n", aims[a], nl / 3, fast, all);
+		CHECK(fast == all, "aim %g: %.9g measured, %.9g walking every triangle", aims[a], fast, all);
+		/* the centroids' distance from the bumpy sphere, less the full mesh's own chord error */
+		double worst = 0, input = 0.04 * 6 * PI_D / SEG * PI_D / SEG + 1 - cos(PI_D / SEG);
+		for (size_t t = 0; t < nl; t += 3) {
+			double c[3] = {0, 0, 0};
+			for (int v = 0; v < 3; v++)
+				for (int x = 0; x < 3; x++) c[x] += pos[3 * (size_t)lv[t + (size_t)v] + (size_t)x] / 3.0;
+			double r = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), th = acos(c[1] / r), ph = atan2(c[2], c[0]);
+			worst = fmax(worst, fabs(r - (1 + 0.04 * sin(6 * th) * sin(5 * ph))));
+		}
+		CHECK(fast >= worst * 0.5 - input, "aim %g: measured %g, centroids %g off the surface", aims[a], fast, worst);
+	}
+	api_lod_measure_destroy(m);
+	free(pos);
+	free(nrm);
+	free(idx);
+	free(lv);
 }

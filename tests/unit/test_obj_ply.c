@@ -142,6 +142,28 @@ TEST(obj_own_reader_takes_materials_and_textures_as_assimp_does)
 	free(png);
 }
 
+TEST(obj_own_reader_refuses_a_broken_texture_as_assimp_does)
+{
+	/* Assimp refuses the skeleton's material (its texture is no image): the file's answer, with
+	 * Assimp's status and message, from that one Assimp run (own_takes: not left to a second
+	 * run over the whole file) */
+	static const char mtl[] = "newmtl red\nKd 0.8 0.1 0.1\n\nnewmtl wood\nKd 1 1 1\nmap_Kd tex/wood.png\n";
+	static const char not_png[] = "this is not a PNG file at all";
+	struct api_model_file files[2] = {{"grid.mtl", (const uint8_t *)mtl, sizeof mtl - 1},
+	                                  {"tex/wood.png", (const uint8_t *)not_png, sizeof not_png - 1}};
+	size_t len;
+	char *s = grid_obj(OBJ_MATERIALS | OBJ_UVS, &len);
+	same_both_ways("obj with a texture that is no image", API_MODEL_OBJ, (const uint8_t *)s, len, files, 2, true);
+	struct api_arena *a = api_arena_create();
+	struct api_model m;
+	size_t bytes;
+	char err[300] = "";
+	int st = api_obj_import((const uint8_t *)s, len, files, 2, 256, a, &m, &bytes, err, sizeof err);
+	CHECK(st == API_WIRE_BAD_INPUT && strstr(err, "tex/wood.png"), "%d \"%s\"", st, err);
+	api_arena_destroy(a);
+	free(s);
+}
+
 TEST(obj_own_reader_leaves_the_rest_to_assimp)
 {
 	static const char *const files[] = {

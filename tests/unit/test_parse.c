@@ -729,7 +729,7 @@ TEST(parse_camera_variants)
 
 	s = PARSE_OK("{'camera':{'fit':'objects','direction':[1,-1,0],'margin':0.2,'fov_y':30},'objects':[]}");
 	REQUIRE(s);
-	/* fit reaches the renderer as it is (it frames the bounds; tests/unit/test_plan.c and
+	/* fit reaches the renderer as it is (it frames the bounds; tests/unit/test_camera.c and
 	 * tests/gpu/test_models.c check where the camera goes). */
 	CHECK(s->scene.camera.fit == RND_FIT_OBJECTS && s->scene.camera.fit_direction[0] == 1 &&
 	      s->scene.camera.fit_direction[1] == -1);

@@ -370,6 +370,8 @@ struct rnd_timings {
 	uint64_t shadow_triangles; /* casters' triangles the shadow maps drew */
 	uint32_t submits;          /* queue submits (more than one when paced by a deadline) */
 	uint32_t shadow_parts;     /* submits of shadow maps drawn in parts (too costly for one) */
+	uint32_t shadow_submits;   /* submits of shadow maps alone, whole or in parts (0: one submit drew
+	                              them with the main pass, as without a deadline) */
 	uint32_t env_directions;   /* environment shadow directions drawn (maps rendered or reused) */
 	double env_ms;             /* this render's share of preparing the environment (CPU analysis and
 	                              the device's prefiltering, once per map: 0 when it was ready) */
