@@ -303,6 +303,9 @@ float api_caster_error(const uint32_t *ia, size_t na, const float *pa, const uin
 bool api_mesh_wants_caster(const struct api_model *m, const struct api_model_mesh *me)
 {
 	if (me->index_count / 3 < API_CASTER_MIN_TRIANGLES) return false;
+	/* A camera level this request draws (built just before) already this coarse: the maps draw
+	 * it, and building the caster would cost more import than it saves them. */
+	if (me->lod_count && me->lods[0].index_count / 3 < API_CASTER_MIN_TRIANGLES) return false;
 	return me->material < m->material_count && m->materials[me->material].alpha_mode == RND_ALPHA_OPAQUE;
 }
 
