@@ -68,6 +68,9 @@ struct api_model_mesh {
 	 * other sizes' levels: api_model_mesh_lods(). */
 	const struct rnd_mesh_lod *lods;
 	uint32_t lod_count;
+	/* The environment's shadow maps' coarse level (api/model_caster.h), or NULL: side-independent,
+	 * built once at import. */
+	const struct rnd_caster_level *caster;
 	bool closed;              /* watertight and wound outward (api/model_lod.h, set by the importer) */
 	float bounds[6];          /* min xyz, max xyz of positions (api_mesh_bounds) */
 	/* private, in the importer only (never on the wire): the weld its join sorted the vertices

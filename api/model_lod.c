@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "lod_error.h"
+#include "model_caster.h"
 #include "lod_simplify.h"
 #include "model_lod.h"
 #include "weld.h"
@@ -261,6 +262,8 @@ static void finish(struct api_model *m, uint32_t output_side, bool mark_closed, 
 		if (mark_closed) me->closed = welded && api_mesh_closed(idx, me->index_count, w.pos);
 		double t1 = api_clock_ms();
 		if (welded && level) mesh_one_level(me, &w, idx, api_lod_import_error(output_side), arena, bytes);
+		/* the environment's maps' caster, at import only (its time counts as the level's) */
+		if (welded && mark_closed && api_mesh_wants_caster(m, me)) api_caster_build(me, idx, me->index_count, w.pos, w.count, arena, bytes);
 		m->times.ms[API_IMPORT_CLOSED] += (float)(t1 - t0);
 		m->times.ms[API_IMPORT_LEVEL] += (float)(api_clock_ms() - t1);
 		welded_free(&w);

@@ -253,12 +253,41 @@ static enum api_result decode_materials(struct dec *d, uint32_t nmat, struct rnd
 static enum api_result decode_mesh_levels(struct dec *d, uint32_t i, const struct api_model_mesh *me,
                                           struct api_mesh_levels *out);
 
+/* The mesh's caster level (api/model_caster.h): coarser than the mesh, inside its bounds, with
+ * a finite error. */
+static enum api_result decode_caster(struct dec *d, uint32_t i, struct api_model_mesh *me)
+{
+	uint32_t nv, ni;
+	float error;
+	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take(&d->r, &error, 4))
+		return bad(&d->r, "mesh %u caster level is cut short", i);
+	if (!nv || ni < 3 || ni % 3 || ni >= me->index_count || nv > ni || !isfinite(error) || error < 0.0f)
+		return bad(&d->r, "mesh %u caster level: %u vertices, %u indices, error %g", i, nv, ni, (double)error);
+	if (!fits(&d->r, nv, 12) || !fits(&d->r, ni, 4) || (uint64_t)nv * 12 > d->r.left - (uint64_t)ni * 4)
+		return bad(&d->r, "mesh %u caster level is cut short", i);
+	const float *pos = take_array(d, nv, 12);
+	const uint32_t *idx = take_array(d, ni, 4);
+	struct rnd_caster_level *lv = dec_alloc(d, 1, sizeof *lv);
+	if (!pos || !idx || !lv) return bad(&d->r, "out of memory");
+	for (uint32_t v = 0; v < nv; v++)
+		for (int k = 0; k < 3; k++) {
+			float x = pos[3 * (size_t)v + (size_t)k];
+			if (!isfinite(x) || x < me->bounds[k] || x > me->bounds[3 + k])
+				return bad(&d->r, "mesh %u caster level: vertex %u lies outside the mesh", i, v);
+		}
+	for (uint32_t k = 0; k < ni; k++)
+		if (idx[k] >= nv) return bad(&d->r, "mesh %u caster level: index %u refers to vertex %u of %u", i, k, idx[k], nv);
+	*lv = (struct rnd_caster_level){pos, idx, nv, ni, error};
+	me->caster = lv;
+	return API_OK;
+}
+
 static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, struct api_model_mesh *me)
 {
 	uint32_t nv, ni, mat, flags;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &mat) || !take_u32(&d->r, &flags))
 		return bad(&d->r, "mesh %u is cut short", i);
-	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 255)
+	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 511)
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
 	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 128 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
 	/* (per_vertex <= 60 and ni * 4 fit the reply: nothing below overflows) */
@@ -288,6 +317,7 @@ static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, str
 		me->lods = lv.lods;
 		me->lod_count = lv.count;
 	}
+	if ((flags & 256) && decode_caster(d, i, me) != API_OK) return API_ERR;
 	return API_OK;
 }
 

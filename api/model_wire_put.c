@@ -169,7 +169,7 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 		put_u32(b, me->material);
 		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u) | (me->colors ? 4u : 0u) | (me->tangents ? 8u : 0u) |
 		           (me->single_sided ? 16u : 0u) | (me->closed ? 32u : 0u) | (me->lod_count ? 64u : 0u) |
-		           (me->uvs1 ? 128u : 0u));
+		           (me->uvs1 ? 128u : 0u) | (me->caster ? 256u : 0u));
 		put(b, me->positions, (size_t)me->vertex_count * 12);
 		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
 		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
@@ -178,6 +178,14 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 		if (me->tangents) put(b, me->tangents, (size_t)me->vertex_count * 16);
 		put(b, me->indices, (size_t)me->index_count * 4);
 		if (me->lod_count) put_mesh_levels(b, me);
+		if (me->caster) {
+			const struct rnd_caster_level *c = me->caster;
+			put_u32(b, c->vertex_count);
+			put_u32(b, c->index_count);
+			put(b, &c->error, 4);
+			put(b, c->positions, (size_t)c->vertex_count * 12);
+			put(b, c->indices, (size_t)c->index_count * 4);
+		}
 	}
 	for (uint32_t i = 0; i < m->instance_count; i++) {
 		put_u32(b, m->instances[i].mesh);

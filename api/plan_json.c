@@ -126,6 +126,9 @@ static json_t *object_object(const struct api_scene *s, const struct rnd_plan *p
 		put(o, "level", json_integer(b.level));
 		put(o, "levels", json_integer(b.levels));
 	}
+	if (o && b.caster_triangles)
+		put(o, "caster_level", json_pack("{s:I, s:f, s:i}", "triangles", (json_int_t)b.caster_triangles, "error",
+		                                 (double)b.caster_error, "maps", (json_int_t)b.caster_maps));
 	return o;
 }
 

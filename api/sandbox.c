@@ -402,6 +402,7 @@ enum api_result api_sandbox_build_levels(const struct api_model *m, uint32_t sid
 		meshes[n].material = 0;
 		meshes[n].lods = NULL;
 		meshes[n].lod_count = 0;
+		meshes[n].caster = NULL;   /* built at import; the job builds levels only */
 		sent[n] = &m->meshes[i];
 		rnd_mat4_identity(inst[n].model);
 		inst[n].mesh = n;

@@ -149,6 +149,7 @@ static uint64_t object_bytes(uint64_t h, const struct rnd_object *src)
 	AS_SET(o.colors);
 	AS_SET(o.tangents);
 	AS_SET(o.lods);
+	AS_SET(o.caster);
 	AS_SET(o.mesh_bounds);
 	return rnd_hash(h, &o, sizeof o);
 }

@@ -322,6 +322,7 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			 * positions, normals and uvs (both sets) only: a mesh with vertex colours or
 			 * tangents is always drawn whole. */
 			if (!me->colors && !me->tangents) o->lods = api_model_mesh_lods(m, in->mesh, c->lim->output_side, &o->lod_count);
+			o->caster = me->caster;   /* the environment's maps' level (renderer/caster_level.h) */
 			o->closed = me->closed;
 			o->mesh_bounds = me->vertex_count ? me->bounds : NULL;
 			/* glTF doubleSided: false culls back faces (the object can only add sidedness). */

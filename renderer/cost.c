@@ -3,6 +3,7 @@
  * (see cost.h).
  */
 #include <math.h>
+#include "caster_level.h"
 #include "casters.h"
 #include "contact.h"
 #include "cost.h"
@@ -94,10 +95,12 @@ double rnd_cost_shadow_view_ms(const struct rnd_shadow_plan *sp, const struct rn
 	int cull;
 	*tris = 0;
 	for (uint32_t i = 0; i < ndraw; i++) {
+		float raise;
 		if (!rnd_shadow_view_draws(sp, lights, draws, v, i, &cull)) continue;
-		const struct draw *d = &draws[i];
-		*tris += d->index_count / 3;
-		fill += rnd_cost_fill(sv->view_proj, res, res, &d->bounds, d->area, d->index_count / 3, d->closed);
+		/* the triangles it draws: the environment's maps may draw a caster level (caster_level.h) */
+		struct draw d = rnd_caster_view_draw(sp, lights, v, &draws[i], &cull, &raise);
+		*tris += d.index_count / 3;
+		fill += rnd_cost_fill(sv->view_proj, res, res, &d.bounds, d.area, d.index_count / 3, d.closed);
 	}
 	double beyond = fill > res * res ? fill - res * res : 0;
 	return res * res * EST_MS_PER_TEXEL + (double)*tris * EST_MS_PER_CASTER + beyond * EST_MS_PER_DEPTH_FRAG;

@@ -17,6 +17,11 @@ struct draw {
 	                                                sphere's proxy (UMBRA_DRAW_SPHERE, proxy.h) */
 	uint32_t cam_first_vertex;                   /* the proxy's first vertex */
 	uint32_t first_vertex, vertex_count;
+	/* What the environment's shadow maps may draw instead (caster_level.h): a mesh's caster
+	 * level, at env_first_vertex; env_index_count 0: none. env_error: its error, world units;
+	 * env_raise: how far it is drawn away from the light (env_error, 0 with UMBRA_CASTER_BIAS=0). */
+	uint32_t env_first_index, env_index_count, env_first_vertex, env_vertex_count;
+	float env_error, env_raise;
 	struct rnd_aabb bounds;
 	double area;         /* world-space area of its triangles (renderer/cost.h) */
 	uint32_t material;

@@ -36,11 +36,13 @@
  * STL sphere in a 512-pixel thumbnail (edge error against a 4x4-supersampled full render): full
  * 0.0066, 1/4 pixel 0.0066 (no level fits), 1/2 pixel 0.0087, 1 pixel 0.0107. */
 #define RND_LOD_MESH_PIXEL_ERROR 0.5f
-/* No bound of its own in the shadow maps (0): a mesh casts with the level the cameras chose. A
- * caster's error moves its shadow's edge by about as much, which the camera sees at its own
- * pixel scale, and one level in every pass keeps a mesh's shadow on itself consistent. Half a
- * texel of the 2048^2 map had a 100k-triangle model drawn in full in a 256^2 thumbnail (main
- * pass 290 ms against 22 with the camera's level). */
+/* No bound of its own in the lights' shadow maps (0): a mesh casts with the level the cameras
+ * chose. A caster's error moves its shadow's edge by about as much, which the camera sees at its
+ * own pixel scale, and one level in every pass keeps a mesh's shadow on itself consistent. Half
+ * a texel of the 2048^2 map had a 100k-triangle model drawn in full in a 256^2 thumbnail (main
+ * pass 290 ms against 22 with the camera's level). The environment's maps are the exception:
+ * soft (PCSS at 64-512 texels), they draw a dense mesh's caster level where its error fits 4 of
+ * their texels, with their bias raised by that error (renderer/caster_level.h). */
 #define RND_LOD_MESH_TEXEL_ERROR 0.0f
 
 /* Fewest segments (even, >= 4) for a circle of radius `radius` whose centred chords deviate at

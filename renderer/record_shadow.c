@@ -5,6 +5,7 @@
  * drawn in parts, one submit each (record_shadow_part, sized by renderer/submit.c).
  */
 #include <string.h>
+#include "caster_level.h"
 #include "casters.h"
 #include "moments.h"
 #include "record.h"
@@ -22,6 +23,17 @@ static void begin_depth_load(VkCommandBuffer cmd, VkImage img, VkImageView view,
 	                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, tests, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
 	                     tests, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
 	record_depth_rendering(cmd, view, w, h, true);
+}
+
+/* The depth bias for draws of a caster level with error `raise` (0: the light's own): the draws
+ * moved raise away from the light and the slope bias raised to match (caster_level.h). */
+static void raise_bias(struct rnd_context *ctx, VkCommandBuffer cmd, const struct rnd_shadow_plan *sp, uint32_t v,
+                       const struct rnd_light_plan *lp, float raise, struct umbra_push *push)
+{
+	rnd_caster_view_proj(sp->views[v].view_proj, raise, push->view_proj);
+	vkCmdPushConstants(cmd, ctx->pipes.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+	                   sizeof *push, push);
+	vkCmdSetDepthBias(cmd, lp->bias_constant, 0.0f, lp->bias_slope + rnd_caster_slope_bias(raise, sp->views[v].params[0]));
 }
 
 /* Triangles [lo, hi) of shadow view v's casters (in draw order, those record_shadow_draws
@@ -52,14 +64,21 @@ static void draw_shadow_map(struct rnd_context *ctx, struct rnd_slot *s, const s
 	                   sizeof push, &push);
 	VkPipeline bound = VK_NULL_HANDLE;
 	uint64_t at = 0;   /* casters' triangles before draw i */
+	float raised = 0.0f;   /* the caster level's bias in force (caster_level.h) */
 	for (uint32_t i = 0; i < rv->ndraw && at < hi; i++) {
 		int cull;
+		float raise;
 		if (!record_shadow_draws(rv, v, i, &cull)) continue;
-		struct draw d = rv->draws[i];
+		struct draw d = rnd_caster_view_draw(sp, rv->shadow_lights ? rv->shadow_lights : rv->sc->lights, v, &rv->draws[i],
+		                                     &cull, &raise);
 		uint64_t n = d.index_count / 3, a = lo > at ? lo - at : 0, b = hi - at < n ? hi - at : n;
 		at += n;
 		if (a >= b) continue;
 		if (rv->drawn_shadow) *rv->drawn_shadow += b - a;
+		if (raise != raised) {
+			raise_bias(ctx, cmd, sp, v, lp, raise, &push);
+			raised = raise;
+		}
 		d.first_index += (uint32_t)(3 * a);
 		d.index_count = (uint32_t)(3 * (b - a));
 		record_depth_draw(ctx, s, &d, cull, &push, &bound);

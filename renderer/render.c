@@ -62,6 +62,11 @@ static void plan_device(struct rnd_context *ctx, struct rnd_plan_device *d)
 	d->visibility_force = env && strcmp(env, "0") == 0 ? 0 : env && strcmp(env, "1") == 0 ? 1 : -1;
 	const char *ep = getenv("UMBRA_ENV_PASS");   /* 0: the environment's shadows per fragment (tests) */
 	d->env_pass_force = ep && strcmp(ep, "0") == 0 ? 0 : -1;
+	/* UMBRA_CASTER_LEVEL=0: the environment's maps draw what the camera draws (comparisons) */
+	const char *cl = getenv("UMBRA_CASTER_LEVEL");
+	d->caster_levels_off = cl && strcmp(cl, "0") == 0;
+	const char *cb = getenv("UMBRA_CASTER_BIAS");   /* 0: without their bias (tests: the acne it prevents) */
+	d->caster_bias_off = cb && strcmp(cb, "0") == 0;
 	d->pixel_shading = ctx->pixel_shading;
 	const char *ps = getenv("UMBRA_PIXEL_SHADING");   /* 0: shaded per fragment (tests, comparisons) */
 	d->pixel_shading_force = ps && strcmp(ps, "0") == 0 ? 0 : -1;

@@ -6,6 +6,7 @@
  * render_plan.c), and the limits in them are written once, where they are set.
  */
 #include <string.h>
+#include "caster_level.h"
 #include "env_shadow.h"
 #include "lod.h"
 #include "moments.h"
@@ -179,6 +180,11 @@ void rnd_plan_object(const struct rnd_plan *p, uint32_t i, struct rnd_plan_objec
 	object_detail(p, i, out);
 	out->triangles = d->index_count / 3;
 	out->camera_triangles = d->cam_index_count / 3;
+	out->caster_triangles = d->env_index_count / 3;
+	out->caster_error = d->env_error;
+	const struct rnd_view_plan *vp = &p->views[0];
+	for (uint32_t k = 0; k < vp->shadow_views && d->env_index_count; k++)
+		out->caster_maps += rnd_caster_level_used(&p->esc.lights[vp->view_light[k]], &vp->views[k], vp->view_ortho[k], d);
 	out->proxy = (d->flags & UMBRA_DRAW_SPHERE) != 0;
 	out->casts = d->cast && d->index_count;
 	out->cast_why = rnd_cast_why_text(p->cast_why[i]);

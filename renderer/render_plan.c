@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "atlas.h"
+#include "caster_level.h"
 #include "contact.h"
 #include "cost.h"
 #include "env_shadow.h"
@@ -103,7 +104,8 @@ static enum rnd_result plan_memory(struct rnd_plan *p, struct rnd_error *err)
 /* ---- objects: level of detail, proxies, and each draw, measured before it is written ---- */
 
 /* Where each object's triangles go in the slot's buffers (every mesh in object order, then the
- * camera's proxies of spheres: where the meshes lie does not depend on the camera). */
+ * camera's proxies of spheres: where the meshes lie does not depend on the camera; then the
+ * environment's maps' caster levels). */
 static enum rnd_result plan_layout(struct rnd_plan *p, struct rnd_error *err)
 {
 	const struct rnd_scene *sc = p->sc;
@@ -128,6 +130,20 @@ static enum rnd_result plan_layout(struct rnd_plan *p, struct rnd_error *err)
 		p->draws[i].cam_index_count = x;
 		nv += v;
 		ni += x;
+	}
+	/* The environment's maps' caster levels, after them (caster_level.h). */
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct rnd_object *o = &sc->objects[i];
+		struct draw *d = &p->draws[i];
+		if (p->dev.caster_levels_off || !rnd_caster_level_wanted(sc, o, d->index_count)) continue;
+		d->env_first_vertex = (uint32_t)nv;
+		d->env_vertex_count = o->caster->vertex_count;
+		d->env_first_index = (uint32_t)ni;
+		d->env_index_count = o->caster->index_count;
+		d->env_error = rnd_caster_world_error(o);
+		d->env_raise = p->dev.caster_bias_off ? 0.0f : d->env_error;
+		nv += o->caster->vertex_count;
+		ni += o->caster->index_count;
 	}
 	if (nv > UINT32_MAX || ni > UINT32_MAX)
 		return rnd_fail_at(err, RND_ERR_LIMIT, RND_AT_OBJECTS, 0, "scene too large: %llu vertices, %llu indices",

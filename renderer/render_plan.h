@@ -57,6 +57,8 @@ struct rnd_plan_device {
 	bool visibility_pass;                  /* the device can run the visibility pass */
 	int visibility_force;                  /* UMBRA_VISIBILITY: -1 unset, 0 off, 1 on */
 	int env_pass_force;                    /* UMBRA_ENV_PASS: -1 unset, 0 off */
+	bool caster_levels_off;                /* UMBRA_CASTER_LEVEL=0: no caster levels (caster_level.h) */
+	bool caster_bias_off;                  /* UMBRA_CASTER_BIAS=0: drawn without their bias (tests: the acne) */
 	bool pixel_shading;                    /* the device can shade per pixel (deferred.c) */
 	int pixel_shading_force;               /* UMBRA_PIXEL_SHADING: -1 unset, 0 off */
 	/* The environment map's bins (env.c rnd_env_plan_bins; NULL: no map, or no shadow directions

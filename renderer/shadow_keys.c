@@ -61,6 +61,9 @@ uint64_t rnd_caster_key(const struct rnd_scene *sc, const struct draw *draws, co
 		uint32_t flags[3] = {d->single_sided, d->closed, d->masked};
 		geo = rnd_hash(geo, flags, sizeof flags);
 		geo = hash_geometry(geo, &o);
+		/* the environment's maps may draw its caster level instead (caster_level.h) */
+		float level[3] = {(float)d->env_index_count, d->env_error, d->env_raise};
+		geo = rnd_hash(geo, level, sizeof level);
 		if (d->masked) geo = hash_alpha(geo, &o, &sc->materials[o.material]);
 	}
 	return geo;

@@ -7,6 +7,7 @@
  */
 #include <stdio.h>
 #include <string.h>
+#include "caster_level.h"
 #include "lod.h"
 #include "mesh.h"
 #include "proxy.h"
@@ -79,6 +80,13 @@ enum rnd_result rnd_upload_scene(struct rnd_context *ctx, struct rnd_slot *s, co
 		if (!x) continue;
 		rnd_proxy_write(&plan->proxies[i], vtx + d->cam_first_vertex, idx + d->cam_first_index, d->cam_first_vertex);
 		if (uv1) memset(uv1 + 2 * (size_t)d->cam_first_vertex, 0, (size_t)v * 8);   /* a sphere's proxy: no texture uvs */
+	}
+	/* The environment's maps' caster levels, after the proxies (caster_level.h). */
+	for (uint32_t i = 0; i < sc->object_count; i++) {
+		const struct draw *d = &plan->draws[i];
+		if (!d->env_index_count) continue;
+		rnd_caster_write(&sc->objects[i], vtx + d->env_first_vertex, idx + d->env_first_index, d->env_first_vertex);
+		if (uv1) memset(uv1 + 2 * (size_t)d->env_first_vertex, 0, (size_t)d->env_vertex_count * 8);
 	}
 	rnd_buffer_publish(&s->vertices, 0, (VkDeviceSize)nv * sizeof(struct rnd_vertex));
 	rnd_buffer_publish(&s->indices, 0, (VkDeviceSize)ni * sizeof(uint32_t));

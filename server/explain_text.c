@@ -52,6 +52,9 @@ static void objects(FILE *f, const struct rnd_plan *plan, uint32_t n)
 		fprintf(f, "%-6u %-8s %9llu %9llu %-5s  %s%s%s\n", i, o.shape, (unsigned long long)o.triangles,
 		        (unsigned long long)o.camera_triangles, o.casts ? "yes" : "no", o.detail, o.casts ? "" : "; ",
 		        o.casts ? "" : o.cast_why);
+		if (o.caster_triangles)
+			fprintf(f, "%-6s %-8s %9llu %9s %-5s  caster level: error %g, drawn by %u environment maps\n", "",
+			        "", (unsigned long long)o.caster_triangles, "", "", (double)o.caster_error, o.caster_maps);
 	}
 }
 

@@ -84,6 +84,18 @@ struct rnd_mesh_lod {
 	                         not used for an object with uvs1) */
 };
 
+/* A coarse stand-in for a dense opaque mesh in the environment's shadow maps only (api/model_caster.h
+ * builds it): positions and indices, and error, a bound on the distance between
+ * its surface and the mesh's, both ways, object-space units. Those maps are soft (PCSS over
+ * 128-256 texels): renderer/caster_level.h draws it into a map whose texel it fits, with the
+ * map's depth bias raised by the error; the camera and the lights' maps draw the mesh. */
+struct rnd_caster_level {
+	const float *positions;
+	const uint32_t *indices;
+	uint32_t vertex_count, index_count;
+	float error;
+};
+
 struct rnd_object {
 	enum rnd_shape shape;
 	float size[3];        /* plane: [sx, 0, sz]; box: [sx, sy, sz] */
@@ -104,6 +116,7 @@ struct rnd_object {
 	const uint8_t *colors;  /* optional linear RGBA8 per vertex (glTF COLOR_0): multiplies base colour */
 	const float *tangents;  /* optional xyzw per vertex (w = bitangent sign), for normal maps */
 	const struct rnd_mesh_lod *lods; uint32_t lod_count; /* mesh: coarser levels, finest first, or none */
+	const struct rnd_caster_level *caster; /* mesh: the environment's shadow maps' level, or NULL */
 	/* mesh: min xyz then max xyz of its positions when the caller knows them (a cached model),
 	 * or NULL: then every request that needs the bounds passes over the vertices (a 1M-triangle
 	 * model: ~3 ms each time). */

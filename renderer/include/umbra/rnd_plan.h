@@ -108,6 +108,12 @@ struct rnd_plan_object_info {
 	bool casts;
 	const char *cast_why;
 	bool in_casters_box;                /* sizes a `fit` sun map */
+	/* Its caster level for the environment's shadow maps (api/model_caster.h), if it has one
+	 * laid out: triangles, error (world units), and how many of the first view's maps draw it
+	 * (those whose texel its error fits; the rest draw `triangles`). caster_triangles 0: none. */
+	uint64_t caster_triangles;
+	float caster_error;
+	uint32_t caster_maps;
 };
 void rnd_plan_object(const struct rnd_plan *plan, uint32_t i, struct rnd_plan_object_info *out);
 
