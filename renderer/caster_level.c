@@ -18,12 +18,7 @@ bool rnd_caster_level_wanted(const struct rnd_scene *sc, const struct rnd_object
 
 float rnd_caster_world_error(const struct rnd_object *o)
 {
-	float s = 0.0f;
-	for (int c = 0; c < 3; c++) {
-		const float *col = o->model + 4 * c;
-		s = fmaxf(s, sqrtf(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]));
-	}
-	return o->caster ? o->caster->error * s : 0.0f;
+	return o->caster ? o->caster->error * rnd_mat4_max_axis_scale(o->model) : 0.0f;
 }
 
 bool rnd_caster_level_used(const struct rnd_light *L, const struct umbra_shadow_view *sv, bool ortho,

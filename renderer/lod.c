@@ -74,11 +74,7 @@ float rnd_lod_pixel_world(const float view_proj[16], float width, float height, 
 static void object_sphere(const struct rnd_object *o, float centre[3], float *bound, float *scale)
 {
 	const float *m = o->model;
-	float s = 0.0f, lc[3] = {0, 0, 0}, r = fabsf(o->radius);
-	for (int c = 0; c < 3; c++) {
-		float l = sqrtf(m[4 * c] * m[4 * c] + m[4 * c + 1] * m[4 * c + 1] + m[4 * c + 2] * m[4 * c + 2]);
-		if (l > s) s = l;
-	}
+	float s = rnd_mat4_max_axis_scale(m), lc[3] = {0, 0, 0}, r = fabsf(o->radius);
 	if (o->shape == RND_SHAPE_MESH && o->lod_count) {
 		const struct rnd_mesh_lod *l = &o->lods[o->lod_count - 1];
 		struct rnd_aabb b;

@@ -100,6 +100,19 @@ bool rnd_mat4_invert(float out[16], const float m[16]);
 float rnd_mat4_det3(const float m[16]);
 /* w = 1, divides by w. Inline, as the rest below: the renderer's tessellation and the render
  * plan's measure of each mesh run them once or twice per vertex. */
+/* The largest length of the matrix's first three columns: the most it stretches an object-space
+ * distance (a level's error, a radius) in world space. */
+static inline float rnd_mat4_max_axis_scale(const float m[16])
+{
+	float s = 0.0f;
+	for (int c = 0; c < 3; c++) {
+		const float *col = m + 4 * c;
+		float l = sqrtf(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]);
+		if (l > s) s = l;
+	}
+	return s;
+}
+
 static inline void rnd_mat4_mul_point(float out[3], const float m[16], const float p[3])
 {
 	float r[4];
