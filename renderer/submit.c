@@ -227,8 +227,10 @@ static void moments_tmp_undefined(struct rnd_slot *s)
 }
 
 /* One map estimated past half a slice, in parts of its casters' triangles, a submit each (the
- * deadline checked between): the first part sized by the estimate, the next ones by the
- * measured time per triangle (grown at most 2x a part, as the bands). */
+ * deadline checked between): the first part sized by the estimate (est ms for the whole map, as
+ * the cost model says, times the pacer's scale), the next ones by the measured time per triangle
+ * (grown at most 2x a part, as the bands). Each part's wall time feeds the scale of the groups
+ * after it, as a whole group's does (rnd_pacer_shadow_part_measured). */
 static enum rnd_result submit_shadow_parts(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
                                            uint32_t v, double est, uint64_t total, struct rnd_pacer *p,
                                            struct cmd_state *st, struct rnd_timings *tm, bool *gpu_busy,
@@ -237,7 +239,7 @@ static enum rnd_result submit_shadow_parts(struct rnd_context *ctx, struct rnd_s
 	enum rnd_result r;
 	double target = p->slice_ms / 2;
 	uint32_t fixed = rv->sc->shadow_part_triangles;
-	double per = fixed ? fixed : fmax(1.0, floor((double)total * target / est));
+	double per = fixed ? fixed : fmax(1.0, floor((double)total * target / (p->shadow_scale * est)));
 	for (uint64_t lo = 0; lo < total;) {
 		uint64_t hi = lo + (uint64_t)per < total ? lo + (uint64_t)per : total;
 		if ((r = cmd_open(s, p, st, err)) != RND_OK) return r;
@@ -246,6 +248,7 @@ static enum rnd_result submit_shadow_parts(struct rnd_context *ctx, struct rnd_s
 		cmd_mark(s, st, RND_TS_SHADOW_END);
 		double wall;
 		if ((r = cmd_flush(ctx, s, p, st, tm, &wall, gpu_busy, err)) != RND_OK) return r;
+		rnd_pacer_shadow_part_measured(p, st->prologue, est, hi - lo, total, wall);
 		double rate = wall / (double)(hi - lo);   /* ms per triangle, measured */
 		double next = rate > 0 ? target / rate : 2 * per;
 		if (!fixed) per = fmax(1.0, fmin(next, 2 * per));
@@ -267,14 +270,17 @@ static double shadow_budget(const struct rnd_pacer *p)
 	return p->shadow_measured ? p->slice_ms / 2 : p->slice_ms / 8;
 }
 
-/* After a whole group (estimated est ms, measured wall ms): the scale for the next ones.
- * Never below 1 (never plan with less than the estimate, as the bands); a submit that also
- * built the textures and the environment (the prologue) says nothing of the maps'. */
-static void shadow_measure(struct rnd_pacer *p, const struct cmd_state *st, double est, double wall)
+void rnd_pacer_shadow_measured(struct rnd_pacer *p, bool prologue, double est, double wall)
 {
-	if (st->prologue || !(est > 0)) return;
+	if (prologue || !(est > 0)) return;
 	p->shadow_scale = fmax(1.0, wall / est);
 	p->shadow_measured = true;
+}
+
+void rnd_pacer_shadow_part_measured(struct rnd_pacer *p, bool prologue, double est, uint64_t part, uint64_t total,
+                                    double wall)
+{
+	if (total) rnd_pacer_shadow_measured(p, prologue, est * (double)part / (double)total, wall);
 }
 
 static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *s, const struct record_view *rv,
@@ -292,7 +298,7 @@ static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *
 		uint32_t fixed = rv->sc->shadow_part_triangles;
 		double k = p->shadow_scale;
 		if (fixed ? tris[v] > fixed : paced && k * est[v] > p->slice_ms / 2 && tris[v] > 1) {
-			if ((r = submit_shadow_parts(ctx, s, rv, v, k * est[v], tris[v], p, st, tm, gpu_busy, err)) != RND_OK)
+			if ((r = submit_shadow_parts(ctx, s, rv, v, est[v], tris[v], p, st, tm, gpu_busy, err)) != RND_OK)
 				return r;
 			v++;
 			continue;
@@ -312,7 +318,7 @@ static enum rnd_result submit_shadows(struct rnd_context *ctx, struct rnd_slot *
 		if (paced) {
 			if ((r = cmd_flush(ctx, s, p, st, tm, &wall, gpu_busy, err)) != RND_OK) return r;
 			p->shadow_submits++;
-			shadow_measure(p, st, sum, wall);
+			rnd_pacer_shadow_measured(p, st->prologue, sum, wall);
 		}
 		v = end;
 	}

@@ -42,6 +42,17 @@ struct rnd_pacer {
 	uint32_t measured;
 };
 
+/* After a whole group of shadow maps, estimated est ms by the cost model and measured wall ms:
+ * the scale of the groups after it (wall / est, never below 1: never plan with less than the
+ * estimate, as the bands) and shadow_measured (the first group is kept small until then). A
+ * submit that also carried the prologue (textures, environment: prologue true) says nothing of
+ * the maps' and does not count. */
+void rnd_pacer_shadow_measured(struct rnd_pacer *p, bool prologue, double est, double wall);
+/* The same after one part of a map drawn in parts: part of its total caster triangles, the
+ * map estimated est ms whole; the part's share of the estimate is measured against wall. */
+void rnd_pacer_shadow_part_measured(struct rnd_pacer *p, bool prologue, double est, uint64_t part, uint64_t total,
+                                    double wall);
+
 /* Sets the slice from the deadline left (a quarter of it, 50..1000 ms) or 0 without one. */
 void rnd_pacer_init(struct rnd_pacer *p, const struct rnd_scene *sc);
 /* RND_ERR_TIMEOUT when the rows_left of the main pass cannot be drawn before the deadline at

@@ -95,3 +95,38 @@ TEST(pacer_stops_a_render_that_cannot_make_its_deadline)
 	fresh.sc = &sc;
 	CHECK(rnd_pacer_hopeless(&fresh, 1000, &err) == RND_OK, "nothing measured yet: no judgement");
 }
+
+/* Shadow maps (renderer/submit.c): a map drawn in parts measures each part against its share of
+ * the map's estimate, and that sets the scale the later groups are sized by, as a whole group's
+ * measure does. Before, only whole groups fed it: after a map in parts, the groups behind it
+ * were still planned with the idle-machine estimate (scale 1) and an eighth of a slice. The
+ * walls are injected: no timing is asserted. */
+TEST(pacer_shadow_parts_feed_the_group_scale)
+{
+	struct rnd_pacer p = pacer(1000);
+	p.shadow_scale = 1.0;
+	/* a map estimated 800 ms for 1,000 triangles: a part of 250 is 200 ms by estimate, ran 600 */
+	rnd_pacer_shadow_part_measured(&p, false, 800, 250, 1000, 600);
+	CHECK(p.shadow_measured, "a part's measure counts as one");
+	CHECK(p.shadow_scale > 2.999 && p.shadow_scale < 3.001, "scale %g after a part 3x its estimate", p.shadow_scale);
+	/* the next part ran as estimated (100 ms of 400 triangles' 320): the scale follows it */
+	rnd_pacer_shadow_part_measured(&p, false, 800, 400, 1000, 640);
+	CHECK(p.shadow_scale > 1.999 && p.shadow_scale < 2.001, "scale %g after a part 2x its estimate", p.shadow_scale);
+	/* faster than the estimate: never planned below it */
+	rnd_pacer_shadow_part_measured(&p, false, 800, 350, 1000, 10);
+	CHECK(p.shadow_scale == 1.0, "scale %g after a fast part", p.shadow_scale);
+}
+
+TEST(pacer_shadow_part_with_the_prologue_does_not_count)
+{
+	struct rnd_pacer p = pacer(1000);
+	p.shadow_scale = 1.0;
+	/* the first submit also built the textures and the environment: its wall says nothing */
+	rnd_pacer_shadow_part_measured(&p, true, 800, 250, 1000, 5000);
+	CHECK(!p.shadow_measured && p.shadow_scale == 1.0, "measured %d, scale %g", p.shadow_measured, p.shadow_scale);
+	rnd_pacer_shadow_part_measured(&p, false, 800, 0, 0, 5000);   /* an empty map: nothing to measure */
+	CHECK(!p.shadow_measured, "an empty map measured");
+	/* a whole group after it measures as before */
+	rnd_pacer_shadow_measured(&p, false, 100, 450);
+	CHECK(p.shadow_measured && p.shadow_scale > 4.499 && p.shadow_scale < 4.501, "group scale %g", p.shadow_scale);
+}
