@@ -396,3 +396,46 @@ TEST(model_lod_level_error_ordered_equals_every_walk)
 	free(idx);
 	free(lv);
 }
+
+/* The worst-first walk must give the every-walk figure where the cheap estimate misranks the
+ * level's triangles (on the bumpy sphere above the worst estimate is also the worst triangle,
+ * so a measure that walked only the first triangle, or stopped at estimates under the worst
+ * instead of under half of it, passed there). A flat 15 x 7 grid (spacing 0.05) with two domes,
+ * b sin(pi u) sin(pi v) over 6 x 6 cells each, and a level of one triangle over each, corners on
+ * the dome's rim: every sample of a level triangle (centroid, edge midpoints) lies right under a
+ * full-mesh vertex, so the estimate is the dome's height there times that vertex normal's y.
+ * Dome A: 0.009 high, normals up: estimate 0.009, truth ~0.009. Dome W: 0.02 high, its normals
+ * leaning to y = 0.3 (a model's authored normals can): estimate 0.006, truth ~0.02. A is walked
+ * first; W's estimate is under A's truth but over half of it, so W must be walked too. */
+TEST(model_lod_level_error_walks_a_misranked_worst)
+{
+	enum { NI = 15, NJ = 7 };
+	float pos[NI * NJ * 3], nrm[NI * NJ * 3];
+	uint32_t idx[(NI - 1) * (NJ - 1) * 6], ni = 0;
+	for (uint32_t i = 0; i < NI; i++)
+		for (uint32_t j = 0; j < NJ; j++) {
+			float *p = pos + 3 * (i * NJ + j), *n = nrm + 3 * (i * NJ + j);
+			bool w = i >= 8;
+			double u = ((double)i - (w ? 8 : 0)) / 6, v = (double)j / 6, b = w ? 0.02 : 0.009;
+			p[0] = 0.05f * (float)i, p[2] = 0.05f * (float)j;
+			p[1] = i == 7 ? 0.0f : (float)(b * sin(PI_D * u) * sin(PI_D * v));
+			n[0] = w ? (float)sqrt(1 - 0.09) : 0.0f, n[1] = w ? 0.3f : 1.0f, n[2] = 0.0f;
+		}
+	for (uint32_t i = 0; i + 1 < NI; i++)
+		for (uint32_t j = 0; j + 1 < NJ; j++) {
+			uint32_t a = i * NJ + j, q[6] = {a, a + 1, a + NJ, a + 1, a + NJ + 1, a + NJ};
+			for (int k = 0; k < 6; k++) idx[ni++] = q[k];
+		}
+	float lo[3], hi[3], ext = api_points_box(pos, NI * NJ, lo, hi);
+	struct api_lod_measure *m = api_lod_measure_create(pos, nrm, NI * NJ, idx, ni, lo, hi, ext);
+	REQUIRE(m);
+	/* dome A: corners (0,0) (6,0) (0,6); dome W: (8,0) (14,0) (8,6) (grid i, j) */
+	const uint32_t level[6] = {0, 6 * NJ, 6, 8 * NJ, 14 * NJ, 8 * NJ + 6};
+	float fast = api_lod_measure_level(m, level, 6, false), all = api_lod_measure_level(m, level, 6, true);
+	float a_only = api_lod_measure_level(m, level, 3, true), w_only = api_lod_measure_level(m, level + 3, 3, true);
+	CHECK(a_only > 0.0085f && a_only <= 0.009f && w_only > 0.019f && w_only <= 0.02f, "dome A %g, dome W %g", a_only,
+	      w_only);
+	CHECK(fast == all, "%.9g measured, %.9g walking every triangle (the worst, dome W, estimated under dome A)", fast,
+	      all);
+	api_lod_measure_destroy(m);
+}
