@@ -13,7 +13,7 @@
 #   make bench-cluster  1 vs 3 daemons, cache hit rates with and without affinity
 #   make bench-farm-remote  the local farm against --server on 3 daemons, 300 models
 #   make check-deploy   haproxy -c, systemd-analyze verify/security, k8s manifest checks
-#   make sizes      files over ~600 lines and functions over ~80 in api/ renderer/ server/ (a list)
+#   make sizes      files over ~600 lines and functions over ~80 in api/ renderer/ server/, test files over ~600 (a list)
 #   make soak       10,000 mixed requests against one umbrad; RSS and descriptors must stay flat
 BUILD ?= build
 SHARED ?= ../shared
