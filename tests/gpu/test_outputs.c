@@ -12,6 +12,7 @@
 #include "api.h"
 #include "gpu_util.h"
 #include "test.h"
+#include "util.h"
 
 /* ---- helpers ---- */
 
@@ -490,20 +491,6 @@ TEST(outputs_png_16bit_matches_8bit)
 
 /* ---- 4. base-colour texture ---- */
 
-static void b64(const uint8_t *d, size_t n, char *out)
-{
-	static const char T[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	size_t o = 0;
-	for (size_t i = 0; i < n; i += 3) {
-		uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
-		out[o++] = T[v >> 18 & 63];
-		out[o++] = T[v >> 12 & 63];
-		out[o++] = i + 1 < n ? T[v >> 6 & 63] : '=';
-		out[o++] = i + 2 < n ? T[v & 63] : '=';
-	}
-	out[o] = 0;
-}
-
 TEST(outputs_textured_plane_checker)
 {
 	/* A 2x2 checker, red and blue, as a PNG written by libpng. */
@@ -518,7 +505,7 @@ TEST(outputs_textured_plane_checker)
 	png_alloc_size_t len = sizeof png;
 	REQUIRE(png_image_write_to_memory(&pi, png, &len, 0, texels, 0, NULL), "%s", pi.message);
 	char enc[1024];
-	b64(png, len, enc);
+	test_b64_into(png, len, enc);
 	/* Straight down onto a 2x2 plane (white material, light of intensity pi: radiance = texel). */
 	struct rnd_image img;
 	REQUIRE(gpu_render(&img, "{'width':64,'height':64,'camera':{'position':[0,5,0.001],'target':[0,0,0],'fov_y':30},"

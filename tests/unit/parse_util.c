@@ -62,18 +62,3 @@ void check_bad(const struct bad *b, const struct api_limits *lim, int idx)
 	CHECK(!strncmp(p.type, "https://umbra.dev/problems/", 27), "doc %d: type %s", idx, p.type);
 	CHECK(p.title[0] != 0, "doc %d: no title", idx);
 }
-
-void b64_encode(const void *data, size_t n, char *out)
-{
-	static const char tbl[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-	const unsigned char *b = data;
-	size_t o = 0;
-	for (size_t i = 0; i < n; i += 3) {
-		uint32_t v = (uint32_t)b[i] << 16 | (i + 1 < n ? (uint32_t)b[i + 1] << 8 : 0) | (i + 2 < n ? b[i + 2] : 0);
-		out[o++] = tbl[v >> 18 & 63];
-		out[o++] = tbl[v >> 12 & 63];
-		out[o++] = i + 1 < n ? tbl[v >> 6 & 63] : '=';
-		out[o++] = i + 2 < n ? tbl[v & 63] : '=';
-	}
-	out[o] = 0;
-}

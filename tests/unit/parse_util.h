@@ -35,7 +35,5 @@ struct bad {
 
 /* Checks that b's document fails under lim (NULL: the defaults) as it says; idx names it. */
 void check_bad(const struct bad *b, const struct api_limits *lim, int idx);
-/* base64 of data into out (NUL-terminated); out must hold 4*ceil(n/3)+1 bytes. */
-void b64_encode(const void *data, size_t n, char *out);
 
 #endif

@@ -9,6 +9,7 @@
 #include "test.h"
 #include "umbra/rnd_math.h"
 #include "parse_util.h"
+#include "util.h"
 
 TEST(parse_defaults)
 {
@@ -268,10 +269,10 @@ TEST(parse_mesh_base64_equals_array)
 	const float uv[8] = {0, 0, 1, 0, 0, 1, 1, 1};
 	unsigned char bytes[48];
 	char bp[80], bi[40], bn[80], bu[60];
-	le32(pos, 12, bytes); b64_encode(bytes, 48, bp);
-	le32(idx, 6, bytes); b64_encode(bytes, 24, bi);
-	le32(nrm, 12, bytes); b64_encode(bytes, 48, bn);
-	le32(uv, 8, bytes); b64_encode(bytes, 32, bu);
+	le32(pos, 12, bytes); test_b64_into(bytes, 48, bp);
+	le32(idx, 6, bytes); test_b64_into(bytes, 24, bi);
+	le32(nrm, 12, bytes); test_b64_into(bytes, 48, bn);
+	le32(uv, 8, bytes); test_b64_into(bytes, 32, bu);
 	char doc[2048];
 	snprintf(doc, sizeof doc,
 	         "{" C ",'objects':["
@@ -293,7 +294,7 @@ TEST(parse_mesh_base64_equals_array)
 	/* Unpadded, URL-safe and line-wrapped base64 decode the same. */
 	float one[3] = {-1, 2, 0.5f};
 	le32(one, 3, bytes);
-	b64_encode(bytes, 12, bp);
+	test_b64_into(bytes, 12, bp);
 	char wrapped[96];
 	snprintf(wrapped, sizeof wrapped, "%.8s\\n%s", bp, bp + 8);
 	snprintf(doc, sizeof doc, "{" C ",'objects':[{'shape':'mesh','positions':'%s','indices':[0,0,0]}]}", wrapped);

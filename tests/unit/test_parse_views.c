@@ -9,6 +9,7 @@
 #include "test.h"
 #include "umbra/rnd_math.h"
 #include "parse_util.h"
+#include "util.h"
 
 TEST(parse_hostile_input)
 {
@@ -318,7 +319,7 @@ TEST(parse_base_color_texture)
 	png_alloc_size_t len = sizeof png;
 	REQUIRE(png_image_write_to_memory(&img, png, &len, 0, texels, 0, NULL), "%s", img.message);
 	char enc[2048], doc[8192];
-	b64_encode(png, len, enc);
+	test_b64_into(png, len, enc);
 	snprintf(doc, sizeof doc,
 	         "{'camera':{},'materials':{'t':{'base_color':[1,0.5,1],'base_color_texture':'%s'}},"
 	         "'objects':[{'shape':'plane','material':'t'},{'shape':'box','material':{'base_color_texture':'%s'}},"
@@ -340,7 +341,7 @@ TEST(parse_base_color_texture)
 
 	/* A truncated PNG: 400 at the member with the decoder's message. */
 	char bad[4096];
-	b64_encode(png, len / 2, enc);
+	test_b64_into(png, len / 2, enc);
 	snprintf(bad, sizeof bad, "{'camera':{},'objects':[],'materials':{'t':{'base_color_texture':'%s'}}}", enc);
 	struct api_problem p;
 	struct api_scene *sb = parse(q(bad), &p);
@@ -354,7 +355,7 @@ TEST(parse_base_color_texture)
 	api_limits_defaults(&lim);
 	lim.max_textures = 16;
 	for (int n = 16; n <= 17; n++) {
-		b64_encode(png, len, enc);
+		test_b64_into(png, len, enc);
 		size_t cap = 256 + (size_t)(n + 1) * (strlen(enc) + 128);
 		char *d = malloc(cap);
 		REQUIRE(d);

@@ -7,12 +7,11 @@
 #include "api.h"
 #include "util.h"
 
-char *test_b64(const void *data, size_t n)
+void test_b64_into(const void *data, size_t n, char *out)
 {
 	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 	const uint8_t *d = data;
-	char *o = malloc(n / 3 * 4 + 8), *p = o;
-	if (!o) return NULL;
+	char *p = out;
 	size_t i = 0;
 	for (; i + 2 < n; i += 3) {
 		uint32_t v = (uint32_t)d[i] << 16 | (uint32_t)d[i + 1] << 8 | d[i + 2];
@@ -25,6 +24,12 @@ char *test_b64(const void *data, size_t n)
 		*p++ = '=';
 	}
 	*p = 0;
+}
+
+char *test_b64(const void *data, size_t n)
+{
+	char *o = malloc(n / 3 * 4 + 8);
+	if (o) test_b64_into(data, n, o);
 	return o;
 }
 

@@ -10,8 +10,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Standard base64 (with padding) of d[0..n), NUL-terminated. */
+/* Standard base64 (with padding) of d[0..n), NUL-terminated: malloc'd, or into out (which
+ * holds 4 * ceil(n / 3) + 1 bytes). */
 char *test_b64(const void *d, size_t n);
+void test_b64_into(const void *d, size_t n, char *out);
 /* Writes text to dir/name (created or truncated); a file that cannot be written is left as
  * it is (the test's own checks then fail on what it reads). */
 void test_put_file(const char *dir, const char *name, const char *text);
