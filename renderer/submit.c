@@ -260,7 +260,7 @@ static enum rnd_result submit_shadow_parts(struct rnd_context *ctx, struct rnd_s
 }
 
 /* What a group of shadow views may be estimated at: half a slice, in estimates scaled by what
- * the last group measured; until one was measured, an eighth. The estimate is the cost model's
+ * the last group or map part measured; until one was measured, an eighth. The estimate is the cost model's
  * for an idle machine, and a group runs whole before the deadline is checked: 32 spot maps
  * estimated at 0.4 s together went in one submit that took 11 s on a machine at load 15 (the
  * request behind it, answered at the deadline's half, missed its own). A small first group

@@ -27,8 +27,9 @@ struct rnd_pacer {
 	uint32_t submits;           /* submitted by this render so far */
 	uint32_t shadow_parts;      /* of them, parts of shadow maps (submit.c) */
 	uint32_t shadow_submits;    /* of them, those of shadow maps alone (whole or in parts; paced only) */
-	/* Shadow groups: measured wall time over the estimate of the last group measured (at
-	 * least 1), and whether one was (submit.c: the first group is kept small until then). */
+	/* Shadow groups: measured wall time over the estimate of the last group or map part
+	 * measured (at least 1), and whether one was (submit.c: the first group is kept small
+	 * until then). */
 	double shadow_scale;
 	bool shadow_measured;
 	const struct rnd_texture *const *tex; /* staged textures, recorded into the first submit */
