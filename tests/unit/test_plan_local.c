@@ -40,6 +40,14 @@ static void local_scene_init(struct local_scene *s, enum rnd_light_type type, fl
 	s->casters = (struct rnd_aabb){{-0.15f, 0, -0.1f}, {0.15f, 0.3f, 0.1f}};
 }
 
+/* The light moved to (x, y, z). */
+static void light_at(struct local_scene *s, float x, float y, float z)
+{
+	s->light.position[0] = x;
+	s->light.position[1] = y;
+	s->light.position[2] = z;
+}
+
 static enum rnd_result local_plan_atlas(struct local_scene *s, const struct rnd_aabb *casters, uint32_t atlas,
                                         struct rnd_shadow_plan *sp)
 {
@@ -127,8 +135,7 @@ TEST(plan_local_spot_pcss_search_reach)
 	static struct local_scene s;
 	static struct rnd_shadow_plan cone, fit;
 	local_scene_init(&s, RND_LIGHT_SPOT, 0.3f);
-	float pos[3] = {0.3f, 1.2f, 0.2f};
-	memcpy(s.light.position, pos, sizeof pos);
+	light_at(&s, 0.3f, 1.2f, 0.2f);
 	REQUIRE(local_plan(&s, NULL, &cone) == RND_OK, "cone plan");
 	REQUIRE(local_plan(&s, &s.casters, &fit) == RND_OK, "fitted plan");
 	CHECK(fit.lights[0].filter == UMBRA_FILTER_PCSS, "filter %u", fit.lights[0].filter);
@@ -149,8 +156,7 @@ TEST(plan_local_point_faces_sized_for_camera)
 	static struct local_scene s;
 	static struct rnd_shadow_plan sp;
 	local_scene_init(&s, RND_LIGHT_POINT, 0.02f);
-	float pos[3] = {1.0f, 2.0f, 0.8f};
-	memcpy(s.light.position, pos, sizeof pos);
+	light_at(&s, 1.0f, 2.0f, 0.8f);
 	REQUIRE(local_plan(&s, NULL, &sp) == RND_OK, "plan");
 	uint32_t before = sp.lights[0].resolution;
 	REQUIRE(local_plan(&s, &s.casters, &sp) == RND_OK, "plan");
@@ -175,8 +181,7 @@ TEST(plan_local_asked_size_within_atlas)
 	static struct local_scene s;
 	static struct rnd_shadow_plan def, big;
 	local_scene_init(&s, RND_LIGHT_POINT, 0.02f);
-	float pos[3] = {0.5f, 1.0f, 0.4f};
-	memcpy(s.light.position, pos, sizeof pos);
+	light_at(&s, 0.5f, 1.0f, 0.4f);
 	REQUIRE(local_plan_atlas(&s, &s.casters, 4096, &def) == RND_OK, "default plan");
 	s.light.shadow.resolution = 4096;
 	REQUIRE(local_plan_atlas(&s, &s.casters, 4096, &big) == RND_OK, "4096 plan");
