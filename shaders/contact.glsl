@@ -35,7 +35,13 @@ bool contact_occludes(vec2 uv, vec2 tsz, float smooth_range, float lo, float hi,
 	vec4 d = textureGather(scene_depth, uv);
 	vec4 z = mix(min(scene_view_depth(d), vec4(1e20)), vec4(1e20), greaterThanEqual(d, vec4(1.0)));
 	float range = max(max(z.x, z.y), max(z.z, z.w)) - min(min(z.x, z.y), min(z.z, z.w));
-	if (range <= smooth_range) return all(lessThan(z, vec4(hi))) && any(greaterThan(z, vec4(lo - thick)));
+	// The receiver's own plane never shadows it (see below): on one smooth surface, a texel must
+	// lie in front of that plane by more than the two pixels' slope that the four texels' centres
+	// span around uv. Without it, a ray rising towards a grazing light on the camera's side was
+	// occluded by the ground a pixel nearer to the camera (issue 31: false_core 0.021).
+	if (range <= smooth_range)
+		return all(lessThan(z, vec4(hi))) && any(greaterThan(z, vec4(lo - thick)))
+			&& any(lessThan(z, vec4(z_recv - smooth_range)));
 	// textureGather's order: x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0)
 	vec2 f = fract(uv * tsz - 0.5);
 	vec2 col = f.x < 0.5 ? z.wx : z.zy;   // (j0, j1) of the nearer column
