@@ -21,13 +21,32 @@ static uint32_t piece_of(const float *pos, const uint32_t *t, const float lo[3],
 	return (c[2] * k + c[1]) * k + c[0];
 }
 
+/* Each triangle's piece, in PIECE_TASKS tasks of consecutive triangles on the import's threads. */
+enum { PIECE_TASKS = 64 };
+struct piece_of_task {
+	const float *pos, *lo, *hi;
+	const uint32_t *idx;
+	size_t nt;
+	uint32_t k, *piece;
+};
+
+static void pieces_of(void *ctx, size_t task, unsigned w)
+{
+	(void)w;
+	const struct piece_of_task *q = ctx;
+	for (size_t t = task * q->nt / PIECE_TASKS; t < (task + 1) * q->nt / PIECE_TASKS; t++)
+		q->piece[t] = piece_of(q->pos, q->idx + 3 * t, q->lo, q->hi, q->k);
+}
+
 /* The triangles of idx grouped by piece into by[] (piece p: by[3 * start[p] .. 3 * start[p + 1])). */
 static void group_pieces(const float *pos, const uint32_t *idx, size_t nt, const float lo[3], const float hi[3],
                          uint32_t k, uint32_t *by, size_t *start, uint32_t *piece)
 {
 	uint32_t np = k * k * k;
+	struct piece_of_task q = {pos, lo, hi, idx, nt, k, piece};
+	api_workers_run(PIECE_TASKS, pieces_of, &q);
 	memset(start, 0, (np + 1) * sizeof *start);
-	for (size_t t = 0; t < nt; t++) start[(piece[t] = piece_of(pos, idx + 3 * t, lo, hi, k)) + 1]++;
+	for (size_t t = 0; t < nt; t++) start[piece[t] + 1]++;
 	for (uint32_t p = 0; p < np; p++) start[p + 1] += start[p];
 	for (size_t t = 0; t < nt; t++) memcpy(by + 3 * start[piece[t]]++, idx + 3 * t, 12);
 	for (uint32_t p = np; p > 0; p--) start[p] = start[p - 1];
