@@ -22,9 +22,14 @@ static struct {
 	unsigned ready;               /* workers past their start (api_workers_start waits for all) */
 } pool = {.mu = PTHREAD_MUTEX_INITIALIZER, .go = PTHREAD_COND_INITIALIZER, .done = PTHREAD_COND_INITIALIZER};
 
+/* Set on a thread while it runs tasks: a loop inside a task runs on that thread alone. */
+static _Thread_local bool in_task;
+
 static void drain(unsigned w)
 {
+	in_task = true;
 	for (size_t i; (i = atomic_fetch_add(&pool.next, 1)) < pool.n;) pool.fn(pool.ctx, i, w);
+	in_task = false;
 }
 
 static void *worker(void *arg)
@@ -72,7 +77,8 @@ unsigned api_workers_count(void)
 
 void api_workers_run(size_t n, api_worker_fn fn, void *ctx)
 {
-	if (!pool.nth || n < 2) {
+	if (!pool.nth || n < 2 || in_task) {
+		/* (slot 0 inside a task too: a slot names the scratch of the call that runs the loop) */
 		for (size_t i = 0; i < n; i++) fn(ctx, i, 0);
 		return;
 	}

@@ -10,7 +10,7 @@
  *                                   is the thread's slot, for per-thread scratch.
  *   api_workers_stop()              joins the threads (tests; the importer's child just exits)
  *
- * Without a pool every call runs on the caller, in order. Results must not depend on the
+ * Without a pool, or inside a task (a loop in a loop), every call runs on the caller, in order. Results must not depend on the
  * thread count: each task writes only its own outputs (the callers keep that promise).
  * One process-wide pool, used by one thread at a time (the child's main thread).
  */
