@@ -264,7 +264,7 @@ void rnd_lod_choose(const struct rnd_scene *sc, uint32_t nviews, struct rnd_shad
 		struct rnd_camera_plan cam;
 		if (rnd_camera_plan(camera, sc->width, sc->height, camera->fit == RND_FIT_OBJECTS ? &obj_bounds : &bounds, &cam,
 		                    &err) != RND_OK ||
-		    rnd_shadow_plan_with(sc, &bounds, &casters, &cam, NULL, scratch, &err) != RND_OK) {
+		    rnd_shadow_plan_with(sc, &bounds, &casters, &cam, NULL, 0, scratch, &err) != RND_OK) {
 			as_asked(sc, segments);
 			return;
 		}

@@ -59,6 +59,7 @@ enum rnd_size_rule {
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
 	RND_SIZE_SEARCH,       /* a PCSS spot / point map: texels no finer than its blocker search reaches
 	                          the widest penumbra its casters cast (plan_local.c) */
+	RND_SIZE_ATLAS,        /* a spot or point light's tiles as large as the atlas holds them alone */
 	RND_SIZE_RULE_COUNT
 };
 /* A rule in words ("" for none). */
@@ -90,10 +91,11 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
  * a `fit` sun map covers instead of the whole scene, in a smaller tile, with texels no coarser
  * than the whole scene's and finer where cam sees the casters close (plan.c fit_casters; a
  * light asking for a resolution under the default keeps the whole scene) (NULL: the whole
- * scene, as rnd_shadow_plan). */
+ * scene, as rnd_shadow_plan); atlas: the shadow atlas's side in texels (0: unknown), which
+ * caps a spot or point light's tiles at what the atlas holds of them alone (RND_SIZE_ATLAS). */
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
                                      const struct rnd_aabb *casters, const struct rnd_camera_plan *cam,
-                                     const uint8_t *cascades,
+                                     const uint8_t *cascades, uint32_t atlas,
                                      struct rnd_shadow_plan *out, struct rnd_error *err);
 
 /* Practical split scheme: far distance of each of n cascades between znear and zfar,

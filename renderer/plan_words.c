@@ -15,6 +15,7 @@ const char *rnd_size_rule_text(unsigned why)
 		[RND_SIZE_CASTERS] = "the casters' box: texels finer than the default map's where the camera sees them close",
 		[RND_SIZE_SEARCH] = "the casters' box: texels no finer than the PCSS blocker search reaches for their widest penumbra",
 		[RND_SIZE_CAPPED] = "the server's largest shadow resolution",
+		[RND_SIZE_ATLAS] = "the light's shadow.resolution, cut to what the atlas holds of its tiles alone",
 	};
 	return why < RND_SIZE_RULE_COUNT ? text[why] : "";
 }

@@ -319,7 +319,7 @@ static enum rnd_result plan_shadows(const struct rnd_plan *p, uint32_t v, const 
 {
 	const struct rnd_scene *sc = p->sc, *esc = &p->esc;
 	enum rnd_result r;
-	if ((r = rnd_shadow_plan_with(esc, &p->bounds, &p->casters, cam, v ? cascades : NULL, sp, err)) != RND_OK) return r;
+	if ((r = rnd_shadow_plan_with(esc, &p->bounds, &p->casters, cam, v ? cascades : NULL, p->dev.atlas_size, sp, err)) != RND_OK) return r;
 	if (v == 0)
 		for (uint32_t i = 0; i < esc->light_count && i < UMBRA_MAX_LIGHTS; i++)
 			cascades[i] = sp->lights[i].follows_camera && !sp->lights[i].clipmap;

@@ -15,10 +15,10 @@
 #define CYCLES_DIR "tests/gpu/truth_cycles/"
 
 /* Bounds at the default settings; at 4096 no score may be worse than the default's by more
- * than the slack (two seeds of the reference differ by ~0.001 rmse). */
+ * than the slack (two seeds of the reference differ by ~0.001 rmse; rmse_slack 0: 0.002). */
 struct cycles_case {
 	const char *name;
-	double max_rmse, min_iou, max_missing_contact;
+	double max_rmse, min_iou, max_missing_contact, rmse_slack;
 };
 
 static void print_score(const char *name, const char *what, const struct truth_score *s)
@@ -56,7 +56,8 @@ static void check_cycles(const struct cycles_case *c)
 		CHECK(s.false_core <= 0.002, "%s: false_core %.4f > 0.002", c->name, s.false_core);
 		CHECK(s.missing_contact <= c->max_missing_contact, "%s: missing_contact %.4f > %.4f", c->name,
 		      s.missing_contact, c->max_missing_contact);
-		CHECK(sb.rmse <= s.rmse + 0.002, "%s: rmse %.4f at 4096, %.4f at the default", c->name, sb.rmse, s.rmse);
+		double slack = c->rmse_slack > 0 ? c->rmse_slack : 0.002;
+		CHECK(sb.rmse <= s.rmse + slack, "%s: rmse %.4f at 4096, %.4f at the default", c->name, sb.rmse, s.rmse);
 		CHECK(sb.iou >= s.iou - 0.003, "%s: iou %.4f at 4096, %.4f at the default", c->name, sb.iou, s.iou);
 		CHECK(sb.false_core <= 0.002, "%s: false_core %.4f at 4096", c->name, sb.false_core);
 		CHECK(sb.missing_contact <= s.missing_contact + 0.01, "%s: missing_contact %.4f at 4096, %.4f at the default",
@@ -106,4 +107,16 @@ TEST(cycles_masked_checker_sun)
 TEST(cycles_small_casters_wide_spot)
 {
 	check_cycles(&(struct cycles_case){"small_spot", 0.02, 0.97, 0.02});
+}
+
+/* The small body of cycles_small_casters_wide_spot under a point light of radius 2 cm, 1.2 m from
+ * it, seen from 0.75 m. At `resolution: 4096` six 4096 faces do not fit the 4096 atlas: they were
+ * planned at 4096 (the casters' face cut to PCSS's search floor, wider than the casters), granted
+ * 1024 and drawn with texels 20 % coarser than the default size's. Before: default rmse 0.0086,
+ * iou 0.9934; at 4096 0.0101, 0.9934. Now the faces are planned at the 1024 the atlas holds
+ * (plan.c, RND_SIZE_ATLAS): both 0.0086, 0.9934 (the same image). Both renders are scored
+ * against the same reference, so its noise mostly cancels: the slack is 0.0005. */
+TEST(cycles_point_light_4096_within_atlas)
+{
+	check_cycles(&(struct cycles_case){"small_point", 0.02, 0.97, 0.02, 0.0005});
 }

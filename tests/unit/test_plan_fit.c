@@ -79,9 +79,9 @@ TEST(plan_fit_covers_the_casters_on_whole_texels)
 			struct rnd_error err = {0};
 			REQUIRE(rnd_camera_plan(&f.scene.camera, 512, 512, &scene, &cp, &err) == RND_OK, "camera: %s", err.msg);
 			REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
-			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &part, &err) == RND_OK, "casters: %s",
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &part, &err) == RND_OK, "casters: %s",
 			        err.msg);
-			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &empty, &cp, NULL, &none, &err) == RND_OK, "none: %s",
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &empty, &cp, NULL, 0, &none, &err) == RND_OK, "none: %s",
 			        err.msg);
 			const struct umbra_shadow_view *w = &whole.views[0], *v = &part.views[0];
 			CHECK(w->rect[2] == 2048.0f && v->rect[2] <= (di == 2 ? 2048.0f : 1024.0f) &&
@@ -109,13 +109,13 @@ TEST(plan_fit_covers_the_casters_on_whole_texels)
 				}
 			}
 			f.light.shadow.resolution = 1024;
-			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &asked, &err) == RND_OK, "asked: %s",
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &asked, &err) == RND_OK, "asked: %s",
 			        err.msg);
 			REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
 			CHECK(!memcmp(&asked.views[0], &whole.views[0], sizeof asked.views[0]),
 			      "dir %d: an asked-for resolution under the default must keep the whole scene's map", di);
 			f.light.shadow.resolution = 4096;
-			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &asked, &err) == RND_OK, "4096: %s",
+			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &asked, &err) == RND_OK, "4096: %s",
 			        err.msg);
 			CHECK(asked.views[0].rect[2] == 4096.0f && asked.views[0].params[0] < v->params[0],
 			      "dir %d filter %d: asked 4096: tile %g, texel %g, the default's %g", di, fi, asked.views[0].rect[2],
@@ -143,7 +143,7 @@ TEST(plan_fit_texels_finer_where_the_camera_sees_the_casters)
 		struct rnd_camera_plan cp;
 		struct rnd_error err = {0};
 		REQUIRE(rnd_camera_plan(&f.scene.camera, 128, 128, &scene, &cp, &err) == RND_OK, "camera: %s", err.msg);
-		REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, &plan[c], &err) == RND_OK, "plan: %s",
+		REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &plan[c], &err) == RND_OK, "plan: %s",
 		        err.msg);
 	}
 	const struct umbra_shadow_view *far = &plan[0].views[0], *near = &plan[1].views[0];
