@@ -3,11 +3,13 @@
  * (an STL's, a PLY's with face colours) joined where they are one vertex, within the groups of
  * the sorted weld (api/weld.h), which the mesh then keeps for the closedness check and the level.
  */
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <meshoptimizer.h>
 #include "model_conv.h"
 #include "weld.h"
+#include "workers.h"
 
 /* What join_vertices compares of a corner. */
 struct join_key {
@@ -70,6 +72,27 @@ static int join_group(const float *pos, const float *nrm, const uint8_t *col, co
 	return 0;
 }
 
+/* The weld's groups joined in GROUP_TASKS tasks of consecutive groups on the import's threads
+ * (api/workers.h): each writes lead[] of its own members only. */
+enum { GROUP_TASKS = 64 };
+struct groups {
+	const float *pos, *nrm;
+	const uint8_t *col;
+	const struct api_weld *w;
+	uint32_t *lead;
+	atomic_int failed;
+};
+
+static void join_groups(void *ctx, size_t task, unsigned wk)
+{
+	(void)wk;
+	struct groups *q = ctx;
+	const struct api_weld *w = q->w;
+	for (size_t g = task * w->groups / GROUP_TASKS; g < (task + 1) * w->groups / GROUP_TASKS; g++)
+		if (join_group(q->pos, q->nrm, q->col, w->order + w->start[g], w->start[g + 1] - w->start[g], q->lead))
+			atomic_store(&q->failed, 1);
+}
+
 uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, uint32_t *idx, uint32_t ni,
                            struct api_arena *arena, const uint32_t **weld_group, uint32_t *weld_groups)
 {
@@ -81,9 +104,9 @@ uint32_t api_join_vertices(float *pos, float *nrm, uint8_t *col, uint32_t nv, ui
 		free(remap);
 		return nv;
 	}
-	int rc = 0;
-	for (size_t g = 0; rc == 0 && g < w.groups; g++)
-		rc = join_group(pos, nrm, col, w.order + w.start[g], w.start[g + 1] - w.start[g], remap);
+	struct groups q = {pos, nrm, col, &w, remap, 0};
+	api_workers_run(GROUP_TASKS, join_groups, &q);
+	int rc = atomic_load(&q.failed) ? -1 : 0;
 	uint32_t *jg = rc == 0 ? api_arena_calloc(arena, nv ? nv : 1, sizeof *jg) : NULL;
 	if (!jg) {
 		api_weld_release(&w);

@@ -9,6 +9,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +24,7 @@
 #include "sandbox.h"
 #include "sandbox_stats.h"
 #include "umbra/rnd_math.h"
+#include "workers.h"
 
 /* The daemon waits this long past the job's timeout for the fork server to report: it kills
  * the child at the timeout, so only a stuck fork server could make the daemon wait longer. */
@@ -279,6 +281,20 @@ out:
 	return rc;
 }
 
+/* Jobs of this process in their child now. */
+static atomic_uint jobs_running;
+
+/* A job's threads: this machine's cores shared among the jobs running (a model's import
+ * or levels; the others are single-threaded), at most 4: 1 when every core has a job. */
+static uint32_t job_threads(uint32_t kind, unsigned running)
+{
+	static long cores;
+	if (!cores) cores = sysconf(_SC_NPROCESSORS_ONLN);
+	if (kind == API_WIRE_IMAGE || cores < 2) return 1;
+	long t = cores / (running ? running : 1);
+	return t < 1 ? 1 : t > 4 ? 4 : (uint32_t)t;
+}
+
 /* One job: its reply (mapped, header checked) or a classified failure, *how the outcome
  * (API_SBX_OUT_OK with API_OK; the caller's check of the body may still refuse it). */
 static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, const struct api_limits *lim,
@@ -301,7 +317,10 @@ static enum api_result run_job(struct api_sbx_request *rq, const uint8_t *data, 
 	rq->reply_size = rq->memory ? rq->memory : (uint64_t)4 << 30;
 	int fd = reply_file(status, err, errsize);
 	enum api_result rc = API_ERR;
-	if (fd < 0 || await_child(rq, data, fd, &len, how, status, err, errsize) < 0) goto out;
+	rq->threads = job_threads(rq->kind, atomic_fetch_add(&jobs_running, 1) + 1);
+	int awaited = fd < 0 ? -1 : await_child(rq, data, fd, &len, how, status, err, errsize);
+	atomic_fetch_sub(&jobs_running, 1);
+	if (awaited < 0) goto out;
 	if (len > rq->reply_size || map_reply(fd, len, reply) < 0) {
 		*how = API_SBX_OUT_INVALID;
 		fail(status, 400, err, errsize, "the importer's reply (%llu bytes, it says) cannot be mapped",

@@ -117,7 +117,7 @@ struct api_sbx_request {
 	uint64_t model_len;     /* model: the model file's bytes at the start of the input ... */
 	uint32_t file_count;    /* ... followed by this many files (api_sbx_bundle_encode) */
 	uint32_t output_side;   /* model: api_limits.output_side (api_model_finish_import) */
-	uint32_t reserved;      /* 0 */
+	uint32_t threads;       /* the import's threads, the caller's included (0: 1; api/workers.h) */
 	uint64_t reply_size;    /* the reply file's size: no reply may be longer */
 };
 

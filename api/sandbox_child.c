@@ -11,6 +11,7 @@
  */
 #include <errno.h>
 #include <fcntl.h>
+#include <malloc.h>
 #include <poll.h>
 #include <seccomp.h>
 #include <signal.h>
@@ -30,6 +31,7 @@
 #include "model_lod.h"
 #include "model_wire.h"
 #include "sandbox.h"
+#include "workers.h"
 
 #define SBX_SANITIZED API_SBX_SANITIZED
 
@@ -72,6 +74,9 @@ static int apply_filter(void)
 	if (!rc) rc = seccomp_rule_add(f, SCMP_ACT_ALLOW, SCMP_SYS(mprotect), 1, SCMP_A2(SCMP_CMP_MASKED_EQ, PROT_EXEC, 0));
 	if (!rc) rc = seccomp_rule_add(f, SCMP_ACT_ALLOW, SCMP_SYS(tgkill), 1, SCMP_A0(SCMP_CMP_EQ, (scmp_datum_t)getpid()));
 	if (!rc) rc = seccomp_rule_add(f, SCMP_ACT_ALLOW, SCMP_SYS(kill), 1, SCMP_A0(SCMP_CMP_EQ, (scmp_datum_t)getpid()));
+	/* TSYNC: the filter covers the import's threads (started just before) as well; no clone
+	 * is allowed, so none can be started after. */
+	if (!rc) rc = seccomp_attr_set(f, SCMP_FLTATR_CTL_TSYNC, 1);
 	if (!rc) rc = seccomp_load(f);
 	seccomp_release(f);
 	return rc ? -1 : 0;
@@ -79,7 +84,8 @@ static int apply_filter(void)
 
 static int set_limits(const struct api_sbx_request *rq)
 {
-	rlim_t cpu = (rq->timeout_ms + 999) / 1000;
+	/* the CPU time of all the import's threads together */
+	rlim_t cpu = (rq->timeout_ms + 999) / 1000 * (rq->threads > 1 ? rq->threads : 1);
 	struct rlimit r_cpu = {cpu ? cpu : 1, (cpu ? cpu : 1) + 1}, zero = {0, 0};
 	/* The only file it can write is its reply file, up to the size the daemon allows. */
 	struct rlimit r_fsize = {rq->reply_size, rq->reply_size};
@@ -199,6 +205,13 @@ static void child_main(int data_fd, int reply_fd, const struct api_sbx_request *
 	/* jansson (the glTF pre-check) seeds its hash from /dev/urandom on first use: done here,
 	 * while files can still be opened, and fresh in every child. */
 	json_object_seed(0);
+	/* The import's threads (api/workers.h), the daemon's share of the cores: started before
+	 * the limits and the filter, which then cover them (no thread can be made after). One
+	 * malloc arena for them all: a thread's own arena would reserve 64 MiB of RLIMIT_AS. */
+	if (rq->threads > 1) {
+		mallopt(M_ARENA_MAX, 1);
+		api_workers_start(rq->threads);
+	}
 	if (set_limits(rq) || prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) || apply_filter()) _exit(API_SBX_EXIT_SETUP);
 
 	uint8_t *in = malloc(rq->input_len ? rq->input_len : 1);

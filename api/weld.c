@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "weld.h"
+#include "workers.h"
 
 /* LSD passes over the bits below `bits` of keys[0..n), `digit` (at most 11) bits a pass: the
  * histograms in one read, then a stable scatter per digit that is not the same in every key
@@ -59,6 +60,38 @@ static void insertion(uint64_t *k, uint32_t *v, size_t n)
 	}
 }
 
+/* The buckets of api_radix_sort's first pass, each sorted on its own (in tmp, vtmp) by the
+ * bits below the top digit: BUCKET_TASKS tasks of consecutive buckets, on the import's
+ * threads (api/workers.h). Bucket d: [d ? end[d - 1] : 0, end[d]). */
+enum { BUCKET_TASKS = 64 };
+struct buckets {
+	uint64_t *keys, *tmp;
+	uint32_t *vals, *vtmp;
+	const size_t *end;
+	size_t count;
+	unsigned shift;
+};
+
+static void sort_buckets(void *ctx, size_t task, unsigned w)
+{
+	(void)w;
+	const struct buckets *q = ctx;
+	uint32_t *v;
+	for (size_t d = task * q->count / BUCKET_TASKS; d < (task + 1) * q->count / BUCKET_TASKS; d++) {
+		size_t b = d ? q->end[d - 1] : 0, m = q->end[d] - b;
+		if (m <= 32) {
+			insertion(q->tmp + b, q->vals ? q->vtmp + b : NULL, m);
+			continue;
+		}
+		uint64_t *k = lsd(q->tmp + b, q->keys + b, q->vals ? q->vtmp + b : NULL, q->vals ? q->vals + b : NULL, m,
+		                  q->shift, 8, &v);
+		if (k != q->tmp + b) {
+			memcpy(q->tmp + b, k, m * sizeof *k);
+			if (q->vals) memcpy(q->vtmp + b, v, m * sizeof *v);
+		}
+	}
+}
+
 uint64_t *api_radix_sort(uint64_t *keys, uint64_t *tmp, uint32_t *vals, uint32_t *vtmp, size_t n)
 {
 	uint64_t any = 0, all = ~0ull;
@@ -85,18 +118,8 @@ uint64_t *api_radix_sort(uint64_t *keys, uint64_t *tmp, uint32_t *vals, uint32_t
 		tmp[j] = keys[i];
 		if (vals) vtmp[j] = vals[i];
 	}
-	for (size_t d = 0, b = 0; d <= mask; b = start[d++]) {
-		size_t m = start[d] - b;
-		if (m <= 32) {
-			insertion(tmp + b, vals ? vtmp + b : NULL, m);
-			continue;
-		}
-		uint64_t *k = lsd(tmp + b, keys + b, vals ? vtmp + b : NULL, vals ? vals + b : NULL, m, shift, 8, &v);
-		if (k != tmp + b) {
-			memcpy(tmp + b, k, m * sizeof *k);
-			if (vals) memcpy(vtmp + b, v, m * sizeof *v);
-		}
-	}
+	struct buckets q = {keys, tmp, vals, vtmp, start, mask + 1, shift};
+	api_workers_run(BUCKET_TASKS, sort_buckets, &q);
 	free(start);
 	return tmp;
 }

@@ -12,7 +12,10 @@
 #include "lod.h"
 #include "lod_error.h"
 #include "lod_simplify.h"
+#include "model_conv.h"
 #include "model_lod.h"
+#include "weld.h"
+#include "workers.h"
 
 #define PI_D 3.14159265358979323846
 
@@ -438,4 +441,58 @@ TEST(model_lod_level_error_walks_a_misranked_worst)
 	CHECK(fast == all, "%.9g measured, %.9g walking every triangle (the worst, dome W, estimated under dome A)", fast,
 	      all);
 	api_lod_measure_destroy(m);
+}
+
+/* The import's threads (api/workers.h) change nothing but the time: a flat-shaded sphere of
+ * 259,200 facets joined (the weld's radix sort in buckets, the groups joined), welded and
+ * simplified in pieces gives the same bytes with 1 and 3 threads; and every task runs once. */
+static void tally(void *ctx, size_t i, unsigned w)
+{
+	uint32_t *seen = ctx;
+	__atomic_fetch_add(&seen[i], 1u + (w >= api_workers_count() ? 1000u : 0u), __ATOMIC_RELAXED);
+}
+
+TEST(model_lod_threads_give_the_same_bytes)
+{
+	uint32_t *out[2] = {NULL, NULL}, *widx[2] = {NULL, NULL}, joined[2] = {0, 0};
+	size_t got[2] = {0, 0}, welded[2] = {0, 0};
+	float *wpos[2] = {NULL, NULL};
+	for (int run = 0; run < 2; run++) {
+		api_workers_start(run ? 3 : 1);
+		CHECK(api_workers_count() == (run ? 3u : 1u), "%u threads", api_workers_count());
+		static uint32_t seen[1000];
+		memset(seen, 0, sizeof seen);
+		api_workers_run(1000, tally, seen);
+		int wrong = 0;
+		for (int i = 0; i < 1000; i++) wrong += seen[i] != 1;
+		CHECK(wrong == 0, "%d of 1000 tasks not run exactly once", wrong);
+		float *pos, *nrm;
+		uint32_t *idx, nv, ni;
+		flat_sphere(360, &pos, &nrm, &idx, &nv, &ni);
+		struct api_arena *a = api_arena_create();
+		const uint32_t *group;
+		uint32_t groups;
+		REQUIRE(a);
+		joined[run] = api_join_vertices(pos, nrm, NULL, nv, idx, ni, a, &group, &groups);
+		struct api_welded w;
+		widx[run] = malloc(ni * 4ull);
+		out[run] = malloc(ni * 4ull);
+		REQUIRE(widx[run] && out[run] && api_weld_mesh(pos, joined[run], idx, ni, group, groups, widx[run], &w));
+		REQUIRE(ni / 3 >= 8 * API_LOD_PIECE_TRIANGLES);
+		welded[run] = w.count;
+		wpos[run] = w.pos;
+		w.pos = NULL;
+		got[run] = api_lod_simplify(out[run], widx[run], ni, wpos[run], w.count, 2.0f, 0.25f * api_lod_import_error(256));
+		api_welded_release(&w);
+		api_arena_destroy(a);
+		free(pos), free(nrm), free(idx);
+		api_workers_stop();
+	}
+	CHECK(joined[0] == joined[1] && welded[0] == welded[1] && welded[0] * 3 < joined[0], "joined %u / %u, welded %zu / %zu",
+	      joined[0], joined[1], welded[0], welded[1]);
+	CHECK(!memcmp(widx[0], widx[1], 6ull * 360 * 360 * 4) && !memcmp(wpos[0], wpos[1], welded[0] * 12),
+	      "the same welded mesh");
+	CHECK(got[0] == got[1] && got[0] > 0 && got[0] * 10 < 6ull * 360 * 360 && !memcmp(out[0], out[1], got[0] * 4),
+	      "the same level: %zu / %zu indices", got[0], got[1]);
+	for (int run = 0; run < 2; run++) free(out[run]), free(widx[run]), free(wpos[run]);
 }
