@@ -15,11 +15,13 @@
  * not match the size, a position that is not finite, no facet with an area), for its messages.
  */
 #include <math.h>
+#include <stdatomic.h>
 #include <string.h>
 #include "errmsg.h"
 #include "model_conv.h"
 #include "stl_import.h"
 #include "umbra/rnd_math.h"
+#include "workers.h"
 
 static bool has_colour(const uint8_t *d, uint32_t n)
 {
@@ -44,6 +46,42 @@ static void face_normal(const float a[3], const float b[3], const float c[3], fl
 	}
 }
 
+/* The facets in FACET_TASKS slices on the import's threads (api/workers.h): each slice writes
+ * only its own facets' corners, normals and indices, so the bytes do not depend on the thread
+ * count; a slice only ever sets the two flags. */
+#define FACET_TASKS 64
+
+struct facets {
+	const uint8_t *d;
+	uint32_t n;
+	float *pos, *nrm;
+	uint32_t *idx;
+	atomic_int infinite, area;
+};
+
+static void read_facets(void *ctx, size_t task, unsigned wk)
+{
+	(void)wk;
+	struct facets *q = ctx;
+	bool area = false;
+	for (uint32_t f = (uint32_t)(task * q->n / FACET_TASKS); f < (uint32_t)((task + 1) * q->n / FACET_TASKS); f++) {
+		const uint8_t *r = q->d + 84 + 50 * (size_t)f + 12;
+		float *p = q->pos + 9 * (size_t)f, *nm = q->nrm + 9 * (size_t)f;
+		memcpy(p, r, 36);
+		for (int k = 0; k < 9; k++)
+			if (!isfinite(p[k])) {
+				atomic_store(&q->infinite, 1);
+				return;
+			}
+		face_normal(p, p + 3, p + 6, nm);
+		area |= nm[0] != 0.0f || nm[1] != 0.0f || nm[2] != 0.0f;
+		memcpy(nm + 3, nm, 12);
+		memcpy(nm + 6, nm, 12);
+		for (uint32_t k = 0; k < 3; k++) q->idx[3 * f + k] = 3 * f + k;
+	}
+	if (area) atomic_store(&q->area, 1);
+}
+
 int api_stl_import_binary(const uint8_t *d, size_t len, struct api_arena *arena, struct api_model *out,
                           size_t *bytes, char *err, size_t errsize)
 {
@@ -61,20 +99,9 @@ int api_stl_import_binary(const uint8_t *d, size_t len, struct api_arena *arena,
 		api_err_set(err, errsize, "out of memory importing the model");
 		return API_WIRE_OVER_MEMORY;
 	}
-	bool area = false;
-	for (uint32_t f = 0; f < n; f++) {
-		const uint8_t *r = d + 84 + 50 * (size_t)f + 12;
-		float *p = pos + 9 * (size_t)f;
-		memcpy(p, r, 36);
-		for (int k = 0; k < 9; k++)
-			if (!isfinite(p[k])) return API_STL_NOT_MINE;
-		face_normal(p, p + 3, p + 6, nrm + 9 * (size_t)f);
-		area |= nrm[9 * (size_t)f] != 0.0f || nrm[9 * (size_t)f + 1] != 0.0f || nrm[9 * (size_t)f + 2] != 0.0f;
-		memcpy(nrm + 9 * (size_t)f + 3, nrm + 9 * (size_t)f, 12);
-		memcpy(nrm + 9 * (size_t)f + 6, nrm + 9 * (size_t)f, 12);
-		for (uint32_t k = 0; k < 3; k++) idx[3 * f + k] = 3 * f + k;
-	}
-	if (!area) return API_STL_NOT_MINE;
+	struct facets q = {d, n, pos, nrm, idx, 0, 0};
+	api_workers_run(FACET_TASKS, read_facets, &q);
+	if (atomic_load(&q.infinite) || !atomic_load(&q.area)) return API_STL_NOT_MINE;
 	rnd_material_defaults(mat);
 	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .indices = idx, .index_count = nv, .material = 0};
 	me->vertex_count = api_join_vertices(pos, nrm, NULL, nv, idx, nv, arena, &me->weld_group_, &me->weld_groups_);

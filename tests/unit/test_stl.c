@@ -13,7 +13,9 @@
 #include "model.h"
 #include "model_import.h"
 #include "models.h"
+#include "stl_import.h"
 #include "test.h"
+#include "workers.h"
 
 /* A binary STL of `n` facets (corners tri[t][0..2], normals left zero) into out. */
 static size_t stl_of(uint8_t *out, const float (*tri)[3][3], uint32_t n)
@@ -136,5 +138,47 @@ TEST(stl_binary_reader_leaves_colours_to_assimp)
 	REQUIRE(api_model_import_files(d, len, NULL, 0, API_MODEL_STL, 0, a, &m, &bytes, err, sizeof err) == API_WIRE_OK, "%s", err);
 	CHECK(m.mesh_count == 1 && m.meshes[0].colors != NULL, "the coloured facet's colours are kept");
 	api_arena_destroy(a);
+	free(d);
+}
+
+/* The reader's facets are read in slices on the import's threads (api/workers.h): 1 and 3
+ * threads give the same bytes, and a corner that is not finite in a late slice, or no facet
+ * with an area, still sends the file to Assimp. */
+TEST(stl_binary_reader_gives_the_same_bytes_on_threads)
+{
+	size_t len;
+	uint8_t *d = test_bumpy_stl(48, &len);
+	REQUIRE(d != NULL);
+	struct api_arena *a[2] = {api_arena_create(), api_arena_create()};
+	REQUIRE(a[0] && a[1]);
+	struct api_model m[2];
+	size_t bytes;
+	char err[300];
+	for (int run = 0; run < 2; run++) {
+		api_workers_start(run ? 3 : 1);
+		REQUIRE(api_stl_import_binary(d, len, a[run], &m[run], &bytes, err, sizeof err) == API_WIRE_OK, "%s", err);
+		api_workers_stop();
+	}
+	const struct api_model_mesh *f = &m[0].meshes[0], *s = &m[1].meshes[0];
+	REQUIRE(f->vertex_count == s->vertex_count && f->index_count == s->index_count && f->index_count > 3000,
+	        "%u/%u vertices, %u/%u indices", f->vertex_count, s->vertex_count, f->index_count, s->index_count);
+	CHECK(!memcmp(f->positions, s->positions, (size_t)f->vertex_count * 12) &&
+	      !memcmp(f->normals, s->normals, (size_t)f->vertex_count * 12) &&
+	      !memcmp(f->indices, s->indices, (size_t)f->index_count * 4), "the same vertices and indices");
+	uint32_t n;
+	memcpy(&n, d + 80, 4);
+	uint8_t *bad = malloc(len);
+	REQUIRE(bad != NULL);
+	memcpy(bad, d, len);
+	float inf = INFINITY, zero[9] = {0};
+	memcpy(bad + 84 + 50 * (size_t)(n - 2) + 12 + 20, &inf, 4);
+	api_workers_start(3);
+	CHECK(api_stl_import_binary(bad, len, a[0], &m[0], &bytes, err, sizeof err) == API_STL_NOT_MINE, "infinite corner");
+	for (uint32_t t = 0; t < n; t++) memcpy(bad + 84 + 50 * (size_t)t + 12, zero, 36);
+	CHECK(api_stl_import_binary(bad, len, a[0], &m[0], &bytes, err, sizeof err) == API_STL_NOT_MINE, "no area");
+	api_workers_stop();
+	free(bad);
+	api_arena_destroy(a[0]);
+	api_arena_destroy(a[1]);
 	free(d);
 }
