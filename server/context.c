@@ -198,9 +198,12 @@ uint64_t srv_rss_bytes(void)
 /* issue 28: a warm daemon under 200 MB after any mix of requests (lavapipe: ~150 MB ready) */
 #define RSS_DEFAULT_BOUND (192ull << 20)
 
-/* The main-pass variants a trim keeps (the most recently used): what a thumbnail farm's model
- * request uses (main, pixel shading, resolve, environment pass; server/warmup.c warms eight). */
-#define RSS_KEEP_VARIANTS 4u
+/* The main-pass variants a trim keeps (the most recently used): what a thumbnail farm's requests
+ * use between them (an untextured model's main and pixel shading, a textured one's main,
+ * resolve, environment pass; server/warmup.c warms eight) and one more. Four dropped one of a
+ * mixed corpus's five at every trim, and lavapipe compiled it again (0.2-0.8 s, every render
+ * waiting for the device meanwhile): three of the corpus's four compiles over HTTP. */
+#define RSS_KEEP_VARIANTS 6u
 
 /* One step of srv_context_fit_rss: what the renderer keeps, by how dear it is to make again. */
 static void rss_step(struct srv_server *s, int step)

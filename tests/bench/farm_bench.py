@@ -16,7 +16,8 @@ tests/bench/farm_corpus.py (its manifest.json lists the models). In one run, one
          one `xvfb-run -a`; per-process ms; images/s from their sum.
 
 Then prints images/s and the ratios farm/f3d and http/f3d, the medians of each Server-Timing
-stage over all models and per size class (10k / 100k / 1M), and a table of median ms per class,
+stage over all models and per size class (10k / 100k / 1M; a stage a response leaves out counts as
+0 ms there, and a line says how many named it), and a table of median ms per class,
 format and texture. Numbers only: nothing is asserted; a failed model is listed and left out of
 the rates. Images, logs and results.json stay in OUT (or $FARM_BENCH_OUT; default: a temporary
 folder, removed).
@@ -350,15 +351,28 @@ def report(models, farm, http_, f3d, out):
             names = [k for k in names if k != "total"] + ["(rest)", "total"]
         log("")
         log("Server-Timing medians, ms (c=%d; (rest) = total - the named stages), and the client's wall:" % CONC)
-        srows = []
+        srows, notes = [], []
         for cls in ("all",) + CLASSES:
             sel = [m for m in ok_http if cls == "all" or m["class"] == cls]
             if not sel:
                 continue
-            srows.append([cls, str(len(sel))] + [fmt_ms(median([v for v in (stage_value(m, k) for m in sel)
-                                                                  if v is not None])) for k in names] +
+            # A stage a response does not name took no time there (umbrad leaves out a stage of 0 ms:
+            # no compile, no import for a cached model), so it counts as 0 in the median.
+            srows.append([cls, str(len(sel))] + [fmt_ms(median([stage_value(m, k) or 0.0 for m in sel]))
+                                                 for k in names] +
                          [fmt_ms(median([m["http_ms"] for m in sel]))])
+            some = []
+            for k in names:
+                had = [v for v in (stage_value(m, k) for m in sel) if v]
+                if 0 < len(had) < len(sel):
+                    some.append("%s %d/%d (%s)" % (k, len(had), len(sel), fmt_ms(median(had))))
+            if some:
+                notes.append("%s: %s" % (cls, ", ".join(some)))
         log(table(["class", "n"] + names + ["wall"], srows))
+        if notes:
+            log("stages only some responses name (how many, their median ms); the table counts the rest as 0:")
+            for line in notes:
+                log("  " + line)
 
     log("")
     log("median ms per model by class, format and texture (farm: report.jsonl ms; http: wall at c=%d "
