@@ -14,6 +14,7 @@
  * 503 answer goes out; its worker then recreates the context (srv_context_recover) and runs
  * the warm-up again, and only then is the daemon ready again.
  */
+#include <malloc.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,10 +55,14 @@ static void job_deadline(struct srv_server *s, struct srv_request *req, const ch
 	job_problem(req, &p);
 }
 
-/* After a request this big its memory goes back to the system at once (srv_context_trim), not
- * at the idle trim: admitted by the estimate, or sent (a 1 MB scene document is ~20 MB of
- * parsed JSON; 48,000 planes in 4.5 MB left 130 MB resident). */
+/* After a request admitted this big its memory goes back to the system at once
+ * (srv_context_trim: shadow maps nobody holds, atlas pages, the heap), not at the idle trim. */
 #define BIG_REQUEST_BYTES (64ull << 20)
+/* After one that sent this much, the heap alone (a 1 MB scene document is ~20 MB of parsed JSON;
+ * a model's part, its import's buffers). Its shadow maps stay: a thumbnail farm sends a model
+ * of a few MB every request, and dropping every map after each (with the atlas pages, faulted
+ * in again by the next render) made a model sent again draw all its maps again; --max-rss and
+ * the idle trim bound what they keep. */
 #define BIG_INPUT_BYTES (1ull << 20)
 
 static uint64_t input_bytes(const struct srv_request *req)
@@ -470,8 +475,9 @@ out:
 	api_scene_free(sc);
 	srv_admit_release(&s->admit, admitted);
 	/* After an enormous request, its memory back to the system now: its freed heap, and its
-	 * shadow maps (and any other nobody holds) with the atlas pages. */
-	if (!*parked && (admitted > BIG_REQUEST_BYTES || sent >= BIG_INPUT_BYTES)) srv_context_trim(s, 0);
+	 * shadow maps (and any other nobody holds) with the atlas pages; after a big input, the heap. */
+	if (!*parked && admitted > BIG_REQUEST_BYTES) srv_context_trim(s, 0);
+	else if (!*parked && sent >= BIG_INPUT_BYTES) malloc_trim(0);
 	return lost_gen;
 }
 
