@@ -144,9 +144,10 @@ def parse_server_timing(value):
     return out
 
 
-def multipart(model, data):
-    scene = {"preset": "thumbnail", "width": SIZE, "height": SIZE,
-             "objects": [{"shape": "model", "part": "m", "format": model["format"]}]}
+def multipart(model, data, obj_extra=None):
+    obj = {"shape": "model", "part": "m", "format": model["format"]}
+    obj.update(obj_extra or {})
+    scene = {"preset": "thumbnail", "width": SIZE, "height": SIZE, "objects": [obj]}
     boundary = "umbra-farm-bench-7c1d0e5a93b2"
     while boundary.encode() in data:
         boundary += "x"
