@@ -269,6 +269,9 @@ enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, 
 /* Memory back to the system: shadow maps unused for idle_s seconds, the atlases' pages once no
  * map is left (rnd_context_trim), then malloc's free pages. Returns the atlas bytes released. */
 uint64_t srv_context_trim(struct srv_server *s, double idle_s);
+/* At start: how malloc keeps memory between requests (context.c): big buffers mapped, the rest
+ * served from heaps that keep what the next request will ask again. */
+void srv_heap_policy(void);
 /* The process's resident memory now (bytes, /proc/self/statm). */
 uint64_t srv_rss_bytes(void);
 /* After a request: when the process is over --max-rss, gives back what it keeps between
