@@ -200,6 +200,7 @@ struct srv_request {
 	const char *part_error;        /* why the multipart body is unusable, or NULL */
 	char *body;
 	size_t body_len, body_cap;
+	size_t content_length;         /* the request's Content-Length (0: none or not yet read) */
 	uint64_t body_received;        /* raw body bytes so far (multipart included) */
 	bool body_oom;                 /* a body buffer could not grow: answer 503 */
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
