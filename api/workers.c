@@ -35,8 +35,11 @@ static void drain(unsigned w)
 static void *worker(void *arg)
 {
 	unsigned w = (unsigned)(size_t)arg;
-	unsigned long seen = 0;
 	pthread_mutex_lock(&pool.mu);
+	/* The generations so far are not this thread's: a pool started again after earlier runs
+	 * (tests do) began at 0, ran a phantom generation and took one off the next run's count
+	 * of busy threads, which then returned early or waited forever. */
+	unsigned long seen = pool.gen;
 	pool.ready++;
 	pthread_cond_signal(&pool.done);
 	for (;;) {
