@@ -194,7 +194,8 @@ bench-farm: bench-deps
 	@BUILD=$(BUILD) SHARED=$(SHARED) BENCH_ONLY=farm sh tests/bench.sh
 
 # The floor (../shared/floor, read-only) builds out of tree into $(BUILD)/floor.
-bench-tools:
+# After `all` (not beside it): `make -j2 all bench-tools` ran two makes writing the playground page at once.
+bench-tools: all
 	@$(MAKE) --no-print-directory all $(BUILD)/tests/bench $(BUILD)/tests/http_bench $(BUILD)/tests/import_bench $(BUILD)/tests/import_compare \
 		$(BUILD)/tests/edge_error
 	@$(MAKE) --no-print-directory -f $(SHARED)/floor/Makefile B=$(BUILD)/floor

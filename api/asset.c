@@ -211,6 +211,7 @@ enum api_result api_asset_read_stamped(const char *root, const char *path, uint8
 	} else if (!(buf = malloc((size_t)st.st_size))) {
 		rc = api_err_set(err, errsize, "path \"%.128s\" is too large to read (out of memory)", path);
 	} else {
+		api_mem_huge(buf, (size_t)st.st_size);
 		size_t got = 0;
 		while (got < (size_t)st.st_size) {
 			ssize_t r = read(fd, buf + got, (size_t)st.st_size - got);

@@ -9,6 +9,7 @@
 #include <string.h>
 #include "lod_error.h"
 #include "weld.h"   /* api_radix_sort */
+#include "workers.h"
 #include "umbra/rnd_math.h"
 
 /* The full mesh: welded positions and their unit normals. */
@@ -331,6 +332,33 @@ static float walk_triangle(struct walk *k, const struct surface *w, const uint32
 	return most;
 }
 
+/* The cheap estimates of level_error's triangles, each its key (the estimate's bits, inverted:
+ * descending, then the triangle's index), in ESTIMATE_TASKS fixed slices on the import's threads
+ * (api/workers.h): each triangle writes its own key, whatever thread measures it. */
+enum { ESTIMATE_TASKS = 32 };
+struct estimates {
+	const struct grid *g;
+	const struct surface *w;
+	const uint32_t *idx;
+	size_t nt;
+	uint64_t *key;
+};
+
+static void estimate_slice(void *ctx, size_t i, unsigned wk)
+{
+	(void)wk;
+	const struct estimates *q = ctx;
+	for (size_t t = i * q->nt / ESTIMATE_TASKS; t < (i + 1) * q->nt / ESTIMATE_TASKS; t++) {
+		const float *v[3];
+		float s[4][3], e = 0.0f;
+		tri_samples(q->w, q->idx + 3 * t, v, s);
+		for (int k = 0; k < 4; k++) e = max_f(e, surface_distance(q->g, q->w, s[k]));
+		uint32_t bits;
+		memcpy(&bits, &e, sizeof bits);   /* e >= 0: its bits order as it does */
+		q->key[t] = (uint64_t)~bits << 32 | (uint64_t)t;
+	}
+}
+
 /* How far a level (idx: ni indices into w) is from the full mesh: the largest distance of its
  * triangles' centroids and edge midpoints (its vertices are the full mesh's own) from the full
  * mesh's faces around them (walk_triangle): exact, where the faces nearest a point are among
@@ -357,15 +385,8 @@ static float level_error(const struct grid *g, struct walk *k, const struct surf
 	size_t nt = ni / 3;
 	uint64_t *key = malloc((nt ? nt : 1) * 2 * sizeof *key);
 	if (!key) return INFINITY;   /* out of memory: no level (the full mesh is always correct) */
-	for (size_t t = 0; t < nt; t++) {
-		const float *v[3];
-		float s[4][3], e = 0.0f;
-		tri_samples(w, idx + 3 * t, v, s);
-		for (int q = 0; q < 4; q++) e = max_f(e, surface_distance(g, w, s[q]));
-		uint32_t bits;
-		memcpy(&bits, &e, sizeof bits);   /* e >= 0: its bits order as it does */
-		key[t] = (uint64_t)~bits << 32 | (uint64_t)t;
-	}
+	struct estimates q = {g, w, idx, nt, key};
+	api_workers_run(ESTIMATE_TASKS, estimate_slice, &q);
 	const uint64_t *order = api_radix_sort(key, key + nt, NULL, NULL, nt);
 	float worst2 = 0.0f;
 	for (size_t i = 0; i < nt; i++) {

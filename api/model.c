@@ -139,7 +139,7 @@ static uint8_t *src_copy(struct api_arena *arena, const uint8_t *data, size_t le
 {
 	void *p = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
 	if (p == MAP_FAILED) return NULL;
-	madvise(p, len, MADV_HUGEPAGE);   /* a hint: refused or ignored, the copy is only slower */
+	api_mem_huge(p, len);   /* a hint: refused or ignored, the copy is only slower */
 	if (api_arena_own_mapping(arena, p, len) != 0) {
 		munmap(p, len);
 		return NULL;

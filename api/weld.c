@@ -92,35 +92,97 @@ static void sort_buckets(void *ctx, size_t task, unsigned w)
 	}
 }
 
+/* api_radix_sort's passes over all the keys of a large sort, in SCATTER_TASKS fixed slices on
+ * the import's threads: which bits vary (each slice's OR and AND), each slice's histogram of the
+ * top digit, then each slice's stable scatter from its own offsets (slice s's keys of digit d
+ * go after those of slices 0..s-1): the same bytes as one scatter in order, whatever the thread
+ * count. */
+enum { SCATTER_TASKS = 16 };
+struct scatter {
+	uint64_t *keys, *tmp;
+	uint32_t *vals, *vtmp;
+	size_t n;
+	unsigned shift;
+	uint64_t mask;
+	uint64_t any[SCATTER_TASKS], all[SCATTER_TASKS];
+	size_t *at;   /* [SCATTER_TASKS][mask + 1]: counts, then each slice's next place per digit */
+};
+
+static void slice_bits(void *ctx, size_t s, unsigned w)
+{
+	(void)w;
+	struct scatter *q = ctx;
+	uint64_t any = 0, all = ~0ull;
+	for (size_t i = s * q->n / SCATTER_TASKS; i < (s + 1) * q->n / SCATTER_TASKS; i++) any |= q->keys[i], all &= q->keys[i];
+	q->any[s] = any;
+	q->all[s] = all;
+}
+
+static void slice_count(void *ctx, size_t s, unsigned w)
+{
+	(void)w;
+	struct scatter *q = ctx;
+	size_t *c = q->at + s * (q->mask + 1);
+	for (size_t i = s * q->n / SCATTER_TASKS; i < (s + 1) * q->n / SCATTER_TASKS; i++) c[(q->keys[i] >> q->shift) & q->mask]++;
+}
+
+static void slice_scatter(void *ctx, size_t s, unsigned w)
+{
+	(void)w;
+	struct scatter *q = ctx;
+	size_t *c = q->at + s * (q->mask + 1);
+	for (size_t i = s * q->n / SCATTER_TASKS; i < (s + 1) * q->n / SCATTER_TASKS; i++) {
+		size_t j = c[(q->keys[i] >> q->shift) & q->mask]++;
+		q->tmp[j] = q->keys[i];
+		if (q->vals) q->vtmp[j] = q->vals[i];
+	}
+}
+
 uint64_t *api_radix_sort(uint64_t *keys, uint64_t *tmp, uint32_t *vals, uint32_t *vtmp, size_t n)
 {
-	uint64_t any = 0, all = ~0ull;
-	for (size_t i = 0; i < n; i++) any |= keys[i], all &= keys[i];
-	unsigned bits = 0, top = 4;
-	while (bits < 64 && (any ^ all) >> bits) bits++;
-	while (top < 11 && (size_t)2048 << top < n) top++;   /* buckets of about 2048 keys */
-	uint32_t *v;
 	if (n <= 32) {   /* (a histogram of 2048 counters a digit would cost more than the keys) */
 		insertion(keys, vals, n);
 		return keys;
 	}
-	size_t *start = n >= ((size_t)1 << 16) && bits > top ? calloc(((size_t)1 << top) + 1, sizeof *start) : NULL;
-	if (!start) return lsd(keys, tmp, vals, vtmp, n, bits, n < 4096 ? 8 : 11, &v);
+	struct scatter q = {keys, tmp, vals, vtmp, n, 0, 0, {0}, {0}, NULL};
+	bool large = n >= ((size_t)1 << 16);
+	uint64_t any = 0, all = ~0ull;
+	if (large) {
+		api_workers_run(SCATTER_TASKS, slice_bits, &q);
+		for (size_t s = 0; s < SCATTER_TASKS; s++) any |= q.any[s], all &= q.all[s];
+	} else {
+		for (size_t i = 0; i < n; i++) any |= keys[i], all &= keys[i];
+	}
+	unsigned bits = 0, top = 4;
+	while (bits < 64 && (any ^ all) >> bits) bits++;
+	while (top < 11 && (size_t)2048 << top < n) top++;   /* buckets of about 2048 keys */
+	uint32_t *v;
+	size_t *end = large && bits > top ? malloc((((size_t)1 << top) + 1) * sizeof *end) : NULL;
+	q.at = end ? calloc(SCATTER_TASKS << top, sizeof *q.at) : NULL;
+	if (!q.at) {
+		free(end);
+		return lsd(keys, tmp, vals, vtmp, n, bits, n < 4096 ? 8 : 11, &v);
+	}
 	/* Many keys: one stable scatter by the top digit, then each bucket (its keys stay in the
 	 * cache) sorted by the bits below it; only the first pass runs through memory. The sorted
 	 * keys end in tmp (the values in vtmp). */
-	const unsigned shift = bits - top;
-	const uint64_t mask = ((uint64_t)1 << top) - 1;
-	for (size_t i = 0; i < n; i++) start[((keys[i] >> shift) & mask) + 1]++;
-	for (size_t d = 0; d <= mask; d++) start[d + 1] += start[d];
-	for (size_t i = 0; i < n; i++) {
-		size_t j = start[(keys[i] >> shift) & mask]++;   /* ends as the next bucket's start */
-		tmp[j] = keys[i];
-		if (vals) vtmp[j] = vals[i];
+	q.shift = bits - top;
+	q.mask = ((uint64_t)1 << top) - 1;
+	api_workers_run(SCATTER_TASKS, slice_count, &q);
+	size_t sum = 0;
+	for (size_t d = 0; d <= q.mask; d++) {
+		for (size_t s = 0; s < SCATTER_TASKS; s++) {
+			size_t k = q.at[s * (q.mask + 1) + d];
+			q.at[s * (q.mask + 1) + d] = sum;
+			sum += k;
+		}
+		end[d] = sum;
 	}
-	struct buckets q = {keys, tmp, vals, vtmp, start, mask + 1, shift};
-	api_workers_run(BUCKET_TASKS, sort_buckets, &q);
-	free(start);
+	api_workers_run(SCATTER_TASKS, slice_scatter, &q);
+	free(q.at);
+	struct buckets b = {keys, tmp, vals, vtmp, end, q.mask + 1, q.shift};
+	api_workers_run(BUCKET_TASKS, sort_buckets, &b);
+	free(end);
 	return tmp;
 }
 

@@ -205,18 +205,39 @@ uint64_t srv_rss_bytes(void)
  * waiting for the device meanwhile): three of the corpus's four compiles over HTTP. */
 #define RSS_KEEP_VARIANTS 6u
 
-/* One step of srv_context_fit_rss: what the renderer keeps, by how dear it is to make again. */
+/* The heap between requests. Buffers of 32 MiB and more (a 1M-triangle model's bytes and
+ * arrays) come straight from mmap and go back to the system when freed; smaller ones are
+ * served from the heaps, each of which keeps up to 16 MiB free at its top for the next
+ * request. It was the other way (mmap from 1 MiB, glibc's 128 KiB trim threshold): every
+ * request mapped its buffers anew and each heap gave its top back after every free, and the
+ * next request faulted them all in again, lavapipe's own allocations included. On the 2-core
+ * VM a page fault is dear: a new model's 12 environment maps drew in 90-130 ms against
+ * 35-50, and a warm thumbnail took 90-230 ms against 46-64. Not 64 MiB: malloc_trim (the
+ * first step of --max-rss below) gives back a thread arena's free chunks but not the free
+ * top of its heap, which only a free past this threshold shrinks; at 64 MiB a daemon kept
+ * ~210 MB after the farm corpus, at 16 MiB 164-171 MB (147 before). */
+#define HEAP_MMAP_THRESHOLD (32 << 20)
+#define HEAP_TRIM_THRESHOLD (16 << 20)
+
+void srv_heap_policy(void)
+{
+	mallopt(M_MMAP_THRESHOLD, HEAP_MMAP_THRESHOLD);
+	mallopt(M_TRIM_THRESHOLD, HEAP_TRIM_THRESHOLD);
+}
+
+/* One step of srv_context_fit_rss: the free heap first, then what the renderer keeps, by how
+ * dear it is to make again. Every step ends with malloc_trim (below). */
 static void rss_step(struct srv_server *s, int step)
 {
 	pthread_rwlock_rdlock(&s->ctx_lock);
-	if (s->ctx && step == 0)
-		rnd_context_trim(s->ctx, 0);                       /* maps nobody holds, atlas pages */
 	if (s->ctx && step == 1)
-		rnd_context_trim_slots(s->ctx);                    /* idle slots' targets and buffers */
+		rnd_context_trim(s->ctx, 0);                       /* maps nobody holds, atlas pages */
 	if (s->ctx && step == 2)
+		rnd_context_trim_slots(s->ctx);                    /* idle slots' targets and buffers */
+	if (s->ctx && step == 3)
 		rnd_context_trim_pipelines(s->ctx, RSS_KEEP_VARIANTS); /* JIT code: ~14 MB a variant on lavapipe */
 	pthread_rwlock_unlock(&s->ctx_lock);
-	if (step == 3) {
+	if (step == 4) {
 		/* every cached model nobody uses (an import is the dearest thing to make again) */
 		api_model_cache_set_limit(0);
 		api_model_cache_set_limit(s->cfg.model_cache_bytes);
@@ -241,7 +262,7 @@ void srv_context_fit_rss(struct srv_server *s)
 		return;
 	uint64_t before = srv_rss_bytes();
 	int step = 0;
-	for (; step < 4 && srv_rss_bytes() > s->cfg.max_rss; step++)
+	for (; step < 5 && srv_rss_bytes() > s->cfg.max_rss; step++)
 		rss_step(s, step);
 	srv_metrics_add(s->metrics, SRV_CTR_RSS_TRIM, 1);
 	uint64_t after = srv_rss_bytes();

@@ -44,7 +44,14 @@ char *farm_read_file(const char *path, size_t *len)
 	FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
 	if (!f) return NULL;
 	size_t cap = 1 << 16, n = 0;
+	/* A file's size at once (a 50 MB model was copied by every doubling), hinted for huge pages
+	 * before the read writes it (api_mem_huge); standard input grows as it comes. */
+	struct stat st;
+	if (f != stdin && fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && (uint64_t)st.st_size >= cap &&
+	    (uint64_t)st.st_size < SIZE_MAX / 2)
+		cap = (size_t)st.st_size + 1;   /* +1: the read that finds the end fits, no doubling */
 	char *buf = malloc(cap + 1);
+	if (buf) api_mem_huge(buf, cap + 1);
 	while (buf) {
 		n += fread(buf + n, 1, cap - n, f);
 		if (n < cap) break;

@@ -8,7 +8,6 @@
  * Exit codes: 0 clean, 1 start-up failure, 2 bad flags, 3 validation-layer messages seen.
  */
 #include <errno.h>
-#include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -125,10 +124,7 @@ int main(int argc, char **argv)
 	if (rc < 0)
 		return 2;
 	srv_log_init(s->cfg.log_format);
-	/* Buffers of 1 MiB and more (a model's bytes, the importer's reply, its arrays) straight
-	 * from mmap and back to the system when freed: glibc's threshold otherwise rises to each
-	 * freed size and a 50 MB model's buffers stay in the heap for good. */
-	mallopt(M_MMAP_THRESHOLD, 1 << 20);
+	srv_heap_policy();
 	api_model_cache_set_limit(s->cfg.model_cache_bytes);
 
 	sigset_t sigs;

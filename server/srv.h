@@ -200,6 +200,7 @@ struct srv_request {
 	const char *part_error;        /* why the multipart body is unusable, or NULL */
 	char *body;
 	size_t body_len, body_cap;
+	size_t content_length;         /* the request's Content-Length (0: none or not yet read) */
 	uint64_t body_received;        /* raw body bytes so far (multipart included) */
 	bool body_oom;                 /* a body buffer could not grow: answer 503 */
 	uint64_t body_discarded;       /* bytes dropped after going over --max-body */
@@ -269,6 +270,9 @@ enum rnd_result srv_render(struct srv_server *s, const struct rnd_scene *scene, 
 /* Memory back to the system: shadow maps unused for idle_s seconds, the atlases' pages once no
  * map is left (rnd_context_trim), then malloc's free pages. Returns the atlas bytes released. */
 uint64_t srv_context_trim(struct srv_server *s, double idle_s);
+/* At start: how malloc keeps memory between requests (context.c): big buffers mapped, the rest
+ * served from heaps that keep what the next request will ask again. */
+void srv_heap_policy(void);
 /* The process's resident memory now (bytes, /proc/self/statm). */
 uint64_t srv_rss_bytes(void);
 /* After a request: when the process is over --max-rss, gives back what it keeps between

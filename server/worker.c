@@ -14,6 +14,7 @@
  * 503 answer goes out; its worker then recreates the context (srv_context_recover) and runs
  * the warm-up again, and only then is the daemon ready again.
  */
+#include <malloc.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,10 +55,14 @@ static void job_deadline(struct srv_server *s, struct srv_request *req, const ch
 	job_problem(req, &p);
 }
 
-/* After a request this big its memory goes back to the system at once (srv_context_trim), not
- * at the idle trim: admitted by the estimate, or sent (a 1 MB scene document is ~20 MB of
- * parsed JSON; 48,000 planes in 4.5 MB left 130 MB resident). */
+/* After a request admitted this big its memory goes back to the system at once
+ * (srv_context_trim: shadow maps nobody holds, atlas pages, the heap), not at the idle trim. */
 #define BIG_REQUEST_BYTES (64ull << 20)
+/* After one that sent this much, the heap alone (a 1 MB scene document is ~20 MB of parsed JSON;
+ * a model's part, its import's buffers). Its shadow maps stay: a thumbnail farm sends a model
+ * of a few MB every request, and dropping every map after each (with the atlas pages, faulted
+ * in again by the next render) made a model sent again draw all its maps again; --max-rss and
+ * the idle trim bound what they keep. */
 #define BIG_INPUT_BYTES (1ull << 20)
 
 static uint64_t input_bytes(const struct srv_request *req)
@@ -344,7 +349,10 @@ static void format_timing(struct srv_request *req, const struct api_scene *sc, c
 	bool models = sc->import.imports || sc->import.ms[API_IMPORT_READ] > 0;
 	if (models)
 		for (int k = 0; k < API_IMPORT_STAGES; k++) in_models += sc->import.ms[k];
-	timing_append(h, cap, &n, "queue;dur=%.3f, parse;dur=%.3f", queue_ms,
+	/* `receive`: from the request's headers to its whole body (a 50 MB model part: ~0.2 s on
+	 * the 2-core machine, unnamed before); `total` counts from there too. */
+	double receive_ms = (req->t_queued - req->t_start) * 1000.0;
+	timing_append(h, cap, &n, "receive;dur=%.3f, queue;dur=%.3f, parse;dur=%.3f", receive_ms, queue_ms,
 	              parse_ms > in_models ? parse_ms - in_models : 0.0);
 	if (models)
 		for (int k = 0; k < API_IMPORT_STAGES; k++)
@@ -393,7 +401,7 @@ static void job_encode(struct srv_server *s, struct srv_request *req, const stru
 			return;
 		}
 	}
-	format_timing(req, sc, t, ms[0], ms[1], ms[2], encode_s * 1000.0, (t3 - req->t_queued) * 1000.0);
+	format_timing(req, sc, t, ms[0], ms[1], ms[2], encode_s * 1000.0, (t3 - req->t_start) * 1000.0);
 }
 
 /* One request from the queue: parse, admit by memory, render, encode, answer (POST
@@ -470,8 +478,9 @@ out:
 	api_scene_free(sc);
 	srv_admit_release(&s->admit, admitted);
 	/* After an enormous request, its memory back to the system now: its freed heap, and its
-	 * shadow maps (and any other nobody holds) with the atlas pages. */
-	if (!*parked && (admitted > BIG_REQUEST_BYTES || sent >= BIG_INPUT_BYTES)) srv_context_trim(s, 0);
+	 * shadow maps (and any other nobody holds) with the atlas pages; after a big input, the heap. */
+	if (!*parked && admitted > BIG_REQUEST_BYTES) srv_context_trim(s, 0);
+	else if (!*parked && sent >= BIG_INPUT_BYTES) malloc_trim(0);
 	return lost_gen;
 }
 

@@ -144,9 +144,10 @@ def parse_server_timing(value):
     return out
 
 
-def multipart(model, data):
-    scene = {"preset": "thumbnail", "width": SIZE, "height": SIZE,
-             "objects": [{"shape": "model", "part": "m", "format": model["format"]}]}
+def multipart(model, data, obj_extra=None):
+    obj = {"shape": "model", "part": "m", "format": model["format"]}
+    obj.update(obj_extra or {})
+    scene = {"preset": "thumbnail", "width": SIZE, "height": SIZE, "objects": [obj]}
     boundary = "umbra-farm-bench-7c1d0e5a93b2"
     while boundary.encode() in data:
         boundary += "x"
@@ -214,6 +215,10 @@ def run_http(build, models, out):
         ends = [r["t_end"] for r in results if r.get("t_end")]
         wall = (max(ends) if ends else time.monotonic()) - t0
         rss_after = vm_status(daemon.pid)
+        # The trim to --max-rss follows each answer: one second for the last one's (the idle
+        # trim waits --idle-trim, 30 s).
+        time.sleep(1.0)
+        rss_settled = vm_status(daemon.pid)
     finally:
         daemon.send_signal(signal.SIGTERM)
         try:
@@ -237,7 +242,8 @@ def run_http(build, models, out):
                 except ValueError:
                     version = line.strip()[:80]
                 break
-    return {"wall": wall, "rss_ready": rss_ready, "rss_after": rss_after, "exit": rc, "version": version}
+    return {"wall": wall, "rss_ready": rss_ready, "rss_after": rss_after, "rss_settled": rss_settled, "exit": rc,
+            "version": version}
 
 
 # ---- f3d -------------------------------------------------------------------------------------
@@ -342,9 +348,10 @@ def report(models, farm, http_, f3d, out):
         log("farm: the first job of each thread (%s) is left out of the table below (first use of the device)" %
             ", ".join("%s %.0f ms" % (m["file"], m["farm_ms"]) for m in first))
     if http_:
-        log("%s RSS ready %s MB (peak %s); after the run %s MB (peak VmHWM %s MB); exit %s" % (
+        log("%s RSS ready %s MB (peak %s); after the run %s MB (peak VmHWM %s MB), 1 s later %s MB; exit %s" % (
             http_.get("version") or "umbrad", http_["rss_ready"].get("VmRSS", "?"), http_["rss_ready"].get("VmHWM", "?"),
-            http_["rss_after"].get("VmRSS", "?"), http_["rss_after"].get("VmHWM", "?"), http_["exit"]))
+            http_["rss_after"].get("VmRSS", "?"), http_["rss_after"].get("VmHWM", "?"),
+            http_["rss_settled"].get("VmRSS", "?"), http_["exit"]))
 
         names = stage_names(ok_http)
         if "total" in names:

@@ -2,12 +2,14 @@
 """tests/bench/first_request.py BUILD MODEL... — what a new model costs one request at a time (issue
 28's first targets): a fresh BUILD/umbrad on a free loopback port, then per model and per round
 the file POSTed with bytes it has not seen (a first import: a binary STL's header, an OBJ's or
-PLY's comment, a glb's JSON padding changed, the model itself the same), then the same bytes once
-more (its warm render: model and shadow map cached). Prints, per model, the medians over the
+PLY's comment, a glb's JSON padding changed, the model itself the same) and the model turned by a
+different hundredth of a degree (so its shadow maps are new too: their keys hash the geometry
+and its transform, and an earlier round's would be found), then the same request once more
+(its warm render: model and shadow maps cached). Prints, per model, the medians over the
 rounds of the first request's wall time and its Server-Timing stages, the warm request's, and
 their ratio. One client, nothing else running in the daemon; numbers only, nothing asserted.
 Env: FIRST_ROUNDS (5), FIRST_SIZE (256), FIRST_UMBRAD_ARGS (extra umbrad flags)."""
-import http.client, json, os, signal, statistics, struct, subprocess, sys, tempfile, time
+import http.client, json, math, os, signal, statistics, struct, subprocess, sys, tempfile, time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import farm_bench  # noqa: E402  (its multipart, Server-Timing parser and table)
@@ -58,8 +60,14 @@ def start(build, tmp):
     raise RuntimeError("umbrad not ready")
 
 
-def post(port, model, data):
-    body, ctype = farm_bench.multipart(model, data)
+def turned(n):
+    """objects[0]'s members for round n: a turn about +Y of (n + 1) hundredths of a degree."""
+    a = math.radians(0.01 * (n + 1)) / 2
+    return {"transform": {"rotation": [0.0, math.sin(a), 0.0, math.cos(a)]}}
+
+
+def post(port, model, data, obj_extra=None):
+    body, ctype = farm_bench.multipart(model, data, obj_extra)
     t0 = time.monotonic()
     c = http.client.HTTPConnection("127.0.0.1", port, timeout=600)
     c.request("POST", "/v1/render", body=body, headers={"Content-Type": ctype})
@@ -88,8 +96,8 @@ def main():
                 first, warm = [], []
                 for n in range(ROUNDS):
                     new = fresh(data, fmt, n)
-                    first.append(post(port, model, new))
-                    warm.append(post(port, model, new))
+                    first.append(post(port, model, new, turned(n)))
+                    warm.append(post(port, model, new, turned(n)))
                 med = lambda xs: statistics.median(xs)
                 f_ms, w_ms = med([m for m, _ in first]), med([m for m, _ in warm])
                 names = [k for k in first[0][1] if k not in ("total",)]

@@ -444,8 +444,9 @@ TEST(model_lod_level_error_walks_a_misranked_worst)
 }
 
 /* The import's threads (api/workers.h) change nothing but the time: a flat-shaded sphere of
- * 259,200 facets joined (the weld's radix sort in buckets, the groups joined), welded and
- * simplified in pieces gives the same bytes with 1 and 3 threads; and every task runs once. */
+ * 259,200 facets joined (the weld's radix sort in slices and buckets, the groups joined), welded,
+ * checked closed (the edges in slices) and simplified in pieces gives the same bytes with 1 and 3
+ * threads, and its level the same measure (the estimates in slices); and every task runs once. */
 static void tally(void *ctx, size_t i, unsigned w)
 {
 	uint32_t *seen = ctx;
@@ -456,6 +457,8 @@ TEST(model_lod_threads_give_the_same_bytes)
 {
 	uint32_t *out[2] = {NULL, NULL}, *widx[2] = {NULL, NULL}, joined[2] = {0, 0};
 	size_t got[2] = {0, 0}, welded[2] = {0, 0};
+	bool closed[2] = {false, false}, flipped[2] = {true, true};
+	float measured[2] = {0.0f, 1.0f};
 	float *wpos[2] = {NULL, NULL};
 	for (int run = 0; run < 2; run++) {
 		api_workers_start(run ? 3 : 1);
@@ -483,6 +486,21 @@ TEST(model_lod_threads_give_the_same_bytes)
 		wpos[run] = w.pos;
 		w.pos = NULL;
 		got[run] = api_lod_simplify(out[run], widx[run], ni, wpos[run], w.count, 2.0f, 0.25f * api_lod_import_error(256));
+		/* the closedness check's slices: closed, and not with one face in a late slice flipped */
+		closed[run] = api_mesh_closed(widx[run], ni, wpos[run]);
+		uint32_t *f = widx[run] + ni - 300, keep = f[0];
+		f[0] = f[1], f[1] = keep;
+		flipped[run] = api_mesh_closed(widx[run], ni, wpos[run]);
+		f[1] = f[0], f[0] = keep;
+		/* the level's measure: its estimates in slices */
+		float lo[3], hi[3], ext = api_points_box(wpos[run], w.count, lo, hi), *nrm_w = malloc(w.count * 12ull);
+		REQUIRE(nrm_w);
+		for (size_t v = 0; v < w.count; v++) rnd_v3_normalize(nrm_w + 3 * v, wpos[run] + 3 * v);
+		struct api_lod_measure *m = api_lod_measure_create(wpos[run], nrm_w, w.count, widx[run], ni, lo, hi, ext);
+		REQUIRE(m);
+		measured[run] = api_lod_measure_level(m, out[run], got[run], false);
+		api_lod_measure_destroy(m);
+		free(nrm_w);
 		api_welded_release(&w);
 		api_arena_destroy(a);
 		free(pos), free(nrm), free(idx);
@@ -494,5 +512,9 @@ TEST(model_lod_threads_give_the_same_bytes)
 	      "the same welded mesh");
 	CHECK(got[0] == got[1] && got[0] > 0 && got[0] * 10 < 6ull * 360 * 360 && !memcmp(out[0], out[1], got[0] * 4),
 	      "the same level: %zu / %zu indices", got[0], got[1]);
+	CHECK(closed[0] && closed[1] && !flipped[0] && !flipped[1], "closed %d %d, one face flipped %d %d", closed[0],
+	      closed[1], flipped[0], flipped[1]);
+	CHECK(measured[0] > 0.0f && !memcmp(&measured[0], &measured[1], sizeof measured[0]), "the level measured %.9g / %.9g",
+	      measured[0], measured[1]);
 	for (int run = 0; run < 2; run++) free(out[run]), free(widx[run]), free(wpos[run]);
 }

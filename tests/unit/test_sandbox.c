@@ -407,6 +407,51 @@ TEST(sandbox_reply_identity_indices)
 	api_wire_buf_release(&other);
 }
 
+/* A reply of 900 corners: the checks run in blocks of 256 there, and an index past the vertices
+ * or a NaN deep inside a block (not in the tail) is refused as at the start. */
+static void wire_long(struct api_wire_buf *b, size_t bad_index_at, size_t nan_at)
+{
+	enum { NV = 900 };
+	static float pos[NV * 3], nrm[NV * 3];
+	static uint32_t idx[NV];
+	for (uint32_t v = 0; v < NV; v++) {
+		pos[3 * v] = (float)(v % 30);
+		pos[3 * v + 1] = (float)(v / 30);
+		pos[3 * v + 2] = (float)(v % 3);
+		nrm[3 * v] = nrm[3 * v + 1] = 0.0f;
+		nrm[3 * v + 2] = 1.0f;
+		idx[v] = v;
+	}
+	if (bad_index_at < NV) idx[bad_index_at] = NV;
+	if (nan_at < NV * 3) pos[nan_at] = NAN;
+	struct rnd_material mat;
+	rnd_material_defaults(&mat);
+	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = NV,
+	                              .index_count = NV, .material = 0};
+	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
+	                      .materials = &mat, .material_count = 1};
+	api_wire_put_header(b, API_WIRE_MODEL, API_WIRE_OK, NULL);
+	api_wire_put_model(b, &m);
+}
+
+TEST(sandbox_reply_decoder_checks_long_arrays_in_blocks)
+{
+	struct api_wire_buf b = {0};
+	struct api_model m;
+	char err[300];
+	wire_long(&b, SIZE_MAX, SIZE_MAX);
+	REQUIRE(!b.failed);
+	CHECK(decode(b.data, b.len, &m, err, sizeof err) == API_OK && m.triangles == 300, "%s", err);
+	api_wire_buf_release(&b);
+	wire_long(&b, 700, SIZE_MAX);
+	CHECK(decode(b.data, b.len, &m, err, sizeof err) == API_ERR && strstr(err, "index 700 refers to vertex 900"), "%s", err);
+	api_wire_buf_release(&b);
+	wire_long(&b, SIZE_MAX, 2000);
+	CHECK(decode(b.data, b.len, &m, err, sizeof err) == API_ERR && strstr(err, "finite"), "%s", err);
+	api_wire_buf_release(&b);
+}
+
 /* The second uv set (glTF TEXCOORD_1), in a mesh and in its level, and a slot's choice of it
  * cross the wire as they were; every truncation of such a reply is refused, and so is a uv1
  * that is not finite. */

@@ -13,6 +13,7 @@
 #include "model_conv.h"
 #include "test.h"
 #include "weld.h"
+#include "workers.h"
 
 struct old_key {
 	float pos[3];
@@ -195,9 +196,10 @@ TEST(weld_leaves_out_unnamed_vertices)
  * by their top bits first), with values and without: sorted, ties in their first order. */
 TEST(weld_radix_sort_is_stable)
 {
-	static const uint32_t sizes[4] = {20, 1000, 5000, 200000};
-	for (int z = 0; z < 4; z++) {
+	static const uint32_t sizes[5] = {20, 1000, 5000, 200000, 200000};
+	for (int z = 0; z < 5; z++) {
 		uint32_t n = sizes[z], x = 7;
+		api_workers_start(z == 4 ? 3 : 1);   /* the large sort's slices and buckets on threads too */
 		uint64_t *k = malloc(n * 8ull), *t = malloc(n * 8ull), *k2 = malloc(n * 8ull), *t2 = malloc(n * 8ull);
 		uint32_t *v = malloc(n * 4ull), *vt = malloc(n * 4ull);
 		for (uint32_t i = 0; i < n; i++) {
@@ -211,6 +213,7 @@ TEST(weld_radix_sort_is_stable)
 		for (uint32_t i = 1; i < n; i++) bad += s[i] < s[i - 1] || (s[i] == s[i - 1] && sv[i] < sv[i - 1]);
 		for (uint32_t i = 0; i < n; i++) bad += s2[i] != s[i];
 		CHECK(bad == 0, "%u keys: %d out of order", n, bad);
+		api_workers_stop();
 		free(k);
 		free(t);
 		free(k2);
