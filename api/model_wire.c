@@ -311,29 +311,40 @@ static enum api_result decode_caster(struct dec *d, uint32_t i, struct api_model
 	return API_OK;
 }
 
+/* A mesh's indices 0, 1, ..., n-1 counted out here (flag 512: each corner its own vertex, as
+ * in an STL; they are in range by construction). NULL when out of memory. */
+static uint32_t *identity_indices(struct dec *d, uint32_t n)
+{
+	uint32_t *idx = dec_alloc(d, n, 4);
+	for (uint32_t k = 0; idx && k < n; k++) idx[k] = k;
+	return idx;
+}
+
 static enum api_result decode_mesh(struct dec *d, uint32_t i, uint32_t nmat, struct api_model_mesh *me)
 {
 	uint32_t nv, ni, mat, flags;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &mat) || !take_u32(&d->r, &flags))
 		return bad(&d->r, "mesh %u is cut short", i);
-	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 511)
+	if (!nv || !ni || ni % 3 || mat >= nmat || flags > 1023 || ((flags & 512) && ni != nv))
 		return bad(&d->r, "mesh %u: %u vertices, %u indices, material %u, flags %u", i, nv, ni, mat, flags);
 	uint64_t per_vertex = 12 + (flags & 1 ? 12 : 0) + (flags & 2 ? 8 : 0) + (flags & 128 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
 	/* (per_vertex <= 60 and ni * 4 fit the reply: nothing below overflows) */
-	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4) || (uint64_t)nv * per_vertex > d->r.left - (uint64_t)ni * 4)
+	uint64_t wire_ni = flags & 512 ? 0 : ni;   /* flag 512: the indices 0..n-1, not sent */
+	if (!fits(&d->r, nv, per_vertex) || wire_ni * 4 > d->r.left ||
+	    (uint64_t)nv * per_vertex > d->r.left - wire_ni * 4)
 		return bad(&d->r, "mesh %u is cut short", i);
 	const float *pos = take_array(d, nv, 12), *nrm = flags & 1 ? take_array(d, nv, 12) : NULL;
 	const float *uv = flags & 2 ? take_array(d, nv, 8) : NULL, *uv1 = flags & 128 ? take_array(d, nv, 8) : NULL;
 	const uint8_t *col = flags & 4 ? take_array(d, nv, 4) : NULL;
 	const float *tan = flags & 8 ? take_array(d, nv, 16) : NULL;
-	const uint32_t *idx = take_array(d, ni, 4);
+	const uint32_t *idx = flags & 512 ? identity_indices(d, ni) : take_array(d, ni, 4);
 	if (!pos || ((flags & 1) && !nrm) || ((flags & 2) && !uv) || ((flags & 128) && !uv1) || ((flags & 4) && !col) || ((flags & 8) && !tan) || !idx)
 		return bad(&d->r, "out of memory");
 	if (!finite_all(pos, (size_t)nv * 3) || (nrm && !finite_all(nrm, (size_t)nv * 3)) ||
 	    (uv && !finite_all(uv, (size_t)nv * 2)) || (uv1 && !finite_all(uv1, (size_t)nv * 2)) ||
 	    (tan && !finite_all(tan, (size_t)nv * 4)))
 		return bad(&d->r, "mesh %u has a value that is not finite", i);
-	size_t k = first_out_of_range(idx, ni, nv);
+	size_t k = flags & 512 ? ni : first_out_of_range(idx, ni, nv);   /* 512: in range by construction */
 	if (k < ni) return bad(&d->r, "mesh %u: index %zu refers to vertex %u of %u", i, k, idx[k], nv);
 	*me = (struct api_model_mesh){.positions = pos, .normals = nrm, .uvs = uv, .uvs1 = uv1, .colors = col, .tangents = tan,
 	                              .indices = idx, .vertex_count = nv, .index_count = ni, .material = mat,

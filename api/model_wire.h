@@ -32,10 +32,11 @@
  *                       specular factor colour[3] ior (f32)
  *            meshes:    vertex_count index_count material flags(1 normals, 2 uvs, 4 colours,
  *                       8 tangents, 16 single-sided, 32 closed, 64 levels, 128 second uv set,
- *                       256 caster level),
+ *                       256 caster level, 512 the indices are 0..v-1: index_count = v and
+ *                       none are sent, the daemon counts them out),
  *                       positions f32[3v], normals f32[3v], uvs f32[2v], uvs1 f32[2v], colours
  *                       u8[4v], tangents f32[4v], indices
- *                       u32[i], then with flag 64 the mesh's levels as below (level_count ...),
+ *                       u32[i] (none with flag 512), then with flag 64 the mesh's levels as below (level_count ...),
  *                       then with flag 256 its caster level (api/model_caster.h): vertex_count
  *                       index_count error(f32), positions f32[3v], indices u32[i]
  *            instances: mesh (u32), model matrix f32[16] (column-major)
@@ -59,7 +60,7 @@
 #include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 8u
+#define API_WIRE_VERSION 9u
 /* Beside the RND_EXT_* bits of a material: its specular.spec_gloss. */
 #define API_WIRE_SPEC_GLOSS (1u << 16)
 #define API_WIRE_MAX_MESSAGE 1024u

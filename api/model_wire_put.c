@@ -131,6 +131,16 @@ static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh 
 	}
 }
 
+/* Whether a mesh's indices are 0, 1, ..., n-1 (each corner its own vertex, as an STL's facets
+ * are): then none cross the wire and the daemon counts them out itself (flag 512). */
+static int indices_identity(const struct api_model_mesh *me)
+{
+	if (me->index_count != me->vertex_count) return 0;
+	for (uint32_t k = 0; k < me->index_count; k++)
+		if (me->indices[k] != k) return 0;
+	return 1;
+}
+
 void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 {
 	/* Textures are shared between materials by pointer: each goes once, by its first index. */
@@ -164,19 +174,20 @@ void api_wire_put_model(struct api_wire_buf *b, const struct api_model *m)
 	for (uint32_t i = 0; i < m->material_count; i++) put_material(b, &m->materials[i], tex, ntex);
 	for (uint32_t i = 0; i < m->mesh_count; i++) {
 		const struct api_model_mesh *me = &m->meshes[i];
+		int identity = indices_identity(me);
 		put_u32(b, me->vertex_count);
 		put_u32(b, me->index_count);
 		put_u32(b, me->material);
 		put_u32(b, (me->normals ? 1u : 0u) | (me->uvs ? 2u : 0u) | (me->colors ? 4u : 0u) | (me->tangents ? 8u : 0u) |
 		           (me->single_sided ? 16u : 0u) | (me->closed ? 32u : 0u) | (me->lod_count ? 64u : 0u) |
-		           (me->uvs1 ? 128u : 0u) | (me->caster ? 256u : 0u));
+		           (me->uvs1 ? 128u : 0u) | (me->caster ? 256u : 0u) | (identity ? 512u : 0u));
 		put(b, me->positions, (size_t)me->vertex_count * 12);
 		if (me->normals) put(b, me->normals, (size_t)me->vertex_count * 12);
 		if (me->uvs) put(b, me->uvs, (size_t)me->vertex_count * 8);
 		if (me->uvs1) put(b, me->uvs1, (size_t)me->vertex_count * 8);
 		if (me->colors) put(b, me->colors, (size_t)me->vertex_count * 4);
 		if (me->tangents) put(b, me->tangents, (size_t)me->vertex_count * 16);
-		put(b, me->indices, (size_t)me->index_count * 4);
+		if (!identity) put(b, me->indices, (size_t)me->index_count * 4);
 		if (me->lod_count) put_mesh_levels(b, me);
 		if (me->caster) {
 			const struct rnd_caster_level *c = me->caster;

@@ -369,6 +369,44 @@ TEST(sandbox_reply_decoder_refuses_malformed)
 	api_wire_buf_release(&b);
 }
 
+/* Indices 0..n-1 (an STL's corners) do not cross the wire (flag 512): the daemon counts them
+ * out; a reply that claims them for a mesh whose index count is not its vertex count is refused. */
+TEST(sandbox_reply_identity_indices)
+{
+	struct api_wire_buf id = {0}, other = {0};
+	wire_model(&id, 2, 0);      /* indices 0 1 2 */
+	wire_model(&other, 0, 0);   /* indices 0 1 0 */
+	REQUIRE(!id.failed && !other.failed);
+	CHECK(id.len + 12 == other.len, "identity %zu bytes, other %zu", id.len, other.len);
+	const uint8_t *body;
+	size_t blen, bytes;
+	enum api_wire_kind k;
+	enum api_wire_status st;
+	char err[300];
+	REQUIRE(api_wire_header(id.data, id.len, &k, &st, NULL, 0, &body, &blen, err, sizeof err) == API_OK, "%s", err);
+	for (unsigned f = 0; f < 2; f++) {
+		struct api_arena *a = api_arena_create();
+		struct api_model m;
+		REQUIRE(api_wire_decode_model(body, blen, f ? API_WIRE_IN_PLACE : 0, a, 1u << 20, &m, &bytes, err,
+		                              sizeof err) == API_OK, "%s", err);
+		const uint32_t *ix = m.meshes[0].indices;
+		CHECK(m.meshes[0].index_count == 3 && ix[0] == 0 && ix[1] == 1 && ix[2] == 2);
+		api_arena_destroy(a);
+	}
+	/* The mesh's counts (3 vertices, 3 indices, material 0, flags 1|2|512): index count 6 lies. */
+	uint32_t head[4] = {3, 3, 0, 1 | 2 | 512};
+	uint8_t *at = NULL;
+	for (size_t o = 0; o + sizeof head <= id.len && !at; o += 4)
+		if (!memcmp(id.data + o, head, sizeof head)) at = id.data + o;
+	REQUIRE(at, "the mesh's counts are not on the wire");
+	uint32_t six = 6;
+	memcpy(at + 4, &six, 4);
+	struct api_model m;
+	CHECK(decode(id.data, id.len, &m, err, sizeof err) == API_ERR && strstr(err, "6 indices"), "%s", err);
+	api_wire_buf_release(&id);
+	api_wire_buf_release(&other);
+}
+
 /* A reply of 900 corners: the checks run in blocks of 256 there, and an index past the vertices
  * or a NaN deep inside a block (not in the tail) is refused as at the start. */
 static void wire_long(struct api_wire_buf *b, size_t bad_index_at, size_t nan_at)
@@ -512,7 +550,7 @@ static void mapping_of(const void *p, char *line, size_t n)
 	if (f) fclose(f);
 }
 
-/* The importer's reply comes back in a sealed memfd that the model's arrays stay in, mapped
+/* The importer's reply comes back in a sealed memfd that the model's (sent) arrays stay in, mapped
  * read-only and shared (no copy): a write through them would fault; and the mapping goes with
  * the model. */
 TEST(sandbox_reply_is_mapped_read_only)
@@ -530,8 +568,11 @@ TEST(sandbox_reply_is_mapped_read_only)
 	mapping_of(pos, line, sizeof line);
 	CHECK(strstr(line, "memfd:umbra-import-reply") != NULL, "positions in: %s", line);
 	CHECK(strstr(line, " r--s ") != NULL, "mapped read-only, shared: %s", line);
+	/* An STL's corners are each their own vertex: its indices 0..n-1 do not cross the wire
+	 * (flag 512), the daemon counts them out into its arena. */
 	mapping_of(m.meshes[0].indices, line, sizeof line);
-	CHECK(strstr(line, "memfd:umbra-import-reply") != NULL, "indices in: %s", line);
+	CHECK(!strstr(line, "memfd:umbra-import-reply"), "indices in: %s", line);
+	for (uint32_t k = 0; k < m.meshes[0].index_count; k++) CHECK(m.meshes[0].indices[k] == k, "index %u", k);
 	api_arena_destroy(a);
 	mapping_of(pos, line, sizeof line);
 	CHECK(!strstr(line, "memfd:umbra-import-reply"), "unmapped with the arena: %s", line);
