@@ -157,3 +157,96 @@ TEST(caster_level_none_for_masked_or_small_meshes)
 	api_arena_destroy(a);
 	sphere_free(&me);
 }
+
+/* Exact distance from p to triangle (a, b, c), in doubles: the nearest of the plane's foot when
+ * it falls inside, and the three edges (an independent form of what the measure computes). */
+static double seg_d(const double p[3], const double a[3], const double b[3])
+{
+	double ab[3], ap[3], l = 0, t = 0, d = 0;
+	for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ap[k] = p[k] - a[k], l += ab[k] * ab[k], t += ap[k] * ab[k];
+	t = l > 0 ? fmin(fmax(t / l, 0), 1) : 0;
+	for (int k = 0; k < 3; k++) d += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+	return sqrt(d);
+}
+
+static double tri_d(const double p[3], const double a[3], const double b[3], const double c[3])
+{
+	double u[3], v[3], w[3], n[3];
+	for (int k = 0; k < 3; k++) u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = p[k] - a[k];
+	n[0] = u[1] * v[2] - u[2] * v[1], n[1] = u[2] * v[0] - u[0] * v[2], n[2] = u[0] * v[1] - u[1] * v[0];
+	double uu = 0, uv = 0, vv = 0, wu = 0, wv = 0, nn = 0, wn = 0;
+	for (int k = 0; k < 3; k++)
+		uu += u[k] * u[k], uv += u[k] * v[k], vv += v[k] * v[k], wu += w[k] * u[k], wv += w[k] * v[k],
+		nn += n[k] * n[k], wn += w[k] * n[k];
+	double den = uu * vv - uv * uv, s = (vv * wu - uv * wv) / den, t = (uu * wv - uv * wu) / den;
+	double best = fmin(seg_d(p, a, b), fmin(seg_d(p, a, c), seg_d(p, b, c)));
+	if (den > 0 && s >= 0 && t >= 0 && s + t <= 1) best = fmin(best, fabs(wn) / sqrt(nn));
+	return best;
+}
+
+/* The measure one way, searched exhaustively: every sample of every triangle of a (its corners,
+ * and the m x m lattice of a triangle longer than spacing) against every triangle of b. */
+static double brute_way(const uint32_t *ia, size_t na, const float *pa, const uint32_t *ib, size_t nb, const float *pb,
+                        double spacing)
+{
+	double worst = 0;
+	for (size_t t = 0; t + 2 < na; t += 3) {
+		double a[3], ab[3], ac[3], longest = 0;
+		for (int k = 0; k < 3; k++) {
+			a[k] = pa[3 * ia[t] + k];
+			ab[k] = pa[3 * ia[t + 1] + k] - a[k];
+			ac[k] = pa[3 * ia[t + 2] + k] - a[k];
+		}
+		for (int e = 0; e < 3; e++) {
+			double l = 0;
+			for (int k = 0; k < 3; k++) {
+				double d = e == 0 ? ab[k] : e == 1 ? ac[k] : ac[k] - ab[k];
+				l += d * d;
+			}
+			longest = fmax(longest, sqrt(l));
+		}
+		int m = (int)fmin(fmax(ceil(longest / spacing), 1), 64), found_m = m;
+		double found = 0;
+		for (int i = 0; i <= m; i++)
+			for (int j = 0; i + j <= m; j++) {
+				double q[3], near = INFINITY;
+				for (int k = 0; k < 3; k++) q[k] = a[k] + (double)i / m * ab[k] + (double)j / m * ac[k];
+				for (size_t s = 0; s + 2 < nb; s += 3) {
+					double x[3], y[3], z[3];
+					for (int k = 0; k < 3; k++)
+						x[k] = pb[3 * ib[s] + k], y[k] = pb[3 * ib[s + 1] + k], z[k] = pb[3 * ib[s + 2] + k];
+					near = fmin(near, tri_d(q, x, y, z));
+				}
+				found = fmax(found, near);
+			}
+		worst = fmax(worst, found + longest / found_m / sqrt(3.0));
+	}
+	return worst;
+}
+
+/* A bumpy sphere against a coarse smooth one: the measure (which searches exactly only the
+ * triangles whose cheap bound could raise it) gives the exhaustive search's figure, both ways. */
+TEST(caster_error_matches_the_exhaustive_search)
+{
+	float *pf, *nf, *pc, *nc;
+	uint32_t *fi, *ci, nvf, nif, nvc, nic;
+	sphere(24, &pf, &nf, &fi, &nvf, &nif);
+	sphere(7, &pc, &nc, &ci, &nvc, &nic);
+	REQUIRE(pf && fi && pc && ci);
+	/* bumps of up to 3 % of the radius: many triangles near the worst, whose cheap bounds mislead */
+	for (uint32_t v = 0; v < nvf; v++) {
+		float s = 1.0f + 0.03f * sinf(7.0f * pf[3 * v] + 5.0f * pf[3 * v + 1]) * cosf(6.0f * pf[3 * v + 2]);
+		for (int k = 0; k < 3; k++) pf[3 * v + k] *= s;
+	}
+	const float spacing = 0.1f;
+	double want_ab = brute_way(fi, nif, pf, ci, nic, pc, spacing), want_ba = brute_way(ci, nic, pc, fi, nif, pf, spacing);
+	float e = api_caster_error(fi, nif, pf, ci, nic, pc, spacing);
+	double want = fmax(want_ab, want_ba);
+	printf("    measure %.6f, exhaustive %.6f (fine to coarse %.6f, coarse to fine %.6f)\n", (double)e, want, want_ab,
+	       want_ba);
+	CHECK(fabs(e - want) <= 1e-4 * want, "measure %g against exhaustive %g", (double)e, want);
+	/* the direction that decides the figure, alone (swapped roles give the same measure) */
+	float e2 = api_caster_error(ci, nic, pc, fi, nif, pf, spacing);
+	CHECK(fabs(e2 - want) <= 1e-4 * want, "swapped: %g against %g", (double)e2, want);
+	free(pf); free(nf); free(fi); free(pc); free(nc); free(ci);
+}
