@@ -58,7 +58,7 @@ check "ground: the shadow beside the box ($s) is darker than the background ($b)
 
 code=$(get pg /)
 # A model part over 1 MB (a cube and a long comment) sent twice: the second request reuses the
-# maps the first drew (the heap trim after a big input keeps them; it dropped every map before).
+# maps the first drew (nothing after a big input drops them; every map was dropped before).
 # 5.5 MB: past 4 MiB a part's buffer is sized to the whole body at once (render_route.c), so
 # the cube's faces, after the comment, come through that copy.
 { python3 -c 'import sys; sys.stdout.write(("# " + "x" * 1022 + "\n") * 5400)'; cat "$T/cube.obj"; } >"$T/bigcube.obj"
