@@ -51,7 +51,14 @@ void rnd_caster_view_proj(const float view_proj[16], float raise, float out[16])
 
 float rnd_caster_slope_bias(float raise, float texel)
 {
-	return texel > 0.0f ? 1.41421356f * raise / texel : 0.0f;
+	float s = texel > 0.0f ? 1.41421356f * raise / texel : 0.0f;
+	if (!(s > 0.0f)) return 0.0f;
+	/* up to the ladder's next step (caster_level.h): never less than asked */
+	float k = ceilf(RND_CASTER_BIAS_STEPS * log2f(s));
+	if (k > RND_CASTER_BIAS_RANGE) return s;   /* past the ladder: e / texel is 4 at most */
+	k = fmaxf(k, -RND_CASTER_BIAS_RANGE);
+	float q = exp2f(k / RND_CASTER_BIAS_STEPS);
+	return q >= s ? q : exp2f((k + 1.0f) / RND_CASTER_BIAS_STEPS);
 }
 
 void rnd_caster_write(const struct rnd_object *o, struct rnd_vertex *vtx, uint32_t *idx, uint32_t base)

@@ -57,7 +57,17 @@ struct draw rnd_caster_view_draw(const struct rnd_shadow_plan *sp, const struct 
 void rnd_caster_view_proj(const float view_proj[16], float raise, float out[16]);
 
 /* Slope-scaled bias to add for a raise of `raise` world units in a map of texel world size
- * `texel`. */
+ * `texel`: sqrt(2) raise / texel, rounded UP to a ladder of 2^(k / RND_CASTER_BIAS_STEPS) for
+ * |k| <= RND_CASTER_BIAS_RANGE (at most 19 % more; the lowest step, 1/256, where less is
+ * asked). Why a ladder: lavapipe (llvmpipe) JIT-compiles a triangle-setup function for every
+ * distinct depth bias it is given (Mesa 22.3 keys its setup variants by the bias floats,
+ * lp_state_setup.h, and keeps 64). A bias that followed each map's texel exactly made every
+ * environment map drawn from a caster level compile one: ~7 ms each, 12 a request (the 100k
+ * vertex-coloured corpus PLY's new maps: ~95 ms, against ~23 ms for the knot STL's 12 maps of
+ * its camera level, which keep the light's own bias). On the ladder a daemon compiles each
+ * value once, ~43 in all. */
+#define RND_CASTER_BIAS_STEPS 4.0f
+#define RND_CASTER_BIAS_RANGE 32.0f
 float rnd_caster_slope_bias(float raise, float texel);
 
 /* Writes o's caster level at vtx / idx (indices offset by base): world positions, the rest 0. */
