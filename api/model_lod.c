@@ -259,7 +259,7 @@ static void finish(struct api_model *m, uint32_t output_side, bool mark_closed, 
 		uint32_t *idx = me->index_count ? malloc((size_t)me->index_count * sizeof *idx) : NULL;
 		struct welded w = {0};
 		bool welded = welded_mesh(me, idx, &w);
-		if (mark_closed) me->closed = welded && api_mesh_closed(idx, me->index_count, w.pos);
+		if (mark_closed) me->closed = welded && api_mesh_closed(idx, me->index_count, w.pos, w.count);
 		double t1 = api_clock_ms();
 		if (welded && level) mesh_one_level(me, &w, idx, api_lod_import_error(output_side), arena, bytes);
 		/* the environment's maps' caster, at import only (its time counts as the level's) */

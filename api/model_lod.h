@@ -49,9 +49,9 @@ float api_lod_import_error(uint32_t output_side);
 /* Sets me->bounds: min xyz, max xyz of its positions (0 for a mesh without vertices). */
 void api_mesh_bounds(struct api_model_mesh *me);
 
-/* Whether triangles idx (ni indices into pos) close a volume wound outward; pure. Triangles
- * with a repeated index are left out. */
-bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos);
+/* Whether triangles idx (ni indices into pos: nv vertices) close a volume wound outward; pure.
+ * Triangles with a repeated index are left out; an index past nv: not closed. */
+bool api_mesh_closed(const uint32_t *idx, size_t ni, const float *pos, size_t nv);
 
 /* Levels of one mesh on the wire (api/model_wire.h): one per size. */
 #define API_LOD_LEVELS 1u

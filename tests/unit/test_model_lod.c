@@ -263,19 +263,28 @@ TEST(model_mesh_closed_needs_watertight_outward_winding)
 	memcpy(open, out, sizeof open);
 	memcpy(twisted, out, sizeof twisted);
 	twisted[1] = out[2]; twisted[2] = out[1]; /* one face turned around */
-	CHECK(api_mesh_closed(out, 12, pos), "outward tetrahedron");
-	CHECK(!api_mesh_closed(in, 12, pos), "inward: back faces are what shows from outside");
-	CHECK(!api_mesh_closed(open, 9, pos), "a face missing");
-	CHECK(!api_mesh_closed(twisted, 12, pos), "one face wound the other way");
+	CHECK(api_mesh_closed(out, 12, pos, 4), "outward tetrahedron");
+	CHECK(!api_mesh_closed(in, 12, pos, 4), "inward: back faces are what shows from outside");
+	CHECK(!api_mesh_closed(open, 9, pos, 4), "a face missing");
+	CHECK(!api_mesh_closed(twisted, 12, pos, 4), "one face wound the other way");
 	uint32_t doubled[24];
 	memcpy(doubled, out, sizeof out);
 	memcpy(doubled + 12, out, sizeof out);
-	CHECK(!api_mesh_closed(doubled, 24, pos), "every edge used four times");
+	CHECK(!api_mesh_closed(doubled, 24, pos, 4), "every edge used four times");
+	CHECK(!api_mesh_closed(out, 12, pos, 3), "an index past the vertices");
+	/* two tetrahedra sharing vertex 0 (a pinch): still two closed volumes, its edges sorted at
+	 * one vertex among six others */
+	static const float pos2[21] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, -1, 0, 0, 0, -1, 0, 0, 0, -1};
+	uint32_t two[24];
+	memcpy(two, out, sizeof out);
+	for (int i = 0; i < 12; i++) two[12 + i] = out[i] ? out[i] + 3 : 0;   /* mirrored: wound the other way */
+	for (int i = 12; i < 24; i += 3) { uint32_t t = two[i + 1]; two[i + 1] = two[i + 2]; two[i + 2] = t; }
+	CHECK(api_mesh_closed(two, 24, pos2, 7), "two tetrahedra pinched at a vertex");
 	/* a flat-shaded sphere (no vertex shared) is closed once welded by position */
 	float *p, *n;
 	uint32_t *idx, nv, ni;
 	flat_sphere(40, &p, &n, &idx, &nv, &ni);
-	CHECK(!api_mesh_closed(idx, ni, p), "unwelded facets share no edge");
+	CHECK(!api_mesh_closed(idx, ni, p, nv), "unwelded facets share no edge");
 	struct api_model_mesh me = {.positions = p, .normals = n, .indices = idx, .vertex_count = nv, .index_count = ni};
 	struct api_model m = {0};
 	m.meshes = &me;
@@ -487,10 +496,10 @@ TEST(model_lod_threads_give_the_same_bytes)
 		w.pos = NULL;
 		got[run] = api_lod_simplify(out[run], widx[run], ni, wpos[run], w.count, 2.0f, 0.25f * api_lod_import_error(256));
 		/* the closedness check's slices: closed, and not with one face in a late slice flipped */
-		closed[run] = api_mesh_closed(widx[run], ni, wpos[run]);
+		closed[run] = api_mesh_closed(widx[run], ni, wpos[run], w.count);
 		uint32_t *f = widx[run] + ni - 300, keep = f[0];
 		f[0] = f[1], f[1] = keep;
-		flipped[run] = api_mesh_closed(widx[run], ni, wpos[run]);
+		flipped[run] = api_mesh_closed(widx[run], ni, wpos[run], w.count);
 		f[1] = f[0], f[0] = keep;
 		/* the level's measure: its estimates in slices */
 		float lo[3], hi[3], ext = api_points_box(wpos[run], w.count, lo, hi), *nrm_w = malloc(w.count * 12ull);
