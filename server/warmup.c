@@ -58,16 +58,23 @@
 #define WARM_MODEL_HEAD \
 	"{\"preset\":\"thumbnail\",\"width\":32,\"height\":32,\"objects\":[{\"shape\":\"mesh\",\"positions\":["
 #define WARM_MODEL_TAIL "]}]}"
+/* ... and the same dome with uvs and a base colour texture (a 2x2 PNG): a textured model's
+ * material is shaded in the main pass (no pixel shading), a variant of its own that a farm's
+ * first textured glTF compiled (150-180 ms on the 2-core machine, in the farm benchmark's
+ * first textured request every run). */
+#define WARM_TEXTURE "iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAE0lEQVR42mM4UREQteAEAxADWQAungal0+71zgAAAABJRU5ErkJggg=="
+#define WARM_TEXTURED_TAIL "],\"material\":{\"base_color_texture\":\"" WARM_TEXTURE "\"}}]}"
 #define WARM_MESH_SIDE 10
 
 /* The contract's defaults first (WARM_DEFAULTS of them), then what `--warm-up all` adds. */
-static const struct { const char *name, *json; } warm_scenes[] = {
+static const struct { const char *name, *json; int mesh; } warm_scenes[] = {   /* mesh: warm_mesh's, 0 plain, 1 textured */
 	{ "msaa 4, directional pcf", WARM_SCENE(WARM_DIR, PNG4) },
 	{ "msaa 4, directional pcss", WARM_SCENE(WARM_SUN, PNG4) },
 	{ "msaa 4, cascades pcss", WARM_SCENE(WARM_CSM, PNG4) },
 	{ "msaa 4, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG4) },
 	{ "thumbnail preset, studio environment", WARM_THUMBNAIL },
-	{ "thumbnail preset, a model", NULL },   /* warm_mesh() */
+	{ "thumbnail preset, a model", NULL, 0 },
+	{ "thumbnail preset, a textured model", NULL, 1 },
 	{ "msaa 1, directional pcf", WARM_SCENE(WARM_DIR, PNG1) },
 	{ "msaa 1, directional pcss", WARM_SCENE(WARM_SUN, PNG1) },
 	{ "msaa 1, directional+spot+point pcss/pcf", WARM_SCENE(WARM_SUN "," WARM_SPOT "," WARM_POINT "," WARM_POINT_HARD, PNG1) },
@@ -75,12 +82,12 @@ static const struct { const char *name, *json; } warm_scenes[] = {
 	{ "msaa 4, vsm+evsm", WARM_SCENE(WARM_VSM "," WARM_EVSM "," WARM_EVSM_SUN "," WARM_VSM_SPOT, PNG4) },
 };
 
-#define WARM_DEFAULTS 6u
+#define WARM_DEFAULTS 7u
 #define WARM_ALL (unsigned)(sizeof warm_scenes / sizeof warm_scenes[0])
 
-static int warm_one(struct srv_server *s, size_t i, const char *mesh)
+static int warm_one(struct srv_server *s, size_t i, char *const mesh[2])
 {
-	const char *json = warm_scenes[i].json ? warm_scenes[i].json : mesh;
+	const char *json = warm_scenes[i].json ? warm_scenes[i].json : mesh ? mesh[warm_scenes[i].mesh] : NULL;
 	double t1 = srv_now();
 	struct api_scene *sc = NULL;
 	struct api_problem p = { 0 };
@@ -113,7 +120,7 @@ static int warm_one(struct srv_server *s, size_t i, const char *mesh)
 
 struct warm_state {
 	struct srv_server *srv;
-	const char *mesh;      /* warm_mesh()'s scene */
+	char *mesh[2];         /* warm_mesh()'s scenes: plain, textured */
 	atomic_uint next;
 	unsigned count;
 };
@@ -128,24 +135,29 @@ static void *warm_thread(void *arg)
 }
 
 /* A dome of WARM_MESH_SIDE^2 quads as a triangle list (WARM_MODEL_HEAD ... TAIL): the scene of
- * "thumbnail preset, a model". NULL when out of memory. */
-static char *warm_mesh(void)
+ * "thumbnail preset, a model"; textured: with uvs and WARM_TEXTURE. NULL when out of memory. */
+static char *warm_mesh(bool textured)
 {
-	size_t cap = strlen(WARM_MODEL_HEAD WARM_MODEL_TAIL) + (size_t)WARM_MESH_SIDE * WARM_MESH_SIDE * 6 * 3 * 12 + 1;
+	size_t cap = strlen(WARM_MODEL_HEAD WARM_TEXTURED_TAIL ",\"uvs\":[") +
+	             (size_t)WARM_MESH_SIDE * WARM_MESH_SIDE * 6 * 5 * 12 + 1;
 	char *json = malloc(cap);
 	if (!json) return NULL;
 	size_t n = (size_t)snprintf(json, cap, "%s", WARM_MODEL_HEAD);
 	static const int corner[6][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
-	for (int y = 0; y < WARM_MESH_SIDE; y++)
-		for (int x = 0; x < WARM_MESH_SIDE; x++)
-			for (int k = 0; k < 6; k++) {
-				double u = (double)(x + corner[k][0]) / WARM_MESH_SIDE * 2 - 1;
-				double v = (double)(y + corner[k][1]) / WARM_MESH_SIDE * 2 - 1;
-				double h = 1 - 0.5 * (u * u + v * v);
-				n += (size_t)snprintf(json + n, cap - n, "%s%.2f,%.2f,%.2f", n > strlen(WARM_MODEL_HEAD) ? "," : "", u,
-				                      h, v);
-			}
-	snprintf(json + n, cap - n, "%s", WARM_MODEL_TAIL);
+	for (int pass = 0; pass < (textured ? 2 : 1); pass++) {
+		if (pass) n += (size_t)snprintf(json + n, cap - n, "],\"uvs\":[");
+		size_t first = n;
+		for (int y = 0; y < WARM_MESH_SIDE; y++)
+			for (int x = 0; x < WARM_MESH_SIDE; x++)
+				for (int k = 0; k < 6; k++) {
+					double s = (double)(x + corner[k][0]) / WARM_MESH_SIDE, t = (double)(y + corner[k][1]) / WARM_MESH_SIDE;
+					double u = s * 2 - 1, v = t * 2 - 1, h = 1 - 0.5 * (u * u + v * v);
+					const char *sep = n > first ? "," : "";
+					n += pass ? (size_t)snprintf(json + n, cap - n, "%s%.2f,%.2f", sep, s, t)
+					          : (size_t)snprintf(json + n, cap - n, "%s%.2f,%.2f,%.2f", sep, u, h, v);
+				}
+	}
+	snprintf(json + n, cap - n, "%s", textured ? WARM_TEXTURED_TAIL : WARM_MODEL_TAIL);
 	return json;
 }
 
@@ -159,8 +171,7 @@ int srv_warmup(struct srv_server *s)
 	}
 	/* The rest on as many threads as there are render slots: pipeline compilation (LLVM in
 	 * lavapipe) is single-threaded per pipeline. */
-	char *mesh = warm_mesh();
-	struct warm_state w = { .srv = s, .mesh = mesh, .count = s->cfg.warm_up && !strcmp(s->cfg.warm_up, "all") ? WARM_ALL : WARM_DEFAULTS };
+	struct warm_state w = { .srv = s, .mesh = { warm_mesh(false), warm_mesh(true) }, .count = s->cfg.warm_up && !strcmp(s->cfg.warm_up, "all") ? WARM_ALL : WARM_DEFAULTS };
 	atomic_init(&w.next, 1);
 	pthread_t th[16];
 	unsigned n = s->cfg.workers < 16 ? s->cfg.workers : 16, started = 0;
@@ -170,7 +181,8 @@ int srv_warmup(struct srv_server *s)
 	warm_thread(&w);
 	for (unsigned i = 0; i < started; i++)
 		pthread_join(th[i], NULL);
-	free(mesh);
+	free(w.mesh[0]);
+	free(w.mesh[1]);
 	/* Pipeline compilation leaves tens of MB free in malloc's arenas: give them back. */
 	malloc_trim(0);
 	srv_log(SRV_LOG_INFO, "warm-up done in %.0f ms", (srv_now() - t0) * 1000);
