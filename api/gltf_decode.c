@@ -241,3 +241,15 @@ bool api_gltf_drop_skins(json_t *root)
 	}
 	return changed;
 }
+
+bool api_gltf_all_indexed(json_t *root)
+{
+	json_t *m, *p;
+	size_t i, j;
+	json_array_foreach(json_object_get(root, "meshes"), i, m) {
+		json_array_foreach(json_object_get(m, "primitives"), j, p) {
+			if (!json_is_integer(json_object_get(p, "indices"))) return false;
+		}
+	}
+	return true;
+}

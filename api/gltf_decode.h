@@ -43,5 +43,10 @@ void api_gltf_drop_fallbacks(json_t *root);
  * ("elemSize 16 > targetElemSize 8": CesiumMan, Fox, BrainStem, RiggedFigure). Returns
  * whether it changed root. */
 bool api_gltf_drop_skins(json_t *root);
+/* Whether every primitive of every mesh has indices (after api_gltf_decode: a Draco
+ * primitive's decoded accessor is in its "indices"): its vertices are then the exporter's
+ * own, one per distinct set of attributes, and Assimp's join of identical vertices has
+ * nothing to join (api/model_import.c leaves it out). */
+bool api_gltf_all_indexed(json_t *root);
 
 #endif

@@ -414,8 +414,9 @@ static enum api_wire_status import_error(enum api_model_format format, char *err
 	return msg && strstr(msg, "bad_alloc") ? API_WIRE_OVER_MEMORY : API_WIRE_BAD_INPUT;
 }
 
-/* Assimp's post-processing for a file of this format. */
-static unsigned import_flags(enum api_model_format format, bool face_colors)
+/* Assimp's post-processing for a file of this format (indexed: a glTF whose primitives all
+ * have indices, api_gltf_all_indexed). */
+static unsigned import_flags(enum api_model_format format, bool face_colors, bool indexed)
 {
 	unsigned flags = aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
 	                 aiProcess_SortByPType | aiProcess_ValidateDataStructure;
@@ -432,6 +433,11 @@ static unsigned import_flags(enum api_model_format format, bool face_colors)
 	if (face_colors) flags &= ~(unsigned)aiProcess_JoinIdenticalVertices;
 	/* Normal maps need tangents: the file's, or made from the uvs where it has none. */
 	if (format == API_MODEL_GLB || format == API_MODEL_GLTF) flags |= aiProcess_CalcTangentSpace;
+	/* An indexed glTF's vertices are already one per distinct set of attributes: Assimp's join
+	 * (a spatial sort of every vertex) found nothing to join in the farm corpus's glbs and was
+	 * most of their import (the 100k knot's parse 39-57 -> 15-16 ms, the 1M torus's 540-634 ->
+	 * 195-230). A primitive without indices (every corner its own vertex) keeps it. */
+	if (indexed) flags &= ~(unsigned)aiProcess_JoinIdenticalVertices;
 	return flags;
 }
 
@@ -466,7 +472,7 @@ static int prepare_gltf(json_t *root, const uint8_t *data, size_t len, bool glb,
  * own file and those it names), or NULL with *st and err saying why. The caller releases the
  * scene (aiReleaseImport, under import_mu). */
 static const struct aiScene *assimp_read(const uint8_t *data, size_t len, const struct api_model_file *io_files,
-                                         size_t io_nfiles, enum api_model_format format, bool face_colors,
+                                         size_t io_nfiles, enum api_model_format format, bool face_colors, bool indexed,
                                          enum api_wire_status *st, char *err, size_t errsize)
 {
 	struct api_mem_io mi = {.data = data, .len = len, .files = io_files, .nfiles = io_nfiles};
@@ -477,7 +483,7 @@ static const struct aiScene *assimp_read(const uint8_t *data, size_t len, const 
 	/* SortByPType puts points and lines in meshes of their own: drawn as thin geometry (convert). */
 	aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_NO_SKELETON_MESHES, 1);
 	pthread_mutex_lock(&import_mu);   /* Assimp's error string is global: read under the lock */
-	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, import_flags(format, face_colors), &io, props);
+	const struct aiScene *sc = aiImportFileExWithProperties(mi.name, import_flags(format, face_colors, indexed), &io, props);
 	if (!sc) *st = import_error(format, err, errsize);
 	pthread_mutex_unlock(&import_mu);
 	aiReleasePropertyStore(props);
@@ -500,6 +506,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	struct api_conv c = {.arena = arena, .out = out, .err = err, .errsize = errsize, .gltf = gltf,
 	                     .join = format == API_MODEL_STL, .texture_side = api_texture_class(output_side)};
 	uint8_t *tagged = NULL;
+	bool indexed = false;
 	struct api_gltf_bufs bufs;
 	memset(&bufs, 0, sizeof bufs);
 	const struct api_model_file *io_files = files;
@@ -508,6 +515,7 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 		size_t tagged_len = 0;
 		int rc = prepare_gltf(root, data, len, format == API_MODEL_GLB, files, nfiles, &c, &bufs, &tagged, &tagged_len,
 		                      &io_files, &io_nfiles, err, errsize);
+		indexed = rc == 0 && api_gltf_all_indexed(root);
 		json_decref(root);
 		if (rc != 0) {
 			bool oom = bufs.oom;   /* a decode over the memory limit, not a bad file */
@@ -534,7 +542,8 @@ enum api_wire_status api_model_import_assimp(const uint8_t *data, size_t len, co
 	 * out): convert_mesh joins them by position, normal and colour. */
 	if (face_colors) c.join = true;
 	enum api_wire_status st = API_WIRE_OK;
-	const struct aiScene *sc = assimp_read(data, len, io_files, io_nfiles, format, face_colors, &st, err, errsize);
+	const struct aiScene *sc = assimp_read(data, len, io_files, io_nfiles, format, face_colors, indexed, &st, err,
+	                                       errsize);
 	free(strips);   /* Assimp copied what it needed */
 	free(tagged);
 	api_gltf_bufs_release(&bufs);

@@ -13,7 +13,9 @@
 #include <sys/stat.h>
 #include "api.h"
 #include "asset.h"
+#include "arena.h"
 #include "model.h"
+#include "model_import.h"
 #include "models.h"
 #include "ply_colors.h"
 #include "test.h"
@@ -320,4 +322,53 @@ TEST(model_points_and_lines_drawn_as_thin_geometry)
 	/* the octahedron at (4, 3, 0) reaches 0.025 past it; the prism along x = 4 reaches 0.01 */
 	CHECK(fabsf(b.max[0] - 4.025f) < 1e-3f && fabsf(b.max[1] - 3.025f) < 1e-3f, "box max %.4f %.4f", b.max[0], b.max[1]);
 	api_scene_free(s);
+}
+
+/* A glb of one quad as two triangles with six vertices, the shared corners written twice with
+ * the same attributes; indexed (0..5) or not. Its vertex count once imported. */
+static uint32_t quad_six_vertices(bool indexed)
+{
+	static const float pos[18] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, 1, 1, 0, -1, 1, 0};
+	static const float nrm[18] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+	static const uint32_t idx[6] = {0, 1, 2, 3, 4, 5};
+	uint8_t bin[168];
+	memcpy(bin, pos, 72);
+	memcpy(bin + 72, nrm, 72);
+	memcpy(bin + 144, idx, 24);
+	char json[1024];
+	int jn = snprintf(json, sizeof json,
+		"{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1}%s}]}],"
+		"\"buffers\":[{\"byteLength\":168}],"
+		"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":72},"
+		"{\"buffer\":0,\"byteOffset\":144,\"byteLength\":24}],"
+		"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\",\"min\":[-1,-1,0],"
+		"\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"},"
+		"{\"bufferView\":2,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}]}",
+		indexed ? ",\"indices\":2" : "");
+	size_t len;
+	uint8_t *glb = test_glb_pack(json, (size_t)jn, bin, sizeof bin, sizeof bin, &len);
+	struct api_arena *a = api_arena_create();
+	struct api_model m;
+	size_t bytes;
+	char err[256] = "";
+	uint32_t nv = 0;
+	if (glb && a && api_model_import_local(glb, len, API_MODEL_GLB, a, &m, &bytes, err, sizeof err) == API_WIRE_OK &&
+	    m.mesh_count == 1 && m.meshes[0].index_count == 6)
+		nv = m.meshes[0].vertex_count;
+	else
+		printf("    import: %s\n", err);
+	api_arena_destroy(a);
+	free(glb);
+	return nv;
+}
+
+/* Assimp's join of identical vertices runs only for a glTF with a primitive without indices
+ * (each corner its own vertex): an indexed one's vertices are the exporter's, kept as they
+ * are (the join's spatial sort was most of a glb's import). */
+TEST(gltf_vertices_joined_only_where_a_primitive_has_no_indices)
+{
+	uint32_t plain = quad_six_vertices(false), indexed = quad_six_vertices(true);
+	CHECK(plain == 4, "no indices: the six corners joined into 4 vertices, got %u", plain);
+	CHECK(indexed == 6, "indexed: its 6 vertices kept as written, got %u", indexed);
 }
