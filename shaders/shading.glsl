@@ -274,7 +274,7 @@ float pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref, flo
 	float radius = clamp(penumbra_texels(v, size, vec4(zb), zr, texel).x, 1.0, L.shadow_params.y);
 	float sum = 0.0;
 	for (int i = 0; i < taps; i++) {
-		vec2 off = poisson(i) * radius;
+		vec2 off = (poisson(i) - frame.filter_taps.xy) * (radius * frame.filter_taps.z);   // a uniform disk's spread (frame.c)
 		sum += bilinear_compare(p + off, rect, ref + dot(grad, off), res);
 	}
 	return known == 2 ? 0.0 : taps == 0 ? 1.0 : sum / 32.0;

@@ -240,6 +240,8 @@ struct umbra_frame {
 	U_VEC4 target;           /* x, y view size in pixels; z world size of a pixel at view depth 1
 	                            (perspective) or everywhere (orthographic); w 1 = orthographic */
 	U_VEC4 poisson[16];      /* 32 Poisson-disk taps in the unit disk, two per vec4 */
+	U_VEC4 filter_taps;      /* PCSS's filter reads tap i as (poisson[i] - xy) * z: centred, with a
+	                            uniform disk's mean squared radius (renderer/frame.c); w unused */
 };
 
 struct umbra_material {

@@ -298,3 +298,26 @@ TEST(plan_poisson_wide_taps_ascend)
 	}
 	CHECK(longest == worst && longest > 1.0f, "longest tap %g, table's %g", longest, worst);
 }
+
+/* PCSS filters with the taps as (tap - centre) * scale (umbra_frame.filter_taps): they stand for a
+ * uniform disk of the penumbra's half-width, so they must average at its centre and have its
+ * mean squared radius, 1/2, and stay within the longest tap (the reach pcss_bounds and the
+ * views' margins allow). The table as it is averages at (-0.061, -0.030) with mean squared
+ * radius 0.663: every penumbra 15 % too wide and off centre (issue 31). */
+TEST(plan_pcss_filter_taps_are_a_uniform_disk)
+{
+	float longest = 0, ft[3] = {0, 0, 0};
+	const float *t = rnd_frame_poisson(&longest);
+	rnd_frame_filter_taps(ft);
+	double mx = 0, my = 0, r2 = 0, far = 0;
+	for (int i = 0; i < 32; i++) {
+		double x = (t[2 * i] - ft[0]) * ft[2], y = (t[2 * i + 1] - ft[1]) * ft[2];
+		mx += x / 32;
+		my += y / 32;
+		r2 += (x * x + y * y) / 32;
+		if (sqrt(x * x + y * y) > far) far = sqrt(x * x + y * y);
+	}
+	CHECK(fabs(mx) < 1e-5 && fabs(my) < 1e-5, "filter taps average at (%g, %g), not the centre", mx, my);
+	CHECK(fabs(r2 - 0.5) < 1e-4, "filter taps' mean squared radius %g, a uniform disk's is 0.5", r2);
+	CHECK(far <= longest, "a filter tap reaches %g, beyond the longest tap %g", far, (double)longest);
+}
