@@ -49,17 +49,21 @@ const float *rnd_frame_poisson(float *longest)
  * depth PCSS knows exactly, umbra's 10-90 % widths were 12.2-13.6 px where the traced reference
  * and Cycles (which agree within 0.5 %) have 11.6-11.7, and its edges stood 0.6 px off. The
  * filter reads the taps centred and scaled by 0.872 (the longest then 1.046, within
- * params.w's reach); the search keeps the table as it is. */
-void rnd_frame_filter_taps(float out[3])
+ * params.w's reach); the search keeps the table as it is. The environment's filter (ibl.glsl
+ * env_pcss) reads the 16 odd taps the same way, with their own centre and scale. */
+void rnd_frame_filter_taps(float out[3], int first, int step)
 {
 	double mx = 0.0, my = 0.0, r2 = 0.0;
-	for (int i = 0; i < 32; i++) {
-		mx += POISSON[2 * i] / 32.0;
-		my += POISSON[2 * i + 1] / 32.0;
+	int n = 0;
+	for (int i = first; i < 32; i += step, n++) {
+		mx += POISSON[2 * i];
+		my += POISSON[2 * i + 1];
 	}
-	for (int i = 0; i < 32; i++) {
+	mx /= n;
+	my /= n;
+	for (int i = first; i < 32; i += step) {
 		double x = POISSON[2 * i] - mx, y = POISSON[2 * i + 1] - my;
-		r2 += (x * x + y * y) / 32.0;
+		r2 += (x * x + y * y) / n;
 	}
 	out[0] = (float)mx;
 	out[1] = (float)my;
@@ -120,7 +124,8 @@ static void write_frame(struct umbra_frame *f, const struct rnd_scene *sc, const
 	const char *cull = getenv("UMBRA_LIGHT_CULL");
 	f->mode2[2] = cull && strcmp(cull, "0") == 0 ? 1u : 0u;
 	memcpy(f->poisson, rnd_frame_poisson(&f->params[3]), sizeof f->poisson);
-	rnd_frame_filter_taps(f->filter_taps);
+	rnd_frame_filter_taps(f->filter_taps, 0, 1);
+	rnd_frame_filter_taps(f->env_filter_taps, 1, 2);   /* env_pcss's 16 odd taps (ibl.glsl) */
 	f->depth_lin[0] = cam->proj[10];
 	f->depth_lin[1] = cam->proj[14];
 	f->depth_lin[2] = cam->proj[11];

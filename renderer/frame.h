@@ -30,8 +30,9 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
  * longest tap's length (umbra_frame.params.w). Tests check the order the search relies on. */
 const float *rnd_frame_poisson(float *longest);
 
-/* How PCSS's filter reads those taps, (tap - centre) * scale: out[0], out[1] the taps' mean,
- * out[2] the scale that gives them a uniform disk's mean squared radius, 1/2 (umbra_frame.filter_taps). */
-void rnd_frame_filter_taps(float out[3]);
+/* How PCSS's filter reads those taps, (tap - centre) * scale: out[0], out[1] the mean of taps
+ * first, first + step, ..., out[2] the scale that gives them a uniform disk's mean squared
+ * radius, 1/2 (umbra_frame.filter_taps: all 32; env_filter_taps: the 16 odd ones). */
+void rnd_frame_filter_taps(float out[3], int first, int step);
 
 #endif

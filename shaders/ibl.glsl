@@ -77,7 +77,8 @@ float env_pcss(umbra_light L, umbra_shadow_view v, vec2 p, vec4 rect, float ref,
 	                     L.shadow_params.y);
 	float sum = 0.0;
 	for (int i = 0; i < taps; i++) {
-		vec2 off = poisson(2 * i + 1) * radius;   // the odd taps, spread over the disk
+		// the odd taps, spread over the disk: centred and scaled to a uniform disk's spread (frame.c)
+		vec2 off = (poisson(2 * i + 1) - frame.env_filter_taps.xy) * (radius * frame.env_filter_taps.z);
 		sum += bilinear_compare(p + off, rect, ref + dot(grad, off), res);
 	}
 	return known == 2 ? 0.0 : taps == 0 ? 1.0 : sum / 16.0;

@@ -242,6 +242,7 @@ struct umbra_frame {
 	U_VEC4 poisson[16];      /* 32 Poisson-disk taps in the unit disk, two per vec4 */
 	U_VEC4 filter_taps;      /* PCSS's filter reads tap i as (poisson[i] - xy) * z: centred, with a
 	                            uniform disk's mean squared radius (renderer/frame.c); w unused */
+	U_VEC4 env_filter_taps;  /* the same for the environment's filter, of the 16 odd taps (ibl.glsl) */
 };
 
 struct umbra_material {
