@@ -4,10 +4,14 @@
  * random colours (no level could show them) gets none, and a level drawn for a coloured object
  * brings its own colours. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "test.h"
+#include "api.h"
 #include "arena.h"
+#include "model.h"
+#include "model_levels.h"
 #include "lod.h"
 #include "lod_colour.h"
 #include "model_lod.h"
@@ -187,4 +191,86 @@ TEST(lod_apply_draws_a_level_with_its_colours)
 	struct rnd_object u = {.shape = RND_SHAPE_MESH, .lods = &with, .lod_count = 1};
 	rnd_lod_apply(&u, 1);
 	CHECK(u.colors == NULL && u.index_count == 3, "an uncoloured object stays uncoloured");
+}
+
+/* me as a binary PLY (positions, uchar RGB, triangles); malloc'd, *len its size. */
+static uint8_t *ply_of(const struct api_model_mesh *me, size_t *len)
+{
+	char head[400];
+	int h = snprintf(head, sizeof head,
+	                 "ply\nformat binary_little_endian 1.0\nelement vertex %u\nproperty float x\nproperty float y\n"
+	                 "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face %u\n"
+	                 "property list uchar int vertex_indices\nend_header\n",
+	                 me->vertex_count, me->index_count / 3);
+	*len = (size_t)h + (size_t)me->vertex_count * 15 + (size_t)me->index_count / 3 * 13;
+	uint8_t *d = malloc(*len), *p = d;
+	if (!d) return NULL;
+	memcpy(p, head, (size_t)h);
+	p += h;
+	for (uint32_t v = 0; v < me->vertex_count; v++, p += 15) {
+		memcpy(p, me->positions + 3 * v, 12);
+		memcpy(p + 12, me->colors + 4 * v, 3);
+	}
+	for (uint32_t t = 0; t < me->index_count; t += 3, p += 13) {
+		p[0] = 3;
+		memcpy(p + 1, me->indices + t, 12);
+	}
+	return d;
+}
+
+static struct api_model *get_ply(const uint8_t *d, size_t len, uint32_t side)
+{
+	struct api_limits l;
+	api_limits_defaults(&l);
+	l.output_side = side;
+	struct api_model *m = NULL;
+	char err[300];
+	int st;
+	if (api_model_get(d, len, API_MODEL_PLY, &l, &m, &st, err, sizeof err) != API_OK) printf("    %s\n", err);
+	return m;
+}
+
+/* Through the sandbox: a banded PLY imported for 256^2 images has its coloured level, and
+ * drawn from the cache at 128^2 gets that size's level built by the levels job, with colours,
+ * the same level (colours too) as a fresh import for 128^2 builds. */
+TEST(model_lod_coloured_level_for_another_size_equals_a_fresh_imports)
+{
+	struct api_model_mesh me = coloured_sphere(120, bands);   /* 57,600 triangles */
+	size_t len;
+	uint8_t *d = ply_of(&me, &len);
+	REQUIRE(d != NULL);
+	api_model_cache_clear();
+	struct api_model *a = get_ply(d, len, 256), *b = get_ply(d, len, 128);
+	REQUIRE(a && b == a);
+	uint32_t n256, n128, nf;
+	const struct rnd_mesh_lod *l256 = api_model_mesh_lods(a, 0, 256, &n256), *l128 = api_model_mesh_lods(a, 0, 128, &n128);
+	REQUIRE(n256 == 1 && n128 == 1, "%u and %u levels", n256, n128);
+	CHECK(a->meshes[0].colors && l256->colors && l128->colors, "the levels carry colours");
+	CHECK(l128->index_count < l256->index_count, "128^2: %u indices; 256^2: %u", l128->index_count, l256->index_count);
+	/* the levels job's level, kept past the model's release */
+	uint32_t nv = l128->vertex_count, ni = l128->index_count;
+	float *pos = malloc((size_t)nv * 12);
+	uint32_t *idx = malloc((size_t)ni * 4);
+	uint8_t *col = malloc((size_t)nv * 4);
+	REQUIRE(pos && idx && col);
+	memcpy(pos, l128->positions, (size_t)nv * 12);
+	memcpy(idx, l128->indices, (size_t)ni * 4);
+	memcpy(col, l128->colors ? l128->colors : col, (size_t)nv * 4);
+	api_model_release(a);
+	api_model_release(b);
+	api_model_cache_clear();
+	struct api_model *fresh = get_ply(d, len, 128);
+	REQUIRE(fresh != NULL);
+	const struct rnd_mesh_lod *lf = api_model_mesh_lods(fresh, 0, 128, &nf);
+	REQUIRE(nf == 1);
+	CHECK(lf->vertex_count == nv && lf->index_count == ni && !memcmp(lf->positions, pos, (size_t)nv * 12) &&
+	      !memcmp(lf->indices, idx, (size_t)ni * 4) && lf->colors && !memcmp(lf->colors, col, (size_t)nv * 4),
+	      "the fresh import's level is the levels job's");
+	api_model_release(fresh);
+	api_model_cache_clear();
+	free(pos);
+	free(idx);
+	free(col);
+	free(d);
+	free_sphere(&me);
 }
