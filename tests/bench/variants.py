@@ -94,7 +94,7 @@ d["width"], d["height"] = 256, 256
 save("studio-single256.json", d)
 
 # A new model's thumbnail (issue 28): a bumpy closed sphere of ~100k triangles with a colour
-# per vertex as a binary PLY (vertex-coloured meshes get no level of detail: drawn in full),
+# per vertex as a binary PLY (its smooth colours measure over the level's colour bound: drawn in full),
 # and a 10k one, under the thumbnail preset at 256². build/tests/bench -s draws the sun map
 # every run, as for a model never seen before.
 def bumpy_ply(tris):

@@ -513,6 +513,55 @@ TEST(sandbox_reply_second_uv_set_round_trip)
 	}
 }
 
+/* A level's vertex colours cross the wire as they were, and a level with colours for a mesh
+ * without them is refused (its colours could never be drawn: renderer/lod.c). */
+TEST(sandbox_reply_level_colours_round_trip)
+{
+	float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+	uint8_t col[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 9, 9, 9, 255};
+	uint8_t lv_col[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	struct rnd_mesh_lod level = {pos, nrm, NULL, idx, 3, 3, 0.5f, NULL, lv_col};
+	struct rnd_material mat;
+	rnd_material_defaults(&mat);
+	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .colors = col, .indices = idx, .vertex_count = 4,
+	                              .index_count = 6, .material = 0, .lods = &level, .lod_count = 1};
+	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
+	                      .materials = &mat, .material_count = 1};
+	for (int bare = 0; bare < 2; bare++) {
+		mesh.colors = bare ? NULL : col;
+		struct api_wire_buf b = {0};
+		api_wire_put_header(&b, API_WIRE_MODEL, API_WIRE_OK, NULL);
+		api_wire_put_model(&b, &m);
+		REQUIRE(!b.failed);
+		enum api_wire_kind k;
+		enum api_wire_status st;
+		const uint8_t *body;
+		size_t blen, bytes;
+		char err[300];
+		REQUIRE(api_wire_header(b.data, b.len, &k, &st, NULL, 0, &body, &blen, err, sizeof err) == API_OK, "%s", err);
+		struct api_arena *a = api_arena_create();
+		struct api_model out;
+		enum api_result rc = api_wire_decode_model(body, blen, 0, a, 1u << 20, &out, &bytes, err, sizeof err);
+		if (bare) {
+			CHECK(rc == API_ERR && strstr(err, "level 0"), "colours for a mesh without: %d %s", rc, err);
+		} else {
+			REQUIRE(rc == API_OK, "%s", err);
+			CHECK(out.meshes[0].lod_count == 1 && out.meshes[0].lods[0].colors &&
+			      !memcmp(out.meshes[0].lods[0].colors, lv_col, sizeof lv_col), "the level's colours changed on the wire");
+			int accepted = 0;
+			for (size_t cut = 0; cut < b.len; cut++) {
+				struct api_model part;
+				accepted += decode(b.data, cut, &part, err, sizeof err) == API_OK;
+			}
+			CHECK(accepted == 0, "%d truncations accepted", accepted);
+		}
+		api_arena_destroy(a);
+		api_wire_buf_release(&b);
+	}
+}
+
 /* A binary STL whose stored facet normal opposes its winding (common from some exporters):
  * the normal follows the winding (counter-clockwise seen from the front, as glTF and the
  * renderer's culling assume), so the model is not shaded from behind. */
