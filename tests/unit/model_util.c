@@ -65,3 +65,17 @@ uint8_t *quad_glb(size_t *len)
 {
 	return quad_glb_ex("", "", len);
 }
+
+struct api_model *model_get_for(const uint8_t *d, size_t len, enum api_model_format format, uint32_t side,
+                                uint32_t timeout_ms)
+{
+	struct api_limits l;
+	api_limits_defaults(&l);
+	l.output_side = side;
+	if (timeout_ms) l.import_timeout_ms = timeout_ms;
+	struct api_model *m = NULL;
+	char err[300];
+	int st;
+	if (api_model_get(d, len, format, &l, &m, &st, err, sizeof err) != API_OK) printf("    %s\n", err);
+	return m;
+}

@@ -9,6 +9,8 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "api.h"
+#include "model.h"
 
 extern const uint8_t TEX[16];
 /* TEX as a PNG (malloc'd; *len its size). */
@@ -19,5 +21,9 @@ uint8_t *quad_glb_png(uint8_t *png, size_t pnglen, const char *tex_extra, const 
 /* The same with png_2x2 as the texture; quad_glb: with no extras. */
 uint8_t *quad_glb_ex(const char *tex_extra, const char *root_extra, size_t *len);
 uint8_t *quad_glb(size_t *len);
+/* api_model_get of d as format for images of `side` (0: the default limits' import timeout,
+ * else timeout_ms): the model (a reference), or NULL with the reason printed. */
+struct api_model *model_get_for(const uint8_t *d, size_t len, enum api_model_format format, uint32_t side,
+                                uint32_t timeout_ms);
 
 #endif

@@ -124,14 +124,7 @@ static uint8_t *checker_png(size_t *len)
 
 static struct api_model *get_for(const uint8_t *d, size_t len, uint32_t side)
 {
-	struct api_limits l;
-	api_limits_defaults(&l);
-	l.output_side = side;
-	struct api_model *m = NULL;
-	char err[300];
-	int st;
-	if (api_model_get(d, len, API_MODEL_GLB, &l, &m, &st, err, sizeof err) != API_OK) printf("    %s\n", err);
-	return m;
+	return model_get_for(d, len, API_MODEL_GLB, side, 0);
 }
 
 /* A texture is decoded no larger than the request's images need (API_TEXTURE_SIDE_PER_PIXEL

@@ -12,6 +12,7 @@
 #include "model.h"
 #include "model_levels.h"
 #include "model_lod.h"
+#include "model_util.h"
 #include "model_wire.h"
 #include "lod.h"
 #include "models.h"
@@ -20,15 +21,7 @@
 
 static struct api_model *get(const uint8_t *d, size_t len, uint32_t side, uint32_t timeout_ms)
 {
-	struct api_limits l;
-	api_limits_defaults(&l);
-	l.output_side = side;
-	if (timeout_ms) l.import_timeout_ms = timeout_ms;
-	struct api_model *m = NULL;
-	char err[300];
-	int st;
-	if (api_model_get(d, len, API_MODEL_STL, &l, &m, &st, err, sizeof err) != API_OK) printf("    %s\n", err);
-	return m;
+	return model_get_for(d, len, API_MODEL_STL, side, timeout_ms);
 }
 
 static float extent(const struct api_model_mesh *me)

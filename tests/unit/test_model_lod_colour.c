@@ -15,6 +15,7 @@
 #include "lod.h"
 #include "lod_colour.h"
 #include "model_lod.h"
+#include "model_util.h"
 
 #define PI_D 3.14159265358979323846
 
@@ -220,14 +221,7 @@ static uint8_t *ply_of(const struct api_model_mesh *me, size_t *len)
 
 static struct api_model *get_ply(const uint8_t *d, size_t len, uint32_t side)
 {
-	struct api_limits l;
-	api_limits_defaults(&l);
-	l.output_side = side;
-	struct api_model *m = NULL;
-	char err[300];
-	int st;
-	if (api_model_get(d, len, API_MODEL_PLY, &l, &m, &st, err, sizeof err) != API_OK) printf("    %s\n", err);
-	return m;
+	return model_get_for(d, len, API_MODEL_PLY, side, 0);
 }
 
 /* Through the sandbox: a banded PLY imported for 256^2 images has its coloured level, and

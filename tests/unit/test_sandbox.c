@@ -409,6 +409,18 @@ TEST(sandbox_reply_identity_indices)
 
 /* A reply of 900 corners: the checks run in blocks of 256 there, and an index past the vertices
  * or a NaN deep inside a block (not in the tail) is refused as at the start. */
+/* m written as a model reply into b, and its body found (api_wire_header): false with err. */
+static bool wire_model_body(const struct api_model *m, struct api_wire_buf *b, const uint8_t **body, size_t *blen,
+                            char *err, size_t errsize)
+{
+	enum api_wire_kind k;
+	enum api_wire_status st;
+	api_wire_put_header(b, API_WIRE_MODEL, API_WIRE_OK, NULL);
+	api_wire_put_model(b, m);
+	if (b->failed) return snprintf(err, errsize, "out of memory"), false;
+	return api_wire_header(b->data, b->len, &k, &st, NULL, 0, body, blen, err, errsize) == API_OK;
+}
+
 static void wire_long(struct api_wire_buf *b, size_t bad_index_at, size_t nan_at)
 {
 	enum { NV = 900 };
@@ -476,15 +488,10 @@ TEST(sandbox_reply_second_uv_set_round_trip)
 		uv1[3] = nan ? NAN : 0.5f;
 		mat.sampling[RND_TEX_BASE].transform[0] = 1.0f;
 		struct api_wire_buf b = {0};
-		api_wire_put_header(&b, API_WIRE_MODEL, API_WIRE_OK, NULL);
-		api_wire_put_model(&b, &m);
-		REQUIRE(!b.failed);
-		enum api_wire_kind k;
-		enum api_wire_status st;
 		const uint8_t *body;
 		size_t blen, bytes;
 		char err[300];
-		REQUIRE(api_wire_header(b.data, b.len, &k, &st, NULL, 0, &body, &blen, err, sizeof err) == API_OK, "%s", err);
+		REQUIRE(wire_model_body(&m, &b, &body, &blen, err, sizeof err), "%s", err);
 		struct api_arena *a = api_arena_create();
 		struct api_model out;
 		unsigned in_place = (unsigned)nan ^ 1u;   /* the good reply decoded in place, the bad one copied */
@@ -532,15 +539,10 @@ TEST(sandbox_reply_level_colours_round_trip)
 	for (int bare = 0; bare < 2; bare++) {
 		mesh.colors = bare ? NULL : col;
 		struct api_wire_buf b = {0};
-		api_wire_put_header(&b, API_WIRE_MODEL, API_WIRE_OK, NULL);
-		api_wire_put_model(&b, &m);
-		REQUIRE(!b.failed);
-		enum api_wire_kind k;
-		enum api_wire_status st;
 		const uint8_t *body;
 		size_t blen, bytes;
 		char err[300];
-		REQUIRE(api_wire_header(b.data, b.len, &k, &st, NULL, 0, &body, &blen, err, sizeof err) == API_OK, "%s", err);
+		REQUIRE(wire_model_body(&m, &b, &body, &blen, err, sizeof err), "%s", err);
 		struct api_arena *a = api_arena_create();
 		struct api_model out;
 		enum api_result rc = api_wire_decode_model(body, blen, 0, a, 1u << 20, &out, &bytes, err, sizeof err);
