@@ -144,12 +144,25 @@ struct colour_job {
 	float worst[COLOUR_SLICES];
 };
 
-static float to_srgb(const struct colour_job *j, float linear)
+static void srgb_table(float *t)
+{
+	for (int i = 0; i <= SRGB_STEPS; i++) {
+		float x = (float)i / SRGB_STEPS;
+		t[i] = x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+	}
+}
+
+static float srgb_of(const float *t, float linear)
 {
 	float x = fminf(fmaxf(linear, 0.0f), 1.0f) * SRGB_STEPS;
 	int i = (int)x;
-	if (i >= SRGB_STEPS) return j->srgb[SRGB_STEPS];
-	return j->srgb[i] + (x - (float)i) * (j->srgb[i + 1] - j->srgb[i]);
+	if (i >= SRGB_STEPS) return t[SRGB_STEPS];
+	return t[i] + (x - (float)i) * (t[i + 1] - t[i]);
+}
+
+static float to_srgb(const struct colour_job *j, float linear)
+{
+	return srgb_of(j->srgb, linear);
 }
 
 /* The colour error of vertex v: the least over the level triangles within reach (else the
@@ -212,10 +225,7 @@ float api_lod_colour_error(const float *pos, const uint8_t *col, size_t nv, cons
 	for (size_t i = 0; i < nfull; i++) in_full[full[i]] = 1;
 	for (size_t i = 0; i < nlevel; i++) in_full[nv + level[i]] = 1;
 	*j = (struct colour_job){pos, col, nv, in_full, in_full + nv, level, &g, reach, stop, {0}, {0}};
-	for (int i = 0; i <= SRGB_STEPS; i++) {
-		float x = (float)i / SRGB_STEPS;
-		j->srgb[i] = x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
-	}
+	srgb_table(j->srgb);
 	api_workers_run(COLOUR_SLICES, colour_slice, j);
 	worst = 0.0f;
 	for (int s = 0; s < COLOUR_SLICES; s++) worst = fmaxf(worst, j->worst[s]);
@@ -225,4 +235,50 @@ done:
 	free(in_full);
 	free(j);
 	return worst;
+}
+
+/* Vertex v's colour c against its ring's mean m (linear 0..255 per channel), as vertex_error
+ * weighs a level's colour: past one step of c's 8 bits (RGB: the sRGB encodings of c -+ 1 less
+ * and plus the bound, lo[c] and hi[c]), RGB in sRGB encoding, alpha in its own units. */
+static bool rough_vertex(const float *t, const float *lo, const float *hi, const uint8_t *c, const float m[4])
+{
+	if (fabsf(m[3] - c[3]) - 1.0f > API_LOD_COLOUR_BOUND * 255.0f) return true;
+	for (int k = 0; k < 3; k++) {
+		float x = srgb_of(t, m[k] / 255.0f);
+		if (x < lo[c[k]] || x > hi[c[k]]) return true;
+	}
+	return false;
+}
+
+bool api_lod_colours_rough(const uint8_t *col, size_t nv, const uint32_t *idx, size_t ni)
+{
+	float *sum = calloc(nv ? nv : 1, 4 * sizeof *sum), *t = malloc((SRGB_STEPS + 1 + 512) * sizeof *t);
+	uint32_t *n = calloc(nv ? nv : 1, sizeof *n);
+	bool rough = false;
+	if (!sum || !t || !n) goto done;
+	srgb_table(t);
+	float *lo = t + SRGB_STEPS + 1, *hi = lo + 256;
+	for (int c = 0; c < 256; c++)
+		lo[c] = srgb_of(t, (c - 1.0f) / 255.0f) - API_LOD_COLOUR_BOUND,
+		hi[c] = srgb_of(t, (c + 1.0f) / 255.0f) + API_LOD_COLOUR_BOUND;
+	for (size_t i = 0; i + 2 < ni; i += 3)
+		for (int c = 0; c < 3; c++) {
+			uint32_t v = idx[i + (size_t)c], a = idx[i + (size_t)(c + 1) % 3], b = idx[i + (size_t)(c + 2) % 3];
+			for (int k = 0; k < 4; k++) sum[4 * (size_t)v + k] += (float)col[4 * (size_t)a + k] + (float)col[4 * (size_t)b + k];
+			n[v] += 2;
+		}
+	size_t used = 0, over = 0;
+	for (size_t v = 0; v < nv; v++) {
+		if (!n[v]) continue;
+		float m[4];
+		for (int k = 0; k < 4; k++) m[k] = sum[4 * v + (size_t)k] / (float)n[v];
+		used++;
+		over += rough_vertex(t, lo, hi, col + 4 * v, m);
+	}
+	rough = (float)over > API_LOD_COLOUR_ROUGH_SHARE * (float)used;
+done:
+	free(sum);
+	free(t);
+	free(n);
+	return rough;
 }

@@ -16,6 +16,7 @@
 #ifndef UMBRA_API_LOD_COLOUR_H
 #define UMBRA_API_LOD_COLOUR_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -32,5 +33,19 @@
 float api_lod_colour_error(const float *pos, const uint8_t *col, size_t nv, const uint32_t *full, size_t nfull,
                            const uint32_t *level, size_t nlevel, const float lo[3], const float hi[3], float extent,
                            float reach, float stop);
+
+/* The share of vertices over which api_lod_colours_rough gives up (see there). */
+#define API_LOD_COLOUR_ROUGH_SHARE 0.25f
+
+/* Whether colours col (linear RGBA8, nv vertices, triangles idx[0..ni)) are too rough for any
+ * level to show: more than API_LOD_COLOUR_ROUGH_SHARE of the vertices whose colour the mean of
+ * their neighbours' (linear, as a level interpolates) misses by more than API_LOD_COLOUR_BOUND,
+ * the error api_lod_colour_error would give a vertex that a level replaced by its ring. A level
+ * keeps a few percent of the vertices, so with a quarter of them that rough it is refused after
+ * its whole cost (the 100k blob with noise of +-12/255: 96 %, ~80 ms of simplification and
+ * measure for no level); bands and ramps, smooth between their edges, stay well under (the
+ * corpus's banded blob: 5 %). A cheap guess, one pass: it only spares a level's cost, and the
+ * measure above still decides every level that is built. False when out of memory. */
+bool api_lod_colours_rough(const uint8_t *col, size_t nv, const uint32_t *idx, size_t ni);
 
 #endif

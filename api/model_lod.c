@@ -314,6 +314,8 @@ static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, co
 		goto done;
 	if (me->colors) {
 		if (!split_by_colour(me, w, cur, &sp) || !(lvl = malloc(ni * sizeof *lvl))) goto done;
+		/* colours no level would show: spare the level's cost (the measure would refuse it) */
+		if (api_lod_colours_rough(sp.col, sp.count, sp.idx, ni)) goto done;
 		s = &sp;
 	}
 	const uint32_t *full = s ? s->idx : cur;

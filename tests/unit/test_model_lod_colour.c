@@ -148,6 +148,42 @@ TEST(model_lod_colours_no_level_can_show_get_none)
 	free_sphere(&me);
 }
 
+/* A smooth ramp of colour by height (a level interpolates it), and the bands with noise of
+ * +-12/255 on every vertex (a scan's colours: no level keeps them). */
+static void ramp(uint32_t i, uint32_t j, uint32_t rows, uint8_t out[4])
+{
+	(void)j;
+	out[0] = (uint8_t)(255 * i / rows), out[1] = (uint8_t)(128 + 100 * i / rows), out[2] = 40, out[3] = 255;
+}
+
+static void noisy_bands(uint32_t i, uint32_t j, uint32_t rows, uint8_t out[4])
+{
+	uint8_t n[4];
+	bands(i, j, rows, out);
+	noise(i, j, rows, n);
+	for (int k = 0; k < 3; k++) out[k] = (uint8_t)fmin(255.0, fmax(0.0, out[k] + (n[k] % 25) - 12.0));
+}
+
+/* The cheap guess that spares a level's cost: rough for random colours and noisy bands, not
+ * for bands or a ramp, which get their levels; the noisy bands none (before the guess, the
+ * same outcome after a refused build). */
+TEST(model_lod_colours_rough_only_where_no_level_can_show_them)
+{
+	void (*kinds[4])(uint32_t, uint32_t, uint32_t, uint8_t[4]) = {bands, ramp, noise, noisy_bands};
+	const char *names[4] = {"bands", "ramp", "noise", "noisy bands"};
+	for (int k = 0; k < 4; k++) {
+		struct api_model_mesh me = coloured_sphere(120, kinds[k]);
+		bool rough = api_lod_colours_rough(me.colors, me.vertex_count, me.indices, me.index_count);
+		CHECK(rough == (k >= 2), "%s: rough %d", names[k], rough);
+		if (k != 2) {   /* (noise: model_lod_colours_no_level_can_show_get_none) */
+			struct api_arena *a = level_for(&me, 256);
+			CHECK(me.lod_count == (k < 2), "%s: %u levels", names[k], me.lod_count);
+			api_arena_destroy(a);
+		}
+		free_sphere(&me);
+	}
+}
+
 TEST(model_lod_colour_error_of_a_level_that_blurs_a_stripe)
 {
 	/* A square of two triangles over a full mesh whose middle vertex is red among white: the
