@@ -7,7 +7,7 @@ different hundredth of a degree (so its shadow maps are new too: their keys hash
 and its transform, and an earlier round's would be found), then the same request once more
 (its warm render: model and shadow maps cached). Prints, per model, the medians over the
 rounds of the first request's wall time and its Server-Timing stages, the warm request's, and
-their ratio. One client, nothing else running in the daemon; numbers only, nothing asserted.
+their ratio, and the warm request's stages. One client, nothing else running in the daemon; numbers only, nothing asserted.
 Env: FIRST_ROUNDS (5), FIRST_SIZE (256), FIRST_UMBRAD_ARGS (extra umbrad flags)."""
 import http.client, json, math, os, signal, statistics, struct, subprocess, sys, tempfile, time
 
@@ -105,7 +105,8 @@ def main():
                     if k not in stages:
                         stages.append(k)
                 st = {k: med([t.get(k) or 0 for _, t in first]) for k in names}
-                rows.append((model["file"], f_ms, min(m for m, _ in first), max(m for m, _ in first), w_ms, st))
+                wst = {k: med([t.get(k) or 0 for _, t in warm]) for k in names}
+                rows.append((model["file"], f_ms, min(m for m, _ in first), max(m for m, _ in first), w_ms, st, wst))
         finally:
             daemon.send_signal(signal.SIGTERM)
             daemon.wait(60)
@@ -117,6 +118,10 @@ def main():
              farm_bench.fmt_ms(r[4]), "%.1f" % (r[1] / r[4])] + [farm_bench.fmt_ms(r[5].get(s)) for s in shown]
             for r in rows]
     print(farm_bench.table(head, body))
+    print("\nThe warm requests' Server-Timing (medians, ms):")
+    shown = [s for s in stages if any(r[6].get(s) for r in rows)]
+    body = [[r[0], farm_bench.fmt_ms(r[4])] + [farm_bench.fmt_ms(r[6].get(s)) for s in shown] for r in rows]
+    print(farm_bench.table(["model", "warm"] + shown, body))
 
 
 if __name__ == "__main__":
