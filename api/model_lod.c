@@ -9,8 +9,9 @@
  * own figure leaves out how far the new triangles' insides are from the surface. Every level
  * gets its own vertex arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
  * position (weld), so a level's normals are computed from its own triangles with a crease angle
- * (write_level) and its uvs (both sets) those of each position's first vertex: a texture seam of a
- * coarse level can show the wrong side's uvs (a thumbnail rarely can tell). Vertex colours are
+ * (write_level) and its uvs (both sets) and tangents (a normal map's) those of each position's
+ * first vertex: a texture seam of a coarse level can show the wrong side's uvs (a thumbnail
+ * rarely can tell; the shader makes the tangent orthogonal to the level's normal). Vertex colours are
  * not taken that way (a band's edge came out ragged at 256²): a coloured mesh is split again by
  * colour for the simplifier (struct split), each level vertex keeps its own colour, and the level
  * is refused unless it shows every vertex's colour within a bound (api/lod_colour.h).
@@ -200,8 +201,8 @@ static bool corner_normals(const struct api_model_mesh *me, const struct welded 
 	return ok;
 }
 
-/* Writes one level into the arena: corners with equal position, normal, uvs (both sets:
- * those of the position's first vertex) and colour (s's, of the level's split vertices sidx)
+/* Writes one level into the arena: corners with equal position, normal, uvs (both sets) and
+ * tangent (those of the position's first vertex) and colour (s's, of the level's split vertices sidx)
  * become one vertex again. */
 static bool write_level(struct api_arena *arena, const struct api_model_mesh *me, const struct welded *w,
                         const uint32_t *idx, const struct split *s, const uint32_t *sidx, size_t ni,
@@ -209,20 +210,23 @@ static bool write_level(struct api_arena *arena, const struct api_model_mesh *me
 {
 	const float *src[2] = {me->uvs, me->uvs1};
 	float *cp = malloc(ni * 12), *cn = malloc(ni * 12), *cu[2] = {NULL, NULL}, *uv[2] = {NULL, NULL};
+	float *ct = NULL, *tan = NULL;
 	unsigned int *remap = malloc(ni * sizeof *remap);
 	bool ok = cp && cn && remap;
 	uint8_t *cc = NULL, *col = NULL;
-	struct meshopt_Stream st[5] = {{cp, 12, 12}, {cn, 12, 12}};
+	struct meshopt_Stream st[6] = {{cp, 12, 12}, {cn, 12, 12}};
 	size_t ns = 2;
 	for (int k = 0; k < 2; k++)
 		if (src[k] && (ok = ok && (cu[k] = malloc(ni * 8)))) st[ns++] = (struct meshopt_Stream){cu[k], 8, 8};
 	if (s && (ok = ok && (cc = malloc(ni * 4)))) st[ns++] = (struct meshopt_Stream){cc, 4, 4};
+	if (me->tangents && (ok = ok && (ct = malloc(ni * 16)))) st[ns++] = (struct meshopt_Stream){ct, 16, 16};
 	if (!ok || !corner_normals(me, w, idx, ni, cn)) goto done;
 	for (size_t i = 0; i < ni; i++) {
 		memcpy(cp + 3 * i, w->pos + 3 * (size_t)idx[i], 12);
 		for (int k = 0; k < 2; k++)
 			if (cu[k]) memcpy(cu[k] + 2 * i, src[k] + 2 * (size_t)w->rep[idx[i]], 8);
 		if (cc) memcpy(cc + 4 * i, s->col + 4 * (size_t)sidx[i], 4);
+		if (ct) memcpy(ct + 4 * i, me->tangents + 4 * (size_t)w->rep[idx[i]], 16);
 	}
 	size_t nv = meshopt_generateVertexRemapMulti(remap, NULL, ni, ni, st, ns);
 	float *pos = api_arena_alloc(arena, nv * 12), *nrm = api_arena_alloc(arena, nv * 12);
@@ -231,16 +235,19 @@ static bool write_level(struct api_arena *arena, const struct api_model_mesh *me
 	for (int k = 0; k < 2; k++)
 		if (cu[k]) ok = ok && (uv[k] = api_arena_alloc(arena, nv * 8));
 	if (cc) ok = ok && (col = api_arena_alloc(arena, nv * 4));
+	if (ct) ok = ok && (tan = api_arena_alloc(arena, nv * 16));
 	if (!ok) goto done;
 	meshopt_remapVertexBuffer(pos, cp, ni, 12, remap);
 	meshopt_remapVertexBuffer(nrm, cn, ni, 12, remap);
 	for (int k = 0; k < 2; k++)
 		if (cu[k]) meshopt_remapVertexBuffer(uv[k], cu[k], ni, 8, remap);
 	if (cc) meshopt_remapVertexBuffer(col, cc, ni, 4, remap);
+	if (ct) meshopt_remapVertexBuffer(tan, ct, ni, 16, remap);
 	meshopt_remapIndexBuffer(ix, NULL, ni, remap);
-	*out = (struct rnd_mesh_lod){pos, nrm, uv[0], ix, (uint32_t)nv, (uint32_t)ni, 0.0f, uv[1], col};
-	*bytes += nv * (24 + (cu[0] ? 8 : 0) + (cu[1] ? 8 : 0) + (cc ? 4 : 0)) + ni * 4;
+	*out = (struct rnd_mesh_lod){pos, nrm, uv[0], ix, (uint32_t)nv, (uint32_t)ni, 0.0f, uv[1], col, tan};
+	*bytes += nv * (24 + (cu[0] ? 8 : 0) + (cu[1] ? 8 : 0) + (cc ? 4 : 0) + (ct ? 16 : 0)) + ni * 4;
 done:
+	free(ct);
 	free(cc);
 	free(cp);
 	free(cn);
@@ -405,5 +412,5 @@ float api_lod_import_error(uint32_t output_side)
 
 bool api_mesh_wants_levels(const struct api_model_mesh *me)
 {
-	return me->index_count / 3 >= API_LOD_MIN_TRIANGLES && me->normals && !me->tangents;
+	return me->index_count / 3 >= API_LOD_MIN_TRIANGLES && me->normals;
 }

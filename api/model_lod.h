@@ -25,9 +25,9 @@
 /* Meshes with fewer triangles are left alone: drawing them costs less than choosing. */
 #define API_LOD_MIN_TRIANGLES 20000u
 
-/* Whether levels are built for this mesh: at least API_LOD_MIN_TRIANGLES triangles, normals,
- * and no tangents (levels carry positions, normals, uvs and vertex colours only; a coloured
- * mesh's level must also show its colours, api/lod_colour.h, or there is none). */
+/* Whether levels are built for this mesh: at least API_LOD_MIN_TRIANGLES triangles and normals
+ * (levels carry positions, normals, uvs, vertex colours and tangents; a coloured mesh's level
+ * must also show its colours, api/lod_colour.h, or there is none). */
 bool api_mesh_wants_levels(const struct api_model_mesh *me);
 
 /* The level of every mesh of m that wants one (api_mesh_wants_levels) for images of

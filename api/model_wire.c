@@ -434,8 +434,8 @@ enum api_result api_wire_decode_model(const uint8_t *body, size_t len, unsigned 
 
 
 /* One level of mesh `me` (the one it simplifies): coarser than what it follows (fewer indices),
- * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs (each set)
- * and colours only where the mesh has them, and an error no finer than the previous level's. */
+ * within the mesh's bounds (the renderer bounds a mesh by its full vertices), uvs (each set),
+ * colours and tangents only where the mesh has them, and an error no finer than the previous level's. */
 static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const struct api_model_mesh *me,
                                     uint32_t max_indices, float min_error, struct rnd_mesh_lod *out)
 {
@@ -443,22 +443,24 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 	float error;
 	if (!take_u32(&d->r, &nv) || !take_u32(&d->r, &ni) || !take_u32(&d->r, &flags) || !take(&d->r, &error, 4))
 		return bad(&d->r, "mesh %u level %u is cut short", i, l);
-	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 7 || ((flags & 1) && !me->uvs) ||
-	    ((flags & 2) && !me->uvs1) || ((flags & 4) && !me->colors) ||
+	if (!nv || ni < 3 || ni % 3 || ni >= max_indices || nv > ni || flags > 15 || ((flags & 1) && !me->uvs) ||
+	    ((flags & 2) && !me->uvs1) || ((flags & 4) && !me->colors) || ((flags & 8) && !me->tangents) ||
 	    !isfinite(error) || error < min_error)
 		return bad(&d->r, "mesh %u level %u: %u vertices, %u indices, flags %u, error %g", i, l, nv, ni, flags,
 		           (double)error);
-	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0) + (flags & 2 ? 8 : 0) + (flags & 4 ? 4 : 0);
+	uint64_t per_vertex = 24 + (flags & 1 ? 8 : 0) + (flags & 2 ? 8 : 0) + (flags & 4 ? 4 : 0) + (flags & 8 ? 16 : 0);
 	if (!fits(&d->r, nv, per_vertex) || !fits(&d->r, ni, 4) || (uint64_t)nv * per_vertex > d->r.left - (uint64_t)ni * 4)
 		return bad(&d->r, "mesh %u level %u is cut short", i, l);
 	const float *pos = take_array(d, nv, 12), *nrm = take_array(d, nv, 12), *uv = flags & 1 ? take_array(d, nv, 8) : NULL;
 	const float *uv1 = flags & 2 ? take_array(d, nv, 8) : NULL;
 	const uint8_t *col = flags & 4 ? take_array(d, nv, 4) : NULL;
+	const float *tan = flags & 8 ? take_array(d, nv, 16) : NULL;
 	const uint32_t *idx = take_array(d, ni, 4);
-	if (!pos || !nrm || ((flags & 1) && !uv) || ((flags & 2) && !uv1) || ((flags & 4) && !col) || !idx)
+	if (!pos || !nrm || ((flags & 1) && !uv) || ((flags & 2) && !uv1) || ((flags & 4) && !col) || ((flags & 8) && !tan) ||
+	    !idx)
 		return bad(&d->r, "out of memory");
 	if (!finite_all(pos, (size_t)nv * 3) || !finite_all(nrm, (size_t)nv * 3) || (uv && !finite_all(uv, (size_t)nv * 2)) ||
-	    (uv1 && !finite_all(uv1, (size_t)nv * 2)))
+	    (uv1 && !finite_all(uv1, (size_t)nv * 2)) || (tan && !finite_all(tan, (size_t)nv * 4)))
 		return bad(&d->r, "mesh %u level %u has a value that is not finite", i, l);
 	for (uint32_t v = 0; v < nv; v++)
 		for (int k = 0; k < 3; k++)
@@ -466,7 +468,7 @@ static enum api_result decode_level(struct dec *d, uint32_t i, uint32_t l, const
 				return bad(&d->r, "mesh %u level %u: vertex %u lies outside the mesh", i, l, v);
 	size_t k = first_out_of_range(idx, ni, nv);
 	if (k < ni) return bad(&d->r, "mesh %u level %u: index %zu refers to vertex %u of %u", i, l, k, idx[k], nv);
-	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error, uv1, col};
+	*out = (struct rnd_mesh_lod){pos, nrm, uv, idx, nv, ni, error, uv1, col, tan};
 	return API_OK;
 }
 

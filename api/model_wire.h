@@ -43,8 +43,9 @@
  *   Nothing may follow the last instance.
  *   levels   (a levels-of-detail job: its input is a model, its reply this) mesh_count, then per
  *            mesh level_count (at most API_LOD_LEVELS), per level vertex_count index_count
- *            flags(1 uvs, 2 second uv set, 4 colours) error(f32), positions f32[3v], normals f32[3v],
- *            uvs f32[2v], uvs1 f32[2v], colours u8[4v] (linear RGBA), indices u32[i]
+ *            flags(1 uvs, 2 second uv set, 4 colours, 8 tangents) error(f32), positions f32[3v],
+ *            normals f32[3v], uvs f32[2v], uvs1 f32[2v], colours u8[4v] (linear RGBA), tangents
+ *            f32[4v] (xyzw), indices u32[i]
  *
  * Usage (parent): api_wire_header(); then api_wire_decode_model() / _image() on the body.
  * Usage (child):  struct api_wire_buf b = {.fd = fd}; api_wire_put_model(&b, model); api_wire_flush(&b).
@@ -60,7 +61,7 @@
 #include "model_lod.h"
 
 #define API_WIRE_MAGIC "UMBRAIMP"
-#define API_WIRE_VERSION 10u
+#define API_WIRE_VERSION 11u
 /* Beside the RND_EXT_* bits of a material: its specular.spec_gloss. */
 #define API_WIRE_SPEC_GLOSS (1u << 16)
 #define API_WIRE_MAX_MESSAGE 1024u

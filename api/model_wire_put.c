@@ -121,13 +121,14 @@ static void put_mesh_levels(struct api_wire_buf *b, const struct api_model_mesh 
 		const struct rnd_mesh_lod *lv = &me->lods[l];
 		put_u32(b, lv->vertex_count);
 		put_u32(b, lv->index_count);
-		put_u32(b, (lv->uvs ? 1u : 0u) | (lv->uvs1 ? 2u : 0u) | (lv->colors ? 4u : 0u));
+		put_u32(b, (lv->uvs ? 1u : 0u) | (lv->uvs1 ? 2u : 0u) | (lv->colors ? 4u : 0u) | (lv->tangents ? 8u : 0u));
 		put(b, &lv->error, 4);
 		put(b, lv->positions, (size_t)lv->vertex_count * 12);
 		put(b, lv->normals, (size_t)lv->vertex_count * 12);
 		if (lv->uvs) put(b, lv->uvs, (size_t)lv->vertex_count * 8);
 		if (lv->uvs1) put(b, lv->uvs1, (size_t)lv->vertex_count * 8);
 		if (lv->colors) put(b, lv->colors, (size_t)lv->vertex_count * 4);
+		if (lv->tangents) put(b, lv->tangents, (size_t)lv->vertex_count * 16);
 		put(b, lv->indices, (size_t)lv->index_count * 4);
 	}
 }

@@ -318,10 +318,9 @@ static int expand_models(struct pctx *c, json_t *objs, struct api_model *const *
 			o->uvs1 = me->uvs1;
 			o->colors = me->colors;
 			o->tangents = me->tangents;
-			/* The level for this request's size (api/model_levels.h). Levels carry
-			 * positions, normals, uvs (both sets) and vertex colours: a mesh with
-			 * tangents is always drawn whole. */
-			if (!me->tangents) o->lods = api_model_mesh_lods(m, in->mesh, c->lim->output_side, &o->lod_count);
+			/* The level for this request's size (api/model_levels.h): positions, normals,
+			 * uvs (both sets), vertex colours and tangents, where the mesh has them. */
+			o->lods = api_model_mesh_lods(m, in->mesh, c->lim->output_side, &o->lod_count);
 			o->caster = me->caster;   /* the environment's maps' level (renderer/caster_level.h) */
 			o->closed = me->closed;
 			o->mesh_bounds = me->vertex_count ? me->bounds : NULL;

@@ -108,13 +108,15 @@ void rnd_lod_apply(struct rnd_object *o, uint32_t lod)
 		o->segments = lod;
 	} else if (o->shape == RND_SHAPE_MESH && lod > 0 && lod <= o->lod_count &&
 	           (!o->uvs1 || o->lods[lod - 1].uvs1) &&   /* a level without the second set: the full mesh */
-	           (!o->colors || o->lods[lod - 1].colors)) {   /* nor without the colours */
+	           (!o->colors || o->lods[lod - 1].colors) &&   /* nor without the colours */
+	           (!o->tangents || o->lods[lod - 1].tangents)) {   /* nor without the tangents */
 		const struct rnd_mesh_lod *l = &o->lods[lod - 1];
 		o->positions = l->positions;
 		o->normals = l->normals;
 		o->uvs = l->uvs;
 		o->uvs1 = l->uvs1;
 		if (o->colors) o->colors = l->colors;
+		if (o->tangents) o->tangents = l->tangents;
 		o->indices = l->indices;
 		o->vertex_count = l->vertex_count;
 		o->index_count = l->index_count;

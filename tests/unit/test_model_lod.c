@@ -214,6 +214,44 @@ TEST(model_lod_levels_carry_both_uv_sets)
 	free(pos); free(nrm); free(idx); free(uv); free(uv1);
 }
 
+/* A normal-mapped mesh (tangents, a glTF's with a normalTexture) gets its levels like any
+ * other, each level vertex with its position's tangent (a function of the position here: the
+ * direction of increasing longitude, w the hemisphere's sign). Before: no level at all, so
+ * such a model drew every triangle into every thumbnail and its environment maps. */
+TEST(model_lod_levels_carry_tangents)
+{
+	float *pos, *nrm;
+	uint32_t *idx, nv, ni;
+	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni);
+	float *uv = malloc(nv * 8), *tan = malloc(nv * 16);
+	REQUIRE(uv && tan);
+	for (uint32_t v = 0; v < nv; v++) {
+		const float *p = pos + 3 * v;
+		uv[2 * v] = p[0], uv[2 * v + 1] = p[1];
+		tan[4 * v] = -p[2], tan[4 * v + 1] = 0.0f, tan[4 * v + 2] = p[0], tan[4 * v + 3] = p[1] < 0.0f ? -1.0f : 1.0f;
+	}
+	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .tangents = tan, .indices = idx,
+	                            .vertex_count = nv, .index_count = ni};
+	CHECK(api_mesh_wants_levels(&me));
+	size_t bytes;
+	struct rnd_mesh_lod keep[4];
+	struct api_arena *a = build_levels(&me, keep, &bytes);
+	REQUIRE(me.lod_count >= 2, "levels: %u", me.lod_count);
+	for (uint32_t l = 0; l < me.lod_count; l++) {
+		const struct rnd_mesh_lod *lv = &me.lods[l];
+		REQUIRE(lv->tangents, "level %u has no tangents", l + 1);
+		CHECK(lv->index_count * 4 <= ni * 3, "level %u: %u of %u indices", l + 1, lv->index_count, ni);
+		uint32_t wrong = 0;
+		for (uint32_t v = 0; v < lv->vertex_count; v++) {
+			const float *p = lv->positions + 3 * v, *t = lv->tangents + 4 * v;
+			wrong += t[0] != -p[2] || t[1] != 0.0f || t[2] != p[0] || t[3] != (p[1] < 0.0f ? -1.0f : 1.0f);
+		}
+		CHECK(wrong == 0, "level %u: %u of %u vertices with another tangent", l + 1, wrong, lv->vertex_count);
+	}
+	api_arena_destroy(a);
+	free(pos); free(nrm); free(idx); free(uv); free(tan);
+}
+
 TEST(model_lod_small_meshes_get_no_levels)
 {
 	float *pos, *nrm;

@@ -213,6 +213,25 @@ TEST(model_lod_colour_error_of_a_level_that_blurs_a_stripe)
 	CHECK(e > API_LOD_COLOUR_BOUND, "alpha 251 shown 128: error %g", e);
 }
 
+/* The same for tangents: a normal-mapped object draws a level only with them. */
+TEST(lod_apply_draws_a_level_with_its_tangents)
+{
+	float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, n[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+	float full_tan[12] = {0}, level_tan[12] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, -1};
+	uint32_t i[3] = {0, 1, 2};
+	struct rnd_mesh_lod with = {p, n, NULL, i, 3, 3, 0.1f, NULL, NULL, level_tan};
+	struct rnd_mesh_lod without = {p, n, NULL, i, 3, 3, 0.1f, NULL, NULL, NULL};
+	struct rnd_object o = {.shape = RND_SHAPE_MESH, .tangents = full_tan, .lods = &with, .lod_count = 1};
+	rnd_lod_apply(&o, 1);
+	CHECK(o.tangents == level_tan && o.index_count == 3, "the level's tangents are drawn");
+	struct rnd_object q = {.shape = RND_SHAPE_MESH, .tangents = full_tan, .lods = &without, .lod_count = 1, .index_count = 99};
+	rnd_lod_apply(&q, 1);
+	CHECK(q.tangents == full_tan && q.index_count == 99, "a level without tangents is not drawn for a normal-mapped mesh");
+	struct rnd_object u = {.shape = RND_SHAPE_MESH, .lods = &with, .lod_count = 1};
+	rnd_lod_apply(&u, 1);
+	CHECK(u.tangents == NULL && u.index_count == 3, "an object without tangents gets none");
+}
+
 TEST(lod_apply_draws_a_level_with_its_colours)
 {
 	float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, n[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};

@@ -564,6 +564,45 @@ TEST(sandbox_reply_level_colours_round_trip)
 	}
 }
 
+/* A level's tangents (a normal-mapped mesh's) through the wire: the same floats back; refused
+ * for a mesh without tangents, and for a tangent that is not finite. */
+TEST(sandbox_reply_level_tangents_round_trip)
+{
+	float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+	float tan[16] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
+	float lv_tan[12] = {1, 0, 0, 1, 0.6f, 0.8f, 0, -1, 0, 1, 0, 1};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	struct rnd_mesh_lod level = {pos, nrm, NULL, idx, 3, 3, 0.5f, NULL, NULL, lv_tan};
+	struct rnd_material mat;
+	rnd_material_defaults(&mat);
+	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .tangents = tan, .indices = idx, .vertex_count = 4,
+	                              .index_count = 6, .material = 0, .lods = &level, .lod_count = 1};
+	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
+	                      .materials = &mat, .material_count = 1};
+	for (int k = 0; k < 3; k++) {
+		mesh.tangents = k == 1 ? NULL : tan;
+		lv_tan[5] = k == 2 ? NAN : 0.0f;
+		struct api_wire_buf b = {0};
+		const uint8_t *body;
+		size_t blen, bytes;
+		char err[300];
+		REQUIRE(wire_model_body(&m, &b, &body, &blen, err, sizeof err), "%s", err);
+		struct api_arena *a = api_arena_create();
+		struct api_model out;
+		enum api_result rc = api_wire_decode_model(body, blen, 0, a, 1u << 20, &out, &bytes, err, sizeof err);
+		if (k) {
+			CHECK(rc == API_ERR && strstr(err, "level 0"), "case %d: %d %s", k, rc, err);
+		} else {
+			REQUIRE(rc == API_OK, "%s", err);
+			CHECK(out.meshes[0].lod_count == 1 && out.meshes[0].lods[0].tangents &&
+			      !memcmp(out.meshes[0].lods[0].tangents, lv_tan, sizeof lv_tan), "the level's tangents changed on the wire");
+		}
+		api_arena_destroy(a);
+		api_wire_buf_release(&b);
+	}
+}
+
 /* A binary STL whose stored facet normal opposes its winding (common from some exporters):
  * the normal follows the winding (counter-clockwise seen from the front, as glTF and the
  * renderer's culling assume), so the model is not shaded from behind. */

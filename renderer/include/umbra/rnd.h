@@ -74,7 +74,8 @@ enum rnd_shape { RND_SHAPE_PLANE, RND_SHAPE_BOX, RND_SHAPE_SPHERE, RND_SHAPE_CYL
 
 /* A coarser version of a mesh object's geometry (api/model_lod.c builds them for imported
  * models with meshoptimizer); renderer/lod.h picks the coarsest whose error the output cannot
- * show. Arrays as in rnd_object (normals and indices always present, uvs and colours optional). */
+ * show. Arrays as in rnd_object (normals and indices always present, uvs, colours and tangents
+ * optional). */
 struct rnd_mesh_lod {
 	const float *positions, *normals, *uvs;
 	const uint32_t *indices;
@@ -84,6 +85,8 @@ struct rnd_mesh_lod {
 	                         not used for an object with uvs1) */
 	const uint8_t *colors; /* linear RGBA8 per vertex, where the mesh has them (a level without
 	                         them is not used for an object with colors) */
+	const float *tangents; /* xyzw per vertex, where the mesh has them (a normal map's; a level
+	                         without them is not used for an object with tangents) */
 };
 
 /* A coarse stand-in for a dense opaque mesh in the environment's shadow maps only (api/model_caster.h
