@@ -9,12 +9,11 @@
  * own figure leaves out how far the new triangles' insides are from the surface. Every level
  * gets its own vertex arrays, so drawing it touches only its vertices. Simplification runs on the mesh welded by
  * position (weld), so a level's normals are computed from its own triangles with a crease angle
- * (write_level) and its uvs (both sets) and tangents (a normal map's) those of each position's
- * first vertex: a texture seam of a coarse level can show the wrong side's uvs (a thumbnail
- * rarely can tell; the shader makes the tangent orthogonal to the level's normal). Vertex colours are
- * not taken that way (a band's edge came out ragged at 256²): a coloured mesh is split again by
- * colour for the simplifier (struct split), each level vertex keeps its own colour, and the level
- * is refused unless it shows every vertex's colour within a bound (api/lod_colour.h).
+ * (write_level). A mesh with uvs or colours is split again where its corners at one position
+ * differ in them (struct split: a texture seam, a colour edge), so that each side keeps its own
+ * uvs, tangents (the shader makes them orthogonal to the level's normal) and colours; a
+ * coloured level is refused unless it shows every vertex's colour within a bound
+ * (api/lod_colour.h).
  */
 #include <math.h>
 #include <meshoptimizer.h>
@@ -38,17 +37,21 @@ struct welded {
 	size_t count;
 };
 
-/* The welded mesh split again for vertex colours: a welded vertex whose corners differ in colour
- * becomes one vertex a colour, and so does one where triangles whose corners all have one colour
- * meet triangles whose corners differ (a band's edge: the row of triangles that blends one band
- * into the next). meshoptimizer keeps vertices at one position as a seam, collapsing them only
- * along it, so a colour edge stays where it was instead of moving by a collapse across it; the
+/* The welded mesh split again where a level must keep attributes apart: a welded vertex whose
+ * corners differ in uvs (either set: a texture seam, a chart's edge) or colour becomes one
+ * vertex each, and so does one where triangles whose corners all have one colour meet
+ * triangles whose corners differ (a band's edge: the row of triangles that blends one band into
+ * the next). meshoptimizer keeps vertices at one position as a seam, collapsing them only along
+ * it, so a seam or a colour edge stays where it was instead of moving by a collapse across it,
+ * and each level vertex takes its attributes from its own side (a level of the welded mesh took
+ * one side's uvs for both: a strip of the whole texture squeezed along every seam). A coloured
  * level is then measured for its colours (api/lod_colour.h) and refused when they are off. */
 struct split {
 	uint32_t *idx;    /* the full mesh's index_count indices into these vertices */
 	float *pos;       /* count positions (their welded vertex's) */
 	uint32_t *base;   /* the welded vertex of each */
-	uint8_t *col;     /* linear RGBA8 of each */
+	uint32_t *first;  /* a vertex of the mesh with its attributes (the first its corners met) */
+	uint8_t *col;     /* linear RGBA8 of each, when the mesh has colours */
 	size_t count;
 };
 
@@ -57,7 +60,16 @@ static void split_free(struct split *s)
 	free(s->idx);
 	free(s->pos);
 	free(s->base);
+	free(s->first);
 	free(s->col);
+}
+
+/* Whether the mesh's vertices a and b have the same uvs (each set) and colour. */
+static bool same_attributes(const struct api_model_mesh *me, uint32_t a, uint32_t b)
+{
+	return (!me->uvs || !memcmp(me->uvs + 2 * (size_t)a, me->uvs + 2 * (size_t)b, 8)) &&
+	       (!me->uvs1 || !memcmp(me->uvs1 + 2 * (size_t)a, me->uvs1 + 2 * (size_t)b, 8)) &&
+	       (!me->colors || !memcmp(me->colors + 4 * (size_t)a, me->colors + 4 * (size_t)b, 4));
 }
 
 /* Whether triangle t's corners differ in colour. */
@@ -68,43 +80,44 @@ static bool blends(const struct api_model_mesh *me, size_t t)
 	return memcmp(c + 4 * (size_t)v[0], c + 4 * (size_t)v[1], 4) || memcmp(c + 4 * (size_t)v[0], c + 4 * (size_t)v[2], 4);
 }
 
-/* s from me welded by position (idx, w): a split vertex per welded vertex and (colour, blends)
- * key of its corners, the welded vertex's own id for the first key its corners meet, new ids
- * after w->count for the others in the order met. False when out of memory. */
-static bool split_by_colour(const struct api_model_mesh *me, const struct welded *w, const uint32_t *idx,
-                            struct split *s)
+/* s from me welded by position (idx, w): a split vertex per welded vertex and (uvs, colour,
+ * blends) key of its corners, the welded vertex's own id for the first key its corners meet,
+ * new ids after w->count for the others in the order met. False when out of memory. */
+static bool split_mesh(const struct api_model_mesh *me, const struct welded *w, const uint32_t *idx, struct split *s)
 {
-	size_t ni = me->index_count, cap = w->count + ni;
-	uint32_t *key = malloc(cap * sizeof *key), *chain = malloc(cap * sizeof *chain);
+	/* each corner makes at most one new vertex; each mesh vertex one, or two with colours
+	 * (blending and not) */
+	size_t ni = me->index_count, more = (me->colors ? 2u : 1u) * (size_t)me->vertex_count;
+	size_t cap = w->count + (more < ni ? more : ni);
+	uint32_t *chain = malloc(cap * sizeof *chain);
 	uint8_t *mix = calloc(cap, 1), *set = calloc(w->count, 1);
 	s->idx = malloc(ni * sizeof *s->idx);
 	s->base = malloc(cap * sizeof *s->base);
-	bool ok = key && chain && mix && set && s->idx && s->base;
+	s->first = malloc(cap * sizeof *s->first);
+	bool ok = chain && mix && set && s->idx && s->base && s->first;
 	size_t n = w->count;
 	for (size_t i = 0; ok && i < ni; i++) {
-		uint32_t b = idx[i], c, u = b;
-		memcpy(&c, me->colors + 4 * (size_t)me->indices[i], 4);
-		uint8_t m = blends(me, i / 3);
+		uint32_t b = idx[i], mv = me->indices[i], u = b;
+		uint8_t m = me->colors ? blends(me, i / 3) : 0;
 		if (!set[b]) {
-			set[b] = 1, key[b] = c, mix[b] = m, chain[b] = UINT32_MAX, s->base[b] = b, s->idx[i] = b;
+			set[b] = 1, s->first[b] = mv, mix[b] = m, chain[b] = UINT32_MAX, s->base[b] = b, s->idx[i] = b;
 			continue;
 		}
-		while ((key[u] != c || mix[u] != m) && chain[u] != UINT32_MAX) u = chain[u];
-		if (key[u] != c || mix[u] != m) {
-			chain[u] = (uint32_t)n, key[n] = c, mix[n] = m, chain[n] = UINT32_MAX, s->base[n] = b;
+		while ((mix[u] != m || !same_attributes(me, s->first[u], mv)) && chain[u] != UINT32_MAX) u = chain[u];
+		if (mix[u] != m || !same_attributes(me, s->first[u], mv)) {
+			chain[u] = (uint32_t)n, s->first[n] = mv, mix[n] = m, chain[n] = UINT32_MAX, s->base[n] = b;
 			u = (uint32_t)n++;
 		}
 		s->idx[i] = u;
 	}
 	s->count = n;
 	s->pos = ok ? malloc(n * 12) : NULL;
-	s->col = ok ? malloc(n * 4) : NULL;
-	ok = ok && s->pos && s->col;
+	s->col = ok && me->colors ? malloc(n * 4) : NULL;
+	ok = ok && s->pos && (s->col || !me->colors);
 	for (size_t v = 0; ok && v < n; v++) {
 		memcpy(s->pos + 3 * v, w->pos + 3 * (size_t)s->base[v], 12);
-		memcpy(s->col + 4 * v, key + v, 4);
+		if (s->col) memcpy(s->col + 4 * v, me->colors + 4 * (size_t)s->first[v], 4);
 	}
-	free(key);
 	free(chain);
 	free(mix);
 	free(set);
@@ -218,15 +231,16 @@ static bool write_level(struct api_arena *arena, const struct api_model_mesh *me
 	size_t ns = 2;
 	for (int k = 0; k < 2; k++)
 		if (src[k] && (ok = ok && (cu[k] = malloc(ni * 8)))) st[ns++] = (struct meshopt_Stream){cu[k], 8, 8};
-	if (s && (ok = ok && (cc = malloc(ni * 4)))) st[ns++] = (struct meshopt_Stream){cc, 4, 4};
+	if (s && s->col && (ok = ok && (cc = malloc(ni * 4)))) st[ns++] = (struct meshopt_Stream){cc, 4, 4};
 	if (me->tangents && (ok = ok && (ct = malloc(ni * 16)))) st[ns++] = (struct meshopt_Stream){ct, 16, 16};
 	if (!ok || !corner_normals(me, w, idx, ni, cn)) goto done;
 	for (size_t i = 0; i < ni; i++) {
 		memcpy(cp + 3 * i, w->pos + 3 * (size_t)idx[i], 12);
+		uint32_t mv = s ? s->first[sidx[i]] : w->rep[idx[i]];   /* the mesh vertex it stands for */
 		for (int k = 0; k < 2; k++)
-			if (cu[k]) memcpy(cu[k] + 2 * i, src[k] + 2 * (size_t)w->rep[idx[i]], 8);
+			if (cu[k]) memcpy(cu[k] + 2 * i, src[k] + 2 * (size_t)mv, 8);
 		if (cc) memcpy(cc + 4 * i, s->col + 4 * (size_t)sidx[i], 4);
-		if (ct) memcpy(ct + 4 * i, me->tangents + 4 * (size_t)w->rep[idx[i]], 16);
+		if (ct) memcpy(ct + 4 * i, me->tangents + 4 * (size_t)mv, 16);
 	}
 	size_t nv = meshopt_generateVertexRemapMulti(remap, NULL, ni, ni, st, ns);
 	float *pos = api_arena_alloc(arena, nv * 12), *nrm = api_arena_alloc(arena, nv * 12);
@@ -319,10 +333,10 @@ static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, co
 	if (!lod || !next || !(extent > 0.0f) ||
 	    !(measure = api_lod_measure_create(w->pos, w->nrm, w->count, cur, ni, lo, hi, extent)))
 		goto done;
-	if (me->colors) {
-		if (!split_by_colour(me, w, cur, &sp) || !(lvl = malloc(ni * sizeof *lvl))) goto done;
+	if (me->colors || me->uvs || me->uvs1) {
+		if (!split_mesh(me, w, cur, &sp) || !(lvl = malloc(ni * sizeof *lvl))) goto done;
 		/* colours no level would show: spare the level's cost (the measure would refuse it) */
-		if (api_lod_colours_rough(sp.col, sp.count, sp.idx, ni)) goto done;
+		if (sp.col && api_lod_colours_rough(sp.col, sp.count, sp.idx, ni)) goto done;
 		s = &sp;
 	}
 	const uint32_t *full = s ? s->idx : cur;
@@ -335,7 +349,7 @@ static void mesh_one_level(struct api_model_mesh *me, const struct welded *w, co
 		for (size_t i = 0; s && i < got; i++) lvl[i] = s->base[next[i]];
 		/* colours first: a level they refuse is not measured (the colour measure stops at the
 		 * first vertex over; the geometric one walks the level to its end) */
-		float ce = s && got >= 3 ? api_lod_colour_error(s->pos, s->col, s->count, s->idx, ni, next, got, lo, hi, extent,
+		float ce = s && s->col && got >= 3 ? api_lod_colour_error(s->pos, s->col, s->count, s->idx, ni, next, got, lo, hi, extent,
 		                                                want * extent, API_LOD_COLOUR_BOUND)
 		                         : 0.0f;
 		float e = got >= 3 && ce <= API_LOD_COLOUR_BOUND ? api_lod_measure_level(measure, lvl, got, false) : INFINITY;

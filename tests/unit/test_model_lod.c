@@ -252,6 +252,65 @@ TEST(model_lod_levels_carry_tangents)
 	free(pos); free(nrm); free(idx); free(uv); free(tan);
 }
 
+/* A texture seam (a sphere's u = 0 and u = 1 meeting, its positions repeated) stays a seam in
+ * the level: every level triangle's corners keep their own side's uvs, so none spans the
+ * texture's width. Before, the level of the mesh welded by position took one side's uvs for
+ * both: the triangles along the seam spanned u 0..0.97, the whole texture squeezed into a
+ * strip (a visible line down a textured blob's thumbnail). */
+TEST(model_lod_level_keeps_a_texture_seam)
+{
+	enum { S = 200 };   /* 80,000 triangles */
+	uint32_t nv = (S + 1) * (S + 1), ni = 6 * S * S;
+	float *pos = malloc(nv * 12ull), *nrm = malloc(nv * 12ull), *uv = malloc(nv * 8ull);
+	uint32_t *idx = malloc(ni * 4ull), k = 0;
+	REQUIRE(pos && nrm && uv && idx);
+	for (uint32_t i = 0; i <= S; i++)
+		for (uint32_t j = 0; j <= S; j++) {
+			uint32_t v = i * (S + 1) + j;
+			double th = PI_D * i / S, ph = 2 * PI_D * (j % S) / S;   /* column S repeats column 0 */
+			float *p = pos + 3 * v;
+			p[0] = (float)(sin(th) * cos(ph)), p[1] = (float)cos(th), p[2] = (float)(-sin(th) * sin(ph));
+			if (i == 0 || i == S) p[0] = p[2] = 0.0f;
+			memcpy(nrm + 3 * v, p, 12);
+			uv[2 * v] = (float)j / S, uv[2 * v + 1] = (float)i / S;
+		}
+	for (uint32_t i = 0; i < S; i++)
+		for (uint32_t j = 0; j < S; j++) {
+			uint32_t a = i * (S + 1) + j, b = a + 1, c = a + S + 1, d = c + 1;
+			uint32_t t[6] = {a, c, b, b, c, d};
+			memcpy(idx + k, t, sizeof t);
+			k += 6;
+		}
+	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .indices = idx, .vertex_count = nv,
+	                            .index_count = ni};
+	struct api_model m = {0};
+	m.meshes = &me;
+	m.mesh_count = 1;
+	struct api_arena *a = api_arena_create();
+	size_t bytes = 0;
+	api_model_build_level(&m, 256, a, &bytes);
+	REQUIRE(me.lod_count == 1 && me.lods[0].uvs, "levels: %u", me.lod_count);
+	const struct rnd_mesh_lod *lv = &me.lods[0];
+	float widest = 0.0f;
+	for (uint32_t t = 0; t < lv->index_count; t += 3) {
+		float lo = 1.0f, hi = 0.0f;
+		bool pole = false;
+		for (int c = 0; c < 3; c++) {
+			uint32_t v = lv->indices[t + (uint32_t)c];
+			float u = lv->uvs[2 * (size_t)v];
+			lo = u < lo ? u : lo, hi = u > hi ? u : hi;
+			pole |= fabsf(lv->positions[3 * (size_t)v + 1]) > 0.999f;
+		}
+		/* (not at the poles, where every u meets at one point: any u is that point's) */
+		if (!pole) widest = hi - lo > widest ? hi - lo : widest;
+	}
+	CHECK(widest < 0.25f, "a level triangle spans %.3f of the texture's width (%u triangles)", widest,
+	      lv->index_count / 3);
+	CHECK(lv->index_count * 10 < ni, "the level keeps %u of %u triangles", lv->index_count / 3, ni / 3);
+	api_arena_destroy(a);
+	free(pos); free(nrm); free(uv); free(idx);
+}
+
 TEST(model_lod_small_meshes_get_no_levels)
 {
 	float *pos, *nrm;
