@@ -57,8 +57,9 @@ enum rnd_size_rule {
 	RND_SIZE_CASTERS,      /* a `fit` sun map or a spot's cone cut to the casters' box, or a point light's
 	                          faces, texels for where the camera sees the casters (fit_casters, plan_local.c) */
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
-	RND_SIZE_SEARCH,       /* a PCSS spot / point map: texels no finer than its blocker search reaches
-	                          the widest penumbra its casters cast (plan_local.c) */
+	RND_SIZE_SEARCH,       /* a PCSS map on the casters: texels no finer than its blocker search reaches
+	                          the widest penumbra its casters cast (plan_local.c; a sun's, fit_casters,
+	                          where that is coarser than the whole scene's) */
 	RND_SIZE_ATLAS,        /* a spot or point light's tiles as large as the atlas holds them alone */
 	RND_SIZE_RULE_COUNT
 };

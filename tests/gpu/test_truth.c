@@ -128,6 +128,40 @@ TEST(truth_plate_point_pcss_penumbra_width)
 	check_scene("plate_point", 0.02, 0.94, 0.002, 30.0);
 }
 
+/* Issue 31: a sun 14 degrees wide (11 degrees from straight down) over the same plate, 1.2 m
+ * over the ground: a penumbra 0.15 m in half-width, some 50 of the whole scene's map texels
+ * (3 mm). PCSS searches and filters 24 texels at most, and the fitted map's texels were never
+ * coarser than the scene's: the penumbra came out half as wide as the traced one (10-90 %
+ * width 4.1 px against 8.5): rmse 0.0344, iou 0.949. After (plan.c fit_casters: texels as
+ * coarse as the search needs to reach the widest penumbra, 6 mm in a 256 tile instead of 3 mm
+ * in 512): rmse 0.0075, iou 0.991, width 8.2 px. */
+TEST(truth_plate_wide_sun_pcss_penumbra_width)
+{
+	check_scene("plate_sun", 0.015, 0.97, 0.002, 30.0);
+}
+
+/* The same at `resolution: 4096`, which must be no worse. Before: rmse 0.0496, iou 0.939 (3 mm
+ * texels in a 4096 tile, the search reaching a third of the penumbra); after: the same texels
+ * and bytes as at the default size, the asked tile cut to the casters (256). */
+TEST(truth_plate_wide_sun_pcss_4096_no_worse)
+{
+	struct reference ref = {0};
+	struct rnd_image img = {0};
+	struct truth_score s;
+	char *big = NULL;
+	if (reference_load(&ref, "plate_sun")) {
+		big = truth_replaced(ref.doc, "\"filter\": \"pcss\"}", "\"filter\": \"pcss\", \"resolution\": 4096}");
+		CHECK(big, "plate_sun.json lacks the member this test edits");
+	}
+	if (big && truth_render_scored(big, ref.truth, ref.mask, ref.edge, 128, 128, &img, &s)) {
+		printf("    [plate_sun at 4096 vs traced reference] rmse %.4f, iou %.4f\n", s.rmse, s.iou);
+		CHECK(s.rmse <= 0.015 && s.iou >= 0.97, "rmse %.4f, iou %.4f", s.rmse, s.iou);
+		rnd_image_release(&img);
+	}
+	free(big);
+	reference_release(&ref);
+}
+
 /* A hard point light (no radius, the default filter: PCF, radius 1) over the same casters.
  * Before: rmse 0.0303 (iou 0.979): every shadow edge a pixel-wide ramp moved outwards — a
  * 1.5-texel normal offset shifted the lookups (o tan(theta) along the floor) and the 512-texel

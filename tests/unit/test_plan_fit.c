@@ -152,6 +152,51 @@ TEST(plan_fit_texels_finer_where_the_camera_sees_the_casters)
 	CHECK(plan[1].lights[0].size_rule == RND_SIZE_CASTERS, "size rule %u", plan[1].lights[0].size_rule);
 }
 
+/* Issue 31: a 14-degree PCSS sun over a 1 m plate 1.2 m above a 6 m ground (the traced
+ * tests/gpu/truth/plate_sun): its widest penumbra, tan(7 deg) x 1.23 m = 0.15 m in half-width,
+ * is some 50 of the whole scene's texels (3 mm) and its search reaches 24. The casters' map
+ * takes texels at least 0.15 m / 24 wide, coarser than the scene's, in the tile they need
+ * (256 here), with the search's reach as margin; an asked 4096 the same texels and tile. */
+TEST(plan_fit_wide_sun_pcss_texels_as_coarse_as_its_search_needs)
+{
+	static const float dir[3] = {0.2f, -1, 0};
+	struct rnd_aabb scene, casters;
+	set_box(&scene, -3, 0, -3, 3, 1.21f, 3);
+	set_box(&casters, -0.5f, 1.19f, -0.5f, 0.5f, 1.21f, 0.5f);
+	static struct rnd_shadow_plan whole, part, asked;
+	struct fixture f;
+	fixture_fit_sun(&f, 6.0f, dir);
+	f.light.shadow.filter = RND_FILTER_PCSS;
+	f.light.angular_diameter = 14.0f * (float)PI_D / 180.0f;
+	struct rnd_camera_plan cp;
+	struct rnd_error err = {0};
+	REQUIRE(rnd_camera_plan(&f.scene.camera, 128, 128, &scene, &cp, &err) == RND_OK, "camera: %s", err.msg);
+	REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
+	REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &part, &err) == RND_OK, "casters: %s", err.msg);
+	const struct umbra_shadow_view *w = &whole.views[0], *v = &part.views[0];
+	double len = sqrt(0.2 * 0.2 + 1.0), penumbra = tan(7.0 * PI_D / 180.0) * 1.21 * len;
+	CHECK(v->params[0] >= penumbra / 24.0 * (1.0 - 1e-4) && v->params[0] > 1.5f * w->params[0],
+	      "texel %g: the search needs %g, the whole scene's %g", v->params[0], penumbra / 24.0, w->params[0]);
+	CHECK(v->rect[2] == 256.0f && part.lights[0].size_rule == RND_SIZE_SEARCH, "tile %g, size rule %u", v->rect[2],
+	      part.lights[0].size_rule);
+	for (int i = 0; i < 8; i++) {
+		double p[3], nv[3];
+		corner(&casters, i, p);
+		ndc3(v->view_proj, p, nv);
+		for (int a = 0; a < 2; a++) {
+			double tv = (nv[a] * 0.5 + 0.5) * v->rect[2];
+			CHECK(tv >= 26.0 - 1e-3 && tv <= v->rect[2] - 26.0 + 1e-3, "corner %d axis %d at texel %.2f of %g", i, a,
+			      tv, v->rect[2]);
+		}
+	}
+	f.light.shadow.resolution = 4096;
+	REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &asked, &err) == RND_OK, "4096: %s", err.msg);
+	const struct umbra_shadow_view *a = &asked.views[0];
+	CHECK(fabsf(a->params[0] - v->params[0]) <= 1e-5f * v->params[0] && a->rect[2] == v->rect[2],
+	      "asked 4096: tile %g, texel %g; the default's %g, %g",
+	      asked.views[0].rect[2], asked.views[0].params[0], v->rect[2], v->params[0]);
+}
+
 /* A sun 7 degrees above a 30 m plane: the bounds' light-space box is ~8:1, and the fitted map
  * is that box (both axes span the map), not the square around it that left 7/8 of its rows
  * empty; a sun 60 degrees up (box under 2:1) and PCSS keep square texels. */
