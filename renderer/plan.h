@@ -91,7 +91,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
  * with the bounds of what casts shadows (casters, within bounds; empty: nothing casts), which
  * a `fit` sun map covers instead of the whole scene, in a smaller tile, with texels no coarser
  * than the whole scene's and finer where cam sees the casters close (plan.c fit_casters; a
- * light asking for a resolution under the default keeps the whole scene) (NULL: the whole
+ * light asking for a resolution gets that tile on the casters) (NULL: the whole
  * scene, as rnd_shadow_plan); atlas: the shadow atlas's side in texels (0: unknown), which
  * caps a spot or point light's tiles at what the atlas holds of them alone (RND_SIZE_ATLAS). */
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,
