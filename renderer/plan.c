@@ -315,8 +315,11 @@ float rnd_plan_kernel_texels(const struct rnd_light_plan *lp)
  * shadow pass grows at most 4x); then the tile filled (the texel shrunk until the box and the
  * filter's reach span it: the same texels, finer), except that PCSS's texels stay wide enough
  * for its 24-texel search to reach the light's widest penumbra on the scene's receivers
- * (`penumbra`), in the tile they need. A light asking for a resolution (at or above the
- * default: the caller decides) gets that tile. Issue 31: a masked checker 0.7 m over a
+ * (`penumbra`), in the tile they need, coarser than the scene's if need be. A light asking for
+ * a resolution gets that tile, filled, unless PCSS's texels are coarser than the scene's: then
+ * the tile they need. Below the default too (issue 31: a 4 cm pole on a 10 m ground under a
+ * soft sun, asked 256, had 4 cm texels over the whole ground and its shadow came out a grey
+ * line: missing_contact 0.156 with contact shadows; on the casters 0.031). Issue 31: a masked checker 0.7 m over a
  * 14 m ground had the ground's 9 mm texels in a half-empty 256 tile, about three to a pixel:
  * PCSS's narrowest disk blurred its cells' edges over a pixel (IoU 0.948 against Cycles).
  * The grid: whole texels from the light basis' origin. A moment blur clamps at the tile's edge
@@ -332,6 +335,7 @@ static void fit_casters(const struct rnd_shadow *s, const float view[16], const 
 	/* the whole scene's map's texels */
 	float tx = 2.0f * *hx * *grow / *fres, ty = 2.0f * *hy * *grow / *fres;
 	uint32_t res = 64;
+	float fill = 1.0f;   /* texels per scene texel: > 1 finer than the scene's, < 1 coarser */
 	bool cut = rnd_aabb_is_empty(casters);   /* nothing casts: the smallest tile */
 	if (!cut) {
 		struct rnd_aabb lc;
@@ -343,12 +347,22 @@ static void fit_casters(const struct rnd_shadow *s, const float view[16], const 
 		if (span / finer + 2.0f * reach + 2.0f > (float)res && 2.0f * (float)res <= *fres) res *= 2;
 		float fit = ((float)res - 2.0f * reach - 2.0f) / fmaxf(span, 1e-6f);   /* texels per scene texel */
 		/* PCSS searches and filters within search_texels: texels no finer than its widest
-		 * penumbra there, never coarser than the scene's; the tile no larger than they need */
-		float fill = fit;
-		if (lp->filter == UMBRA_FILTER_PCSS && need->penumbra > 0)
-			fill = fminf(fit, fmaxf(fmaxf(tx, ty) * lp->search_texels / need->penumbra, 1.0f));
-		while (!s->resolution && res > 64 && (float)res / 2.0f >= span * fill + 2.0f * reach + 2.0f) res /= 2;
-		if (fit >= 1.0f) {
+		 * penumbra there needs (coarser than the scene's if need be: a 14 degree sun's
+		 * penumbra 1.2 m under a plate is 50 of the scene's texels wide, and a search and
+		 * filter cut at 24 drew it half as wide as the traced one); the tile no larger than
+		 * they need */
+		float least = 1.0f;   /* the coarsest texels allowed, per scene texel */
+		fill = fit;
+		if (lp->filter == UMBRA_FILTER_PCSS && need->penumbra > 0) {
+			float search = fmaxf(tx, ty) * lp->search_texels / need->penumbra;
+			fill = fminf(fit, search);
+			least = fminf(search, 1.0f);
+		}
+		/* an asked tile too where the search's texels are coarser than the scene's: the
+		 * rest of it would cover nothing that casts, in the same texels */
+		while ((!s->resolution || fill < 1.0f) && res > 64 && (float)res / 2.0f >= span * fill + 2.0f * reach + 2.0f)
+			res /= 2;
+		if (fit >= least) {
 			cut = true;
 			tx /= fill; ty /= fill;
 			*hx = 0.5f * (float)res * tx; *hy = 0.5f * (float)res * ty;
@@ -360,7 +374,7 @@ static void fit_casters(const struct rnd_shadow *s, const float view[16], const 
 	}
 	if (!cut) res = (uint32_t)*fres;
 	lp->resolution = res;
-	if (cut) lp->size_rule = RND_SIZE_CASTERS;
+	if (cut) lp->size_rule = fill < 1.0f ? RND_SIZE_SEARCH : RND_SIZE_CASTERS;
 	*fres = (float)lp->resolution;
 }
 
@@ -382,7 +396,7 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		plan_clipmap(s, i, view, d, zmin, zmax, bounds, cam, ncasc, lp, out);
 	} else if (!cascades) {
 		/* fit: the box (fit_box) of the scene's light-space bounds, the texels it has at
-		 * the light's resolution; then, unless the light asks for a resolution, the casters'. */
+		 * the light's resolution; then the casters' (fit_casters). */
 		float cx, cy, hx, hy;
 		/* RND_DIR_CASTERS (the environment's directions): the casters' box at the light's own
 		 * resolution; as deep as the scene, which holds every receiver. */
@@ -390,7 +404,7 @@ static enum rnd_result plan_directional(const struct rnd_light *L, uint32_t i, c
 		fit_box(view, own ? casters : bounds, lp->filter, &cx, &cy, &hx, &hy);
 		float grow = 1.0f + 4.0f / fres;   /* a filter footprint of margin at the edges */
 		if (own) grow = 1.0f + 2.0f * ((lp->filter == UMBRA_FILTER_PCSS ? lp->search_texels : (float)lp->pcf_radius) + 3.0f) / fres;
-		else if (casters && (!s->resolution || s->resolution >= RND_DEFAULT_SHADOW_RESOLUTION)) {
+		else if (casters) {
 			struct fit_need need = {cam_pixel, tanf(0.5f * L->angular_diameter) * shadow_reach(d, casters, bounds)};
 			fit_casters(s, view, casters, &need, lp, &fres, &cx, &cy, &hx, &hy, &grow);
 		}

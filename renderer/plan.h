@@ -57,8 +57,9 @@ enum rnd_size_rule {
 	RND_SIZE_CASTERS,      /* a `fit` sun map or a spot's cone cut to the casters' box, or a point light's
 	                          faces, texels for where the camera sees the casters (fit_casters, plan_local.c) */
 	RND_SIZE_CAPPED,       /* the scene's max_shadow_resolution (a server's cap) */
-	RND_SIZE_SEARCH,       /* a PCSS spot / point map: texels no finer than its blocker search reaches
-	                          the widest penumbra its casters cast (plan_local.c) */
+	RND_SIZE_SEARCH,       /* a PCSS map on the casters: texels no finer than its blocker search reaches
+	                          the widest penumbra its casters cast (plan_local.c; a sun's, fit_casters,
+	                          where that is coarser than the whole scene's) */
 	RND_SIZE_ATLAS,        /* a spot or point light's tiles as large as the atlas holds them alone */
 	RND_SIZE_RULE_COUNT
 };
@@ -90,7 +91,7 @@ enum rnd_result rnd_shadow_plan(const struct rnd_scene *scene, const struct rnd_
  * with the bounds of what casts shadows (casters, within bounds; empty: nothing casts), which
  * a `fit` sun map covers instead of the whole scene, in a smaller tile, with texels no coarser
  * than the whole scene's and finer where cam sees the casters close (plan.c fit_casters; a
- * light asking for a resolution under the default keeps the whole scene) (NULL: the whole
+ * light asking for a resolution gets that tile on the casters) (NULL: the whole
  * scene, as rnd_shadow_plan); atlas: the shadow atlas's side in texels (0: unknown), which
  * caps a spot or point light's tiles at what the atlas holds of them alone (RND_SIZE_ATLAS). */
 enum rnd_result rnd_shadow_plan_with(const struct rnd_scene *scene, const struct rnd_aabb *bounds,

@@ -128,6 +128,40 @@ TEST(truth_plate_point_pcss_penumbra_width)
 	check_scene("plate_point", 0.02, 0.94, 0.002, 30.0);
 }
 
+/* Issue 31: a sun 14 degrees wide (11 degrees from straight down) over the same plate, 1.2 m
+ * over the ground: a penumbra 0.15 m in half-width, some 50 of the whole scene's map texels
+ * (3 mm). PCSS searches and filters 24 texels at most, and the fitted map's texels were never
+ * coarser than the scene's: the penumbra came out half as wide as the traced one (10-90 %
+ * width 4.1 px against 8.5): rmse 0.0344, iou 0.949. After (plan.c fit_casters: texels as
+ * coarse as the search needs to reach the widest penumbra, 6 mm in a 256 tile instead of 3 mm
+ * in 512): rmse 0.0075, iou 0.991, width 8.2 px. */
+TEST(truth_plate_wide_sun_pcss_penumbra_width)
+{
+	check_scene("plate_sun", 0.015, 0.97, 0.002, 30.0);
+}
+
+/* The same at `resolution: 4096`, which must be no worse. Before: rmse 0.0496, iou 0.939 (3 mm
+ * texels in a 4096 tile, the search reaching a third of the penumbra); after: the same texels
+ * and bytes as at the default size, the asked tile cut to the casters (256). */
+TEST(truth_plate_wide_sun_pcss_4096_no_worse)
+{
+	struct reference ref = {0};
+	struct rnd_image img = {0};
+	struct truth_score s;
+	char *big = NULL;
+	if (reference_load(&ref, "plate_sun")) {
+		big = truth_replaced(ref.doc, "\"filter\": \"pcss\"}", "\"filter\": \"pcss\", \"resolution\": 4096}");
+		CHECK(big, "plate_sun.json lacks the member this test edits");
+	}
+	if (big && truth_render_scored(big, ref.truth, ref.mask, ref.edge, 128, 128, &img, &s)) {
+		printf("    [plate_sun at 4096 vs traced reference] rmse %.4f, iou %.4f\n", s.rmse, s.iou);
+		CHECK(s.rmse <= 0.015 && s.iou >= 0.97, "rmse %.4f, iou %.4f", s.rmse, s.iou);
+		rnd_image_release(&img);
+	}
+	free(big);
+	reference_release(&ref);
+}
+
 /* A hard point light (no radius, the default filter: PCF, radius 1) over the same casters.
  * Before: rmse 0.0303 (iou 0.979): every shadow edge a pixel-wide ramp moved outwards — a
  * 1.5-texel normal offset shifted the lookups (o tan(theta) along the floor) and the 512-texel
@@ -160,7 +194,11 @@ TEST(truth_grazing_sun_default_filter)
  * reference has lit; the same request gives the same bytes; the EXR shadow AOV carries the
  * same visibility as the debug view. Measured: missing_contact 0.531 off, 0.313 on; rmse
  * 0.191 -> 0.154; iou 0.485 -> 0.674; false_core 0 both. Before contact shadows were rendered
- * the request was a 422 and this test failed at the first render. */
+ * the request was a 422 and this test failed at the first render. The map is one clipmap
+ * level 8 m wide (128 texels over the whole ground): since issue 31 an asked `fit` size is
+ * spent on the casters' box (1.5 cm texels here, missing_contact 0.014 without contact
+ * shadows), which leaves them nothing to give back; with the clipmap level: 0.346 off, 0.187
+ * on, rmse 0.138 -> 0.113. */
 TEST(truth_contact_shadows_sun_low_res_map)
 {
 	const int w = 128, h = 128;
@@ -291,4 +329,16 @@ TEST(truth_thin_pole_contact_cascades_256)
 TEST(truth_grazing_front_no_false_contact)
 {
 	check_pole_reference("pole_grazing_front", 0.09);
+}
+
+/* A 4 cm pole leaning 25 degrees under a sun 0.5 degrees wide, 20 degrees up in front of the
+ * camera, seen from 2.5 m, `resolution: 256`, contact on (issue 31, thin-pole contact; case
+ * pole-r2-sun0.5-e20-front-lean-near of tests/truth-scenes/poles.py). The asked 256 covered
+ * the whole 10 m ground (4 cm texels, the pole's width): its 3 m shadow came out a grey line at
+ * visibility 0.5-0.6, and beside the pole's image, far up its length, no contact march reaches
+ * it: missing_contact 0.156 (5 of 32 px), rmse 0.0513. After (an asked size spent on the
+ * casters' box, plan.c fit_casters): 0.031, rmse 0.0084. */
+TEST(truth_thin_pole_soft_sun_asked_256_on_the_casters)
+{
+	check_pole_reference("pole_soft_sun_lean", 0.02);
 }

@@ -58,9 +58,9 @@ TEST(plan_fit_covers_scene_bounds)
  * casters): the fitted map is a smaller tile around the casters (at most 1024, 2048 under a
  * sun 8 degrees up, whose map is a long box) with texels no coarser than the default map's
  * around the whole scene, on whole texels from the light basis' origin, with the filter's
- * reach as margin; a light that asks for less than the default resolution keeps the whole
- * scene, one that asks for more spends it on the casters (finer than the default's); no
- * caster at all gives the smallest tile. */
+ * reach as margin; a light that asks for a resolution spends it on the casters, less than
+ * the default too (issue 31: it kept the whole scene, texels 20 times coarser here), more than
+ * it finer than the default's; no caster at all gives the smallest tile. */
 TEST(plan_fit_covers_the_casters_on_whole_texels)
 {
 	static const float dirs[][3] = {{-0.5f, -1, -0.3f}, {0.2f, -1, 0.1f}, {1, -0.15f, 0.3f}};
@@ -112,8 +112,9 @@ TEST(plan_fit_covers_the_casters_on_whole_texels)
 			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &asked, &err) == RND_OK, "asked: %s",
 			        err.msg);
 			REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
-			CHECK(!memcmp(&asked.views[0], &whole.views[0], sizeof asked.views[0]),
-			      "dir %d: an asked-for resolution under the default must keep the whole scene's map", di);
+			CHECK(asked.views[0].rect[2] == 1024.0f && asked.views[0].params[0] < 0.5f * whole.views[0].params[0],
+			      "dir %d filter %d: asked 1024: tile %g, texel %g, the whole scene's at 1024 %g", di, fi,
+			      asked.views[0].rect[2], asked.views[0].params[0], whole.views[0].params[0]);
 			f.light.shadow.resolution = 4096;
 			REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &asked, &err) == RND_OK, "4096: %s",
 			        err.msg);
@@ -150,6 +151,51 @@ TEST(plan_fit_texels_finer_where_the_camera_sees_the_casters)
 	CHECK(near->params[0] < 0.6f * far->params[0], "texel %g from 1.5 m, %g from 40 m", near->params[0], far->params[0]);
 	CHECK(near->rect[2] <= 2.0f * far->rect[2], "tile %g from 1.5 m, %g from 40 m", near->rect[2], far->rect[2]);
 	CHECK(plan[1].lights[0].size_rule == RND_SIZE_CASTERS, "size rule %u", plan[1].lights[0].size_rule);
+}
+
+/* Issue 31: a 14-degree PCSS sun over a 1 m plate 1.2 m above a 6 m ground (the traced
+ * tests/gpu/truth/plate_sun): its widest penumbra, tan(7 deg) x 1.23 m = 0.15 m in half-width,
+ * is some 50 of the whole scene's texels (3 mm) and its search reaches 24. The casters' map
+ * takes texels at least 0.15 m / 24 wide, coarser than the scene's, in the tile they need
+ * (256 here), with the search's reach as margin; an asked 4096 the same texels and tile. */
+TEST(plan_fit_wide_sun_pcss_texels_as_coarse_as_its_search_needs)
+{
+	static const float dir[3] = {0.2f, -1, 0};
+	struct rnd_aabb scene, casters;
+	set_box(&scene, -3, 0, -3, 3, 1.21f, 3);
+	set_box(&casters, -0.5f, 1.19f, -0.5f, 0.5f, 1.21f, 0.5f);
+	static struct rnd_shadow_plan whole, part, asked;
+	struct fixture f;
+	fixture_fit_sun(&f, 6.0f, dir);
+	f.light.shadow.filter = RND_FILTER_PCSS;
+	f.light.angular_diameter = 14.0f * (float)PI_D / 180.0f;
+	struct rnd_camera_plan cp;
+	struct rnd_error err = {0};
+	REQUIRE(rnd_camera_plan(&f.scene.camera, 128, 128, &scene, &cp, &err) == RND_OK, "camera: %s", err.msg);
+	REQUIRE(rnd_shadow_plan(&f.scene, &scene, &cp, &whole, &err) == RND_OK, "whole: %s", err.msg);
+	REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &part, &err) == RND_OK, "casters: %s", err.msg);
+	const struct umbra_shadow_view *w = &whole.views[0], *v = &part.views[0];
+	double len = sqrt(0.2 * 0.2 + 1.0), penumbra = tan(7.0 * PI_D / 180.0) * 1.21 * len;
+	CHECK(v->params[0] >= penumbra / 24.0 * (1.0 - 1e-4) && v->params[0] > 1.5f * w->params[0],
+	      "texel %g: the search needs %g, the whole scene's %g", v->params[0], penumbra / 24.0, w->params[0]);
+	CHECK(v->rect[2] == 256.0f && part.lights[0].size_rule == RND_SIZE_SEARCH, "tile %g, size rule %u", v->rect[2],
+	      part.lights[0].size_rule);
+	for (int i = 0; i < 8; i++) {
+		double p[3], nv[3];
+		corner(&casters, i, p);
+		ndc3(v->view_proj, p, nv);
+		for (int a = 0; a < 2; a++) {
+			double tv = (nv[a] * 0.5 + 0.5) * v->rect[2];
+			CHECK(tv >= 26.0 - 1e-3 && tv <= v->rect[2] - 26.0 + 1e-3, "corner %d axis %d at texel %.2f of %g", i, a,
+			      tv, v->rect[2]);
+		}
+	}
+	f.light.shadow.resolution = 4096;
+	REQUIRE(rnd_shadow_plan_with(&f.scene, &scene, &casters, &cp, NULL, 0, &asked, &err) == RND_OK, "4096: %s", err.msg);
+	const struct umbra_shadow_view *a = &asked.views[0];
+	CHECK(fabsf(a->params[0] - v->params[0]) <= 1e-5f * v->params[0] && a->rect[2] == v->rect[2],
+	      "asked 4096: tile %g, texel %g; the default's %g, %g",
+	      asked.views[0].rect[2], asked.views[0].params[0], v->rect[2], v->params[0]);
 }
 
 /* A sun 7 degrees above a 30 m plane: the bounds' light-space box is ~8:1, and the fitted map
