@@ -31,7 +31,7 @@ struct draw {
 	bool single_sided;   /* double_sided: false */
 	bool masked;         /* alpha_mode MASK or BLEND (dithered): alpha-tested depth passes */
 	uint32_t texture_set; /* slot->texture_sets index: 0 = white, 1 + i = textured material i */
-	uint32_t tex_bits;    /* (1 << UMBRA_TEX_*) its material samples | UMBRA_TEXBIT_VERTEX_COLOR */
+	uint32_t tex_bits;    /* (1 << UMBRA_TEX_*) its material samples (| UMBRA_TEXBIT_UV1) */
 };
 
 #endif

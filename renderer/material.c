@@ -225,8 +225,6 @@ enum rnd_result rnd_material_textures(struct rnd_context *ctx, struct rnd_slot *
 				/* the uv1 path only where the scene has the set (else binding 1 is uv0) */
 				if (sc->materials[mi].sampling[k].uv_set == 1 && s->has_uv1) draws[i].tex_bits |= UMBRA_TEXBIT_UV1;
 			}
-		if (sc->objects[i].shape == RND_SHAPE_MESH && sc->objects[i].colors)
-			draws[i].tex_bits |= UMBRA_TEXBIT_VERTEX_COLOR;
 	}
 	VkDeviceSize bytes = 0, off = 0;
 	for (uint32_t i = 0; i < p->n; i++) bytes += rnd_texture_chain_bytes(tex[i]->width, tex[i]->height);

@@ -188,7 +188,6 @@ static enum rnd_result plan_draw(struct rnd_plan *p, uint32_t i, uint64_t *kept,
 	d->texture_set = 0; /* the upload's (material.c rnd_material_textures) */
 	/* the slots its material samples (material.c sets the same, and the second uv set's bit) */
 	d->tex_bits = sc->material_count ? rnd_material_slot_bits(&sc->materials[o->material]) : 0;
-	if (o->shape == RND_SHAPE_MESH && o->colors) d->tex_bits |= UMBRA_TEXBIT_VERTEX_COLOR;
 	d->single_sided = !o->double_sided;
 	d->closed = o->shape == RND_SHAPE_SPHERE || o->shape == RND_SHAPE_BOX || o->shape == RND_SHAPE_CYLINDER ||
 	            (o->shape == RND_SHAPE_MESH && o->closed);

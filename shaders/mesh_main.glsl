@@ -15,7 +15,7 @@ umbra_material draw_material()
 	m.emissive = pc.emissive;
 	m.params = pc.params;
 	m.tex = pc.tex;
-	if ((SC_TEXTURES & ~(UMBRA_TEXBIT_VERTEX_COLOR | UMBRA_TEXBIT_UV1)) != 0u) m.uvx = materials[pc.info.x].uvx;
+	if ((SC_TEXTURES & ~UMBRA_TEXBIT_UV1) != 0u) m.uvx = materials[pc.info.x].uvx;
 	if (SC_MATERIAL_EXT != 0u) {   // the extensions' members, where a drawn material has one (material_ext.glsl)
 		m.clearcoat = materials[pc.info.x].clearcoat;
 		m.sheen = materials[pc.info.x].sheen;

@@ -55,7 +55,7 @@ layout(constant_id = UMBRA_SC_TONEMAP) const uint SC_TONEMAP = 0u;     // UMBRA_
 layout(constant_id = UMBRA_SC_CATCHER) const uint SC_CATCHER = 0u;     // scene has shadow catchers
 layout(constant_id = UMBRA_SC_LIGHT_TYPES) const uint SC_LIGHT_TYPES = 7u; // bit (1 << UMBRA_LIGHT_*)
 layout(constant_id = UMBRA_SC_CASCADES) const uint SC_CASCADES = 1u;   // any directional light has cascades
-layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 16383u; // bit (1 << UMBRA_TEX_*) | vertex colour | uv1
+layout(constant_id = UMBRA_SC_TEXTURES) const uint SC_TEXTURES = 8191u; // bit (1 << UMBRA_TEX_*) | uv1
 layout(constant_id = UMBRA_SC_MASKED) const uint SC_MASKED = 6u;       // bit (1 << UMBRA_ALPHA_*)
 layout(constant_id = UMBRA_SC_CONTACT) const uint SC_CONTACT = 0u;     // any light marches contact shadows
 layout(constant_id = UMBRA_SC_PCF_RADIUS) const uint SC_PCF_RADIUS = 0u; // 1 + the PCF radius all lights share; 0: per light
@@ -481,7 +481,7 @@ vec4 base_color(umbra_material m)
 {
 	vec4 c = m.base_color;
 	if (has_tex(m, UMBRA_TEX_BASE)) c *= material_texture(base_texture, m, UMBRA_TEX_BASE, v_uv, v_uv1);
-	if ((SC_TEXTURES & UMBRA_TEXBIT_VERTEX_COLOR) != 0u) c *= v_color;
+	c *= v_color;   // (white where a mesh has no colours: mesh.c)
 	if (has_tex(m, UMBRA_TEX_TRANSMISSION))
 		c.a *= see_through_keep(transmission_texture, m, materials[pc.info.x].ext.z, v_uv, v_uv1);
 	if (SC_MASKED != 0u && m.tex.y != UMBRA_ALPHA_OPAQUE && !alpha_keep(m, c.a, gl_FragCoord.xy)) discard;

@@ -112,10 +112,11 @@
 #define UMBRA_BINDING_OCCLUSION_TEXTURE  UMBRA_TEX_OCCLUSION
 #define UMBRA_BINDING_EMISSIVE_TEXTURE   UMBRA_TEX_EMISSIVE
 /* umbra_material.tex.x: bit (1 << UMBRA_TEX_*) per texture the material samples; the same
- * bits, ORed over a scene, make UMBRA_SC_TEXTURES, plus this one for vertex colours. */
-#define UMBRA_TEXBIT_VERTEX_COLOR    (1u << UMBRA_TEX_SLOTS)
-/* ... and this one when a textured slot of a drawn material reads the second uv set (the
- * scene then has a uv1 vertex buffer; without it the shaders never read location UV1). */
+ * bits, ORed over a scene, make UMBRA_SC_TEXTURES, and this one when a textured slot of a
+ * drawn material reads the second uv set (the scene then has a uv1 vertex buffer; without it
+ * the shaders never read location UV1). Vertex colours have no bit: every vertex has one
+ * (white where the mesh has none, renderer/mesh.c) and the main pass always multiplies by it,
+ * so a coloured mesh needs no pipeline variant of its own. */
 #define UMBRA_TEXBIT_UV1             (1u << (UMBRA_TEX_SLOTS + 1))
 /* umbra_material.tex.x, bit (1 << (UMBRA_TEX_UV1_SHIFT + UMBRA_TEX_*)): that slot samples
  * the second uv set (glTF TEXCOORD_1) instead of the first. */
@@ -190,7 +191,7 @@
 #define UMBRA_SC_CATCHER     4
 #define UMBRA_SC_LIGHT_TYPES 5
 #define UMBRA_SC_CASCADES    6
-#define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_VERTEX_COLOR | UMBRA_TEXBIT_UV1 */
+#define UMBRA_SC_TEXTURES    7    /* bits (1 << UMBRA_TEX_*) | UMBRA_TEXBIT_UV1 */
 #define UMBRA_SC_MASKED      8    /* bit (1 << UMBRA_ALPHA_*) of the alpha modes in the scene */
 #define UMBRA_SC_CONTACT     9    /* any light marches contact shadows (scene depth bound) */
 #define UMBRA_SC_PCF_RADIUS  10   /* 2 when every PCF-filtered light has the default radius 1; 0: read per light */

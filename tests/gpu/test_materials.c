@@ -133,6 +133,31 @@ TEST(materials_vertex_color_multiplies_base)
 	rnd_image_release(&img);
 }
 
+/* Vertex colours need no pipeline of their own: the main pass multiplies by the vertex colour
+ * always (white where a mesh has none, renderer/mesh.c). The same quad drawn with and without
+ * COLOR_0 uses the same variants: the coloured one compiles nothing and adds none. Before, a
+ * scene's first vertex-coloured mesh compiled a main-pass variant (~190 ms on lavapipe, and
+ * ~14 MB kept): a farm's first coloured PLY waited for it. */
+TEST(materials_vertex_color_compiles_no_variant_of_its_own)
+{
+	static const float red[16] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
+	const char *mat = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],\"metallicFactor\":0,"
+	                  "\"roughnessFactor\":0.7}}";
+	struct mglb plain = {.material = mat, .uscale = 3}, coloured = {.material = mat, .uscale = 3, .color = red};
+	struct rnd_image img;
+	if (!render_quad(__LINE__, &img, &plain, true, false)) return;
+	rnd_image_release(&img);
+	struct rnd_stats before, after;
+	rnd_context_stats(gpu_ctx(), &before);
+	if (!render_quad(__LINE__, &img, &coloured, true, false)) return;
+	rnd_context_stats(gpu_ctx(), &after);
+	double r = lin_at(&img, false, 0.3, 0.2, 0), gr = lin_at(&img, false, 0.3, 0.2, 1);
+	CHECK(r > 0.9 && gr < 0.05, "the colour is drawn: %.3f %.3f", r, gr);
+	CHECK(after.pipeline_variants == before.pipeline_variants, "variants %u -> %u", before.pipeline_variants,
+	      after.pipeline_variants);
+	rnd_image_release(&img);
+}
+
 /* ---- metallic-roughness texture ---- */
 
 /* A 2x1 MR texture: left texel B 255 (metallic 1), right B 0 (metallic 0); G 255 (roughness
