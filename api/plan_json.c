@@ -161,6 +161,7 @@ static json_t *actual_object(const struct rnd_plan_info *in, const struct api_pl
 	                      (json_int_t)a->visibility_views, "pixel_shaded_views", (json_int_t)a->pixel_shaded_views,
 	                      "sphere_proxies", (json_int_t)a->sphere_proxies);
 	if (o) put(o, "shadow_submits", json_integer((json_int_t)a->shadow_submits));
+	if (o) put(o, "env_passes_reused", json_integer((json_int_t)a->env_passes_reused));
 	if (o && t && t->parse_ms >= 0) put(o, "parse_ms", ms(t->parse_ms));
 	if (o && t && t->encode_ms >= 0) put(o, "encode_ms", ms(t->encode_ms));
 	if (o && t && t->total_ms >= 0) put(o, "total_ms", ms(t->total_ms));

@@ -34,6 +34,7 @@ void rnd_env_pass_size(uint32_t w, uint32_t h, uint32_t *pw, uint32_t *ph)
 
 void rnd_env_pass_release(struct rnd_context *ctx, struct rnd_slot *s)
 {
+	s->env_pass_key = 0;
 	rnd_image_destroy(ctx, &s->env_surfaces);
 	rnd_image_destroy(ctx, &s->env_normals);
 	rnd_image_destroy(ctx, &s->env_depth);
@@ -64,6 +65,21 @@ enum rnd_result rnd_slot_env_pass(struct rnd_context *ctx, struct rnd_slot *s, u
 		}
 	}
 	return RND_OK;
+}
+
+uint64_t rnd_env_pass_key(const struct rnd_slot *s, const struct record_view *rv, const uint64_t *map_keys,
+                          uint32_t nmaps, uint64_t vertex_bytes, uint64_t index_bytes)
+{
+	uint32_t size[3];
+	rnd_env_pass_size(rv->sc->width, rv->sc->height, &size[0], &size[1]);
+	size[2] = rnd_env_pass_scale(rv->sc->width, rv->sc->height);
+	uint64_t h = rnd_hash(0x656e762070617373ull, size, sizeof size);
+	h = rnd_hash(h, s->params.map, (size_t)s->params_used);
+	h = rnd_hash(h, map_keys, nmaps * sizeof *map_keys);
+	h = rnd_hash(h, rv->draws, rv->ndraw * sizeof *rv->draws);
+	h = rnd_hash(h, s->vertices.cpu, (size_t)vertex_bytes);
+	h = rnd_hash(h, s->indices.cpu, (size_t)index_bytes);
+	return h ? h : 1;
 }
 
 /* The visibility over the whole grid into env_vis, from the surfaces just drawn. */

@@ -332,6 +332,7 @@ enum rnd_result rnd_frame_write(struct rnd_context *ctx, struct rnd_slot *s, con
 	if (r != RND_OK) return r;
 	uint8_t *base = s->params.map;
 	memset(base, 0, lay.total);
+	s->params_used = lay.total;
 	/* The environment's directions come after the scene's lights (render.c): lights, but not
 	 * shaded as such (ibl.glsl reads their maps). */
 	uint32_t env_lights = env ? env->mapped : 0, shaded = sc->light_count - env_lights;

@@ -51,6 +51,7 @@ struct record_view {
 	const struct rnd_light *shadow_lights;
 	const struct rnd_env_use *env;  /* the view's environment (NULL: none) */
 	bool env_pass;                 /* its shadows from the environment pass (env_pass.c), drawn once */
+	bool env_pass_reused;          /* that pass's images as the slot holds them (env_pass.h): not drawn */
 };
 
 /* The rows of the view that this submit draws (band_y, band_h). */

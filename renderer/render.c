@@ -254,6 +254,20 @@ static enum rnd_result place_tiles(struct render *rq, uint32_t v, struct rnd_err
 	return rnd_slot_shadow_scratch(ctx, rq->s, max_res, err);
 }
 
+/* The key of the view's environment pass (env_pass.h) once its constants are written; 0 where the
+ * slot's images are not to be reused (UMBRA_ENV_PASS_REUSE=0: comparisons and tests). */
+static uint64_t env_pass_key(const struct render *rq)
+{
+	const char *e = getenv("UMBRA_ENV_PASS_REUSE");
+	if (e && strcmp(e, "0") == 0) return 0;
+	const struct rnd_plan *p = rq->plan;
+	uint64_t keys[UMBRA_MAX_LIGHTS];
+	for (uint32_t k = 0; k < p->nmaps; k++) keys[k] = p->maps[k].key;
+	struct record_view rv = {.sc = rq->sc, .draws = rq->draws, .ndraw = rq->sc->object_count};
+	return rnd_env_pass_key(rq->s, &rv, keys, p->nmaps, p->vertices * sizeof(struct rnd_vertex),
+	                        p->indices * sizeof(uint32_t));
+}
+
 /* View v as planned: its tiles placed, its constants written, recorded and submitted. */
 static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_error *err)
 {
@@ -289,6 +303,11 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 	                         err)) != RND_OK)
 		return r;
 
+	uint64_t env_key = vp->env_pass ? env_pass_key(rq) : 0;
+	bool env_reused = env_key && env_key == s->env_pass_key;
+	if (!env_reused) s->env_pass_key = 0;   /* its images are drawn again (or not this view's) */
+	if (env_reused) rq->tm.env_passes_reused++;
+
 	uint32_t col = v % sh->cols, row = v / sh->cols;
 	VkDeviceSize cell = ((VkDeviceSize)row * sc->height * sh->width + (VkDeviceSize)col * sc->width);
 	struct record_view rv = {
@@ -297,11 +316,12 @@ static enum rnd_result render_view(struct render *rq, uint32_t v, struct rnd_err
 		.sheet_width = (uint32_t)sh->width, .pixel_bytes = (uint32_t)sh->px, .contact = vp->contact, .vis = passes,
 		.deferred = vp->deferred, .map_ms = rq->map_ms, .map_tris = rq->map_tris, .row_ms = vp->row_ms,
 		.band_ms = vp->band_ms, .drawn_camera = &rq->tm.camera_triangles, .drawn_shadow = &rq->tm.shadow_triangles,
-		.shadow_lights = p->esc.lights, .env = &rq->env, .env_pass = vp->env_pass,
+		.shadow_lights = p->esc.lights, .env = &rq->env, .env_pass = vp->env_pass, .env_pass_reused = env_reused,
 	};
 	double shadow0 = rq->tm.shadow_ms, main0 = rq->tm.main_ms;
 	uint32_t bands0 = rq->pacer.measured;
 	r = rnd_submit_view(ctx, s, &rv, &rq->pacer, &rq->tm, &rq->gpu_busy, err);
+	if (r == RND_OK && env_key) s->env_pass_key = env_key;   /* its submits completed */
 	p->actual.shadow_ms[v] = rq->tm.shadow_ms - shadow0;
 	p->actual.main_ms[v] = rq->tm.main_ms - main0;
 	p->actual.bands[v] = rq->pacer.measured - bands0;

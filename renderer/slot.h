@@ -61,6 +61,11 @@ struct rnd_slot {
 	struct rnd_image_res shading, shaded;
 	/* the environment pass (env_pass.c): the surfaces at its scale, their depth, its visibility */
 	struct rnd_image_res env_surfaces, env_normals, env_depth, env_vis;
+	/* What those images hold (rnd_env_pass_key of the view that drew them), set only once the
+	 * submit that drew them completed; 0: nothing to reuse (never drawn, being redrawn, a
+	 * failed render, the images made again). */
+	uint64_t env_pass_key;
+	VkDeviceSize params_used;     /* bytes of `params` this render's rnd_frame_write wrote */
 };
 
 /* Makes the colour/depth targets match (format, w, h, samples). */

@@ -338,7 +338,7 @@ enum rnd_result rnd_submit_view(struct rnd_context *ctx, struct rnd_slot *s, con
 		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
 		record_scene_depth(ctx, s, rv);
 	}
-	if (rv->env_pass) {
+	if (rv->env_pass && !rv->env_pass_reused) {
 		if ((r = cmd_open(s, p, &st, err)) != RND_OK) goto fail;
 		if ((r = record_env_pass(ctx, s, rv, err)) != RND_OK) goto fail;
 	}

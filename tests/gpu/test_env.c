@@ -138,6 +138,48 @@ TEST(env_map_built_once_and_its_shadow_maps_reused)
 	gpu_asset_root = NULL;
 }
 
+/* The environment pass's images are reused by a request that comes back with the same inputs
+ * (env_pass.h rnd_env_pass_key), never by one whose geometry or camera moved, and a reused pass
+ * gives the bytes a drawn one gives. */
+static bool env_pass_render(struct rnd_image *img, const char *box, const char *cam, uint32_t *reused)
+{
+	bool ok = gpu_render(img, "{'width': 48, 'height': 48, 'camera': {'position': %s, 'target': [0, 0.3, 0]},"
+	                          "'environment': {'map': {'path': 'patch.hdr', 'rotation': 17}, 'shadow': {'directions': 6}},"
+	                          "'objects': [{'shape': 'plane', 'size': [4, 4]}, {'shape': 'box', 'size': [0.6, 0.6, 0.6],"
+	                          " 'transform': {'translation': %s}}], 'output': {'msaa': 1}}", cam, box);
+	*reused = ok ? gpu_last_timings.env_passes_reused : 99;
+	return ok;
+}
+
+TEST(env_pass_reused_only_for_the_same_inputs)
+{
+	gpu_asset_root = env_root();
+	const char *box = "[0, 0.3, 0]", *moved = "[0.05, 0.3, 0]", *cam = "[3, 2, 3]", *cam2 = "[3, 2.1, 3]";
+	struct rnd_image a1, a2, b, c, a3, a4;
+	uint32_t r[6];
+	bool ok = env_pass_render(&a1, box, cam, &r[0]);
+	ok = env_pass_render(&a2, box, cam, &r[1]) && ok;
+	ok = env_pass_render(&b, moved, cam, &r[2]) && ok;
+	ok = env_pass_render(&c, moved, cam2, &r[3]) && ok;
+	ok = env_pass_render(&a3, box, cam, &r[4]) && ok;
+	setenv("UMBRA_ENV_PASS_REUSE", "0", 1);
+	ok = env_pass_render(&a4, box, cam, &r[5]) && ok;
+	unsetenv("UMBRA_ENV_PASS_REUSE");
+	if (ok) {
+		printf("  passes reused: %u %u %u %u %u %u\n", r[0], r[1], r[2], r[3], r[4], r[5]);
+		CHECK(r[1] == 1, "the same request again: its pass reused (%u)", r[1]);
+		CHECK(r[2] == 0 && r[3] == 0, "the box moved, then the camera: drawn (%u, %u)", r[2], r[3]);
+		CHECK(r[4] == 0 && r[5] == 0, "after another scene, and with reuse off: drawn (%u, %u)", r[4], r[5]);
+		CHECK(gpu_bytes_differ(&a1, &a2, NULL) == 0, "reused: the bytes of the drawn pass");
+		CHECK(gpu_bytes_differ(&a1, &a3, NULL) == 0 && gpu_bytes_differ(&a1, &a4, NULL) == 0,
+		      "drawn again, with and without reuse: the same bytes");
+		CHECK(gpu_bytes_differ(&a1, &b, NULL) > 0 && gpu_bytes_differ(&b, &c, NULL) > 0, "the moves show");
+	}
+	struct rnd_image *all[6] = {&a1, &a2, &b, &c, &a3, &a4};
+	for (int i = 0; i < 6; i++) rnd_image_release(all[i]);
+	gpu_asset_root = NULL;
+}
+
 /* ---- shadows against Cycles ---- */
 
 struct env_score {

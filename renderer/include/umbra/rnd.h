@@ -378,6 +378,8 @@ struct rnd_timings {
 	uint32_t shadow_submits;   /* submits of shadow maps alone, whole or in parts (0: one submit drew
 	                              them with the main pass, as without a deadline) */
 	uint32_t env_directions;   /* environment shadow directions drawn (maps rendered or reused) */
+	uint32_t env_passes_reused; /* views whose environment pass (renderer/env_pass.h) the slot still held
+	                               from a render of the same inputs: not drawn again */
 	double env_ms;             /* this render's share of preparing the environment (CPU analysis and
 	                              the device's prefiltering, once per map: 0 when it was ready) */
 	double targets_ms;         /* the slot's colour/depth targets, AOV images and readback buffer:
