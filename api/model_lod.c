@@ -156,7 +156,7 @@ static bool weld(const struct api_model_mesh *me, uint32_t *idx, struct welded *
  * mean of all face normals around the corner's vertex when that is within 30 degrees of its own
  * face's (or its face is a sliver, whose own normal is noise), else the mean of those within 30
  * degrees of its face's (smooth across the fine facets of a curved surface, a crease at a real
- * edge). Face normals follow the file's normals where the winding disagrees. */
+ * edge). Face normals follow the winding, all turned when most disagree with the file's normals. */
 static bool corner_normals(const struct api_model_mesh *me, const struct welded *w, const uint32_t *idx, size_t ni,
                            float *nrm)
 {
@@ -164,18 +164,25 @@ static bool corner_normals(const struct api_model_mesh *me, const struct welded 
 	uint32_t *start = calloc(w->count + 1, sizeof *start), *faces = malloc(ni * sizeof *faces);
 	float *fn = malloc(nt * 12);
 	bool ok = start && faces && fn;
+	size_t against = 0;
 	for (size_t t = 0; ok && t < nt; t++) {
 		const float *a = w->pos + 3 * idx[3 * t], *b = w->pos + 3 * idx[3 * t + 1], *c = w->pos + 3 * idx[3 * t + 2];
 		float e1[3], e2[3];
 		rnd_v3_sub(e1, b, a);
 		rnd_v3_sub(e2, c, a);
 		rnd_v3_cross(fn + 3 * t, e1, e2);
-		/* Winding can disagree with the file's normals: the file's normals say outside. */
 		float ref[3] = {0, 0, 0};
 		for (int k = 0; k < 3; k++) rnd_v3_add(ref, ref, me->normals + 3 * (size_t)w->rep[idx[3 * t + k]]);
-		if (rnd_v3_dot(ref, fn + 3 * t) < 0.0f) rnd_v3_scale(fn + 3 * t, fn + 3 * t, -1.0f);
+		against += rnd_v3_dot(ref, fn + 3 * t) < 0.0f;
 		for (int k = 0; k < 3; k++) start[idx[3 * t + k] + 1]++;
 	}
+	/* The winding can disagree with the file's normals, which say outside: then every face is
+	 * turned, by the vote of them all. Not face by face: a few wrong normals in a file (the
+	 * corpus terrain's border rows point down) turned whole level faces over them, and the
+	 * renderer, which lights a double-sided face seen from behind on its other side, drew them
+	 * as dark teeth along the border. */
+	if (ok && 2 * against > nt)
+		for (size_t k = 0; k < 3 * nt; k++) fn[k] = -fn[k];
 	if (ok) {
 		/* faces around each vertex, grouped (counting sort) */
 		for (size_t v = 0; v < w->count; v++) start[v + 1] += start[v];
