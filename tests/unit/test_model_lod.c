@@ -178,60 +178,26 @@ TEST(model_lod_error_ignores_a_part_close_by)
 	free(pos); free(nrm); free(idx); free(pos2); free(nrm2); free(idx2); free(p); free(n); free(x);
 }
 
-/* Both uv sets travel into the levels: each level vertex has the uvs of a full-mesh vertex at
- * its position (here uv = (x, y), uv1 = (z, x + y): a function of the position, so exact). */
-TEST(model_lod_levels_carry_both_uv_sets)
+/* Both uv sets and the tangents (a normal map's) travel into the levels: each level vertex has
+ * those of a full-mesh vertex at its position (here uv = (x, y), uv1 = (z, x + y), the tangent
+ * (-z, 0, x) with w the hemisphere's sign: functions of the position, so exact). A mesh with
+ * tangents had no level at all before: it drew every triangle into every thumbnail and its
+ * environment maps. */
+TEST(model_lod_levels_carry_uv_sets_and_tangents)
 {
 	float *pos, *nrm;
 	uint32_t *idx, nv, ni;
 	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni);
-	float *uv = malloc(nv * 8), *uv1 = malloc(nv * 8);
-	REQUIRE(uv && uv1);
-	for (uint32_t v = 0; v < nv; v++) {
-		uv[2 * v] = pos[3 * v];
-		uv[2 * v + 1] = pos[3 * v + 1];
-		uv1[2 * v] = pos[3 * v + 2];
-		uv1[2 * v + 1] = pos[3 * v] + pos[3 * v + 1];
-	}
-	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .uvs1 = uv1, .indices = idx,
-	                            .vertex_count = nv, .index_count = ni};
-	CHECK(api_mesh_wants_levels(&me));
-	size_t bytes;
-	struct rnd_mesh_lod keep[4];
-	struct api_arena *a = build_levels(&me, keep, &bytes);
-	REQUIRE(me.lod_count >= 1, "levels: %u", me.lod_count);
-	for (uint32_t l = 0; l < me.lod_count; l++) {
-		const struct rnd_mesh_lod *lv = &me.lods[l];
-		REQUIRE(lv->uvs && lv->uvs1, "level %u has uvs %p, uvs1 %p", l + 1, (void *)lv->uvs, (void *)lv->uvs1);
-		uint32_t wrong = 0;
-		for (uint32_t v = 0; v < lv->vertex_count; v++) {
-			const float *p = lv->positions + 3 * v, *t = lv->uvs + 2 * v, *t1 = lv->uvs1 + 2 * v;
-			wrong += t[0] != p[0] || t[1] != p[1] || t1[0] != p[2] || t1[1] != p[0] + p[1];
-		}
-		CHECK(wrong == 0, "level %u: %u of %u vertices with other uvs", l + 1, wrong, lv->vertex_count);
-	}
-	api_arena_destroy(a);
-	free(pos); free(nrm); free(idx); free(uv); free(uv1);
-}
-
-/* A normal-mapped mesh (tangents, a glTF's with a normalTexture) gets its levels like any
- * other, each level vertex with its position's tangent (a function of the position here: the
- * direction of increasing longitude, w the hemisphere's sign). Before: no level at all, so
- * such a model drew every triangle into every thumbnail and its environment maps. */
-TEST(model_lod_levels_carry_tangents)
-{
-	float *pos, *nrm;
-	uint32_t *idx, nv, ni;
-	flat_sphere(160, &pos, &nrm, &idx, &nv, &ni);
-	float *uv = malloc(nv * 8), *tan = malloc(nv * 16);
-	REQUIRE(uv && tan);
+	float *uv = malloc(nv * 8), *uv1 = malloc(nv * 8), *tan = malloc(nv * 16);
+	REQUIRE(uv && uv1 && tan);
 	for (uint32_t v = 0; v < nv; v++) {
 		const float *p = pos + 3 * v;
 		uv[2 * v] = p[0], uv[2 * v + 1] = p[1];
+		uv1[2 * v] = p[2], uv1[2 * v + 1] = p[0] + p[1];
 		tan[4 * v] = -p[2], tan[4 * v + 1] = 0.0f, tan[4 * v + 2] = p[0], tan[4 * v + 3] = p[1] < 0.0f ? -1.0f : 1.0f;
 	}
-	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .tangents = tan, .indices = idx,
-	                            .vertex_count = nv, .index_count = ni};
+	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .uvs1 = uv1, .tangents = tan,
+	                            .indices = idx, .vertex_count = nv, .index_count = ni};
 	CHECK(api_mesh_wants_levels(&me));
 	size_t bytes;
 	struct rnd_mesh_lod keep[4];
@@ -239,17 +205,19 @@ TEST(model_lod_levels_carry_tangents)
 	REQUIRE(me.lod_count >= 2, "levels: %u", me.lod_count);
 	for (uint32_t l = 0; l < me.lod_count; l++) {
 		const struct rnd_mesh_lod *lv = &me.lods[l];
-		REQUIRE(lv->tangents, "level %u has no tangents", l + 1);
+		REQUIRE(lv->uvs && lv->uvs1 && lv->tangents, "level %u has uvs %p, uvs1 %p, tangents %p", l + 1,
+		        (void *)lv->uvs, (void *)lv->uvs1, (void *)lv->tangents);
 		CHECK(lv->index_count * 4 <= ni * 3, "level %u: %u of %u indices", l + 1, lv->index_count, ni);
 		uint32_t wrong = 0;
 		for (uint32_t v = 0; v < lv->vertex_count; v++) {
-			const float *p = lv->positions + 3 * v, *t = lv->tangents + 4 * v;
-			wrong += t[0] != -p[2] || t[1] != 0.0f || t[2] != p[0] || t[3] != (p[1] < 0.0f ? -1.0f : 1.0f);
+			const float *p = lv->positions + 3 * v, *t = lv->uvs + 2 * v, *t1 = lv->uvs1 + 2 * v, *g = lv->tangents + 4 * v;
+			wrong += t[0] != p[0] || t[1] != p[1] || t1[0] != p[2] || t1[1] != p[0] + p[1] || g[0] != -p[2] || g[1] != 0.0f ||
+			         g[2] != p[0] || g[3] != (p[1] < 0.0f ? -1.0f : 1.0f);
 		}
-		CHECK(wrong == 0, "level %u: %u of %u vertices with another tangent", l + 1, wrong, lv->vertex_count);
+		CHECK(wrong == 0, "level %u: %u of %u vertices with other uvs or tangents", l + 1, wrong, lv->vertex_count);
 	}
 	api_arena_destroy(a);
-	free(pos); free(nrm); free(idx); free(uv); free(tan);
+	free(pos); free(nrm); free(idx); free(uv); free(uv1); free(tan);
 }
 
 /* A texture seam (a sphere's u = 0 and u = 1 meeting, its positions repeated) stays a seam in

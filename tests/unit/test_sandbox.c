@@ -520,69 +520,30 @@ TEST(sandbox_reply_second_uv_set_round_trip)
 	}
 }
 
-/* A level's vertex colours cross the wire as they were, and a level with colours for a mesh
- * without them is refused (its colours could never be drawn: renderer/lod.c). */
-TEST(sandbox_reply_level_colours_round_trip)
+/* A level's vertex colours and tangents cross the wire as they were; a level with colours or
+ * tangents for a mesh without them is refused (they could never be drawn: renderer/lod.c), and
+ * so is a tangent that is not finite; every truncation of the good reply is refused. */
+TEST(sandbox_reply_level_colours_and_tangents_round_trip)
 {
 	float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
 	uint8_t col[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 9, 9, 9, 255};
 	uint8_t lv_col[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
-	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-	struct rnd_mesh_lod level = {pos, nrm, NULL, idx, 3, 3, 0.5f, NULL, lv_col};
-	struct rnd_material mat;
-	rnd_material_defaults(&mat);
-	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .colors = col, .indices = idx, .vertex_count = 4,
-	                              .index_count = 6, .material = 0, .lods = &level, .lod_count = 1};
-	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
-	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
-	                      .materials = &mat, .material_count = 1};
-	for (int bare = 0; bare < 2; bare++) {
-		mesh.colors = bare ? NULL : col;
-		struct api_wire_buf b = {0};
-		const uint8_t *body;
-		size_t blen, bytes;
-		char err[300];
-		REQUIRE(wire_model_body(&m, &b, &body, &blen, err, sizeof err), "%s", err);
-		struct api_arena *a = api_arena_create();
-		struct api_model out;
-		enum api_result rc = api_wire_decode_model(body, blen, 0, a, 1u << 20, &out, &bytes, err, sizeof err);
-		if (bare) {
-			CHECK(rc == API_ERR && strstr(err, "level 0"), "colours for a mesh without: %d %s", rc, err);
-		} else {
-			REQUIRE(rc == API_OK, "%s", err);
-			CHECK(out.meshes[0].lod_count == 1 && out.meshes[0].lods[0].colors &&
-			      !memcmp(out.meshes[0].lods[0].colors, lv_col, sizeof lv_col), "the level's colours changed on the wire");
-			int accepted = 0;
-			for (size_t cut = 0; cut < b.len; cut++) {
-				struct api_model part;
-				accepted += decode(b.data, cut, &part, err, sizeof err) == API_OK;
-			}
-			CHECK(accepted == 0, "%d truncations accepted", accepted);
-		}
-		api_arena_destroy(a);
-		api_wire_buf_release(&b);
-	}
-}
-
-/* A level's tangents (a normal-mapped mesh's) through the wire: the same floats back; refused
- * for a mesh without tangents, and for a tangent that is not finite. */
-TEST(sandbox_reply_level_tangents_round_trip)
-{
-	float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
 	float tan[16] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
 	float lv_tan[12] = {1, 0, 0, 1, 0.6f, 0.8f, 0, -1, 0, 1, 0, 1};
 	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-	struct rnd_mesh_lod level = {pos, nrm, NULL, idx, 3, 3, 0.5f, NULL, NULL, lv_tan};
+	struct rnd_mesh_lod level = {pos, nrm, NULL, idx, 3, 3, 0.5f, NULL, lv_col, lv_tan};
 	struct rnd_material mat;
 	rnd_material_defaults(&mat);
-	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .tangents = tan, .indices = idx, .vertex_count = 4,
-	                              .index_count = 6, .material = 0, .lods = &level, .lod_count = 1};
+	struct api_model_mesh mesh = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = 4, .index_count = 6,
+	                              .material = 0, .lods = &level, .lod_count = 1};
 	struct api_model_instance inst = {0, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
 	struct api_model m = {.meshes = &mesh, .mesh_count = 1, .instances = &inst, .instance_count = 1,
 	                      .materials = &mat, .material_count = 1};
-	for (int k = 0; k < 3; k++) {
-		mesh.tangents = k == 1 ? NULL : tan;
-		lv_tan[5] = k == 2 ? NAN : 0.0f;
+	/* 0: as it should be; 1: no colours on the mesh; 2: no tangents on it; 3: a NaN tangent */
+	for (int k = 0; k < 4; k++) {
+		mesh.colors = k == 1 ? NULL : col;
+		mesh.tangents = k == 2 ? NULL : tan;
+		lv_tan[5] = k == 3 ? NAN : 0.0f;
 		struct api_wire_buf b = {0};
 		const uint8_t *body;
 		size_t blen, bytes;
@@ -595,8 +556,15 @@ TEST(sandbox_reply_level_tangents_round_trip)
 			CHECK(rc == API_ERR && strstr(err, "level 0"), "case %d: %d %s", k, rc, err);
 		} else {
 			REQUIRE(rc == API_OK, "%s", err);
-			CHECK(out.meshes[0].lod_count == 1 && out.meshes[0].lods[0].tangents &&
-			      !memcmp(out.meshes[0].lods[0].tangents, lv_tan, sizeof lv_tan), "the level's tangents changed on the wire");
+			const struct rnd_mesh_lod *got = out.meshes[0].lod_count == 1 ? &out.meshes[0].lods[0] : NULL;
+			CHECK(got && got->colors && !memcmp(got->colors, lv_col, sizeof lv_col) && got->tangents &&
+			      !memcmp(got->tangents, lv_tan, sizeof lv_tan), "the level's colours or tangents changed on the wire");
+			int accepted = 0;
+			for (size_t cut = 0; cut < b.len; cut++) {
+				struct api_model part;
+				accepted += decode(b.data, cut, &part, err, sizeof err) == API_OK;
+			}
+			CHECK(accepted == 0, "%d truncations accepted", accepted);
 		}
 		api_arena_destroy(a);
 		api_wire_buf_release(&b);
