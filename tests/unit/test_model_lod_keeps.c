@@ -12,6 +12,32 @@
 
 #define PI_D 3.14159265358979323846
 
+/* The indices of an s x s grid of quads over (s + 1)^2 vertices in rows, two triangles each,
+ * counter-clockwise seen from +Y for a grid laid out along +x (columns) and +z (rows). */
+static void grid_indices(uint32_t s, uint32_t *idx)
+{
+	uint32_t k = 0;
+	for (uint32_t i = 0; i < s; i++)
+		for (uint32_t j = 0; j < s; j++) {
+			uint32_t a = i * (s + 1) + j, b = a + 1, c = a + s + 1, d = c + 1;
+			uint32_t t[6] = {a, c, b, b, c, d};
+			memcpy(idx + k, t, sizeof t);
+			k += 6;
+		}
+}
+
+/* me's level for 256² images (into me->lods), in the arena returned. */
+static struct api_arena *level_at_256(struct api_model_mesh *me)
+{
+	struct api_model m = {0};
+	m.meshes = me;
+	m.mesh_count = 1;
+	struct api_arena *a = api_arena_create();
+	size_t bytes = 0;
+	api_model_build_level(&m, 256, a, &bytes);
+	return a;
+}
+
 /* A texture seam (a sphere's u = 0 and u = 1 meeting, its positions repeated) stays a seam in
  * the level: every level triangle's corners keep their own side's uvs, so none spans the
  * texture's width. Before, the level of the mesh welded by position took one side's uvs for
@@ -22,7 +48,7 @@ TEST(model_lod_level_keeps_a_texture_seam)
 	enum { S = 200 };   /* 80,000 triangles */
 	uint32_t nv = (S + 1) * (S + 1), ni = 6 * S * S;
 	float *pos = malloc(nv * 12ull), *nrm = malloc(nv * 12ull), *uv = malloc(nv * 8ull);
-	uint32_t *idx = malloc(ni * 4ull), k = 0;
+	uint32_t *idx = malloc(ni * 4ull);
 	REQUIRE(pos && nrm && uv && idx);
 	for (uint32_t i = 0; i <= S; i++)
 		for (uint32_t j = 0; j <= S; j++) {
@@ -34,21 +60,10 @@ TEST(model_lod_level_keeps_a_texture_seam)
 			memcpy(nrm + 3 * v, p, 12);
 			uv[2 * v] = (float)j / S, uv[2 * v + 1] = (float)i / S;
 		}
-	for (uint32_t i = 0; i < S; i++)
-		for (uint32_t j = 0; j < S; j++) {
-			uint32_t a = i * (S + 1) + j, b = a + 1, c = a + S + 1, d = c + 1;
-			uint32_t t[6] = {a, c, b, b, c, d};
-			memcpy(idx + k, t, sizeof t);
-			k += 6;
-		}
+	grid_indices(S, idx);
 	struct api_model_mesh me = {.positions = pos, .normals = nrm, .uvs = uv, .indices = idx, .vertex_count = nv,
 	                            .index_count = ni};
-	struct api_model m = {0};
-	m.meshes = &me;
-	m.mesh_count = 1;
-	struct api_arena *a = api_arena_create();
-	size_t bytes = 0;
-	api_model_build_level(&m, 256, a, &bytes);
+	struct api_arena *a = level_at_256(&me);
 	REQUIRE(me.lod_count == 1 && me.lods[0].uvs, "levels: %u", me.lod_count);
 	const struct rnd_mesh_lod *lv = &me.lods[0];
 	float widest = 0.0f;
@@ -79,7 +94,7 @@ TEST(model_lod_level_keeps_a_texture_seam)
 TEST(model_lod_level_faces_follow_the_winding_not_stray_normals)
 {
 	enum { S = 200 };   /* 80,000 triangles */
-	uint32_t nv = (S + 1) * (S + 1), ni = 6 * S * S, k = 0;
+	uint32_t nv = (S + 1) * (S + 1), ni = 6 * S * S;
 	float *pos = malloc(nv * 12ull), *nrm = malloc(nv * 12ull);
 	uint32_t *idx = malloc(ni * 4ull);
 	REQUIRE(pos && nrm && idx);
@@ -93,20 +108,9 @@ TEST(model_lod_level_faces_follow_the_winding_not_stray_normals)
 			bool border = i == 0 || j == 0 || i == S || j == S;
 			nrm[3 * v] = (float)(-dx / l), nrm[3 * v + 1] = (float)((border ? -1 : 1) / l), nrm[3 * v + 2] = (float)(-dz / l);
 		}
-	for (uint32_t i = 0; i < S; i++)
-		for (uint32_t j = 0; j < S; j++) {
-			uint32_t a = i * (S + 1) + j, b = a + 1, c = a + S + 1, d = c + 1;
-			uint32_t t[6] = {a, c, b, b, c, d};   /* counter-clockwise seen from above */
-			memcpy(idx + k, t, sizeof t);
-			k += 6;
-		}
+	grid_indices(S, idx);
 	struct api_model_mesh me = {.positions = pos, .normals = nrm, .indices = idx, .vertex_count = nv, .index_count = ni};
-	struct api_model m = {0};
-	m.meshes = &me;
-	m.mesh_count = 1;
-	struct api_arena *a = api_arena_create();
-	size_t bytes = 0;
-	api_model_build_level(&m, 256, a, &bytes);
+	struct api_arena *a = level_at_256(&me);
 	REQUIRE(me.lod_count == 1, "levels: %u", me.lod_count);
 	const struct rnd_mesh_lod *lv = &me.lods[0];
 	uint32_t down = 0;
